@@ -1,0 +1,5 @@
+"""``python -m facadecli`` is the ``facade`` command."""
+
+from facadecli.cli import main
+
+main()

@@ -1,0 +1,347 @@
+"""Checks that need the whole spec: names that must exist, rules across patterns and axes.
+
+Each check returns problems positioned in the file (when the spec came from one), so a
+user sees every mistake at once, each with a way to fix it.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterator
+from pathlib import Path as FilePath
+
+from facadecli.errors import Problem
+from facadecli.patterns import PatternSyntaxError, parse_pattern
+from facadecli.patterns.ast import Named, Node, Repeat, Sym, named_counters, symbols, walk
+from facadecli.spec.model import BUILTIN_MESHES, ShapeRule, Spec
+from facadecli.spec.resolve import (
+    AXES,
+    Axis,
+    PatternText,
+    layer_reference,
+    layer_texts,
+    named_texts,
+)
+from facadecli.spec.source import Path, SourceMap
+
+MESH_SUFFIXES = (".glb", ".gltf", ".obj", ".stl", ".ply")
+
+
+class Checker:
+    """Runs every cross-check of a spec; ``problems`` collects what it finds."""
+
+    def __init__(self, spec: Spec, source: SourceMap | None, base_dir: FilePath | None):
+        self.spec = spec
+        self.source = source or SourceMap("<spec>")
+        self.base_dir = base_dir
+        self.problems: list[Problem] = []
+        self.parsed: dict[Path, Node | None] = {}
+
+    def report(
+        self, path: Path, message: str, hint: str = "", *, key: bool = False, offset: int = -1
+    ) -> None:
+        self.problems.append(self.source.problem(path, message, hint, key=key, offset=offset))
+
+    def run(self) -> list[Problem]:
+        for name in self.spec.patterns:
+            self.check_named_pattern(name)
+        self.check_layers()
+        self.check_counter_axes()
+        self.check_appearance()
+        return self.problems
+
+    # -- patterns ---------------------------------------------------------------------
+    def parse(self, text: PatternText) -> Node | None:
+        if text.path not in self.parsed:
+            try:
+                self.parsed[text.path] = parse_pattern(text.text)
+            except PatternSyntaxError as error:
+                self.parsed[text.path] = None
+                self.report(
+                    text.path,
+                    f"{_describe(text)}: {error.message}",
+                    error.hint,
+                    offset=error.offset,
+                )
+        return self.parsed[text.path]
+
+    def check_named_pattern(self, name: str) -> None:
+        texts = named_texts(self.spec, name)
+        trees = [self.parse(text) for text in texts]
+        if texts[0].role == "control":
+            self.check_substitution(texts, trees)
+        for text, tree in zip(texts, trees, strict=True):
+            if tree is not None:
+                self.check_symbols(text, tree)
+                self.check_counters_declared(text, tree)
+
+    def check_substitution(self, texts: list[PatternText], trees: list[Node | None]) -> None:
+        control, control_tree = texts[0], trees[0]
+        placeholders = {text.placeholder for text in texts[1:]}
+        if control_tree is not None:
+            used = {sym.name for sym in symbols(control_tree)}
+            for placeholder in sorted(p for p in placeholders if p and p not in used):
+                self.report(
+                    (*control.path[:-1], "where", placeholder),
+                    f"placeholder '{placeholder}' is not used by the control pattern "
+                    f"'{control.text}'",
+                    f"use '{placeholder}' in the control pattern or remove it from 'where'",
+                    key=True,
+                )
+        for placeholder in sorted(p for p in placeholders if p):
+            declared = self.spec.symbols.get(placeholder)
+            if declared is not None and declared.size is not None:
+                self.report(
+                    ("symbols", placeholder, "size"),
+                    f"placeholder '{placeholder}' has a size",
+                    "remove it: a placeholder takes the length of its content word",
+                )
+        for text, tree in zip(texts[1:], trees[1:], strict=True):
+            for sym in symbols(tree) if tree is not None else []:
+                if sym.name not in placeholders:
+                    continue
+                kind = "itself" if sym.name == text.placeholder else f"placeholder '{sym.name}'"
+                self.report(
+                    text.path,
+                    f"the content of '{text.placeholder}' contains {kind}: substitutions "
+                    "are applied once and cannot nest",
+                    f"write the content of '{sym.name}' out in full instead of naming it",
+                    offset=sym.pos,
+                )
+
+    def check_symbols(self, text: PatternText, tree: Node) -> None:
+        if text.role == "control":
+            return  # anything goes: undeclared names are transparent, elastic placeholders
+        placeholders = self.placeholders_of(text)
+        for sym in symbols(tree):
+            if sym.name in placeholders:
+                continue  # reported by check_substitution
+            declared = self.spec.symbols.get(sym.name)
+            if declared is None:
+                self.report(
+                    text.path,
+                    f"{_describe(text)}: unknown symbol '{sym.name}'",
+                    self.symbol_hint(sym.name),
+                    offset=sym.pos,
+                )
+            elif declared.size is None:
+                self.report(
+                    text.path,
+                    f"{_describe(text)}: symbol '{sym.name}' has no size; unsized symbols "
+                    "are only allowed in the control pattern of a substituted pattern",
+                    f"give it a preferred size under symbols, e.g. '{sym.name}: 1.0'",
+                    offset=sym.pos,
+                )
+
+    def placeholders_of(self, text: PatternText) -> set[str]:
+        if text.role != "content":
+            return set()
+        definition = self.spec.patterns[str(text.path[1])]
+        return set(getattr(definition, "where", {}))
+
+    def symbol_hint(self, name: str) -> str:
+        known = sorted(self.spec.symbols)
+        split = _split_into(name, set(known))
+        if split:
+            return f"did you mean '{' '.join(split)}'? symbols are separated by spaces"
+        close = difflib.get_close_matches(name, known, n=1)
+        if close:
+            return f"did you mean '{close[0]}'? or declare '{name}' under symbols"
+        return f"declare it under symbols, e.g. '{name}: 1.0'"
+
+    def check_counters_declared(self, text: PatternText, tree: Node) -> None:
+        for counter in named_counters(tree):
+            if counter.name in self.spec.counters:
+                continue
+            close = difflib.get_close_matches(counter.name, list(self.spec.counters), n=1)
+            hint = f"did you mean '{close[0]}'? " if close else ""
+            self.report(
+                text.path,
+                f"{_describe(text)}: unknown counter '{counter.name}'",
+                hint
+                + f"declare it under counters, e.g. 'counters: {{{counter.name}: {{min: 1}}}}'",
+                offset=counter.pos,
+            )
+
+    # -- layers -----------------------------------------------------------------------
+    def check_layers(self) -> None:
+        seen: dict[str, int] = {}
+        for index, layer in enumerate(self.spec.layers):
+            if layer.name in seen:
+                self.report(
+                    ("layers", index, "name"),
+                    f"duplicate layer name '{layer.name}' (also layer {seen[layer.name]})",
+                    "give every layer its own name",
+                )
+            seen.setdefault(layer.name, index)
+            for axis in AXES:
+                self.check_layer_axis(index, axis)
+            for rule_index, rule in enumerate(layer.shapes):
+                self.check_rule(("layers", index, "shapes", rule_index), rule)
+
+    def check_layer_axis(self, index: int, axis: Axis) -> None:
+        if layer_reference(self.spec, index, axis) is None:  # inline; named ones are checked once
+            text = layer_texts(self.spec, index, axis)[0]
+            tree = self.parse(text)
+            if tree is None:
+                return
+            if isinstance(tree, Sym) and tree.name not in self.spec.symbols:
+                self.report_unknown_pattern(text, tree.name)
+                return
+            self.check_symbols(text, tree)
+            self.check_counters_declared(text, tree)
+        mask = self.spec.layers[index].visible
+        visible = getattr(mask, axis) if mask is not None else None
+        if visible is not None:
+            texts = layer_texts(self.spec, index, axis)
+            used = {sym.name for text in texts for sym in self.symbols_of(text)}
+            self.check_mask(index, axis, visible, used)
+
+    def report_unknown_pattern(self, text: PatternText, name: str) -> None:
+        close = difflib.get_close_matches(name, list(self.spec.patterns), n=1)
+        hint = (
+            f"did you mean '{close[0]}'?"
+            if close
+            else ("name one of: " + ", ".join(sorted(self.spec.patterns)) + ", or write a pattern")
+        )
+        self.report(text.path, f"unknown pattern '{name}'", hint)
+
+    def symbols_of(self, text: PatternText) -> list[Sym]:
+        tree = self.parse(text)
+        return symbols(tree) if tree is not None else []
+
+    def check_mask(self, index: int, axis: Axis, visible: list[str], used: set[str]) -> None:
+        for position, name in enumerate(visible):
+            if name not in used:
+                self.report(
+                    ("layers", index, "visible", axis, position),
+                    f"mask symbol '{name}' does not occur in this layer's {axis} pattern",
+                    "list symbols of the pattern: " + ", ".join(sorted(used)),
+                )
+
+    def check_counter_axes(self) -> None:
+        first_axis: dict[str, tuple[Axis, str]] = {}
+        for index, layer in enumerate(self.spec.layers):
+            for axis in AXES:
+                for text in layer_texts(self.spec, index, axis):
+                    for counter in self.counters_in(text):
+                        where = f"layer '{layer.name}'"
+                        seen = first_axis.setdefault(counter.name, (axis, where))
+                        if seen[0] != axis:
+                            self.report(
+                                text.path,
+                                f"counter '{counter.name}' is used on both axes: by the {seen[0]} "
+                                f"pattern of {seen[1]} and by the {axis} pattern of {where}",
+                                "the axes are solved apart: use a separate counter for each",
+                                offset=counter.pos,
+                            )
+
+    def counters_in(self, text: PatternText) -> Iterator[Named]:
+        tree = self.parse(text)
+        if tree is not None:
+            for node in walk(tree):
+                if isinstance(node, Repeat) and isinstance(node.count, Named):
+                    yield node.count
+
+    # -- appearance -------------------------------------------------------------------
+    def check_appearance(self) -> None:
+        for index, rule in enumerate(self.spec.shapes):
+            self.check_rule(("shapes", index), rule)
+        defaults = self.spec.defaults
+        if defaults.material is not None:
+            self.check_material(("defaults", "material"), defaults.material)
+        self.check_mesh(("defaults", "mesh"), defaults.mesh)
+
+    def check_rule(self, path: Path, rule: ShapeRule) -> None:
+        for axis in AXES:
+            name = getattr(rule.match, axis)
+            if name != "*" and name not in self.spec.symbols:
+                self.report(
+                    (*path, "match", axis),
+                    f"shape rule matches unknown symbol '{name}'",
+                    self.symbol_hint(name) + "; or '*' for any symbol",
+                )
+        if rule.material is not None:
+            self.check_material((*path, "material"), rule.material)
+        if rule.mesh is not None:
+            self.check_mesh((*path, "mesh"), rule.mesh)
+
+    def check_material(self, path: Path, name: str) -> None:
+        if name in self.spec.materials:
+            return
+        close = difflib.get_close_matches(name, list(self.spec.materials), n=1)
+        hint = f"did you mean '{close[0]}'? " if close else ""
+        self.report(
+            path,
+            f"unknown material '{name}'",
+            hint + f"define it under materials, e.g. '{name}: {{color: \"#c9a27e\"}}'",
+        )
+
+    def check_mesh(self, path: Path, mesh: str) -> None:
+        if mesh in BUILTIN_MESHES:
+            return
+        candidate = FilePath(mesh)
+        if candidate.suffix.lower() not in MESH_SUFFIXES:
+            close = difflib.get_close_matches(mesh, BUILTIN_MESHES, n=1)
+            hint = f"did you mean '{close[0]}'? " if close else ""
+            self.report(
+                path,
+                f"unknown mesh '{mesh}'",
+                hint + f"use one of {', '.join(BUILTIN_MESHES)}, or a path to a "
+                f"{'/'.join(MESH_SUFFIXES)} file next to the spec",
+            )
+            return
+        if candidate.is_absolute() or ".." in candidate.parts:
+            self.report(
+                path,
+                f"mesh path '{mesh}' leaves the spec's folder",
+                "use a path relative to the spec file, inside its folder",
+            )
+            return
+        if self.base_dir is None:
+            return
+        base = self.base_dir.resolve()
+        resolved = (base / candidate).resolve()
+        if not resolved.is_relative_to(base):
+            self.report(
+                path,
+                f"mesh path '{mesh}' leaves the spec's folder (through a link)",
+                "copy the mesh into the spec's folder",
+            )
+        elif not resolved.is_file():
+            self.report(
+                path,
+                f"mesh file '{mesh}' does not exist",
+                f"put it at {resolved} or fix the path (relative to the spec file)",
+            )
+
+
+def _describe(text: PatternText) -> str:
+    label = "pattern" if text.path[0] == "patterns" else "layer"
+    name = text.path[1]
+    if text.path[0] == "layers":
+        return f"layer {name} {text.path[2]} pattern"
+    if text.role == "control":
+        return f"{label} '{name}' control"
+    if text.role == "content":
+        return f"{label} '{name}' content of '{text.placeholder}'"
+    return f"{label} '{name}'"
+
+
+def _split_into(name: str, known: set[str]) -> list[str] | None:
+    """``'BA'`` -> ``['B', 'A']`` when the name is a run of known symbols (two or more)."""
+    best: dict[int, list[str]] = {0: []}
+    for end in range(1, len(name) + 1):
+        for start in range(end):
+            if start in best and name[start:end] in known:
+                best[end] = [*best[start], name[start:end]]
+                break
+    result = best.get(len(name))
+    return result if result and len(result) > 1 else None
+
+
+def check_spec(
+    spec: Spec, source: SourceMap | None = None, base_dir: FilePath | None = None
+) -> list[Problem]:
+    """Every cross-check problem of a spec (empty when it is valid)."""
+    return Checker(spec, source, base_dir).run()

@@ -1,0 +1,269 @@
+"""The spec model (SPEC section 1): frozen pydantic models, unknown keys rejected.
+
+These models check each value on its own (types, ranges, names). Checks that need the
+whole spec (unknown symbols in patterns, counters on both axes, ...) live in
+:mod:`facadecli.spec.check`, which also knows where in the file each value came from.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    StringConstraints,
+    Tag,
+    field_validator,
+    model_validator,
+)
+
+NAME_RE = r"^[A-Za-z0-9_.-]+$"
+IDENT_RE = r"^[A-Za-z_][A-Za-z0-9_]*$"
+COLOR_RE = r"^#(?:[0-9a-fA-F]{6}|[0-9a-fA-F]{8})$"
+
+#: Built-in parametric meshes; anything else in ``mesh`` is a file path next to the spec.
+BUILTIN_MESHES = ("box", "panel", "frame", "arch", "column", "ledge")
+
+Ident = Annotated[str, StringConstraints(pattern=IDENT_RE)]
+Length = Annotated[float, Field(allow_inf_nan=False)]
+PositiveLength = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Unit = Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)]
+
+
+class Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+
+
+def _shorthand_schema(shorthand: dict[str, Any]) -> Any:
+    """JSON-schema hook: the model also accepts a bare scalar (``A: 0.6``, ``n: 3``)."""
+
+    def extend(schema: dict[str, Any]) -> None:
+        full = dict(schema)
+        schema.clear()
+        schema["anyOf"] = [shorthand, full]
+
+    return extend
+
+
+class Canvas(Model):
+    """The façade's extent in metres."""
+
+    width: PositiveLength
+    height: PositiveLength
+
+
+class Qualifiers(Model):
+    """Default qualifiers for every symbol (SPEC 2.4)."""
+
+    opaque: bool = False
+    attached: bool = False
+    unoccludable: bool = False
+    transparent: bool = False
+
+
+class Symbol(Model):
+    """A symbol: preferred size, hard bounds, qualifiers. ``A: 0.6`` is ``A: {size: 0.6}``."""
+
+    model_config = ConfigDict(
+        json_schema_extra=_shorthand_schema({"type": "number", "exclusiveMinimum": 0})
+    )
+
+    size: PositiveLength | None = None
+    min: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
+    max: PositiveLength | None = None
+    opaque: bool | None = None
+    attached: bool | None = None
+    unoccludable: bool | None = None
+    transparent: bool | None = None
+    label: str | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _shorthand(cls, value: Any) -> Any:
+        if value is None:
+            return {}
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return {"size": value}
+        return value
+
+    @model_validator(mode="after")
+    def _bounds(self) -> Symbol:
+        if self.min is not None and self.max is not None and self.min > self.max:
+            raise ValueError(f"min {self.min} is greater than max {self.max}")
+        if self.size is not None:
+            if self.min is not None and self.min > self.size:
+                raise ValueError(f"min {self.min} is greater than size {self.size}")
+            if self.max is not None and self.size > self.max:
+                raise ValueError(f"size {self.size} is greater than max {self.max}")
+        return self
+
+    def qualifiers(self, defaults: Qualifiers) -> Qualifiers:
+        """This symbol's qualifiers, with unset ones taken from ``defaults``."""
+        return Qualifiers(
+            opaque=defaults.opaque if self.opaque is None else self.opaque,
+            attached=defaults.attached if self.attached is None else self.attached,
+            unoccludable=defaults.unoccludable if self.unoccludable is None else self.unoccludable,
+            transparent=defaults.transparent if self.transparent is None else self.transparent,
+        )
+
+
+class Counter(Model):
+    """A named counter shared by every pattern naming it. ``n: 3`` fixes it to 3."""
+
+    model_config = ConfigDict(
+        json_schema_extra=_shorthand_schema({"type": "integer", "minimum": 0})
+    )
+
+    min: Annotated[int, Field(ge=0)] = 0
+    max: Annotated[int, Field(ge=0)] | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _shorthand(cls, value: Any) -> Any:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return {"min": value, "max": value}
+        return value
+
+    @model_validator(mode="after")
+    def _bounds(self) -> Counter:
+        if self.max is not None and self.min > self.max:
+            raise ValueError(f"min {self.min} is greater than max {self.max}")
+        return self
+
+    @property
+    def fixed(self) -> bool:
+        return self.max == self.min
+
+    @property
+    def bounds(self) -> tuple[int, int | None]:
+        return self.min, self.max
+
+
+class SubstitutedPattern(Model):
+    """A control pattern whose placeholders are replaced by content patterns (SPEC 2.3)."""
+
+    control: str
+    where: Annotated[dict[Ident, str], Field(min_length=1)]
+
+
+def _pattern_kind(value: Any) -> str:
+    return "text" if isinstance(value, str) else "substituted"
+
+
+PatternDef = Annotated[
+    Annotated[str, Tag("text")] | Annotated[SubstitutedPattern, Tag("substituted")],
+    Discriminator(_pattern_kind),
+]
+
+
+class LayerMask(Model):
+    """Symbols whose shapes a layer shows (SPEC 2.5); a missing list shows all."""
+
+    x: list[Ident] | None = None
+    y: list[Ident] | None = None
+
+
+class Groups(Model):
+    """Alignment group of a layer's horizontal and vertical pattern (SPEC 2.6)."""
+
+    x: Ident = "default"
+    y: Ident = "default"
+
+
+class ShapeMatch(Model):
+    """Which shapes a rule applies to: symbols on each axis, ``*`` for any."""
+
+    x: str = "*"
+    y: str = "*"
+
+
+class ShapeRule(Model):
+    """Appearance of the shapes a rule matches; later rules win, field by field."""
+
+    match: ShapeMatch = ShapeMatch()
+    material: Ident | None = None
+    mesh: str | None = None
+    depth: Length | None = None
+    thickness: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
+
+
+class Layer(Model):
+    """One layer: the outer product of a horizontal and a vertical word."""
+
+    name: Annotated[str, StringConstraints(pattern=NAME_RE)]
+    x: str
+    y: str
+    visible: LayerMask | None = None
+    groups: Groups = Groups()
+    offset: Length = 0.0
+    enabled: bool = True
+    shapes: list[ShapeRule] = []
+
+
+class Material(Model):
+    """A PBR material (glTF metallic-roughness)."""
+
+    color: Annotated[str, StringConstraints(pattern=COLOR_RE)] = "#bfbfbf"
+    metallic: Unit = 0.0
+    roughness: Unit = 0.8
+    opacity: Unit = 1.0
+
+
+class Defaults(Model):
+    """Appearance of shapes no rule sets (SPEC 2.8)."""
+
+    mesh: str = "box"
+    material: Ident | None = None
+    thickness: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.2
+    depth: Length = 0.0
+
+
+class Solver(Model):
+    """Solver options."""
+
+    tolerance: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    time_limit: Annotated[float, Field(gt=0, le=86_400)] = 10.0
+    seed: Annotated[int, Field(ge=0)] = 0
+
+
+class Spec(Model):
+    """A façade spec (SPEC section 1)."""
+
+    model_config = ConfigDict(
+        title="facadecli façade spec",
+        json_schema_extra={"$schema": "https://json-schema.org/draft/2020-12/schema"},
+    )
+
+    version: Literal[1]
+    name: Annotated[str, StringConstraints(pattern=NAME_RE, max_length=200)]
+    canvas: Canvas
+    symbol_defaults: Qualifiers = Qualifiers()
+    symbols: Annotated[dict[Ident, Symbol], Field(min_length=1)]
+    counters: dict[Ident, Counter] = {}
+    patterns: Annotated[dict[Ident, PatternDef], Field(min_length=1)]
+    layers: Annotated[list[Layer], Field(min_length=1)]
+    shapes: list[ShapeRule] = []
+    materials: dict[Ident, Material] = {}
+    defaults: Defaults = Defaults()
+    solver: Solver = Solver()
+
+    @field_validator("canvas")
+    @classmethod
+    def _finite_canvas(cls, canvas: Canvas) -> Canvas:
+        if not (math.isfinite(canvas.width) and math.isfinite(canvas.height)):
+            raise ValueError("canvas sizes must be finite")
+        return canvas
+
+    def qualifiers(self, symbol: str) -> Qualifiers:
+        """Qualifiers of a symbol; undeclared symbols (placeholders) take the defaults."""
+        declared = self.symbols.get(symbol)
+        return declared.qualifiers(self.symbol_defaults) if declared else self.symbol_defaults
+
+    def size(self, symbol: str) -> float | None:
+        """Preferred size of a symbol, None for an unsized one (a placeholder)."""
+        declared = self.symbols.get(symbol)
+        return declared.size if declared else None
