@@ -5,6 +5,8 @@ The public API; everything else is internal and may change.
 
 from facadecli.errors import FacadeError, InfeasibleError, Problem, SpecError
 from facadecli.patterns import Choice, Letter, Word, compile_pattern, enumerate_words, make_word
+from facadecli.layout import Layout, Shape
+from facadecli.solve import retarget, solve
 from facadecli.spec import Spec, load_spec, parse_spec, spec_schema, validate_spec
 
 __version__ = "0.1.0"
@@ -13,8 +15,10 @@ __all__ = [
     "Choice",
     "FacadeError",
     "InfeasibleError",
+    "Layout",
     "Letter",
     "Problem",
+    "Shape",
     "Spec",
     "SpecError",
     "Word",
@@ -24,6 +28,8 @@ __all__ = [
     "load_spec",
     "make_word",
     "parse_spec",
+    "retarget",
+    "solve",
     "spec_schema",
     "validate_spec",
 ]

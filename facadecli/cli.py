@@ -14,9 +14,10 @@ from typing import Annotated
 import typer
 
 from facadecli import __version__
-from facadecli.errors import FacadeError, SpecError
-from facadecli.export import write_atomic
+from facadecli.errors import FacadeError, InfeasibleError, SpecError
+from facadecli.export import WRITERS, write_atomic, write_outputs
 from facadecli.preview import preview_words
+from facadecli.solve import retarget, solve
 from facadecli.spec import load_spec, spec_schema_text
 
 app = typer.Typer(
@@ -71,6 +72,68 @@ def validate(specs: SpecPaths) -> None:
     if failed:
         typer.echo(f"{failed} of {len(specs)} specs invalid", err=True)
         raise typer.Exit(2)
+
+
+def _formats(value: str | None) -> list[str]:
+    if value is None:
+        return list(WRITERS)
+    names = [name.strip() for name in value.split(",") if name.strip()]
+    unknown = [name for name in names if name not in WRITERS]
+    if unknown or not names:
+        raise typer.BadParameter(
+            f"unknown format {', '.join(unknown) or '(none)'}; available: {', '.join(WRITERS)}"
+        )
+    return names
+
+
+@app.command("solve")
+def solve_command(
+    specs: SpecPaths,
+    outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
+        "out"
+    ),
+    formats: Annotated[
+        str | None,
+        typer.Option("--format", "-f", help=f"Comma-separated formats (default: all of {','.join(WRITERS)})."),
+    ] = None,
+    width: Annotated[
+        float | None, typer.Option("--width", min=0.001, help="Override the canvas width (m).")
+    ] = None,
+    height: Annotated[
+        float | None, typer.Option("--height", min=0.001, help="Override the canvas height (m).")
+    ] = None,
+    seed: Annotated[int | None, typer.Option("--seed", min=0, help="Override solver.seed.")] = None,
+    timings: Annotated[
+        bool, typer.Option("--timings", help="Record solve times in the report (not reproducible).")
+    ] = False,
+) -> None:
+    """Solve specs into layouts and write their outputs to OUTDIR."""
+    chosen = _formats(formats)
+    codes: list[int] = []
+    for path in specs:
+        try:
+            spec = retarget(load_spec(path), width, height, seed)
+            layout = solve(spec)
+        except (SpecError, InfeasibleError) as error:
+            if isinstance(error, InfeasibleError):
+                typer.echo(f"{path}: error: no layout: {error}", err=True)
+            else:
+                _report(error)
+            codes.append(error.exit_code)
+            continue
+        for warning in layout.warnings:
+            typer.echo(f"{path}: warning: {warning}", err=True)
+        written = write_outputs(layout, outdir, chosen, timings)
+        counters = ", ".join(f"{k}={v}" for k, v in sorted(layout.counters.items()))
+        typer.echo(
+            f"{path}: solved in {layout.time_ms:.1f} ms"
+            + (f" ({counters})" if counters else "")
+            + " -> " + ", ".join(str(p) for p in written)
+        )
+        codes.append(0)
+    failed = [code for code in codes if code]
+    if failed:
+        raise typer.Exit(failed[0] if len(codes) == 1 else 1)
 
 
 @app.command()

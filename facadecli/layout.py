@@ -1,0 +1,169 @@
+"""Both axes -> the layout: letters of every layer, shapes (outer product, masks,
+transparency, appearance rules) and occlusion flags (SPEC 2.5, 2.8)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from facadecli.solver.axis import AxisLayout, PlacedLetter
+from facadecli.spec.model import Layer, ShapeRule, Spec
+
+DEFAULT_MATERIAL = "default"  # the built-in neutral grey when no material is named
+
+
+@dataclass(frozen=True)
+class Shape:
+    layer: str
+    x: str
+    y: str
+    x0: float
+    x1: float
+    y0: float
+    y1: float
+    z0: float
+    z1: float
+    material: str
+    mesh: str
+    reflected_x: bool
+    reflected_y: bool
+    opaque: bool  # covers its whole cell (both symbols opaque, material not see-through)
+    visible: bool = True  # False when hidden behind opaque shapes of layers in front
+
+
+@dataclass(frozen=True)
+class Layout:
+    """A solved façade."""
+
+    spec: Spec
+    width: float
+    height: float
+    x: AxisLayout
+    y: AxisLayout
+    shapes: tuple[Shape, ...]
+    time_ms: float
+
+    @property
+    def counters(self) -> dict[str, int]:
+        return {**self.x.counters, **self.y.counters}
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        return self.x.warnings + self.y.warnings
+
+    def letters(self, layer: int, axis: str) -> tuple[PlacedLetter, ...]:
+        return (self.x if axis == "x" else self.y).letters.get(layer, ())
+
+
+@dataclass(frozen=True)
+class Appearance:
+    material: str
+    mesh: str
+    depth: float
+    thickness: float
+
+
+def appearance(spec: Spec, layer: Layer, x: str, y: str) -> Appearance:
+    """The last matching rule wins, field by field: defaults, global rules, layer rules."""
+    defaults = spec.defaults
+    current = {
+        "material": defaults.material or DEFAULT_MATERIAL,
+        "mesh": defaults.mesh,
+        "depth": defaults.depth,
+        "thickness": defaults.thickness,
+    }
+    for rule in (*spec.shapes, *layer.shapes):
+        if _matches(rule, x, y):
+            for name in current:
+                value = getattr(rule, name)
+                if value is not None:
+                    current[name] = value
+    return Appearance(**current)  # type: ignore[arg-type]
+
+
+def _matches(rule: ShapeRule, x: str, y: str) -> bool:
+    return rule.match.x in ("*", x) and rule.match.y in ("*", y)
+
+
+def _shown(layer: Layer, x: PlacedLetter, y: PlacedLetter) -> bool:
+    if x.transparent or y.transparent:
+        return False
+    mask = layer.visible
+    if mask is None:
+        return True
+    return (mask.x is None or x.symbol in mask.x) and (mask.y is None or y.symbol in mask.y)
+
+
+def build_shapes(spec: Spec, x: AxisLayout, y: AxisLayout) -> tuple[Shape, ...]:
+    shapes: list[Shape] = []
+    for index, layer in enumerate(spec.layers):
+        if not layer.enabled:
+            continue
+        for row in y.letters.get(index, ()):
+            for column in x.letters.get(index, ()):
+                if not _shown(layer, column, row):
+                    continue
+                look = appearance(spec, layer, column.symbol, row.symbol)
+                front = layer.offset + look.depth
+                material = spec.materials.get(look.material)
+                see_through = material is not None and material.opacity < 1.0
+                shapes.append(
+                    Shape(
+                        layer=layer.name,
+                        x=column.symbol,
+                        y=row.symbol,
+                        x0=column.start,
+                        x1=column.end,
+                        y0=row.start,
+                        y1=row.end,
+                        z0=round(front - look.thickness, 6),
+                        z1=round(front, 6),
+                        material=look.material,
+                        mesh=look.mesh,
+                        reflected_x=column.reflected,
+                        reflected_y=row.reflected,
+                        opaque=spec.qualifiers(column.symbol).opaque
+                        and spec.qualifiers(row.symbol).opaque
+                        and not see_through,
+                    )
+                )
+    return _cull(shapes)
+
+
+def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
+    """Mark shapes whose cell is covered by opaque shapes of later layers in front of them."""
+    order = {name: i for i, name in enumerate(dict.fromkeys(s.layer for s in shapes))}
+    result = []
+    for shape in shapes:
+        occluders = [
+            other
+            for other in shapes
+            if other.opaque
+            and order[other.layer] > order[shape.layer]
+            and other.z1 >= shape.z1
+            and other.x0 < shape.x1 and other.x1 > shape.x0
+            and other.y0 < shape.y1 and other.y1 > shape.y0
+        ]
+        hidden = bool(occluders) and _covered(shape, occluders)
+        result.append(shape if not hidden else Shape(**{**shape.__dict__, "visible": False}))
+    return tuple(result)
+
+
+def _covered(shape: Shape, occluders: list[Shape]) -> bool:
+    """Is the shape's rectangle inside the union of the occluders' rectangles?"""
+    xs = sorted({shape.x0, shape.x1, *(min(max(o.x0, shape.x0), shape.x1) for o in occluders),
+                 *(min(max(o.x1, shape.x0), shape.x1) for o in occluders)})
+    ys = sorted({shape.y0, shape.y1, *(min(max(o.y0, shape.y0), shape.y1) for o in occluders),
+                 *(min(max(o.y1, shape.y0), shape.y1) for o in occluders)})
+    for xa, xb in zip(xs, xs[1:], strict=False):
+        for ya, yb in zip(ys, ys[1:], strict=False):
+            if xb - xa < 1e-9 or yb - ya < 1e-9:
+                continue
+            cx, cy = (xa + xb) / 2, (ya + yb) / 2
+            if not any(o.x0 <= cx <= o.x1 and o.y0 <= cy <= o.y1 for o in occluders):
+                return False
+    return True
+
+
+def layer_index(spec: Spec) -> Mapping[str, int]:
+    return {layer.name: i for i, layer in enumerate(spec.layers)}

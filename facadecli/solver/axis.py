@@ -1,0 +1,287 @@
+"""One axis end to end: candidates -> alignment per group -> sizing -> placed letters."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+
+from facadecli.errors import InfeasibleError
+from facadecli.patterns import Enumerated, Word, format_word
+from facadecli.solver import sizing
+from facadecli.solver.alignment import Alignment, AlignmentResult, align
+from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
+from facadecli.solver.rows import make_rows
+from facadecli.spec.model import Spec
+from facadecli.spec.resolve import Axis, layer_pattern
+
+FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
+CANDIDATES_TO_TRY = 200
+PRECISION = 6  # decimals of metres kept in the layout (micrometres)
+
+
+@dataclass(frozen=True)
+class PlacedLetter:
+    """A letter with its solved interval on its axis."""
+
+    symbol: str
+    start: float
+    end: float
+    reflected: bool
+    transparent: bool
+
+
+@dataclass(frozen=True)
+class GroupColumns:
+    boundaries: tuple[float, ...]
+    error: float  # the alignment error (Eq. 9, summed over columns)
+    matrix: tuple[tuple[str, ...], ...]  # per row, the text of each entry ("" when empty)
+    layers: tuple[tuple[int, ...], ...]  # per row, the layers it stands for
+
+
+@dataclass(frozen=True)
+class AxisLayout:
+    axis: Axis
+    canvas: float
+    letters: Mapping[int, tuple[PlacedLetter, ...]]  # layer index -> letters in order
+    symbols: Mapping[str, tuple[float | None, float]]  # name -> (preferred, solved)
+    groups: Mapping[str, GroupColumns]
+    counters: Mapping[str, int]
+    words: Mapping[str, str]  # pattern key -> chosen word, as text
+    objective: float
+    mu: float
+    candidates_tried: int
+    warnings: tuple[str, ...] = ()
+    timings: Mapping[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class _Evaluated:
+    candidate: Candidate
+    groups: dict[str, Alignment]
+    program: sizing.Program
+    estimate: sizing.Sizing
+
+    @property
+    def columns(self) -> int:
+        return sum(a.columns for a in self.groups.values())
+
+    @property
+    def rank(self) -> tuple[float, float, int, int]:
+        return (
+            round(self.estimate.objective, 9),
+            round(self.estimate.coverage, 6),
+            -self.columns,
+            self.candidate.order,
+        )
+
+
+def _axis_words(spec: Spec, axis: Axis) -> list[tuple[int, str, str, object]]:
+    found = []
+    for index, layer in enumerate(spec.layers):
+        if layer.enabled:
+            key: str = getattr(layer, axis)
+            group: str = getattr(layer.groups, axis)
+            found.append((index, group, key, layer_pattern(spec, layer, axis)))
+    return found
+
+
+def _group_rows(
+    spec: Spec, uses: Sequence[PatternUse], words: Mapping[str, Enumerated]
+) -> dict[str, list[tuple[int, Word]]]:
+    groups: dict[str, list[tuple[int, Word]]] = {}
+    for use in uses:
+        for layer, group in use.layers:
+            groups.setdefault(group, []).append((layer, words[use.key].word))
+    return groups
+
+
+def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:
+    """Solve one axis; raises :class:`InfeasibleError` with the reason when nothing fits."""
+    started = time.perf_counter()
+    uses = pattern_uses(spec, _axis_words(spec, axis))  # type: ignore[arg-type]
+    candidates = generate_candidates(spec, uses, canvas)
+    generated = time.perf_counter()
+    if not candidates:
+        raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
+    tolerance = spec.solver.tolerance
+    cache: dict[tuple[str, tuple[Word, ...]], AlignmentResult] = {}
+    evaluated: list[_Evaluated] = []
+    failures: list[str] = []
+    timed_out = False
+    tried = 0
+    for candidate in candidates[:CANDIDATES_TO_TRY]:
+        if len(evaluated) >= FEASIBLE_TO_COMPARE:
+            break
+        if time.perf_counter() > deadline and evaluated:
+            timed_out = True
+            break
+        tried += 1
+        mu = max(tolerance, candidate.need)
+        aligned: dict[str, Alignment] = {}
+        for group, members in sorted(_group_rows(spec, uses, candidate.words).items()):
+            rows = make_rows(spec, members)
+            key = (group, tuple(row.word for row in rows))
+            if key not in cache:
+                cache[key] = align(rows, canvas, mu, deadline)
+            result = cache[key]
+            if result.alignment is None:
+                timed_out = timed_out or result.timed_out
+                failures.append(f"group '{group}': {result.reason}")
+                break
+            aligned[group] = result.alignment
+        else:
+            program = sizing.build_program(spec, aligned, canvas)
+            estimate = sizing.estimate(program) or sizing.solve(program)
+            if estimate is None:
+                failures.append(sizing.explain_infeasible(program))
+                continue
+            evaluated.append(_Evaluated(candidate, aligned, program, estimate))
+        if timed_out and evaluated:
+            break
+    aligned_at = time.perf_counter()
+    for choice in sorted(evaluated, key=lambda e: e.rank):
+        final = sizing.solve(choice.program)
+        if final is not None:
+            break
+        failures.append(sizing.explain_infeasible(choice.program))
+    else:
+        raise InfeasibleError(_no_layout_reason(axis, failures, timed_out, spec))
+    sized_at = time.perf_counter()
+    warnings = []
+    if timed_out:
+        warnings.append(
+            f"{axis}: the time limit ({spec.solver.time_limit:g} s) ran out; "
+            "this is the best layout found so far"
+        )
+    if choice.candidate.need > tolerance + 1e-9:
+        warnings.append(
+            f"{axis}: the tolerance was raised to {choice.candidate.need:.3f} m "
+            "for the words to fit the canvas"
+        )
+    layout = _place(spec, axis, canvas, choice, final, uses)
+    for name, (preferred, size) in layout.symbols.items():
+        if preferred and abs(size - preferred) > 0.1 * preferred:
+            warnings.append(
+                f"{axis}: symbol '{name}' is {size:.3f} m, more than 10% off its "
+                f"preferred {preferred:g} m"
+            )
+    timings = {
+        "candidates_ms": (generated - started) * 1000,
+        "alignment_ms": (aligned_at - generated) * 1000,
+        "sizing_ms": (sized_at - aligned_at) * 1000,
+    }
+    return replace(layout, warnings=tuple(warnings), timings=timings, candidates_tried=tried)
+
+
+def _place(
+    spec: Spec,
+    axis: Axis,
+    canvas: float,
+    choice: _Evaluated,
+    final: sizing.Sizing,
+    uses: Sequence[PatternUse],
+) -> AxisLayout:
+    program = choice.program
+    letters: dict[int, tuple[PlacedLetter, ...]] = {}
+    groups: dict[str, GroupColumns] = {}
+    for group, alignment in sorted(choice.groups.items()):
+        bounds = [round(b, PRECISION) for b in sizing.column_starts(final, program, group, alignment.columns)]
+        bounds[-1] = round(canvas, PRECISION)
+        for r, row in enumerate(alignment.rows):
+            spans: dict[int, list[float]] = {}
+            for j, entries in enumerate(alignment.entries):
+                move = entries[r]
+                if move is None:
+                    continue
+                whole, parts = sizing.entry_parts(move)
+                order = sorted([(k, False) for k in whole] + [(k, True) for k in parts])
+                cursor = bounds[j]
+                for position, (k, is_piece) in enumerate(order):
+                    if is_piece:
+                        length = final.of(program.pieces[sizing.Piece(group, r, k, j)])
+                    else:
+                        length = final.of(program.symbols[row.word[k].symbol])
+                    end = bounds[j + 1] if position == len(order) - 1 else round(cursor + length, PRECISION)
+                    span = spans.setdefault(k, [cursor, end])
+                    span[1] = end
+                    cursor = end
+            placed = tuple(
+                PlacedLetter(
+                    symbol=letter.symbol,
+                    start=spans[k][0],
+                    end=spans[k][1],
+                    reflected=letter.reflected,
+                    transparent=row.traits[k].transparent,
+                )
+                for k, letter in enumerate(row.word)
+            )
+            for layer in row.layers:
+                letters[layer] = placed
+        groups[group] = GroupColumns(
+            boundaries=tuple(bounds),
+            error=round(alignment.error, PRECISION),
+            matrix=tuple(
+                tuple(_entry_text(row.word, entries[r]) for entries in alignment.entries)
+                for r, row in enumerate(alignment.rows)
+            ),
+            layers=tuple(row.layers for row in alignment.rows),
+        )
+    symbols = {
+        name: (spec.size(name), round(final.of(index), PRECISION))
+        for name, index in sorted(program.symbols.items())
+    }
+    counters = dict(choice.candidate.counters)
+    for use in uses:
+        for name in use.pattern.counter_names():
+            counters.setdefault(name, spec.counters[name].min)
+    return AxisLayout(
+        axis=axis,
+        canvas=canvas,
+        letters=letters,
+        symbols=symbols,
+        groups=groups,
+        counters=counters,
+        words={key: format_word(item.word) for key, item in choice.candidate.words.items()},
+        objective=round(final.objective, 9),
+        mu=round(max(spec.solver.tolerance, choice.candidate.need), PRECISION),
+        candidates_tried=0,
+    )
+
+
+def _entry_text(word: Word, move: object) -> str:
+    if move is None:
+        return ""
+    whole, parts = sizing.entry_parts(move)  # type: ignore[arg-type]
+    items = sorted([(k, "") for k in whole] + [(k, "~") for k in parts])
+    return " ".join(word[k].symbol + mark for k, mark in items)
+
+
+def _no_candidate_reason(spec: Spec, axis: Axis, uses: Sequence[PatternUse], canvas: float) -> str:
+    from facadecli.patterns import enumerate_words
+
+    sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
+    bounds = {name: counter.bounds for name, counter in spec.counters.items()}
+    for use in uses:
+        if next(iter(enumerate_words(use.pattern, sizes=sizes, max_length=2 * canvas,
+                                     counters=bounds)), None) is None:
+            layers = ", ".join(f"'{spec.layers[layer].name}'" for layer, _ in use.layers)
+            return (
+                f"{axis} axis: pattern '{use.key}' (layer {layers}) makes no word shorter "
+                f"than twice the canvas ({2 * canvas:g} m); make the canvas larger or the "
+                "symbols or fixed counts smaller"
+            )
+    return (
+        f"{axis} axis: the patterns share counters whose values cannot agree "
+        f"within the canvas ({canvas:g} m)"
+    )
+
+
+def _no_layout_reason(axis: Axis, failures: list[str], timed_out: bool, spec: Spec) -> str:
+    if timed_out and not failures:
+        return (
+            f"{axis} axis: no layout found within the time limit "
+            f"({spec.solver.time_limit:g} s); raise solver.time_limit or simplify the patterns"
+        )
+    common = max(set(failures), key=failures.count) if failures else "nothing aligns"
+    return f"{axis} axis: no candidate aligns: {common}"

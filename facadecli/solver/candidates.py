@@ -1,0 +1,246 @@
+"""Candidate generation (Ilčík et al. 2015, section 5.1; DESIGN.md).
+
+A *candidate* picks one word for every pattern used on an axis: values for the named
+counters (shared by all the axis' patterns), branches and anonymous counts. Candidates
+are ranked by the tolerance mu they need to pass Eq. 7,
+
+    l_i <= |w_i| <= L + mu,   l_i = L - mu - (opaque length of the layers above i),
+
+and then by how far their words are from the canvas, so the solver tries them in the
+order in which raising mu would admit them. Unsized placeholders are elastic: a word with
+them only needs its fixed part to stay under L + mu.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+
+from facadecli.patterns import CompiledPattern, Enumerated, enumerate_words
+from facadecli.spec.model import Spec
+
+WORDS_PER_PATTERN = 4000  # words looked at per pattern
+OPTIONS_PER_CLUSTER = 2000  # joint choices kept per cluster of patterns sharing counters
+MAX_LETTERS = 400  # longest word considered
+
+
+@dataclass(frozen=True)
+class PatternUse:
+    """A distinct pattern on one axis and the (layer, group) pairs that use it."""
+
+    key: str  # the pattern's name, or the inline pattern text
+    pattern: CompiledPattern
+    layers: tuple[tuple[int, str], ...]  # (layer index, alignment group), back to front
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One word per pattern of an axis."""
+
+    words: Mapping[str, Enumerated]  # pattern key -> word with its choice and length
+    counters: tuple[tuple[str, int], ...]
+    need: float  # the least tolerance mu under which every word passes Eq. 7
+    misfit: float  # sum of squared Eq. 7 violations at mu = 0 (a tie-break)
+    order: int = field(default=0, compare=False)
+
+    @property
+    def key(self) -> tuple[float, float, int]:
+        return (round(self.need, 9), round(self.misfit, 9), self.order)
+
+
+def opaque_length(spec: Spec, item: Enumerated) -> float:
+    """Preferred length of the opaque letters of a word (what lower layers may make room for)."""
+    total = 0.0
+    for letter in item.word:
+        qualifiers = spec.qualifiers(letter.symbol)
+        size = spec.size(letter.symbol)
+        if size and qualifiers.opaque and not (letter.transparent or qualifiers.transparent):
+            total += size
+    return total
+
+
+def word_need(length: float, elastic: bool, canvas: float, made_room: float) -> float:
+    """Least mu with ``canvas - mu - made_room <= length <= canvas + mu`` (Eq. 7)."""
+    over = length - canvas
+    if elastic:
+        return max(0.0, over)
+    under = canvas - made_room - length
+    return max(0.0, over, under)
+
+
+def placeholder_range(
+    item: Enumerated, spec: Spec, canvas: float, mu: float, made_room: float = 0.0
+) -> tuple[float, float] | None:
+    """Sizes an elastic word's placeholders may take (all of them alike) under Eq. 7.
+
+    The paper samples this range uniformly (Figure 7); the solver keeps it elastic.
+    """
+    count = sum(1 for letter in item.word if spec.size(letter.symbol) is None)
+    if not count:
+        return None
+    low = max(0.0, (canvas - mu - made_room - item.length) / count)
+    high = (canvas + mu - item.length) / count
+    return (low, high) if high >= low else None
+
+
+def pattern_uses(spec: Spec, axis_words: Sequence[tuple[int, str, str, CompiledPattern]]) -> list[PatternUse]:
+    """Group (layer, group, key, pattern) tuples by pattern key, in order of first use."""
+    uses: dict[str, tuple[CompiledPattern, list[tuple[int, str]]]] = {}
+    for layer, group, key, pattern in axis_words:
+        uses.setdefault(key, (pattern, []))[1].append((layer, group))
+    return [PatternUse(key, pattern, tuple(layers)) for key, (pattern, layers) in uses.items()]
+
+
+def generate_candidates(
+    spec: Spec, uses: Sequence[PatternUse], canvas: float, limit: int = 500
+) -> list[Candidate]:
+    """Up to ``limit`` candidates, best first (by needed mu, then misfit)."""
+    sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
+    transparent = frozenset(n for n in spec.symbols if spec.qualifiers(n).transparent)
+    bounds = {name: counter.bounds for name, counter in spec.counters.items()}
+    words: dict[str, list[Enumerated]] = {}
+    for use in uses:
+        found = enumerate_words(
+            use.pattern,
+            sizes=sizes,
+            max_length=2.0 * canvas,
+            transparent=transparent,
+            counters=bounds,
+            max_letters=MAX_LETTERS,
+        )
+        words[use.key] = list(itertools.islice(found, WORDS_PER_PATTERN))
+        if not words[use.key]:
+            return []
+    clusters = _clusters(uses)
+    options = [_cluster_options(cluster, words) for cluster in clusters]
+    if any(not found for found in options):
+        return []
+    # rank each cluster's options by a context-free estimate, then merge best-first
+    room = {use.key: _max_room_above(spec, use, uses, words) for use in uses}
+    ranked = []
+    for found in options:
+        scored = [(_estimate(spec, option, canvas, room), index, option) for index, option in enumerate(found)]
+        scored.sort(key=lambda item: (item[0], item[1]))
+        ranked.append([option for _, _, option in scored])
+    candidates = []
+    for order, combination in enumerate(_best_combinations(ranked, limit)):
+        merged: dict[str, Enumerated] = {}
+        for option in combination:
+            merged.update(option)
+        candidates.append(_candidate(spec, uses, merged, canvas, order))
+    candidates.sort(key=lambda candidate: candidate.key)
+    return candidates
+
+
+def _clusters(uses: Sequence[PatternUse]) -> list[list[PatternUse]]:
+    """Patterns connected by shared named counters (union-find over counter names)."""
+    parent = list(range(len(uses)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    owner: dict[str, int] = {}
+    for index, use in enumerate(uses):
+        for name in use.pattern.counter_names():
+            if name in owner:
+                parent[find(index)] = find(owner[name])
+            else:
+                owner[name] = index
+    clusters: dict[int, list[PatternUse]] = {}
+    for index, use in enumerate(uses):
+        clusters.setdefault(find(index), []).append(use)
+    return list(clusters.values())
+
+
+def _cluster_options(
+    cluster: list[PatternUse], words: Mapping[str, list[Enumerated]]
+) -> list[dict[str, Enumerated]]:
+    """Joint word choices of a cluster whose shared counters agree."""
+    options: list[dict[str, Enumerated]] = []
+
+    def extend(index: int, chosen: dict[str, Enumerated], counters: dict[str, int]) -> None:
+        if len(options) >= OPTIONS_PER_CLUSTER:
+            return
+        if index == len(cluster):
+            options.append(dict(chosen))
+            return
+        use = cluster[index]
+        for item in words[use.key]:
+            values = item.choice.counters
+            if any(counters.get(name, value) != value for name, value in values.items()):
+                continue
+            chosen[use.key] = item
+            extend(index + 1, chosen, {**counters, **values})
+            del chosen[use.key]
+
+    extend(0, {}, {})
+    return options
+
+
+def _max_room_above(
+    spec: Spec, use: PatternUse, uses: Sequence[PatternUse], words: Mapping[str, list[Enumerated]]
+) -> float:
+    """The most opaque length the layers above ``use`` (in its groups) could make room for."""
+    best = 0.0
+    for layer, group in use.layers:
+        room = 0.0
+        for other in uses:
+            if any(g == group and l > layer for l, g in other.layers):
+                room += max((opaque_length(spec, item) for item in words[other.key]), default=0.0)
+        best = max(best, room)
+    return best
+
+
+def _estimate(
+    spec: Spec, option: Mapping[str, Enumerated], canvas: float, room: Mapping[str, float]
+) -> tuple[float, float]:
+    needs = [word_need(i.length, i.elastic, canvas, room[key]) for key, i in option.items()]
+    return (max(needs, default=0.0), sum(n * n for n in needs))
+
+
+def _best_combinations(
+    ranked: list[list[dict[str, Enumerated]]], limit: int
+) -> Iterator[tuple[dict[str, Enumerated], ...]]:
+    """Combinations of one option per cluster, by increasing sum of ranks (a heap)."""
+    start = (0,) * len(ranked)
+    heap = [(0, start)]
+    seen = {start}
+    produced = 0
+    while heap and produced < limit:
+        _, indices = heapq.heappop(heap)
+        yield tuple(options[i] for options, i in zip(ranked, indices, strict=True))
+        produced += 1
+        for position in range(len(indices)):
+            if indices[position] + 1 < len(ranked[position]):
+                successor = (*indices[:position], indices[position] + 1, *indices[position + 1 :])
+                if successor not in seen:
+                    seen.add(successor)
+                    heapq.heappush(heap, (sum(successor), successor))
+
+
+def _candidate(
+    spec: Spec, uses: Sequence[PatternUse], words: Mapping[str, Enumerated], canvas: float, order: int
+) -> Candidate:
+    """A candidate with its exact Eq. 7 need (opaque room from the chosen words above)."""
+    opaque = {key: opaque_length(spec, item) for key, item in words.items()}
+    need = misfit = 0.0
+    for use in uses:
+        item = words[use.key]
+        for layer, group in use.layers:
+            room = sum(
+                opaque[other.key]
+                for other in uses
+                if any(g == group and l > layer for l, g in other.layers)
+            )
+            row_need = word_need(item.length, item.elastic, canvas, room)
+            need = max(need, row_need)
+            misfit += row_need * row_need
+    counters: dict[str, int] = {}
+    for item in words.values():
+        counters.update(item.choice.counters)
+    return Candidate(dict(words), tuple(sorted(counters.items())), need, misfit, order)

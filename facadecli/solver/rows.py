@@ -1,0 +1,68 @@
+"""What the solver needs to know about the words of one axis: rows and letter properties.
+
+A *row* is one word in one alignment group; layers of a group whose words are identical
+share a row (they move together: the same pattern makes the same word, SPEC 2.6).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from facadecli.patterns import Letter, Word
+from facadecli.spec.model import Spec
+
+
+@dataclass(frozen=True)
+class LetterTraits:
+    """The qualifiers of one letter that the alignment uses (SPEC 2.4)."""
+
+    size: float | None  # preferred size; None for an unsized (elastic) placeholder
+    transparent: bool
+    opaque: bool  # never true for a transparent letter
+    attached: bool
+    unoccludable: bool
+
+
+def letter_traits(spec: Spec, letter: Letter) -> LetterTraits:
+    qualifiers = spec.qualifiers(letter.symbol)
+    transparent = letter.transparent or qualifiers.transparent
+    return LetterTraits(
+        size=spec.size(letter.symbol),
+        transparent=transparent,
+        opaque=qualifiers.opaque and not transparent,
+        attached=qualifiers.attached,
+        unoccludable=qualifiers.unoccludable and not transparent,
+    )
+
+
+@dataclass(frozen=True)
+class Row:
+    """One word of an alignment group and the layers (stack indices) that show it."""
+
+    layers: tuple[int, ...]
+    word: Word
+    traits: tuple[LetterTraits, ...]
+
+    @property
+    def lowest(self) -> int:
+        return self.layers[0]
+
+    @property
+    def highest(self) -> int:
+        return self.layers[-1]
+
+    def is_above(self, other: Row) -> bool:
+        """Some layer of this row lies in front of some layer of ``other``."""
+        return self is not other and self.highest > other.lowest
+
+
+def make_rows(spec: Spec, words: list[tuple[int, Word]]) -> list[Row]:
+    """Rows of one group from (layer index, word) pairs; identical words share a row."""
+    by_word: dict[Word, list[int]] = {}
+    for layer, word in sorted(words, key=lambda item: item[0]):
+        by_word.setdefault(word, []).append(layer)
+    rows = [
+        Row(tuple(layers), word, tuple(letter_traits(spec, letter) for letter in word))
+        for word, layers in by_word.items()
+    ]
+    return sorted(rows, key=lambda row: row.lowest)

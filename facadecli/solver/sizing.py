@@ -1,0 +1,226 @@
+"""Sizing (Ilčík et al. 2015, section 5.3; SPEC 2.7): one quadratic program per axis.
+
+Variables: one size per symbol on the axis (shared by every group), the width of every
+column of every group, and one length per piece of a split transparent letter. Equalities:
+the columns of a group fill the canvas; every non-empty entry is as wide as its column;
+the pieces of a split letter add up to its symbol's size. Objective: the sum over sized
+symbols of (size - preferred)^2, plus a tiny weight on everything else so that the
+solution is unique (a placeholder covers as little as it can).
+
+``estimate`` solves the equality-constrained problem in closed form (a few hundred
+microseconds) to rank alignments; ``solve`` is the cvxpy QP with every bound.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from facadecli.solver.alignment import Alignment, Move
+from facadecli.spec.model import Spec
+
+TINY = 1e-6  # weight of unsized variables: breaks ties, never trades against a deviation
+MIN_SIZE = 1e-3  # every sized letter is at least a millimetre long
+
+
+@dataclass(frozen=True)
+class Piece:
+    """Where a piece of a split letter sits: group, row, letter index, column."""
+
+    group: str
+    row: int
+    letter: int
+    column: int
+
+
+def entry_parts(move: Move) -> tuple[list[int], list[int]]:
+    """(whole letters, letters of which the entry holds a piece) of a non-empty entry."""
+    if move.start == move.end:
+        return [], [move.start // 2]
+    first, last = move.start // 2, move.end // 2
+    pieces = []
+    whole_from = first
+    if move.start % 2:
+        pieces.append(first)
+        whole_from = first + 1
+    if move.end % 2:
+        pieces.append(last)
+    return list(range(whole_from, last)), pieces
+
+
+@dataclass
+class Program:
+    """The sizing problem of one axis as matrices: minimise sum w (z - t)^2, E z = d."""
+
+    names: list[str]  # one per variable, for messages
+    target: np.ndarray
+    weight: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    equalities: np.ndarray
+    rhs: np.ndarray
+    symbols: dict[str, int]
+    columns: dict[tuple[str, int], int]
+    pieces: dict[Piece, int]
+    sized: list[int]  # variables whose deviation is the objective
+
+
+def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) -> Program:
+    names: list[str] = []
+    target: list[float] = []
+    weight: list[float] = []
+    lower: list[float] = []
+    upper: list[float] = []
+    symbols: dict[str, int] = {}
+    columns: dict[tuple[str, int], int] = {}
+    pieces: dict[Piece, int] = {}
+    sized: list[int] = []
+
+    def variable(name: str, goal: float, w: float, low: float, high: float) -> int:
+        names.append(name)
+        target.append(goal)
+        weight.append(w)
+        lower.append(low)
+        upper.append(high)
+        return len(names) - 1
+
+    def symbol(name: str) -> int:
+        if name not in symbols:
+            declared = spec.symbols.get(name)
+            size = declared.size if declared else None
+            if size is None:
+                symbols[name] = variable(f"size of {name}", 0.0, TINY, 0.0, np.inf)
+            else:
+                low = max(MIN_SIZE, declared.min or 0.0) if declared else MIN_SIZE
+                high = declared.max if declared and declared.max is not None else np.inf
+                symbols[name] = variable(f"size of {name}", size, 1.0, low, high)
+                sized.append(symbols[name])
+        return symbols[name]
+
+    rows: list[tuple[dict[int, float], float]] = []  # sparse equality rows
+    for group, alignment in sorted(groups.items()):
+        for j in range(alignment.columns):
+            columns[(group, j)] = variable(f"column {j} of group {group}", 0.0, TINY, 0.0, np.inf)
+        rows.append(({columns[(group, j)]: 1.0 for j in range(alignment.columns)}, canvas))
+        split: dict[tuple[int, int], list[int]] = {}
+        for j, entries in enumerate(alignment.entries):
+            for r, move in enumerate(entries):
+                if move is None:
+                    continue
+                whole, parts = entry_parts(move)
+                coefficients: dict[int, float] = {columns[(group, j)]: -1.0}
+                word = alignment.rows[r].word
+                for k in whole:
+                    index = symbol(word[k].symbol)
+                    coefficients[index] = coefficients.get(index, 0.0) + 1.0
+                for k in parts:
+                    piece = Piece(group, r, k, j)
+                    pieces[piece] = variable(f"piece of {word[k].symbol}", 0.0, TINY, 0.0, np.inf)
+                    coefficients[pieces[piece]] = 1.0
+                    split.setdefault((r, k), []).append(pieces[piece])
+                rows.append((coefficients, 0.0))
+        for (r, k), parts in split.items():
+            coefficients = {p: 1.0 for p in parts}
+            index = symbol(alignment.rows[r].word[k].symbol)
+            coefficients[index] = coefficients.get(index, 0.0) - 1.0
+            rows.append((coefficients, 0.0))
+    matrix = np.zeros((len(rows), len(names)))
+    for i, (coefficients, _) in enumerate(rows):
+        for j, value in coefficients.items():
+            matrix[i, j] = value
+    return Program(
+        names=names,
+        target=np.array(target),
+        weight=np.array(weight),
+        lower=np.array(lower),
+        upper=np.array(upper),
+        equalities=matrix,
+        rhs=np.array([value for _, value in rows]),
+        symbols=symbols,
+        columns=columns,
+        pieces=pieces,
+        sized=sized,
+    )
+
+
+@dataclass(frozen=True)
+class Sizing:
+    values: np.ndarray
+    objective: float  # sum of squared deviations of sized symbols
+    coverage: float  # total size of unsized (placeholder) symbols
+
+    def of(self, index: int) -> float:
+        return float(self.values[index])
+
+
+def _result(program: Program, values: np.ndarray) -> Sizing:
+    deviation = values[program.sized] - program.target[program.sized]
+    unsized = [i for i in program.symbols.values() if i not in set(program.sized)]
+    return Sizing(values, float(deviation @ deviation), float(values[unsized].sum()))
+
+
+def estimate(program: Program) -> Sizing | None:
+    """Equality-constrained least squares in closed form; None when the equalities conflict
+    or the solution breaks a bound by more than a millimetre (the QP would then differ)."""
+    h = 2.0 * program.weight
+    e, d = program.equalities, program.rhs
+    f = h * program.target
+    # z = H^-1 (f - E^T nu),  (E H^-1 E^T) nu = E H^-1 f - d
+    e_scaled = e / h
+    normal = e_scaled @ e.T
+    nu, *_ = np.linalg.lstsq(normal, e_scaled @ f - d, rcond=None)
+    z = (f - e.T @ nu) / h
+    if np.abs(e @ z - d).max(initial=0.0) > 1e-6:
+        return None
+    if (z < program.lower - 1e-3).any() or (z > program.upper + 1e-3).any():
+        return None
+    return _result(program, z)
+
+
+def solve(program: Program) -> Sizing | None:
+    """The QP with all bounds, in cvxpy; None if infeasible."""
+    import cvxpy as cp
+    import scipy.sparse as sparse
+
+    n = len(program.names)
+    z = cp.Variable(n)
+    root = np.sqrt(program.weight)
+    objective = cp.Minimize(cp.sum_squares(cp.multiply(root, z - program.target)))
+    constraints = [sparse.csr_matrix(program.equalities) @ z == program.rhs]
+    finite_low = np.isfinite(program.lower)
+    finite_high = np.isfinite(program.upper)
+    if finite_low.any():
+        constraints.append(z[np.flatnonzero(finite_low)] >= program.lower[finite_low])
+    if finite_high.any():
+        constraints.append(z[np.flatnonzero(finite_high)] <= program.upper[finite_high])
+    problem = cp.Problem(objective, constraints)
+    try:
+        problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError:
+        return None
+    if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or z.value is None:
+        return None
+    values = np.clip(np.asarray(z.value, dtype=float), program.lower, program.upper)
+    return _result(program, values)
+
+
+def explain_infeasible(program: Program) -> str:
+    """A short reason for an infeasible sizing: the bounds that cannot all hold."""
+    bounded = [
+        program.names[i]
+        for i in range(len(program.names))
+        if np.isfinite(program.upper[i]) or program.lower[i] > 1e-3 + 1e-12
+    ]
+    if bounded:
+        return "the min/max bounds of " + ", ".join(bounded[:6]) + " cannot all hold"
+    return "the aligned columns cannot fill the canvas"
+
+
+def column_starts(sizing: Sizing, program: Program, group: str, count: int) -> Sequence[float]:
+    """Boundaries of a group's columns: 0, then the running sum of their widths."""
+    bounds = [0.0]
+    for j in range(count):
+        bounds.append(bounds[-1] + sizing.of(program.columns[(group, j)]))
+    return bounds
