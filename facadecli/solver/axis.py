@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 from facadecli.errors import InfeasibleError
 from facadecli.patterns import Enumerated, Word, format_word
 from facadecli.solver import sizing
-from facadecli.solver.alignment import Alignment, AlignmentResult, align
+from facadecli.solver.alignment import INF, Alignment, AlignmentResult, align
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
 from facadecli.solver.rows import make_rows
 from facadecli.spec.model import Spec
@@ -67,12 +67,32 @@ class _Evaluated:
         return sum(a.columns for a in self.groups.values())
 
     @property
-    def rank(self) -> tuple[float, float, int, int]:
+    def empties(self) -> int:
+        return sum(
+            entry is None for a in self.groups.values() for column in a.entries for entry in column
+        )
+
+    @property
+    def splits(self) -> int:
+        """Sized transparent letters cut into pieces (a last resort, section 5.2)."""
+        return sum(
+            entry is not None and entry.tail is not None and entry.tail != INF
+            for a in self.groups.values()
+            for column in a.entries
+            for entry in column
+        )
+
+    @property
+    def rank(self) -> tuple[float, int, float, int, int, tuple[float, ...]]:
+        """Least deviation; then fewest sized letters split; placeholders covering least;
+        fewest holes made; most columns; then the candidate order."""
         return (
-            round(self.estimate.objective, 9),
+            round(self.estimate.objective, 8),
+            self.splits,
             round(self.estimate.coverage, 6),
+            self.empties,
             -self.columns,
-            self.candidate.order,
+            self.candidate.key,
         )
 
 

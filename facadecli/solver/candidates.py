@@ -42,12 +42,20 @@ class Candidate:
     words: Mapping[str, Enumerated]  # pattern key -> word with its choice and length
     counters: tuple[tuple[str, int], ...]
     need: float  # the least tolerance mu under which every word passes Eq. 7
-    misfit: float  # sum of squared Eq. 7 violations at mu = 0 (a tie-break)
+    misfit: float  # sum of squared Eq. 7 violations at mu = 0
+    shortfall: float  # how much the words below opaque letters rely on them making room
+    slack: float  # how much placeholders must cover (elastic words short of the canvas)
     order: int = field(default=0, compare=False)
 
     @property
-    def key(self) -> tuple[float, float, int]:
-        return (round(self.need, 9), round(self.misfit, 9), self.order)
+    def key(self) -> tuple[float, float, float, float, int]:
+        return (
+            round(self.need, 9),
+            round(self.misfit, 9),
+            round(self.shortfall, 6),
+            round(self.slack, 6),
+            self.order,
+        )
 
 
 def opaque_length(spec: Spec, item: Enumerated) -> float:
@@ -228,7 +236,7 @@ def _candidate(
 ) -> Candidate:
     """A candidate with its exact Eq. 7 need (opaque room from the chosen words above)."""
     opaque = {key: opaque_length(spec, item) for key, item in words.items()}
-    need = misfit = 0.0
+    need = misfit = shortfall = slack = 0.0
     for use in uses:
         item = words[use.key]
         for layer, group in use.layers:
@@ -240,7 +248,13 @@ def _candidate(
             row_need = word_need(item.length, item.elastic, canvas, room)
             need = max(need, row_need)
             misfit += row_need * row_need
+            if item.elastic:
+                slack += max(0.0, canvas - item.length)
+            else:
+                shortfall += max(0.0, canvas - item.length - row_need)
     counters: dict[str, int] = {}
     for item in words.values():
         counters.update(item.choice.counters)
-    return Candidate(dict(words), tuple(sorted(counters.items())), need, misfit, order)
+    return Candidate(
+        dict(words), tuple(sorted(counters.items())), need, misfit, shortfall, slack, order
+    )
