@@ -42,17 +42,22 @@ class SearchTimeout(Exception):
     """The time limit ran out during an alignment search."""
 
 
+Sizes = dict[str, float]  # sizes of unsized symbols fixed so far in a search
+
+
 @dataclass(frozen=True)
 class Move:
     """One row's non-empty entry in a column, from position ``start`` to ``end``."""
 
     start: int
     end: int
-    whole_low: float  # preferred length of the letters it holds whole (unsized count 0)
-    whole_high: float  # INF when one of them is unsized
+    fixed: float  # preferred length of the sized letters it holds whole
+    unsized: tuple[str, ...]  # the unsized (placeholder) letters it holds whole
     letters: int  # letters and pieces of letters
     lead: bool  # it finishes the split letter it starts inside
-    tail: float | None  # size of the letter whose first piece ends it (INF if unsized)
+    piece_of: str | None  # the split letter it starts inside (lead or middle piece)
+    tail: float | None  # preferred size of the letter whose first piece ends it (INF if unsized)
+    tail_symbol: str | None
     opaque: bool  # holds only whole opaque letters
     transparent: bool
     unoccludable: bool
@@ -64,19 +69,32 @@ class Move:
         """Only a middle piece of a split letter: the row stays inside it."""
         return self.start == self.end
 
-    def interval(self, remaining: float) -> tuple[float, float]:
-        """Least and greatest preferred length, given what the split letter has left."""
+    def tail_size(self, sizes: Sizes) -> float | None:
+        if self.tail is None:
+            return None
+        return sizes.get(self.tail_symbol or "", self.tail)
+
+    def interval(self, left: float, sizes: Sizes) -> tuple[float, float]:
+        """Least and greatest length: ``left`` is what the split letter it starts inside
+        has left, ``sizes`` the placeholder sizes already fixed."""
         if self.middle:
-            return 0.0, remaining
-        low, high = self.whole_low, self.whole_high
+            return 0.0, left
+        low = high = self.fixed
+        for symbol in self.unsized:
+            if symbol in sizes:
+                low += sizes[symbol]
+                high += sizes[symbol]
+            else:
+                high = INF
         if self.lead:
-            if remaining == INF:
+            if left == INF:
                 high = INF
             else:
-                low += remaining
-                high += remaining
-        if self.tail is not None:
-            high += self.tail
+                low += left
+                high += left
+        tail = self.tail_size(sizes)
+        if tail is not None:
+            high += tail
         return low, high
 
 
@@ -106,8 +124,8 @@ class _Row:
         """Entries out of ``position`` sorted by their least whole length, and those lengths."""
         cached = self.cache.get(position)
         if cached is None:
-            moves = sorted(self._moves(position), key=lambda m: (m.whole_low, m.letters, m.end))
-            cached = self.cache[position] = (moves, [m.whole_low for m in moves])
+            moves = sorted(self._moves(position), key=lambda m: (m.fixed, m.letters, m.end))
+            cached = self.cache[position] = (moves, [m.fixed for m in moves])
         return cached
 
     def size(self, k: int) -> float:
@@ -119,50 +137,53 @@ class _Row:
         if k >= self.n:
             return
         if inside:  # within transparent letter k: a middle piece, or finish it and go on
-            yield self._move(position, position, [], lead=False)
-            yield from self._extend(position, k + 1, True, lead=True)
+            yield self._move(position, position, [], piece_of=k)
+            yield from self._extend(position, k + 1, True, piece_of=k)
             return
         transparent = self.row.traits[k].transparent
         if transparent:
-            yield self._move(position, position + 1, [], lead=False, tail=self.size(k))
-        yield from self._extend(position, k, transparent, lead=False)
+            yield self._move(position, position + 1, [], tail=k)
+        yield from self._extend(position, k, transparent, piece_of=None)
 
-    def _extend(self, start: int, k: int, transparent: bool, lead: bool) -> Iterator[Move]:
+    def _extend(
+        self, start: int, k: int, transparent: bool, piece_of: int | None
+    ) -> Iterator[Move]:
         """Entries from ``start`` holding letters k, k+1, ... whole (of one transparency)."""
         traits = self.row.traits
-        if lead:
-            yield self._move(start, 2 * k, [], lead=True)
+        if piece_of is not None:
+            yield self._move(start, 2 * k, [], piece_of=piece_of)
         whole: list[int] = []
         for index in range(k, self.n):
             if traits[index].transparent != transparent:
                 return
             whole.append(index)
-            yield self._move(start, 2 * (index + 1), whole, lead=lead)
+            yield self._move(start, 2 * (index + 1), whole, piece_of=piece_of)
             following = index + 1
             if transparent and following < self.n and traits[following].transparent:
-                yield self._move(
-                    start, 2 * following + 1, whole, lead=lead, tail=self.size(following)
-                )
+                yield self._move(start, 2 * following + 1, whole, piece_of=piece_of, tail=following)
 
     def _move(
-        self, start: int, end: int, whole: list[int], lead: bool, tail: float | None = None
+        self, start: int, end: int, whole: list[int], piece_of: int | None = None,
+        tail: int | None = None,
     ) -> Move:
+        word = self.row.word
         traits = [self.row.traits[i] for i in whole]
-        sizes = [t.size for t in traits]
-        low = sum(s for s in sizes if s is not None)
-        pieces = (1 if lead or start == end else 0) + (1 if tail is not None else 0)
+        lead = piece_of is not None and end != start
+        pieces = (1 if piece_of is not None else 0) + (1 if tail is not None else 0)
         return Move(
             start=start,
             end=end,
-            whole_low=low,
-            whole_high=INF if None in sizes else low,
+            fixed=sum(t.size for t in traits if t.size is not None),
+            unsized=tuple(word[i].symbol for i in whole if self.row.traits[i].size is None),
             letters=len(whole) + pieces,
             lead=lead,
-            tail=tail,
+            piece_of=None if piece_of is None else word[piece_of].symbol,
+            tail=None if tail is None else self.size(tail),
+            tail_symbol=None if tail is None else word[tail].symbol,
             opaque=bool(traits) and not pieces and all(t.opaque for t in traits),
             transparent=all(t.transparent for t in traits) if traits else True,
             unoccludable=any(t.unoccludable for t in traits),
-            first_attached=not lead and bool(traits) and traits[0].attached,
+            first_attached=piece_of is None and bool(traits) and traits[0].attached,
             last_attached=tail is None and bool(traits) and traits[-1].attached,
         )
 
@@ -176,7 +197,20 @@ class _Column:
     entries: tuple[Move | None, ...]
 
 
-State = tuple[tuple[int, ...], tuple[int, ...], tuple[float, ...]]  # positions, memory, left
+@dataclass(frozen=True)
+class State:
+    """Where the search stands: each row's position, the attached rule's memory, what the
+    split letter each row is inside has left and has used, and the placeholder sizes
+    fixed so far (every occurrence of a placeholder has one size, SPEC 2.3)."""
+
+    positions: tuple[int, ...]
+    memory: tuple[int, ...]
+    left: tuple[float, ...]
+    used: tuple[float, ...]
+    sizes: tuple[tuple[str, float], ...]
+
+    def key(self) -> tuple[object, ...]:
+        return (self.positions, self.memory, self.left, self.used, self.sizes)
 
 
 class _Search:
@@ -189,7 +223,7 @@ class _Search:
         self.mu = mu
         self.deadline = deadline
         self.ends = tuple(2 * r.n for r in self.rows)
-        self.failed: dict[tuple[State, bool], float] = {}
+        self.failed: dict[tuple[object, ...], float] = {}
         self.nodes = 0
         self.overflow = INF  # least cost beyond the budget seen: the next budget
         self.rejections: Counter[str] = Counter()
@@ -197,45 +231,47 @@ class _Search:
     # -- columns out of a state ---------------------------------------------------------
     def columns(self, state: State, span: float) -> list[_Column]:
         """Valid columns out of ``state``, best first."""
-        positions = state[0]
+        positions = state.positions
+        sizes = dict(state.sizes)
         targets: set[float] = set()
         for r, row in enumerate(self.rows):
             if positions[r] < self.ends[r]:
                 moves, _ = row.moves(positions[r])
-                left = state[2][r]
                 for move in moves[:TARGETS_PER_STATE]:
-                    low, high = move.interval(left)
+                    low, high = move.interval(state.left[r], sizes)
                     targets.add(round(low, 9))
                     if high != INF:
                         targets.add(round(high, 9))
         found: dict[tuple[int, ...], _Column] = {}
         for target in sorted(targets)[:TARGETS_PER_STATE]:
-            nearest = [self.nearest(r, state, target) for r in range(len(self.rows))]
-            for variant in self.variants(nearest, state, target):
+            nearest = [self.nearest(r, state, sizes, target) for r in range(len(self.rows))]
+            for variant in self.variants(nearest, state, sizes, target):
                 ends = tuple(m.end if m else positions[r] for r, m in enumerate(variant))
                 if ends in found and not any(m is not None and m.middle for m in variant):
                     continue
-                column = self.score(variant, state, span)
+                column = self.score(variant, state, sizes, span)
                 if column is not None and (ends not in found or column.cost < found[ends].cost):
                     found[ends] = column
         return sorted(found.values(), key=lambda c: (round(c.cost, 9), c.letters, c.width))
 
-    def nearest(self, r: int, state: State, target: float) -> tuple[Move | None, Move | None]:
+    def nearest(
+        self, r: int, state: State, sizes: Sizes, target: float
+    ) -> tuple[Move | None, Move | None]:
         """Row r's entries nearest ``target`` with the fewest letters: the best that ends at
         a letter boundary, and the best that ends inside a split letter when as near."""
-        position, left = state[0][r], state[2][r]
+        position, left = state.positions[r], state.left[r]
         if position >= self.ends[r]:
             return None, None
         moves, lows = self.rows[r].moves(position)
-        if position % 2 == 0:  # whole lengths are the lengths: look near the target only
+        if position % 2 == 0:  # fixed lengths bound the lengths: look near the target only
             upto = bisect.bisect_right(lows, target + EPS)
             window = moves[max(0, upto - 3) : upto + 1]
-            window += [m for m in moves[: max(0, upto - 3)] if m.whole_high == INF or m.tail]
+            window += [m for m in moves[: max(0, upto - 3)] if m.unsized or m.tail is not None]
         else:
             window = moves
         best: dict[bool, tuple[tuple[float, int], Move]] = {}
         for move in window:
-            low, high = move.interval(left)
+            low, high = move.interval(left, sizes)
             key = (round(max(0.0, low - target, target - high), 9), move.letters)
             split = move.end % 2 == 1
             if split not in best or key < best[split][0]:
@@ -246,27 +282,38 @@ class _Search:
         return whole[1], (piece[1] if piece and piece[0][0] == whole[0][0] else None)
 
     def variants(
-        self, nearest: list[tuple[Move | None, Move | None]], state: State, target: float
+        self,
+        nearest: list[tuple[Move | None, Move | None]],
+        state: State,
+        sizes: Sizes,
+        target: float,
     ) -> Iterator[list[Move | None]]:
         """Every row at its nearest entry; the same with split letters where as near; and
         rows that miss the target left empty (making room under opaque rows above)."""
         best = [pair[0] for pair in nearest]
+        split = [pair[1] if pair[1] is not None else pair[0] for pair in nearest]
         yield best
-        if any(pair[1] is not None for pair in nearest):
-            yield [pair[1] if pair[1] is not None else pair[0] for pair in nearest]
+        tied = [r for r, pair in enumerate(nearest) if pair[1] is not None]
+        if tied:
+            yield split
+        if len(tied) > 1:  # each row alone may split, or alone stop splitting
+            for r in tied:
+                yield [split[i] if i == r else move for i, move in enumerate(best)]
+                yield [best[i] if i == r else move for i, move in enumerate(split)]
         emptied = list(best)
         for r, move in enumerate(best):
-            if move is None or state[0][r] % 2 or state[1][r] == AFTER_ATTACHED:
+            if move is None or state.positions[r] % 2 or state.memory[r] == AFTER_ATTACHED:
                 continue
-            low, high = move.interval(state[2][r])
+            low, high = move.interval(state.left[r], sizes)
             if max(0.0, low - target, target - high) > EPS:
                 emptied[r] = None
         if emptied != best:
             yield emptied
 
-    def score(self, entries: list[Move | None], state: State, span: float) -> _Column | None:
+    def score(
+        self, entries: list[Move | None], state: State, sizes: Sizes, span: float
+    ) -> _Column | None:
         """The column, or None if it breaks a rule of SPEC 2.4."""
-        positions, memory, left = state
         if not any(m is not None and (m.end > m.start) for m in entries):
             return None
         if not any(m is not None and m.opaque for m in entries):
@@ -276,16 +323,16 @@ class _Search:
         highs: list[float] = []
         for r, move in enumerate(entries):
             if move is None:
-                if positions[r] % 2:
+                if state.positions[r] % 2:
                     return None  # a split letter has no gaps
-                if memory[r] == AFTER_ATTACHED:
+                if state.memory[r] == AFTER_ATTACHED:
                     self.rejections["attached letter separated"] += 1
                     return None
-                if not any(entries[a] is not None and entries[a].opaque for a in self.above[r]):  # type: ignore[union-attr]
+                if not any(_opaque(entries[a]) for a in self.above[r]):
                     self.rejections["an empty entry with no opaque letter above it"] += 1
                     return None
                 continue
-            if move.first_attached and memory[r] == AFTER_EMPTY:
+            if move.first_attached and state.memory[r] == AFTER_EMPTY:
                 self.rejections["attached letter separated"] += 1
                 return None
             if move.unoccludable:
@@ -294,7 +341,7 @@ class _Search:
                     if other is not None and not other.transparent:
                         self.rejections["unoccludable letter covered"] += 1
                         return None
-            low, high = move.interval(left[r])
+            low, high = move.interval(state.left[r], sizes)
             lows.append(low)
             highs.append(high)
         low, high = max(lows), min(highs)
@@ -305,9 +352,10 @@ class _Search:
         for r, move in enumerate(entries):
             if move is None:
                 continue
-            if move.middle and width >= left[r] - EPS:
+            if move.middle and width >= state.left[r] - EPS:
                 return None  # the piece takes all the letter has left: finish it instead
-            if move.tail is not None and width - move.interval(left[r])[0] >= move.tail - EPS:
+            tail = move.tail_size(sizes)
+            if tail is not None and width - move.interval(state.left[r], sizes)[0] >= tail - EPS:
                 return None  # the first piece would be the whole letter: take it whole
         growth = max(0.0, span + width - self.limit) - max(0.0, span - self.limit)
         letters = sum(m.letters for m in entries if m is not None)
@@ -315,31 +363,52 @@ class _Search:
 
     # -- the search ---------------------------------------------------------------------
     def after(self, state: State, column: _Column) -> State:
-        positions, memory, left = state
-        new_positions, new_memory, new_left = [], [], []
+        """The state after ``column``: positions advance, split letters use up length, and
+        placeholders met for the first time get their size (the column's leftover)."""
+        sizes = dict(state.sizes)
+        positions, memory, left, used = [], [], [], []
+        width = column.width
         for r, move in enumerate(column.entries):
+            attached = self.rows[r].has_attached
             if move is None:
-                new_positions.append(positions[r])
-                keep = memory[r] if memory[r] == AFTER_ATTACHED else AFTER_EMPTY
-                new_memory.append(keep if self.rows[r].has_attached else FREE)
-                new_left.append(left[r])
+                positions.append(state.positions[r])
+                kept = state.memory[r] if state.memory[r] == AFTER_ATTACHED else AFTER_EMPTY
+                memory.append(kept if attached else FREE)
+                left.append(state.left[r])
+                used.append(state.used[r])
                 continue
-            new_positions.append(move.end)
-            attached = self.rows[r].has_attached and move.last_attached
-            new_memory.append(AFTER_ATTACHED if attached else FREE)
+            positions.append(move.end)
+            memory.append(AFTER_ATTACHED if attached and move.last_attached else FREE)
             if move.middle:
-                new_left.append(left[r] if left[r] == INF else max(0.0, left[r] - column.width))
-            elif move.tail is not None and move.tail != INF:
-                low, _ = move.interval(left[r])
-                used = max(0.0, column.width - low)
-                new_left.append(round(max(0.0, move.tail - used), 6))
+                left.append(state.left[r] if state.left[r] == INF else state.left[r] - width)
+                used.append(round(state.used[r] + width, 6))
+                continue
+            low, _ = move.interval(state.left[r], sizes)
+            free = max(0.0, width - low)  # what the elastic parts of the entry share
+            if move.tail is not None:  # the tail piece takes it; other placeholders none
+                share = 0.0
             else:
-                new_left.append(INF)
-        return tuple(new_positions), tuple(new_memory), tuple(new_left)
+                unknown = [s for s in move.unsized if s not in sizes]
+                lead_unknown = move.lead and state.left[r] == INF
+                share = free / max(1, len(unknown) + lead_unknown)
+            for symbol in move.unsized:
+                sizes.setdefault(symbol, round(share, 6))
+            if move.lead and state.left[r] == INF and move.piece_of:
+                sizes.setdefault(move.piece_of, round(state.used[r] + share, 6))
+            tail = move.tail_size(sizes)
+            if tail is None:
+                left.append(INF)
+                used.append(0.0)
+            else:
+                left.append(INF if tail == INF else round(max(0.0, tail - free), 6))
+                used.append(round(free, 6))
+        return State(
+            tuple(positions), tuple(memory), tuple(left), tuple(used), tuple(sorted(sizes.items()))
+        )
 
     def run(self) -> Alignment | None:
         count = len(self.rows)
-        start: State = ((0,) * count, (FREE,) * count, (INF,) * count)
+        start = State((0,) * count, (FREE,) * count, (INF,) * count, (0.0,) * count, ())
         budget = self.mu
         while True:
             self.overflow = INF
@@ -364,28 +433,34 @@ class _Search:
         self.nodes += 1
         if self.nodes % 128 == 0 and time.perf_counter() > self.deadline:
             raise SearchTimeout
-        if state[0] == self.ends:
+        if state.positions == self.ends:
             shortfall = 0.0 if stretchable else max(0.0, self.floor - span)
             if spent + shortfall > budget + EPS:
                 self.overflow = min(self.overflow, spent + shortfall)
                 return None
             return []
-        key = (state, stretchable)
+        key = (state.key(), stretchable)
         if self.failed.get(key, -1.0) >= budget - spent - EPS:
             return None
+        sizes = dict(state.sizes)
         for column in self.columns(state, span):
             cost = spent + column.cost
             if cost > budget + EPS:
                 self.overflow = min(self.overflow, cost)
                 continue
             elastic = stretchable or all(
-                m is None or m.interval(state[2][r])[1] == INF for r, m in enumerate(column.entries)
+                m is None or m.interval(state.left[r], sizes)[1] == INF
+                for r, m in enumerate(column.entries)
             )
             rest = self.dfs(self.after(state, column), cost, span + column.width, elastic, budget)
             if rest is not None:
                 return [column, *rest]
         self.failed[key] = max(self.failed.get(key, -1.0), budget - spent)
         return None
+
+
+def _opaque(move: Move | None) -> bool:
+    return move is not None and move.opaque
 
 
 @dataclass(frozen=True)
