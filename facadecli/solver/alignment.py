@@ -33,6 +33,8 @@ from facadecli.solver.rows import Row
 INF = math.inf
 EPS = 1e-9
 TARGETS_PER_STATE = 24  # target widths tried from one state, smallest first
+MAX_NODES = 20_000  # states one search may visit before it gives up on a candidate
+BUDGET_STEP = 0.01  # least deepening of the error budget, as a share of the canvas
 
 # what a row's previous entry means for the attached rule (SPEC 2.4)
 FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2
@@ -40,6 +42,10 @@ FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2
 
 class SearchTimeout(Exception):
     """The time limit ran out during an alignment search."""
+
+
+class SearchExhausted(Exception):
+    """The search visited MAX_NODES states without finding an alignment."""
 
 
 Sizes = dict[str, float]  # sizes of unsized symbols fixed so far in a search
@@ -421,7 +427,9 @@ class _Search:
                 )
             if self.overflow == INF or self.overflow > self.canvas:
                 return None
-            budget = max(self.overflow, budget * 1.5 + EPS)
+            # deepen in steps of at least 1% of the canvas: the alignment's error is a guide
+            # for the sizing, which settles the exact sizes
+            budget = max(self.overflow, budget * 2.0, budget + BUDGET_STEP * self.canvas)
 
     def dfs(
         self, state: State, spent: float, span: float, stretchable: bool, budget: float
@@ -433,6 +441,8 @@ class _Search:
         self.nodes += 1
         if self.nodes % 128 == 0 and time.perf_counter() > self.deadline:
             raise SearchTimeout
+        if self.nodes > MAX_NODES:
+            raise SearchExhausted
         if state.positions == self.ends:
             shortfall = 0.0 if stretchable else max(0.0, self.floor - span)
             if spent + shortfall > budget + EPS:
@@ -478,6 +488,10 @@ def align(rows: Sequence[Row], canvas: float, mu: float, deadline: float) -> Ali
         found = search.run()
     except SearchTimeout:
         return AlignmentResult(None, True, search.nodes, "time limit reached")
+    except SearchExhausted:
+        return AlignmentResult(
+            None, False, search.nodes, f"no alignment within {MAX_NODES:,} search states"
+        )
     reason = ""
     if found is None:
         common = search.rejections.most_common(1)

@@ -16,6 +16,8 @@ from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
+TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
+# aligns (in tolerance, or in room made by opaque letters) still compete with it
 CANDIDATES_TO_TRY = 200
 PRECISION = 6  # decimals of metres kept in the layout (micrometres)
 
@@ -96,6 +98,13 @@ class _Evaluated:
         )
 
 
+def _beyond_tier(candidate: Candidate, first: Candidate, step: float) -> bool:
+    return (
+        candidate.need > first.need + step + 1e-9
+        or candidate.shortfall > first.shortfall + step + 1e-9
+    )
+
+
 def _axis_words(spec: Spec, axis: Axis) -> list[tuple[int, str, str, object]]:
     found = []
     for index, layer in enumerate(spec.layers):
@@ -130,9 +139,12 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     failures: list[str] = []
     timed_out = False
     tried = 0
+    step = max(tolerance, TIER * canvas)
     for candidate in candidates[:CANDIDATES_TO_TRY]:
         if len(evaluated) >= FEASIBLE_TO_COMPARE:
             break
+        if evaluated and _beyond_tier(candidate, evaluated[0].candidate, step):
+            break  # mu is raised only until something aligns
         if time.perf_counter() > deadline and evaluated:
             timed_out = True
             break
