@@ -15,7 +15,7 @@ import typer
 
 from facadecli import __version__
 from facadecli.errors import FacadeError, InfeasibleError, SpecError
-from facadecli.export import WRITERS, write_atomic, write_outputs
+from facadecli.export import WRITERS, OutputOptions, write_atomic, write_outputs
 from facadecli.preview import preview_words
 from facadecli.solve import retarget, solve
 from facadecli.spec import load_spec, spec_schema_text
@@ -106,6 +106,9 @@ def solve_command(
     timings: Annotated[
         bool, typer.Option("--timings", help="Record solve times in the report (not reproducible).")
     ] = False,
+    labels: Annotated[
+        bool, typer.Option("--labels", help="Symbol names and column lines over the SVG.")
+    ] = False,
 ) -> None:
     """Solve specs into layouts and write their outputs to OUTDIR."""
     chosen = _formats(formats)
@@ -123,7 +126,7 @@ def solve_command(
             continue
         for warning in layout.warnings:
             typer.echo(f"{path}: warning: {warning}", err=True)
-        written = write_outputs(layout, outdir, chosen, timings)
+        written = write_outputs(layout, outdir, chosen, OutputOptions(timings, labels))
         counters = ", ".join(f"{k}={v}" for k, v in sorted(layout.counters.items()))
         typer.echo(
             f"{path}: solved in {layout.time_ms:.1f} ms"

@@ -3,31 +3,49 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from facadecli.export.atomic import write_atomic
 from facadecli.layout import Layout
 
-Writer = Callable[[Layout, Path, bool], list[Path]]
+
+@dataclass(frozen=True)
+class OutputOptions:
+    timings: bool = False  # record solve times in the report (they vary run to run)
+    labels: bool = False  # symbol names and column lines over the SVG elevation
 
 
-def _write_json(layout: Layout, outdir: Path, timings: bool) -> list[Path]:
+Writer = Callable[[Layout, Path, OutputOptions], list[Path]]
+
+
+def _write_json(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.report import report_text
 
     path = outdir / f"{layout.spec.name}.layout.json"
-    write_atomic(path, report_text(layout, timings=timings))
+    write_atomic(path, report_text(layout, timings=options.timings))
     return [path]
 
 
-#: format name -> writer(layout, outdir, timings) returning the files it wrote
-WRITERS: dict[str, Writer] = {"json": _write_json}
+def _write_svg(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
+    from facadecli.export.svg import svg_text
+
+    path = outdir / f"{layout.spec.name}.svg"
+    write_atomic(path, svg_text(layout, labels=options.labels))
+    return [path]
 
 
-def write_outputs(layout: Layout, outdir: Path, formats: list[str], timings: bool) -> list[Path]:
+#: format name -> writer(layout, outdir, options) returning the files it wrote
+WRITERS: dict[str, Writer] = {"json": _write_json, "svg": _write_svg}
+
+
+def write_outputs(
+    layout: Layout, outdir: Path, formats: list[str], options: OutputOptions
+) -> list[Path]:
     written: list[Path] = []
     for name in formats:
-        written.extend(WRITERS[name](layout, outdir, timings))
+        written.extend(WRITERS[name](layout, outdir, options))
     return written
 
 
-__all__ = ["WRITERS", "write_atomic", "write_outputs"]
+__all__ = ["WRITERS", "OutputOptions", "write_atomic", "write_outputs"]
