@@ -307,14 +307,19 @@ class _Search:
                 yield [split[i] if i == r else move for i, move in enumerate(best)]
                 yield [best[i] if i == r else move for i, move in enumerate(split)]
         emptied = list(best)
+        room = list(best)
         for r, move in enumerate(best):
             if move is None or state.positions[r] % 2 or state.memory[r] == AFTER_ATTACHED:
                 continue
             low, high = move.interval(state.left[r], sizes)
             if max(0.0, low - target, target - high) > EPS:
                 emptied[r] = None
+            if any(_opaque(best[above]) for above in self.above[r]):
+                room[r] = None
         if emptied != best:
             yield emptied
+        if room != best and room != emptied:
+            yield room
 
     def score(
         self, entries: list[Move | None], state: State, sizes: Sizes, span: float
@@ -413,28 +418,47 @@ class _Search:
         )
 
     def run(self) -> Alignment | None:
+        """Deepen the budget until a path is found, then tighten it below that path's cost
+        until no cheaper path exists (branch and bound); the best path found wins. Running
+        out of nodes or time after a path was found keeps that path."""
         count = len(self.rows)
         start = State((0,) * count, (FREE,) * count, (INF,) * count, (0.0,) * count, ())
+        step = BUDGET_STEP * self.canvas
         budget = self.mu
+        best: list[_Column] | None = None
+        cost = INF
         while True:
             self.overflow = INF
-            path = self.dfs(start, 0.0, 0.0, False, budget)
+            try:
+                path = self.dfs(start, 0.0, 0.0, False, budget)
+            except (SearchTimeout, SearchExhausted):
+                if best is None:
+                    raise
+                break
             if path is not None:
-                return Alignment(
-                    tuple(r.row for r in self.rows),
-                    tuple(c.entries for c in path),
-                    sum(c.error for c in path),
-                )
+                best, cost = path
+                if cost <= EPS:
+                    break
+                budget = cost - max(step / 10, EPS * 10)
+                self.failed.clear()  # failures were recorded under the looser budget
+                continue
+            if best is not None:
+                break
             if self.overflow == INF or self.overflow > self.canvas:
                 return None
-            # deepen in steps of at least 1% of the canvas: the alignment's error is a guide
-            # for the sizing, which settles the exact sizes
-            budget = max(self.overflow, budget * 2.0, budget + BUDGET_STEP * self.canvas)
+            # deepen in steps of at least 1% of the canvas; tightening refines afterwards
+            budget = max(self.overflow, budget * 2.0, budget + step)
+        return Alignment(
+            tuple(r.row for r in self.rows),
+            tuple(c.entries for c in best),
+            sum(c.error for c in best),
+        )
 
     def dfs(
         self, state: State, spent: float, span: float, stretchable: bool, budget: float
-    ) -> list[_Column] | None:
-        """Columns from ``state`` to the ends within ``budget``, best columns first.
+    ) -> tuple[list[_Column], float] | None:
+        """Columns from ``state`` to the ends within ``budget``, best columns first, and the
+        total cost of the path they complete.
 
         ``stretchable``: a column so far holds only elastic entries, so the span can grow.
         """
@@ -448,7 +472,7 @@ class _Search:
             if spent + shortfall > budget + EPS:
                 self.overflow = min(self.overflow, spent + shortfall)
                 return None
-            return []
+            return [], spent + shortfall
         key = (state.key(), stretchable)
         if self.failed.get(key, -1.0) >= budget - spent - EPS:
             return None
@@ -464,7 +488,7 @@ class _Search:
             )
             rest = self.dfs(self.after(state, column), cost, span + column.width, elastic, budget)
             if rest is not None:
-                return [column, *rest]
+                return [column, *rest[0]], rest[1]
         self.failed[key] = max(self.failed.get(key, -1.0), budget - spent)
         return None
 

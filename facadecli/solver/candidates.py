@@ -14,6 +14,7 @@ them only needs its fixed part to stay under L + mu.
 from __future__ import annotations
 
 import heapq
+import math
 import itertools
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -258,3 +259,12 @@ def _candidate(
     return Candidate(
         dict(words), tuple(sorted(counters.items())), need, misfit, shortfall, slack, order
     )
+
+
+def placeholder_samples(bounds: tuple[float, float], step: float) -> list[float]:
+    """Sizes in ``bounds`` at multiples of ``step`` (zero left out), as the paper samples
+    unsized symbols (section 5.1, Figure 7): a readable list of the options."""
+    low, high = bounds
+    first = max(1, math.ceil(low / step - 1e-9))
+    last = math.floor(high / step + 1e-9)
+    return [round(i * step, 9) for i in range(first, last + 1)]

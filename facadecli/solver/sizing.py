@@ -21,7 +21,7 @@ import numpy as np
 from facadecli.solver.alignment import Alignment, Move
 from facadecli.spec.model import Spec
 
-TINY = 1e-6  # weight of unsized variables: breaks ties, never trades against a deviation
+TINY = 1e-8  # weight of unsized variables: breaks ties, never trades against a deviation
 MIN_SIZE = 1e-3  # every sized letter is at least a millimetre long
 
 
