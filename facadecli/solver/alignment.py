@@ -202,6 +202,12 @@ class _Column:
     letters: int
     entries: tuple[Move | None, ...]
 
+    @property
+    def pieces(self) -> int:
+        return sum(
+            (m.piece_of is not None) + (m.tail is not None) for m in self.entries if m is not None
+        )
+
 
 @dataclass(frozen=True)
 class State:
@@ -258,7 +264,11 @@ class _Search:
                 column = self.score(variant, state, sizes, span)
                 if column is not None and (ends not in found or column.cost < found[ends].cost):
                     found[ends] = column
-        return sorted(found.values(), key=lambda c: (round(c.cost, 9), c.letters, c.width))
+        # equal costs: whole letters before pieces (split only where needed, section 5.2),
+        # then fewer letters (more columns), then narrower
+        return sorted(
+            found.values(), key=lambda c: (round(c.cost, 9), c.pieces, c.letters, c.width)
+        )
 
     def nearest(
         self, r: int, state: State, sizes: Sizes, target: float
@@ -521,3 +531,46 @@ def align(rows: Sequence[Row], canvas: float, mu: float, deadline: float) -> Ali
         common = search.rejections.most_common(1)
         reason = common[0][0] if common else "the words cannot be cut into matching columns"
     return AlignmentResult(found, False, search.nodes, reason)
+
+
+def score_alignment(
+    rows: Sequence[Row],
+    cuts: Sequence[Sequence[tuple[int, int] | None]],
+    canvas: float,
+    mu: float,
+) -> float | None:
+    """The cost of a given alignment, or None if it breaks a rule (SPEC 2.4).
+
+    ``cuts[r][j]`` is row r's entry in column j as (first letter, end letter), or None for
+    an empty entry; letters are whole (no splits). For checking and explaining alignments.
+    """
+    search = _Search(rows, canvas, mu, INF)
+    count = len(rows)
+    state = State((0,) * count, (FREE,) * count, (INF,) * count, (0.0,) * count, ())
+    total = span = 0.0
+    stretchable = False
+    for j in range(len(cuts[0])):
+        entries: list[Move | None] = []
+        for r, row in enumerate(search.rows):
+            cut = cuts[r][j]
+            if cut is None:
+                entries.append(None)
+                continue
+            moves, _ = row.moves(2 * cut[0])
+            match = [m for m in moves if m.start == 2 * cut[0] and m.end == 2 * cut[1]]
+            if not match:
+                return None  # e.g. transparent and visible letters in one entry
+            entries.append(match[0])
+        column = search.score(entries, state, dict(state.sizes), span)
+        if column is None:
+            return None
+        stretchable = stretchable or all(
+            m is None or m.interval(state.left[r], dict(state.sizes))[1] == INF
+            for r, m in enumerate(entries)
+        )
+        total += column.cost
+        span += column.width
+        state = search.after(state, column)
+    if state.positions != search.ends:
+        return None
+    return total + (0.0 if stretchable else max(0.0, search.floor - span))

@@ -1,0 +1,318 @@
+"""The solver on the paper's examples (Ilčík et al. 2015) and the SPEC's semantics."""
+
+from __future__ import annotations
+
+import textwrap
+
+import pytest
+
+from facadecli import InfeasibleError, compile_pattern, make_word, parse_spec, solve
+from facadecli.solver.alignment import align, score_alignment
+from facadecli.solver.candidates import (
+    generate_candidates,
+    pattern_uses,
+    placeholder_range,
+    placeholder_samples,
+)
+from facadecli.solver.rows import make_rows
+from facadecli.spec.resolve import layer_pattern
+from tests.solving import letters, solve_text, spans
+
+FIG7 = """
+version: 1
+name: figure-7
+canvas: {width: 10, height: 1}
+solver: {tolerance: 1.0}
+symbols: {A: 2, B: 3, C: 1.3, H: 1}
+counters: {s: {min: 1}, t: {min: 1}}
+patterns:
+  lower: "A^s C^t A^s"
+  upper: {control: "e b^s e", where: {b: "B"}}
+layers:
+  - {name: w2, x: lower, y: H}
+  - {name: w1, x: upper, y: H}
+"""
+
+
+def test_figure_7_counting_and_sizing_candidates() -> None:
+    spec = parse_spec(FIG7)
+    uses = pattern_uses(
+        spec,
+        [(i, "default", layer.x, layer_pattern(spec, layer, "x")) for i, layer in enumerate(spec.layers)],
+    )
+    mu = spec.solver.tolerance
+    admitted = [c for c in generate_candidates(spec, uses, 10.0) if c.need <= mu + 1e-9]
+    table = set()
+    for candidate in admitted:
+        values = dict(candidate.counters)
+        upper = candidate.words["upper"]
+        bounds = placeholder_range(upper, spec, 10.0, mu)
+        assert bounds is not None
+        for size in placeholder_samples(bounds, step=mu):
+            table.add((values["s"], values["t"], size))
+        assert 9.0 - 1e-9 <= candidate.words["lower"].length <= 11.0 + 1e-9
+    # the paper's table: (s, t) and |e| of the six candidates for alignment
+    assert table == {(1, 5, 4.0), (1, 5, 3.0), (1, 4, 4.0), (1, 4, 3.0), (2, 2, 2.0), (2, 1, 2.0)}
+
+
+def _rows(spec_text: str, words: dict[str, dict[str, int]]):  # type: ignore[no-untyped-def]
+    spec = parse_spec(textwrap.dedent(spec_text))
+    members = []
+    for index, layer in enumerate(spec.layers):
+        word = make_word(layer_pattern(spec, layer, "x"), words.get(layer.name, {}))
+        members.append((index, word))
+    return spec, make_rows(spec, members)
+
+
+EQ8 = """
+version: 1
+name: equation-8
+canvas: {width: 6, height: 1}
+symbol_defaults: {opaque: true}
+symbols: {A: 1, B: 1.5, C: 1, H: 1}
+patterns:
+  base: "A B A B A"
+  columns: {control: "c e c", where: {c: "C"}}
+layers:
+  - {name: base, x: base, y: H}
+  - {name: columns, x: columns, y: H}
+"""
+
+
+def test_equation_8_alignments_and_the_winner() -> None:
+    _, rows = _rows(EQ8, {})
+    base, columns = rows  # back to front: A B A B A, then C e C
+    # letter cuts per row (None = empty entry); positions count letters
+    mixed = [[(0, 3), (3, 5)], [(0, 2), (2, 3)]]  # (ABA | BA) under (Ce | C)
+    room = [[None, (0, 5), None], [(0, 1), (1, 2), (2, 3)]]  # (eps | ABABA | eps)
+    snug = [[(0, 1), (1, 4), (4, 5)], [(0, 1), (1, 2), (2, 3)]]  # (A | BAB | A)
+    canvas = 6.0
+    assert score_alignment(rows, mixed, canvas, 0.0) is None  # C and e share an entry
+    assert score_alignment(rows, room, canvas, 0.0) == pytest.approx(2.0)  # span 8 > 6
+    assert score_alignment(rows, snug, canvas, 0.0) == pytest.approx(0.0)
+    found = align(rows, canvas, 0.0, deadline=float("inf")).alignment
+    assert found is not None
+    cuts = [[(e.start // 2, e.end // 2) if e else None for e in column] for column in found.entries]
+    assert [c[0] for c in cuts] == [(0, 1), (1, 4), (4, 5)]
+    assert [c[1] for c in cuts] == [(0, 1), (1, 2), (2, 3)]
+
+
+TRANSPARENT_SPLIT = """
+version: 1
+name: transparent-split
+canvas: {width: 12, height: 3}
+symbol_defaults: {opaque: true}
+symbols: {A: 2, B: 3, C: 2, H: 3}
+patterns:
+  base: "A B A B A"
+  columns: {control: "c e c", where: {c: "C"}}
+  top: {control: "f a f", where: {a: "A"}}
+layers:
+  - {name: base, x: base, y: H}
+  - {name: columns, x: columns, y: H}
+  - {name: top, x: top, y: H}
+"""
+
+
+def test_transparent_split_keeps_every_preferred_size() -> None:
+    layout = solve_text(TRANSPARENT_SPLIT)
+    assert spans(layout, "top", "x", "A") == [(5.0, 7.0)]
+    assert spans(layout, "columns", "x", "C") == [(0.0, 2.0), (10.0, 12.0)]
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
+    # f is cut into pieces where C and e change: the columns of the paper's matrix
+    assert layout.x.groups["default"].boundaries == (0.0, 2.0, 5.0, 7.0, 10.0, 12.0)
+
+
+RESIDENTIAL = """
+version: 1
+name: residential-house
+canvas: {width: 6.0, height: 3.0}
+symbol_defaults: {opaque: true}
+symbols:
+  A: 0.6
+  B: 1.0
+  P: 1.6
+  Q: 1.4
+  C: {size: 0.4, opaque: false}
+  D: {size: 1.0, label: door}
+counters: {k: {min: 1}}
+patterns:
+  house_x: "A (B A)^k"
+  house_y: "P Q"
+  corner_columns: {control: "c e c", where: {c: "C"}}
+  entrance: {control: "y d y", where: {d: "D"}}
+layers:
+  - {name: base, x: house_x, y: house_y}
+  - {name: columns, x: corner_columns, y: house_y, visible: {y: [P]}, offset: 0.05}
+  - {name: door, x: entrance, y: house_y, visible: {y: [P]}, offset: 0.02}
+"""
+
+
+def test_residential_house_of_section_4() -> None:
+    layout = solve_text(RESIDENTIAL)
+    # 0.6 + 1.6 k is 5.4 or 7.0: no integer k fits 6 m; the nearer one is taken and stretched
+    assert layout.counters["k"] == 3
+    base = letters(layout, "base", "x")
+    assert base[0].start == 0.0 and base[-1].end == 6.0
+    lengths = {round(p.end - p.start, 6) for p in base if p.symbol == "A"}
+    assert len(lengths) == 1  # every A alike
+    # corner columns on the ground floor only
+    columns = [s for s in layout.shapes if s.layer == "columns"]
+    assert {(s.x, s.y) for s in columns} == {("C", "P")}
+    assert sorted((s.x0, s.x1) for s in columns)[0][0] == 0.0
+    assert sorted((s.x0, s.x1) for s in columns)[-1][1] == 6.0
+    # the door is centred by the two y placeholders
+    y_sizes = {round(p.end - p.start, 6) for p in letters(layout, "door", "x") if p.symbol == "y"}
+    assert len(y_sizes) == 1
+    (door,) = spans(layout, "door", "x", "D")
+    assert (door[0] + door[1]) / 2 == pytest.approx(3.0)
+
+
+FIG4 = """
+version: 1
+name: figure-4
+canvas: {{width: 8.9, height: 3}}
+symbol_defaults: {{opaque: true}}
+symbols:
+  A: 1.5
+  D: {{size: 0.5{d}}}
+  B: {{size: 1.2{b}}}
+  P: {{size: 0.5, opaque: {p}}}
+  H: 3
+counters: {{m: 2, n: {{min: 1}}}}
+patterns:
+  wall: "A (D B D A)^m"
+  front: {{control: "a (d b d a)^n", where: {{d: "P"}}}}
+layers:
+  - {{name: L0, x: wall, y: H}}
+  - {{name: L1, x: front, y: H}}
+"""
+
+
+def _figure_4(d: str = "", b: str = "", p: str = "false") -> tuple[list, list]:  # type: ignore[type-arg]
+    layout = solve_text(FIG4.format(d=d, b=b, p=p))
+    wall = [(x.symbol, round(x.start, 6), round(x.end, 6)) for x in letters(layout, "L0", "x")]
+    pilasters = spans(layout, "L1", "x", "P")
+    return wall, pilasters
+
+
+def _under(wall: list, span: tuple[float, float]) -> list[str]:  # type: ignore[type-arg]
+    return [s for s, a, b in wall if a < span[1] - 1e-6 and b > span[0] + 1e-6]
+
+
+def test_figure_4a_by_default_p_occludes_d() -> None:
+    wall, pilasters = _figure_4()
+    assert pilasters and all(_under(wall, p) == ["D"] for p in pilasters)
+    assert all(any((a, b) == p for s, a, b in wall if s == "D") for p in pilasters)
+
+
+def test_figure_4b_unoccludable_d_sends_p_to_b() -> None:
+    wall, pilasters = _figure_4(d=", unoccludable: true")
+    assert pilasters and all(_under(wall, p) == ["B"] for p in pilasters)
+
+
+def test_figure_4c_opaque_p_sits_between_elements() -> None:
+    wall, pilasters = _figure_4(d=", unoccludable: true", p="true")
+    assert pilasters and all(_under(wall, p) == [] for p in pilasters)  # L0 makes room
+
+
+def test_figure_4d_attached_b_keeps_its_neighbours() -> None:
+    wall, pilasters = _figure_4(d=", unoccludable: true", b=", attached: true", p="true")
+    assert pilasters and all(_under(wall, p) == [] for p in pilasters)
+    for index, (symbol, start, end) in enumerate(wall):
+        if symbol == "B":  # no gap next to a B: its Ds touch it
+            assert wall[index - 1][2] == start and wall[index + 1][1] == end
+
+
+TERRACED = """
+version: 1
+name: terraced-house
+canvas: {{width: 20.0, height: 22.5}}
+symbol_defaults: {{opaque: true}}
+symbols:
+  W: 2.6
+  B: 3.2
+  Q: 0.4
+  L: 5.8
+  G: 4.0
+  X: 0.3
+  S: 3.0
+  Z: 3.0
+  Y: 0.3
+  T: 2.8
+counters: {{m: {{min: 1}}, n: {{min: 1}}, p: {{min: 0}}, b: {{min: 0, max: 1}}}}
+patterns:
+  floors: "G X S^m Y T"
+  bays: "{bays}"
+  balcony_x: {{control: "W l h", where: {{l: "L"}}}}
+  balcony_y: {{control: "G X (z S)^p z^b v", where: {{z: "Z"}}}}
+layers:
+  - {{name: base, x: bays, y: floors}}
+  - {{name: balconies, x: balcony_x, y: balcony_y, offset: 1.2}}
+"""
+
+
+def test_section_6_1_terraced_house_balconies_on_odd_floors() -> None:
+    layout = solve_text(TERRACED.format(bays="W (B W)^n"))
+    floors = [p for p in letters(layout, "base", "y") if p.symbol == "S"]
+    assert layout.counters["m"] == 5 == len(floors)  # 4.3 + 3 m + 3.1 = 22.4 ~ 22.5
+    balconies = spans(layout, "balconies", "y", "Z")
+    with_balcony = [i + 1 for i, f in enumerate(floors) if (round(f.start, 6), round(f.end, 6)) in balconies]
+    assert with_balcony == [1, 3, 5]
+    (large,) = spans(layout, "balconies", "x", "L")
+    firsts = [p for p in letters(layout, "base", "x")][1:3]  # the first B W
+    assert large == (round(firsts[0].start, 6), round(firsts[1].end, 6))
+
+
+def test_section_6_1_delimiters() -> None:
+    layout = solve_text(TERRACED.format(bays="W (Q B W)^n"))
+    word = [p.symbol for p in letters(layout, "base", "x")]
+    assert word[:4] == ["W", "Q", "B", "W"] and word.count("Q") == layout.counters["n"]
+
+
+GROUPS = """
+version: 1
+name: groups
+canvas: {width: 12.0, height: 7.0}
+symbol_defaults: {opaque: true}
+symbols: {E: 1.0, W: 1.2, S: 2.6, D: 1.2, G: 3.5, U: 3.5}
+counters: {n: {min: 1}, k: {min: 1}}
+patterns:
+  upper_x: "E (W E)^n"
+  ground_x: "S (D S)^k"
+  storeys: "G U"
+layers:
+  - {name: wall, x: upper_x, y: storeys, visible: {y: [U]}}
+  - {name: shops, x: ground_x, y: storeys, visible: {y: [G]}, groups: {x: ground}}
+  - {name: frames, x: upper_x, y: storeys, visible: {y: [U]}, offset: 0.05}
+"""
+
+
+def test_alignment_groups_keep_their_own_rhythm_and_share_sizes() -> None:
+    layout = solve_text(GROUPS)
+    upper = set(layout.x.groups["default"].boundaries)
+    ground = set(layout.x.groups["ground"].boundaries)
+    assert ground - upper  # the ground floor does not follow the upper windows
+    assert letters(layout, "wall", "x") == letters(layout, "frames", "x")
+    sizes = {round(p.end - p.start, 6) for layer in ("wall", "shops") for p in letters(layout, layer, "x") if p.symbol in "E"}
+    assert len(sizes) == 1
+
+
+def test_infeasible_spec_exits_with_the_reason() -> None:
+    text = EQ8.replace("A: 1, B: 1.5", "A: {size: 1, max: 1.1}, B: {size: 1.5, max: 1.6}")
+    text = text.replace("C: 1,", "C: {size: 1, opaque: false},")  # so A B A B A cannot make room
+    text = text.replace("canvas: {width: 6", "canvas: {width: 8")  # A B A B A is 6.5 at most
+    with pytest.raises(InfeasibleError, match="x axis: .*cannot all hold"):
+        solve(parse_spec(text))
+
+
+def test_a_fixed_counter_that_cannot_fit_is_infeasible() -> None:
+    text = EQ8.replace('base: "A B A B A"', 'base: "A^n"').replace("symbols:", "counters: {n: 40}\nsymbols:")
+    with pytest.raises(InfeasibleError, match="pattern 'base'"):
+        solve(parse_spec(text))
+
+
+def test_same_spec_same_layout() -> None:
+    first = solve_text(TERRACED.format(bays="W (B W)^n"))
+    second = solve_text(TERRACED.format(bays="W (B W)^n"))
+    assert first.shapes == second.shapes
