@@ -94,7 +94,9 @@ def solve_command(
     ),
     formats: Annotated[
         str | None,
-        typer.Option("--format", "-f", help=f"Comma-separated formats (default: all of {','.join(WRITERS)})."),
+        typer.Option(
+            "--format", "-f", help=f"Comma-separated formats (default: all of {','.join(WRITERS)})."
+        ),
     ] = None,
     width: Annotated[
         float | None, typer.Option("--width", min=0.001, help="Override the canvas width (m).")
@@ -131,7 +133,8 @@ def solve_command(
         typer.echo(
             f"{path}: solved in {layout.time_ms:.1f} ms"
             + (f" ({counters})" if counters else "")
-            + " -> " + ", ".join(str(p) for p in written)
+            + " -> "
+            + ", ".join(str(p) for p in written)
         )
         codes.append(0)
     failed = [code for code in codes if code]

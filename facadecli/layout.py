@@ -141,8 +141,10 @@ def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
             if other.opaque
             and order[other.layer] > order[shape.layer]
             and other.z1 >= shape.z1
-            and other.x0 < shape.x1 and other.x1 > shape.x0
-            and other.y0 < shape.y1 and other.y1 > shape.y0
+            and other.x0 < shape.x1
+            and other.x1 > shape.x0
+            and other.y0 < shape.y1
+            and other.y1 > shape.y0
         ]
         hidden = bool(occluders) and _covered(shape, occluders)
         result.append(shape if not hidden else Shape(**{**shape.__dict__, "visible": False}))
@@ -151,10 +153,22 @@ def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
 
 def _covered(shape: Shape, occluders: list[Shape]) -> bool:
     """Is the shape's rectangle inside the union of the occluders' rectangles?"""
-    xs = sorted({shape.x0, shape.x1, *(min(max(o.x0, shape.x0), shape.x1) for o in occluders),
-                 *(min(max(o.x1, shape.x0), shape.x1) for o in occluders)})
-    ys = sorted({shape.y0, shape.y1, *(min(max(o.y0, shape.y0), shape.y1) for o in occluders),
-                 *(min(max(o.y1, shape.y0), shape.y1) for o in occluders)})
+    xs = sorted(
+        {
+            shape.x0,
+            shape.x1,
+            *(min(max(o.x0, shape.x0), shape.x1) for o in occluders),
+            *(min(max(o.x1, shape.x0), shape.x1) for o in occluders),
+        }
+    )
+    ys = sorted(
+        {
+            shape.y0,
+            shape.y1,
+            *(min(max(o.y0, shape.y0), shape.y1) for o in occluders),
+            *(min(max(o.y1, shape.y0), shape.y1) for o in occluders),
+        }
+    )
     for xa, xb in zip(xs, xs[1:], strict=False):
         for ya, yb in zip(ys, ys[1:], strict=False):
             if xb - xa < 1e-9 or yb - ya < 1e-9:

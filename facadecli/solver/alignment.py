@@ -34,6 +34,7 @@ INF = math.inf
 EPS = 1e-9
 TARGETS_PER_STATE = 24  # target widths tried from one state, smallest first
 MAX_NODES = 20_000  # states one search may visit before it gives up on a candidate
+REFINE_NODES = 400  # least extra effort spent looking for a cheaper path than the first
 BUDGET_STEP = 0.01  # least deepening of the error budget, as a share of the canvas
 
 # what a row's previous entry means for the attached rule (SPEC 2.4)
@@ -169,7 +170,11 @@ class _Row:
                 yield self._move(start, 2 * following + 1, whole, piece_of=piece_of, tail=following)
 
     def _move(
-        self, start: int, end: int, whole: list[int], piece_of: int | None = None,
+        self,
+        start: int,
+        end: int,
+        whole: list[int],
+        piece_of: int | None = None,
         tail: int | None = None,
     ) -> Move:
         word = self.row.word
@@ -196,11 +201,15 @@ class _Row:
 
 @dataclass(frozen=True)
 class _Column:
-    cost: float  # error plus growth of the span beyond the canvas
     error: float
     width: float
     letters: int
     entries: tuple[Move | None, ...]
+    stretchable: bool  # only elastic entries: the column can grow to fill the canvas
+
+    def cost(self, span: float, limit: float) -> float:
+        """Its error plus how much it pushes the span beyond ``limit``."""
+        return self.error + max(0.0, span + self.width - limit) - max(0.0, span - limit)
 
     @property
     def pieces(self) -> int:
@@ -236,13 +245,22 @@ class _Search:
         self.deadline = deadline
         self.ends = tuple(2 * r.n for r in self.rows)
         self.failed: dict[tuple[object, ...], float] = {}
+        self.column_cache: dict[tuple[object, ...], list[_Column]] = {}
         self.nodes = 0
+        self.node_limit = MAX_NODES
         self.overflow = INF  # least cost beyond the budget seen: the next budget
         self.rejections: Counter[str] = Counter()
 
     # -- columns out of a state ---------------------------------------------------------
-    def columns(self, state: State, span: float) -> list[_Column]:
-        """Valid columns out of ``state``, best first."""
+    def columns(self, state: State) -> list[_Column]:
+        """Valid columns out of ``state`` (cached: iterations revisit the same states)."""
+        key = state.key()
+        cached = self.column_cache.get(key)
+        if cached is None:
+            cached = self.column_cache[key] = self.generate(state)
+        return cached
+
+    def generate(self, state: State) -> list[_Column]:
         positions = state.positions
         sizes = dict(state.sizes)
         targets: set[float] = set()
@@ -261,14 +279,10 @@ class _Search:
                 ends = tuple(m.end if m else positions[r] for r, m in enumerate(variant))
                 if ends in found and not any(m is not None and m.middle for m in variant):
                     continue
-                column = self.score(variant, state, sizes, span)
-                if column is not None and (ends not in found or column.cost < found[ends].cost):
+                column = self.score(variant, state, sizes)
+                if column is not None and (ends not in found or column.error < found[ends].error):
                     found[ends] = column
-        # equal costs: whole letters before pieces (split only where needed, section 5.2),
-        # then fewer letters (more columns), then narrower
-        return sorted(
-            found.values(), key=lambda c: (round(c.cost, 9), c.pieces, c.letters, c.width)
-        )
+        return list(found.values())
 
     def nearest(
         self, r: int, state: State, sizes: Sizes, target: float
@@ -331,9 +345,7 @@ class _Search:
         if room != best and room != emptied:
             yield room
 
-    def score(
-        self, entries: list[Move | None], state: State, sizes: Sizes, span: float
-    ) -> _Column | None:
+    def score(self, entries: list[Move | None], state: State, sizes: Sizes) -> _Column | None:
         """The column, or None if it breaks a rule of SPEC 2.4."""
         if not any(m is not None and (m.end > m.start) for m in entries):
             return None
@@ -378,9 +390,11 @@ class _Search:
             tail = move.tail_size(sizes)
             if tail is not None and width - move.interval(state.left[r], sizes)[0] >= tail - EPS:
                 return None  # the first piece would be the whole letter: take it whole
-        growth = max(0.0, span + width - self.limit) - max(0.0, span - self.limit)
         letters = sum(m.letters for m in entries if m is not None)
-        return _Column(error + growth, error, width, letters, tuple(entries))
+        stretchable = all(
+            m is None or m.interval(state.left[r], sizes)[1] == INF for r, m in enumerate(entries)
+        )
+        return _Column(error, width, letters, tuple(entries), stretchable)
 
     # -- the search ---------------------------------------------------------------------
     def after(self, state: State, column: _Column) -> State:
@@ -428,36 +442,34 @@ class _Search:
         )
 
     def run(self) -> Alignment | None:
-        """Deepen the budget until a path is found, then tighten it below that path's cost
-        until no cheaper path exists (branch and bound); the best path found wins. Running
-        out of nodes or time after a path was found keeps that path."""
+        """Find a path within the tolerance; failing that, the first path at any cost; then
+        tighten the budget below the best path's cost until no cheaper path exists (branch
+        and bound, with a bounded extra effort). Out of nodes or time after a path was
+        found, that path stands."""
         count = len(self.rows)
         start = State((0,) * count, (FREE,) * count, (INF,) * count, (0.0,) * count, ())
-        step = BUDGET_STEP * self.canvas
-        budget = self.mu
         best: list[_Column] | None = None
-        cost = INF
+        budget = self.mu
         while True:
             self.overflow = INF
             try:
-                path = self.dfs(start, 0.0, 0.0, False, budget)
+                found = self.dfs(start, 0.0, 0.0, False, budget)
             except (SearchTimeout, SearchExhausted):
                 if best is None:
                     raise
                 break
-            if path is not None:
-                best, cost = path
+            if found is not None:
+                best, cost = found
                 if cost <= EPS:
                     break
-                budget = cost - max(step / 10, EPS * 10)
-                self.failed.clear()  # failures were recorded under the looser budget
-                continue
-            if best is not None:
+                budget = cost - max(BUDGET_STEP * self.canvas / 10, EPS * 10)
+                self.node_limit = min(MAX_NODES, self.nodes + max(REFINE_NODES, self.nodes))
+            elif best is not None or budget == INF:
                 break
-            if self.overflow == INF or self.overflow > self.canvas:
-                return None
-            # deepen in steps of at least 1% of the canvas; tightening refines afterwards
-            budget = max(self.overflow, budget * 2.0, budget + step)
+            else:
+                budget = INF  # nothing within the tolerance: take the first path there is
+        if best is None:
+            return None
         return Alignment(
             tuple(r.row for r in self.rows),
             tuple(c.entries for c in best),
@@ -475,7 +487,7 @@ class _Search:
         self.nodes += 1
         if self.nodes % 128 == 0 and time.perf_counter() > self.deadline:
             raise SearchTimeout
-        if self.nodes > MAX_NODES:
+        if self.nodes > self.node_limit:
             raise SearchExhausted
         if state.positions == self.ends:
             shortfall = 0.0 if stretchable else max(0.0, self.floor - span)
@@ -486,17 +498,24 @@ class _Search:
         key = (state.key(), stretchable)
         if self.failed.get(key, -1.0) >= budget - spent - EPS:
             return None
-        sizes = dict(state.sizes)
-        for column in self.columns(state, span):
-            cost = spent + column.cost
-            if cost > budget + EPS:
-                self.overflow = min(self.overflow, cost)
+        # equal costs: whole letters before pieces (split only where needed, section 5.2),
+        # then fewer letters (more columns), then narrower
+        ranked = sorted(
+            ((c.cost(span, self.limit), c) for c in self.columns(state)),
+            key=lambda item: (round(item[0], 9), item[1].pieces, item[1].letters, item[1].width),
+        )
+        for cost, column in ranked:
+            total = spent + cost
+            if total > budget + EPS:
+                self.overflow = min(self.overflow, total)
                 continue
-            elastic = stretchable or all(
-                m is None or m.interval(state.left[r], sizes)[1] == INF
-                for r, m in enumerate(column.entries)
+            rest = self.dfs(
+                self.after(state, column),
+                total,
+                span + column.width,
+                stretchable or column.stretchable,
+                budget,
             )
-            rest = self.dfs(self.after(state, column), cost, span + column.width, elastic, budget)
             if rest is not None:
                 return [column, *rest[0]], rest[1]
         self.failed[key] = max(self.failed.get(key, -1.0), budget - spent)
@@ -561,14 +580,11 @@ def score_alignment(
             if not match:
                 return None  # e.g. transparent and visible letters in one entry
             entries.append(match[0])
-        column = search.score(entries, state, dict(state.sizes), span)
+        column = search.score(entries, state, dict(state.sizes))
         if column is None:
             return None
-        stretchable = stretchable or all(
-            m is None or m.interval(state.left[r], dict(state.sizes))[1] == INF
-            for r, m in enumerate(entries)
-        )
-        total += column.cost
+        stretchable = stretchable or column.stretchable
+        total += column.cost(span, search.limit)
         span += column.width
         state = search.after(state, column)
     if state.positions != search.ends:

@@ -218,7 +218,10 @@ def _place(
     letters: dict[int, tuple[PlacedLetter, ...]] = {}
     groups: dict[str, GroupColumns] = {}
     for group, alignment in sorted(choice.groups.items()):
-        bounds = [round(b, PRECISION) for b in sizing.column_starts(final, program, group, alignment.columns)]
+        bounds = [
+            round(b, PRECISION)
+            for b in sizing.column_starts(final, program, group, alignment.columns)
+        ]
         bounds[-1] = round(canvas, PRECISION)
         for r, row in enumerate(alignment.rows):
             spans: dict[int, list[float]] = {}
@@ -234,7 +237,11 @@ def _place(
                         length = final.of(program.pieces[sizing.Piece(group, r, k, j)])
                     else:
                         length = final.of(program.symbols[row.word[k].symbol])
-                    end = bounds[j + 1] if position == len(order) - 1 else round(cursor + length, PRECISION)
+                    end = (
+                        bounds[j + 1]
+                        if position == len(order) - 1
+                        else round(cursor + length, PRECISION)
+                    )
                     span = spans.setdefault(k, [cursor, end])
                     span[1] = end
                     cursor = end
@@ -295,8 +302,17 @@ def _no_candidate_reason(spec: Spec, axis: Axis, uses: Sequence[PatternUse], can
     sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
     bounds = {name: counter.bounds for name, counter in spec.counters.items()}
     for use in uses:
-        if next(iter(enumerate_words(use.pattern, sizes=sizes, max_length=2 * canvas,
-                                     counters=bounds)), None) is None:
+        if (
+            next(
+                iter(
+                    enumerate_words(
+                        use.pattern, sizes=sizes, max_length=2 * canvas, counters=bounds
+                    )
+                ),
+                None,
+            )
+            is None
+        ):
             layers = ", ".join(f"'{spec.layers[layer].name}'" for layer, _ in use.layers)
             return (
                 f"{axis} axis: pattern '{use.key}' (layer {layers}) makes no word shorter "

@@ -94,7 +94,9 @@ def placeholder_range(
     return (low, high) if high >= low else None
 
 
-def pattern_uses(spec: Spec, axis_words: Sequence[tuple[int, str, str, CompiledPattern]]) -> list[PatternUse]:
+def pattern_uses(
+    spec: Spec, axis_words: Sequence[tuple[int, str, str, CompiledPattern]]
+) -> list[PatternUse]:
     """Group (layer, group, key, pattern) tuples by pattern key, in order of first use."""
     uses: dict[str, tuple[CompiledPattern, list[tuple[int, str]]]] = {}
     for layer, group, key, pattern in axis_words:
@@ -130,7 +132,10 @@ def generate_candidates(
     room = {use.key: _max_room_above(spec, use, uses, words) for use in uses}
     ranked = []
     for found in options:
-        scored = [(_estimate(spec, option, canvas, room), index, option) for index, option in enumerate(found)]
+        scored = [
+            (_estimate(spec, option, canvas, room), index, option)
+            for index, option in enumerate(found)
+        ]
         scored.sort(key=lambda item: (item[0], item[1]))
         ranked.append([option for _, _, option in scored])
     candidates = []
@@ -233,7 +238,11 @@ def _best_combinations(
 
 
 def _candidate(
-    spec: Spec, uses: Sequence[PatternUse], words: Mapping[str, Enumerated], canvas: float, order: int
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    words: Mapping[str, Enumerated],
+    canvas: float,
+    order: int,
 ) -> Candidate:
     """A candidate with its exact Eq. 7 need (opaque room from the chosen words above)."""
     opaque = {key: opaque_length(spec, item) for key, item in words.items()}
