@@ -28,7 +28,8 @@ from collections import Counter
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
-from facadecli.solver.rows import Row
+from facadecli.patterns import Letter
+from facadecli.solver.rows import LetterTraits, Row
 
 INF = math.inf
 EPS = 1e-9
@@ -112,6 +113,8 @@ class Alignment:
     rows: tuple[Row, ...]
     entries: tuple[tuple[Move | None, ...], ...]
     error: float
+    widths: tuple[float, ...]  # each column's width at preferred sizes (a guide)
+    elastic: tuple[bool, ...]  # the column holds only elastic entries
 
     @property
     def columns(self) -> int:
@@ -160,8 +163,9 @@ class _Row:
         if piece_of is not None:
             yield self._move(start, 2 * k, [], piece_of=piece_of)
         whole: list[int] = []
+        segment = traits[k].segment if k < self.n else 0
         for index in range(k, self.n):
-            if traits[index].transparent != transparent:
+            if traits[index].transparent != transparent or traits[index].segment != segment:
                 return
             whole.append(index)
             yield self._move(start, 2 * (index + 1), whole, piece_of=piece_of)
@@ -474,6 +478,8 @@ class _Search:
             tuple(r.row for r in self.rows),
             tuple(c.entries for c in best),
             sum(c.error for c in best),
+            tuple(c.width for c in best),
+            tuple(c.stretchable for c in best),
         )
 
     def dfs(
@@ -534,8 +540,10 @@ class AlignmentResult:
     reason: str  # why there is none (the rule that rejected most columns)
 
 
-def align(rows: Sequence[Row], canvas: float, mu: float, deadline: float) -> AlignmentResult:
-    """The least-cost alignment of a group's rows, or why there is none."""
+def align_jointly(
+    rows: Sequence[Row], canvas: float, mu: float, deadline: float
+) -> AlignmentResult:
+    """The least-cost alignment of rows searched all together."""
     search = _Search(rows, canvas, mu, deadline)
     try:
         found = search.run()
@@ -550,6 +558,177 @@ def align(rows: Sequence[Row], canvas: float, mu: float, deadline: float) -> Ali
         common = search.rejections.most_common(1)
         reason = common[0][0] if common else "the words cannot be cut into matching columns"
     return AlignmentResult(found, False, search.nodes, reason)
+
+
+def align(rows: Sequence[Row], canvas: float, mu: float, deadline: float) -> AlignmentResult:
+    """The alignment of a group's rows (back to front).
+
+    Two rows are searched together. More are added one at a time, from the back: the
+    columns found so far become the letters of one *composite* row, and the next row is
+    aligned against it (the paper's pre-alignment, generalised). A composite letter is one
+    column: never split; backed (every column has an opaque entry); unoccludable if it
+    holds an unoccludable letter; attached if it holds an attached one at either end; and
+    two neighbouring columns merge only where no row changes between transparent and
+    visible content or between empty and not. Each step is a two-row search, so the work
+    grows with the number of rows instead of exponentially.
+    """
+    if len(rows) <= 2:
+        return align_jointly(rows, canvas, mu, deadline)
+    prepared = [_Row(row) for row in rows]
+    result = align_jointly(rows[:2], canvas, mu, deadline)
+    nodes = result.nodes
+    current = result.alignment
+    for index, row in enumerate(rows[2:], start=2):
+        if current is None:
+            break
+        composite, parts = composite_row(current, prepared[:index])
+        result = align_jointly([composite, row], canvas, mu, deadline)
+        nodes += result.nodes
+        if result.alignment is None:
+            current = None
+            break
+        current = compose(current, parts, result.alignment, row, prepared[:index])
+    if current is None:
+        return AlignmentResult(None, result.timed_out, nodes, result.reason)
+    return AlignmentResult(current, False, nodes, "")
+
+
+@dataclass(frozen=True)
+class _Part:
+    """A letter of a composite row: sub-letter ``index`` of ``count`` of column ``column``."""
+
+    column: int
+    index: int
+    count: int
+
+
+def _subdivision(column: Sequence[Move | None], rows: Sequence[_Row]) -> int | None:
+    """The row whose letters may subdivide a column: its entry is the only visible one
+    and holds several whole letters, and every other entry is one transparent letter (or
+    a piece of one), which may be split anywhere. None if the column stays whole."""
+    visible = [q for q, m in enumerate(column) if m is not None and not m.transparent]
+    if len(visible) != 1:
+        return None
+    entry = column[visible[0]]
+    assert entry is not None
+    if entry.letters < 2 or entry.piece_of is not None or entry.tail is not None:
+        return None
+    for q, move in enumerate(column):
+        if q != visible[0] and move is not None and move.letters != 1:
+            return None
+    return visible[0]
+
+
+def composite_row(alignment: Alignment, rows: Sequence[_Row]) -> tuple[Row, list[_Part]]:
+    """The columns of an alignment as the letters of one row (see :func:`align`), with
+    columns subdivided where one row's letters may cut them."""
+    traits: list[LetterTraits] = []
+    parts: list[_Part] = []
+    segment = 0
+    entries = alignment.entries
+    for j, column in enumerate(entries):
+        if j and _must_stay_apart(entries[j - 1], column):
+            segment += 1
+        present = [m for m in column if m is not None]
+        cutter = _subdivision(column, rows)
+        if cutter is None:
+            parts.append(_Part(j, 0, 1))
+            traits.append(
+                LetterTraits(
+                    size=None if alignment.elastic[j] else alignment.widths[j],
+                    transparent=False,
+                    opaque=True,
+                    attached=any(m.first_attached or m.last_attached for m in present),
+                    unoccludable=any(m.unoccludable for m in present),
+                    segment=segment,
+                )
+            )
+            continue
+        entry = column[cutter]
+        assert entry is not None
+        letters = range(entry.start // 2, entry.end // 2)
+        for index, k in enumerate(letters):
+            own = rows[cutter].row.traits[k]
+            parts.append(_Part(j, index, len(letters)))
+            traits.append(
+                LetterTraits(
+                    size=own.size,
+                    transparent=False,
+                    opaque=own.opaque,
+                    attached=own.attached,
+                    unoccludable=own.unoccludable,
+                    segment=segment,
+                )
+            )
+    layers = tuple(sorted({layer for row in alignment.rows for layer in row.layers}))
+    word = tuple(Letter(f"#part{i}") for i in range(len(parts)))
+    return Row(layers, word, tuple(traits)), parts
+
+
+def _must_stay_apart(left: Sequence[Move | None], right: Sequence[Move | None]) -> bool:
+    for a, b in zip(left, right, strict=True):
+        if (a is None) != (b is None):
+            return True
+        if a is not None and b is not None and a.transparent != b.transparent:
+            return True
+    return False
+
+
+def _part_entry(move: Move | None, part: _Part, first: int, last: int) -> tuple[int, int] | None:
+    """Positions of the share of ``move`` (an entry of the part's column) that sub-letters
+    ``first`` to ``last`` (inclusive) of the column cover."""
+    if move is None:
+        return None
+    if part.count == 1:
+        return move.start, move.end
+    if move.letters > 1:  # the cutting row: whole letters
+        return move.start + 2 * first, move.start + 2 * (last + 1)
+    # one transparent letter (or a piece of one): a piece of it
+    k = move.start // 2 if move.start % 2 == 0 else (move.start - 1) // 2
+    start = move.start if first == 0 else 2 * k + 1
+    end = move.end if last == part.count - 1 else 2 * k + 1
+    return start, end
+
+
+def compose(
+    previous: Alignment, parts: list[_Part], step: Alignment, row: Row, rows: Sequence[_Row]
+) -> Alignment:
+    """The alignment of ``previous``'s rows plus ``row``, from the two-row ``step`` that
+    aligned ``row`` with the composite row of ``parts``."""
+    entries = []
+    for column in step.entries:
+        composite, own = column
+        merged: list[Move | None] = []
+        covered = [] if composite is None else parts[composite.start // 2 : composite.end // 2]
+        by_column: dict[int, list[_Part]] = {}
+        for part in covered:
+            by_column.setdefault(part.column, []).append(part)
+        for q, prepared in enumerate(rows):
+            spans = []
+            for j, group in by_column.items():
+                share = _part_entry(
+                    previous.entries[j][q], group[0], group[0].index, group[-1].index
+                )
+                if share is not None:
+                    spans.append(share)
+            merged.append(_entry(prepared, spans[0][0], spans[-1][1]) if spans else None)
+        entries.append((*merged, own))
+    return Alignment(
+        (*previous.rows, row),
+        tuple(entries),
+        previous.error + step.error,
+        step.widths,
+        step.elastic,
+    )
+
+
+def _entry(row: _Row, start: int, end: int) -> Move:
+    """The entry of a row from ``start`` to ``end`` (positions in half-steps)."""
+    moves, _ = row.moves(start)
+    for move in moves:
+        if move.end == end:
+            return move
+    raise AssertionError(f"no entry from {start} to {end}")  # prevented by _must_stay_apart
 
 
 def score_alignment(

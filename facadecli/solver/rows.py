@@ -21,6 +21,7 @@ class LetterTraits:
     opaque: bool  # never true for a transparent letter
     attached: bool
     unoccludable: bool
+    segment: int = 0  # an entry never spans two segments (used for merged columns)
 
 
 def letter_traits(spec: Spec, letter: Letter) -> LetterTraits:
