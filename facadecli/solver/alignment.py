@@ -129,6 +129,29 @@ class _Row:
         self.n = len(row.word)
         self.cache: dict[int, tuple[list[Move], list[float]]] = {}
         self.has_attached = any(t.attached for t in row.traits)
+        # from each letter on: preferred length of the sized letters, and the unsized ones
+        self.fixed_after = [0.0] * (self.n + 1)
+        self.unsized_after: list[dict[str, int]] = [{} for _ in range(self.n + 1)]
+        for k in range(self.n - 1, -1, -1):
+            size = row.traits[k].size
+            self.fixed_after[k] = self.fixed_after[k + 1] + (size or 0.0)
+            counts = dict(self.unsized_after[k + 1])
+            if size is None:
+                counts[row.word[k].symbol] = counts.get(row.word[k].symbol, 0) + 1
+            self.unsized_after[k] = counts
+
+    def remaining(self, position: int, left: float, sizes: Sizes) -> float:
+        """Least length the row still has to lay out from ``position`` on."""
+        k, inside = divmod(position, 2)
+        if k >= self.n:
+            return 0.0
+        start = k + 1 if inside else k
+        total = self.fixed_after[start]
+        for symbol, count in self.unsized_after[start].items():
+            total += count * sizes.get(symbol, 0.0)
+        if inside and left != INF:
+            total += left
+        return total
 
     def moves(self, position: int) -> tuple[list[Move], list[float]]:
         """Entries out of ``position`` sorted by their least whole length, and those lengths."""
@@ -482,6 +505,16 @@ class _Search:
             tuple(c.stretchable for c in best),
         )
 
+    def estimate(self, state: State, span: float) -> float:
+        """A lower bound on the cost still to come: every row must still lay out what it has
+        left, and what runs past the canvas costs (an admissible heuristic)."""
+        sizes = dict(state.sizes)
+        longest = max(
+            row.remaining(state.positions[r], state.left[r], sizes)
+            for r, row in enumerate(self.rows)
+        )
+        return max(0.0, span + longest - self.limit) - max(0.0, span - self.limit)
+
     def dfs(
         self, state: State, spent: float, span: float, stretchable: bool, budget: float
     ) -> tuple[list[_Column], float] | None:
@@ -504,19 +537,28 @@ class _Search:
         key = (state.key(), stretchable)
         if self.failed.get(key, -1.0) >= budget - spent - EPS:
             return None
+        bound = spent + self.estimate(state, span)
+        if bound > budget + EPS:
+            self.overflow = min(self.overflow, bound)
+            return None
         # equal costs: whole letters before pieces (split only where needed, section 5.2),
         # then fewer letters (more columns), then narrower
-        ranked = sorted(
-            ((c.cost(span, self.limit), c) for c in self.columns(state)),
-            key=lambda item: (round(item[0], 9), item[1].pieces, item[1].letters, item[1].width),
+        ranked = []
+        for column in self.columns(state):
+            cost = column.cost(span, self.limit)
+            following = self.after(state, column)
+            guess = cost + self.estimate(following, span + column.width)
+            ranked.append((guess, cost, column, following))
+        ranked.sort(
+            key=lambda item: (round(item[0], 9), item[2].pieces, item[2].letters, item[2].width)
         )
-        for cost, column in ranked:
+        for guess, cost, column, following in ranked:
             total = spent + cost
-            if total > budget + EPS:
-                self.overflow = min(self.overflow, total)
+            if spent + guess > budget + EPS:
+                self.overflow = min(self.overflow, spent + guess)
                 continue
             rest = self.dfs(
-                self.after(state, column),
+                following,
                 total,
                 span + column.width,
                 stretchable or column.stretchable,
