@@ -274,7 +274,7 @@ class _Search:
         self.failed: dict[tuple[object, ...], float] = {}
         self.column_cache: dict[tuple[object, ...], list[_Column]] = {}
         self.nodes = 0
-        self.node_limit = MAX_NODES
+        self.node_limit = self.max_nodes = MAX_NODES
         self.overflow = INF  # least cost beyond the budget seen: the next budget
         self.rejections: Counter[str] = Counter()
 
@@ -490,7 +490,7 @@ class _Search:
                 if cost <= EPS:
                     break
                 budget = cost - max(BUDGET_STEP * self.canvas / 10, EPS * 10)
-                self.node_limit = min(MAX_NODES, self.nodes + max(REFINE_NODES, self.nodes))
+                self.node_limit = min(self.max_nodes, self.nodes + max(REFINE_NODES, self.nodes))
             elif best is not None or budget == INF:
                 break
             else:
@@ -583,17 +583,19 @@ class AlignmentResult:
 
 
 def align_jointly(
-    rows: Sequence[Row], canvas: float, mu: float, deadline: float
+    rows: Sequence[Row], canvas: float, mu: float, deadline: float, nodes: int = MAX_NODES
 ) -> AlignmentResult:
-    """The least-cost alignment of rows searched all together."""
+    """The least-cost alignment of rows searched all together, visiting at most ``nodes``
+    states."""
     search = _Search(rows, canvas, mu, deadline)
+    search.node_limit = search.max_nodes = nodes
     try:
         found = search.run()
     except SearchTimeout:
         return AlignmentResult(None, True, search.nodes, "time limit reached")
     except SearchExhausted:
         return AlignmentResult(
-            None, False, search.nodes, f"no alignment within {MAX_NODES:,} search states"
+            None, False, search.nodes, f"no alignment within {search.max_nodes:,} search states"
         )
     reason = ""
     if found is None:
@@ -602,7 +604,9 @@ def align_jointly(
     return AlignmentResult(found, False, search.nodes, reason)
 
 
-def align(rows: Sequence[Row], canvas: float, mu: float, deadline: float) -> AlignmentResult:
+def align(
+    rows: Sequence[Row], canvas: float, mu: float, deadline: float, nodes: int = MAX_NODES
+) -> AlignmentResult:
     """The alignment of a group's rows (back to front).
 
     Two rows are searched together. More are added one at a time, from the back: the
@@ -615,24 +619,24 @@ def align(rows: Sequence[Row], canvas: float, mu: float, deadline: float) -> Ali
     grows with the number of rows instead of exponentially.
     """
     if len(rows) <= 2:
-        return align_jointly(rows, canvas, mu, deadline)
+        return align_jointly(rows, canvas, mu, deadline, nodes)
     prepared = [_Row(row) for row in rows]
-    result = align_jointly(rows[:2], canvas, mu, deadline)
-    nodes = result.nodes
+    result = align_jointly(rows[:2], canvas, mu, deadline, nodes)
+    visited = result.nodes
     current = result.alignment
     for index, row in enumerate(rows[2:], start=2):
         if current is None:
             break
         composite, parts = composite_row(current, prepared[:index])
-        result = align_jointly([composite, row], canvas, mu, deadline)
-        nodes += result.nodes
+        result = align_jointly([composite, row], canvas, mu, deadline, nodes)
+        visited += result.nodes
         if result.alignment is None:
             current = None
             break
         current = compose(current, parts, result.alignment, row, prepared[:index])
     if current is None:
-        return AlignmentResult(None, result.timed_out, nodes, result.reason)
-    return AlignmentResult(current, False, nodes, "")
+        return AlignmentResult(None, result.timed_out, visited, result.reason)
+    return AlignmentResult(current, False, visited, "")
 
 
 @dataclass(frozen=True)

@@ -9,13 +9,15 @@ from dataclasses import dataclass, field, replace
 from facadecli.errors import InfeasibleError
 from facadecli.patterns import Enumerated, Word, format_word
 from facadecli.solver import sizing
-from facadecli.solver.alignment import INF, Alignment, AlignmentResult, align
+from facadecli.solver.alignment import INF, MAX_NODES, Alignment, AlignmentResult, align
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
 from facadecli.solver.rows import make_rows
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
+EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
+EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
 CANDIDATES_TO_TRY = 200
@@ -140,8 +142,10 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     timed_out = False
     tried = 0
     step = max(tolerance, TIER * canvas)
+    effort = MAX_NODES  # once something aligned, a candidate that needs far more search
+    worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     for candidate in candidates[:CANDIDATES_TO_TRY]:
-        if len(evaluated) >= FEASIBLE_TO_COMPARE:
+        if len(evaluated) >= FEASIBLE_TO_COMPARE or worse >= 2:
             break
         if evaluated and _beyond_tier(candidate, evaluated[0].candidate, step):
             break  # mu is raised only until something aligns
@@ -155,11 +159,12 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
             rows = make_rows(spec, members)
             key = (group, tuple(row.word for row in rows))
             if key not in cache:
-                cache[key] = align(rows, canvas, mu, deadline)
+                cache[key] = align(rows, canvas, mu, deadline, effort)
             result = cache[key]
             if result.alignment is None:
                 timed_out = timed_out or result.timed_out
                 failures.append(f"group '{group}': {result.reason}")
+                worse += 1 if evaluated else 0
                 break
             aligned[group] = result.alignment
         else:
@@ -168,7 +173,12 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
             if estimate is None:
                 failures.append(sizing.explain_infeasible(program))
                 continue
+            best = min((e.estimate.objective for e in evaluated), default=None)
             evaluated.append(_Evaluated(candidate, aligned, program, estimate))
+            worse = worse + 1 if best is not None and estimate.objective > best + 1e-9 else 0
+            needed = sum(cache[(g, tuple(r.word for r in make_rows(spec, m)))].nodes
+                         for g, m in _group_rows(spec, uses, candidate.words).items())
+            effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * needed))
         if timed_out and evaluated:
             break
     aligned_at = time.perf_counter()

@@ -49,14 +49,11 @@ class Candidate:
     order: int = field(default=0, compare=False)
 
     @property
-    def key(self) -> tuple[float, float, float, float, int]:
-        return (
-            round(self.need, 9),
-            round(self.misfit, 9),
-            round(self.shortfall, 6),
-            round(self.slack, 6),
-            self.order,
-        )
+    def key(self) -> tuple[float, float, float, int]:
+        """Tolerance needed, misfit, room relied on; then enumeration order (counts
+        ascending, as the paper enumerates). How much placeholders cover is left to the
+        comparison of solved layouts (SPEC 2.7)."""
+        return (round(self.need, 9), round(self.misfit, 9), round(self.shortfall, 6), self.order)
 
 
 def opaque_length(spec: Spec, item: Enumerated) -> float:
