@@ -4,7 +4,9 @@ transparency, appearance rules) and occlusion flags (SPEC 2.5, 2.8)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+
+import numpy as np
 
 from facadecli.solver.axis import AxisLayout, PlacedLetter
 from facadecli.spec.model import Layer, ShapeRule, Spec
@@ -133,21 +135,23 @@ def build_shapes(spec: Spec, x: AxisLayout, y: AxisLayout) -> tuple[Shape, ...]:
 def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
     """Mark shapes whose cell is covered by opaque shapes of later layers in front of them."""
     order = {name: i for i, name in enumerate(dict.fromkeys(s.layer for s in shapes))}
+    opaque = [s for s in shapes if s.opaque]
+    if not opaque:
+        return tuple(shapes)
+    boxes = np.array([(s.x0, s.x1, s.y0, s.y1, s.z1, order[s.layer]) for s in opaque])
     result = []
     for shape in shapes:
-        occluders = [
-            other
-            for other in shapes
-            if other.opaque
-            and order[other.layer] > order[shape.layer]
-            and other.z1 >= shape.z1
-            and other.x0 < shape.x1
-            and other.x1 > shape.x0
-            and other.y0 < shape.y1
-            and other.y1 > shape.y0
-        ]
+        near = (
+            (boxes[:, 5] > order[shape.layer])
+            & (boxes[:, 4] >= shape.z1)
+            & (boxes[:, 0] < shape.x1)
+            & (boxes[:, 1] > shape.x0)
+            & (boxes[:, 2] < shape.y1)
+            & (boxes[:, 3] > shape.y0)
+        )
+        occluders = [opaque[i] for i in np.flatnonzero(near)]
         hidden = bool(occluders) and _covered(shape, occluders)
-        result.append(shape if not hidden else Shape(**{**shape.__dict__, "visible": False}))
+        result.append(replace(shape, visible=False) if hidden else shape)
     return tuple(result)
 
 

@@ -35,7 +35,8 @@ INF = math.inf
 EPS = 1e-9
 TARGETS_PER_STATE = 24  # target widths tried from one state, smallest first
 MAX_NODES = 20_000  # states one search may visit before it gives up on a candidate
-REFINE_NODES = 400  # least extra effort spent looking for a cheaper path than the first
+JOINT_ROWS = 2  # rows searched together; more are added one at a time
+REFINE_NODES = 200  # least extra effort spent looking for a cheaper path than the first
 BUDGET_STEP = 0.01  # least deepening of the error budget, as a share of the canvas
 
 # what a row's previous entry means for the attached rule (SPEC 2.4)
@@ -71,6 +72,7 @@ class Move:
     unoccludable: bool
     first_attached: bool  # starts, at a letter boundary, with an attached letter
     last_attached: bool  # ends, at a letter boundary, with an attached letter
+    fixed_only: bool = False  # == plain, stored: interval() is the search's hottest call
 
     @property
     def middle(self) -> bool:
@@ -82,9 +84,16 @@ class Move:
             return None
         return sizes.get(self.tail_symbol or "", self.tail)
 
+    @property
+    def plain(self) -> bool:
+        """Only sized letters, whole: its length does not depend on the search."""
+        return not self.unsized and self.piece_of is None and self.tail is None
+
     def interval(self, left: float, sizes: Sizes) -> tuple[float, float]:
         """Least and greatest length: ``left`` is what the split letter it starts inside
         has left, ``sizes`` the placeholder sizes already fixed."""
+        if self.fixed_only:
+            return self.fixed, self.fixed
         if self.middle:
             return 0.0, left
         low = high = self.fixed
@@ -223,6 +232,9 @@ class _Row:
             unoccludable=any(t.unoccludable for t in traits),
             first_attached=piece_of is None and bool(traits) and traits[0].attached,
             last_attached=tail is None and bool(traits) and traits[-1].attached,
+            fixed_only=piece_of is None
+            and tail is None
+            and all(t.size is not None for t in traits),
         )
 
 
@@ -237,6 +249,10 @@ class _Column:
     def cost(self, span: float, limit: float) -> float:
         """Its error plus how much it pushes the span beyond ``limit``."""
         return self.error + max(0.0, span + self.width - limit) - max(0.0, span - limit)
+
+    @property
+    def empties(self) -> int:
+        return sum(m is None for m in self.entries)
 
     @property
     def pieces(self) -> int:
@@ -265,6 +281,7 @@ class _Search:
     def __init__(self, rows: Sequence[Row], canvas: float, mu: float, deadline: float):
         self.rows = [_Row(row) for row in rows]
         self.above = [[j for j, other in enumerate(rows) if other.is_above(row)] for row in rows]
+        self.covering = [[j for j, other in enumerate(rows) if other.covers(row)] for row in rows]
         self.canvas = canvas
         self.limit = canvas + mu  # the span may not exceed this without cost
         self.floor = canvas - mu  # nor fall short of this, unless a column can stretch
@@ -365,7 +382,7 @@ class _Search:
             low, high = move.interval(state.left[r], sizes)
             if max(0.0, low - target, target - high) > EPS:
                 emptied[r] = None
-            if any(_opaque(best[above]) for above in self.above[r]):
+            if any(_opaque(best[above]) for above in self.covering[r]):
                 room[r] = None
         if emptied != best:
             yield emptied
@@ -388,7 +405,7 @@ class _Search:
                 if state.memory[r] == AFTER_ATTACHED:
                     self.rejections["attached letter separated"] += 1
                     return None
-                if not any(_opaque(entries[a]) for a in self.above[r]):
+                if not any(_opaque(entries[a]) for a in self.covering[r]):
                     self.rejections["an empty entry with no opaque letter above it"] += 1
                     return None
                 continue
@@ -469,14 +486,14 @@ class _Search:
         )
 
     def run(self) -> Alignment | None:
-        """Find a path within the tolerance; failing that, the first path at any cost; then
-        tighten the budget below the best path's cost until no cheaper path exists (branch
-        and bound, with a bounded extra effort). Out of nodes or time after a path was
-        found, that path stands."""
+        """Look for a perfect path, then deepen the budget (to the tolerance, then doubling)
+        until a path is found; then tighten the budget below the best path's cost until no
+        cheaper path exists (branch and bound, with a bounded extra effort). Out of nodes or
+        time after a path was found, that path stands."""
         count = len(self.rows)
         start = State((0,) * count, (FREE,) * count, (INF,) * count, (0.0,) * count, ())
         best: list[_Column] | None = None
-        budget = self.mu
+        budget = 0.0  # a perfect alignment is the common case, and quick to find
         while True:
             self.overflow = INF
             try:
@@ -490,11 +507,13 @@ class _Search:
                 if cost <= EPS:
                     break
                 budget = cost - max(BUDGET_STEP * self.canvas / 10, EPS * 10)
-                self.node_limit = min(self.max_nodes, self.nodes + max(REFINE_NODES, self.nodes))
-            elif best is not None or budget == INF:
+                extra = max(REFINE_NODES, self.nodes // 2)
+                self.node_limit = min(self.max_nodes, self.nodes + extra)
+            elif best is not None or self.overflow == INF or self.overflow > self.canvas:
                 break
-            else:
-                budget = INF  # nothing within the tolerance: take the first path there is
+            else:  # deepen: to the tolerance, then doubling, at least 1% of the canvas
+                step = BUDGET_STEP * self.canvas
+                budget = max(self.overflow, self.mu, budget * 2.0, budget + step)
         if best is None:
             return None
         return Alignment(
@@ -541,24 +560,36 @@ class _Search:
         if bound > budget + EPS:
             self.overflow = min(self.overflow, bound)
             return None
-        # equal costs: whole letters before pieces (split only where needed, section 5.2),
-        # then fewer letters (more columns), then narrower
         ranked = []
+        sizes = dict(state.sizes)
         for column in self.columns(state):
             cost = column.cost(span, self.limit)
-            following = self.after(state, column)
-            guess = cost + self.estimate(following, span + column.width)
-            ranked.append((guess, cost, column, following))
+            # a cheap lower bound after the column: positions advance, sizes as they are
+            longest = max(
+                row.remaining(m.end if m is not None else state.positions[r], INF, sizes)
+                for r, (row, m) in enumerate(zip(self.rows, column.entries, strict=True))
+            )
+            grown = span + column.width
+            guess = cost + max(0.0, grown + longest - self.limit) - max(0.0, grown - self.limit)
+            ranked.append((guess, cost, column))
+        # equal estimates: whole letters before pieces (split only where needed, section
+        # 5.2), no room made before room made, then fewer letters (more columns)
         ranked.sort(
-            key=lambda item: (round(item[0], 9), item[2].pieces, item[2].letters, item[2].width)
+            key=lambda item: (
+                round(item[0], 9),
+                item[2].pieces,
+                item[2].empties,
+                item[2].letters,
+                item[2].width,
+            )
         )
-        for guess, cost, column, following in ranked:
+        for guess, cost, column in ranked:
             total = spent + cost
             if spent + guess > budget + EPS:
                 self.overflow = min(self.overflow, spent + guess)
                 continue
             rest = self.dfs(
-                following,
+                self.after(state, column),
                 total,
                 span + column.width,
                 stretchable or column.stretchable,
@@ -609,7 +640,7 @@ def align(
 ) -> AlignmentResult:
     """The alignment of a group's rows (back to front).
 
-    Two rows are searched together. More are added one at a time, from the back: the
+    Up to three rows are searched together. More are added one at a time: the
     columns found so far become the letters of one *composite* row, and the next row is
     aligned against it (the paper's pre-alignment, generalised). A composite letter is one
     column: never split; backed (every column has an opaque entry); unoccludable if it
@@ -618,13 +649,13 @@ def align(
     visible content or between empty and not. Each step is a two-row search, so the work
     grows with the number of rows instead of exponentially.
     """
-    if len(rows) <= 2:
+    if len(rows) <= JOINT_ROWS:
         return align_jointly(rows, canvas, mu, deadline, nodes)
     prepared = [_Row(row) for row in rows]
-    result = align_jointly(rows[:2], canvas, mu, deadline, nodes)
+    result = align_jointly(rows[:JOINT_ROWS], canvas, mu, deadline, nodes)
     visited = result.nodes
     current = result.alignment
-    for index, row in enumerate(rows[2:], start=2):
+    for index, row in enumerate(rows[JOINT_ROWS:], start=JOINT_ROWS):
         if current is None:
             break
         composite, parts = composite_row(current, prepared[:index])

@@ -53,8 +53,14 @@ class Row:
         return self.layers[-1]
 
     def is_above(self, other: Row) -> bool:
-        """Some layer of this row lies in front of some layer of ``other``."""
+        """Some layer of this row lies in front of some layer of ``other`` (so it may cover
+        an unoccludable letter of it)."""
         return self is not other and self.highest > other.lowest
+
+    def covers(self, other: Row) -> bool:
+        """Every layer of this row lies in front of every layer of ``other`` (so ``other``
+        may make room for an opaque letter of it)."""
+        return self is not other and self.lowest > other.highest
 
 
 def make_rows(spec: Spec, words: list[tuple[int, Word]]) -> list[Row]:

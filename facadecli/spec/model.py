@@ -8,6 +8,7 @@ whole spec (unknown symbols in patterns, counters on both axes, ...) live in
 from __future__ import annotations
 
 import math
+from functools import cached_property
 from typing import Annotated, Any, Literal
 
 from pydantic import (
@@ -258,10 +259,13 @@ class Spec(Model):
             raise ValueError("canvas sizes must be finite")
         return canvas
 
+    @cached_property
+    def _qualifiers(self) -> dict[str, Qualifiers]:
+        return {name: s.qualifiers(self.symbol_defaults) for name, s in self.symbols.items()}
+
     def qualifiers(self, symbol: str) -> Qualifiers:
         """Qualifiers of a symbol; undeclared symbols (placeholders) take the defaults."""
-        declared = self.symbols.get(symbol)
-        return declared.qualifiers(self.symbol_defaults) if declared else self.symbol_defaults
+        return self._qualifiers.get(symbol, self.symbol_defaults)
 
     def size(self, symbol: str) -> float | None:
         """Preferred size of a symbol, None for an unsized one (a placeholder)."""
