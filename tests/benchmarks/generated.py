@@ -24,6 +24,9 @@ ORNAMENTS = [
 ]
 
 
+MATERIALS = {"render": "#e8dcc4", "glass": "#8fb3d9", "stone": "#b9a88a", "iron": "#3a3a3a"}
+
+
 def generated_spec(layers: int = 24, bays: int = 7) -> str:
     """YAML text of a façade with ``layers`` layers and ``bays`` window bays: about half
     the layers on the wall's rhythm, the other half ornaments, repeated as needed."""
@@ -58,8 +61,8 @@ def generated_spec(layers: int = 24, bays: int = 7) -> str:
         '  cornice_y: {control: "h t", where: {t: "T"}}',
         '  ledges_y: {control: "z g (l x)^f u", where: {l: "V"}}',
         '  plinth_x: {control: "b (g b)^n", where: {b: "N"}}',
-        '  bays_x: {control: "s w s", where: {w: "(E Q)^2 E"}}',
-        "layers:",
+        '  bays_x: {control: "s w s", where: {w: "(Q E)^2 Q"}}',
+        "defaults: {material: render}",
     ]
     wall_count = min(len(WALL_LAYERS), max(1, layers // 2))
     chosen = [WALL_LAYERS[i] for i in range(wall_count)]
@@ -69,6 +72,14 @@ def generated_spec(layers: int = 24, bays: int = 7) -> str:
         chosen.append((f"{name}-{copy}" if copy else name, x, y, mask, offset + 0.01 * copy))
     while len(chosen) < layers:  # more wall layers than templates: extra shutters
         chosen.insert(wall_count, (f"shutters-{len(chosen)}", "wall_x", "storeys", "[F]", 0.07))
+    body.append("materials:")
+    body.extend(f"  {name}: {{color: \"{colour}\"}}" for name, colour in MATERIALS.items())
+    body.append("shapes:")
+    for symbol, material in (("W", "glass"), ("Lp", "stone"), ("K", "stone"), ("R", "iron"),
+                             ("M", "iron"), ("N", "stone"), ("T", "stone")):
+        axis = "y" if symbol == "T" else "x"
+        body.append(f"  - {{match: {{{axis}: {symbol}}}, material: {material}}}")
+    body.append("layers:")
     for name, x, y, mask, offset in chosen:
         visible = f", visible: {{y: {mask}}}" if mask else ""
         body.append(f"  - {{name: {name}, x: {x}, y: {y}{visible}, offset: {offset:.3f}}}")
