@@ -4,8 +4,8 @@ The public API; everything else is internal and may change.
 """
 
 from facadecli.errors import FacadeError, InfeasibleError, Problem, SpecError
-from facadecli.patterns import Choice, Letter, Word, compile_pattern, enumerate_words, make_word
 from facadecli.layout import Layout, Shape
+from facadecli.patterns import Choice, Letter, Word, compile_pattern, enumerate_words, make_word
 from facadecli.solve import retarget, solve
 from facadecli.spec import Spec, load_spec, parse_spec, spec_schema, validate_spec
 

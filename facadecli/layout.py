@@ -3,6 +3,7 @@ transparency, appearance rules) and occlusion flags (SPEC 2.5, 2.8)."""
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
@@ -173,8 +174,8 @@ def _covered(shape: Shape, occluders: list[Shape]) -> bool:
             *(min(max(o.y1, shape.y0), shape.y1) for o in occluders),
         }
     )
-    for xa, xb in zip(xs, xs[1:], strict=False):
-        for ya, yb in zip(ys, ys[1:], strict=False):
+    for xa, xb in itertools.pairwise(xs):
+        for ya, yb in itertools.pairwise(ys):
             if xb - xa < 1e-9 or yb - ya < 1e-9:
                 continue
             cx, cy = (xa + xb) / 2, (ya + yb) / 2

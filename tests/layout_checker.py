@@ -6,6 +6,7 @@ the solver, so the solver cannot pass by agreeing with itself.
 
 from __future__ import annotations
 
+import itertools
 from typing import Any
 
 from facadecli.spec.model import Spec
@@ -50,9 +51,11 @@ def violations(spec: Spec, report: dict[str, Any]) -> list[str]:
             groups.setdefault(getattr(layer.groups, axis), []).append(index)
         for group, members in groups.items():
             columns = report["alignment"][axis][group]["columns"]
-            for start, end in zip(columns, columns[1:], strict=False):
+            for start, end in itertools.pairwise(columns):
                 if not any(_opaque_cover(spec, words[layers[i].name], start, end) for i in members):
-                    found.append(f"{axis} group {group}: column [{start}, {end}] has no opaque backing")
+                    found.append(
+                        f"{axis} group {group}: column [{start}, {end}] has no opaque backing"
+                    )
             for position, i in enumerate(members):
                 for letter in words[layers[i].name]:
                     qualifiers = spec.qualifiers(letter["symbol"])

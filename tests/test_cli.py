@@ -86,3 +86,87 @@ def test_words_previews_each_layer() -> None:
     assert result.returncode == 0, result.stderr
     assert "A B A B A B A   (k=3)" in result.stdout
     assert "C [e] C" in result.stdout
+
+
+REPORT_KEYS = {
+    "version",
+    "name",
+    "canvas",
+    "counters",
+    "symbols",
+    "layers",
+    "shapes",
+    "alignment",
+    "objective",
+    "stats",
+}
+
+
+def test_solve_writes_the_report_and_the_elevation(tmp_path: Path) -> None:
+    spec = ROOT / "specs" / "residential-house.yaml"
+    result = facade("solve", str(spec), "-o", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    report = json.loads((tmp_path / "residential-house.layout.json").read_text())
+    assert set(report) >= REPORT_KEYS
+    assert report["canvas"] == {"width": 6.0, "height": 3.0}
+    assert report["counters"]["k"] == 3
+    assert {"time_ms"} <= set(report["stats"])
+    base = report["layers"][0]
+    assert base["x"][0]["start"] == 0.0 and base["x"][-1]["end"] == 6.0
+    shape = report["shapes"][0]
+    assert {
+        "layer",
+        "x",
+        "y",
+        "x0",
+        "x1",
+        "y0",
+        "y1",
+        "z0",
+        "z1",
+        "material",
+        "mesh",
+        "visible",
+    } <= set(shape)
+    assert (tmp_path / "residential-house.svg").read_text().startswith("<?xml")
+    assert not list(tmp_path.glob(".*.tmp"))  # atomic writes leave nothing behind
+
+
+def test_solve_is_deterministic(tmp_path: Path) -> None:
+    spec = ROOT / "specs" / "terraced-house.yaml"
+    for run in ("a", "b"):
+        assert facade("solve", str(spec), "-o", str(tmp_path / run)).returncode == 0
+    for name in ("terraced-house.layout.json", "terraced-house.svg"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+
+
+def test_solve_retargets_and_picks_formats(tmp_path: Path) -> None:
+    spec = ROOT / "specs" / "residential-house.yaml"
+    result = facade("solve", str(spec), "-o", str(tmp_path), "--width", "9.0", "--format", "json")
+    assert result.returncode == 0, result.stderr
+    report = json.loads((tmp_path / "residential-house.layout.json").read_text())
+    assert report["canvas"]["width"] == 9.0 and report["counters"]["k"] == 5  # 8.6 m at k = 5
+    assert not (tmp_path / "residential-house.svg").exists()
+    bad = facade("solve", str(spec), "-o", str(tmp_path), "--format", "gif")
+    assert bad.returncode == 2 and "available" in bad.stderr
+
+
+def test_solve_exit_codes(tmp_path: Path) -> None:
+    infeasible = tmp_path / "tight.yaml"
+    infeasible.write_text(
+        "version: 1\nname: tight\ncanvas: {width: 10, height: 3}\n"
+        "symbols: {A: {size: 1, max: 1.2, opaque: true}, H: {size: 3, opaque: true}}\n"
+        'counters: {n: 3}\npatterns: {row: "A^n"}\n'
+        "layers: [{name: wall, x: row, y: H}]\n"
+    )
+    result = facade("solve", str(infeasible), "-o", str(tmp_path / "out"))
+    assert result.returncode == 3
+    assert "no layout" in result.stderr and "x axis" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not (tmp_path / "out").exists()  # nothing written for a failed spec
+    invalid = CASES / "invalid" / "unknown-symbol.yaml"
+    assert facade("solve", str(invalid), "-o", str(tmp_path / "out")).returncode == 2
+    good = ROOT / "specs" / "residential-house.yaml"
+    mixed = facade("solve", str(good), str(infeasible), "-o", str(tmp_path / "mixed"))
+    assert mixed.returncode == 1  # some specs of a multi-spec run failed
+    assert (tmp_path / "mixed" / "residential-house.layout.json").exists()

@@ -6,7 +6,7 @@ import textwrap
 
 import pytest
 
-from facadecli import InfeasibleError, compile_pattern, make_word, parse_spec, solve
+from facadecli import InfeasibleError, make_word, parse_spec, solve
 from facadecli.solver.alignment import align, score_alignment
 from facadecli.solver.candidates import (
     generate_candidates,
@@ -38,7 +38,10 @@ def test_figure_7_counting_and_sizing_candidates() -> None:
     spec = parse_spec(FIG7)
     uses = pattern_uses(
         spec,
-        [(i, "default", layer.x, layer_pattern(spec, layer, "x")) for i, layer in enumerate(spec.layers)],
+        [
+            (i, "default", layer.x, layer_pattern(spec, layer, "x"))
+            for i, layer in enumerate(spec.layers)
+        ],
     )
     mu = spec.solver.tolerance
     admitted = [c for c in generate_candidates(spec, uses, 10.0) if c.need <= mu + 1e-9]
@@ -81,7 +84,7 @@ layers:
 
 def test_equation_8_alignments_and_the_winner() -> None:
     _, rows = _rows(EQ8, {})
-    base, columns = rows  # back to front: A B A B A, then C e C
+    # rows back to front: A B A B A, then C e C
     # letter cuts per row (None = empty entry); positions count letters
     mixed = [[(0, 3), (3, 5)], [(0, 2), (2, 3)]]  # (ABA | BA) under (Ce | C)
     room = [[None, (0, 5), None], [(0, 1), (1, 2), (2, 3)]]  # (eps | ABABA | eps)
@@ -257,7 +260,9 @@ def test_section_6_1_terraced_house_balconies_on_odd_floors() -> None:
     floors = [p for p in letters(layout, "base", "y") if p.symbol == "S"]
     assert layout.counters["m"] == 5 == len(floors)  # 4.3 + 3 m + 3.1 = 22.4 ~ 22.5
     balconies = spans(layout, "balconies", "y", "Z")
-    with_balcony = [i + 1 for i, f in enumerate(floors) if (round(f.start, 6), round(f.end, 6)) in balconies]
+    with_balcony = [
+        i + 1 for i, f in enumerate(floors) if (round(f.start, 6), round(f.end, 6)) in balconies
+    ]
     assert with_balcony == [1, 3, 5]
     (large,) = spans(layout, "balconies", "x", "L")
     firsts = [p for p in letters(layout, "base", "x")][1:3]  # the first B W
@@ -294,7 +299,12 @@ def test_alignment_groups_keep_their_own_rhythm_and_share_sizes() -> None:
     ground = set(layout.x.groups["ground"].boundaries)
     assert ground - upper  # the ground floor does not follow the upper windows
     assert letters(layout, "wall", "x") == letters(layout, "frames", "x")
-    sizes = {round(p.end - p.start, 6) for layer in ("wall", "shops") for p in letters(layout, layer, "x") if p.symbol in "E"}
+    sizes = {
+        round(p.end - p.start, 6)
+        for layer in ("wall", "shops")
+        for p in letters(layout, layer, "x")
+        if p.symbol in "E"
+    }
     assert len(sizes) == 1
 
 
@@ -302,12 +312,14 @@ def test_infeasible_spec_exits_with_the_reason() -> None:
     text = EQ8.replace("A: 1, B: 1.5", "A: {size: 1, max: 1.1}, B: {size: 1.5, max: 1.6}")
     text = text.replace("C: 1,", "C: {size: 1, opaque: false},")  # so A B A B A cannot make room
     text = text.replace("canvas: {width: 6", "canvas: {width: 8")  # A B A B A is 6.5 at most
-    with pytest.raises(InfeasibleError, match="x axis: .*cannot all hold"):
+    with pytest.raises(InfeasibleError, match=r"x axis: .*cannot all hold"):
         solve(parse_spec(text))
 
 
 def test_a_fixed_counter_that_cannot_fit_is_infeasible() -> None:
-    text = EQ8.replace('base: "A B A B A"', 'base: "A^n"').replace("symbols:", "counters: {n: 40}\nsymbols:")
+    text = EQ8.replace('base: "A B A B A"', 'base: "A^n"').replace(
+        "symbols:", "counters: {n: 40}\nsymbols:"
+    )
     with pytest.raises(InfeasibleError, match="pattern 'base'"):
         solve(parse_spec(text))
 

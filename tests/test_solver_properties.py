@@ -28,7 +28,8 @@ def specs(draw: st.DrawFn) -> str:
     lines = [
         "version: 1",
         "name: random",
-        f"canvas: {{width: {draw(st.integers(30, 120)) / 10}, height: {draw(st.integers(20, 80)) / 10}}}",
+        f"canvas: {{width: {draw(st.integers(30, 120)) / 10}, "
+        f"height: {draw(st.integers(20, 80)) / 10}}}",
         "counters: {k: {min: 1}, j: {min: 1, max: 4}, n: {min: 1}}",
         "symbols:",
     ]

@@ -54,7 +54,8 @@ def svg_text(layout: Layout, labels: bool = False) -> str:
                 f'height="{_number((shape.y1 - shape.y0) * scale)}" fill="{colour}" '
                 + (f'fill-opacity="{_number(opacity)}" ' if opacity < 1 else "")
                 + 'stroke="#333333" stroke-width="0.5">'
-                f"<title>{escape(shape.layer)}: {escape(shape.x)} x {escape(shape.y)}</title></rect>"
+                f"<title>{escape(shape.layer)}: {escape(shape.x)} x {escape(shape.y)}</title>"
+                "</rect>"
             )
         lines.append("</g>")
     if labels:

@@ -7,7 +7,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from facadecli.errors import InfeasibleError
-from facadecli.patterns import Enumerated, Word, format_word
+from facadecli.patterns import CompiledPattern, Enumerated, Word, format_word
 from facadecli.solver import sizing
 from facadecli.solver.alignment import INF, MAX_NODES, Alignment, AlignmentResult, align
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
@@ -107,7 +107,8 @@ def _beyond_tier(candidate: Candidate, first: Candidate, step: float) -> bool:
     )
 
 
-def _axis_words(spec: Spec, axis: Axis) -> list[tuple[int, str, str, object]]:
+def _axis_words(spec: Spec, axis: Axis) -> list[tuple[int, str, str, CompiledPattern]]:
+    """(layer index, alignment group, pattern key, pattern) of every enabled layer."""
     found = []
     for index, layer in enumerate(spec.layers):
         if layer.enabled:
@@ -130,7 +131,7 @@ def _group_rows(
 def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:
     """Solve one axis; raises :class:`InfeasibleError` with the reason when nothing fits."""
     started = time.perf_counter()
-    uses = pattern_uses(spec, _axis_words(spec, axis))  # type: ignore[arg-type]
+    uses = pattern_uses(spec, _axis_words(spec, axis))
     candidates = generate_candidates(spec, uses, canvas)
     generated = time.perf_counter()
     if not candidates:
@@ -176,8 +177,10 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
             best = min((e.estimate.objective for e in evaluated), default=None)
             evaluated.append(_Evaluated(candidate, aligned, program, estimate))
             worse = worse + 1 if best is not None and estimate.objective > best + 1e-9 else 0
-            needed = sum(cache[(g, tuple(r.word for r in make_rows(spec, m)))].nodes
-                         for g, m in _group_rows(spec, uses, candidate.words).items())
+            needed = sum(
+                cache[(g, tuple(r.word for r in make_rows(spec, m)))].nodes
+                for g, m in _group_rows(spec, uses, candidate.words).items()
+            )
             effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * needed))
         if timed_out and evaluated:
             break

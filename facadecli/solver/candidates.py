@@ -14,8 +14,8 @@ them only needs its fixed part to stay under L + mu.
 from __future__ import annotations
 
 import heapq
-import math
 import itertools
+import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -110,7 +110,7 @@ def generate_candidates(
     bounds = {name: counter.bounds for name, counter in spec.counters.items()}
     words: dict[str, list[Enumerated]] = {}
     for use in uses:
-        found = enumerate_words(
+        enumerated = enumerate_words(
             use.pattern,
             sizes=sizes,
             max_length=2.0 * canvas,
@@ -118,20 +118,20 @@ def generate_candidates(
             counters=bounds,
             max_letters=MAX_LETTERS,
         )
-        words[use.key] = list(itertools.islice(found, WORDS_PER_PATTERN))
+        words[use.key] = list(itertools.islice(enumerated, WORDS_PER_PATTERN))
         if not words[use.key]:
             return []
     clusters = _clusters(uses)
     options = [_cluster_options(cluster, words) for cluster in clusters]
-    if any(not found for found in options):
+    if any(not cluster_options for cluster_options in options):
         return []
     # rank each cluster's options by a context-free estimate, then merge best-first
     room = {use.key: _max_room_above(spec, use, uses, words) for use in uses}
     ranked = []
-    for found in options:
+    for cluster_options in options:
         scored = [
             (_estimate(spec, option, canvas, room), index, option)
-            for index, option in enumerate(found)
+            for index, option in enumerate(cluster_options)
         ]
         scored.sort(key=lambda item: (item[0], item[1]))
         ranked.append([option for _, _, option in scored])
@@ -201,7 +201,7 @@ def _max_room_above(
     for layer, group in use.layers:
         room = 0.0
         for other in uses:
-            if any(g == group and l > layer for l, g in other.layers):
+            if any(g == group and i > layer for i, g in other.layers):
                 room += max((opaque_length(spec, item) for item in words[other.key]), default=0.0)
         best = max(best, room)
     return best
@@ -250,7 +250,7 @@ def _candidate(
             room = sum(
                 opaque[other.key]
                 for other in uses
-                if any(g == group and l > layer for l, g in other.layers)
+                if any(g == group and i > layer for i, g in other.layers)
             )
             row_need = word_need(item.length, item.elastic, canvas, room)
             need = max(need, row_need)

@@ -181,7 +181,7 @@ def estimate(program: Program) -> Sizing | None:
 
 def solve(program: Program) -> Sizing | None:
     """The QP with all bounds, in cvxpy; None if infeasible."""
-    import cvxpy as cp
+    import cvxpy as cp  # imported here: it takes half a second, and only sizing needs it
     import scipy.sparse as sparse
 
     n = len(program.names)

@@ -73,10 +73,17 @@ def generated_spec(layers: int = 24, bays: int = 7) -> str:
     while len(chosen) < layers:  # more wall layers than templates: extra shutters
         chosen.insert(wall_count, (f"shutters-{len(chosen)}", "wall_x", "storeys", "[F]", 0.07))
     body.append("materials:")
-    body.extend(f"  {name}: {{color: \"{colour}\"}}" for name, colour in MATERIALS.items())
+    body.extend(f'  {name}: {{color: "{colour}"}}' for name, colour in MATERIALS.items())
     body.append("shapes:")
-    for symbol, material in (("W", "glass"), ("Lp", "stone"), ("K", "stone"), ("R", "iron"),
-                             ("M", "iron"), ("N", "stone"), ("T", "stone")):
+    for symbol, material in (
+        ("W", "glass"),
+        ("Lp", "stone"),
+        ("K", "stone"),
+        ("R", "iron"),
+        ("M", "iron"),
+        ("N", "stone"),
+        ("T", "stone"),
+    ):
         axis = "y" if symbol == "T" else "x"
         body.append(f"  - {{match: {{{axis}: {symbol}}}, material: {material}}}")
     body.append("layers:")
