@@ -21,12 +21,10 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP) ## Create .venv and install facadecli with its test and lint tools
 
-demo: $(STAMP) ## Validate the example specs and preview the words of one into out/
+demo: $(STAMP) ## Validate the example specs and solve them into out/ (report + SVG)
 	$(BIN)/facade validate $(SPECS)
-	mkdir -p $(OUT)
-	$(BIN)/facade words $(DEMO) | tee $(OUT)/$(notdir $(DEMO:.yaml=.words.txt))
-	$(BIN)/facade schema --output $(OUT)/facade.schema.json
-	@echo "demo outputs are in $(OUT)/"
+	$(BIN)/facade solve $(SPECS) -o $(OUT) --labels
+	@echo "open $(OUT)/$(notdir $(DEMO:.yaml=.svg)) to see a façade; reports are $(OUT)/*.layout.json"
 
 test: $(STAMP) ## Run the whole test suite
 	$(BIN)/python -m pytest
@@ -40,7 +38,7 @@ format: $(STAMP) ## Reformat the code with ruff
 	$(BIN)/ruff check --fix facadecli tests
 	$(BIN)/ruff format facadecli tests
 
-bench: $(STAMP) ## Time spec loading and word enumeration (benchmarks are not tests)
+bench: $(STAMP) ## Time loading and solving the examples and a generated 24-layer façade
 	$(BIN)/python tests/benchmarks/bench.py
 
 schema: $(STAMP) ## Regenerate specs/facade.schema.json
