@@ -328,3 +328,16 @@ def test_same_spec_same_layout() -> None:
     first = solve_text(TERRACED.format(bays="W (B W)^n"))
     second = solve_text(TERRACED.format(bays="W (B W)^n"))
     assert first.shapes == second.shapes
+
+
+def test_hard_specs_never_hang() -> None:
+    import time
+
+    from tests.benchmarks.generated import generated_spec
+
+    text = generated_spec(24, 28).replace("counters:", "solver: {time_limit: 0.01}\ncounters:")
+    started = time.perf_counter()
+    layout = solve(parse_spec(text))
+    assert time.perf_counter() - started < 5.0
+    assert any("time limit" in warning for warning in layout.warnings)
+    assert layout.shapes

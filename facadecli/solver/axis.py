@@ -18,6 +18,7 @@ from facadecli.spec.resolve import Axis, layer_pattern
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
 EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
+GRACE_SECONDS = 1.0  # a last try past the time limit when nothing aligned in time
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
 CANDIDATES_TO_TRY = 200
@@ -145,14 +146,21 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     step = max(tolerance, TIER * canvas)
     effort = MAX_NODES  # once something aligned, a candidate that needs far more search
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
+    search_deadline = deadline
+    grace_used = False
     for candidate in candidates[:CANDIDATES_TO_TRY]:
         if len(evaluated) >= FEASIBLE_TO_COMPARE or worse >= 2:
             break
         if evaluated and _beyond_tier(candidate, evaluated[0].candidate, step):
             break  # mu is raised only until something aligns
-        if time.perf_counter() > deadline and evaluated:
+        now = time.perf_counter()
+        if now > deadline:
             timed_out = True
-            break
+            if evaluated or grace_used:
+                break
+            # nothing aligned in time: one last, bounded try at the best-ranked candidate
+            grace_used = True
+            search_deadline = now + max(GRACE_SECONDS, spec.solver.time_limit)
         tried += 1
         mu = max(tolerance, candidate.need)
         aligned: dict[str, Alignment] = {}
@@ -160,7 +168,7 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
             rows = make_rows(spec, members)
             key = (group, tuple(row.word for row in rows))
             if key not in cache:
-                cache[key] = align(rows, canvas, mu, deadline, effort)
+                cache[key] = align(rows, canvas, mu, search_deadline, effort)
             result = cache[key]
             if result.alignment is None:
                 timed_out = timed_out or result.timed_out
