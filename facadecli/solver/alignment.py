@@ -635,8 +635,16 @@ def align_jointly(
     return AlignmentResult(found, False, search.nodes, reason)
 
 
+Prefixes = dict[tuple[object, ...], "AlignmentResult"]  # alignments of leading rows, reused
+
+
 def align(
-    rows: Sequence[Row], canvas: float, mu: float, deadline: float, nodes: int = MAX_NODES
+    rows: Sequence[Row],
+    canvas: float,
+    mu: float,
+    deadline: float,
+    nodes: int = MAX_NODES,
+    prefixes: Prefixes | None = None,
 ) -> AlignmentResult:
     """The alignment of a group's rows (back to front).
 
@@ -651,20 +659,34 @@ def align(
     """
     if len(rows) <= JOINT_ROWS:
         return align_jointly(rows, canvas, mu, deadline, nodes)
+    prefixes = {} if prefixes is None else prefixes
     prepared = [_Row(row) for row in rows]
-    result = align_jointly(rows[:JOINT_ROWS], canvas, mu, deadline, nodes)
+    key: tuple[object, ...] = (canvas, mu, *((r.layers, r.word) for r in rows[:JOINT_ROWS]))
+    result = prefixes.get(key) or align_jointly(rows[:JOINT_ROWS], canvas, mu, deadline, nodes)
+    if not result.timed_out:
+        prefixes[key] = result
     visited = result.nodes
     current = result.alignment
     for index, row in enumerate(rows[JOINT_ROWS:], start=JOINT_ROWS):
         if current is None:
             break
+        key = (*key, (row.layers, row.word))
+        if key in prefixes:
+            result = prefixes[key]
+            current = result.alignment
+            continue
         composite, parts = composite_row(current, prepared[:index])
         result = align_jointly([composite, row], canvas, mu, deadline, nodes)
         visited += result.nodes
         if result.alignment is None:
             current = None
+        else:
+            current = compose(current, parts, result.alignment, row, prepared[:index])
+            result = AlignmentResult(current, False, result.nodes, "")
+        if not result.timed_out:
+            prefixes[key] = result
+        if current is None:
             break
-        current = compose(current, parts, result.alignment, row, prepared[:index])
     if current is None:
         return AlignmentResult(None, result.timed_out, visited, result.reason)
     return AlignmentResult(current, False, visited, "")

@@ -9,7 +9,14 @@ from dataclasses import dataclass, field, replace
 from facadecli.errors import InfeasibleError
 from facadecli.patterns import CompiledPattern, Enumerated, Word, format_word
 from facadecli.solver import sizing
-from facadecli.solver.alignment import INF, MAX_NODES, Alignment, AlignmentResult, align
+from facadecli.solver.alignment import (
+    INF,
+    MAX_NODES,
+    Alignment,
+    AlignmentResult,
+    Prefixes,
+    align,
+)
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
 from facadecli.solver.rows import make_rows
 from facadecli.spec.model import Spec
@@ -148,6 +155,7 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     search_deadline = deadline
     grace_used = False
+    prefixes: Prefixes = {}
     for candidate in candidates[:CANDIDATES_TO_TRY]:
         if len(evaluated) >= FEASIBLE_TO_COMPARE or worse >= 2:
             break
@@ -168,7 +176,7 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
             rows = make_rows(spec, members)
             key = (group, tuple(row.word for row in rows))
             if key not in cache:
-                cache[key] = align(rows, canvas, mu, search_deadline, effort)
+                cache[key] = align(rows, canvas, mu, search_deadline, effort, prefixes)
             result = cache[key]
             if result.alignment is None:
                 timed_out = timed_out or result.timed_out

@@ -121,12 +121,13 @@ def generate_candidates(
         words[use.key] = list(itertools.islice(enumerated, WORDS_PER_PATTERN))
         if not words[use.key]:
             return []
+    opaque = {id(item): opaque_length(spec, item) for found in words.values() for item in found}
     clusters = _clusters(uses)
     options = [_cluster_options(cluster, words) for cluster in clusters]
     if any(not cluster_options for cluster_options in options):
         return []
     # rank each cluster's options by a context-free estimate, then merge best-first
-    room = {use.key: _max_room_above(spec, use, uses, words) for use in uses}
+    room = {use.key: _max_room_above(use, uses, words, opaque) for use in uses}
     ranked = []
     for cluster_options in options:
         scored = [
@@ -140,7 +141,7 @@ def generate_candidates(
         merged: dict[str, Enumerated] = {}
         for option in combination:
             merged.update(option)
-        candidates.append(_candidate(spec, uses, merged, canvas, order))
+        candidates.append(_candidate(uses, merged, canvas, order, opaque))
     candidates.sort(key=lambda candidate: candidate.key)
     return candidates
 
@@ -194,7 +195,10 @@ def _cluster_options(
 
 
 def _max_room_above(
-    spec: Spec, use: PatternUse, uses: Sequence[PatternUse], words: Mapping[str, list[Enumerated]]
+    use: PatternUse,
+    uses: Sequence[PatternUse],
+    words: Mapping[str, list[Enumerated]],
+    opaque: Mapping[int, float],
 ) -> float:
     """The most opaque length the layers above ``use`` (in its groups) could make room for."""
     best = 0.0
@@ -202,7 +206,7 @@ def _max_room_above(
         room = 0.0
         for other in uses:
             if any(g == group and i > layer for i, g in other.layers):
-                room += max((opaque_length(spec, item) for item in words[other.key]), default=0.0)
+                room += max((opaque[id(item)] for item in words[other.key]), default=0.0)
         best = max(best, room)
     return best
 
@@ -235,14 +239,14 @@ def _best_combinations(
 
 
 def _candidate(
-    spec: Spec,
     uses: Sequence[PatternUse],
     words: Mapping[str, Enumerated],
     canvas: float,
     order: int,
+    opaque_of: Mapping[int, float],
 ) -> Candidate:
     """A candidate with its exact Eq. 7 need (opaque room from the chosen words above)."""
-    opaque = {key: opaque_length(spec, item) for key, item in words.items()}
+    opaque = {key: opaque_of[id(item)] for key, item in words.items()}
     need = misfit = shortfall = slack = 0.0
     for use in uses:
         item = words[use.key]
