@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import sys
 import traceback
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
@@ -18,7 +19,7 @@ from facadecli.errors import FacadeError, InfeasibleError, SpecError
 from facadecli.export import WRITERS, OutputOptions, write_atomic, write_outputs
 from facadecli.preview import preview_words
 from facadecli.solve import retarget, solve
-from facadecli.spec import load_spec, spec_schema_text
+from facadecli.spec import Spec, load_spec, spec_schema_text
 
 app = typer.Typer(
     name="facade",
@@ -57,18 +58,47 @@ def _report(error: FacadeError) -> None:
     typer.echo(str(error), err=True)
 
 
+class _Run:
+    """A multi-spec run: reports each failure, then exits with one code (SPEC 4): the
+    spec's own code when there is one spec, 1 when some of several failed."""
+
+    def __init__(self, paths: list[Path]):
+        self.paths = paths
+        self.codes: list[int] = []
+
+    def specs(self) -> Iterator[tuple[Path, Spec]]:
+        for path in self.paths:
+            try:
+                spec = load_spec(path)
+            except SpecError as error:
+                self.fail(path, error)
+                continue
+            yield path, spec
+
+    def fail(self, path: Path, error: FacadeError) -> None:
+        if isinstance(error, InfeasibleError):
+            typer.echo(f"{path}: error: no layout: {error}", err=True)
+        else:
+            _report(error)
+        self.codes.append(error.exit_code)
+
+    def succeed(self) -> None:
+        self.codes.append(0)
+
+    def finish(self) -> None:
+        failed = [code for code in self.codes if code]
+        if failed:
+            raise typer.Exit(failed[0] if len(self.paths) == 1 else 1)
+
+
 @app.command()
 def validate(specs: SpecPaths) -> None:
     """Check specs without solving them; print every problem with file:line:col."""
-    failed = 0
-    for path in specs:
-        try:
-            spec = load_spec(path)
-        except SpecError as error:
-            _report(error)
-            failed += 1
-            continue
+    run = _Run(specs)
+    for path, spec in run.specs():
         typer.echo(f"{path}: ok ({spec.name}: {len(spec.layers)} layers)")
+        run.succeed()
+    failed = sum(1 for code in run.codes if code)
     if failed:
         typer.echo(f"{failed} of {len(specs)} specs invalid", err=True)
         raise typer.Exit(2)
@@ -114,17 +144,12 @@ def solve_command(
 ) -> None:
     """Solve specs into layouts and write their outputs to OUTDIR."""
     chosen = _formats(formats)
-    codes: list[int] = []
-    for path in specs:
+    run = _Run(specs)
+    for path, spec in run.specs():
         try:
-            spec = retarget(load_spec(path), width, height, seed)
-            layout = solve(spec)
-        except (SpecError, InfeasibleError) as error:
-            if isinstance(error, InfeasibleError):
-                typer.echo(f"{path}: error: no layout: {error}", err=True)
-            else:
-                _report(error)
-            codes.append(error.exit_code)
+            layout = solve(retarget(spec, width, height, seed))
+        except InfeasibleError as error:
+            run.fail(path, error)
             continue
         for warning in layout.warnings:
             typer.echo(f"{path}: warning: {warning}", err=True)
@@ -136,10 +161,8 @@ def solve_command(
             + " -> "
             + ", ".join(str(p) for p in written)
         )
-        codes.append(0)
-    failed = [code for code in codes if code]
-    if failed:
-        raise typer.Exit(failed[0] if len(codes) == 1 else 1)
+        run.succeed()
+    run.finish()
 
 
 @app.command()
@@ -163,19 +186,13 @@ def words(
     limit: Annotated[int, typer.Option("--limit", "-n", min=1, help="Words per layer axis.")] = 5,
 ) -> None:
     """List the words each layer's patterns make that fit the canvas, nearest first."""
-    failed = 0
-    for path in specs:
-        try:
-            spec = load_spec(path)
-        except SpecError as error:
-            _report(error)
-            failed += 1
-            continue
+    run = _Run(specs)
+    for path, spec in run.specs():
         typer.echo(f"# {path} ({spec.name})")
         for preview in preview_words(spec, limit):
             typer.echo("\n".join(preview.lines()))
-    if failed:
-        raise typer.Exit(2 if failed == len(specs) else 1)
+        run.succeed()
+    run.finish()
 
 
 def main() -> None:
