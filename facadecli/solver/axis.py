@@ -136,6 +136,48 @@ def _group_rows(
     return groups
 
 
+@dataclass
+class _SearchMemory:
+    """Alignments already searched in one axis solve, shared by its candidates."""
+
+    groups: dict[tuple[str, tuple[Word, ...]], AlignmentResult] = field(default_factory=dict)
+    prefixes: Prefixes = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _Attempt:
+    groups: dict[str, Alignment] | None  # None when some group does not align
+    nodes: int  # search states visited
+    reason: str = ""
+    timed_out: bool = False
+
+
+def _align_candidate(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    candidate: Candidate,
+    canvas: float,
+    deadline: float,
+    effort: int,
+    memory: _SearchMemory,
+) -> _Attempt:
+    """Align every group of a candidate's words (each group at most once per solve)."""
+    mu = max(spec.solver.tolerance, candidate.need)
+    aligned: dict[str, Alignment] = {}
+    nodes = 0
+    for group, members in sorted(_group_rows(spec, uses, candidate.words).items()):
+        rows = make_rows(spec, members)
+        key = (group, tuple(row.word for row in rows))
+        if key not in memory.groups:
+            memory.groups[key] = align(rows, canvas, mu, deadline, effort, memory.prefixes)
+        result = memory.groups[key]
+        nodes += result.nodes
+        if result.alignment is None:
+            return _Attempt(None, nodes, f"group '{group}': {result.reason}", result.timed_out)
+        aligned[group] = result.alignment
+    return _Attempt(aligned, nodes)
+
+
 def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:
     """Solve one axis; raises :class:`InfeasibleError` with the reason when nothing fits."""
     started = time.perf_counter()
@@ -145,7 +187,7 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     if not candidates:
         raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
     tolerance = spec.solver.tolerance
-    cache: dict[tuple[str, tuple[Word, ...]], AlignmentResult] = {}
+    memory = _SearchMemory()
     evaluated: list[_Evaluated] = []
     failures: list[str] = []
     timed_out = False
@@ -155,7 +197,6 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     search_deadline = deadline
     grace_used = False
-    prefixes: Prefixes = {}
     for candidate in candidates[:CANDIDATES_TO_TRY]:
         if len(evaluated) >= FEASIBLE_TO_COMPARE or worse >= 2:
             break
@@ -170,34 +211,21 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
             grace_used = True
             search_deadline = now + max(GRACE_SECONDS, spec.solver.time_limit)
         tried += 1
-        mu = max(tolerance, candidate.need)
-        aligned: dict[str, Alignment] = {}
-        for group, members in sorted(_group_rows(spec, uses, candidate.words).items()):
-            rows = make_rows(spec, members)
-            key = (group, tuple(row.word for row in rows))
-            if key not in cache:
-                cache[key] = align(rows, canvas, mu, search_deadline, effort, prefixes)
-            result = cache[key]
-            if result.alignment is None:
-                timed_out = timed_out or result.timed_out
-                failures.append(f"group '{group}': {result.reason}")
-                worse += 1 if evaluated else 0
-                break
-            aligned[group] = result.alignment
-        else:
-            program = sizing.build_program(spec, aligned, canvas)
-            estimate = sizing.estimate(program) or sizing.solve(program)
-            if estimate is None:
-                failures.append(sizing.explain_infeasible(program))
-                continue
-            best = min((e.estimate.objective for e in evaluated), default=None)
-            evaluated.append(_Evaluated(candidate, aligned, program, estimate))
-            worse = worse + 1 if best is not None and estimate.objective > best + 1e-9 else 0
-            needed = sum(
-                cache[(g, tuple(r.word for r in make_rows(spec, m)))].nodes
-                for g, m in _group_rows(spec, uses, candidate.words).items()
-            )
-            effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * needed))
+        attempt = _align_candidate(spec, uses, candidate, canvas, search_deadline, effort, memory)
+        if attempt.groups is None:
+            timed_out = timed_out or attempt.timed_out
+            failures.append(attempt.reason)
+            worse += 1 if evaluated else 0
+            continue
+        program = sizing.build_program(spec, attempt.groups, canvas)
+        estimate = sizing.estimate(program) or sizing.solve(program)
+        if estimate is None:
+            failures.append(sizing.explain_infeasible(program))
+            continue
+        best = min((e.estimate.objective for e in evaluated), default=None)
+        evaluated.append(_Evaluated(candidate, attempt.groups, program, estimate))
+        worse = worse + 1 if best is not None and estimate.objective > best + 1e-9 else 0
+        effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
         if timed_out and evaluated:
             break
     aligned_at = time.perf_counter()
