@@ -6,6 +6,7 @@ STAMP  := $(VENV)/.installed
 SPECS  := $(wildcard specs/*.yaml)
 DEMO   ?= specs/residential-house.yaml
 OUT    ?= out
+VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 
 .DEFAULT_GOAL := help
 .PHONY: help install demo test lint format bench schema clean
@@ -26,7 +27,12 @@ demo: $(STAMP) ## Validate the example specs and solve them into out/ (report + 
 	$(BIN)/facade solve $(SPECS) -o $(OUT) --labels
 	@echo "open $(OUT)/$(notdir $(DEMO:.yaml=.svg)) to see a façade; reports are $(OUT)/*.layout.json"
 
-test: $(STAMP) ## Run the whole test suite
+$(VALIDATOR): | $(STAMP)
+	@if command -v npm >/dev/null 2>&1; then \
+	  npm install --silent --no-audit --no-fund --prefix $(VENV)/node gltf-validator@2.0.0-dev.3.10; \
+	else echo "npm not found: the glTF validator test will be skipped"; fi
+
+test: $(STAMP) $(VALIDATOR) ## Run the whole test suite
 	$(BIN)/python -m pytest
 
 lint: $(STAMP) ## ruff (lint + format check) and mypy

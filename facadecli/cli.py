@@ -16,7 +16,13 @@ import typer
 
 from facadecli import __version__
 from facadecli.errors import FacadeError, InfeasibleError, SpecError
-from facadecli.export import WRITERS, OutputOptions, write_atomic, write_outputs
+from facadecli.export import (
+    DEFAULT_FORMATS,
+    WRITERS,
+    OutputOptions,
+    write_atomic,
+    write_outputs,
+)
 from facadecli.preview import preview_words
 from facadecli.solve import retarget, solve
 from facadecli.spec import Spec, load_spec, spec_schema_text
@@ -106,7 +112,7 @@ def validate(specs: SpecPaths) -> None:
 
 def _formats(value: str | None) -> list[str]:
     if value is None:
-        return list(WRITERS)
+        return list(DEFAULT_FORMATS)
     names = [name.strip() for name in value.split(",") if name.strip()]
     unknown = [name for name in names if name not in WRITERS]
     if unknown or not names:
@@ -125,7 +131,9 @@ def solve_command(
     formats: Annotated[
         str | None,
         typer.Option(
-            "--format", "-f", help=f"Comma-separated formats (default: all of {','.join(WRITERS)})."
+            "--format",
+            "-f",
+            help=f"Comma-separated, of {','.join(WRITERS)} (default: {','.join(DEFAULT_FORMATS)}).",
         ),
     ] = None,
     width: Annotated[
@@ -153,7 +161,8 @@ def solve_command(
             continue
         for warning in layout.warnings:
             typer.echo(f"{path}: warning: {warning}", err=True)
-        written = write_outputs(layout, outdir, chosen, OutputOptions(timings, labels))
+        options = OutputOptions(timings, labels, path.parent)
+        written = write_outputs(layout, outdir, chosen, options)
         counters = ", ".join(f"{k}={v}" for k, v in sorted(layout.counters.items()))
         typer.echo(
             f"{path}: solved in {layout.time_ms:.1f} ms"

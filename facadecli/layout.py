@@ -16,6 +16,17 @@ DEFAULT_MATERIAL = "default"  # the built-in neutral grey when no material is na
 
 
 @dataclass(frozen=True)
+class Appearance:
+    material: str
+    mesh: str
+    depth: float
+    thickness: float
+    frame_width: float | None = None
+    pane_depth: float | None = None
+    segments: int | None = None
+
+
+@dataclass(frozen=True)
 class Shape:
     layer: str
     x: str
@@ -32,6 +43,7 @@ class Shape:
     reflected_y: bool
     opaque: bool  # covers its whole cell (both symbols opaque, material not see-through)
     visible: bool = True  # False when hidden behind opaque shapes of layers in front
+    look: Appearance | None = None  # the rule's parameters, for the geometry
 
 
 @dataclass(frozen=True)
@@ -58,22 +70,17 @@ class Layout:
         return (self.x if axis == "x" else self.y).letters.get(layer, ())
 
 
-@dataclass(frozen=True)
-class Appearance:
-    material: str
-    mesh: str
-    depth: float
-    thickness: float
-
-
 def appearance(spec: Spec, layer: Layer, x: str, y: str) -> Appearance:
     """The last matching rule wins, field by field: defaults, global rules, layer rules."""
     defaults = spec.defaults
-    current = {
+    current: dict[str, object] = {
         "material": defaults.material or DEFAULT_MATERIAL,
         "mesh": defaults.mesh,
         "depth": defaults.depth,
         "thickness": defaults.thickness,
+        "frame_width": None,
+        "pane_depth": None,
+        "segments": None,
     }
     for rule in (*spec.shapes, *layer.shapes):
         if _matches(rule, x, y):
@@ -128,6 +135,7 @@ def build_shapes(spec: Spec, x: AxisLayout, y: AxisLayout) -> tuple[Shape, ...]:
                         opaque=spec.qualifiers(column.symbol).opaque
                         and spec.qualifiers(row.symbol).opaque
                         and not see_through,
+                        look=look,
                     )
                 )
     return _cull(shapes)

@@ -6,6 +6,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import trimesh
+
 from facadecli.export.atomic import write_atomic
 from facadecli.layout import Layout
 
@@ -14,6 +16,7 @@ from facadecli.layout import Layout
 class OutputOptions:
     timings: bool = False  # record solve times in the report (they vary run to run)
     labels: bool = False  # symbol names and column lines over the SVG elevation
+    base_dir: Path | None = None  # where the spec is: mesh asset paths are relative to it
 
 
 Writer = Callable[[Layout, Path, OutputOptions], list[Path]]
@@ -35,8 +38,40 @@ def _write_svg(layout: Layout, outdir: Path, options: OutputOptions) -> list[Pat
     return [path]
 
 
-#: format name -> writer(layout, outdir, options) returning the files it wrote
-WRITERS: dict[str, Writer] = {"json": _write_json, "svg": _write_svg}
+def _scene(layout: Layout, options: OutputOptions) -> trimesh.Scene:
+    from facadecli.geometry.facade import facade_scene
+
+    return facade_scene(layout, options.base_dir)
+
+
+def _write_glb(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
+    from facadecli.export.gltf import write_glb
+
+    return write_glb(_scene(layout, options), outdir / f"{layout.spec.name}.glb")
+
+
+def _write_gltf(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
+    from facadecli.export.gltf import write_gltf
+
+    return write_gltf(_scene(layout, options), outdir / f"{layout.spec.name}.gltf")
+
+
+def _write_obj(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
+    from facadecli.export.obj import write_obj
+
+    return write_obj(_scene(layout, options), outdir / f"{layout.spec.name}.obj")
+
+
+#: format name -> writer(layout, outdir, options) returning the files it wrote; the
+#: default set of ``facade solve`` is SPEC 4's: glb, obj, json, svg
+WRITERS: dict[str, Writer] = {
+    "glb": _write_glb,
+    "obj": _write_obj,
+    "json": _write_json,
+    "svg": _write_svg,
+    "gltf": _write_gltf,
+}
+DEFAULT_FORMATS = ("glb", "obj", "json", "svg")
 
 
 def write_outputs(
@@ -48,4 +83,4 @@ def write_outputs(
     return written
 
 
-__all__ = ["WRITERS", "OutputOptions", "write_atomic", "write_outputs"]
+__all__ = ["DEFAULT_FORMATS", "WRITERS", "OutputOptions", "write_atomic", "write_outputs"]

@@ -190,6 +190,9 @@ class ShapeRule(Model):
     mesh: str | None = None
     depth: Length | None = None
     thickness: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
+    frame_width: PositiveLength | None = None  # frame and arch: width of the frame's bars
+    pane_depth: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None  # pane recess
+    segments: Annotated[int, Field(ge=3, le=128)] | None = None  # arch and column smoothness
 
 
 class Layer(Model):

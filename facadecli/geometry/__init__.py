@@ -1,0 +1,1 @@
+"""Geometry: parametric primitives sized from their cells, and the façade scene."""

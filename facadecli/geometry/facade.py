@@ -1,0 +1,116 @@
+"""The façade as a 3D scene: one node per layer, one child per visible shape.
+
+Shapes with the same mesh, cell size, parameters, mirroring and material share one mesh
+(glTF instancing), so a façade with a thousand windows stores one window. Coordinates: x
+along the façade, y up, z towards the viewer (SPEC 2.1), metres: glTF's own frame.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from trimesh.visual.material import PBRMaterial
+
+from facadecli.geometry.primitives import PRIMITIVES, Cell, asset
+from facadecli.layout import Layout, Shape
+from facadecli.spec.model import Material
+
+DEFAULT_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
+
+
+def pbr(name: str, material: Material) -> PBRMaterial:
+    """A glTF metallic-roughness material; see-through ones blend."""
+    colour = material.color.lstrip("#")
+    rgb = [int(colour[i : i + 2], 16) for i in (0, 2, 4)]
+    alpha = round(255 * material.opacity)
+    return PBRMaterial(
+        name=name,
+        baseColorFactor=[*rgb, alpha],
+        metallicFactor=material.metallic,
+        roughnessFactor=material.roughness,
+        alphaMode="BLEND" if material.opacity < 1.0 else "OPAQUE",
+        doubleSided=False,
+    )
+
+
+def _cell(shape: Shape) -> Cell:
+    look = shape.look
+    assert look is not None
+    return Cell(
+        width=round(shape.x1 - shape.x0, 6),
+        height=round(shape.y1 - shape.y0, 6),
+        thickness=round(shape.z1 - shape.z0, 6),
+        frame_width=look.frame_width,
+        pane_depth=look.pane_depth,
+        segments=look.segments,
+    )
+
+
+def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
+    """Mirror a mesh within its cell on the axes whose letters are reflected."""
+    if not (x or y):
+        return
+    matrix = np.eye(4)
+    if x:
+        matrix[0, 0], matrix[0, 3] = -1.0, cell.width
+    if y:
+        matrix[1, 1], matrix[1, 3] = -1.0, cell.height
+    mesh.apply_transform(matrix)  # trimesh flips the winding of a reflection
+
+
+def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
+    """The visible shapes of a layout as a scene (hidden ones are culled)."""
+    spec = layout.spec
+    materials = {name: pbr(name, m) for name, m in spec.materials.items()}
+    assets: dict[str, trimesh.Trimesh] = {}
+    scene = trimesh.Scene()
+    world = scene.graph.base_frame
+    shared: dict[tuple[object, ...], str] = {}
+    for layer in spec.layers:
+        if not layer.enabled:
+            continue
+        layer_node = f"layer:{layer.name}"
+        scene.graph.update(frame_to=layer_node, frame_from=world)
+        count = 0
+        for shape in layout.shapes:
+            if shape.layer != layer.name or not shape.visible:
+                continue
+            cell = _cell(shape)
+            key = (shape.mesh, cell, shape.material, shape.reflected_x, shape.reflected_y)
+            placement = trimesh.transformations.translation_matrix((shape.x0, shape.y0, shape.z1))
+            node = f"{layer.name}/{shape.x}.{shape.y}/{count}"
+            count += 1
+            if key in shared:
+                scene.graph.update(
+                    frame_to=node, frame_from=layer_node, matrix=placement, geometry=shared[key]
+                )
+                continue
+            mesh = _build(shape, cell, base_dir, assets)
+            _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
+            material = materials.get(shape.material) or pbr(shape.material, DEFAULT_MATERIAL)
+            mesh.visual = trimesh.visual.TextureVisuals(material=material)
+            name = f"{shape.mesh.replace('/', '_')}-{shape.material}-{len(shared)}"
+            shared[key] = name
+            scene.add_geometry(
+                mesh,
+                geom_name=name,
+                node_name=node,
+                parent_node_name=layer_node,
+                transform=placement,
+            )
+    return scene
+
+
+def _build(
+    shape: Shape, cell: Cell, base_dir: Path | None, assets: dict[str, trimesh.Trimesh]
+) -> trimesh.Trimesh:
+    builder = PRIMITIVES.get(shape.mesh)
+    if builder is not None:
+        return builder(cell)
+    if shape.mesh not in assets:
+        path = (base_dir or Path(".")) / shape.mesh
+        loaded = trimesh.load(path, force="mesh")
+        assets[shape.mesh] = loaded
+    return asset(assets[shape.mesh], cell)

@@ -1,0 +1,178 @@
+"""Parametric primitives (SPEC 2.8), built in a cell's own frame.
+
+Every primitive fills ``0 <= x <= width``, ``0 <= y <= height`` and ``-thickness <= z <= 0``:
+its front face is at z = 0, the façade plane at the shape's depth. Positions are placed
+and mirrored later (facade.py). Built with numpy only, so every mesh is deterministic.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+
+DEFAULT_SEGMENTS = 12
+
+
+@dataclass(frozen=True)
+class Cell:
+    """What a primitive is sized from: the cell and the shape rule's parameters."""
+
+    width: float
+    height: float
+    thickness: float
+    frame_width: float | None = None
+    pane_depth: float | None = None
+    segments: int | None = None
+
+    @property
+    def frame(self) -> float:
+        """Frame width: the rule's, or a tenth of the smaller side (at most 12 cm)."""
+        default = min(0.12, 0.1 * min(self.width, self.height))
+        wanted = self.frame_width if self.frame_width is not None else default
+        return max(1e-3, min(wanted, 0.45 * min(self.width, self.height)))
+
+    @property
+    def pane(self) -> float:
+        """How far the pane sits behind the frame's front."""
+        return self.pane_depth if self.pane_depth is not None else max(0.02, 0.5 * self.thickness)
+
+
+def _block(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> trimesh.Trimesh:
+    """An axis-aligned box between the given bounds."""
+    box = trimesh.creation.box(extents=(x1 - x0, y1 - y0, max(z1 - z0, 1e-4)))
+    box.apply_translation(((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2))
+    return box
+
+
+def box(cell: Cell) -> trimesh.Trimesh:
+    return _block(0, cell.width, 0, cell.height, -cell.thickness, 0)
+
+
+def panel(cell: Cell) -> trimesh.Trimesh:
+    """A thin quad facing the viewer."""
+    vertices = np.array(
+        [(0, 0, 0), (cell.width, 0, 0), (cell.width, cell.height, 0), (0, cell.height, 0)],
+        dtype=float,
+    )
+    return trimesh.Trimesh(vertices, np.array([(0, 1, 2), (0, 2, 3)]), process=False)
+
+
+def frame(cell: Cell) -> trimesh.Trimesh:
+    """A window or door frame: four bars and a pane recessed behind them."""
+    w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
+    pane_z = -min(cell.pane, t)
+    parts = [
+        _block(0, w, 0, f, -t, 0),  # sill
+        _block(0, w, h - f, h, -t, 0),  # head
+        _block(0, f, f, h - f, -t, 0),  # jambs
+        _block(w - f, w, f, h - f, -t, 0),
+        _block(f, w - f, f, h - f, pane_z - 0.01, pane_z),  # the pane
+    ]
+    return trimesh.util.concatenate(parts)
+
+
+def arch(cell: Cell) -> trimesh.Trimesh:
+    """A frame whose top is a round arch (a semicircle as wide as the cell, when it fits)."""
+    w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
+    radius = min(w / 2, h - f)
+    spring = h - radius  # where the arch starts
+    segments = max(3, cell.segments or DEFAULT_SEGMENTS)
+    pane_z = -min(cell.pane, t)
+    parts = [
+        _block(0, w, 0, f, -t, 0),
+        _block(0, f, f, spring, -t, 0),
+        _block(w - f, w, f, spring, -t, 0),
+        _block(f, w - f, f, spring, pane_z - 0.01, pane_z),
+    ]
+    centre = (w / 2, spring)
+    inner = max(radius - f, 1e-3)
+    ring = []
+    pane = []
+    for i in range(segments):
+        a0 = math.pi * i / segments
+        a1 = math.pi * (i + 1) / segments
+        outer_points = [
+            (centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a)) for a in (a0, a1)
+        ]
+        inner_points = [
+            (centre[0] + inner * math.cos(a), centre[1] + inner * math.sin(a)) for a in (a0, a1)
+        ]
+        ring.append(
+            _prism([outer_points[0], outer_points[1], inner_points[1], inner_points[0]], -t, 0)
+        )
+        pane.append(_prism([centre, inner_points[0], inner_points[1]], pane_z - 0.01, pane_z))
+    return trimesh.util.concatenate(parts + ring + pane)
+
+
+def _prism(outline: list[tuple[float, float]], z0: float, z1: float) -> trimesh.Trimesh:
+    """A convex polygon (counter-clockwise or not) extruded from z0 to z1."""
+    points = np.array(outline, dtype=float)
+    area = 0.5 * np.sum(
+        points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]
+    )
+    if area < 0:
+        points = points[::-1]
+    n = len(points)
+    bottom = np.column_stack([points, np.full(n, z0)])
+    top = np.column_stack([points, np.full(n, z1)])
+    vertices = np.vstack([bottom, top])
+    faces = []
+    for i in range(1, n - 1):
+        faces.append((n, n + i, n + i + 1))  # front (z1), counter-clockwise seen from +z
+        faces.append((0, i + 1, i))  # back
+    for i in range(n):
+        j = (i + 1) % n
+        faces.append((i, j, n + j))
+        faces.append((i, n + j, n + i))
+    return trimesh.Trimesh(vertices, np.array(faces), process=False)
+
+
+def column(cell: Cell) -> trimesh.Trimesh:
+    """A round column standing in the cell, as wide as the cell (its depth follows)."""
+    radius = cell.width / 2
+    cylinder = trimesh.creation.cylinder(
+        radius=radius, height=cell.height, sections=max(6, cell.segments or 16)
+    )
+    cylinder.apply_transform(trimesh.transformations.rotation_matrix(-math.pi / 2, (1, 0, 0)))
+    cylinder.apply_translation((radius, cell.height / 2, -radius))
+    return cylinder
+
+
+def ledge(cell: Cell) -> trimesh.Trimesh:
+    """A profiled horizontal band: three steps, each standing further out than the one below."""
+    w, h, t = cell.width, cell.height, cell.thickness
+    return trimesh.util.concatenate(
+        [
+            _block(0, w, 0, 0.3 * h, -t, -0.4 * t),
+            _block(0, w, 0.3 * h, 0.6 * h, -t, -0.2 * t),
+            _block(0, w, 0.6 * h, h, -t, 0),
+        ]
+    )
+
+
+PRIMITIVES: dict[str, Callable[[Cell], trimesh.Trimesh]] = {
+    "box": box,
+    "panel": panel,
+    "frame": frame,
+    "arch": arch,
+    "column": column,
+    "ledge": ledge,
+}
+
+
+def asset(mesh: trimesh.Trimesh, cell: Cell) -> trimesh.Trimesh:
+    """A loaded mesh scaled into the cell (x, y to the cell, z to the thickness)."""
+    fitted = mesh.copy()
+    low, high = fitted.bounds
+    extent = np.where(high - low > 1e-9, high - low, 1.0)
+    scale = np.array([cell.width, cell.height, max(cell.thickness, 1e-3)]) / extent
+    fitted.apply_translation(-low)
+    fitted.apply_scale(1.0)  # keep trimesh's caches coherent before the non-uniform scale
+    matrix = np.diag([*scale, 1.0])
+    fitted.apply_transform(matrix)
+    fitted.apply_translation((0, 0, -cell.thickness))
+    return fitted
