@@ -194,3 +194,24 @@ def _covered(shape: Shape, occluders: list[Shape]) -> bool:
 
 def layer_index(spec: Spec) -> Mapping[str, int]:
     return {layer.name: i for i, layer in enumerate(spec.layers)}
+
+
+def uncovered_area(layout: Layout) -> float:
+    """Area of the canvas that no shape of any layer covers: a hole in the façade.
+
+    Each axis is aligned on its own, so a lower layer may make room on one axis for a
+    layer that does not cover that room on the other axis (SPEC 2.4's per-axis rule);
+    this finds such holes in the plane."""
+    xs = np.unique(
+        [0.0, layout.width, *(s.x0 for s in layout.shapes), *(s.x1 for s in layout.shapes)]
+    )
+    ys = np.unique(
+        [0.0, layout.height, *(s.y0 for s in layout.shapes), *(s.y1 for s in layout.shapes)]
+    )
+    covered = np.zeros((len(xs) - 1, len(ys) - 1), dtype=bool)
+    for shape in layout.shapes:
+        i0, i1 = np.searchsorted(xs, [shape.x0, shape.x1])
+        j0, j1 = np.searchsorted(ys, [shape.y0, shape.y1])
+        covered[i0:i1, j0:j1] = True
+    areas = np.outer(np.diff(xs), np.diff(ys))
+    return float(areas[~covered].sum())

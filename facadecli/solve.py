@@ -1,24 +1,49 @@
-"""``solve(spec) -> Layout``: both axes, then the shapes."""
+"""``solve(spec) -> Layout``: both axes, then the shapes; and variations of a spec."""
 
 from __future__ import annotations
 
+import itertools
+import random
 import time
+from dataclasses import replace
 
-from facadecli.layout import Layout, build_shapes
-from facadecli.solver.axis import solve_axis
+from facadecli.layout import Layout, build_shapes, uncovered_area
+from facadecli.solver.axis import AxisLayout, solve_axis_alternatives
 from facadecli.spec.model import Canvas, Solver, Spec
+
+ALTERNATIVES_PER_AXIS = 8
+HOLE = 1e-6  # m^2: less uncovered area than this is no hole
 
 
 def retarget(
-    spec: Spec, width: float | None = None, height: float | None = None, seed: int | None = None
+    spec: Spec,
+    width: float | None = None,
+    height: float | None = None,
+    seed: int | None = None,
+    name: str | None = None,
 ) -> Spec:
-    """The spec with another canvas size or seed (``--width/--height/--seed``)."""
+    """The spec with another canvas size, seed or name (``--width/--height/--seed``)."""
     canvas = Canvas(
         width=spec.canvas.width if width is None else width,
         height=spec.canvas.height if height is None else height,
     )
     solver = spec.solver if seed is None else Solver(**{**spec.solver.model_dump(), "seed": seed})
-    return spec.model_copy(update={"canvas": canvas, "solver": solver})
+    return spec.model_copy(update={"canvas": canvas, "solver": solver, "name": name or spec.name})
+
+
+def _axes(spec: Spec, alternatives: int) -> tuple[list[AxisLayout], list[AxisLayout], float]:
+    """Both axes' best layouts (the horizontal may use half the time limit)."""
+    started = time.perf_counter()
+    limit = spec.solver.time_limit
+    x = solve_axis_alternatives(spec, "x", spec.canvas.width, started + limit / 2, alternatives)
+    y = solve_axis_alternatives(spec, "y", spec.canvas.height, started + limit, alternatives)
+    return x, y, started
+
+
+def _layout(spec: Spec, x: AxisLayout, y: AxisLayout, started: float) -> Layout:
+    shapes = build_shapes(spec, x, y)
+    elapsed = (time.perf_counter() - started) * 1000
+    return Layout(spec, spec.canvas.width, spec.canvas.height, x, y, shapes, elapsed)
 
 
 def solve(spec: Spec) -> Layout:
@@ -27,10 +52,36 @@ def solve(spec: Spec) -> Layout:
     The whole solve is bounded by ``spec.solver.time_limit``: the horizontal axis may use
     half of it, the vertical the rest; a search that runs out returns its best layout.
     """
-    started = time.perf_counter()
-    limit = spec.solver.time_limit
-    x = solve_axis(spec, "x", spec.canvas.width, started + limit / 2)
-    y = solve_axis(spec, "y", spec.canvas.height, started + limit)
-    shapes = build_shapes(spec, x, y)
-    elapsed = (time.perf_counter() - started) * 1000
-    return Layout(spec, spec.canvas.width, spec.canvas.height, x, y, shapes, elapsed)
+    x, y, started = _axes(spec, 1)
+    layout = _layout(spec, x[0], y[0], started)
+    if uncovered_area(layout) <= HOLE:
+        return layout
+    # the axes' best layouts leave a hole together: look among near-best pairs for one that
+    # does not, else keep the best and say where the hole is
+    x, y, _ = _axes(spec, ALTERNATIVES_PER_AXIS)
+    pairs = sorted(itertools.product(x, y), key=lambda pair: pair[0].objective + pair[1].objective)
+    for pair in pairs:
+        candidate = _layout(spec, pair[0], pair[1], started)
+        if uncovered_area(candidate) <= HOLE:
+            return candidate
+    hole = uncovered_area(layout)
+    warning = f"the layers leave {hole:.3f} m2 of the canvas uncovered (a hole in the façade)"
+    return replace(layout, x=replace(layout.x, warnings=(*layout.x.warnings, warning)))
+
+
+def solve_variants(spec: Spec, count: int) -> list[Layout]:
+    """Up to ``count`` different layouts of a spec: the best first, then others drawn with
+    ``spec.solver.seed`` from the pairs of near-best horizontal and vertical layouts (where
+    the spec leaves choices open: alternations, free counters, placeholders)."""
+    x, y, started = _axes(spec, ALTERNATIVES_PER_AXIS)
+    pairs = list(itertools.product(range(len(x)), range(len(y))))
+    rest = pairs[1:]
+    random.Random(spec.solver.seed).shuffle(rest)
+    layouts = [solve(spec)]
+    for i, j in rest:
+        if len(layouts) >= count:
+            break
+        layout = _layout(spec, x[i], y[j], started)
+        if uncovered_area(layout) <= HOLE and layout.shapes != layouts[0].shapes:
+            layouts.append(layout)
+    return layouts

@@ -14,7 +14,7 @@ from facadecli.solver.candidates import (
     placeholder_range,
     placeholder_samples,
 )
-from facadecli.solver.rows import make_rows
+from facadecli.solver.rows import full_layers, make_rows
 from facadecli.spec.resolve import layer_pattern
 from tests.solving import letters, solve_text, spans
 
@@ -64,7 +64,7 @@ def _rows(spec_text: str, words: dict[str, dict[str, int]]):  # type: ignore[no-
     for index, layer in enumerate(spec.layers):
         word = make_word(layer_pattern(spec, layer, "x"), words.get(layer.name, {}))
         members.append((index, word))
-    return spec, make_rows(spec, members)
+    return spec, make_rows(spec, members, full_layers(spec, "x"))
 
 
 EQ8 = """

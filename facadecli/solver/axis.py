@@ -18,7 +18,7 @@ from facadecli.solver.alignment import (
     align,
 )
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
-from facadecli.solver.rows import make_rows
+from facadecli.solver.rows import full_layers, make_rows
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
@@ -26,6 +26,7 @@ FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objecti
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
 EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
 GRACE_SECONDS = 1.0  # a last try past the time limit when nothing aligned in time
+NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
 CANDIDATES_TO_TRY = 200
@@ -140,6 +141,7 @@ def _group_rows(
 class _SearchMemory:
     """Alignments already searched in one axis solve, shared by its candidates."""
 
+    full: frozenset[int]  # layers that show all along the other axis
     groups: dict[tuple[str, tuple[Word, ...]], AlignmentResult] = field(default_factory=dict)
     prefixes: Prefixes = field(default_factory=dict)
 
@@ -166,7 +168,7 @@ def _align_candidate(
     aligned: dict[str, Alignment] = {}
     nodes = 0
     for group, members in sorted(_group_rows(spec, uses, candidate.words).items()):
-        rows = make_rows(spec, members)
+        rows = make_rows(spec, members, memory.full)
         key = (group, tuple(row.word for row in rows))
         if key not in memory.groups:
             memory.groups[key] = align(rows, canvas, mu, deadline, effort, memory.prefixes)
@@ -178,8 +180,12 @@ def _align_candidate(
     return _Attempt(aligned, nodes)
 
 
-def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:
-    """Solve one axis; raises :class:`InfeasibleError` with the reason when nothing fits."""
+def solve_axis_alternatives(
+    spec: Spec, axis: Axis, canvas: float, deadline: float, alternatives: int = 1
+) -> list[AxisLayout]:
+    """The best layouts of one axis, best first: the best, and up to ``alternatives`` - 1
+    others whose sizing objective is within NEAR_EQUAL of it (for ``facade vary``).
+    Raises :class:`InfeasibleError` with the reason when nothing fits."""
     started = time.perf_counter()
     uses = pattern_uses(spec, _axis_words(spec, axis))
     candidates = generate_candidates(spec, uses, canvas)
@@ -187,7 +193,7 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     if not candidates:
         raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
     tolerance = spec.solver.tolerance
-    memory = _SearchMemory()
+    memory = _SearchMemory(full_layers(spec, axis))
     evaluated: list[_Evaluated] = []
     failures: list[str] = []
     timed_out = False
@@ -197,11 +203,16 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     search_deadline = deadline
     grace_used = False
+    compare = max(FEASIBLE_TO_COMPARE, alternatives)
     for candidate in candidates[:CANDIDATES_TO_TRY]:
-        if len(evaluated) >= FEASIBLE_TO_COMPARE or worse >= 2:
+        if len(evaluated) >= compare or worse >= 2:
             break
-        if evaluated and _beyond_tier(candidate, evaluated[0].candidate, step):
-            break  # mu is raised only until something aligns
+        if (
+            alternatives == 1
+            and evaluated
+            and _beyond_tier(candidate, evaluated[0].candidate, step)
+        ):
+            break  # mu is raised only until something aligns (variations look further)
         now = time.perf_counter()
         if now > deadline:
             timed_out = True
@@ -229,21 +240,52 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
         if timed_out and evaluated:
             break
     aligned_at = time.perf_counter()
-    for choice in sorted(evaluated, key=lambda e: e.rank):
-        final = sizing.solve(choice.program)
-        if final is not None:
+    ranked = sorted(evaluated, key=lambda e: e.rank)
+    layouts: list[AxisLayout] = []
+    best_objective: float | None = None
+    for choice in ranked:
+        if best_objective is not None and (
+            len(layouts) >= alternatives or choice.estimate.objective > best_objective + NEAR_EQUAL
+        ):
             break
-        failures.append(sizing.explain_infeasible(choice.program))
-    else:
+        final = sizing.solve(choice.program)
+        if final is None:
+            failures.append(sizing.explain_infeasible(choice.program))
+            continue
+        best_objective = final.objective if best_objective is None else best_objective
+        layouts.append(_finish(spec, axis, canvas, choice, final, uses, timed_out))
+    if not layouts:
         raise InfeasibleError(_no_layout_reason(axis, failures, timed_out, spec))
-    sized_at = time.perf_counter()
+    timings = {
+        "candidates_ms": (generated - started) * 1000,
+        "alignment_ms": (aligned_at - generated) * 1000,
+        "sizing_ms": (time.perf_counter() - aligned_at) * 1000,
+    }
+    return [replace(layout, timings=timings, candidates_tried=tried) for layout in layouts]
+
+
+def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:
+    """Solve one axis; raises :class:`InfeasibleError` with the reason when nothing fits."""
+    return solve_axis_alternatives(spec, axis, canvas, deadline, alternatives=1)[0]
+
+
+def _finish(
+    spec: Spec,
+    axis: Axis,
+    canvas: float,
+    choice: _Evaluated,
+    final: sizing.Sizing,
+    uses: Sequence[PatternUse],
+    timed_out: bool,
+) -> AxisLayout:
+    """The placed letters of a chosen candidate, with the warnings a user should see."""
     warnings = []
     if timed_out:
         warnings.append(
             f"{axis}: the time limit ({spec.solver.time_limit:g} s) ran out; "
             "this is the best layout found so far"
         )
-    if choice.candidate.need > tolerance + 1e-9:
+    if choice.candidate.need > spec.solver.tolerance + 1e-9:
         warnings.append(
             f"{axis}: the tolerance was raised to {choice.candidate.need:.3f} m "
             "for the words to fit the canvas"
@@ -255,12 +297,7 @@ def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLa
                 f"{axis}: symbol '{name}' is {size:.3f} m, more than 10% off its "
                 f"preferred {preferred:g} m"
             )
-    timings = {
-        "candidates_ms": (generated - started) * 1000,
-        "alignment_ms": (aligned_at - generated) * 1000,
-        "sizing_ms": (sized_at - aligned_at) * 1000,
-    }
-    return replace(layout, warnings=tuple(warnings), timings=timings, candidates_tried=tried)
+    return replace(layout, warnings=tuple(warnings))
 
 
 def _place(

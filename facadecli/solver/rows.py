@@ -9,7 +9,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from facadecli.patterns import Letter, Word
+from facadecli.patterns.ast import symbols
 from facadecli.spec.model import Spec
+from facadecli.spec.resolve import Axis, layer_pattern
 
 
 @dataclass(frozen=True)
@@ -43,6 +45,7 @@ class Row:
     layers: tuple[int, ...]
     word: Word
     traits: tuple[LetterTraits, ...]
+    full_height: bool = True  # its layers cover the whole other axis (see covers())
 
     @property
     def lowest(self) -> int:
@@ -58,18 +61,46 @@ class Row:
         return self is not other and self.highest > other.lowest
 
     def covers(self, other: Row) -> bool:
-        """Every layer of this row lies in front of every layer of ``other`` (so ``other``
-        may make room for an opaque letter of it)."""
-        return self is not other and self.lowest > other.highest
+        """``other`` may make room for an opaque letter of this row: every layer of this row
+        lies in front of every layer of ``other``, and shows all along the other axis (no
+        mask, no transparent letter there), so the room made leaves no hole in the plane."""
+        return self is not other and self.full_height and self.lowest > other.highest
 
 
-def make_rows(spec: Spec, words: list[tuple[int, Word]]) -> list[Row]:
-    """Rows of one group from (layer index, word) pairs; identical words share a row."""
+def make_rows(
+    spec: Spec, words: list[tuple[int, Word]], full: frozenset[int] = frozenset()
+) -> list[Row]:
+    """Rows of one group from (layer index, word) pairs; identical words share a row.
+    ``full``: the layers that show all along the other axis."""
     by_word: dict[Word, list[int]] = {}
     for layer, word in sorted(words, key=lambda item: item[0]):
         by_word.setdefault(word, []).append(layer)
     rows = [
-        Row(tuple(layers), word, tuple(letter_traits(spec, letter) for letter in word))
+        Row(
+            tuple(layers),
+            word,
+            tuple(letter_traits(spec, letter) for letter in word),
+            full_height=all(layer in full for layer in layers),
+        )
         for word, layers in by_word.items()
     ]
     return sorted(rows, key=lambda row: row.lowest)
+
+
+def full_layers(spec: Spec, axis: Axis) -> frozenset[int]:
+    """Layers that show all along the other axis: no mask there, and a plain pattern of
+    opaque, non-transparent symbols (so on this axis, lower layers may make room for them
+    without leaving a hole in the plane)."""
+    other: Axis = "y" if axis == "x" else "x"
+    full = set()
+    for index, layer in enumerate(spec.layers):
+        mask = layer.visible
+        if mask is not None and getattr(mask, other) is not None:
+            continue
+        pattern = layer_pattern(spec, layer, other)
+        if pattern.substituted:
+            continue
+        names = {sym.name for sym in symbols(pattern.root)}
+        if all(spec.qualifiers(n).opaque and not spec.qualifiers(n).transparent for n in names):
+            full.add(index)
+    return frozenset(full)
