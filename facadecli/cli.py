@@ -9,6 +9,7 @@ from __future__ import annotations
 import sys
 import traceback
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -23,8 +24,9 @@ from facadecli.export import (
     write_atomic,
     write_outputs,
 )
+from facadecli.export.contact import Variant, contact_sheet
 from facadecli.preview import preview_words
-from facadecli.solve import retarget, solve
+from facadecli.solve import retarget, solve, solve_variants
 from facadecli.spec import Spec, load_spec, spec_schema_text
 
 app = typer.Typer(
@@ -172,6 +174,77 @@ def solve_command(
         )
         run.succeed()
     run.finish()
+
+
+def _sizes(text: str | None, option: str) -> list[float | None]:
+    if text is None:
+        return [None]
+    try:
+        sizes = [float(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise typer.BadParameter(
+            f"{option} takes metres separated by commas, e.g. 8,10,12"
+        ) from None
+    if not sizes or any(size <= 0 for size in sizes):
+        raise typer.BadParameter(f"{option} takes positive sizes, e.g. 8,10,12")
+    return list(sizes)
+
+
+@app.command()
+def vary(
+    spec_path: Annotated[Path, typer.Argument(help="Spec file (YAML).", metavar="SPEC")],
+    widths: Annotated[
+        str | None, typer.Option("--widths", help="Canvas widths, e.g. 8,10,12 (metres).")
+    ] = None,
+    heights: Annotated[
+        str | None, typer.Option("--heights", help="Canvas heights, e.g. 6,9 (metres).")
+    ] = None,
+    count: Annotated[
+        int, typer.Option("--count", "-n", min=1, max=64, help="Layouts per size.")
+    ] = 1,
+    seed: Annotated[int | None, typer.Option("--seed", min=0, help="Override solver.seed.")] = None,
+    outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
+        "out"
+    ),
+    formats: Annotated[
+        str | None, typer.Option("--format", "-f", help="Formats of each variant (as solve).")
+    ] = None,
+) -> None:
+    """Retarget a spec to several sizes and sample different layouts at each; writes every
+    variant and contact-sheet.svg, a grid of their elevations."""
+    chosen = _formats(formats)
+    width_list = _sizes(widths, "--widths")
+    height_list = _sizes(heights, "--heights")
+    spec = load_spec(spec_path)
+    rows: list[list[Variant]] = []
+    failed = 0
+    for width in width_list:
+        for height in height_list:
+            sized = retarget(spec, width, height, seed)
+            size = (sized.canvas.width, sized.canvas.height)
+            stem = f"{spec.name}-{size[0]:g}x{size[1]:g}"
+            try:
+                layouts = solve_variants(sized, count)
+            except InfeasibleError as error:
+                typer.echo(
+                    f"{spec_path}: {size[0]:g} x {size[1]:g} m: no layout: {error}", err=True
+                )
+                rows.append([Variant(None, size, sized.solver.seed, 0, "no layout")])
+                failed += 1
+                continue
+            row = []
+            for index, layout in enumerate(layouts):
+                named = replace(layout, spec=retarget(layout.spec, name=f"{stem}-{index}"))
+                options = OutputOptions(base_dir=spec_path.parent)
+                written = write_outputs(named, outdir, chosen, options)
+                row.append(Variant(named, size, sized.solver.seed, index))
+                typer.echo(f"{size[0]:g} x {size[1]:g} m #{index}: " + ", ".join(map(str, written)))
+            rows.append(row)
+    sheet = outdir / "contact-sheet.svg"
+    write_atomic(sheet, contact_sheet(rows, spec.name))
+    typer.echo(f"contact sheet: {sheet}")
+    if failed:
+        raise typer.Exit(1)
 
 
 @app.command()

@@ -170,3 +170,28 @@ def test_solve_exit_codes(tmp_path: Path) -> None:
     mixed = facade("solve", str(good), str(infeasible), "-o", str(tmp_path / "mixed"))
     assert mixed.returncode == 1  # some specs of a multi-spec run failed
     assert (tmp_path / "mixed" / "residential-house.layout.json").exists()
+
+
+def test_vary_writes_each_variant_and_a_contact_sheet(tmp_path: Path) -> None:
+    spec = ROOT / "specs" / "residential-house.yaml"
+    args = ["vary", str(spec), "--widths", "8,12", "--count", "3", "--seed", "7"]
+    result = facade(*args, "-o", str(tmp_path / "a"), "-f", "json,svg")
+    assert result.returncode == 0, result.stderr
+    reports = sorted((tmp_path / "a").glob("*.layout.json"))
+    names = [p.name for p in reports]
+    assert "residential-house-8x3-0.layout.json" in names
+    assert "residential-house-12x3-0.layout.json" in names
+    counters = {json.dumps(json.loads(p.read_text())["counters"]) for p in reports}
+    assert len(counters) >= 2  # different layouts, not copies
+    sheet = (tmp_path / "a" / "contact-sheet.svg").read_text()
+    assert sheet.count("<svg") == len(reports) + 1 and "12 x 3 m, seed 7, #0" in sheet
+    again = facade(*args, "-o", str(tmp_path / "b"), "-f", "json,svg")
+    assert again.returncode == 0
+    for path in (tmp_path / "a").iterdir():
+        assert path.read_bytes() == (tmp_path / "b" / path.name).read_bytes()
+
+
+def test_vary_rejects_bad_sizes(tmp_path: Path) -> None:
+    spec = ROOT / "specs" / "residential-house.yaml"
+    result = facade("vary", str(spec), "--widths", "8,x", "-o", str(tmp_path))
+    assert result.returncode == 2 and "metres" in result.stderr

@@ -127,3 +127,14 @@ materials: {glass: {color: "#8fb3d9", opacity: 0.5}}
     windows = [s for s in layout.shapes if s.layer == "windows" and s.x == "W" and s.y == "F"]
     assert len(windows) >= 500
     assert len(glb_bytes(facade_scene(layout))) < 2_000_000
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_elevations_match_the_golden_svgs(path: Path) -> None:
+    from tests.golden import GOLDEN, elevation, same_drawing
+
+    golden = GOLDEN / f"{path.stem}.svg"
+    assert golden.exists(), "run 'make golden' to create it"
+    assert same_drawing(elevation(path), golden.read_text()), (
+        f"{path.name}: the elevation changed; look at it, then 'make golden'"
+    )
