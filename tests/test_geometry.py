@@ -72,8 +72,9 @@ def test_glb_and_obj_load_back_with_the_canvas_bounds(path: Path, tmp_path: Path
     instances = loaded.graph.nodes_geometry
     assert len(instances) == len(visible)  # one node per visible shape
     assert all(len(loaded.geometry[loaded.graph[n][1]].faces) >= 1 for n in instances)
-    text, material = obj_files(scene, "f")
+    text, files = obj_files(scene, "f")
     (tmp_path / "f.obj").write_text(text)
+    material = files["f.mtl"]
     (tmp_path / "f.mtl").write_bytes(material)
     mesh = trimesh.load(tmp_path / "f.obj", force="mesh")
     assert mesh.bounds[1][:2] == pytest.approx([width, height], abs=1e-5)
@@ -138,3 +139,45 @@ def test_elevations_match_the_golden_svgs(path: Path) -> None:
     assert same_drawing(elevation(path), golden.read_text()), (
         f"{path.name}: the elevation changed; look at it, then 'make golden'"
     )
+
+
+def test_textures_get_uvs_in_metres(tmp_path: Path) -> None:
+    from PIL import Image
+
+    Image.new("RGB", (8, 8), (180, 80, 60)).save(tmp_path / "brick.png")
+    (tmp_path / "wall.yaml").write_text(
+        "version: 1\nname: wall\ncanvas: {width: 4, height: 3}\n"
+        "symbols: {A: {size: 4, opaque: true}, H: {size: 3, opaque: true}}\n"
+        "patterns: {x: A, y: H}\nlayers: [{name: wall, x: x, y: y}]\n"
+        "materials: {brick: {texture: brick.png, texture_size: 0.5}}\n"
+        "defaults: {material: brick}\n"
+    )
+    layout = solve(load_spec(tmp_path / "wall.yaml"))
+    scene = facade_scene(layout, tmp_path)
+    (tmp_path / "wall.glb").write_bytes(glb_bytes(scene))
+    loaded = trimesh.load(tmp_path / "wall.glb", force="scene")
+    (mesh,) = loaded.geometry.values()
+    assert mesh.visual.material.baseColorTexture.size == (8, 8)
+    # the 4 m x 3 m front face spans 8 x 6 copies of a 0.5 m texture
+    assert mesh.visual.uv.max(axis=0) == pytest.approx([8.0, 6.0])
+    _, files = obj_files(scene, "wall")
+    assert "brick.png" in files and b"map_Kd brick.png" in files["wall.mtl"]
+
+
+def test_hidden_shapes_are_culled_from_the_mesh_not_the_report() -> None:
+    text = """
+version: 1
+name: hidden
+canvas: {width: 4, height: 3}
+symbol_defaults: {opaque: true}
+symbols: {A: 1, B: 2, H: 3, F: 4}
+patterns: {back: "A B A", front: F}
+layers:
+  - {name: back, x: back, y: H}
+  - {name: front, x: front, y: H, offset: 0.5}
+"""
+    layout = solve(parse_spec(text))
+    back = [s for s in layout.shapes if s.layer == "back"]
+    assert len(back) == 3 and not any(s.visible for s in back)  # all behind the front wall
+    scene = facade_scene(layout)
+    assert len(scene.graph.nodes_geometry) == 1  # only the front wall is built

@@ -10,8 +10,9 @@ from trimesh.exchange.obj import export_obj
 from facadecli.export.atomic import write_atomic
 
 
-def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, bytes]:
-    """(OBJ text, MTL bytes): the scene's instances placed and merged by layer and material."""
+def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, dict[str, bytes]]:
+    """(OBJ text, {file name: bytes} of the MTL and its texture images): the scene's
+    instances placed and merged by layer and material."""
     groups: dict[tuple[str, str], list[trimesh.Trimesh]] = {}
     for node in _ordered(scene):
         matrix, geometry = scene.graph[node]
@@ -22,7 +23,8 @@ def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, bytes]:
     flat = trimesh.Scene()
     for (layer, material), meshes in groups.items():
         merged = trimesh.util.concatenate(meshes)
-        merged.visual = trimesh.visual.TextureVisuals(material=meshes[0].visual.material)
+        if meshes[0].visual.uv is None:
+            merged.visual = trimesh.visual.TextureVisuals(material=meshes[0].visual.material)
         flat.add_geometry(merged, geom_name=f"{layer}.{material}")
     text, textures = export_obj(
         flat,
@@ -32,7 +34,7 @@ def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, bytes]:
         return_texture=True,
         mtl_name=f"{name}.mtl",
     )
-    return text, textures.get(f"{name}.mtl", b"")
+    return text, dict(sorted(textures.items()))
 
 
 def _ordered(scene: trimesh.Scene) -> list[str]:
@@ -49,8 +51,10 @@ def _ordered(scene: trimesh.Scene) -> list[str]:
 
 
 def write_obj(scene: trimesh.Scene, path: Path) -> list[Path]:
-    text, material = obj_files(scene, path.stem)
-    mtl = path.with_suffix(".mtl")
-    write_atomic(mtl, material)
+    text, files = obj_files(scene, path.stem)
+    written = []
+    for name, data in files.items():  # the MTL and textures first, the OBJ that names them last
+        write_atomic(path.parent / name, data)
+        written.append(path.parent / name)
     write_atomic(path, text)
-    return [path, mtl]
+    return [path, *written]

@@ -20,19 +20,45 @@ from facadecli.spec.model import Material
 DEFAULT_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
 
 
-def pbr(name: str, material: Material) -> PBRMaterial:
-    """A glTF metallic-roughness material; see-through ones blend."""
+def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMaterial:
+    """A glTF metallic-roughness material; see-through ones blend; a texture is tinted by
+    the colour."""
     colour = material.color.lstrip("#")
     rgb = [int(colour[i : i + 2], 16) for i in (0, 2, 4)]
     alpha = round(255 * material.opacity)
+    texture = None
+    if material.texture is not None:
+        from PIL import Image
+
+        with Image.open((base_dir or Path(".")) / material.texture) as image:
+            texture = image.convert("RGBA" if material.opacity < 1.0 else "RGB")
     return PBRMaterial(
         name=name,
         baseColorFactor=[*rgb, alpha],
+        baseColorTexture=texture,
         metallicFactor=material.metallic,
         roughnessFactor=material.roughness,
         alphaMode="BLEND" if material.opacity < 1.0 else "OPAQUE",
         doubleSided=False,
     )
+
+
+def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
+    """Texture coordinates in metres (one texture copy per ``size`` metres), projected on
+    each face's dominant plane, so brick stays brick-sized in a cell of any size."""
+    flat = mesh.copy()
+    flat.unmerge_vertices()
+    normals = np.abs(flat.face_normals)
+    dominant = normals.argmax(axis=1)  # 0: facing x, 1: facing y, 2: facing z
+    planes = np.array([(2, 1), (0, 2), (0, 1)])[dominant]  # the two axes of the plane
+    uv = np.zeros((len(flat.vertices), 2))
+    for corner in range(3):
+        vertex = flat.faces[:, corner]
+        rows = np.arange(len(vertex))
+        uv[vertex, 0] = flat.vertices[vertex, planes[rows, 0]]
+        uv[vertex, 1] = flat.vertices[vertex, planes[rows, 1]]
+    flat.visual = trimesh.visual.TextureVisuals(uv=uv / size)
+    return flat
 
 
 def _cell(shape: Shape) -> Cell:
@@ -63,7 +89,7 @@ def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
 def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     """The visible shapes of a layout as a scene (hidden ones are culled)."""
     spec = layout.spec
-    materials = {name: pbr(name, m) for name, m in spec.materials.items()}
+    materials = {name: pbr(name, m, base_dir) for name, m in spec.materials.items()}
     assets: dict[str, trimesh.Trimesh] = {}
     scene = trimesh.Scene()
     world = scene.graph.base_frame
@@ -90,7 +116,12 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             mesh = _build(shape, cell, base_dir, assets)
             _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
             material = materials.get(shape.material) or pbr(shape.material, DEFAULT_MATERIAL)
-            mesh.visual = trimesh.visual.TextureVisuals(material=material)
+            declared = spec.materials.get(shape.material)
+            if declared is not None and declared.texture is not None:
+                mesh = metric_uv(mesh, declared.texture_size)
+                mesh.visual.material = material
+            else:
+                mesh.visual = trimesh.visual.TextureVisuals(material=material)
             name = f"{shape.mesh.replace('/', '_')}-{shape.material}-{len(shared)}"
             shared[key] = name
             scene.add_geometry(

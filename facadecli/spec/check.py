@@ -25,6 +25,7 @@ from facadecli.spec.resolve import (
 from facadecli.spec.source import Path, SourceMap
 
 MESH_SUFFIXES = (".glb", ".gltf", ".obj", ".stl", ".ply")
+TEXTURE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 
 class Checker:
@@ -247,6 +248,11 @@ class Checker:
     def check_appearance(self) -> None:
         for index, rule in enumerate(self.spec.shapes):
             self.check_rule(("shapes", index), rule)
+        for name, material in self.spec.materials.items():
+            if material.texture is not None:
+                self.check_file(
+                    ("materials", name, "texture"), material.texture, TEXTURE_SUFFIXES, "texture"
+                )
         defaults = self.spec.defaults
         if defaults.material is not None:
             self.check_material(("defaults", "material"), defaults.material)
@@ -291,10 +297,22 @@ class Checker:
                 f"{'/'.join(MESH_SUFFIXES)} file next to the spec",
             )
             return
+        self.check_file(path, mesh, MESH_SUFFIXES, "mesh")
+
+    def check_file(self, path: Path, value: str, suffixes: tuple[str, ...], kind: str) -> None:
+        """A file named in the spec: of a known kind, inside the spec's folder, present."""
+        candidate = FilePath(value)
+        if candidate.suffix.lower() not in suffixes:
+            self.report(
+                path,
+                f"{kind} '{value}' is not a {'/'.join(suffixes)} file",
+                f"name a {'/'.join(suffixes)} file next to the spec",
+            )
+            return
         if candidate.is_absolute() or ".." in candidate.parts:
             self.report(
                 path,
-                f"mesh path '{mesh}' leaves the spec's folder",
+                f"{kind} path '{value}' leaves the spec's folder",
                 "use a path relative to the spec file, inside its folder",
             )
             return
@@ -305,13 +323,13 @@ class Checker:
         if not resolved.is_relative_to(base):
             self.report(
                 path,
-                f"mesh path '{mesh}' leaves the spec's folder (through a link)",
-                "copy the mesh into the spec's folder",
+                f"{kind} path '{value}' leaves the spec's folder (through a link)",
+                f"copy the {kind} into the spec's folder",
             )
         elif not resolved.is_file():
             self.report(
                 path,
-                f"mesh file '{mesh}' does not exist",
+                f"{kind} file '{value}' does not exist",
                 f"put it at {resolved} or fix the path (relative to the spec file)",
             )
 

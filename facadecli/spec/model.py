@@ -215,6 +215,8 @@ class Material(Model):
     metallic: Unit = 0.0
     roughness: Unit = 0.8
     opacity: Unit = 1.0
+    texture: str | None = None  # a PNG or JPEG next to the spec, tinted by color
+    texture_size: PositiveLength = 1.0  # metres of façade one copy of the texture covers
 
 
 class Defaults(Model):
