@@ -136,8 +136,28 @@ def test_solve_is_deterministic(tmp_path: Path) -> None:
     spec = ROOT / "specs" / "terraced-house.yaml"
     for run in ("a", "b"):
         assert facade("solve", str(spec), "-o", str(tmp_path / run)).returncode == 0
-    for name in ("terraced-house.layout.json", "terraced-house.svg"):
+    names = sorted(p.name for p in (tmp_path / "a").iterdir())
+    assert names == [
+        "terraced-house.glb",
+        "terraced-house.layout.json",
+        "terraced-house.mtl",
+        "terraced-house.obj",
+        "terraced-house.svg",
+    ]  # SPEC 4's default formats
+    for name in names:
         assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+
+
+def test_gltf_is_json_and_a_buffer_that_load_back(tmp_path: Path) -> None:
+    import trimesh
+
+    spec = ROOT / "specs" / "shop-front.yaml"
+    assert facade("solve", str(spec), "-o", str(tmp_path), "-f", "gltf").returncode == 0
+    gltf = json.loads((tmp_path / "shop-front.gltf").read_text())
+    (buffer,) = gltf["buffers"]
+    assert (tmp_path / buffer["uri"]).stat().st_size == buffer["byteLength"]
+    scene = trimesh.load(tmp_path / "shop-front.gltf", force="scene")
+    assert scene.bounds[1][:2] == pytest.approx([14.4, 18.0], abs=1e-5)
 
 
 def test_solve_retargets_and_picks_formats(tmp_path: Path) -> None:
