@@ -181,3 +181,23 @@ layers:
     assert len(back) == 3 and not any(s.visible for s in back)  # all behind the front wall
     scene = facade_scene(layout)
     assert len(scene.graph.nodes_geometry) == 1  # only the front wall is built
+
+
+def test_a_mesh_file_next_to_the_spec_is_scaled_into_its_cells(tmp_path: Path) -> None:
+    statue = trimesh.creation.icosphere(subdivisions=1, radius=5.0)
+    statue.export(tmp_path / "statue.obj")
+    (tmp_path / "niche.yaml").write_text(
+        "version: 1\nname: niche\ncanvas: {width: 3, height: 3}\nsymbol_defaults: {opaque: true}\n"
+        "symbols: {A: 1, S: 1, H: 3}\npatterns: {x: A S A, y: H}\n"
+        "layers: [{name: wall, x: x, y: y}]\n"
+        "shapes: [{match: {x: S}, mesh: statue.obj, thickness: 0.5}]\n"
+    )
+    layout = solve(load_spec(tmp_path / "niche.yaml"))
+    scene = facade_scene(layout, tmp_path)
+    placed = [
+        scene.geometry[scene.graph[n][1]].bounds + scene.graph[n][0][:3, 3]
+        for n in scene.graph.nodes_geometry
+        if "/S." in n
+    ]
+    assert len(placed) == 1
+    assert placed[0].flatten().tolist() == pytest.approx([1, 0, -0.5, 2, 3, 0], abs=1e-6)
