@@ -9,7 +9,7 @@ OUT    ?= out
 VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 
 .DEFAULT_GOAL := help
-.PHONY: help install demo test lint format bench schema golden clean
+.PHONY: help install demo test lint format bench schema golden city clean
 
 help: ## Show the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-8s %s\n", $$1, $$2}'
@@ -49,6 +49,13 @@ bench: $(STAMP) ## Time loading and solving the examples and a generated 24-laye
 
 schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json
+
+CITY ?=
+city: $(STAMP) ## Build a city: the generated demo district, or CITY=path/to/manifest.yaml
+	@if [ -z "$(CITY)" ]; then \
+	  $(BIN)/python -c "from pathlib import Path; from facadecli.city.demo import write_demo; write_demo(Path('$(OUT)/city-demo'), Path('specs'))" && \
+	  $(BIN)/facade city $(OUT)/city-demo/district.yaml -o $(OUT)/city; \
+	else $(BIN)/facade city $(CITY) -o $(OUT)/city; fi
 
 golden: $(STAMP) ## Regenerate the golden SVG elevations of the examples (tests/cases/golden)
 	$(BIN)/python tests/golden.py

@@ -248,6 +248,54 @@ def vary(
 
 
 @app.command()
+def city(
+    manifest: Annotated[Path, typer.Argument(help="City manifest (YAML).", metavar="MANIFEST")],
+    outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
+        "out/city"
+    ),
+    jobs: Annotated[
+        int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes.")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option("--scheduler", help="A Dask scheduler, tcp://HOST:PORT.")
+    ] = None,
+    resume: Annotated[bool, typer.Option("--resume", help="Skip buildings already built.")] = False,
+    limit: Annotated[int | None, typer.Option("--limit", min=1, help="Only the first N.")] = None,
+) -> None:
+    """Build every footprint of a city manifest into whole buildings (SPEC 5)."""
+    import os
+
+    from facadecli.city.manifest import load_city
+    from facadecli.city.run import run_city
+
+    if scheduler is not None:
+        raise SpecError.at(
+            "--scheduler",
+            None,
+            None,
+            "running on a Dask cluster is not supported yet",
+            "leave --scheduler out to use local worker processes (-j)",
+        )
+    loaded = load_city(manifest)
+    step = max(1, (limit or 1000) // 20)
+
+    def progress(done: int, total: int) -> None:
+        if done == total or done % step == 0:
+            typer.echo(f"{done}/{total} buildings", err=True)
+
+    report = run_city(loaded, outdir, jobs or os.cpu_count() or 1, limit, resume, progress)
+    summary = report["summary"]
+    for entry in (*report["rejected"], *(b for b in report["buildings"] if b["status"] != "ok")):
+        typer.echo(f"{manifest}: building {entry['id']}: {entry['error']}", err=True)
+    typer.echo(
+        f"{summary['ok']} of {summary['buildings']} buildings built in {summary['seconds']} s "
+        f"-> {outdir}/{report['name']}.glb, {outdir}/{report['name']}.report.json"
+    )
+    if summary["failed"]:
+        raise typer.Exit(1)
+
+
+@app.command()
 def schema(
     output: Annotated[
         Path | None,

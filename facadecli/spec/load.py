@@ -10,7 +10,7 @@ import difflib
 import types
 import typing
 from pathlib import Path as FilePath
-from typing import Any
+from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
@@ -74,34 +74,44 @@ def validate_spec(
 ) -> Spec:
     """Validate plain data (e.g. parsed YAML) as a spec; raises :class:`SpecError`."""
     source = source or SourceMap("<spec>")
-    if not isinstance(data, dict):
-        kind = type(data).__name__ if data is not None else "nothing"
-        raise SpecError(
-            [
-                source.problem(
-                    (),
-                    f"a spec must be a mapping of keys (version, name, canvas, ...), not {kind}",
-                    "start from an example in specs/",
-                )
-            ]
-        )
-    try:
-        spec = Spec.model_validate(data)
-    except ValidationError as error:
-        raise SpecError(_model_problem(e, data, source) for e in error.errors()) from None
+    spec = validate_model(Spec, data, source, "version, name, canvas, ...")
     problems = check_spec(spec, source, base_dir)
     if problems:
         raise SpecError(problems)
     return spec
 
 
-def _model_problem(error: ErrorDetails, data: Any, source: SourceMap) -> Problem:
+ModelT = TypeVar("ModelT", bound=BaseModel)
+
+
+def validate_model(model: type[ModelT], data: Any, source: SourceMap, keys: str) -> ModelT:
+    """Validate a YAML document as ``model``; every problem is positioned in its file."""
+    if not isinstance(data, dict):
+        kind = type(data).__name__ if data is not None else "nothing"
+        raise SpecError(
+            [
+                source.problem(
+                    (),
+                    f"the file must be a mapping of keys ({keys}), not {kind}",
+                    "start from an example in the README",
+                )
+            ]
+        )
+    try:
+        return model.model_validate(data)
+    except ValidationError as error:
+        raise SpecError(_model_problem(e, data, source, model) for e in error.errors()) from None
+
+
+def _model_problem(
+    error: ErrorDetails, data: Any, source: SourceMap, model: type[BaseModel]
+) -> Problem:
     path = _data_path(error["loc"], data)
     kind = error["type"]
     where = format_path(path)
     if kind == "extra_forbidden":
         key = str(error["loc"][-1])
-        allowed = _allowed_keys(error["loc"][:-1])
+        allowed = _allowed_keys(error["loc"][:-1], model)
         close = difflib.get_close_matches(key, allowed, n=1)
         hint = (f"did you mean '{close[0]}'? " if close else "") + (
             "allowed keys: " + ", ".join(allowed) if allowed else "remove it"
@@ -157,9 +167,9 @@ def _data_path(loc: tuple[int | str, ...], data: Any) -> Path:
     return tuple(path)
 
 
-def _allowed_keys(loc: tuple[int | str, ...]) -> list[str]:
+def _allowed_keys(loc: tuple[int | str, ...], root: type[BaseModel]) -> list[str]:
     """Field names of the model found at ``loc`` (following lists, dicts and unions)."""
-    candidates: list[Any] = [Spec]
+    candidates: list[Any] = [root]
     for part in loc:
         advanced: list[Any] = []
         for leaf in (leaf for c in candidates for leaf in _leaves(c)):

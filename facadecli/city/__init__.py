@@ -1,0 +1,1 @@
+"""Buildings and cities: footprints, manifests, whole buildings, city runs (SPEC 5)."""

@@ -1,0 +1,139 @@
+"""Cities: footprints, manifests, whole buildings, a run (SPEC 5). Small fixtures only."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+import trimesh
+
+from facadecli import SpecError
+from facadecli.city.demo import district, write_demo
+from facadecli.city.footprints import building_height, read_footprints
+from facadecli.city.manifest import load_city
+from facadecli.city.run import run_city, safe_name
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _geojson(tmp_path: Path, features: list[dict[str, object]], crs: str | None = None) -> Path:
+    data: dict[str, object] = {"type": "FeatureCollection", "features": features}
+    if crs:
+        data["crs"] = {"type": "name", "properties": {"name": crs}}
+    path = tmp_path / "f.geojson"
+    path.write_text(json.dumps(data))
+    return path
+
+
+def _square(fid: str, x: float, y: float, side: float, **properties: object) -> dict[str, object]:
+    ring = [[x, y], [x + side, y], [x + side, y + side], [x, y + side], [x, y]]
+    return {
+        "type": "Feature",
+        "id": fid,
+        "properties": properties,
+        "geometry": {"type": "Polygon", "coordinates": [ring]},
+    }
+
+
+def test_lon_lat_is_projected_to_metres(tmp_path: Path) -> None:
+    # 0.001 degrees of latitude is about 111 m; of longitude at 60 N about 55.8 m
+    side = 0.001
+    found = read_footprints(_geojson(tmp_path, [_square("way/1", 26.95, 60.52, side)]))
+    (part,) = found.footprints[0].parts
+    width = part.bounds[2] - part.bounds[0]
+    height = part.bounds[3] - part.bounds[1]
+    assert width == pytest.approx(111_320 * side * math.cos(math.radians(60.5205)), rel=0.01)
+    assert height == pytest.approx(111_200 * side, rel=0.01)
+    assert part.exterior.is_ccw
+
+
+def test_a_projected_crs_is_used_as_it_is(tmp_path: Path) -> None:
+    path = _geojson(tmp_path, [_square("a", 85000, 447000, 12.5)], "urn:ogc:def:crs:EPSG::28992")
+    found = read_footprints(path)
+    assert found.footprints[0].parts[0].area == pytest.approx(156.25)
+    assert found.origin == (85000, 447000)
+
+
+def test_broken_footprints_are_reported_not_raised(tmp_path: Path) -> None:
+    bowtie = {
+        "type": "Feature",
+        "id": "bow",
+        "properties": {},
+        "geometry": {
+            "type": "Polygon",
+            "coordinates": [[[0, 0], [10, 10], [10, 0], [0, 10], [0, 0]]],
+        },
+    }
+    sliver = _square("tiny", 50, 50, 0.1)
+    point = {
+        "type": "Feature",
+        "id": "pt",
+        "properties": {},
+        "geometry": {"type": "Point", "coordinates": [0, 0]},
+    }
+    broken = {"type": "Feature", "id": "bad", "properties": {}, "geometry": {"type": "Polygon"}}
+    found = read_footprints(_geojson(tmp_path, [bowtie, sliver, point, broken], "EPSG:3857"))
+    assert [f.id for f in found.footprints] == ["bow"] and found.footprints[0].repaired
+    assert {r.id for r in found.rejected} == {"tiny", "pt", "bad"}
+
+
+@pytest.mark.parametrize(
+    ("properties", "height"),
+    [
+        ({"height": "12.5"}, 12.5),
+        ({"measuredHeight": 6}, 6.0),
+        ({"building:levels": "2.5"}, 7.5),
+        ({"levels": 4}, 12.0),
+        ({"building:levels": "3;4"}, 9.0),
+        ({}, 9.0),
+        ({"height": "tall"}, 9.0),
+    ],
+)
+def test_heights_from_properties(properties: dict[str, object], height: float) -> None:
+    assert building_height(properties, 9.0, 3.0) == pytest.approx(height)
+
+
+def test_safe_names_never_collide() -> None:
+    assert safe_name("way/123") != safe_name("way_123")
+    assert "/" not in safe_name("relation/9") and safe_name("plain-1") == "plain-1"
+
+
+def test_a_manifest_naming_a_missing_or_bad_spec_is_rejected_first(tmp_path: Path) -> None:
+    manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
+    text = manifest.read_text().replace("terraced-house.yaml", "missing.yaml")
+    manifest.write_text(text + "  - when: {building: yes}\n    roof: {type: hip}\n")
+    with pytest.raises(SpecError) as caught:
+        load_city(manifest)
+    messages = " ".join(p.message for p in caught.value.problems)
+    assert "missing.yaml" in messages and "not supported yet" in messages
+    assert all(p.line for p in caught.value.problems)
+
+
+def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
+    manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
+    city = load_city(manifest)
+    out = tmp_path / "out"
+    report = run_city(city, out, jobs=2)
+    assert report["summary"] == {**report["summary"], "buildings": 4, "ok": 4, "failed": 0}
+    merged = trimesh.load(out / "demo-district.glb", force="scene")
+    assert len(list((out / "buildings").glob("*.glb"))) == 4
+    low, high = merged.bounds
+    assert low[1] == pytest.approx(-0.01, abs=1e-3)  # the ground
+    assert high[1] >= 9.0  # the tallest building's roof
+    first = json.loads((out / "demo-district.report.json").read_text())["buildings"][0]
+    assert first["facades"] >= 4 and first["id"] == "way/1000"
+    again = run_city(city, out, jobs=1, resume=True)
+    assert all(b.get("resumed") for b in again["buildings"])
+    serial = run_city(city, tmp_path / "serial", jobs=1)
+    for name in sorted(p.name for p in (out / "buildings").iterdir()):
+        assert (out / "buildings" / name).read_bytes() == (
+            tmp_path / "serial" / "buildings" / name
+        ).read_bytes()
+    assert serial["summary"]["ok"] == 4
+
+
+def test_the_demo_district_is_deterministic() -> None:
+    assert district(2, seed=1) == district(2, seed=1)
+    assert len(district(2)["features"]) == 16  # type: ignore[arg-type]
