@@ -16,12 +16,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import trimesh
-
 from facadecli.city.building import AxisCache, build_building
 from facadecli.city.footprints import Footprint, read_footprints
 from facadecli.city.manifest import City, Roof
 from facadecli.export.atomic import write_atomic
+from facadecli.export.glb_merge import merge_glb
 from facadecli.export.gltf import glb_bytes
 from facadecli.spec.model import Spec
 
@@ -137,8 +136,10 @@ def run_city(
             progress(done, len(tasks))
     order = {task.footprint.id: i for i, task in enumerate(tasks)}
     results.sort(key=lambda r: order[r["id"]])
-    merged = outdir / f"{city.manifest.name}.glb"
-    write_atomic(merged, _merge(outdir, results))
+    merge_glb(
+        ((r["id"], outdir / r["file"]) for r in results if r["status"] == "ok"),
+        outdir / f"{city.manifest.name}.glb",
+    )
     failed = [r for r in results if r["status"] != "ok"]
     report = {
         "version": 1,
@@ -170,18 +171,3 @@ def _map(
     chunk = max(1, min(16, len(tasks) // (jobs * 4)))
     with ProcessPoolExecutor(max_workers=jobs) as pool:
         yield from pool.map(function, tasks, chunksize=chunk)
-
-
-def _merge(outdir: Path, results: list[dict[str, Any]]) -> bytes:
-    """One glb of every built building (their nodes side by side, by id)."""
-    scene = trimesh.Scene()
-    for result in results:
-        if result["status"] != "ok":
-            continue
-        building = trimesh.load(outdir / result["file"], force="scene")
-        for node in sorted(building.graph.nodes_geometry):
-            matrix, geometry = building.graph[node]
-            scene.add_geometry(
-                building.geometry[geometry], geom_name=node, node_name=node, transform=matrix
-            )
-    return glb_bytes(scene)

@@ -1,0 +1,143 @@
+"""Merge .glb files into one without holding them all: a streaming writer.
+
+Each input's binary chunk is appended to a temporary file as it is read; only the JSON
+(nodes, meshes, accessors: a few kilobytes a building) stays in memory. The output is
+assembled at the end and renamed into place, so a city of any size merges in flat memory.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import struct
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+MAGIC = 0x46546C67  # "glTF"
+JSON_CHUNK = 0x4E4F534A
+BIN_CHUNK = 0x004E4942
+
+# glTF arrays whose entries point at each other, and the fields that point
+_REFERENCES = {
+    "bufferViews": [],
+    "accessors": [("bufferView", "bufferViews")],
+    "images": [("bufferView", "bufferViews")],
+    "samplers": [],
+    "textures": [("source", "images"), ("sampler", "samplers")],
+    "materials": [],
+    "meshes": [],
+    "nodes": [("mesh", "meshes")],
+}
+
+
+def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
+    magic, _, length = struct.unpack_from("<III", data, 0)
+    if magic != MAGIC:
+        raise ValueError("not a glb file")
+    offset, document, binary = 12, None, b""
+    while offset < length:
+        size, kind = struct.unpack_from("<II", data, offset)
+        chunk = data[offset + 8 : offset + 8 + size]
+        if kind == JSON_CHUNK:
+            document = json.loads(chunk)
+        elif kind == BIN_CHUNK:
+            binary = chunk
+        offset += 8 + size
+    if document is None:
+        raise ValueError("glb without a JSON chunk")
+    return document, binary
+
+
+def merge_glb(parts: Iterable[tuple[str, Path]], target: Path) -> None:
+    """Write one glb holding every (name, file) part under a root node of that name."""
+    merged: dict[str, Any] = {key: [] for key in _REFERENCES}
+    merged.update(
+        asset={"version": "2.0", "generator": "facadecli"}, scenes=[{"nodes": []}], scene=0
+    )
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, binary_path = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".bin", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as binary:
+            for name, path in parts:
+                document, chunk = read_glb(path.read_bytes())
+                _append(merged, document, name, binary.tell())
+                binary.write(chunk)
+                binary.write(b"\0" * (-len(chunk) % 4))
+            length = binary.tell()
+        _write(merged, binary_path, length, target)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(binary_path)
+
+
+def _append(merged: dict[str, Any], document: dict[str, Any], name: str, offset: int) -> None:
+    base = {key: len(merged[key]) for key in _REFERENCES}
+    for key, links in _REFERENCES.items():
+        for entry in document.get(key, []):
+            entry = dict(entry)
+            for field, target in links:
+                if field in entry:
+                    entry[field] += base[target]
+            if key == "bufferViews":
+                entry["buffer"] = 0
+                entry["byteOffset"] = entry.get("byteOffset", 0) + offset
+            if key == "nodes" and "children" in entry:
+                entry["children"] = [child + base["nodes"] for child in entry["children"]]
+            if key == "materials":
+                _shift_textures(entry, base["textures"])
+            if key == "meshes":
+                entry["primitives"] = [_primitive(p, base) for p in entry["primitives"]]
+            merged[key].append(entry)
+    scene = document.get("scenes", [{}])[document.get("scene", 0)]
+    roots = [node + base["nodes"] for node in scene.get("nodes", [])]
+    merged["nodes"].append({"name": name, "children": roots})
+    merged["scenes"][0]["nodes"].append(len(merged["nodes"]) - 1)
+
+
+def _primitive(primitive: dict[str, Any], base: dict[str, int]) -> dict[str, Any]:
+    shifted = dict(primitive)
+    shifted["attributes"] = {k: v + base["accessors"] for k, v in primitive["attributes"].items()}
+    if "indices" in primitive:
+        shifted["indices"] = primitive["indices"] + base["accessors"]
+    if "material" in primitive:
+        shifted["material"] = primitive["material"] + base["materials"]
+    return shifted
+
+
+def _shift_textures(value: Any, base: int) -> None:
+    """Texture references sit in nested ``{"index": i}`` objects of a material."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if key.endswith("Texture") and isinstance(item, dict) and "index" in item:
+                item["index"] += base
+            else:
+                _shift_textures(item, base)
+
+
+def _write(merged: dict[str, Any], binary_path: str, length: int, target: Path) -> None:
+    merged["buffers"] = [{"byteLength": length}]
+    for key in list(merged):
+        if isinstance(merged[key], list) and not merged[key]:
+            del merged[key]
+    text = json.dumps(merged, separators=(",", ":")).encode("utf-8")
+    text += b" " * (-len(text) % 4)
+    total = 12 + 8 + len(text) + (8 + length if length else 0)
+    fd, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as out, open(binary_path, "rb") as binary:
+            out.write(struct.pack("<III", MAGIC, 2, total))
+            out.write(struct.pack("<II", len(text), JSON_CHUNK))
+            out.write(text)
+            if length:
+                out.write(struct.pack("<II", length, BIN_CHUNK))
+                shutil.copyfileobj(binary, out, 1 << 20)
+        os.chmod(temporary, 0o644)
+        os.replace(temporary, target)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(temporary)
+        raise
