@@ -8,6 +8,7 @@ in the manifest's order, so the report and the merged model do not depend on sch
 from __future__ import annotations
 
 import hashlib
+import json
 import re
 import time
 from collections.abc import Callable, Iterator
@@ -155,8 +156,6 @@ def run_city(
             "seconds": round(time.perf_counter() - started, 2),
         },
     }
-    import json
-
     write_atomic(outdir / f"{city.manifest.name}.report.json", json.dumps(report, indent=2) + "\n")
     return report
 
