@@ -268,22 +268,34 @@ def city(
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
 
-    if scheduler is not None:
+    if scheduler is not None and not scheduler.startswith(("tcp://", "tls://", "inproc://")):
         raise SpecError.at(
             "--scheduler",
             None,
             None,
-            "running on a Dask cluster is not supported yet",
-            "leave --scheduler out to use local worker processes (-j)",
+            f"'{scheduler}' is not a scheduler address",
+            "write tcp://HOST:PORT",
         )
     loaded = load_city(manifest)
-    step = max(1, (limit or 1000) // 20)
+    workers = jobs or os.cpu_count() or 1
+    if sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
+        from rich.progress import Progress
 
-    def progress(done: int, total: int) -> None:
-        if done == total or done % step == 0:
-            typer.echo(f"{done}/{total} buildings", err=True)
+        with Progress(transient=True) as bar:
+            task = bar.add_task("buildings", total=None)
 
-    report = run_city(loaded, outdir, jobs or os.cpu_count() or 1, limit, resume, progress)
+            def progress(done: int, total: int) -> None:
+                bar.update(task, completed=done, total=total)
+
+            report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler)
+    else:
+        step = max(1, (limit or 1000) // 20)
+
+        def progress(done: int, total: int) -> None:
+            if done == total or done % step == 0:
+                typer.echo(f"{done}/{total} buildings", err=True)
+
+        report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler)
     summary = report["summary"]
     for entry in (*report["rejected"], *(b for b in report["buildings"] if b["status"] != "ok")):
         typer.echo(f"{manifest}: building {entry['id']}: {entry['error']}", err=True)

@@ -137,3 +137,26 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
 def test_the_demo_district_is_deterministic() -> None:
     assert district(2, seed=1) == district(2, seed=1)
     assert len(district(2)["features"]) == 16  # type: ignore[arg-type]
+
+
+def test_a_dask_cluster_gives_the_same_files_as_local_processes(tmp_path: Path) -> None:
+    from distributed import LocalCluster
+
+    manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
+    city = load_city(manifest)
+    run_city(city, tmp_path / "local", jobs=2)
+    with LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        host="127.0.0.1",
+        processes=True,
+        dashboard_address=None,
+    ) as cluster:
+        report = run_city(city, tmp_path / "dask", scheduler=cluster.scheduler_address)
+    assert report["summary"]["ok"] == 4
+    local = sorted(p.relative_to(tmp_path / "local") for p in (tmp_path / "local").rglob("*.glb"))
+    assert local == sorted(
+        p.relative_to(tmp_path / "dask") for p in (tmp_path / "dask").rglob("*.glb")
+    )
+    for path in local:
+        assert (tmp_path / "local" / path).read_bytes() == (tmp_path / "dask" / path).read_bytes()
