@@ -6,13 +6,17 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 import trimesh
+from shapely.geometry import Polygon
+from shapely.geometry.polygon import orient
 
 from facadecli import SpecError
 from facadecli.city.demo import district, write_demo
 from facadecli.city.footprints import building_height, read_footprints
-from facadecli.city.manifest import load_city
+from facadecli.city.manifest import Roof, load_city
+from facadecli.city.roofs import roof_meshes
 from facadecli.city.run import run_city, safe_name
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -103,11 +107,15 @@ def test_safe_names_never_collide() -> None:
 def test_a_manifest_naming_a_missing_or_bad_spec_is_rejected_first(tmp_path: Path) -> None:
     manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
     text = manifest.read_text().replace("terraced-house.yaml", "missing.yaml")
-    manifest.write_text(text + "  - when: {building: yes}\n    roof: {type: hip}\n")
+    manifest.write_text(text)
     with pytest.raises(SpecError) as caught:
         load_city(manifest)
     messages = " ".join(p.message for p in caught.value.problems)
-    assert "missing.yaml" in messages and "not supported yet" in messages
+    assert "missing.yaml" in messages
+    manifest.write_text(text + "  - when: {building: yes}\n    roof: {type: dome}\n")
+    with pytest.raises(SpecError) as caught:
+        load_city(manifest)
+    assert "roof.type" in caught.value.problems[0].message
     assert all(p.line for p in caught.value.problems)
 
 
@@ -160,3 +168,46 @@ def test_a_dask_cluster_gives_the_same_files_as_local_processes(tmp_path: Path) 
     )
     for path in local:
         assert (tmp_path / "local" / path).read_bytes() == (tmp_path / "dask" / path).read_bytes()
+
+
+AWKWARD = {
+    "rectangle": Polygon([(0, 0), (10, 0), (10, 6), (0, 6)]),
+    "concave": Polygon([(0, 0), (10, 0), (10, 10), (5, 4), (0, 10)]),
+    "L": Polygon([(0, 0), (10, 0), (10, 4), (4, 4), (4, 10), (0, 10)]),
+    "T": Polygon([(0, 0), (12, 0), (12, 4), (8, 4), (8, 10), (4, 10), (4, 4), (0, 4)]),
+    "U": Polygon([(0, 0), (12, 0), (12, 10), (8, 10), (8, 4), (4, 4), (4, 10), (0, 10)]),
+    "courtyard": Polygon(
+        [(0, 0), (20, 0), (20, 20), (0, 20)], [[(5, 5), (5, 15), (15, 15), (15, 5)]]
+    ),
+}
+
+
+@pytest.mark.parametrize("kind", ["shed", "gable", "hip"])
+@pytest.mark.parametrize("name", sorted(AWKWARD))
+def test_sloped_roofs_cover_any_footprint(kind: str, name: str) -> None:
+    part = orient(AWKWARD[name], sign=1.0)
+    roof, walls = roof_meshes(part, 9.0, Roof(type=kind, pitch=30))
+    plan = trimesh.Trimesh(
+        np.column_stack([roof.vertices[:, :2], np.zeros(len(roof.vertices))]), roof.faces
+    )
+    assert plan.area == pytest.approx(part.area, rel=1e-6)  # covered once, no gaps or overlaps
+    assert (roof.face_normals[:, 2] > 0).all()  # every face looks up
+    assert roof.bounds[0][2] == pytest.approx(9.0, abs=1e-6)  # down to the eaves
+    if kind == "hip":
+        assert not walls  # a hip roof meets the walls at the eaves all round
+    else:
+        assert walls and all(w.bounds[0][2] == pytest.approx(9.0) for w in walls)
+
+
+def test_roof_heights_follow_the_pitch() -> None:
+    rectangle = orient(AWKWARD["rectangle"], sign=1.0)  # 10 x 6 m
+    rise = math.tan(math.radians(30))
+    assert roof_meshes(rectangle, 9.0, Roof(type="hip"))[0].bounds[1][2] == pytest.approx(
+        9 + 3 * rise
+    )
+    assert roof_meshes(rectangle, 9.0, Roof(type="gable"))[0].bounds[1][2] == pytest.approx(
+        9 + 3 * rise
+    )
+    assert roof_meshes(rectangle, 9.0, Roof(type="shed"))[0].bounds[1][2] == pytest.approx(
+        9 + 6 * rise
+    )

@@ -20,6 +20,7 @@ from shapely.geometry import Polygon
 
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof
+from facadecli.city.roofs import roof_meshes
 from facadecli.errors import InfeasibleError
 from facadecli.geometry.facade import facade_scene, pbr
 from facadecli.layout import Layout, build_shapes
@@ -99,7 +100,7 @@ def build_building(
     """The building's scene: façades on every wall, a flat roof, the ground."""
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
-    wall_height = height + roof.parapet
+    wall_height = height + (roof.parapet if roof.type == "flat" else 0.0)
     vertical = cache.get(spec_key, spec, "y", wall_height)
     facades = plain = 0
     for part in footprint.parts:
@@ -137,10 +138,12 @@ def build_building(
             for mesh in _placed(facade_scene(layout)):
                 mesh.apply_transform(placement)
                 parts.setdefault(mesh.visual.material.name, []).append(mesh)
-        slab = trimesh.creation.extrude_polygon(part, SLAB)
-        slab.apply_translation((0, 0, height - SLAB))
-        slab.apply_transform(MAP_TO_WORLD)
-        parts.setdefault("roof", []).append(slab)
+        cover, infill = roof_meshes(part, height, roof)
+        cover.apply_transform(MAP_TO_WORLD)
+        parts.setdefault("roof", []).append(cover)
+        for piece in infill:
+            piece.apply_transform(MAP_TO_WORLD)
+            parts.setdefault("wall", []).append(piece)
         ground = trimesh.creation.extrude_polygon(part, 0.01)
         ground.apply_translation((0, 0, -0.01))
         ground.apply_transform(MAP_TO_WORLD)

@@ -18,13 +18,15 @@ defaults:
   facade: {specs}/townhouse.yaml
   height: 12.0
   floor_height: 3.2
-  roof: {{type: flat, parapet: 0.6}}
+  roof: {{type: gable, pitch: 35}}
   min_facade_width: 3.0
 rules:
+  - when: {{building: apartments, building:levels: "7"}}
+    facade: {specs}/terraced-house.yaml
+    roof: {{type: flat, parapet: 0.6}}
   - when: {{building: apartments}}
     facade: {specs}/terraced-house.yaml
-  - when: {{levels: {{min: 6}}}}
-    facade: {specs}/terraced-house.yaml
+    roof: {{type: hip, pitch: 30}}
 """
 
 

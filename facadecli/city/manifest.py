@@ -21,7 +21,7 @@ from facadecli.spec.source import Path as DataPath
 from facadecli.spec.source import SourceMap, read_document
 
 ROOF_TYPES = ("flat", "shed", "gable", "hip")
-SUPPORTED_ROOFS = ("flat",)
+SUPPORTED_ROOFS = ROOF_TYPES
 
 
 class Roof(Model):
