@@ -211,3 +211,15 @@ def test_roof_heights_follow_the_pitch() -> None:
     assert roof_meshes(rectangle, 9.0, Roof(type="shed"))[0].bounds[1][2] == pytest.approx(
         9 + 6 * rise
     )
+
+
+def test_osm_roof_tags_pick_the_roof(tmp_path: Path) -> None:
+    city = load_city(write_demo(tmp_path / "city", ROOT / "specs", blocks=1))
+    _, roof, height = city.choose(
+        {"roof:shape": "hipped", "roof:angle": "40", "building:levels": "3"}
+    )
+    assert (roof.type, roof.pitch) == ("hip", 40.0) and height == pytest.approx(9.6)
+    _, roof, _ = city.choose({"roof:shape": "skillion"})
+    assert roof.type == "shed"
+    _, roof, _ = city.choose({"roof:shape": "onion"})
+    assert roof.type == "gable"  # unknown shapes: the manifest's default

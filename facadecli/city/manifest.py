@@ -68,9 +68,10 @@ class City:
     specs: dict[str, Spec]  # by the path the manifest gives
 
     def choose(self, properties: dict[str, Any]) -> tuple[str, Roof, float]:
-        """(façade spec path, roof, height) for a building: the first matching rule wins."""
+        """(façade spec path, roof, height) for a building: the first matching rule wins;
+        else the feature's own OSM ``roof:shape`` (and ``roof:angle``); else the defaults."""
         defaults = self.manifest.defaults
-        facade, roof = defaults.facade, defaults.roof
+        facade, roof = defaults.facade, _tagged_roof(properties) or defaults.roof
         height = building_height(properties, defaults.height, defaults.floor_height)
         for rule in self.manifest.rules:
             if all(_matches(properties, key, want) for key, want in rule.when.items()):
@@ -79,6 +80,24 @@ class City:
                 height = rule.height or height
                 break
         return facade, roof, height
+
+
+OSM_ROOFS = {
+    "flat": "flat",
+    "skillion": "shed",
+    "lean_to": "shed",
+    "gabled": "gable",
+    "hipped": "hip",
+    "pyramidal": "hip",
+}
+
+
+def _tagged_roof(properties: dict[str, Any]) -> Roof | None:
+    kind = OSM_ROOFS.get(str(properties.get("roof:shape", "")).strip().lower())
+    if kind is None:
+        return None
+    angle = number(properties.get("roof:angle"))
+    return Roof(type=kind, pitch=angle if angle is not None and 0 < angle < 90 else 30.0)
 
 
 def _matches(properties: dict[str, Any], key: str, want: str | float | bool | Range) -> bool:
