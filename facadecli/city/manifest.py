@@ -82,7 +82,8 @@ class City:
         return facade, roof, height
 
 
-OSM_ROOFS = {
+RoofType = Literal["flat", "shed", "gable", "hip"]
+OSM_ROOFS: dict[str, RoofType] = {
     "flat": "flat",
     "skillion": "shed",
     "lean_to": "shed",
