@@ -17,6 +17,8 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from facadecli.export.atomic import atomic_output
+
 MAGIC = 0x46546C67  # "glTF"
 JSON_CHUNK = 0x4E4F534A
 BIN_CHUNK = 0x004E4942
@@ -126,18 +128,10 @@ def _write(merged: dict[str, Any], binary_path: str, length: int, target: Path) 
     text = json.dumps(merged, separators=(",", ":")).encode("utf-8")
     text += b" " * (-len(text) % 4)
     total = 12 + 8 + len(text) + (8 + length if length else 0)
-    fd, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "wb") as out, open(binary_path, "rb") as binary:
-            out.write(struct.pack("<III", MAGIC, 2, total))
-            out.write(struct.pack("<II", len(text), JSON_CHUNK))
-            out.write(text)
-            if length:
-                out.write(struct.pack("<II", length, BIN_CHUNK))
-                shutil.copyfileobj(binary, out, 1 << 20)
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, target)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(temporary)
-        raise
+    with atomic_output(target) as out, open(binary_path, "rb") as binary:
+        out.write(struct.pack("<III", MAGIC, 2, total))
+        out.write(struct.pack("<II", len(text), JSON_CHUNK))
+        out.write(text)
+        if length:
+            out.write(struct.pack("<II", length, BIN_CHUNK))
+            shutil.copyfileobj(binary, out, 1 << 20)
