@@ -4,7 +4,6 @@ transparency, appearance rules) and occlusion flags (SPEC 2.5, 2.8)."""
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -190,10 +189,6 @@ def _covered(shape: Shape, occluders: list[Shape]) -> bool:
             if not any(o.x0 <= cx <= o.x1 and o.y0 <= cy <= o.y1 for o in occluders):
                 return False
     return True
-
-
-def layer_index(spec: Spec) -> Mapping[str, int]:
-    return {layer.name: i for i, layer in enumerate(spec.layers)}
 
 
 def uncovered_area(layout: Layout) -> float:

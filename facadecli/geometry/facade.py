@@ -17,7 +17,7 @@ from facadecli.geometry.primitives import PRIMITIVES, Cell, asset
 from facadecli.layout import Layout, Shape
 from facadecli.spec.model import Material
 
-DEFAULT_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
+FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
 
 
 def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMaterial:
@@ -115,7 +115,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
                 continue
             mesh = _build(shape, cell, base_dir, assets)
             _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
-            material = materials.get(shape.material) or pbr(shape.material, DEFAULT_MATERIAL)
+            material = materials.get(shape.material) or pbr(shape.material, FALLBACK_MATERIAL)
             declared = spec.materials.get(shape.material)
             if declared is not None and declared.texture is not None:
                 mesh = metric_uv(mesh, declared.texture_size)

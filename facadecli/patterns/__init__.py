@@ -23,7 +23,6 @@ from facadecli.patterns.words import (
     format_word,
     make_word,
     mirror,
-    word_length,
 )
 
 __all__ = [
@@ -48,5 +47,4 @@ __all__ = [
     "make_word",
     "mirror",
     "parse_pattern",
-    "word_length",
 ]

@@ -390,11 +390,6 @@ def enumerate_words(
             yield Enumerated(Choice.of(values), word, length, elastic)
 
 
-def word_length(word: Word, sizes: Mapping[str, float | None]) -> float:
-    """Sum of the preferred sizes of a word's sized letters."""
-    return sum(sizes.get(letter.symbol) or 0.0 for letter in word)
-
-
 def format_word(word: Word) -> str:
     """Readable text of a word: ``A B'`` for a reflected B, ``[e]`` for a transparent e."""
     parts = []

@@ -13,6 +13,7 @@ microseconds) to rank alignments; ``solve`` is the cvxpy QP with every bound.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -197,7 +198,9 @@ def solve(program: Program) -> Sizing | None:
         constraints.append(z[np.flatnonzero(finite_high)] <= program.upper[finite_high])
     problem = cp.Problem(objective, constraints)
     try:
-        problem.solve(solver=cp.CLARABEL)
+        with warnings.catch_warnings():  # "may be inaccurate": accepted, the layout is checked
+            warnings.simplefilter("ignore", UserWarning)
+            problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError:
         return None
     if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or z.value is None:
