@@ -223,3 +223,14 @@ def test_osm_roof_tags_pick_the_roof(tmp_path: Path) -> None:
     assert roof.type == "shed"
     _, roof, _ = city.choose({"roof:shape": "onion"})
     assert roof.type == "gable"  # unknown shapes: the manifest's default
+
+
+def test_broken_geojson_files_are_located(tmp_path: Path) -> None:
+    path = tmp_path / "f.geojson"
+    path.write_text('{"type": "FeatureCollection",\n "features": [}\n')
+    with pytest.raises(SpecError) as caught:
+        read_footprints(path)
+    assert (caught.value.problems[0].line, caught.value.problems[0].col) == (2, 15)
+    path.write_text("[1, 2]")
+    with pytest.raises(SpecError, match="FeatureCollection"):
+        read_footprints(path)

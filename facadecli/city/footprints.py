@@ -24,6 +24,8 @@ import shapely.errors
 from shapely.geometry import MultiPolygon, Polygon, shape
 from shapely.geometry.polygon import orient
 
+from facadecli.errors import SpecError
+
 MIN_AREA = 1.0  # m²: smaller parts are slivers, not buildings
 
 
@@ -68,8 +70,33 @@ def _crs(data: dict[str, Any]) -> pyproj.CRS:
 
 def read_footprints(path: Path) -> FootprintSet:
     """Footprints of every usable feature; rejected features with a reason."""
-    data = json.loads(path.read_text(encoding="utf-8"))
-    features = data.get("features") or []
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as error:
+        raise SpecError.at(
+            str(path),
+            error.lineno,
+            error.colno,
+            f"invalid GeoJSON: {error.msg}",
+            "check the file's JSON syntax",
+        ) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise SpecError.at(
+            str(path),
+            None,
+            None,
+            f"cannot read the footprints: {error}",
+            "check the path in the manifest",
+        ) from None
+    if not isinstance(data, dict) or not isinstance(data.get("features"), list):
+        raise SpecError.at(
+            str(path),
+            1,
+            1,
+            "not a GeoJSON FeatureCollection",
+            'write {"type": "FeatureCollection", "features": [...]}',
+        )
+    features = data["features"]
     source = _crs(data)
     geometries: list[tuple[str, dict[str, Any], Any]] = []
     rejected: list[Rejected] = []
