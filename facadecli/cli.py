@@ -308,6 +308,72 @@ def city(
 
 
 @app.command()
+def grammar(
+    layout: Annotated[
+        Path,
+        typer.Argument(
+            help="A labelled layout: CMP .xml, a facadecli "
+            ".layout.json, or a JSON list of rectangles.",
+            metavar="LAYOUT",
+        ),
+    ],
+    outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
+        "out/grammar"
+    ),
+    timings: Annotated[
+        bool, typer.Option("--timings", help="Record the time in the report (not reproducible).")
+    ] = False,
+) -> None:
+    """Derive a split grammar from a labelled façade (Wu et al. 2014; the greedy baseline
+    so far): writes the grammar as text and JSON, the tiling as SVG, and a report."""
+    import time
+
+    from facadecli.grammar.outputs import grammar_json, grammar_report, tiling_svg
+    from facadecli.grammar.split import derive, greedy_grammar
+    from facadecli.grammar.tiling import read_cmp, read_plain, read_report, tile
+
+    if not layout.is_file():
+        raise SpecError.at(str(layout), None, None, "no such file", "check the path")
+    name = layout.name
+    try:
+        if name.endswith(".xml"):
+            labelled = read_cmp(layout)
+        elif name.endswith(".layout.json"):
+            labelled = read_report(layout)
+        else:
+            labelled = read_plain(layout)
+    except (ValueError, KeyError, TypeError) as error:
+        raise SpecError.at(
+            str(layout),
+            None,
+            None,
+            f"not a labelled layout: {error}",
+            "give a CMP .xml, a .layout.json, or [{label, x0, y0, x1, y1}, ...]",
+        ) from None
+    tiling = tile(labelled)
+    started = time.perf_counter()
+    found = greedy_grammar(tiling)
+    elapsed = round((time.perf_counter() - started) * 1000, 3)
+    for label, x0, y0, x1, y1 in derive(found, tiling.xs[-1], tiling.ys[-1]):
+        assert tiling.label_at((x0 + x1) / 2, (y0 + y1) / 2) == label  # exact re-derivation
+    stem = name.removesuffix(".layout.json").rsplit(".", 1)[0] if "." in name else name
+    outputs = {
+        f"{stem}.grammar.txt": found.text(),
+        f"{stem}.grammar.json": grammar_json(found),
+        f"{stem}.tiling.svg": tiling_svg(tiling, stem),
+        f"{stem}.grammar-report.json": grammar_report(
+            found, tiling, name, "greedy", elapsed if timings else None
+        ),
+    }
+    for file, text in outputs.items():
+        write_atomic(outdir / file, text)
+    typer.echo(
+        f"{layout}: {len(found.rules)} rules, cost {found.cost:.1f} -> "
+        + ", ".join(str(outdir / f) for f in outputs)
+    )
+
+
+@app.command()
 def schema(
     output: Annotated[
         Path | None,

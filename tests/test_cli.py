@@ -215,3 +215,23 @@ def test_vary_rejects_bad_sizes(tmp_path: Path) -> None:
     spec = ROOT / "specs" / "residential-house.yaml"
     result = facade("vary", str(spec), "--widths", "8,x", "-o", str(tmp_path))
     assert result.returncode == 2 and "metres" in result.stderr
+
+
+def test_grammar_writes_text_json_svg_and_a_report(tmp_path: Path) -> None:
+    layout = tmp_path / "floors.json"
+    rects = [
+        {"label": "window", "x0": x, "y0": y, "x1": x + 1, "y1": y + 1.5}
+        for y in (0.5, 3.5, 6.5)
+        for x in (1.0, 3.0, 5.0)
+    ]
+    layout.write_text(json.dumps({"canvas": {"width": 7, "height": 9.5}, "rects": rects}))
+    result = facade("grammar", str(layout), "-o", str(tmp_path / "out"))
+    assert result.returncode == 0, result.stderr
+    text = (tmp_path / "out" / "floors.grammar.txt").read_text()
+    assert text.startswith("N1 --> split(y)") and "repeat(y)" in text
+    grammar = json.loads((tmp_path / "out" / "floors.grammar.json").read_text())
+    assert grammar["start"] == "N1" and grammar["terminals"] == ["facade", "window"]
+    report = json.loads((tmp_path / "out" / "floors.grammar-report.json").read_text())
+    assert report["method"] == "greedy" and report["cost"] == grammar["cost"]
+    assert (tmp_path / "out" / "floors.tiling.svg").read_text().startswith("<?xml")
+    assert facade("grammar", str(tmp_path / "missing.xml")).returncode == 2

@@ -1,0 +1,85 @@
+"""What ``facade grammar`` writes: the grammar as text and JSON, the tiling as SVG, and a
+report (cost, rules, time)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict
+from typing import Any
+from xml.sax.saxutils import escape
+
+from facadecli.grammar.split import Grammar
+from facadecli.grammar.tiling import Tiling
+
+SCALE = 600.0  # pixels for the longer side of the façade
+
+
+def grammar_json(grammar: Grammar) -> str:
+    data: dict[str, Any] = {
+        "start": grammar.start,
+        "terminals": sorted(grammar.terminals),
+        "rules": {name: asdict(rule) for name, rule in grammar.rules.items()},
+        "cost": round(grammar.cost, 6),
+    }
+    return json.dumps(data, indent=2) + "\n"
+
+
+def _colour(label: str) -> str:
+    digest = hashlib.sha1(label.encode()).digest()
+    return "#{:02x}{:02x}{:02x}".format(*(80 + b % 150 for b in digest[:3]))
+
+
+def tiling_svg(tiling: Tiling, title: str) -> str:
+    """Cells filled by label (a legend below), drawn bottom up like the façade."""
+    width, height = tiling.xs[-1], tiling.ys[-1]
+    scale = SCALE / max(width, height)
+    labels = sorted({label for row in tiling.labels for label in row})
+    legend = 18 * len(labels) + 10
+    w, h = width * scale, height * scale
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w + 20:.0f}" '
+        f'height="{h + 20 + legend:.0f}">',
+        f"<title>{escape(title)}: tiling</title>",
+        f'<rect width="{w + 20:.0f}" height="{h + 20 + legend:.0f}" fill="#ffffff"/>',
+    ]
+    for r, row in enumerate(tiling.labels):
+        y = 10 + (height - tiling.ys[r + 1]) * scale
+        cell_h = (tiling.ys[r + 1] - tiling.ys[r]) * scale
+        for c, label in enumerate(row):
+            x = 10 + tiling.xs[c] * scale
+            cell_w = (tiling.xs[c + 1] - tiling.xs[c]) * scale
+            lines.append(
+                f'<rect x="{x:.2f}" y="{y:.2f}" width="{cell_w:.2f}" height="{cell_h:.2f}" '
+                f'fill="{_colour(label)}"/>'
+            )
+    for i, label in enumerate(labels):
+        y = h + 24 + 18 * i
+        lines.append(f'<rect x="10" y="{y:.0f}" width="12" height="12" fill="{_colour(label)}"/>')
+        lines.append(
+            f'<text x="28" y="{y + 11:.0f}" font-family="sans-serif" font-size="12">'
+            f"{escape(label)}</text>"
+        )
+    lines.append("</svg>")
+    return "\n".join(lines) + "\n"
+
+
+def grammar_report(
+    grammar: Grammar, tiling: Tiling, source: str, method: str, time_ms: float | None
+) -> str:
+    return (
+        json.dumps(
+            {
+                "source": source,
+                "method": method,
+                "cost": round(grammar.cost, 6),
+                "rules": len(grammar.rules),
+                "terminals": len(grammar.terminals),
+                "cells": (len(tiling.xs) - 1) * (len(tiling.ys) - 1),
+                "time_ms": time_ms,
+            },
+            indent=2,
+        )
+        + "\n"
+    )
