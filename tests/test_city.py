@@ -234,3 +234,30 @@ def test_broken_geojson_files_are_located(tmp_path: Path) -> None:
     path.write_text("[1, 2]")
     with pytest.raises(SpecError, match="FeatureCollection"):
         read_footprints(path)
+
+
+def test_mesh_files_of_a_spec_are_found_next_to_the_spec(tmp_path: Path) -> None:
+    specs = tmp_path / "specs"
+    specs.mkdir()
+    trimesh.creation.box(extents=(1, 1, 1)).export(specs / "block.obj")
+    (specs / "plain.yaml").write_text(
+        "version: 1\nname: plain\ncanvas: {width: 6, height: 6}\nsymbol_defaults: {opaque: true}\n"
+        "symbols: {A: 1, H: 3}\ncounters: {n: {min: 1}, m: {min: 1}}\npatterns: {x: A^n, y: H^m}\n"
+        "layers: [{name: wall, x: x, y: y}]\ndefaults: {mesh: block.obj}\n"
+    )
+    (tmp_path / "city").mkdir()
+    (tmp_path / "city" / "f.geojson").write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "crs": {"type": "name", "properties": {"name": "EPSG:28992"}},
+                "features": [_square("a", 0, 0, 8, height=6)],
+            }
+        )
+    )
+    (tmp_path / "city" / "m.yaml").write_text(
+        "version: 1\nname: m\nfootprints: f.geojson\ndefaults: {facade: ../specs/plain.yaml}\n"
+    )
+    report = run_city(load_city(tmp_path / "city" / "m.yaml"), tmp_path / "out", jobs=1)
+    (building,) = report["buildings"]
+    assert building["status"] == "ok" and building["facades"] == 4, building

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import trimesh
@@ -44,17 +46,11 @@ class AxisCache:
         slot = (key, axis, round(length, 2))
         if slot not in self.axes:
             try:
-                deadline = _now() + spec.solver.time_limit / 2
+                deadline = time.perf_counter() + spec.solver.time_limit / 2
                 self.axes[slot] = solve_axis(spec, axis, round(length, 2), deadline)  # type: ignore[arg-type]
             except InfeasibleError:
                 self.axes[slot] = None
         return self.axes[slot]
-
-
-def _now() -> float:
-    import time
-
-    return time.perf_counter()
 
 
 @dataclass(frozen=True)
@@ -96,8 +92,10 @@ def build_building(
     roof: Roof,
     min_facade_width: float,
     cache: AxisCache,
+    base_dir: Path | None = None,
 ) -> BuildingResult:
-    """The building's scene: façades on every wall, a flat roof, the ground."""
+    """The building's scene: façades on every wall, the roof, the ground. ``base_dir`` is
+    the spec's folder, where its mesh and texture files are."""
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
     wall_height = height + (roof.parapet if roof.type == "flat" else 0.0)
@@ -135,7 +133,7 @@ def build_building(
                 build_shapes(sized, horizontal, vertical),
                 0.0,
             )
-            for mesh in _placed(facade_scene(layout)):
+            for mesh in _placed(facade_scene(layout, base_dir)):
                 mesh.apply_transform(placement)
                 parts.setdefault(mesh.visual.material.name, []).append(mesh)
         cover, infill = roof_meshes(part, height, roof)
@@ -148,7 +146,7 @@ def build_building(
         ground.apply_translation((0, 0, -0.01))
         ground.apply_transform(MAP_TO_WORLD)
         parts.setdefault("ground", []).append(ground)
-    materials = {name: pbr(name, m) for name, m in spec.materials.items()}
+    materials = {name: pbr(name, m, base_dir) for name, m in spec.materials.items()}
     materials.update(
         {"wall": pbr("wall", WALL), "roof": pbr("roof", ROOF), "ground": pbr("ground", GROUND)}
     )

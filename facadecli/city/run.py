@@ -35,6 +35,7 @@ class Task:
     roof: Roof
     min_facade_width: float
     target: Path
+    spec_dir: Path  # the spec's folder: its mesh and texture paths are relative to it
 
 
 def safe_name(building_id: str) -> str:
@@ -62,6 +63,7 @@ def build(task: Task) -> dict[str, Any]:
             task.roof,
             task.min_facade_width,
             cache,
+            task.spec_dir,
         )
         write_atomic(task.target, glb_bytes(result.scene))
     except Exception as error:
@@ -97,6 +99,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
                 roof,
                 city.manifest.defaults.min_facade_width,
                 target,
+                (city.folder / key).parent,
             )
         )
     return tasks

@@ -7,6 +7,7 @@ along the façade, y up, z towards the viewer (SPEC 2.1), metres: glTF's own fra
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -20,9 +21,11 @@ from facadecli.spec.model import Material
 FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
 
 
+@lru_cache(maxsize=256)
 def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMaterial:
     """A glTF metallic-roughness material; see-through ones blend; a texture is tinted by
-    the colour."""
+    the colour. Cached: a city builds the same materials for every wall, and reads each
+    texture image once."""
     colour = material.color.lstrip("#")
     rgb = [int(colour[i : i + 2], 16) for i in (0, 2, 4)]
     alpha = round(255 * material.opacity)
