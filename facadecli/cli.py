@@ -307,6 +307,16 @@ def city(
         raise typer.Exit(1)
 
 
+def _size(text: str) -> tuple[float, float]:
+    try:
+        width, height = (float(v) for v in text.lower().split("x"))
+    except ValueError:
+        width = height = -1.0
+    if not (width > 0 and height > 0):
+        raise typer.BadParameter(f"{text!r} is not WIDTHxHEIGHT, e.g. 12x9", param_hint="--derive")
+    return width, height
+
+
 @app.command()
 def grammar(
     layout: Annotated[
@@ -320,56 +330,90 @@ def grammar(
     outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
         "out/grammar"
     ),
+    method: Annotated[
+        str, typer.Option("--method", help="adp (the search) or greedy (the baseline).")
+    ] = "adp",
+    iterations: Annotated[
+        int, typer.Option("--iterations", "-n", min=1, help="ADP iterations.")
+    ] = 2000,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="ADP's random seed.")] = 0,
+    extensions: Annotated[
+        str,
+        typer.Option(
+            "--extensions", help="Extra rules, comma-separated: repeatABA,symsplit,gridsplit."
+        ),
+    ] = "",
+    split_cost: Annotated[
+        float, typer.Option("--split-cost", min=0, help="Cost of a split rule (Eq. 2).")
+    ] = 0.1,
+    repeat_cost: Annotated[
+        float, typer.Option("--repeat-cost", min=0, help="Cost of a repeat rule (Eq. 2).")
+    ] = 0.5,
+    tolerance: Annotated[
+        float | None,
+        typer.Option(
+            "--tolerance",
+            min=0,
+            help="Regularise: give repeated elements one size when they differ by less than "
+            "this fraction of the façade [default: 0.01; 0 for .layout.json].",
+            show_default=False,
+        ),
+    ] = None,
+    derive: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--derive",
+            help="Also apply the grammar at a new size WxH (repeatable): writes "
+            "<name>-<W>x<H>.* through the layout writers.",
+            show_default=False,
+        ),
+    ] = None,
+    formats: Annotated[
+        str | None,
+        typer.Option("--format", "-f", help=f"Formats of derived layouts [{','.join(DEFAULT_FORMATS)}]."),
+    ] = None,
     timings: Annotated[
         bool, typer.Option("--timings", help="Record the time in the report (not reproducible).")
     ] = False,
 ) -> None:
-    """Derive a split grammar from a labelled façade (Wu et al. 2014; the greedy baseline
-    so far): writes the grammar as text and JSON, the tiling as SVG, and a report."""
-    import time
-
+    """Derive a split grammar from a labelled façade (Wu et al. 2014): writes it as text
+    and JSON, the tiling as SVG and a report; with --derive, the grammar at new sizes."""
     from facadecli.grammar.outputs import grammar_json, grammar_report, tiling_svg
-    from facadecli.grammar.split import derive, greedy_grammar
-    from facadecli.grammar.tiling import read_cmp, read_plain, read_report, tile
+    from facadecli.grammar.run import Options, extract_grammar, stem
+    from facadecli.grammar.split import EXTENSIONS, Costs
 
-    if not layout.is_file():
-        raise SpecError.at(str(layout), None, None, "no such file", "check the path")
-    name = layout.name
-    try:
-        if name.endswith(".xml"):
-            labelled = read_cmp(layout)
-        elif name.endswith(".layout.json"):
-            labelled = read_report(layout)
-        else:
-            labelled = read_plain(layout)
-    except (ValueError, KeyError, TypeError) as error:
-        raise SpecError.at(
-            str(layout),
-            None,
-            None,
-            f"not a labelled layout: {error}",
-            "give a CMP .xml, a .layout.json, or [{label, x0, y0, x1, y1}, ...]",
-        ) from None
-    tiling = tile(labelled)
-    started = time.perf_counter()
-    found = greedy_grammar(tiling)
-    elapsed = round((time.perf_counter() - started) * 1000, 3)
-    for label, x0, y0, x1, y1 in derive(found, tiling.xs[-1], tiling.ys[-1]):
-        assert tiling.label_at((x0 + x1) / 2, (y0 + y1) / 2) == label  # exact re-derivation
-    stem = name.removesuffix(".layout.json").rsplit(".", 1)[0] if "." in name else name
+    if method not in ("adp", "greedy"):
+        raise typer.BadParameter(f"{method!r}: use adp or greedy", param_hint="--method")
+    chosen = tuple(e.strip() for e in extensions.split(",") if e.strip())
+    for name in chosen:
+        if name not in EXTENSIONS:
+            raise typer.BadParameter(f"{name!r}: use {', '.join(EXTENSIONS)}", param_hint="--extensions")
+    sizes = [_size(text) for text in derive or []]
+    kinds = _formats(formats)
+    options = Options(method, iterations, seed, chosen, Costs(split_cost, repeat_cost), tolerance=tolerance)
+    extraction = extract_grammar(layout, options)
+    if extraction.problems:  # a bug, never a user's error
+        raise RuntimeError("the grammar does not derive its layout: " + "; ".join(extraction.problems))
+    found = extraction.grammar
+    name = stem(layout)
     outputs = {
-        f"{stem}.grammar.txt": found.text(),
-        f"{stem}.grammar.json": grammar_json(found),
-        f"{stem}.tiling.svg": tiling_svg(tiling, stem),
-        f"{stem}.grammar-report.json": grammar_report(
-            found, tiling, name, "greedy", elapsed if timings else None
-        ),
+        f"{name}.grammar.txt": found.text(),
+        f"{name}.grammar.json": grammar_json(found),
+        f"{name}.tiling.svg": tiling_svg(extraction.tiling, name),
+        f"{name}.grammar-report.json": grammar_report(extraction, timings),
     }
     for file, text in outputs.items():
         write_atomic(outdir / file, text)
+    written = [outdir / file for file in outputs]
+    if sizes:
+        from facadecli.grammar.variation import derive_layout
+
+        for width, height in sizes:
+            derived = derive_layout(found, extraction.tiling, width, height, name)
+            written += write_outputs(derived, outdir, kinds, OutputOptions())
     typer.echo(
-        f"{layout}: {len(found.rules)} rules, cost {found.cost:.1f} -> "
-        + ", ".join(str(outdir / f) for f in outputs)
+        f"{layout}: {len(found.rules)} rules, cost {found.cost:.1f} "
+        f"(greedy {extraction.found.greedy_cost:.1f}) -> " + ", ".join(str(p) for p in written)
     )
 
 

@@ -225,13 +225,15 @@ def test_grammar_writes_text_json_svg_and_a_report(tmp_path: Path) -> None:
         for x in (1.0, 3.0, 5.0)
     ]
     layout.write_text(json.dumps({"canvas": {"width": 7, "height": 9.5}, "rects": rects}))
-    result = facade("grammar", str(layout), "-o", str(tmp_path / "out"))
+    result = facade("grammar", str(layout), "-o", str(tmp_path / "out"), "-n", "300")
     assert result.returncode == 0, result.stderr
     text = (tmp_path / "out" / "floors.grammar.txt").read_text()
     assert text.startswith("N1 --> split(y)") and "repeat(y)" in text
     grammar = json.loads((tmp_path / "out" / "floors.grammar.json").read_text())
     assert grammar["start"] == "N1" and grammar["terminals"] == ["facade", "window"]
     report = json.loads((tmp_path / "out" / "floors.grammar-report.json").read_text())
-    assert report["method"] == "greedy" and report["cost"] == grammar["cost"]
+    assert report["method"] == "adp" and report["iterations"] == 300
+    assert report["cost"] == grammar["cost"] == 10.3 < report["greedy_cost"]
+    assert report["rederives_exactly"] and report["time_ms"] is None
     assert (tmp_path / "out" / "floors.tiling.svg").read_text().startswith("<?xml")
     assert facade("grammar", str(tmp_path / "missing.xml")).returncode == 2

@@ -9,6 +9,7 @@ from dataclasses import asdict
 from typing import Any
 from xml.sax.saxutils import escape
 
+from facadecli.grammar.run import Extraction
 from facadecli.grammar.split import Grammar
 from facadecli.grammar.tiling import Tiling
 
@@ -19,6 +20,7 @@ def grammar_json(grammar: Grammar) -> str:
     data: dict[str, Any] = {
         "start": grammar.start,
         "terminals": sorted(grammar.terminals),
+        "costs": asdict(grammar.costs),
         "rules": {name: asdict(rule) for name, rule in grammar.rules.items()},
         "cost": round(grammar.cost, 6),
     }
@@ -65,21 +67,31 @@ def tiling_svg(tiling: Tiling, title: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def grammar_report(
-    grammar: Grammar, tiling: Tiling, source: str, method: str, time_ms: float | None
-) -> str:
-    return (
-        json.dumps(
-            {
-                "source": source,
-                "method": method,
-                "cost": round(grammar.cost, 6),
-                "rules": len(grammar.rules),
-                "terminals": len(grammar.terminals),
-                "cells": (len(tiling.xs) - 1) * (len(tiling.ys) - 1),
-                "time_ms": time_ms,
-            },
-            indent=2,
-        )
-        + "\n"
-    )
+def grammar_report(extraction: Extraction, timings: bool = False) -> str:
+    grammar, found, tiling = extraction.grammar, extraction.found, extraction.tiling
+    options = extraction.options
+    ops: dict[str, int] = {}
+    for rule in grammar.rules.values():
+        ops[rule.op] = ops.get(rule.op, 0) + 1
+    data = {
+        "source": extraction.source,
+        "method": found.method,
+        "iterations": found.iterations,
+        "seed": options.seed,
+        "best_iteration": found.best_iteration,
+        "extensions": list(options.extensions),
+        "costs": {"split": grammar.costs.split, "repeat": grammar.costs.repeat},
+        "cost": round(grammar.cost, 6),
+        "greedy_cost": round(found.greedy_cost, 6),
+        "rules": len(grammar.rules),
+        "rules_by_op": dict(sorted(ops.items())),
+        "terminals": len(grammar.terminals),
+        "canvas": {"width": tiling.xs[-1], "height": tiling.ys[-1]},
+        "cells": (len(tiling.xs) - 1) * (len(tiling.ys) - 1),
+        "regions_explored": found.regions,
+        "repeated_regions": found.repeats,
+        "rederives_exactly": not extraction.problems,
+        "regularization": extraction.regularization.summary(),
+        "time_ms": round(extraction.time_ms, 3) if timings else None,
+    }
+    return json.dumps(data, indent=2) + "\n"

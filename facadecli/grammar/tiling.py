@@ -142,9 +142,10 @@ def read_report(path: Path) -> LabelledLayout:
     return LabelledLayout(report["canvas"]["width"], report["canvas"]["height"], rects)
 
 
-def snap(values: list[float], tolerance: float) -> dict[float, float]:
-    """Each value mapped to the mean of its cluster (values within ``tolerance`` in a row)."""
-    ordered = sorted(set(values))
+def snap(values: list[float], tolerance: float, anchors: tuple[float, ...] = ()) -> dict[float, float]:
+    """Each value mapped to the mean of its cluster (values within ``tolerance`` in a row),
+    or to the anchor in its cluster if it holds one (the façade's edges stay put)."""
+    ordered = sorted(set(values) | set(anchors))
     clusters: list[list[float]] = []
     for value in ordered:
         if clusters and value - clusters[-1][-1] <= tolerance:
@@ -153,27 +154,43 @@ def snap(values: list[float], tolerance: float) -> dict[float, float]:
             clusters.append([value])
     mapping = {}
     for cluster in clusters:
-        mean = sum(cluster) / len(cluster)
+        held = [a for a in anchors if a in cluster]
+        target = held[0] if held else sum(cluster) / len(cluster)
         for value in cluster:
-            mapping[value] = mean
+            mapping[value] = target
     return mapping
 
 
-def tile(layout: LabelledLayout, tolerance: float = 0.005, background: str = BACKGROUND) -> Tiling:
-    """The tiling of a labelled layout; edges closer than ``tolerance`` x the façade's size
-    are snapped together first (the façade's own edges stay where they are)."""
+def snap_layout(layout: LabelledLayout, tolerance: float = 0.005) -> LabelledLayout:
+    """The layout with edges closer than ``tolerance`` x the façade's size moved to their
+    mean (the façade's own edges stay where they are), clipped to the façade; rectangles
+    that vanish are dropped."""
     w, h = layout.width, layout.height
-    xmap = snap([0.0, w, *(v for r in layout.rects for v in (r.x0, r.x1))], tolerance * w)
-    ymap = snap([0.0, h, *(v for r in layout.rects for v in (r.y0, r.y1))], tolerance * h)
-    xmap.update({0.0: 0.0, w: w})
-    ymap.update({0.0: 0.0, h: h})
-    rects = [
+    xmap = snap([v for r in layout.rects for v in (r.x0, r.x1)], tolerance * w, (0.0, w))
+    ymap = snap([v for r in layout.rects for v in (r.y0, r.y1)], tolerance * h, (0.0, h))
+    for mapping, extent in ((xmap, w), (ymap, h)):
+        for value, target in mapping.items():
+            mapping[value] = min(max(target, 0.0), extent)
+    rects = tuple(
         Rect(r.label, xmap[r.x0], ymap[r.y0], xmap[r.x1], ymap[r.y1], r.z)
         for r in layout.rects
         if xmap[r.x1] > xmap[r.x0] and ymap[r.y1] > ymap[r.y0]
+    )
+    return LabelledLayout(w, h, rects)
+
+
+def tile(layout: LabelledLayout, tolerance: float = 0.005, background: str = BACKGROUND) -> Tiling:
+    """The tiling of a labelled layout, snapped first (``snap_layout``): cuts at every edge,
+    and each cell the label of the top-most rectangle covering it, else the background."""
+    layout = snap_layout(layout, tolerance) if tolerance > 0 else layout
+    w, h = layout.width, layout.height
+    clip = [
+        Rect(r.label, max(r.x0, 0.0), max(r.y0, 0.0), min(r.x1, w), min(r.y1, h), r.z)
+        for r in layout.rects
     ]
-    xs = sorted({min(max(v, 0.0), w) for v in xmap.values()})
-    ys = sorted({min(max(v, 0.0), h) for v in ymap.values()})
+    rects = [r for r in clip if r.x1 > r.x0 and r.y1 > r.y0]
+    xs = sorted({0.0, w, *(v for r in rects for v in (r.x0, r.x1))})
+    ys = sorted({0.0, h, *(v for r in rects for v in (r.y0, r.y1))})
     ranked = sorted(rects, key=lambda r: r.z)
     labels = []
     for y0, y1 in itertools.pairwise(ys):

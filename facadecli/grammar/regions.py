@@ -1,0 +1,139 @@
+"""Regions of a tiling: rectangles of whole cells, their content, and the lines that may cut
+them (Wu et al. 2014, section 3.1).
+
+A region is ``(r0, r1, c0, c1)``: rows ``r0 <= r < r1`` (bottom up) and columns
+``c0 <= c < c1`` of the tiling. Two regions have the same *content* when their labels and
+cell sizes match, so one rule can derive both; contents are numbered as they are met.
+
+A line *crosses an element* where the same label (other than the background) lies on both
+sides of it; such lines are not cut while a clean one exists.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from facadecli.grammar.tiling import BACKGROUND, Tiling
+
+Region = tuple[int, int, int, int]
+SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's extent)
+
+
+class Grid:
+    """A tiling's cells as integers, with prefix sums for fast line tests."""
+
+    def __init__(self, tiling: Tiling, background: str = BACKGROUND):
+        self.tiling = tiling
+        self.background = background
+        names = sorted({label for row in tiling.labels for label in row})
+        self.names = names
+        ids = {name: i for i, name in enumerate(names)}
+        self.labels = np.array([[ids[label] for label in row] for row in tiling.labels], dtype=int)
+        self.rows, self.columns = self.labels.shape
+        self.widths = self._sizes(tiling.xs)
+        self.heights = self._sizes(tiling.ys)
+        self.quantum_x = SIZE_QUANTUM * (tiling.xs[-1] - tiling.xs[0])
+        self.quantum_y = SIZE_QUANTUM * (tiling.ys[-1] - tiling.ys[0])
+        bg = ids.get(background, -1)
+        lab = self.labels
+        # x lines: between columns c-1 and c, per row; y lines: between rows r-1 and r
+        same_x = lab[:, 1:] == lab[:, :-1]
+        same_y = lab[1:, :] == lab[:-1, :]
+        self._change_x = _prefix(~same_x, axis=0)  # [r, c-1] change counts up to row r
+        self._cross_x = _prefix(same_x & (lab[:, 1:] != bg), axis=0)
+        self._change_y = _prefix(~same_y, axis=1)
+        self._cross_y = _prefix(same_y & (lab[1:, :] != bg), axis=1)
+        self.contents: dict[bytes, int] = {}
+        self._content_of: dict[Region, int] = {}
+        self.terminal: dict[int, str] = {}  # content -> its label, for one-label regions
+        self.example: dict[int, Region] = {}  # content -> the first region met with it
+
+    @staticmethod
+    def _sizes(cuts: tuple[float, ...]) -> np.ndarray:
+        return np.diff(np.array(cuts, dtype=float))
+
+    def content(self, region: Region) -> int:
+        """The region's content number: equal for regions with the same labels at the same
+        places, whatever cuts other elements make through them (neighbouring rows and
+        columns with the same labels are merged first)."""
+        cid = self._content_of.get(region)
+        if cid is not None:
+            return cid
+        r0, r1, c0, c1 = region
+        block = self.labels[r0:r1, c0:c1]
+        keep_c = np.ones(block.shape[1], dtype=bool)
+        keep_c[1:] = (block[:, 1:] != block[:, :-1]).any(axis=0)
+        keep_r = np.ones(block.shape[0], dtype=bool)
+        keep_r[1:] = (block[1:, :] != block[:-1, :]).any(axis=1)
+        starts_c, starts_r = np.nonzero(keep_c)[0], np.nonzero(keep_r)[0]
+        reduced = block[np.ix_(starts_r, starts_c)]
+        widths = np.add.reduceat(self.widths[c0:c1], starts_c) / self.quantum_x
+        heights = np.add.reduceat(self.heights[r0:r1], starts_r) / self.quantum_y
+        key = b"".join(
+            (
+                np.array(reduced.shape, dtype=np.int32).tobytes(),
+                reduced.astype(np.int32).tobytes(),
+                np.rint(widths).astype(np.int64).tobytes(),
+                np.rint(heights).astype(np.int64).tobytes(),
+            )
+        )
+        cid = self.contents.setdefault(key, len(self.contents))
+        if cid not in self.example:
+            self.example[cid] = region
+            if reduced.size == 1:
+                self.terminal[cid] = self.names[int(reduced[0, 0])]
+        self._content_of[region] = cid
+        return cid
+
+    def lines(self, region: Region, axis: str) -> tuple[list[int], list[int]]:
+        """Lines inside the region along an axis (column indices for x, row indices for y)
+        that separate labels somewhere, and how many element cells each crosses."""
+        r0, r1, c0, c1 = region
+        if axis == "x":
+            if c1 - c0 < 2:
+                return [], []
+            changes = self._change_x[r1, c0 : c1 - 1] - self._change_x[r0, c0 : c1 - 1]
+            crosses = self._cross_x[r1, c0 : c1 - 1] - self._cross_x[r0, c0 : c1 - 1]
+            offset = c0 + 1
+        else:
+            if r1 - r0 < 2:
+                return [], []
+            changes = self._change_y[r0 : r1 - 1, c1] - self._change_y[r0 : r1 - 1, c0]
+            crosses = self._cross_y[r0 : r1 - 1, c1] - self._cross_y[r0 : r1 - 1, c0]
+            offset = r0 + 1
+        at = np.nonzero(changes > 0)[0]
+        return [int(i) + offset for i in at], [int(crosses[i]) for i in at]
+
+    def crossed(self, axis: str, line: int, start: int, stop: int) -> bool:
+        """Whether the line (a column index for x, a row index for y) crosses an element
+        between ``start`` and ``stop`` (rows for x, columns for y). Façade edges never do."""
+        if axis == "x":
+            if line <= 0 or line >= self.columns:
+                return False
+            return bool(self._cross_x[stop, line - 1] - self._cross_x[start, line - 1])
+        if line <= 0 or line >= self.rows:
+            return False
+        return bool(self._cross_y[line - 1, stop] - self._cross_y[line - 1, start])
+
+    def closed(self, region: Region) -> bool:
+        r0, r1, c0, c1 = region
+        return not (
+            self.crossed("x", c0, r0, r1)
+            or self.crossed("x", c1, r0, r1)
+            or self.crossed("y", r0, c0, c1)
+            or self.crossed("y", r1, c0, c1)
+        )
+
+    def size(self, axis: str, start: int, stop: int) -> float:
+        cuts = self.tiling.xs if axis == "x" else self.tiling.ys
+        return cuts[stop] - cuts[start]
+
+
+def _prefix(values: np.ndarray, axis: int) -> np.ndarray:
+    """Prefix sums with a leading zero along the axis."""
+    summed = np.cumsum(values.astype(np.int32), axis=axis)
+    pad = [(0, 0), (0, 0)]
+    pad[axis] = (1, 0)
+    return np.pad(summed, pad)

@@ -1,0 +1,134 @@
+"""``facade grammar``'s pipeline, without the writing: read a labelled layout, snap and
+regularise it, tile it, find a grammar, and check that it derives the tiling exactly."""
+
+from __future__ import annotations
+
+import bisect
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from facadecli.errors import SpecError
+from facadecli.grammar.regularize import DEFAULT_TOLERANCE, Regularization, regularize
+from facadecli.grammar.search import SearchResult, extract
+from facadecli.grammar.split import Costs, Grammar, derive
+from facadecli.grammar.tiling import (
+    BACKGROUND,
+    LabelledLayout,
+    Tiling,
+    read_cmp,
+    read_plain,
+    read_report,
+    snap_layout,
+    tile,
+)
+
+SNAP = 0.005  # edges closer than this x the façade's size are one edge
+
+
+@dataclass(frozen=True)
+class Options:
+    method: str = "adp"
+    iterations: int = 2000
+    seed: int = 0
+    extensions: tuple[str, ...] = ()
+    costs: Costs = Costs()
+    snap: float | None = None  # None: SNAP, but 0 for facadecli layouts (they are exact)
+    tolerance: float | None = None  # regularisation; None: as ``snap``'s default
+
+
+@dataclass
+class Extraction:
+    source: str
+    layout: LabelledLayout
+    tiling: Tiling
+    found: SearchResult
+    regularization: Regularization
+    options: Options
+    time_ms: float = 0.0
+    problems: list[str] = field(default_factory=list)
+
+    @property
+    def grammar(self) -> Grammar:
+        return self.found.grammar
+
+
+def read_layout(path: Path) -> tuple[LabelledLayout, bool]:
+    """The labelled layout in a file, and whether it is exact (a facadecli layout)."""
+    if not path.is_file():
+        raise SpecError.at(str(path), None, None, "no such file", "check the path")
+    name = path.name
+    try:
+        if name.endswith(".xml"):
+            return read_cmp(path), False
+        if name.endswith(".layout.json"):
+            return read_report(path), True
+        return read_plain(path), False
+    except (ValueError, KeyError, TypeError) as error:
+        raise SpecError.at(
+            str(path),
+            None,
+            None,
+            f"not a labelled layout: {error}",
+            "give a CMP .xml, a .layout.json, or [{label, x0, y0, x1, y1}, ...]",
+        ) from None
+
+
+def stem(path: Path) -> str:
+    name = path.name.removesuffix(".layout.json")
+    return name.rsplit(".", 1)[0] if "." in name else name
+
+
+def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
+    layout, exact = read_layout(path)
+    if not layout.rects:
+        raise SpecError.at(str(path), None, None, "no rectangles", "label some elements")
+    snap = options.snap if options.snap is not None else (0.0 if exact else SNAP)
+    tolerance = options.tolerance
+    if tolerance is None:
+        tolerance = 0.0 if exact else DEFAULT_TOLERANCE
+    snapped = snap_layout(layout, snap) if snap > 0 else layout
+    regular, regularization = regularize(snapped, tolerance)
+    tiling = tile(regular, tolerance=0.0)
+    started = time.perf_counter()
+    found = extract(
+        tiling,
+        options.method,
+        options.iterations,
+        options.seed,
+        options.costs,
+        options.extensions,
+    )
+    elapsed = (time.perf_counter() - started) * 1000
+    extraction = Extraction(path.name, regular, tiling, found, regularization, options, elapsed)
+    extraction.problems = rederivation_problems(found.grammar, tiling)
+    return extraction
+
+
+def rederivation_problems(grammar: Grammar, tiling: Tiling, limit: int = 5) -> list[str]:
+    """Where the grammar's derivation differs from the tiling (empty when exact): every
+    derived rectangle must cover cells of its own label only, and together they must cover
+    the façade once."""
+    width, height = tiling.xs[-1], tiling.ys[-1]
+    eps = 1e-7 * max(width, height)
+    problems = []
+    area = 0.0
+    for label, x0, y0, x1, y1 in derive(grammar, width, height):
+        area += (x1 - x0) * (y1 - y0)
+        c0 = bisect.bisect_left(tiling.xs, x0 - eps)
+        c1 = bisect.bisect_left(tiling.xs, x1 - eps)
+        r0 = bisect.bisect_left(tiling.ys, y0 - eps)
+        r1 = bisect.bisect_left(tiling.ys, y1 - eps)
+        cells = {tiling.labels[r][c] for r in range(r0, max(r1, r0 + 1)) for c in range(c0, max(c1, c0 + 1))}
+        if cells != {label}:
+            problems.append(
+                f"{label} at ({x0:.4g}, {y0:.4g})-({x1:.4g}, {y1:.4g}) covers {sorted(cells)}"
+            )
+            if len(problems) >= limit:
+                break
+    if abs(area - width * height) > 1e-6 * width * height:
+        problems.append(f"derived area {area:.6g} is not the façade's {width * height:.6g}")
+    return problems
+
+
+__all__ = ["BACKGROUND", "Extraction", "Options", "extract_grammar", "rederivation_problems"]

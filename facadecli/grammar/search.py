@@ -1,0 +1,476 @@
+"""Finding a small split grammar for a tiling (Wu et al. 2014, sections 4.1-4.5).
+
+A grammar is built top down: the non-terminal regions without a rule are taken bottom to
+top, left to right, and each gets a rule (an *action*); only the first region of each content
+is split, the others reuse its rule. The actions offered for a region are the reasonable
+ones (section 4.4): along each axis, a cut at every clean line, a cut at one line, cuts that
+keep a periodic run of parts or the repeated regions found by hashing (``symmetry``) whole,
+and with the extensions a two-way grid. Each is written as the cheapest rule that fits its
+parts (repeat, repeatABA, symsplit or split).
+
+The splitting heuristic (Eq. 5) is the rule's cost plus, for each line it cuts, the cells of
+the repeated regions that line cuts through over the cells of the region.
+
+- ``greedy``: every region takes the action the heuristic likes best.
+- ``adp``: approximate dynamic programming. Each iteration builds a whole grammar; at each
+  region it explores with probability epsilon (an action drawn with probability
+  proportional to ``exp(-H)``) and exploits otherwise (the action with the least rule cost
+  plus the value table's estimate for the new regions it makes, Eq. 4). Epsilon falls
+  linearly over the iterations. After each iteration the table keeps, per content, the
+  least cost found for describing it. The first iteration is the greedy one, so the result
+  is never worse than greedy's; the cheapest grammar of all iterations is returned. A seed
+  makes it reproducible.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+import random
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from facadecli.grammar.regions import Grid, Region
+from facadecli.grammar.split import Axis, Costs, Grammar, Op, Part, Rule
+from facadecli.grammar.symmetry import Repeats, find_repeats
+from facadecli.grammar.tiling import BACKGROUND, Tiling
+
+TOP_ACTIONS = 8  # actions per region the search chooses among (the heuristic's best)
+
+
+@dataclass(frozen=True)
+class Action:
+    op: Op
+    axis: Axis
+    bounds: tuple[int, ...]  # cut indices along the axis, the region's ends included
+    written: tuple[Region, ...]  # the parts written in the rule
+    needs: tuple[int, ...]  # contents of the written parts that are not terminals, once each
+    cost: float
+    heuristic: float
+    count: int = 1
+    centre: bool = False
+    across: tuple[int, ...] = ()  # gridsplit: the column bounds
+    form: tuple[object, ...] = ()  # the rule without its symbols: op, axis, sizes
+
+
+@dataclass
+class SearchResult:
+    grammar: Grammar
+    method: str
+    iterations: int
+    best_iteration: int
+    greedy_cost: float
+    regions: int  # distinct regions given actions
+    repeats: int  # repeated regions found by hashing (kinds)
+
+
+class Search:
+    def __init__(
+        self,
+        tiling: Tiling,
+        costs: Costs = Costs(),
+        extensions: tuple[str, ...] = (),
+        background: str = BACKGROUND,
+    ):
+        self.grid = Grid(tiling, background)
+        self.costs = costs
+        self.extensions = set(extensions)
+        self.repeats: Repeats = find_repeats(self.grid)
+        self._actions: dict[Region, list[Action]] = {}
+        self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
+
+    # -- actions ------------------------------------------------------------------------
+
+    def actions(self, region: Region) -> list[Action]:
+        found = self._actions.get(region)
+        if found is None:
+            found = self._make_actions(region)
+            self._actions[region] = found
+        return found
+
+    def _make_actions(self, region: Region) -> list[Action]:
+        r0, r1, c0, c1 = region
+        usable: dict[Axis, list[int]] = {}
+        fallback: dict[Axis, tuple[int, list[int]]] = {}
+        for axis in ("x", "y"):
+            lines, crosses = self.grid.lines(region, axis)
+            clean = [line for line, k in zip(lines, crosses, strict=True) if k == 0]
+            if clean:
+                usable[axis] = clean
+            elif lines:
+                least = min(crosses)
+                fallback[axis] = (least, [ln for ln, k in zip(lines, crosses, strict=True) if k == least])
+        if not usable:  # every line cuts an element: cut where the fewest element cells are
+            if not fallback:
+                raise ValueError(f"region {region} has one label and no rule")
+            axis = min(fallback, key=lambda a: (fallback[a][0], a))
+            usable[axis] = fallback[axis][1]
+        found: dict[tuple[object, ...], Action] = {}
+        for axis, lines in usable.items():
+            lo, hi = (c0, c1) if axis == "x" else (r0, r1)
+            cost_of_line = self._line_costs(region, axis)
+            full = (lo, *lines, hi)
+            options = [full]
+            if len(lines) > 1:
+                options += [(lo, line, hi) for line in lines]
+            options += self._runs(region, axis, full)
+            options += self._repeated(region, axis, full)
+            for bounds in options:
+                action = self._action(region, axis, bounds, cost_of_line)
+                if action is not None:
+                    found.setdefault((action.axis, action.bounds), action)
+        if "gridsplit" in self.extensions and "x" in usable and "y" in usable:
+            grid = self._gridsplit(region, usable)
+            if grid is not None:
+                found[("xy", grid.bounds, grid.across)] = grid
+        ranked = sorted(found.values(), key=lambda a: (a.heuristic, a.cost, a.axis, a.bounds))
+        return ranked[:TOP_ACTIONS]
+
+    def _line_costs(self, region: Region, axis: Axis) -> dict[int, float]:
+        """The heuristic's cost of each line of an axis inside the region (section 4.4)."""
+        r0, r1, c0, c1 = region
+        rep = self.repeats
+        inside = (rep.r0 >= r0) & (rep.r1 <= r1) & (rep.c0 >= c0) & (rep.c1 <= c1)
+        lo, hi = (c0, c1) if axis == "x" else (r0, r1)
+        lines = np.arange(lo + 1, hi)
+        if not inside.any() or lines.size == 0:
+            return {}
+        start = (rep.c0 if axis == "x" else rep.r0)[inside]
+        stop = (rep.c1 if axis == "x" else rep.r1)[inside]
+        cut = (start[:, None] < lines[None, :]) & (lines[None, :] < stop[:, None])
+        cells = (r1 - r0) * (c1 - c0)
+        costs = rep.cells[inside] @ cut / cells
+        return {int(line): float(c) for line, c in zip(lines, costs, strict=True) if c > 0}
+
+    def _runs(self, region: Region, axis: Axis, full: tuple[int, ...]) -> list[tuple[int, ...]]:
+        """Bounds that keep each maximal periodic run of two or more parts as one part."""
+        cids = [self.grid.content(self._part(region, axis, a, b)) for a, b in itertools.pairwise(full)]
+        n = len(cids)
+        out = []
+        for period in range(1, n // 2 + 1):
+            i = 0
+            while i + 2 * period <= n:
+                k = 1
+                while i + (k + 1) * period <= n and cids[i + k * period : i + (k + 1) * period] == cids[i : i + period]:
+                    k += 1
+                if k >= 2 and not (i == 0 and i + k * period == n):
+                    end = i + k * period
+                    out.append((*full[: i + 1], *full[end:]))
+                    i = end
+                else:
+                    i += 1
+        return out
+
+    def _repeated(self, region: Region, axis: Axis, full: tuple[int, ...]) -> list[tuple[int, ...]]:
+        """Bounds that keep whole the repeated regions spanning the region across the axis."""
+        r0, r1, c0, c1 = region
+        rep = self.repeats
+        if axis == "x":
+            spans = (rep.r0 == r0) & (rep.r1 == r1) & (rep.c0 >= c0) & (rep.c1 <= c1)
+            start, stop = rep.c0[spans], rep.c1[spans]
+        else:
+            spans = (rep.c0 == c0) & (rep.c1 == c1) & (rep.r0 >= r0) & (rep.r1 <= r1)
+            start, stop = rep.r0[spans], rep.r1[spans]
+        lo, hi = full[0], full[-1]
+        blocks: list[tuple[int, int]] = []
+        for a, b in sorted(zip(start.tolist(), stop.tolist(), strict=True), key=lambda s: (s[0] - s[1], s)):
+            if (a, b) != (lo, hi) and all(b <= x or y <= a for x, y in blocks):
+                blocks.append((a, b))
+        if not blocks:
+            return []
+        bounds = {lo, hi, *(v for block in blocks for v in block)}
+        bounds |= {line for line in full if not any(a < line < b for a, b in blocks)}
+        return [tuple(sorted(bounds))]
+
+    def _part(self, region: Region, axis: Axis, a: int, b: int) -> Region:
+        r0, r1, c0, c1 = region
+        return (r0, r1, a, b) if axis == "x" else (a, b, c0, c1)
+
+    def _action(
+        self, region: Region, axis: Axis, bounds: tuple[int, ...], cost_of_line: dict[int, float]
+    ) -> Action | None:
+        parts = [self._part(region, axis, a, b) for a, b in itertools.pairwise(bounds)]
+        n = len(parts)
+        if n < 2:
+            return None
+        cids = [self.grid.content(p) for p in parts]
+        op: Op = "split"
+        written, count, centre = parts, 1, False
+        period = next(
+            (p for p in range(1, n // 2 + 1) if n % p == 0 and all(cids[i] == cids[i % p] for i in range(n))),
+            None,
+        )
+        if period is not None:
+            op, written, count = "repeat", parts[:period], n // period
+        elif (
+            "repeatABA" in self.extensions
+            and n >= 5
+            and n % 2 == 1
+            and len(set(cids[0::2])) == 1
+            and len(set(cids[1::2])) == 1
+        ):
+            op, written, count = "repeatABA", parts[:2], n // 2
+        elif "symsplit" in self.extensions and n >= 3 and cids == cids[::-1]:
+            op, written, centre = "symsplit", parts[: (n + 1) // 2], n % 2 == 1
+        rule_cost = (self.costs.repeat if op in ("repeat", "repeatABA") else self.costs.split) + len(written)
+        heuristic = rule_cost + sum(cost_of_line.get(line, 0.0) for line in bounds[1:-1])
+        sizes = tuple(self._quantum(axis, p) for p in written)
+        return Action(
+            op,
+            axis,
+            bounds,
+            tuple(written),
+            self._needs(written),
+            rule_cost,
+            heuristic,
+            count,
+            centre,
+            form=(op, axis, count, centre, sizes),
+        )
+
+    def _quantum(self, axis: Axis, part: Region) -> int:
+        """A part's size along an axis in steps of the grid's size quantum."""
+        a, b = (part[2], part[3]) if axis == "x" else (part[0], part[1])
+        step = self.grid.quantum_x if axis == "x" else self.grid.quantum_y
+        return round(self.grid.size(axis, a, b) / step)
+
+    def _needs(self, written: list[Region] | tuple[Region, ...]) -> tuple[int, ...]:
+        grid = self.grid
+        cids = (grid.content(p) for p in written)
+        return tuple(dict.fromkeys(c for c in cids if c not in grid.terminal))
+
+    def _gridsplit(self, region: Region, usable: dict[Axis, list[int]]) -> Action | None:
+        r0, r1, c0, c1 = region
+        rows = (r0, *usable["y"], r1)
+        columns = (c0, *usable["x"], c1)
+        cells = [(a, b, c, d) for a, b in itertools.pairwise(rows) for c, d in itertools.pairwise(columns)]
+        cost = self.costs.split + len(cells)
+        cost_x, cost_y = self._line_costs(region, "x"), self._line_costs(region, "y")
+        heuristic = cost + sum(cost_x.get(v, 0.0) for v in columns[1:-1])
+        heuristic += sum(cost_y.get(v, 0.0) for v in rows[1:-1])
+        form = (
+            "gridsplit",
+            tuple(self._quantum("y", (a, b, c0, c1)) for a, b in itertools.pairwise(rows)),
+            tuple(self._quantum("x", (r0, r1, a, b)) for a, b in itertools.pairwise(columns)),
+        )
+        return Action(
+            "gridsplit",
+            "y",
+            rows,
+            tuple(cells),
+            self._needs(cells),
+            cost,
+            heuristic,
+            across=columns,
+            form=form,
+        )
+
+    # -- building grammars ---------------------------------------------------------------
+
+    def build(self, choose: Callable[[Region, int, dict[int, Action], set[int]], Action]) -> dict[int, Action]:
+        """One grammar: regions bottom to top, left to right, each content split once."""
+        grid = self.grid
+        rules: dict[int, Action] = {}
+        start = grid.content(self.whole)
+        if start in grid.terminal:
+            return rules
+        pending = {start}
+        heap = [(self.whole[0], self.whole[2], -self.whole[1], -self.whole[3])]
+        while heap:
+            r0, c0, neg_r1, neg_c1 = heapq.heappop(heap)
+            region = (r0, -neg_r1, c0, -neg_c1)
+            cid = grid.content(region)
+            if cid in rules:
+                continue
+            pending.discard(cid)
+            action = choose(region, cid, rules, pending)
+            rules[cid] = action
+            for part in action.written:
+                sub = grid.content(part)
+                if sub in grid.terminal or sub in rules or sub in pending:
+                    continue
+                pending.add(sub)
+                heapq.heappush(heap, (part[0], part[2], -part[1], -part[3]))
+        return rules
+
+    def canonical(self, rules: dict[int, Action]) -> dict[int, int]:
+        """Each content's rule, merged with every other rule that reads the same (the same
+        operation and sizes over the same symbols): regions of different sizes across the
+        split axis can share a rule. Maps content -> the content whose rule stands for it."""
+        grid = self.grid
+        same: dict[int, int] = {}
+        seen: dict[tuple[object, ...], int] = {}
+
+        def visit(cid: int) -> object:
+            if cid in grid.terminal:
+                return grid.terminal[cid]
+            found = same.get(cid)
+            if found is None:
+                action = rules[cid]
+                symbols = tuple(visit(grid.content(part)) for part in action.written)
+                found = same[cid] = seen.setdefault((action.form, symbols), cid)
+            return found
+
+        for cid in rules:
+            visit(cid)
+        return same
+
+    def cost(self, rules: dict[int, Action]) -> float:
+        """Eq. 1 over the merged rules."""
+        same = self.canonical(rules)
+        return sum(rules[cid].cost for cid in rules if same[cid] == cid)
+
+    def greedy(self) -> dict[int, Action]:
+        return self.build(lambda region, cid, rules, pending: self.actions(region)[0])
+
+    def adp(self, iterations: int, seed: int) -> tuple[dict[int, Action], int]:
+        """The cheapest grammar of ``iterations`` (see the module) and the iteration it was
+        found in (0 is the greedy one)."""
+        rng = random.Random(seed)
+        values: dict[int, float] = {}
+        optimistic = min(self.costs.split + 2, self.costs.repeat + 1)
+        best = self.greedy()
+        best_cost, best_at = self.cost(best), 0
+        self._learn(best, values)
+        epsilon = 1.0
+
+        def choose(region: Region, cid: int, rules: dict[int, Action], pending: set[int]) -> Action:
+            actions = self.actions(region)
+            if len(actions) == 1:
+                return actions[0]
+            if rng.random() < epsilon:  # exploration: the heuristic's odds
+                low = actions[0].heuristic
+                weights = [math.exp(low - a.heuristic) for a in actions]
+                return rng.choices(actions, weights)[0]
+            chosen, least = actions[0], math.inf
+            for action in actions:  # exploitation: Eq. 4 with the value table
+                score = action.cost
+                for need in action.needs:
+                    if need not in rules and need not in pending and need != cid:
+                        score += values.get(need, optimistic)
+                if score < least:
+                    chosen, least = action, score
+            return chosen
+
+        for t in range(1, iterations):
+            epsilon = 1.0 - t / iterations
+            rules = self.build(choose)
+            cost = self.cost(rules)
+            self._learn(rules, values)
+            if cost < best_cost - 1e-9:
+                best, best_cost, best_at = rules, cost, t
+        return best, best_at
+
+    def _learn(self, rules: dict[int, Action], values: dict[int, float]) -> None:
+        """Each content's cost to describe, with the rules below it counted once each."""
+        index = {cid: 1 << i for i, cid in enumerate(rules)}
+        costs = [action.cost for action in rules.values()]
+        reach: dict[int, int] = {}
+
+        def below(cid: int) -> int:
+            found = reach.get(cid)
+            if found is None:
+                found = index[cid]
+                for need in rules[cid].needs:
+                    if need in rules:
+                        found |= below(need)
+                reach[cid] = found
+            return found
+
+        for cid in rules:
+            bits, total, i = below(cid), 0.0, 0
+            while bits:
+                if bits & 1:
+                    total += costs[i]
+                bits >>= 1
+                i += 1
+            if total < values.get(cid, math.inf):
+                values[cid] = total
+
+    # -- the grammar ---------------------------------------------------------------------
+
+    def grammar(self, rules: dict[int, Action]) -> Grammar:
+        grid = self.grid
+        names: dict[int, str] = {}
+        start = grid.content(self.whole)
+        grammar = Grammar(start="", costs=self.costs)
+        same = self.canonical(rules)
+
+        def name(cid: int) -> str:
+            if cid in grid.terminal:
+                grammar.terminals.add(grid.terminal[cid])
+                return grid.terminal[cid]
+            cid = same[cid]
+            if cid not in names:
+                names[cid] = f"N{len(names) + 1}"
+            return names[cid]
+
+        grammar.start = name(start)
+        order = [start]
+        seen = {start}
+        while order:  # breadth first from the start, so names read top down
+            cid = order.pop(0)
+            if cid not in rules:
+                continue
+            action = rules[same[cid]]
+            grammar.rules[name(cid)] = self._rule(action, name)
+            for part in action.written:
+                sub = same.get(grid.content(part), grid.content(part))
+                if sub not in seen:
+                    seen.add(sub)
+                    order.append(sub)
+        return grammar
+
+    def _rule(self, action: Action, name: Callable[[int], str]) -> Rule:
+        grid = self.grid
+        if action.op == "gridsplit":
+            heights = [grid.size("y", a, b) for a, b in itertools.pairwise(action.bounds)]
+            widths = tuple(grid.size("x", a, b) for a, b in itertools.pairwise(action.across))
+            columns = len(widths)
+            parts = tuple(
+                Part(heights[i // columns], name(grid.content(cell)))
+                for i, cell in enumerate(action.written)
+            )
+            return Rule("gridsplit", "y", parts, across=widths)
+        parts = []
+        for part in action.written:
+            a, b = (part[2], part[3]) if action.axis == "x" else (part[0], part[1])
+            parts.append(Part(grid.size(action.axis, a, b), name(grid.content(part))))
+        return Rule(action.op, action.axis, tuple(parts), action.count, action.centre)
+
+
+def extract(
+    tiling: Tiling,
+    method: str = "adp",
+    iterations: int = 2000,
+    seed: int = 0,
+    costs: Costs = Costs(),
+    extensions: tuple[str, ...] = (),
+    background: str = BACKGROUND,
+) -> SearchResult:
+    """A split grammar for the tiling, by ``greedy`` or ``adp`` (see the module)."""
+    search = Search(tiling, costs, extensions, background)
+    greedy = search.greedy()
+    greedy_cost = search.cost(greedy)
+    if method == "greedy" or iterations <= 1:
+        rules, best_at, done = greedy, 0, 1
+    else:
+        rules, best_at = search.adp(iterations, seed)
+        done = iterations
+    return SearchResult(
+        search.grammar(rules),
+        method,
+        done,
+        best_at,
+        greedy_cost,
+        len(search._actions),
+        search.repeats.kinds,
+    )
+
+
+def greedy_grammar(tiling: Tiling, background: str = BACKGROUND) -> Grammar:
+    """The greedy baseline's grammar."""
+    return extract(tiling, "greedy", background=background).grammar

@@ -1,0 +1,159 @@
+"""Repeated regions by hashing (Wu et al. 2014, section 4.3).
+
+Every terminal region (a rectangle of one label that no element crosses) that occurs at
+least twice seeds a table from content to occurrences. Each repeated region is then grown
+left, right, down and up, by the least step that keeps its border clear of elements; where
+two or more of its occurrences grow into equal content, the grown region is repeated too and
+joins the table. Growing in four directions finds repeats that are not grids (Figure 7).
+
+Only the largest repeats are kept for the splitting heuristic: a repeated region whose every
+occurrence lies inside an occurrence of a larger one, as often repeated, says nothing more.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from facadecli.grammar.regions import Grid, Region
+
+MAX_REPEATS = 4000  # repeated regions explored before the search stops growing
+
+
+@dataclass(frozen=True)
+class Repeats:
+    """Occurrences of the repeated regions as arrays, for the heuristic's sums."""
+
+    r0: np.ndarray
+    r1: np.ndarray
+    c0: np.ndarray
+    c1: np.ndarray
+    cells: np.ndarray
+    kinds: int  # how many different repeated regions
+
+    @property
+    def count(self) -> int:
+        return int(self.r0.size)
+
+
+def _seeds(grid: Grid) -> list[Region]:
+    """Rectangular connected regions of one label."""
+    seen = np.zeros(grid.labels.shape, dtype=bool)
+    found = []
+    for r in range(grid.rows):
+        for c in range(grid.columns):
+            if seen[r, c]:
+                continue
+            label = grid.labels[r, c]
+            stack, cells = [(r, c)], []
+            seen[r, c] = True
+            while stack:
+                i, j = stack.pop()
+                cells.append((i, j))
+                for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
+                    if 0 <= a < grid.rows and 0 <= b < grid.columns:
+                        if not seen[a, b] and grid.labels[a, b] == label:
+                            seen[a, b] = True
+                            stack.append((a, b))
+            rows = [i for i, _ in cells]
+            cols = [j for _, j in cells]
+            region = (min(rows), max(rows) + 1, min(cols), max(cols) + 1)
+            if len(cells) == (region[1] - region[0]) * (region[3] - region[2]):
+                found.append(region)
+    return found
+
+
+def _grow(grid: Grid, region: Region, direction: str) -> Region | None:
+    """The region grown one clean step in a direction, or None if it cannot grow."""
+    r0, r1, c0, c1 = region
+    if direction in ("left", "right"):
+        step = 1 if direction == "right" else -1
+        edge = c1 if step > 0 else c0
+        limit = grid.columns if step > 0 else 0
+        while edge != limit:
+            edge += step
+            lo, hi = (c1, edge) if step > 0 else (edge, c0)
+            if grid.crossed("y", r0, lo, hi) or grid.crossed("y", r1, lo, hi):
+                return None  # the new part's border cuts an element above or below
+            if not grid.crossed("x", edge, r0, r1):
+                return (r0, r1, c0, edge) if step > 0 else (r0, r1, edge, c1)
+        return None
+    step = 1 if direction == "up" else -1
+    edge = r1 if step > 0 else r0
+    limit = grid.rows if step > 0 else 0
+    while edge != limit:
+        edge += step
+        lo, hi = (r1, edge) if step > 0 else (edge, r0)
+        if grid.crossed("x", c0, lo, hi) or grid.crossed("x", c1, lo, hi):
+            return None
+        if not grid.crossed("y", edge, c0, c1):
+            return (r0, edge, c0, c1) if step > 0 else (edge, r1, c0, c1)
+    return None
+
+
+def _disjoint(regions: list[Region]) -> list[Region]:
+    kept: list[Region] = []
+    for r in sorted(set(regions)):
+        if all(r[1] <= k[0] or k[1] <= r[0] or r[3] <= k[2] or k[3] <= r[2] for k in kept):
+            kept.append(r)
+    return kept
+
+
+def _inside(inner: Region, outer: Region) -> bool:
+    return outer[0] <= inner[0] and inner[1] <= outer[1] and outer[2] <= inner[2] and inner[3] <= outer[3]
+
+
+def find_repeats(grid: Grid, limit: int = MAX_REPEATS) -> Repeats:
+    table: dict[int, list[Region]] = {}
+    by_content: dict[int, list[Region]] = {}
+    for region in _seeds(grid):
+        by_content.setdefault(grid.content(region), []).append(region)
+    queue = []
+    for cid, regions in sorted(by_content.items()):
+        kept = _disjoint(regions)
+        if len(kept) >= 2:
+            table[cid] = kept
+            queue.append(cid)
+    head = 0
+    while head < len(queue) and len(table) < limit:
+        occurrences = table[queue[head]]
+        head += 1
+        for direction in ("left", "right", "down", "up"):
+            grown: dict[int, list[Region]] = {}
+            for region in occurrences:
+                bigger = _grow(grid, region, direction)
+                if bigger is not None:
+                    grown.setdefault(grid.content(bigger), []).append(bigger)
+            for cid, regions in grown.items():
+                if cid in table or grid.content(regions[0]) in grid.terminal:
+                    continue
+                kept = _disjoint(regions)
+                if len(kept) >= 2:
+                    table[cid] = kept
+                    queue.append(cid)
+    # the largest repeats: drop one whose occurrences all sit in those of a larger one
+    kinds = sorted(table.items(), key=lambda item: -_cells(item[1][0]))
+    kept_kinds: list[list[Region]] = []
+    for _, regions in kinds:
+        if any(
+            len(bigger) >= len(regions)
+            and all(any(_inside(r, b) for b in bigger) for r in regions)
+            for bigger in kept_kinds
+        ):
+            continue
+        kept_kinds.append(regions)
+    flat = [r for regions in kept_kinds for r in regions]
+    array = np.array(flat, dtype=int).reshape(-1, 4)
+    return Repeats(
+        array[:, 0],
+        array[:, 1],
+        array[:, 2],
+        array[:, 3],
+        (array[:, 1] - array[:, 0]) * (array[:, 3] - array[:, 2]),
+        len(kept_kinds),
+    )
+
+
+def _cells(region: Region) -> int:
+    return (region[1] - region[0]) * (region[3] - region[2])
