@@ -307,13 +307,13 @@ def city(
         raise typer.Exit(1)
 
 
-def _size(text: str) -> tuple[float, float]:
+def _size(text: str, option: str = "--derive") -> tuple[float, float]:
     try:
         width, height = (float(v) for v in text.lower().split("x"))
     except ValueError:
         width = height = -1.0
     if not (width > 0 and height > 0):
-        raise typer.BadParameter(f"{text!r} is not WIDTHxHEIGHT, e.g. 12x9", param_hint="--derive")
+        raise typer.BadParameter(f"{text!r} is not WIDTHxHEIGHT, e.g. 12x9", param_hint=option)
     return width, height
 
 
@@ -359,6 +359,15 @@ def grammar(
             show_default=False,
         ),
     ] = None,
+    size: Annotated[
+        str | None,
+        typer.Option(
+            "--size",
+            help="The façade's real size WxH (CMP annotations are a unit square): the "
+            "layout is stretched to it.",
+            show_default=False,
+        ),
+    ] = None,
     derive: Annotated[
         list[str] | None,
         typer.Option(
@@ -390,7 +399,15 @@ def grammar(
             raise typer.BadParameter(f"{name!r}: use {', '.join(EXTENSIONS)}", param_hint="--extensions")
     sizes = [_size(text) for text in derive or []]
     kinds = _formats(formats)
-    options = Options(method, iterations, seed, chosen, Costs(split_cost, repeat_cost), tolerance=tolerance)
+    options = Options(
+        method,
+        iterations,
+        seed,
+        chosen,
+        Costs(split_cost, repeat_cost),
+        tolerance=tolerance,
+        size=_size(size, "--size") if size else None,
+    )
     extraction = extract_grammar(layout, options)
     if extraction.problems:  # a bug, never a user's error
         raise RuntimeError("the grammar does not derive its layout: " + "; ".join(extraction.problems))

@@ -3,12 +3,12 @@ report (cost, rules, time)."""
 
 from __future__ import annotations
 
-import hashlib
 import json
 from dataclasses import asdict
 from typing import Any
 from xml.sax.saxutils import escape
 
+from facadecli.grammar.palette import label_colour
 from facadecli.grammar.run import Extraction
 from facadecli.grammar.split import Grammar
 from facadecli.grammar.tiling import Tiling
@@ -25,11 +25,6 @@ def grammar_json(grammar: Grammar) -> str:
         "cost": round(grammar.cost, 6),
     }
     return json.dumps(data, indent=2) + "\n"
-
-
-def _colour(label: str) -> str:
-    digest = hashlib.sha1(label.encode()).digest()
-    return "#{:02x}{:02x}{:02x}".format(*(80 + b % 150 for b in digest[:3]))
 
 
 def tiling_svg(tiling: Tiling, title: str) -> str:
@@ -54,11 +49,11 @@ def tiling_svg(tiling: Tiling, title: str) -> str:
             cell_w = (tiling.xs[c + 1] - tiling.xs[c]) * scale
             lines.append(
                 f'<rect x="{x:.2f}" y="{y:.2f}" width="{cell_w:.2f}" height="{cell_h:.2f}" '
-                f'fill="{_colour(label)}"/>'
+                f'fill="{label_colour(label)}"/>'
             )
     for i, label in enumerate(labels):
         y = h + 24 + 18 * i
-        lines.append(f'<rect x="10" y="{y:.0f}" width="12" height="12" fill="{_colour(label)}"/>')
+        lines.append(f'<rect x="10" y="{y:.0f}" width="12" height="12" fill="{label_colour(label)}"/>')
         lines.append(
             f'<text x="28" y="{y + 11:.0f}" font-family="sans-serif" font-size="12">'
             f"{escape(label)}</text>"

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import bisect
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from facadecli.errors import SpecError
@@ -35,6 +35,7 @@ class Options:
     costs: Costs = Costs()
     snap: float | None = None  # None: SNAP, but 0 for facadecli layouts (they are exact)
     tolerance: float | None = None  # regularisation; None: as ``snap``'s default
+    size: tuple[float, float] | None = None  # the façade's real size: the layout is scaled
 
 
 @dataclass
@@ -74,6 +75,15 @@ def read_layout(path: Path) -> tuple[LabelledLayout, bool]:
         ) from None
 
 
+def resize(layout: LabelledLayout, width: float, height: float) -> LabelledLayout:
+    """The layout stretched to a new size (CMP annotations are on a unit square)."""
+    sx, sy = width / layout.width, height / layout.height
+    rects = tuple(
+        replace(r, x0=r.x0 * sx, x1=r.x1 * sx, y0=r.y0 * sy, y1=r.y1 * sy) for r in layout.rects
+    )
+    return LabelledLayout(width, height, rects)
+
+
 def stem(path: Path) -> str:
     name = path.name.removesuffix(".layout.json")
     return name.rsplit(".", 1)[0] if "." in name else name
@@ -83,6 +93,8 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
     layout, exact = read_layout(path)
     if not layout.rects:
         raise SpecError.at(str(path), None, None, "no rectangles", "label some elements")
+    if options.size is not None:
+        layout = resize(layout, *options.size)
     snap = options.snap if options.snap is not None else (0.0 if exact else SNAP)
     tolerance = options.tolerance
     if tolerance is None:

@@ -1,0 +1,321 @@
+"""A grammar at a new size (Wu et al. 2014, section 5), and the result as a layout for the
+layout writers.
+
+Size independence: a part thinner than ``THIN`` of the façade's extent along its axis keeps
+its absolute size (frames, sills, slivers of wall); the other parts are weights. A repeat
+lays as many copies as fit best (the nearest whole number, at least one) and stretches them
+slightly. Within a split, parts that hold a repeat along the split's axis are *elastic*: they
+take up the change in size while the others keep theirs, so a wider façade gets more window
+bays rather than wider windows; without elastic parts, the weights share the change.
+
+The derivation is then tidied with a QP per axis (cvxpy), after Bao et al. 2013: edges stay
+near where the derivation put them, terminals that were one size in the source get one size,
+and their edges that nearly line up across the façade are lined up. Constraints that cannot
+all hold are dropped (alignment first, then equal sizes) with a warning.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import defaultdict
+from dataclasses import dataclass
+
+from facadecli.grammar.split import Axis, Grammar, Part, Rule
+from facadecli.grammar.tiling import BACKGROUND, CMP_Z_ORDER, Tiling, snap
+
+THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute size
+ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
+
+
+@dataclass(frozen=True)
+class Piece:
+    """A derived terminal rectangle and its size in the source layout."""
+
+    label: str
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    source_w: float
+    source_h: float
+
+
+def _elastic(grammar: Grammar) -> dict[tuple[str, str], bool]:
+    memo: dict[tuple[str, str], bool] = {}
+
+    def elastic(symbol: str, axis: str) -> bool:
+        key = (symbol, axis)
+        if key not in memo:
+            rule = grammar.rules.get(symbol)
+            memo[key] = rule is not None and rule.axis == axis and rule.op != "gridsplit" and (
+                rule.op in ("repeat", "repeatABA")
+                or any(elastic(p.symbol, axis) for p in rule.parts)
+            )
+        return memo[key]
+
+    for symbol in grammar.rules:
+        for axis in ("x", "y"):
+            elastic(symbol, axis)
+    return memo
+
+
+def distribute(
+    sizes: list[float], absolute: list[bool], elastic: list[bool], extent: float
+) -> list[float]:
+    """New sizes of parts filling ``extent`` (see the module)."""
+    total = sum(sizes)
+    fixed = sum(s for s, a in zip(sizes, absolute, strict=True) if a)
+    if fixed >= extent or fixed >= total:
+        return [s * extent / total for s in sizes]
+    free = [not a for a in absolute]
+    stretch = [f and e for f, e in zip(free, elastic, strict=True)]
+    rigid = sum(s for s, f, e in zip(sizes, free, stretch, strict=True) if f and not e)
+    stretchy = sum(s for s, e in zip(sizes, stretch, strict=True) if e)
+    if stretchy > 0 and extent - fixed - rigid >= stretchy / 2:
+        scale = (extent - fixed - rigid) / stretchy
+        return [s * scale if e else s for s, e in zip(sizes, stretch, strict=True)]
+    scale = (extent - fixed) / (total - fixed)
+    return [s * scale if f else s for s, f in zip(sizes, free, strict=True)]
+
+
+def derive_at(grammar: Grammar, source: tuple[float, float], width: float, height: float) -> list[Piece]:
+    """The grammar applied to a façade of a new size (see the module)."""
+    elastic = _elastic(grammar)
+    thin = {"x": THIN * source[0], "y": THIN * source[1]}
+    out: list[Piece] = []
+
+    def expand(symbol: str, box: tuple[float, float, float, float], src: tuple[float, float]) -> None:
+        x0, y0, x1, y1 = box
+        rule = grammar.rules.get(symbol)
+        if rule is None:
+            out.append(Piece(symbol, x0, y0, x1, y1, src[0], src[1]))
+            return
+        if rule.op == "gridsplit":
+            _grid(rule, box, expand)
+            return
+        axis = rule.axis
+        extent = (x1 - x0) if axis == "x" else (y1 - y0)
+        sequence = _fit(rule, extent)
+        sizes = distribute(
+            [p.size for p in sequence],
+            [p.size < thin[axis] for p in sequence],
+            [elastic.get((p.symbol, axis), False) for p in sequence],
+            extent,
+        )
+        cursor = x0 if axis == "x" else y0
+        for part, size in zip(sequence, sizes, strict=True):
+            end = cursor + size
+            if axis == "x":
+                expand(part.symbol, (cursor, y0, end, y1), (part.size, src[1]))
+            else:
+                expand(part.symbol, (x0, cursor, x1, end), (src[0], part.size))
+            cursor = end
+
+    expand(grammar.start, (0.0, 0.0, width, height), source)
+    return out
+
+
+def _fit(rule: Rule, extent: float) -> tuple[Part, ...]:
+    """The rule's parts in order, with as many repeats as fit best."""
+    period = sum(p.size for p in rule.parts)
+    if rule.op == "repeat":
+        count = max(1, round(extent / period))
+        return rule.parts * count
+    if rule.op == "repeatABA":
+        a, b = rule.parts
+        count = max(1, round((extent - a.size) / period))
+        return (a, *((b, a) * count))
+    return rule.sequence()
+
+
+def _grid(rule: Rule, box: tuple[float, float, float, float], expand: object) -> None:
+    x0, y0, x1, y1 = box
+    columns = len(rule.across)
+    rows = [rule.parts[i * columns].size for i in range(len(rule.parts) // columns)]
+    widths = [w * (x1 - x0) / sum(rule.across) for w in rule.across]
+    heights = [h * (y1 - y0) / sum(rows) for h in rows]
+    y = y0
+    for i, h in enumerate(heights):
+        x = x0
+        for j, w in enumerate(widths):
+            part = rule.parts[i * columns + j]
+            expand(part.symbol, (x, y, x + w, y + h), (rule.across[j], rows[i]))  # type: ignore[operator]
+            x += w
+        y += h
+
+
+# -- the alignment QP -------------------------------------------------------------------
+
+
+def align(
+    pieces: list[Piece], width: float, height: float, background: str = BACKGROUND
+) -> tuple[list[Piece], list[str]]:
+    """Equal terminals one size and lined up (see the module)."""
+    warnings: list[str] = []
+    mapping = {}
+    for axis, extent in (("x", width), ("y", height)):
+        mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background)
+        warnings += axis_warnings
+    aligned = [
+        Piece(
+            p.label,
+            mapping["x"][p.x0],
+            mapping["y"][p.y0],
+            mapping["x"][p.x1],
+            mapping["y"][p.y1],
+            p.source_w,
+            p.source_h,
+        )
+        for p in pieces
+    ]
+    return aligned, warnings
+
+
+def _align_axis(
+    pieces: list[Piece], axis: Axis, extent: float, background: str
+) -> tuple[dict[float, float], list[str]]:
+    import cvxpy as cp  # imported here: it takes half a second
+
+    values = [v for p in pieces for v in ((p.x0, p.x1) if axis == "x" else (p.y0, p.y1))]
+    joined = snap(values, 1e-9 * extent, (0.0, extent))
+    edges = sorted(set(joined.values()))
+    index = {v: i for i, v in enumerate(edges)}
+    spans = []
+    groups: dict[tuple[str, int], list[tuple[int, int]]] = defaultdict(list)
+    for p in pieces:
+        a, b = (p.x0, p.x1) if axis == "x" else (p.y0, p.y1)
+        span = (index[joined[a]], index[joined[b]])
+        spans.append((span, edges[span[1]] - edges[span[0]]))
+        if p.label != background:
+            source = p.source_w if axis == "x" else p.source_h
+            groups[(p.label, round(source / (1e-6 * extent)))].append(span)
+    equal = []
+    lined = []
+    for members in groups.values():
+        unique = sorted(set(members))
+        equal += [(unique[0], other) for other in unique[1:]]
+        for side in (0, 1):
+            ends = sorted({span[side] for span in unique}, key=lambda i: edges[i])
+            lined += [
+                (a, b)
+                for a, b in zip(ends, ends[1:], strict=False)
+                if edges[b] - edges[a] < ALIGN * extent
+            ]
+    v = cp.Variable(len(edges))
+    base = [v[0] == 0.0, v[len(edges) - 1] == extent]
+    base += [v[i + 1] >= v[i] for i in range(len(edges) - 1)]
+    base += [v[b] - v[a] >= size / 2 for (a, b), size in set(spans)]
+    sizes = [v[b1] - v[a1] == v[b0] - v[a0] for (a0, b0), (a1, b1) in equal]
+    lines = [v[a] == v[b] for a, b in lined]
+    warnings = []
+    for constraints, dropped in ((sizes + lines, None), (sizes, "line-ups"), ([], "equal sizes")):
+        if dropped:
+            warnings.append(f"{axis}: {dropped} of equal terminals do not all fit; left out")
+        problem = cp.Problem(cp.Minimize(cp.sum_squares(v - edges)), base + constraints)
+        try:
+            problem.solve(solver=cp.CLARABEL)
+        except cp.error.SolverError:
+            continue
+        if problem.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) and v.value is not None:
+            solved = [float(x) for x in v.value]
+            solved[0], solved[-1] = 0.0, extent
+            merged = snap(solved, 1e-7 * extent, (0.0, extent))
+            return {value: merged[solved[index[joined[value]]]] for value in joined}, warnings
+    return {value: joined[value] for value in joined}, warnings
+
+
+# -- the result as a layout ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Look:
+    mesh: str
+    depth: float  # in units of a tenth of the façade's shorter side... see ``_looks``
+    thickness: float
+
+
+LOOKS = {  # CMP labels; anything else is a shallow box
+    BACKGROUND: Look("box", 0.0, 0.3),
+    "window": Look("frame", 0.0, 0.3),
+    "door": Look("frame", 0.0, 0.3),
+    "shop": Look("frame", 0.0, 0.3),
+    "balcony": Look("box", 0.4, 0.7),
+    "cornice": Look("ledge", 0.15, 0.45),
+    "molding": Look("ledge", 0.1, 0.4),
+    "sill": Look("ledge", 0.1, 0.4),
+    "pillar": Look("box", 0.1, 0.4),
+    "blind": Look("box", 0.02, 0.32),
+}
+DEFAULT_LOOK = Look("box", 0.05, 0.35)
+
+
+def _ident(label: str, taken: set[str]) -> str:
+    name = re.sub(r"[^A-Za-z0-9_]", "_", label) or "label"
+    if not name[0].isalpha():
+        name = "L" + name
+    base, n = name, 2
+    while name in taken:
+        name, n = f"{base}_{n}", n + 1
+    taken.add(name)
+    return name
+
+
+def pieces_layout(pieces: list[Piece], width: float, height: float, name: str, warnings: list[str]) -> object:
+    """A ``Layout`` of the pieces, one layer per label, for the layout writers."""
+    from facadecli.grammar.palette import label_colour
+    from facadecli.layout import Appearance, Layout, Shape
+    from facadecli.solver.axis import AxisLayout
+    from facadecli.spec.model import Spec
+
+    unit = min(width, height) / 10
+    labels = sorted({p.label for p in pieces}, key=lambda label: (CMP_Z_ORDER.get(label, 99), label))
+    taken: set[str] = set()
+    idents = {label: _ident(label, taken) for label in labels}
+    spec = Spec.model_validate(
+        {
+            "version": 1,
+            "name": name,
+            "canvas": {"width": width, "height": height},
+            "symbols": {idents[label]: {"label": label} for label in labels},
+            "patterns": {idents[label]: idents[label] for label in labels},
+            "layers": [
+                {"name": idents[label], "x": idents[label], "y": idents[label]} for label in labels
+            ],
+            "materials": {idents[label]: {"color": label_colour(label)} for label in labels},
+        }
+    )
+    shapes = []
+    for p in sorted(pieces, key=lambda p: (labels.index(p.label), p.y0, p.x0)):
+        look = LOOKS.get(p.label, DEFAULT_LOOK)
+        ident = idents[p.label]
+        shapes.append(
+            Shape(
+                layer=ident,
+                x=ident,
+                y=ident,
+                x0=p.x0,
+                x1=p.x1,
+                y0=p.y0,
+                y1=p.y1,
+                z0=round((look.depth - look.thickness) * unit, 6),
+                z1=round(look.depth * unit, 6),
+                material=ident,
+                mesh=look.mesh,
+                reflected_x=False,
+                reflected_y=False,
+                opaque=True,
+                look=Appearance(ident, look.mesh, look.depth * unit, look.thickness * unit),
+            )
+        )
+    axes = [
+        AxisLayout(axis, extent, {}, {}, {}, {}, {}, 0.0, 0.0, 0, tuple(w for w in warnings if w.startswith(axis)))
+        for axis, extent in (("x", width), ("y", height))
+    ]
+    return Layout(spec, width, height, axes[0], axes[1], tuple(shapes), 0.0)
+
+
+def derive_layout(grammar: Grammar, tiling: Tiling, width: float, height: float, name: str) -> object:
+    """The grammar at a new size, aligned, as a layout named ``<name>-<W>x<H>``."""
+    source = (tiling.xs[-1], tiling.ys[-1])
+    pieces, warnings = align(derive_at(grammar, source, width, height), width, height)
+    return pieces_layout(pieces, width, height, f"{name}-{width:g}x{height:g}", warnings)
