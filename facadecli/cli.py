@@ -379,7 +379,9 @@ def grammar(
     ] = None,
     formats: Annotated[
         str | None,
-        typer.Option("--format", "-f", help=f"Formats of derived layouts [{','.join(DEFAULT_FORMATS)}]."),
+        typer.Option(
+            "--format", "-f", help=f"Formats of derived layouts [{','.join(DEFAULT_FORMATS)}]."
+        ),
     ] = None,
     timings: Annotated[
         bool, typer.Option("--timings", help="Record the time in the report (not reproducible).")
@@ -396,7 +398,9 @@ def grammar(
     chosen = tuple(e.strip() for e in extensions.split(",") if e.strip())
     for name in chosen:
         if name not in EXTENSIONS:
-            raise typer.BadParameter(f"{name!r}: use {', '.join(EXTENSIONS)}", param_hint="--extensions")
+            raise typer.BadParameter(
+                f"{name!r}: use {', '.join(EXTENSIONS)}", param_hint="--extensions"
+            )
     sizes = [_size(text) for text in derive or []]
     kinds = _formats(formats)
     options = Options(
@@ -410,7 +414,9 @@ def grammar(
     )
     extraction = extract_grammar(layout, options)
     if extraction.problems:  # a bug, never a user's error
-        raise RuntimeError("the grammar does not derive its layout: " + "; ".join(extraction.problems))
+        raise RuntimeError(
+            "the grammar does not derive its layout: " + "; ".join(extraction.problems)
+        )
     found = extraction.grammar
     name = stem(layout)
     outputs = {

@@ -233,7 +233,7 @@ def test_grammar_writes_text_json_svg_and_a_report(tmp_path: Path) -> None:
     assert grammar["start"] == "N1" and grammar["terminals"] == ["facade", "window"]
     report = json.loads((tmp_path / "out" / "floors.grammar-report.json").read_text())
     assert report["method"] == "adp" and report["iterations"] == 300
-    assert report["cost"] == grammar["cost"] == 10.3 < report["greedy_cost"]
+    assert report["cost"] == grammar["cost"] <= 10.3 < report["greedy_cost"]
     assert report["rederives_exactly"] and report["time_ms"] is None
     assert (tmp_path / "out" / "floors.tiling.svg").read_text().startswith("<?xml")
     assert facade("grammar", str(tmp_path / "missing.xml")).returncode == 2

@@ -53,7 +53,9 @@ def tiling_svg(tiling: Tiling, title: str) -> str:
             )
     for i, label in enumerate(labels):
         y = h + 24 + 18 * i
-        lines.append(f'<rect x="10" y="{y:.0f}" width="12" height="12" fill="{label_colour(label)}"/>')
+        lines.append(
+            f'<rect x="10" y="{y:.0f}" width="12" height="12" fill="{label_colour(label)}"/>'
+        )
         lines.append(
             f'<text x="28" y="{y + 11:.0f}" font-family="sans-serif" font-size="12">'
             f"{escape(label)}</text>"

@@ -11,8 +11,6 @@ sides of it; such lines are not cut while a clean one exists.
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
 from facadecli.grammar.tiling import BACKGROUND, Tiling

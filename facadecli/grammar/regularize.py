@@ -99,13 +99,13 @@ def _pairs_of(
             by_label[rect.label].append(span)
     for label, spans in sorted(by_label.items()):
         sizes = [(b - a, i) for i, (a, b) in enumerate(spans)]
-        elements[label] = [[spans[i] for i in group] for group in _clusters(sizes, tolerance * extent)]
+        elements[label] = [
+            [spans[i] for i in group] for group in _clusters(sizes, tolerance * extent)
+        ]
     cuts = tiling.xs if axis == "x" else tiling.ys
     bands: dict[tuple[str, ...], list[tuple[float, float]]] = defaultdict(list)
     for k, (a, b) in enumerate(itertools.pairwise(cuts)):
-        column = (
-            tuple(row[k] for row in tiling.labels) if axis == "x" else tiling.labels[k]
-        )
+        column = tuple(row[k] for row in tiling.labels) if axis == "x" else tiling.labels[k]
         bands[column].append((a, b))
     strips: dict[str, list[list[tuple[float, float]]]] = {}
     for column, spans in bands.items():
@@ -135,7 +135,14 @@ def _solve_axis(
         (a0, b0), rest = group[0], group[1:]
         for a, b in rest:
             constraints.append(v[index[b]] - v[index[a]] == v[index[b0]] - v[index[a0]])
-    problem = cp.Problem(cp.Minimize(cp.sum_squares(v - edges)), constraints)
+    kept = sorted(set(elements))  # elements keep their sizes as well as they can
+    starts = [index[a] for a, _ in kept]
+    stops = [index[b] for _, b in kept]
+    drawn = [b - a for a, b in kept]
+    objective = cp.sum_squares(v - edges)
+    if kept:
+        objective += cp.sum_squares(v[stops] - v[starts] - drawn)
+    problem = cp.Problem(cp.Minimize(objective), constraints)
     try:
         problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError:
@@ -161,10 +168,7 @@ def regularize(
         elements, strips = _pairs_of(rects, tiling, axis, extent, tolerance)
         element_groups = [g for groups in elements.values() for g in groups]
         strip_groups = [g for groups in strips.values() for g in groups]
-        spans = [
-            (r.x0, r.x1) if axis == "x" else (r.y0, r.y1)
-            for r in rects
-        ]
+        spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
         spans = [(a, b) for a, b in spans if a in edges and b in edges]
         solved = None
         for kept, used in (

@@ -11,7 +11,7 @@ from pathlib import Path
 from facadecli.errors import SpecError
 from facadecli.grammar.regularize import DEFAULT_TOLERANCE, Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
-from facadecli.grammar.split import Costs, Grammar, derive
+from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
 from facadecli.grammar.tiling import (
     BACKGROUND,
     LabelledLayout,
@@ -24,6 +24,7 @@ from facadecli.grammar.tiling import (
 )
 
 SNAP = 0.005  # edges closer than this x the façade's size are one edge
+REDERIVE_TOLERANCE = 1e-4  # x the façade's size: a derived edge this near a tiling edge is on it
 
 
 @dataclass(frozen=True)
@@ -32,7 +33,7 @@ class Options:
     iterations: int = 2000
     seed: int = 0
     extensions: tuple[str, ...] = ()
-    costs: Costs = Costs()
+    costs: Costs = DEFAULT_COSTS
     snap: float | None = None  # None: SNAP, but 0 for facadecli layouts (they are exact)
     tolerance: float | None = None  # regularisation; None: as ``snap``'s default
     size: tuple[float, float] | None = None  # the façade's real size: the layout is scaled
@@ -120,9 +121,11 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
 def rederivation_problems(grammar: Grammar, tiling: Tiling, limit: int = 5) -> list[str]:
     """Where the grammar's derivation differs from the tiling (empty when exact): every
     derived rectangle must cover cells of its own label only, and together they must cover
-    the façade once."""
+    the façade once. Positions are compared to ``REDERIVE_TOLERANCE`` of the façade's
+    size: regions that share a rule are equal to within the size quantum of ``regions``, and
+    repeats add those differences up."""
     width, height = tiling.xs[-1], tiling.ys[-1]
-    eps = 1e-7 * max(width, height)
+    eps = REDERIVE_TOLERANCE * max(width, height)
     problems = []
     area = 0.0
     for label, x0, y0, x1, y1 in derive(grammar, width, height):
@@ -131,7 +134,11 @@ def rederivation_problems(grammar: Grammar, tiling: Tiling, limit: int = 5) -> l
         c1 = bisect.bisect_left(tiling.xs, x1 - eps)
         r0 = bisect.bisect_left(tiling.ys, y0 - eps)
         r1 = bisect.bisect_left(tiling.ys, y1 - eps)
-        cells = {tiling.labels[r][c] for r in range(r0, max(r1, r0 + 1)) for c in range(c0, max(c1, c0 + 1))}
+        cells = {
+            tiling.labels[r][c]
+            for r in range(r0, max(r1, r0 + 1))
+            for c in range(c0, max(c1, c0 + 1))
+        }
         if cells != {label}:
             problems.append(
                 f"{label} at ({x0:.4g}, {y0:.4g})-({x1:.4g}, {y1:.4g}) covers {sorted(cells)}"

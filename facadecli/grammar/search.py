@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from facadecli.grammar.regions import Grid, Region
-from facadecli.grammar.split import Axis, Costs, Grammar, Op, Part, Rule
+from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Part, Rule
 from facadecli.grammar.symmetry import Repeats, find_repeats
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
@@ -47,6 +47,7 @@ class Action:
     axis: Axis
     bounds: tuple[int, ...]  # cut indices along the axis, the region's ends included
     written: tuple[Region, ...]  # the parts written in the rule
+    cids: tuple[int, ...]  # their contents
     needs: tuple[int, ...]  # contents of the written parts that are not terminals, once each
     cost: float
     heuristic: float
@@ -71,7 +72,7 @@ class Search:
     def __init__(
         self,
         tiling: Tiling,
-        costs: Costs = Costs(),
+        costs: Costs = DEFAULT_COSTS,
         extensions: tuple[str, ...] = (),
         background: str = BACKGROUND,
     ):
@@ -102,32 +103,42 @@ class Search:
                 usable[axis] = clean
             elif lines:
                 least = min(crosses)
-                fallback[axis] = (least, [ln for ln, k in zip(lines, crosses, strict=True) if k == least])
+                fallback[axis] = (
+                    least,
+                    [ln for ln, k in zip(lines, crosses, strict=True) if k == least],
+                )
         if not usable:  # every line cuts an element: cut where the fewest element cells are
             if not fallback:
                 raise ValueError(f"region {region} has one label and no rule")
             axis = min(fallback, key=lambda a: (fallback[a][0], a))
             usable[axis] = fallback[axis][1]
-        found: dict[tuple[object, ...], Action] = {}
+        found: dict[tuple[object, ...], Action] = {}  # cuts that keep structure whole
+        halves: dict[tuple[object, ...], Action] = {}  # cuts in two
         for axis, lines in usable.items():
             lo, hi = (c0, c1) if axis == "x" else (r0, r1)
             cost_of_line = self._line_costs(region, axis)
             full = (lo, *lines, hi)
-            options = [full]
-            if len(lines) > 1:
-                options += [(lo, line, hi) for line in lines]
-            options += self._runs(region, axis, full)
-            options += self._repeated(region, axis, full)
+            options = [full, *self._runs(region, axis, full), *self._repeated(region, axis, full)]
             for bounds in options:
                 action = self._action(region, axis, bounds, cost_of_line)
                 if action is not None:
                     found.setdefault((action.axis, action.bounds), action)
+            for line in lines if len(lines) > 1 else ():
+                action = self._action(region, axis, (lo, line, hi), cost_of_line)
+                if action is not None and (axis, action.bounds) not in found:
+                    halves[(axis, action.bounds)] = action
         if "gridsplit" in self.extensions and "x" in usable and "y" in usable:
             grid = self._gridsplit(region, usable)
             if grid is not None:
                 found[("xy", grid.bounds, grid.across)] = grid
-        ranked = sorted(found.values(), key=lambda a: (a.heuristic, a.cost, a.axis, a.bounds))
-        return ranked[:TOP_ACTIONS]
+
+        def rank(a: Action) -> tuple[object, ...]:
+            return (a.heuristic, a.cost, a.axis, a.bounds)
+
+        # every structural cut, and the heuristic's best cuts in two to fill up the choice
+        kept = sorted(found.values(), key=rank)[:TOP_ACTIONS]
+        kept += sorted(halves.values(), key=rank)[: max(TOP_ACTIONS - len(kept), TOP_ACTIONS // 2)]
+        return sorted(kept, key=rank)
 
     def _line_costs(self, region: Region, axis: Axis) -> dict[int, float]:
         """The heuristic's cost of each line of an axis inside the region (section 4.4)."""
@@ -147,14 +158,19 @@ class Search:
 
     def _runs(self, region: Region, axis: Axis, full: tuple[int, ...]) -> list[tuple[int, ...]]:
         """Bounds that keep each maximal periodic run of two or more parts as one part."""
-        cids = [self.grid.content(self._part(region, axis, a, b)) for a, b in itertools.pairwise(full)]
+        cids = [
+            self.grid.content(self._part(region, axis, a, b)) for a, b in itertools.pairwise(full)
+        ]
         n = len(cids)
         out = []
         for period in range(1, n // 2 + 1):
             i = 0
             while i + 2 * period <= n:
                 k = 1
-                while i + (k + 1) * period <= n and cids[i + k * period : i + (k + 1) * period] == cids[i : i + period]:
+                while (
+                    i + (k + 1) * period <= n
+                    and cids[i + k * period : i + (k + 1) * period] == cids[i : i + period]
+                ):
                     k += 1
                 if k >= 2 and not (i == 0 and i + k * period == n):
                     end = i + k * period
@@ -176,7 +192,9 @@ class Search:
             start, stop = rep.r0[spans], rep.r1[spans]
         lo, hi = full[0], full[-1]
         blocks: list[tuple[int, int]] = []
-        for a, b in sorted(zip(start.tolist(), stop.tolist(), strict=True), key=lambda s: (s[0] - s[1], s)):
+        for a, b in sorted(
+            zip(start.tolist(), stop.tolist(), strict=True), key=lambda s: (s[0] - s[1], s)
+        ):
             if (a, b) != (lo, hi) and all(b <= x or y <= a for x, y in blocks):
                 blocks.append((a, b))
         if not blocks:
@@ -200,7 +218,11 @@ class Search:
         op: Op = "split"
         written, count, centre = parts, 1, False
         period = next(
-            (p for p in range(1, n // 2 + 1) if n % p == 0 and all(cids[i] == cids[i % p] for i in range(n))),
+            (
+                p
+                for p in range(1, n // 2 + 1)
+                if n % p == 0 and all(cids[i] == cids[i % p] for i in range(n))
+            ),
             None,
         )
         if period is not None:
@@ -215,7 +237,9 @@ class Search:
             op, written, count = "repeatABA", parts[:2], n // 2
         elif "symsplit" in self.extensions and n >= 3 and cids == cids[::-1]:
             op, written, centre = "symsplit", parts[: (n + 1) // 2], n % 2 == 1
-        rule_cost = (self.costs.repeat if op in ("repeat", "repeatABA") else self.costs.split) + len(written)
+        rule_cost = (
+            self.costs.repeat if op in ("repeat", "repeatABA") else self.costs.split
+        ) + len(written)
         heuristic = rule_cost + sum(cost_of_line.get(line, 0.0) for line in bounds[1:-1])
         sizes = tuple(self._quantum(axis, p) for p in written)
         return Action(
@@ -223,6 +247,7 @@ class Search:
             axis,
             bounds,
             tuple(written),
+            tuple(self.grid.content(p) for p in written),
             self._needs(written),
             rule_cost,
             heuristic,
@@ -239,14 +264,19 @@ class Search:
 
     def _needs(self, written: list[Region] | tuple[Region, ...]) -> tuple[int, ...]:
         grid = self.grid
-        cids = (grid.content(p) for p in written)
+        larger_first = sorted(written, key=lambda p: -(p[1] - p[0]) * (p[3] - p[2]))
+        cids = (grid.content(p) for p in larger_first)
         return tuple(dict.fromkeys(c for c in cids if c not in grid.terminal))
 
     def _gridsplit(self, region: Region, usable: dict[Axis, list[int]]) -> Action | None:
         r0, r1, c0, c1 = region
         rows = (r0, *usable["y"], r1)
         columns = (c0, *usable["x"], c1)
-        cells = [(a, b, c, d) for a, b in itertools.pairwise(rows) for c, d in itertools.pairwise(columns)]
+        cells = [
+            (a, b, c, d)
+            for a, b in itertools.pairwise(rows)
+            for c, d in itertools.pairwise(columns)
+        ]
         cost = self.costs.split + len(cells)
         cost_x, cost_y = self._line_costs(region, "x"), self._line_costs(region, "y")
         heuristic = cost + sum(cost_x.get(v, 0.0) for v in columns[1:-1])
@@ -261,6 +291,7 @@ class Search:
             "y",
             rows,
             tuple(cells),
+            tuple(self.grid.content(c) for c in cells),
             self._needs(cells),
             cost,
             heuristic,
@@ -270,30 +301,30 @@ class Search:
 
     # -- building grammars ---------------------------------------------------------------
 
-    def build(self, choose: Callable[[Region, int, dict[int, Action], set[int]], Action]) -> dict[int, Action]:
+    def build(
+        self, choose: Callable[[Region, int, dict[int, Action], set[int]], Action]
+    ) -> dict[int, Action]:
         """One grammar: regions bottom to top, left to right, each content split once."""
         grid = self.grid
+        terminal = grid.terminal
         rules: dict[int, Action] = {}
         start = grid.content(self.whole)
         if start in grid.terminal:
             return rules
         pending = {start}
-        heap = [(self.whole[0], self.whole[2], -self.whole[1], -self.whole[3])]
+        r0, r1, c0, c1 = self.whole
+        heap = [(r0, c0, -r1, -c1, start)]
         while heap:
-            r0, c0, neg_r1, neg_c1 = heapq.heappop(heap)
+            r0, c0, neg_r1, neg_c1, cid = heapq.heappop(heap)
             region = (r0, -neg_r1, c0, -neg_c1)
-            cid = grid.content(region)
-            if cid in rules:
-                continue
             pending.discard(cid)
             action = choose(region, cid, rules, pending)
             rules[cid] = action
-            for part in action.written:
-                sub = grid.content(part)
-                if sub in grid.terminal or sub in rules or sub in pending:
+            for part, sub in zip(action.written, action.cids, strict=True):
+                if sub in terminal or sub in rules or sub in pending:
                     continue
                 pending.add(sub)
-                heapq.heappush(heap, (part[0], part[2], -part[1], -part[3]))
+                heapq.heappush(heap, (part[0], part[2], -part[1], -part[3], sub))
         return rules
 
     def canonical(self, rules: dict[int, Action]) -> dict[int, int]:
@@ -304,13 +335,15 @@ class Search:
         same: dict[int, int] = {}
         seen: dict[tuple[object, ...], int] = {}
 
+        terminal = grid.terminal
+
         def visit(cid: int) -> object:
-            if cid in grid.terminal:
-                return grid.terminal[cid]
             found = same.get(cid)
             if found is None:
                 action = rules[cid]
-                symbols = tuple(visit(grid.content(part)) for part in action.written)
+                symbols = tuple(
+                    terminal[sub] if sub in terminal else visit(sub) for sub in action.cids
+                )
                 found = same[cid] = seen.setdefault((action.form, symbols), cid)
             return found
 
@@ -331,10 +364,11 @@ class Search:
         found in (0 is the greedy one)."""
         rng = random.Random(seed)
         values: dict[int, float] = {}
+        below: dict[int, int] = {}  # content -> its best-known rules, as bits of contents
         optimistic = min(self.costs.split + 2, self.costs.repeat + 1)
         best = self.greedy()
         best_cost, best_at = self.cost(best), 0
-        self._learn(best, values)
+        self._learn(best, values, below)
         epsilon = 1.0
 
         def choose(region: Region, cid: int, rules: dict[int, Action], pending: set[int]) -> Action:
@@ -347,10 +381,12 @@ class Search:
                 return rng.choices(actions, weights)[0]
             chosen, least = actions[0], math.inf
             for action in actions:  # exploitation: Eq. 4 with the value table
-                score = action.cost
-                for need in action.needs:
-                    if need not in rules and need not in pending and need != cid:
-                        score += values.get(need, optimistic)
+                score, covered = action.cost, 0
+                for need in action.needs:  # larger parts first: theirs hold the smaller
+                    if need in rules or need in pending or need == cid or covered >> need & 1:
+                        continue
+                    score += values.get(need, optimistic)
+                    covered |= below.get(need, 0)
                 if score < least:
                     chosen, least = action, score
             return chosen
@@ -359,36 +395,42 @@ class Search:
             epsilon = 1.0 - t / iterations
             rules = self.build(choose)
             cost = self.cost(rules)
-            self._learn(rules, values)
+            self._learn(rules, values, below)
             if cost < best_cost - 1e-9:
                 best, best_cost, best_at = rules, cost, t
         return best, best_at
 
-    def _learn(self, rules: dict[int, Action], values: dict[int, float]) -> None:
-        """Each content's cost to describe, with the rules below it counted once each."""
-        index = {cid: 1 << i for i, cid in enumerate(rules)}
-        costs = [action.cost for action in rules.values()]
+    def _learn(
+        self, rules: dict[int, Action], values: dict[int, float], below: dict[int, int]
+    ) -> None:
+        """Each content's cost to describe, with the rules below it counted once each, kept
+        in the value table when it is the least yet, with the contents it took."""
+        order = list(rules)
+        costs = [rules[cid].cost for cid in order]
+        position = {cid: i for i, cid in enumerate(order)}
         reach: dict[int, int] = {}
 
-        def below(cid: int) -> int:
+        def within(cid: int) -> int:
             found = reach.get(cid)
             if found is None:
-                found = index[cid]
+                found = 1 << position[cid]
                 for need in rules[cid].needs:
                     if need in rules:
-                        found |= below(need)
+                        found |= within(need)
                 reach[cid] = found
             return found
 
-        for cid in rules:
-            bits, total, i = below(cid), 0.0, 0
+        for cid in order:
+            bits, total, contents = within(cid), 0.0, 0
             while bits:
-                if bits & 1:
-                    total += costs[i]
-                bits >>= 1
-                i += 1
+                low = bits & -bits
+                i = low.bit_length() - 1
+                total += costs[i]
+                contents |= 1 << order[i]
+                bits ^= low
             if total < values.get(cid, math.inf):
                 values[cid] = total
+                below[cid] = contents
 
     # -- the grammar ---------------------------------------------------------------------
 
@@ -430,11 +472,11 @@ class Search:
             heights = [grid.size("y", a, b) for a, b in itertools.pairwise(action.bounds)]
             widths = tuple(grid.size("x", a, b) for a, b in itertools.pairwise(action.across))
             columns = len(widths)
-            parts = tuple(
+            cells = tuple(
                 Part(heights[i // columns], name(grid.content(cell)))
                 for i, cell in enumerate(action.written)
             )
-            return Rule("gridsplit", "y", parts, across=widths)
+            return Rule("gridsplit", "y", cells, across=widths)
         parts = []
         for part in action.written:
             a, b = (part[2], part[3]) if action.axis == "x" else (part[0], part[1])
@@ -447,7 +489,7 @@ def extract(
     method: str = "adp",
     iterations: int = 2000,
     seed: int = 0,
-    costs: Costs = Costs(),
+    costs: Costs = DEFAULT_COSTS,
     extensions: tuple[str, ...] = (),
     background: str = BACKGROUND,
 ) -> SearchResult:

@@ -32,6 +32,9 @@ class Costs:
     repeat: float = 0.5
 
 
+DEFAULT_COSTS = Costs()
+
+
 @dataclass(frozen=True)
 class Part:
     size: float  # along the rule's axis, in the layout's units
@@ -67,7 +70,9 @@ class Rule:
         if self.op == "gridsplit":
             rows = len(self.parts) // len(self.across)
             body = " ; ".join(
-                " | ".join(p.symbol for p in self.parts[i * len(self.across) : (i + 1) * len(self.across)])
+                " | ".join(
+                    p.symbol for p in self.parts[i * len(self.across) : (i + 1) * len(self.across)]
+                )
                 for i in range(rows)
             )
             heights = ", ".join(f"{self.parts[i * len(self.across)].size:.4g}" for i in range(rows))

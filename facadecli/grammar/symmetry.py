@@ -52,10 +52,10 @@ def _seeds(grid: Grid) -> list[Region]:
                 i, j = stack.pop()
                 cells.append((i, j))
                 for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
-                    if 0 <= a < grid.rows and 0 <= b < grid.columns:
-                        if not seen[a, b] and grid.labels[a, b] == label:
-                            seen[a, b] = True
-                            stack.append((a, b))
+                    inside = 0 <= a < grid.rows and 0 <= b < grid.columns
+                    if inside and not seen[a, b] and grid.labels[a, b] == label:
+                        seen[a, b] = True
+                        stack.append((a, b))
             rows = [i for i, _ in cells]
             cols = [j for _, j in cells]
             region = (min(rows), max(rows) + 1, min(cols), max(cols) + 1)
@@ -101,7 +101,12 @@ def _disjoint(regions: list[Region]) -> list[Region]:
 
 
 def _inside(inner: Region, outer: Region) -> bool:
-    return outer[0] <= inner[0] and inner[1] <= outer[1] and outer[2] <= inner[2] and inner[3] <= outer[3]
+    return (
+        outer[0] <= inner[0]
+        and inner[1] <= outer[1]
+        and outer[2] <= inner[2]
+        and inner[3] <= outer[3]
+    )
 
 
 def find_repeats(grid: Grid, limit: int = MAX_REPEATS) -> Repeats:
@@ -137,8 +142,7 @@ def find_repeats(grid: Grid, limit: int = MAX_REPEATS) -> Repeats:
     kept_kinds: list[list[Region]] = []
     for _, regions in kinds:
         if any(
-            len(bigger) >= len(regions)
-            and all(any(_inside(r, b) for b in bigger) for r in regions)
+            len(bigger) >= len(regions) and all(any(_inside(r, b) for b in bigger) for r in regions)
             for bigger in kept_kinds
         ):
             continue

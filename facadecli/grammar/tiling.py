@@ -142,7 +142,9 @@ def read_report(path: Path) -> LabelledLayout:
     return LabelledLayout(report["canvas"]["width"], report["canvas"]["height"], rects)
 
 
-def snap(values: list[float], tolerance: float, anchors: tuple[float, ...] = ()) -> dict[float, float]:
+def snap(
+    values: list[float], tolerance: float, anchors: tuple[float, ...] = ()
+) -> dict[float, float]:
     """Each value mapped to the mean of its cluster (values within ``tolerance`` in a row),
     or to the anchor in its cluster if it holds one (the façade's edges stay put)."""
     ordered = sorted(set(values) | set(anchors))

@@ -16,12 +16,17 @@ all hold are dropped (alignment first, then equal sizes) with a warning.
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections import defaultdict
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.tiling import BACKGROUND, CMP_Z_ORDER, Tiling, snap
+
+if TYPE_CHECKING:
+    from facadecli.layout import Layout
 
 THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute size
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
@@ -47,9 +52,14 @@ def _elastic(grammar: Grammar) -> dict[tuple[str, str], bool]:
         key = (symbol, axis)
         if key not in memo:
             rule = grammar.rules.get(symbol)
-            memo[key] = rule is not None and rule.axis == axis and rule.op != "gridsplit" and (
-                rule.op in ("repeat", "repeatABA")
-                or any(elastic(p.symbol, axis) for p in rule.parts)
+            memo[key] = (
+                rule is not None
+                and rule.axis == axis
+                and rule.op != "gridsplit"
+                and (
+                    rule.op in ("repeat", "repeatABA")
+                    or any(elastic(p.symbol, axis) for p in rule.parts)
+                )
             )
         return memo[key]
 
@@ -78,13 +88,17 @@ def distribute(
     return [s * scale if f else s for s, f in zip(sizes, free, strict=True)]
 
 
-def derive_at(grammar: Grammar, source: tuple[float, float], width: float, height: float) -> list[Piece]:
+def derive_at(
+    grammar: Grammar, source: tuple[float, float], width: float, height: float
+) -> list[Piece]:
     """The grammar applied to a façade of a new size (see the module)."""
     elastic = _elastic(grammar)
     thin = {"x": THIN * source[0], "y": THIN * source[1]}
     out: list[Piece] = []
 
-    def expand(symbol: str, box: tuple[float, float, float, float], src: tuple[float, float]) -> None:
+    def expand(
+        symbol: str, box: tuple[float, float, float, float], src: tuple[float, float]
+    ) -> None:
         x0, y0, x1, y1 = box
         rule = grammar.rules.get(symbol)
         if rule is None:
@@ -153,10 +167,11 @@ def align(
     """Equal terminals one size and lined up (see the module)."""
     warnings: list[str] = []
     mapping = {}
-    for axis, extent in (("x", width), ("y", height)):
+    axes: tuple[tuple[Axis, float], ...] = (("x", width), ("y", height))
+    for axis, extent in axes:
         mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background)
         warnings += axis_warnings
-    aligned = [
+    moved = [
         Piece(
             p.label,
             mapping["x"][p.x0],
@@ -168,7 +183,7 @@ def align(
         )
         for p in pieces
     ]
-    return aligned, warnings
+    return [p for p in moved if p.x1 > p.x0 and p.y1 > p.y0], warnings
 
 
 def _align_axis(
@@ -185,8 +200,8 @@ def _align_axis(
     for p in pieces:
         a, b = (p.x0, p.x1) if axis == "x" else (p.y0, p.y1)
         span = (index[joined[a]], index[joined[b]])
-        spans.append((span, edges[span[1]] - edges[span[0]]))
-        if p.label != background:
+        if p.label != background:  # elements keep at least half their size; wall may vanish
+            spans.append((span, edges[span[1]] - edges[span[0]]))
             source = p.source_w if axis == "x" else p.source_h
             groups[(p.label, round(source / (1e-6 * extent)))].append(span)
     equal = []
@@ -197,9 +212,7 @@ def _align_axis(
         for side in (0, 1):
             ends = sorted({span[side] for span in unique}, key=lambda i: edges[i])
             lined += [
-                (a, b)
-                for a, b in zip(ends, ends[1:], strict=False)
-                if edges[b] - edges[a] < ALIGN * extent
+                (a, b) for a, b in itertools.pairwise(ends) if edges[b] - edges[a] < ALIGN * extent
             ]
     v = cp.Variable(len(edges))
     base = [v[0] == 0.0, v[len(edges) - 1] == extent]
@@ -260,7 +273,9 @@ def _ident(label: str, taken: set[str]) -> str:
     return name
 
 
-def pieces_layout(pieces: list[Piece], width: float, height: float, name: str, warnings: list[str]) -> object:
+def pieces_layout(
+    pieces: list[Piece], width: float, height: float, name: str, warnings: list[str]
+) -> Layout:
     """A ``Layout`` of the pieces, one layer per label, for the layout writers."""
     from facadecli.grammar.palette import label_colour
     from facadecli.layout import Appearance, Layout, Shape
@@ -268,7 +283,9 @@ def pieces_layout(pieces: list[Piece], width: float, height: float, name: str, w
     from facadecli.spec.model import Spec
 
     unit = min(width, height) / 10
-    labels = sorted({p.label for p in pieces}, key=lambda label: (CMP_Z_ORDER.get(label, 99), label))
+    labels = sorted(
+        {p.label for p in pieces}, key=lambda label: (CMP_Z_ORDER.get(label, 99), label)
+    )
     taken: set[str] = set()
     idents = {label: _ident(label, taken) for label in labels}
     spec = Spec.model_validate(
@@ -307,14 +324,29 @@ def pieces_layout(pieces: list[Piece], width: float, height: float, name: str, w
                 look=Appearance(ident, look.mesh, look.depth * unit, look.thickness * unit),
             )
         )
+    extents: tuple[tuple[Axis, float], ...] = (("x", width), ("y", height))
     axes = [
-        AxisLayout(axis, extent, {}, {}, {}, {}, {}, 0.0, 0.0, 0, tuple(w for w in warnings if w.startswith(axis)))
-        for axis, extent in (("x", width), ("y", height))
+        AxisLayout(
+            axis,
+            extent,
+            {},
+            {},
+            {},
+            {},
+            {},
+            0.0,
+            0.0,
+            0,
+            tuple(w for w in warnings if w.startswith(axis)),
+        )
+        for axis, extent in extents
     ]
     return Layout(spec, width, height, axes[0], axes[1], tuple(shapes), 0.0)
 
 
-def derive_layout(grammar: Grammar, tiling: Tiling, width: float, height: float, name: str) -> object:
+def derive_layout(
+    grammar: Grammar, tiling: Tiling, width: float, height: float, name: str
+) -> Layout:
     """The grammar at a new size, aligned, as a layout named ``<name>-<W>x<H>``."""
     source = (tiling.xs[-1], tiling.ys[-1])
     pieces, warnings = align(derive_at(grammar, source, width, height), width, height)
