@@ -44,8 +44,9 @@ format: $(STAMP) ## Reformat the code with ruff
 	$(BIN)/ruff check --fix facadecli tests
 	$(BIN)/ruff format facadecli tests
 
-bench: $(STAMP) ## Time loading and solving the examples and a generated 24-layer façade
+bench: $(STAMP) ## Time solving the examples, a generated 24-layer façade, and grammar extraction on CMP
 	$(BIN)/python tests/benchmarks/bench.py
+	$(BIN)/python tests/benchmarks/grammar_bench.py
 
 schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json

@@ -422,7 +422,7 @@ def grammar(
     outputs = {
         f"{name}.grammar.txt": found.text(),
         f"{name}.grammar.json": grammar_json(found),
-        f"{name}.tiling.svg": tiling_svg(extraction.tiling, name),
+        f"{name}.tiling.svg": tiling_svg(extraction.tiling, found, name),
         f"{name}.grammar-report.json": grammar_report(extraction, timings),
     }
     for file, text in outputs.items():

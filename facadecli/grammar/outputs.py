@@ -10,7 +10,7 @@ from xml.sax.saxutils import escape
 
 from facadecli.grammar.palette import label_colour
 from facadecli.grammar.run import Extraction
-from facadecli.grammar.split import Grammar
+from facadecli.grammar.split import Grammar, derive_tree
 from facadecli.grammar.tiling import Tiling
 
 SCALE = 600.0  # pixels for the longer side of the façade
@@ -27,30 +27,64 @@ def grammar_json(grammar: Grammar) -> str:
     return json.dumps(data, indent=2) + "\n"
 
 
-def tiling_svg(tiling: Tiling, title: str) -> str:
-    """Cells filled by label (a legend below), drawn bottom up like the façade."""
+def _mix(a: str, b: str) -> str:
+    """Half one colour, half the other."""
+    channels = [(int(a[i : i + 2], 16) + int(b[i : i + 2], 16)) // 2 for i in (1, 3, 5)]
+    return "#{:02x}{:02x}{:02x}".format(*channels)
+
+
+def tiling_svg(tiling: Tiling, grammar: Grammar, title: str) -> str:
+    """Two panels, drawn bottom up like the façade: the tiling's cells filled by label, and
+    the grammar's regions, each terminal filled with the colour of the non-terminal that
+    holds it (regions made by one rule look alike) and every non-terminal region outlined,
+    the outer ones wider and named. Legends of labels and of the outer rules below."""
     width, height = tiling.xs[-1], tiling.ys[-1]
     scale = SCALE / max(width, height)
-    labels = sorted({label for row in tiling.labels for label in row})
-    legend = 18 * len(labels) + 10
     w, h = width * scale, height * scale
+    gap = 30.0
+    tree = derive_tree(grammar, width, height)
+    labels = sorted({label for row in tiling.labels for label in row})
+    legend = 18 * len(labels) + 34
+    total_w, total_h = 2 * w + gap + 20, h + legend + 20
+
+    def rect(x0: float, y0: float, x1: float, y1: float, left: float) -> str:
+        return (
+            f'x="{left + x0 * scale:.2f}" y="{10 + (height - y1) * scale:.2f}" '
+            f'width="{(x1 - x0) * scale:.2f}" height="{(y1 - y0) * scale:.2f}"'
+        )
+
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w + 20:.0f}" '
-        f'height="{h + 20 + legend:.0f}">',
-        f"<title>{escape(title)}: tiling</title>",
-        f'<rect width="{w + 20:.0f}" height="{h + 20 + legend:.0f}" fill="#ffffff"/>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{total_w:.0f}" height="{total_h:.0f}">',
+        f"<title>{escape(title)}: tiling and grammar regions</title>",
+        f'<rect width="{total_w:.0f}" height="{total_h:.0f}" fill="#ffffff"/>',
     ]
     for r, row in enumerate(tiling.labels):
-        y = 10 + (height - tiling.ys[r + 1]) * scale
-        cell_h = (tiling.ys[r + 1] - tiling.ys[r]) * scale
         for c, label in enumerate(row):
-            x = 10 + tiling.xs[c] * scale
-            cell_w = (tiling.xs[c + 1] - tiling.xs[c]) * scale
-            lines.append(
-                f'<rect x="{x:.2f}" y="{y:.2f}" width="{cell_w:.2f}" height="{cell_h:.2f}" '
-                f'fill="{label_colour(label)}"/>'
+            box = rect(tiling.xs[c], tiling.ys[r], tiling.xs[c + 1], tiling.ys[r + 1], 10)
+            lines.append(f'<rect {box} fill="{label_colour(label)}"/>')
+    right = 10 + w + gap
+    parents: list[str] = []
+    outlines, names = [], []
+    for depth, terminal, (symbol, x0, y0, x1, y1) in tree:
+        del parents[depth:]
+        if terminal:
+            holder = parents[-1] if parents else symbol
+            fill = _mix(label_colour(symbol), label_colour(f"rule {holder}"))
+            lines.append(f'<rect {rect(x0, y0, x1, y1, right)} fill="{fill}"/>')
+            continue
+        parents.append(symbol)
+        stroke = max(3.0 - depth, 0.6)
+        outlines.append(
+            f'<rect {rect(x0, y0, x1, y1, right)} fill="none" stroke="#202020" '
+            f'stroke-width="{stroke:.1f}"/>'
+        )
+        if depth <= 2 and (x1 - x0) * scale > 30 and (y1 - y0) * scale > 14:
+            names.append(
+                f'<text x="{right + x0 * scale + 3:.1f}" y="{10 + (height - y1) * scale + 12:.1f}" '
+                f'font-family="sans-serif" font-size="11" fill="#000000">{escape(symbol)}</text>'
             )
+    lines += outlines + names
     for i, label in enumerate(labels):
         y = h + 24 + 18 * i
         lines.append(
@@ -60,6 +94,11 @@ def tiling_svg(tiling: Tiling, title: str) -> str:
             f'<text x="28" y="{y + 11:.0f}" font-family="sans-serif" font-size="12">'
             f"{escape(label)}</text>"
         )
+    lines.append(
+        f'<text x="{right:.0f}" y="{h + 35:.0f}" font-family="sans-serif" font-size="12">'
+        f"{len(grammar.rules)} rules, cost {grammar.cost:.1f}: terminals tinted by the rule "
+        "that makes them</text>"
+    )
     lines.append("</svg>")
     return "\n".join(lines) + "\n"
 

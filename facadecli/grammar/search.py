@@ -28,7 +28,7 @@ import heapq
 import itertools
 import math
 import random
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -242,13 +242,14 @@ class Search:
         ) + len(written)
         heuristic = rule_cost + sum(cost_of_line.get(line, 0.0) for line in bounds[1:-1])
         sizes = tuple(self._quantum(axis, p) for p in written)
+        kept = cids[: len(written)]
         return Action(
             op,
             axis,
             bounds,
             tuple(written),
-            tuple(self.grid.content(p) for p in written),
-            self._needs(written),
+            tuple(kept),
+            self._needs(written, kept),
             rule_cost,
             heuristic,
             count,
@@ -262,11 +263,11 @@ class Search:
         step = self.grid.quantum_x if axis == "x" else self.grid.quantum_y
         return round(self.grid.size(axis, a, b) / step)
 
-    def _needs(self, written: list[Region] | tuple[Region, ...]) -> tuple[int, ...]:
-        grid = self.grid
-        larger_first = sorted(written, key=lambda p: -(p[1] - p[0]) * (p[3] - p[2]))
-        cids = (grid.content(p) for p in larger_first)
-        return tuple(dict.fromkeys(c for c in cids if c not in grid.terminal))
+    def _needs(self, written: Sequence[Region], cids: Sequence[int]) -> tuple[int, ...]:
+        """The non-terminal contents among the parts, once each, larger parts first."""
+        terminal = self.grid.terminal
+        pairs = sorted(zip(written, cids, strict=True), key=lambda pc: -_cells(pc[0]))
+        return tuple(dict.fromkeys(c for _, c in pairs if c not in terminal))
 
     def _gridsplit(self, region: Region, usable: dict[Axis, list[int]]) -> Action | None:
         r0, r1, c0, c1 = region
@@ -277,6 +278,7 @@ class Search:
             for a, b in itertools.pairwise(rows)
             for c, d in itertools.pairwise(columns)
         ]
+        cids = [self.grid.content(cell) for cell in cells]
         cost = self.costs.split + len(cells)
         cost_x, cost_y = self._line_costs(region, "x"), self._line_costs(region, "y")
         heuristic = cost + sum(cost_x.get(v, 0.0) for v in columns[1:-1])
@@ -291,8 +293,8 @@ class Search:
             "y",
             rows,
             tuple(cells),
-            tuple(self.grid.content(c) for c in cells),
-            self._needs(cells),
+            tuple(cids),
+            self._needs(cells, cids),
             cost,
             heuristic,
             across=columns,
@@ -406,8 +408,11 @@ class Search:
         """Each content's cost to describe, with the rules below it counted once each, kept
         in the value table when it is the least yet, with the contents it took."""
         order = list(rules)
-        costs = [rules[cid].cost for cid in order]
         position = {cid: i for i, cid in enumerate(order)}
+        by_cost: dict[float, int] = {}  # rule cost -> the rules with it, as bits
+        for i, cid in enumerate(order):
+            cost = rules[cid].cost
+            by_cost[cost] = by_cost.get(cost, 0) | 1 << i
         reach: dict[int, int] = {}
 
         def within(cid: int) -> int:
@@ -421,15 +426,15 @@ class Search:
             return found
 
         for cid in order:
-            bits, total, contents = within(cid), 0.0, 0
-            while bits:
-                low = bits & -bits
-                i = low.bit_length() - 1
-                total += costs[i]
-                contents |= 1 << order[i]
-                bits ^= low
-            if total < values.get(cid, math.inf):
+            bits = within(cid)
+            total = sum(cost * (bits & mask).bit_count() for cost, mask in by_cost.items())
+            if total < values.get(cid, math.inf) - 1e-12:
                 values[cid] = total
+                contents = 0
+                while bits:
+                    low = bits & -bits
+                    contents |= 1 << order[low.bit_length() - 1]
+                    bits ^= low
                 below[cid] = contents
 
     # -- the grammar ---------------------------------------------------------------------
@@ -482,6 +487,10 @@ class Search:
             a, b = (part[2], part[3]) if action.axis == "x" else (part[0], part[1])
             parts.append(Part(grid.size(action.axis, a, b), name(grid.content(part))))
         return Rule(action.op, action.axis, tuple(parts), action.count, action.centre)
+
+
+def _cells(region: Region) -> int:
+    return (region[1] - region[0]) * (region[3] - region[2])
 
 
 def extract(

@@ -109,12 +109,18 @@ Box = tuple[str, float, float, float, float]
 def derive(grammar: Grammar, width: float, height: float) -> list[Box]:
     """The terminal rectangles (label, x0, y0, x1, y1) the grammar derives, with the sizes
     it was extracted with."""
-    out: list[Box] = []
+    return [box for _, terminal, box in derive_tree(grammar, width, height) if terminal]
 
-    def expand(symbol: str, x0: float, y0: float, x1: float, y1: float) -> None:
+
+def derive_tree(grammar: Grammar, width: float, height: float) -> list[tuple[int, bool, Box]]:
+    """Every region of the derivation, parents before children, as ``(depth, terminal,
+    box)``; the start symbol is at depth 0."""
+    out: list[tuple[int, bool, Box]] = []
+
+    def expand(symbol: str, x0: float, y0: float, x1: float, y1: float, depth: int) -> None:
         rule = grammar.rules.get(symbol)
+        out.append((depth, rule is None, (symbol, x0, y0, x1, y1)))
         if rule is None:
-            out.append((symbol, x0, y0, x1, y1))
             return
         if rule.op == "gridsplit":
             columns = len(rule.across)
@@ -123,7 +129,7 @@ def derive(grammar: Grammar, width: float, height: float) -> list[Box]:
                 row = rule.parts[i * columns : (i + 1) * columns]
                 x = x0
                 for part, w in zip(row, rule.across, strict=True):
-                    expand(part.symbol, x, y, x + w, y + row[0].size)
+                    expand(part.symbol, x, y, x + w, y + row[0].size, depth + 1)
                     x += w
                 y += row[0].size
             return
@@ -131,10 +137,10 @@ def derive(grammar: Grammar, width: float, height: float) -> list[Box]:
         for part in rule.sequence():
             end = cursor + part.size
             if rule.axis == "y":
-                expand(part.symbol, x0, cursor, x1, end)
+                expand(part.symbol, x0, cursor, x1, end, depth + 1)
             else:
-                expand(part.symbol, cursor, y0, end, y1)
+                expand(part.symbol, cursor, y0, end, y1, depth + 1)
             cursor = end
 
-    expand(grammar.start, 0.0, 0.0, width, height)
+    expand(grammar.start, 0.0, 0.0, width, height, 0)
     return out
