@@ -9,7 +9,7 @@ OUT    ?= out
 VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 
 .DEFAULT_GOAL := help
-.PHONY: help install demo test lint format bench schema golden city clean
+.PHONY: help install demo test lint format bench schema golden grammar city clean
 
 help: ## Show the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-8s %s\n", $$1, $$2}'
@@ -52,6 +52,12 @@ schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json
 
 CITY ?=
+grammar: $(STAMP) ## A split grammar of a solved façade, or LAYOUT=file (CMP .xml, JSON), and new sizes
+	@if [ -z "$(LAYOUT)" ]; then \
+	  $(BIN)/facade solve specs/townhouse.yaml -o $(OUT)/grammar --format json && \
+	  $(BIN)/facade grammar $(OUT)/grammar/townhouse.layout.json -o $(OUT)/grammar --derive 14x15 --derive 6x9; \
+	else $(BIN)/facade grammar $(LAYOUT) -o $(OUT)/grammar --derive 24x15; fi
+
 city: $(STAMP) ## Build a city: the generated demo district, or CITY=path/to/manifest.yaml
 	@if [ -z "$(CITY)" ]; then \
 	  $(BIN)/python -c "from pathlib import Path; from facadecli.city.demo import write_demo; write_demo(Path('$(OUT)/city-demo'), Path('specs'))" && \
