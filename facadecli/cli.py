@@ -419,6 +419,8 @@ def grammar(
         )
     found = extraction.grammar
     name = stem(layout)
+    for warning in extraction.regularization.warnings:
+        typer.echo(f"{layout}: warning: {warning}", err=True)
     outputs = {
         f"{name}.grammar.txt": found.text(),
         f"{name}.grammar.json": grammar_json(found),
@@ -433,6 +435,8 @@ def grammar(
 
         for width, height in sizes:
             derived = derive_layout(found, extraction.tiling, width, height, name)
+            for warning in derived.warnings:
+                typer.echo(f"{layout}: warning: {width:g}x{height:g}: {warning}", err=True)
             written += write_outputs(derived, outdir, kinds, OutputOptions())
     typer.echo(
         f"{layout}: {len(found.rules)} rules, cost {found.cost:.1f} "

@@ -177,6 +177,12 @@ def test_every_grammar_rederives_its_tiling_exactly(seed: int, extensions: tuple
     result = extract(tiling, iterations=60, seed=seed, extensions=extensions)
     assert rederivation_problems(result.grammar, tiling) == []
     assert result.grammar.cost <= result.greedy_cost + 1e-9
+    # any grammar applies at any size: the pieces tile the new façade
+    width, height = 5.0 + seed % 7, 4.0 + seed % 5
+    pieces, _ = align(derive_at(result.grammar, (8.0, 6.0), width, height), width, height)
+    assert all(p.x1 > p.x0 and p.y1 > p.y0 for p in pieces)
+    area = sum((p.x1 - p.x0) * (p.y1 - p.y0) for p in pieces)
+    assert area == pytest.approx(width * height)
 
 
 def test_rederivation_problems_are_found() -> None:
@@ -410,6 +416,33 @@ def test_grammar_rejects_bad_options(tmp_path: Path, args: tuple[str, ...], mess
     assert result.returncode == 2 and message in result.stderr
     assert "Traceback" not in result.stderr
     assert not list(tmp_path.glob("house.grammar*"))
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("not json", "bad.json:1:1: error: not JSON"),
+        ('{"rects": [\n  {"label": "w", "x0": 1,}]}', "bad.json:2:26: error: not JSON"),
+        ('[{"label": "w", "x0": 3, "y0": 0, "x1": 1, "y1": 2}]', "rectangle 1 (w) has no area"),
+        ("[]", "no rectangles"),
+    ],
+)
+def test_grammar_points_at_broken_json(tmp_path: Path, text: str, message: str) -> None:
+    source = tmp_path / "bad.json"
+    source.write_text(text)
+    result = _facade("grammar", str(source), "-o", str(tmp_path / "out"))
+    assert result.returncode == 2 and message in result.stderr, result.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_single_terminal_is_a_grammar_too(tmp_path: Path) -> None:
+    source = tmp_path / "wall.json"
+    source.write_text('[{"label": "wall", "x0": 0, "y0": 0, "x1": 4, "y1": 3}]')
+    result = _facade("grammar", str(source), "-o", str(tmp_path), "--derive", "8x3")
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "wall.grammar.txt").read_text() == "wall\n"
+    report = json.loads((tmp_path / "wall-8x3.layout.json").read_text())
+    assert [(s["x0"], s["x1"]) for s in report["shapes"]] == [(0.0, 8.0)]
 
 
 def test_grammar_reads_a_broken_layout_with_a_clear_error(tmp_path: Path) -> None:

@@ -4,6 +4,7 @@ regularise it, tile it, find a grammar, and check that it derives the tiling exa
 from __future__ import annotations
 
 import bisect
+import json
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -66,6 +67,10 @@ def read_layout(path: Path) -> tuple[LabelledLayout, bool]:
         if name.endswith(".layout.json"):
             return read_report(path), True
         return read_plain(path), False
+    except json.JSONDecodeError as error:
+        raise SpecError.at(
+            str(path), error.lineno, error.colno, f"not JSON: {error.msg}", "fix the JSON syntax"
+        ) from None
     except (ValueError, KeyError, TypeError) as error:
         raise SpecError.at(
             str(path),

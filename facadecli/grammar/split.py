@@ -99,6 +99,8 @@ class Grammar:
     def text(self) -> str:
         """One rule a line, CGA-like (the paper's section 4.6), the start symbol first, then
         in the order the rules were made."""
+        if not self.rules:  # the whole façade is one terminal
+            return f"{self.start}\n"
         names = [self.start, *(name for name in self.rules if name != self.start)]
         return "\n".join(self.rules[name].text(name) for name in names if name in self.rules) + "\n"
 

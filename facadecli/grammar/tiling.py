@@ -122,6 +122,16 @@ def read_plain(path: Path) -> LabelledLayout:
         )
         for i, e in enumerate(entries)
     )
+    for i, r in enumerate(rects):
+        if not (r.x1 > r.x0 and r.y1 > r.y0):
+            raise SpecError.at(
+                str(path),
+                None,
+                None,
+                f"rectangle {i + 1} ({r.label}) has no area: x {r.x0:g}..{r.x1:g}, "
+                f"y {r.y0:g}..{r.y1:g}",
+                "give x0 < x1 and y0 < y1",
+            )
     if isinstance(data, dict) and "canvas" in data:
         width, height = float(data["canvas"]["width"]), float(data["canvas"]["height"])
     else:
