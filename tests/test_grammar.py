@@ -238,7 +238,7 @@ def test_gridsplit_splits_both_ways_at_once() -> None:
 # -- round trip of a solved layout ---------------------------------------------------------
 
 
-@pytest.mark.parametrize("spec", ["residential-house.yaml", "townhouse.yaml"])
+@pytest.mark.parametrize("spec", [p.name for p in sorted((ROOT / "specs").glob("*.yaml"))])
 def test_a_solved_layout_round_trips_through_its_grammar(tmp_path: Path, spec: str) -> None:
     layout = solve(load_spec(ROOT / "specs" / spec))
     path = tmp_path / "house.layout.json"
@@ -248,28 +248,29 @@ def test_a_solved_layout_round_trips_through_its_grammar(tmp_path: Path, spec: s
     assert extraction.regularization.moves == []  # a solved layout is exact: nothing moves
     pieces = derive(extraction.grammar, layout.width, layout.height)
     tiling = extraction.tiling
-    for shape in layout.shapes:
+    covered = 0
+    for shape in layout.shapes:  # each shape shows in the derivation where it showed before
         if not shape.visible:
             continue
         label = f"{shape.x}.{shape.y}"
-        inside = [
-            p
-            for p in pieces
-            if p[0] == label
-            and p[1] >= shape.x0 - 1e-4
-            and p[3] <= shape.x1 + 1e-4
-            and p[2] >= shape.y0 - 1e-4
-            and p[4] <= shape.y1 + 1e-4
-        ]
+        box = (shape.x0, shape.y0, shape.x1, shape.y1)
+        derived = sum(_overlap(box, p[1:]) for p in pieces if p[0] == label)
         shown = sum(
-            (tiling.xs[c + 1] - tiling.xs[c]) * (tiling.ys[r + 1] - tiling.ys[r])
+            _overlap(box, (tiling.xs[c], tiling.ys[r], tiling.xs[c + 1], tiling.ys[r + 1]))
             for r in range(len(tiling.ys) - 1)
             for c in range(len(tiling.xs) - 1)
             if tiling.labels[r][c] == label
-            and shape.x0 <= tiling.xs[c] < shape.x1
-            and shape.y0 <= tiling.ys[r] < shape.y1
         )
-        assert sum((p[3] - p[1]) * (p[4] - p[2]) for p in inside) == pytest.approx(shown, abs=1e-4)
+        assert derived == pytest.approx(shown, abs=1e-4)
+        covered += shown > 0
+    visible = sum(shape.visible for shape in layout.shapes)
+    assert covered >= visible // 2  # most show; the rest are drawn over by see-through shapes
+
+
+def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> float:
+    w = min(a[2], b[2]) - max(a[0], b[0])
+    h = min(a[3], b[3]) - max(a[1], b[1])
+    return max(w, 0.0) * max(h, 0.0)
 
 
 # -- new sizes -------------------------------------------------------------------------------
