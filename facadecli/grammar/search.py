@@ -123,7 +123,9 @@ class Search:
                 action = self._action(region, axis, bounds, cost_of_line)
                 if action is not None:
                     found.setdefault((action.axis, action.bounds), action)
-            for line in lines if len(lines) > 1 else ():
+            # cuts in two: only the lines the heuristic likes best are worth making rules of
+            cheapest = sorted(lines, key=lambda ln: (cost_of_line.get(ln, 0.0), ln))
+            for line in cheapest[:TOP_ACTIONS] if len(lines) > 1 else ():
                 action = self._action(region, axis, (lo, line, hi), cost_of_line)
                 if action is not None and (axis, action.bounds) not in found:
                     halves[(axis, action.bounds)] = action
@@ -393,9 +395,14 @@ class Search:
                     chosen, least = action, score
             return chosen
 
+        seen: set[tuple[tuple[int, int], ...]] = set()  # grammars built already: nothing new
         for t in range(1, iterations):
             epsilon = 1.0 - t / iterations
             rules = self.build(choose)
+            signature = tuple((cid, id(action)) for cid, action in rules.items())
+            if signature in seen:
+                continue
+            seen.add(signature)
             cost = self.cost(rules)
             self._learn(rules, values, below)
             if cost < best_cost - 1e-9:
