@@ -38,6 +38,7 @@ from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Par
 from facadecli.grammar.symmetry import Repeats, find_repeats
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
+EMPTY: frozenset[int] = frozenset()
 TOP_ACTIONS = 8  # actions per region the search chooses among (the heuristic's best)
 
 
@@ -368,7 +369,7 @@ class Search:
         found in (0 is the greedy one)."""
         rng = random.Random(seed)
         values: dict[int, float] = {}
-        below: dict[int, int] = {}  # content -> its best-known rules, as bits of contents
+        below: dict[int, frozenset[int]] = {}  # content -> the contents its best rules split
         optimistic = min(self.costs.split + 2, self.costs.repeat + 1)
         best = self.greedy()
         best_cost, best_at = self.cost(best), 0
@@ -385,12 +386,14 @@ class Search:
                 return rng.choices(actions, weights)[0]
             chosen, least = actions[0], math.inf
             for action in actions:  # exploitation: Eq. 4 with the value table
-                score, covered = action.cost, 0
+                score, covered = action.cost, EMPTY
                 for need in action.needs:  # larger parts first: theirs hold the smaller
-                    if need in rules or need in pending or need == cid or covered >> need & 1:
+                    if need in rules or need in pending or need == cid or need in covered:
                         continue
                     score += values.get(need, optimistic)
-                    covered |= below.get(need, 0)
+                    held = below.get(need)
+                    if held:
+                        covered = covered | held
                 if score < least:
                     chosen, least = action, score
             return chosen
@@ -410,7 +413,10 @@ class Search:
         return best, best_at
 
     def _learn(
-        self, rules: dict[int, Action], values: dict[int, float], below: dict[int, int]
+        self,
+        rules: dict[int, Action],
+        values: dict[int, float],
+        below: dict[int, frozenset[int]],
     ) -> None:
         """Each content's cost to describe, with the rules below it counted once each, kept
         in the value table when it is the least yet, with the contents it took."""
@@ -437,12 +443,12 @@ class Search:
             total = sum(cost * (bits & mask).bit_count() for cost, mask in by_cost.items())
             if total < values.get(cid, math.inf) - 1e-12:
                 values[cid] = total
-                contents = 0
+                contents = []
                 while bits:
                     low = bits & -bits
-                    contents |= 1 << order[low.bit_length() - 1]
+                    contents.append(order[low.bit_length() - 1])
                     bits ^= low
-                below[cid] = contents
+                below[cid] = frozenset(contents)
 
     # -- the grammar ---------------------------------------------------------------------
 
