@@ -39,6 +39,7 @@ from facadecli.grammar.symmetry import Repeats, find_repeats
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
 EMPTY: frozenset[int] = frozenset()
+GRID_CELLS = 48  # a gridsplit of more cells than this costs more than it can save
 TOP_ACTIONS = 8  # actions per region the search chooses among (the heuristic's best)
 
 
@@ -130,7 +131,12 @@ class Search:
                 action = self._action(region, axis, (lo, line, hi), cost_of_line)
                 if action is not None and (axis, action.bounds) not in found:
                     halves[(axis, action.bounds)] = action
-        if "gridsplit" in self.extensions and "x" in usable and "y" in usable:
+        if (
+            "gridsplit" in self.extensions
+            and "x" in usable
+            and "y" in usable
+            and (len(usable["x"]) + 1) * (len(usable["y"]) + 1) <= GRID_CELLS
+        ):
             grid = self._gridsplit(region, usable)
             if grid is not None:
                 found[("xy", grid.bounds, grid.across)] = grid
@@ -376,22 +382,32 @@ class Search:
         self._learn(best, values, below)
         epsilon = 1.0
 
+        odds: dict[Region, list[float]] = {}  # cumulative exp(-H) of a region's actions
+        get_value, get_below, draw = values.get, below.get, rng.random
+
         def choose(region: Region, cid: int, rules: dict[int, Action], pending: set[int]) -> Action:
             actions = self.actions(region)
             if len(actions) == 1:
                 return actions[0]
-            if rng.random() < epsilon:  # exploration: the heuristic's odds
-                low = actions[0].heuristic
-                weights = [math.exp(low - a.heuristic) for a in actions]
-                return rng.choices(actions, weights)[0]
+            if draw() < epsilon:  # exploration: the heuristic's odds
+                weights = odds.get(region)
+                if weights is None:
+                    low = actions[0].heuristic
+                    weights = list(
+                        itertools.accumulate(math.exp(low - a.heuristic) for a in actions)
+                    )
+                    odds[region] = weights
+                return rng.choices(actions, cum_weights=weights)[0]
             chosen, least = actions[0], math.inf
             for action in actions:  # exploitation: Eq. 4 with the value table
                 score, covered = action.cost, EMPTY
                 for need in action.needs:  # larger parts first: theirs hold the smaller
-                    if need in rules or need in pending or need == cid or need in covered:
+                    if score >= least:
+                        break  # values only add up
+                    if need in rules or need in pending or need in covered:
                         continue
-                    score += values.get(need, optimistic)
-                    held = below.get(need)
+                    score += get_value(need, optimistic)
+                    held = get_below(need)
                     if held:
                         covered = covered | held
                 if score < least:
