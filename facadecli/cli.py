@@ -349,13 +349,26 @@ def grammar(
     repeat_cost: Annotated[
         float, typer.Option("--repeat-cost", min=0, help="Cost of a repeat rule (Eq. 2).")
     ] = 0.5,
+    snap: Annotated[
+        float | None,
+        typer.Option(
+            "--snap",
+            min=0,
+            max=0.1,
+            help="Join edges closer than this fraction of the façade [default: 0.005 for CMP, "
+            "0.001 for JSON lists, 0 for .layout.json].",
+            show_default=False,
+        ),
+    ] = None,
     tolerance: Annotated[
         float | None,
         typer.Option(
             "--tolerance",
             min=0,
+            max=0.1,
             help="Regularise: give repeated elements one size when they differ by less than "
-            "this fraction of the façade [default: 0.01; 0 for .layout.json].",
+            "this fraction of the façade [default: 0.01 for CMP, 0.005 for JSON lists, 0 for "
+            ".layout.json].",
             show_default=False,
         ),
     ] = None,
@@ -383,6 +396,15 @@ def grammar(
             "--format", "-f", help=f"Formats of derived layouts [{','.join(DEFAULT_FORMATS)}]."
         ),
     ] = None,
+    time_limit: Annotated[
+        float,
+        typer.Option(
+            "--time-limit",
+            min=0.1,
+            help="Seconds of search at most; the best grammar so far is kept (reached, the "
+            "result depends on the machine's speed).",
+        ),
+    ] = 120.0,
     timings: Annotated[
         bool, typer.Option("--timings", help="Record the time in the report (not reproducible).")
     ] = False,
@@ -409,7 +431,9 @@ def grammar(
         seed,
         chosen,
         Costs(split_cost, repeat_cost),
+        snap=snap,
         tolerance=tolerance,
+        time_limit=time_limit,
         size=_size(size, "--size") if size else None,
     )
     extraction = extract_grammar(layout, options)
@@ -419,7 +443,7 @@ def grammar(
         )
     found = extraction.grammar
     name = stem(layout)
-    for warning in extraction.regularization.warnings:
+    for warning in extraction.warnings:
         typer.echo(f"{layout}: warning: {warning}", err=True)
     outputs = {
         f"{name}.grammar.txt": found.text(),

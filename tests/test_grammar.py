@@ -160,6 +160,21 @@ def test_adp_beats_greedy_and_is_reproducible() -> None:
     assert rederivation_problems(greedy, tiling) == []
 
 
+def test_the_search_stops_at_its_time_limit_with_the_best_so_far(tmp_path: Path) -> None:
+    tiling = tile(_house(), 0)
+    stopped = extract(tiling, iterations=100_000, time_limit=0.0)
+    assert stopped.iterations == 1 and stopped.grammar.cost == pytest.approx(stopped.greedy_cost)
+    assert rederivation_problems(stopped.grammar, tiling) == []
+    source = tmp_path / "house.json"
+    _write_plain(source, _house())
+    result = _facade(
+        "grammar", str(source), "-o", str(tmp_path), "-n", "100000", "--time-limit", "0.5"
+    )
+    assert result.returncode == 0 and "time limit of 0.5 s reached" in result.stderr
+    report = json.loads((tmp_path / "house.grammar-report.json").read_text())
+    assert report["iterations"] < 100_000 and "time limit" in report["warnings"][0]
+
+
 def test_costs_are_configurable() -> None:
     tiling = tile(_floors(), 0)
     cheap = extract(tiling, iterations=200, costs=Costs(split=0.1, repeat=0.1)).grammar

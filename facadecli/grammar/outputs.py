@@ -128,6 +128,7 @@ def grammar_report(extraction: Extraction, timings: bool = False) -> str:
         "repeated_regions": found.repeats,
         "rederives_exactly": not extraction.problems,
         "regularization": extraction.regularization.summary(),
+        "warnings": extraction.warnings,
         "time_ms": round(extraction.time_ms, 3) if timings else None,
     }
     return json.dumps(data, indent=2) + "\n"

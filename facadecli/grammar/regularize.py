@@ -6,7 +6,7 @@ edges stay as near as they can to where they were drawn, the façade's own edges
 edges keep their order, and
 
 - elements of one label whose sizes differ by less than ``tolerance`` x the façade's extent
-  get one size;
+  (and less than a tenth) get one size;
 - strips of the tiling between neighbouring edges that show the same labels across the
   whole façade (the wall between two window columns, say) and differ as little get one size.
 
@@ -23,6 +23,7 @@ from dataclasses import dataclass, field, replace
 from facadecli.grammar.tiling import LabelledLayout, Rect, Tiling, snap, tile
 
 DEFAULT_TOLERANCE = 0.01  # of the façade's extent along the axis
+RELATIVE = 0.1  # and never sizes more than this fraction apart
 
 
 @dataclass(frozen=True)
@@ -76,11 +77,12 @@ class Regularization:
 
 
 def _clusters(items: list[tuple[float, int]], tolerance: float) -> list[list[int]]:
-    """Indices grouped by nearly equal value: sorted, a new group where the gap to the
-    group's first value exceeds the tolerance. Groups of one are left out."""
+    """Indices grouped by nearly equal value: sorted, a new group where the value is further
+    from the group's first than the tolerance or than ``RELATIVE`` of itself. Groups of one
+    are left out."""
     groups: list[list[tuple[float, int]]] = []
     for value, index in sorted(items):
-        if groups and value - groups[-1][0][0] <= tolerance:
+        if groups and value - groups[-1][0][0] <= min(tolerance, RELATIVE * value):
             groups[-1].append((value, index))
         else:
             groups.append([(value, index)])

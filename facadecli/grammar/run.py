@@ -10,7 +10,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from facadecli.errors import SpecError
-from facadecli.grammar.regularize import DEFAULT_TOLERANCE, Regularization, regularize
+from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
 from facadecli.grammar.tiling import (
@@ -24,7 +24,11 @@ from facadecli.grammar.tiling import (
     tile,
 )
 
-SNAP = 0.005  # edges closer than this x the façade's size are one edge
+# How much each kind of input is tidied, as fractions of the façade's size: edges closer
+# than ``snap`` become one, and repeated elements closer in size than ``tolerance`` get one
+# size. CMP annotations are drawn by hand on photographs (a few pixels off); plain lists may
+# be measured or detected; facadecli layouts are exact.
+TIDY = {"cmp": (0.005, 0.01), "plain": (0.001, 0.005), "report": (0.0, 0.0)}
 REDERIVE_TOLERANCE = 1e-4  # x the façade's size: a derived edge this near a tiling edge is on it
 
 
@@ -35,9 +39,10 @@ class Options:
     seed: int = 0
     extensions: tuple[str, ...] = ()
     costs: Costs = DEFAULT_COSTS
-    snap: float | None = None  # None: SNAP, but 0 for facadecli layouts (they are exact)
-    tolerance: float | None = None  # regularisation; None: as ``snap``'s default
+    snap: float | None = None  # None: by the kind of input (``TIDY``)
+    tolerance: float | None = None  # regularisation; None: by the kind of input (``TIDY``)
     size: tuple[float, float] | None = None  # the façade's real size: the layout is scaled
+    time_limit: float = 120.0  # seconds of ADP; the best grammar so far is kept
 
 
 @dataclass
@@ -55,18 +60,29 @@ class Extraction:
     def grammar(self) -> Grammar:
         return self.found.grammar
 
+    @property
+    def warnings(self) -> list[str]:
+        found = list(self.regularization.warnings)
+        if self.found.method == "adp" and self.found.iterations < self.options.iterations:
+            found.append(
+                f"time limit of {self.options.time_limit:g} s reached after "
+                f"{self.found.iterations} of {self.options.iterations} iterations: the best "
+                "grammar so far is kept, and it depends on the machine's speed"
+            )
+        return found
 
-def read_layout(path: Path) -> tuple[LabelledLayout, bool]:
-    """The labelled layout in a file, and whether it is exact (a facadecli layout)."""
+
+def read_layout(path: Path) -> tuple[LabelledLayout, str]:
+    """The labelled layout in a file, and its kind: cmp, report or plain."""
     if not path.is_file():
         raise SpecError.at(str(path), None, None, "no such file", "check the path")
     name = path.name
     try:
         if name.endswith(".xml"):
-            return read_cmp(path), False
+            return read_cmp(path), "cmp"
         if name.endswith(".layout.json"):
-            return read_report(path), True
-        return read_plain(path), False
+            return read_report(path), "report"
+        return read_plain(path), "plain"
     except json.JSONDecodeError as error:
         raise SpecError.at(
             str(path), error.lineno, error.colno, f"not JSON: {error.msg}", "fix the JSON syntax"
@@ -96,15 +112,13 @@ def stem(path: Path) -> str:
 
 
 def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
-    layout, exact = read_layout(path)
+    layout, kind = read_layout(path)
     if not layout.rects:
         raise SpecError.at(str(path), None, None, "no rectangles", "label some elements")
     if options.size is not None:
         layout = resize(layout, *options.size)
-    snap = options.snap if options.snap is not None else (0.0 if exact else SNAP)
-    tolerance = options.tolerance
-    if tolerance is None:
-        tolerance = 0.0 if exact else DEFAULT_TOLERANCE
+    snap = options.snap if options.snap is not None else TIDY[kind][0]
+    tolerance = options.tolerance if options.tolerance is not None else TIDY[kind][1]
     snapped = snap_layout(layout, snap) if snap > 0 else layout
     regular, regularization = regularize(snapped, tolerance)
     tiling = tile(regular, tolerance=0.0)
@@ -116,6 +130,7 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
         options.seed,
         options.costs,
         options.extensions,
+        time_limit=options.time_limit,
     )
     elapsed = (time.perf_counter() - started) * 1000
     extraction = Extraction(path.name, regular, tiling, found, regularization, options, elapsed)

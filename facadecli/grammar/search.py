@@ -28,6 +28,7 @@ import heapq
 import itertools
 import math
 import random
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -370,9 +371,13 @@ class Search:
     def greedy(self) -> dict[int, Action]:
         return self.build(lambda region, cid, rules, pending: self.actions(region)[0])
 
-    def adp(self, iterations: int, seed: int) -> tuple[dict[int, Action], int]:
-        """The cheapest grammar of ``iterations`` (see the module) and the iteration it was
-        found in (0 is the greedy one)."""
+    def adp(
+        self, iterations: int, seed: int, time_limit: float = math.inf
+    ) -> tuple[dict[int, Action], int, int]:
+        """The cheapest grammar of ``iterations`` (see the module), the iteration it was
+        found in (0 is the greedy one), and the iterations done: fewer when ``time_limit``
+        seconds run out first."""
+        deadline = time.perf_counter() + time_limit
         rng = random.Random(seed)
         values: dict[int, float] = {}
         below: dict[int, frozenset[int]] = {}  # content -> the contents its best rules split
@@ -415,7 +420,11 @@ class Search:
             return chosen
 
         seen: set[tuple[tuple[int, int], ...]] = set()  # grammars built already: nothing new
+        done = iterations
         for t in range(1, iterations):
+            if time.perf_counter() > deadline:
+                done = t
+                break
             epsilon = 1.0 - t / iterations
             rules = self.build(choose)
             signature = tuple((cid, id(action)) for cid, action in rules.items())
@@ -426,7 +435,7 @@ class Search:
             self._learn(rules, values, below)
             if cost < best_cost - 1e-9:
                 best, best_cost, best_at = rules, cost, t
-        return best, best_at
+        return best, best_at, done
 
     def _learn(
         self,
@@ -530,6 +539,8 @@ def extract(
     costs: Costs = DEFAULT_COSTS,
     extensions: tuple[str, ...] = (),
     background: str = BACKGROUND,
+    *,
+    time_limit: float = math.inf,
 ) -> SearchResult:
     """A split grammar for the tiling, by ``greedy`` or ``adp`` (see the module)."""
     search = Search(tiling, costs, extensions, background)
@@ -538,8 +549,7 @@ def extract(
     if method == "greedy" or iterations <= 1:
         rules, best_at, done = greedy, 0, 1
     else:
-        rules, best_at = search.adp(iterations, seed)
-        done = iterations
+        rules, best_at, done = search.adp(iterations, seed, time_limit)
     return SearchResult(
         search.grammar(rules),
         method,

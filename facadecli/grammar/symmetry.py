@@ -18,7 +18,7 @@ import numpy as np
 
 from facadecli.grammar.regions import Grid, Region
 
-MAX_REPEATS = 4000  # repeated regions explored before the search stops growing
+MAX_REPEATS = 1000  # repeated regions explored before the search stops growing
 
 
 @dataclass(frozen=True)
