@@ -20,7 +20,7 @@ import itertools
 import re
 from collections import defaultdict
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.tiling import BACKGROUND, CMP_Z_ORDER, Tiling, snap
@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 
 THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute size
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
+SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
 
 
 @dataclass(frozen=True)
@@ -218,13 +219,21 @@ def _align_axis(
     base = [v[0] == 0.0, v[len(edges) - 1] == extent]
     base += [v[i + 1] >= v[i] for i in range(len(edges) - 1)]
     base += [v[b] - v[a] >= size / 2 for (a, b), size in set(spans)]
-    sizes = [v[b1] - v[a1] == v[b0] - v[a0] for (a0, b0), (a1, b1) in equal]
-    lines = [v[a] == v[b] for a, b in lined]
+    size_gaps = [v[b1] - v[a1] - (v[b0] - v[a0]) for (a0, b0), (a1, b1) in equal]
+    line_gaps = [v[a] - v[b] for a, b in lined]
+    moves = cp.sum_squares(v - edges)
+    hard_sizes = [g == 0 for g in size_gaps]
+    attempts = [  # hard where they fit, else as near as they can be (weighted), else neither
+        (moves, hard_sizes + [g == 0 for g in line_gaps], None),
+        (moves + SOFT * _squares(cp, line_gaps), hard_sizes, None),
+        (moves + SOFT * _squares(cp, size_gaps + line_gaps), [], "made as near as they can be"),
+        (moves, [], "left out"),
+    ]
     warnings = []
-    for constraints, dropped in ((sizes + lines, None), (sizes, "line-ups"), ([], "equal sizes")):
-        if dropped:
-            warnings.append(f"{axis}: {dropped} of equal terminals do not all fit; left out")
-        problem = cp.Problem(cp.Minimize(cp.sum_squares(v - edges)), base + constraints)
+    for objective, constraints, fallback in attempts:
+        if fallback:
+            warnings.append(f"{axis}: equal sizes of equal terminals {fallback}")
+        problem = cp.Problem(cp.Minimize(objective), base + constraints)
         try:
             problem.solve(solver=cp.CLARABEL)
         except cp.error.SolverError:
@@ -232,9 +241,19 @@ def _align_axis(
         if problem.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) and v.value is not None:
             solved = [float(x) for x in v.value]
             solved[0], solved[-1] = 0.0, extent
+            apart = sum(abs(solved[a] - solved[b]) > 1e-3 * extent for a, b in lined)
+            if apart:
+                warnings.append(
+                    f"{axis}: {apart} of {len(lined)} near line-ups of equal terminals left "
+                    "apart (lining them up would squeeze other elements)"
+                )
             merged = snap(solved, 1e-7 * extent, (0.0, extent))
             return {value: merged[solved[index[joined[value]]]] for value in joined}, warnings
     return {value: joined[value] for value in joined}, warnings
+
+
+def _squares(cp: Any, terms: list[Any]) -> Any:
+    return cp.sum_squares(cp.hstack(terms)) if terms else 0.0
 
 
 # -- the result as a layout ---------------------------------------------------------------
