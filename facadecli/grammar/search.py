@@ -17,9 +17,12 @@ the repeated regions that line cuts through over the cells of the region.
   proportional to ``exp(-H)``) and exploits otherwise (the action with the least rule cost
   plus the value table's estimate for the new regions it makes, Eq. 4). Epsilon falls
   linearly over the iterations. After each iteration the table keeps, per content, the
-  least cost found for describing it. The first iteration is the greedy one, so the result
+  least cost found for describing it (each rule below it counted once) and the contents
+  those rules split, so that a part held inside another part is not paid for twice; a
+  content not in the table yet is valued at the cheapest rule's cost. A grammar built before
+  teaches nothing new and is skipped. The first iteration is the greedy one, so the result
   is never worse than greedy's; the cheapest grammar of all iterations is returned. A seed
-  makes it reproducible.
+  makes it reproducible; a time limit stops early with the best grammar so far.
 """
 
 from __future__ import annotations
@@ -85,6 +88,11 @@ class Search:
         self.repeats: Repeats = find_repeats(self.grid)
         self._actions: dict[Region, list[Action]] = {}
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
+
+    @property
+    def regions_explored(self) -> int:
+        """Regions that were offered actions."""
+        return len(self._actions)
 
     # -- actions ------------------------------------------------------------------------
 
@@ -556,7 +564,7 @@ def extract(
         done,
         best_at,
         greedy_cost,
-        len(search._actions),
+        search.regions_explored,
         search.repeats.kinds,
     )
 

@@ -262,8 +262,8 @@ def _squares(cp: Any, terms: list[Any]) -> Any:
 @dataclass(frozen=True)
 class Look:
     mesh: str
-    depth: float  # in units of a tenth of the façade's shorter side... see ``_looks``
-    thickness: float
+    depth: float  # front face out from the wall, in fifteenths of the façade's shorter side
+    thickness: float  # in the same units
 
 
 LOOKS = {  # CMP labels; anything else is a shallow box
@@ -301,7 +301,7 @@ def pieces_layout(
     from facadecli.solver.axis import AxisLayout
     from facadecli.spec.model import Spec
 
-    unit = min(width, height) / 10
+    unit = min(width, height) / 15  # looks are in metres for a façade 15 m on its shorter side
     labels = sorted(
         {p.label for p in pieces}, key=lambda label: (CMP_Z_ORDER.get(label, 99), label)
     )
