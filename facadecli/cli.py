@@ -451,17 +451,22 @@ def grammar(
         f"{name}.tiling.svg": tiling_svg(extraction.tiling, found, name),
         f"{name}.grammar-report.json": grammar_report(extraction, timings),
     }
+    derived = []  # every size is derived before anything is written
+    if sizes:
+        from facadecli.grammar.variation import TooLarge, derive_layout
+
+        for width, height in sizes:
+            try:
+                derived.append(derive_layout(found, extraction.tiling, width, height, name))
+            except TooLarge as error:
+                raise typer.BadParameter(str(error), param_hint="--derive") from None
+            for warning in derived[-1].warnings:
+                typer.echo(f"{layout}: warning: {width:g}x{height:g}: {warning}", err=True)
     for file, text in outputs.items():
         write_atomic(outdir / file, text)
     written = [outdir / file for file in outputs]
-    if sizes:
-        from facadecli.grammar.variation import derive_layout
-
-        for width, height in sizes:
-            derived = derive_layout(found, extraction.tiling, width, height, name)
-            for warning in derived.warnings:
-                typer.echo(f"{layout}: warning: {width:g}x{height:g}: {warning}", err=True)
-            written += write_outputs(derived, outdir, kinds, OutputOptions())
+    for result in derived:
+        written += write_outputs(result, outdir, kinds, OutputOptions())
     typer.echo(
         f"{layout}: {len(found.rules)} rules, cost {found.cost:.1f} "
         f"(greedy {extraction.found.greedy_cost:.1f}) -> " + ", ".join(str(p) for p in written)

@@ -31,6 +31,11 @@ if TYPE_CHECKING:
 THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute size
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
 SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
+MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
+
+
+class TooLarge(ValueError):
+    """The new size would make too many pieces."""
 
 
 @dataclass(frozen=True)
@@ -104,6 +109,11 @@ def derive_at(
         rule = grammar.rules.get(symbol)
         if rule is None:
             out.append(Piece(symbol, x0, y0, x1, y1, src[0], src[1]))
+            if len(out) > MAX_PIECES:
+                raise TooLarge(
+                    f"{width:g}x{height:g} makes more than {MAX_PIECES:,} pieces; "
+                    "choose a smaller size"
+                )
             return
         if rule.op == "gridsplit":
             _grid(rule, box, expand)
