@@ -64,31 +64,32 @@ def _seeds(grid: Grid) -> list[Region]:
     return found
 
 
+DIRECTIONS = {  # direction -> (the axis it grows along, the step)
+    "left": ("x", -1),
+    "right": ("x", 1),
+    "down": ("y", -1),
+    "up": ("y", 1),
+}
+
+
 def _grow(grid: Grid, region: Region, direction: str) -> Region | None:
-    """The region grown one clean step in a direction, or None if it cannot grow."""
+    """The region grown one clean step in a direction, or None if it cannot grow: the new
+    part's borders across the axis must cut no element, and it stops at the first line
+    along the axis that cuts none."""
+    axis, step = DIRECTIONS[direction]
+    across = "y" if axis == "x" else "x"
     r0, r1, c0, c1 = region
-    if direction in ("left", "right"):
-        step = 1 if direction == "right" else -1
-        edge = c1 if step > 0 else c0
-        limit = grid.columns if step > 0 else 0
-        while edge != limit:
-            edge += step
-            lo, hi = (c1, edge) if step > 0 else (edge, c0)
-            if grid.crossed("y", r0, lo, hi) or grid.crossed("y", r1, lo, hi):
-                return None  # the new part's border cuts an element above or below
-            if not grid.crossed("x", edge, r0, r1):
-                return (r0, r1, c0, edge) if step > 0 else (r0, r1, edge, c1)
-        return None
-    step = 1 if direction == "up" else -1
-    edge = r1 if step > 0 else r0
-    limit = grid.rows if step > 0 else 0
+    lo, hi, side0, side1 = (c0, c1, r0, r1) if axis == "x" else (r0, r1, c0, c1)
+    edge = hi if step > 0 else lo
+    limit = (grid.columns if axis == "x" else grid.rows) if step > 0 else 0
     while edge != limit:
         edge += step
-        lo, hi = (r1, edge) if step > 0 else (edge, r0)
-        if grid.crossed("x", c0, lo, hi) or grid.crossed("x", c1, lo, hi):
+        start, stop = (hi, edge) if step > 0 else (edge, lo)
+        if grid.crossed(across, side0, start, stop) or grid.crossed(across, side1, start, stop):
             return None
-        if not grid.crossed("y", edge, c0, c1):
-            return (r0, edge, c0, c1) if step > 0 else (edge, r1, c0, c1)
+        if not grid.crossed(axis, edge, side0, side1):
+            new = (lo, edge) if step > 0 else (edge, hi)
+            return (r0, r1, *new) if axis == "x" else (*new, c0, c1)
     return None
 
 
