@@ -46,7 +46,6 @@ class Grid:
         self.contents: dict[bytes, int] = {}
         self._content_of: dict[Region, int] = {}
         self.terminal: dict[int, str] = {}  # content -> its label, for one-label regions
-        self.example: dict[int, Region] = {}  # content -> the first region met with it
 
     @staticmethod
     def _sizes(cuts: tuple[float, ...]) -> np.ndarray:
@@ -77,9 +76,9 @@ class Grid:
                 np.rint(heights).astype(np.int64).tobytes(),
             )
         )
-        cid = self.contents.setdefault(key, len(self.contents))
-        if cid not in self.example:
-            self.example[cid] = region
+        cid = self.contents.get(key)
+        if cid is None:
+            cid = self.contents[key] = len(self.contents)
             if reduced.size == 1:
                 self.terminal[cid] = self.names[int(reduced[0, 0])]
         self._content_of[region] = cid
@@ -114,15 +113,6 @@ class Grid:
         if line <= 0 or line >= self.rows:
             return False
         return bool(self._cross_y[line - 1, stop] - self._cross_y[line - 1, start])
-
-    def closed(self, region: Region) -> bool:
-        r0, r1, c0, c1 = region
-        return not (
-            self.crossed("x", c0, r0, r1)
-            or self.crossed("x", c1, r0, r1)
-            or self.crossed("y", r0, c0, c1)
-            or self.crossed("y", r1, c0, c1)
-        )
 
     def size(self, axis: str, start: int, stop: int) -> float:
         cuts = self.tiling.xs if axis == "x" else self.tiling.ys

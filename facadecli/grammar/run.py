@@ -14,7 +14,6 @@ from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
 from facadecli.grammar.tiling import (
-    BACKGROUND,
     LabelledLayout,
     Tiling,
     read_cmp,
@@ -170,4 +169,4 @@ def rederivation_problems(grammar: Grammar, tiling: Tiling, limit: int = 5) -> l
     return problems
 
 
-__all__ = ["BACKGROUND", "Extraction", "Options", "extract_grammar", "rederivation_problems"]
+__all__ = ["Extraction", "Options", "extract_grammar", "rederivation_problems"]
