@@ -376,6 +376,7 @@ def grammar(
         str | None,
         typer.Option(
             "--size",
+            metavar="WxH",
             help="The façade's real size WxH (CMP annotations are a unit square): the "
             "layout is stretched to it.",
             show_default=False,
@@ -385,6 +386,7 @@ def grammar(
         list[str] | None,
         typer.Option(
             "--derive",
+            metavar="WxH",
             help="Also apply the grammar at a new size WxH (repeatable): writes "
             "<name>-<W>x<H>.* through the layout writers.",
             show_default=False,
