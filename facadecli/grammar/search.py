@@ -87,6 +87,7 @@ class Search:
         self.extensions = set(extensions)
         self.repeats: Repeats = find_repeats(self.grid)
         self._actions: dict[Region, list[Action]] = {}
+        self._greedy: dict[int, Action] | None = None
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
 
     @property
@@ -377,7 +378,10 @@ class Search:
         return sum(rules[cid].cost for cid in rules if same[cid] == cid)
 
     def greedy(self) -> dict[int, Action]:
-        return self.build(lambda region, cid, rules, pending: self.actions(region)[0])
+        """The greedy baseline's rules (built once: ADP starts from them too)."""
+        if self._greedy is None:
+            self._greedy = self.build(lambda region, cid, rules, pending: self.actions(region)[0])
+        return self._greedy
 
     def adp(
         self, iterations: int, seed: int, time_limit: float = math.inf
