@@ -1,7 +1,8 @@
 """The ``facade`` command: the only module that talks to the terminal.
 
 Exit codes (SPEC section 4): 0 success, 1 some specs failed in a multi-spec run,
-2 invalid input, 3 no layout exists. No traceback reaches a user unless ``--debug``.
+2 invalid input, 3 no layout exists, 4 the search stopped (work budget or safety time
+limit) before it found a layout. No traceback reaches a user unless ``--debug``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import Annotated
 import typer
 
 from facadecli import __version__
-from facadecli.errors import FacadeError, InfeasibleError, SpecError
+from facadecli.errors import FacadeError, InfeasibleError, SearchLimitError, SpecError
 from facadecli.export import (
     DEFAULT_FORMATS,
     WRITERS,
@@ -86,6 +87,8 @@ class _Run:
     def fail(self, path: Path, error: FacadeError) -> None:
         if isinstance(error, InfeasibleError):
             typer.echo(f"{path}: error: no layout: {error}", err=True)
+        elif isinstance(error, SearchLimitError):
+            typer.echo(f"{path}: error: search stopped: {error}", err=True)
         else:
             _report(error)
         self.codes.append(error.exit_code)
@@ -158,7 +161,7 @@ def solve_command(
     for path, spec in run.specs():
         try:
             layout = solve(retarget(spec, width, height, seed))
-        except InfeasibleError as error:
+        except (InfeasibleError, SearchLimitError) as error:
             run.fail(path, error)
             continue
         for warning in layout.warnings:
@@ -225,7 +228,7 @@ def vary(
             stem = f"{spec.name}-{size[0]:g}x{size[1]:g}"
             try:
                 layouts = solve_variants(sized, count)
-            except InfeasibleError as error:
+            except (InfeasibleError, SearchLimitError) as error:
                 typer.echo(
                     f"{spec_path}: {size[0]:g} x {size[1]:g} m: no layout: {error}", err=True
                 )

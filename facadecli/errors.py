@@ -70,3 +70,11 @@ class InfeasibleError(FacadeError):
     """No layout exists for the spec (exit code 3); the message says why."""
 
     exit_code = 3
+
+
+class SearchLimitError(FacadeError):
+    """The solver stopped before it found any layout (exit code 4): its deterministic work
+    budget or the safety time limit ran out. Not a statement about the spec: a layout may
+    exist."""
+
+    exit_code = 4

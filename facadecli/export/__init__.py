@@ -5,11 +5,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-
-import trimesh
+from typing import TYPE_CHECKING
 
 from facadecli.export.atomic import write_atomic
-from facadecli.layout import Layout
+
+if TYPE_CHECKING:  # trimesh takes half a second to import: only the mesh writers need it
+    import trimesh
+
+    from facadecli.layout import Layout
 
 
 @dataclass(frozen=True)
@@ -19,7 +22,7 @@ class OutputOptions:
     base_dir: Path | None = None  # where the spec is: mesh asset paths are relative to it
 
 
-Writer = Callable[[Layout, Path, OutputOptions], list[Path]]
+Writer = Callable[["Layout", Path, OutputOptions], list[Path]]
 
 
 def _write_json(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:

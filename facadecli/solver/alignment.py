@@ -681,8 +681,15 @@ def align(
         if result.alignment is None:
             current = None
         else:
-            current = compose(current, parts, result.alignment, row, prepared[:index])
-            result = AlignmentResult(current, False, result.nodes, "")
+            try:
+                current = compose(current, parts, result.alignment, row, prepared[:index])
+            except _NoEntry:
+                current = None
+                result = AlignmentResult(
+                    None, False, result.nodes, "the columns of the layers cannot be merged"
+                )
+            else:
+                result = AlignmentResult(current, False, result.nodes, "")
         if not result.timed_out:
             prefixes[key] = result
         if current is None:
@@ -827,7 +834,12 @@ def _entry(row: _Row, start: int, end: int) -> Move:
     for move in moves:
         if move.end == end:
             return move
-    raise AssertionError(f"no entry from {start} to {end}")  # prevented by _must_stay_apart
+    raise _NoEntry(f"no entry from {start} to {end}")
+
+
+class _NoEntry(Exception):
+    """A composed column asks a row for an entry its word cannot give (e.g. transparent
+    and visible letters together): the composition is abandoned, never the solve."""
 
 
 def score_alignment(

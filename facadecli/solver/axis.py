@@ -6,9 +6,9 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
-from facadecli.errors import InfeasibleError
+from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.patterns import CompiledPattern, Enumerated, Word, format_word
-from facadecli.solver import sizing
+from facadecli.solver import exact, sizing
 from facadecli.solver.alignment import (
     INF,
     MAX_NODES,
@@ -18,14 +18,19 @@ from facadecli.solver.alignment import (
     align,
 )
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
-from facadecli.solver.rows import full_layers, make_rows
+from facadecli.solver.rows import Row, full_layers, make_rows
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
+EXACT_WORK = 60_000  # work units of the exact searches of one axis (see solver.exact)
+SMALL_NETWORK = 20_000  # alignment states up to which a candidate is searched exactly
+REFINE_CANDIDATES = 60  # candidates that may be searched exactly to beat the best layout
+REFINE_RESERVE = 1_000  # work units an exact refinement needs at least to start
+CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
 EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
-GRACE_SECONDS = 1.0  # a last try past the time limit when nothing aligned in time
+TIE = 1e-3  # m^2: objectives this close are equally good (SPEC 2.7's tie-breaks decide)
 NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
@@ -185,25 +190,55 @@ def solve_axis_alternatives(
 ) -> list[AxisLayout]:
     """The best layouts of one axis, best first: the best, and up to ``alternatives`` - 1
     others whose sizing objective is within NEAR_EQUAL of it (for ``facade vary``).
-    Raises :class:`InfeasibleError` with the reason when nothing fits."""
+
+    Candidates go first through the heuristic alignment; a candidate it cannot align is
+    searched exactly, and so are small candidates that could still beat the best layout
+    found (:mod:`facadecli.solver.exact`). Every budget is counted in work, so the answer
+    does not depend on the machine; ``deadline`` (wall clock) is only a safety net, and
+    when it fires the layout says so.
+
+    Raises :class:`InfeasibleError` when no layout exists (proven), and
+    :class:`SearchLimitError` when the search stopped before it found one."""
     started = time.perf_counter()
     uses = pattern_uses(spec, _axis_words(spec, axis))
-    candidates = generate_candidates(spec, uses, canvas)
+    candidates = generate_candidates(spec, uses, canvas, CANDIDATE_LIMIT)
     generated = time.perf_counter()
     if not candidates:
         raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
     tolerance = spec.solver.tolerance
     memory = _SearchMemory(full_layers(spec, axis))
+    budget = exact.Budget(EXACT_WORK, deadline)
     evaluated: list[_Evaluated] = []
     failures: list[str] = []
+    unproven = len(candidates) >= CANDIDATE_LIMIT  # candidates beyond the list are unseen
     timed_out = False
     tried = 0
     step = max(tolerance, TIER * canvas)
     effort = MAX_NODES  # once something aligned, a candidate that needs far more search
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
-    search_deadline = deadline
-    grace_used = False
     compare = max(FEASIBLE_TO_COMPARE, alternatives)
+    searched: set[int] = set()  # candidates searched exactly
+
+    def search_exactly(candidate: Candidate, incumbent: float) -> bool:
+        """Search a candidate exactly; True when it gave a layout."""
+        nonlocal unproven
+        searched.add(candidate.order)
+        if not _small(uses, candidate):  # too large a network to search exactly
+            unproven = True
+            return False
+        outcome = exact.align_exactly(
+            spec, _candidate_rows(spec, uses, candidate, memory), canvas, budget, incumbent
+        )
+        nonlocal timed_out
+        timed_out = timed_out or budget.timed_out
+        if outcome.found is None:
+            unproven = unproven or not outcome.complete
+            failures.append(outcome.reason)
+            return False
+        found = outcome.found
+        evaluated.append(_Evaluated(candidate, found.groups, found.program, found.sizing))
+        return True
+
     for candidate in candidates[:CANDIDATES_TO_TRY]:
         if len(evaluated) >= compare or worse >= 2:
             break
@@ -213,55 +248,115 @@ def solve_axis_alternatives(
             and _beyond_tier(candidate, evaluated[0].candidate, step)
         ):
             break  # mu is raised only until something aligns (variations look further)
-        now = time.perf_counter()
-        if now > deadline:
+        if time.perf_counter() > deadline:
             timed_out = True
-            if evaluated or grace_used:
-                break
-            # nothing aligned in time: one last, bounded try at the best-ranked candidate
-            grace_used = True
-            search_deadline = now + max(GRACE_SECONDS, spec.solver.time_limit)
-        tried += 1
-        attempt = _align_candidate(spec, uses, candidate, canvas, search_deadline, effort, memory)
-        if attempt.groups is None:
-            timed_out = timed_out or attempt.timed_out
-            failures.append(attempt.reason)
-            worse += 1 if evaluated else 0
-            continue
-        program = sizing.build_program(spec, attempt.groups, canvas)
-        estimate = sizing.estimate(program) or sizing.solve(program)
-        if estimate is None:
-            failures.append(sizing.explain_infeasible(program))
-            continue
-        best = min((e.estimate.objective for e in evaluated), default=None)
-        evaluated.append(_Evaluated(candidate, attempt.groups, program, estimate))
-        worse = worse + 1 if best is not None and estimate.objective > best + 1e-9 else 0
-        effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
-        if timed_out and evaluated:
             break
+        tried += 1
+        attempt = _align_candidate(spec, uses, candidate, canvas, deadline, effort, memory)
+        timed_out = timed_out or attempt.timed_out
+        if attempt.groups is not None:
+            program = sizing.build_program(spec, attempt.groups, canvas)
+            estimate = sizing.estimate(program) or sizing.exact(program)
+            if estimate is not None:
+                best = min((e.estimate.objective for e in evaluated), default=None)
+                evaluated.append(_Evaluated(candidate, attempt.groups, program, estimate))
+                worse = worse + 1 if best is not None and estimate.objective > best + 1e-9 else 0
+                effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
+                continue
+        # the heuristic found no sizable alignment: only the exact search can tell
+        if not timed_out and search_exactly(candidate, INF):
+            worse = 0
+            continue
+        worse += 1 if evaluated else 0
+    if len(candidates) > tried:
+        unproven = unproven or not evaluated
+    # small candidates that could still beat the best layout by more than a tie are searched
+    # exactly
+    best_objective = min((e.estimate.objective for e in evaluated), default=INF)
+    bounds = sorted(
+        (exact.candidate_bound(spec, _candidate_words(uses, c), canvas), c.key, c)
+        for c in candidates[:REFINE_CANDIDATES]
+    )
+    for bound, _, candidate in bounds:
+        if timed_out or bound >= best_objective - TIE or budget.left < REFINE_RESERVE:
+            break
+        if candidate.order in searched:
+            continue
+        if search_exactly(candidate, best_objective - TIE):
+            best_objective = min(best_objective, evaluated[-1].estimate.objective)
     aligned_at = time.perf_counter()
-    ranked = sorted(evaluated, key=lambda e: e.rank)
+    ranked = _by_rank(evaluated)
     layouts: list[AxisLayout] = []
-    best_objective: float | None = None
+    first: float | None = None
     for choice in ranked:
-        if best_objective is not None and (
-            len(layouts) >= alternatives or choice.estimate.objective > best_objective + NEAR_EQUAL
+        if first is not None and (
+            len(layouts) >= alternatives or choice.estimate.objective > first + NEAR_EQUAL
         ):
             break
-        final = sizing.solve(choice.program)
+        final = sizing.exact(choice.program)
         if final is None:
             failures.append(sizing.explain_infeasible(choice.program))
             continue
-        best_objective = final.objective if best_objective is None else best_objective
+        first = final.objective if first is None else first
         layouts.append(_finish(spec, axis, canvas, choice, final, uses, timed_out))
     if not layouts:
-        raise InfeasibleError(_no_layout_reason(axis, failures, timed_out, spec))
+        if timed_out:
+            raise SearchLimitError(
+                f"{axis} axis: the time limit ({spec.solver.time_limit:g} s) was reached "
+                "before any layout was found; raise solver.time_limit"
+            )
+        if unproven:
+            raise SearchLimitError(
+                f"{axis} axis: no layout was found within the search budget "
+                f"({EXACT_WORK:,} work units); a layout may still exist: simplify the "
+                "patterns or fix more counters"
+            )
+        raise InfeasibleError(_no_layout_reason(axis, failures))
     timings = {
         "candidates_ms": (generated - started) * 1000,
         "alignment_ms": (aligned_at - generated) * 1000,
         "sizing_ms": (time.perf_counter() - aligned_at) * 1000,
     }
     return [replace(layout, timings=timings, candidates_tried=tried) for layout in layouts]
+
+
+def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
+    """Best first (SPEC 2.7): layouts within TIE of the least objective are equally good,
+    and among them the tie-breaks decide (placeholders covering least, more columns)."""
+    if not evaluated:
+        return []
+    least = min(e.estimate.objective for e in evaluated)
+    good = sorted(
+        (e for e in evaluated if e.estimate.objective <= least + TIE), key=lambda e: e.rank[1:]
+    )
+    rest = sorted(
+        (e for e in evaluated if e.estimate.objective > least + TIE), key=lambda e: e.rank
+    )
+    return [*good, *rest]
+
+
+def _candidate_words(uses: Sequence[PatternUse], candidate: Candidate) -> list[list[str]]:
+    return [[letter.symbol for letter in candidate.words[use.key].word] for use in uses]
+
+
+def _small(uses: Sequence[PatternUse], candidate: Candidate) -> bool:
+    """Whether the exact search over a candidate's words stays small: the number of states
+    of its alignment network (positions of every word, per group)."""
+    states: dict[str, int] = {}
+    for use in uses:
+        letters = len(candidate.words[use.key].word)
+        for _, group in use.layers:
+            states[group] = states.get(group, 1) * (2 * letters + 1)
+    return max(states.values(), default=1) <= SMALL_NETWORK
+
+
+def _candidate_rows(
+    spec: Spec, uses: Sequence[PatternUse], candidate: Candidate, memory: _SearchMemory
+) -> dict[str, list[Row]]:
+    return {
+        group: make_rows(spec, members, memory.full)
+        for group, members in _group_rows(spec, uses, candidate.words).items()
+    }
 
 
 def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:
@@ -419,11 +514,6 @@ def _no_candidate_reason(spec: Spec, axis: Axis, uses: Sequence[PatternUse], can
     )
 
 
-def _no_layout_reason(axis: Axis, failures: list[str], timed_out: bool, spec: Spec) -> str:
-    if timed_out and not failures:
-        return (
-            f"{axis} axis: no layout found within the time limit "
-            f"({spec.solver.time_limit:g} s); raise solver.time_limit or simplify the patterns"
-        )
+def _no_layout_reason(axis: Axis, failures: list[str]) -> str:
     common = max(set(failures), key=failures.count) if failures else "nothing aligns"
     return f"{axis} axis: no candidate aligns: {common}"

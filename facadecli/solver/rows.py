@@ -72,9 +72,13 @@ def make_rows(
 ) -> list[Row]:
     """Rows of one group from (layer index, word) pairs; identical words share a row.
     ``full``: the layers that show all along the other axis."""
-    by_word: dict[Word, list[int]] = {}
+    by_word: dict[tuple[Word, int], list[int]] = {}
     for layer, word in sorted(words, key=lambda item: item[0]):
-        by_word.setdefault(word, []).append(layer)
+        traits = [letter_traits(spec, letter) for letter in word]
+        # a word with an unoccludable letter keeps a row of its own in every layer: the same
+        # word in front would cover it, so the front layer must be free to make room
+        alone = layer if any(t.unoccludable for t in traits) else -1
+        by_word.setdefault((word, alone), []).append(layer)
     rows = [
         Row(
             tuple(layers),
@@ -82,7 +86,7 @@ def make_rows(
             tuple(letter_traits(spec, letter) for letter in word),
             full_height=all(layer in full for layer in layers),
         )
-        for word, layers in by_word.items()
+        for (word, _), layers in by_word.items()
     ]
     return sorted(rows, key=lambda row: row.lowest)
 

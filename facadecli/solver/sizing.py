@@ -162,9 +162,9 @@ def _result(program: Program, values: np.ndarray) -> Sizing:
     return Sizing(values, float(deviation @ deviation), float(values[unsized].sum()))
 
 
-def estimate(program: Program) -> Sizing | None:
-    """Equality-constrained least squares in closed form; None when the equalities conflict
-    or the solution breaks a bound by more than a millimetre (the QP would then differ)."""
+def _equality_solution(program: Program) -> np.ndarray | None:
+    """The minimiser under the equalities alone (bounds ignored), in closed form; None when
+    the equalities conflict."""
     h = 2.0 * program.weight
     e, d = program.equalities, program.rhs
     f = h * program.target
@@ -175,9 +175,69 @@ def estimate(program: Program) -> Sizing | None:
     z = (f - e.T @ nu) / h
     if np.abs(e @ z - d).max(initial=0.0) > 1e-6:
         return None
-    if (z < program.lower - 1e-3).any() or (z > program.upper + 1e-3).any():
+    solution: np.ndarray = z
+    return solution
+
+
+def estimate(program: Program) -> Sizing | None:
+    """Equality-constrained least squares in closed form; None when the equalities conflict
+    or the solution breaks a bound by more than a millimetre (the QP would then differ)."""
+    z = _equality_solution(program)
+    if z is None or (z < program.lower - 1e-3).any() or (z > program.upper + 1e-3).any():
         return None
     return _result(program, z)
+
+
+def exact(program: Program) -> Sizing | None:
+    """The QP's optimum: the closed form when it meets every bound (then no bound is
+    active and it is the optimum), else the QP in cvxpy; None if infeasible."""
+    z = _equality_solution(program)
+    if z is None:
+        return None
+    if (z >= program.lower - 1e-9).all() and (z <= program.upper + 1e-9).all():
+        return _result(program, np.clip(z, program.lower, program.upper))
+    return solve(program)
+
+
+def search_solve(program: Program) -> Sizing | None:
+    """The QP with all bounds, for the exact search's many small layouts: the closed form
+    when no bound is active, else Clarabel called directly (the solver cvxpy calls,
+    without cvxpy's compile step of ~10 ms); None if infeasible."""
+    z = _equality_solution(program)
+    if z is None:
+        return None
+    if (z >= program.lower - 1e-9).all() and (z <= program.upper + 1e-9).all():
+        return _result(program, np.clip(z, program.lower, program.upper))
+    import clarabel
+    import scipy.sparse as sparse
+
+    n = len(program.names)
+    hessian = sparse.diags(2.0 * program.weight, format="csc")
+    linear = -2.0 * program.weight * program.target
+    low = np.flatnonzero(np.isfinite(program.lower))
+    high = np.flatnonzero(np.isfinite(program.upper))
+    rows = [sparse.csc_matrix(program.equalities)]
+    rhs = [program.rhs]
+    if low.size:
+        rows.append(-sparse.eye(n, format="csc")[low])
+        rhs.append(-program.lower[low])
+    if high.size:
+        rows.append(sparse.eye(n, format="csc")[high])
+        rhs.append(program.upper[high])
+    cones = [clarabel.ZeroConeT(program.equalities.shape[0])]
+    if low.size + high.size:
+        cones.append(clarabel.NonnegativeConeT(int(low.size + high.size)))
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    solution = clarabel.DefaultSolver(
+        hessian, linear, sparse.vstack(rows, format="csc"), np.concatenate(rhs), cones, settings
+    ).solve()
+    if solution.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
+        return None
+    values = np.clip(np.asarray(solution.x, dtype=float), program.lower, program.upper)
+    if np.abs(program.equalities @ values - program.rhs).max(initial=0.0) > 1e-6:
+        return None
+    return _result(program, values)
 
 
 def solve(program: Program) -> Sizing | None:

@@ -8,7 +8,9 @@ generated palace façade as layers and bays grow, with the stages of each axis.
 from __future__ import annotations
 
 import itertools
+import resource
 import statistics
+import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -30,7 +32,32 @@ def median_ms(action: Callable[[], object], runs: int = 5) -> float:
     return statistics.median(times)
 
 
+def process_cpu_ms(*args: str) -> float:
+    """CPU time (user + system) of one ``facade`` process, in ms: the median of three."""
+    facade = str(Path(sys.executable).parent / "facade")
+    times = []
+    for _ in range(3):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([facade, *args], cwd=ROOT, capture_output=True, check=False)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        times.append((after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime) * 1000)
+    return statistics.median(times)
+
+
+def processes() -> None:
+    print(f"{'one facade process':44} {'CPU':>9}")
+    for args in (
+        ("--version",),
+        ("validate", "specs/residential-house.yaml"),
+        ("solve", "specs/residential-house.yaml", "-o", "out/bench", "--format", "json"),
+        ("solve", "specs/townhouse.yaml", "-o", "out/bench", "--format", "json"),
+    ):
+        print(f"{' '.join(args)[:44]:44} {process_cpu_ms(*args):7.0f}ms")
+    print()
+
+
 def main() -> None:
+    processes()
     solve(load_spec(ROOT / "specs" / "residential-house.yaml"))  # warm up (imports)
     print(f"{'example':28} {'load+check':>11} {'solve':>10}")
     for path in sorted((ROOT / "specs").glob("*.yaml")):
