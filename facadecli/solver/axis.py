@@ -256,7 +256,7 @@ def solve_axis_alternatives(
         timed_out = timed_out or attempt.timed_out
         if attempt.groups is not None:
             program = sizing.build_program(spec, attempt.groups, canvas)
-            estimate = sizing.estimate(program) or sizing.exact(program)
+            estimate = sizing.estimate(program) or sizing.search_solve(program)
             if estimate is not None:
                 best = min((e.estimate.objective for e in evaluated), default=None)
                 evaluated.append(_Evaluated(candidate, attempt.groups, program, estimate))

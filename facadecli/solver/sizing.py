@@ -188,26 +188,32 @@ def estimate(program: Program) -> Sizing | None:
     return _result(program, z)
 
 
-def exact(program: Program) -> Sizing | None:
-    """The QP's optimum: the closed form when it meets every bound (then no bound is
-    active and it is the optimum), else the QP in cvxpy; None if infeasible."""
+def _closed_form(program: Program) -> Sizing | np.ndarray | None:
+    """The optimum in closed form when it meets every bound (then no bound is active and
+    it is the QP's optimum); the equality solution when a bound is broken (a QP solver
+    must decide); None when the equalities conflict."""
     z = _equality_solution(program)
     if z is None:
         return None
     if (z >= program.lower - 1e-9).all() and (z <= program.upper + 1e-9).all():
         return _result(program, np.clip(z, program.lower, program.upper))
-    return solve(program)
+    return z
+
+
+def exact(program: Program) -> Sizing | None:
+    """The QP's optimum: the closed form when no bound is active, else the QP in cvxpy;
+    None if infeasible."""
+    found = _closed_form(program)
+    return solve(program) if isinstance(found, np.ndarray) else found
 
 
 def search_solve(program: Program) -> Sizing | None:
-    """The QP with all bounds, for the exact search's many small layouts: the closed form
-    when no bound is active, else Clarabel called directly (the solver cvxpy calls,
-    without cvxpy's compile step of ~10 ms); None if infeasible."""
-    z = _equality_solution(program)
-    if z is None:
-        return None
-    if (z >= program.lower - 1e-9).all() and (z <= program.upper + 1e-9).all():
-        return _result(program, np.clip(z, program.lower, program.upper))
+    """The QP with all bounds, for the searches' many small layouts: the closed form when
+    no bound is active, else Clarabel called directly (the solver cvxpy calls, without
+    cvxpy's compile step of ~10 ms); None if infeasible."""
+    found = _closed_form(program)
+    if not isinstance(found, np.ndarray):
+        return found
     import clarabel
     import scipy.sparse as sparse
 
