@@ -1,18 +1,20 @@
-"""A preview of the words each layer can make on a canvas, before any alignment.
+"""What the solver considers for each layer: the words of its candidates, in its order.
 
-``facade words`` prints it: a quick way to check that patterns say what was meant.
+``facade words`` prints it: a quick way to check that patterns say what was meant, and
+to see which word ``facade solve`` picks (marked ``*``) among the ones it looked at.
 """
 
 from __future__ import annotations
 
-import itertools
+import time
 from dataclasses import dataclass
 
-from facadecli.patterns import Enumerated, enumerate_words, format_word
+from facadecli.errors import FacadeError
+from facadecli.patterns import Enumerated, format_word
+from facadecli.solver.axis import CANDIDATE_LIMIT, axis_words, solve_axis
+from facadecli.solver.candidates import generate_candidates, pattern_uses
 from facadecli.spec.model import Spec
-from facadecli.spec.resolve import AXES, Axis, layer_pattern
-
-SCAN_LIMIT = 20_000  # words looked at per layer and axis, to keep the preview instant
+from facadecli.spec.resolve import AXES, Axis
 
 
 @dataclass(frozen=True)
@@ -20,45 +22,52 @@ class WordPreview:
     layer: str
     axis: Axis
     canvas: float
-    words: tuple[Enumerated, ...]  # nearest to the canvas first
-    scanned: int
+    words: tuple[Enumerated, ...]  # in the order the solver tries them
+    chosen: str | None  # the word solve picks, as text (None when the axis has no layout)
+    considered: int  # distinct words of this pattern among the solver's candidates
 
     def lines(self) -> list[str]:
-        head = f"{self.layer} {self.axis} (canvas {self.canvas:g} m):"
+        head = f"{self.layer} {self.axis} (canvas {self.canvas:g} m, {self.considered} words):"
         if not self.words:
-            return [head, "  no word fits"]
+            return [head, "  no word: the patterns' words cannot fit the canvas together"]
         rows = [head]
         for item in self.words:
             counters = ", ".join(f"{k}={v}" for k, v in item.choice.values if "#" not in k)
             stretch = " + elastic" if item.elastic else ""
+            mark = "*" if format_word(item.word) == self.chosen else " "
             rows.append(
-                f"  {item.length:8.3f} m{stretch}  {format_word(item.word)}"
+                f" {mark}{item.length:8.3f} m{stretch}  {format_word(item.word)}"
                 + (f"   ({counters})" if counters else "")
             )
         return rows
 
 
 def preview_words(spec: Spec, limit: int = 5) -> list[WordPreview]:
-    """For every enabled layer and axis, the ``limit`` words nearest the canvas length."""
-    sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
-    transparent = frozenset(n for n in spec.symbols if spec.qualifiers(n).transparent)
-    counters = {name: counter.bounds for name, counter in spec.counters.items()}
-    previews = []
-    for layer in spec.layers:
-        if not layer.enabled:
-            continue
-        for axis in AXES:
-            canvas = spec.canvas.width if axis == "x" else spec.canvas.height
-            found = enumerate_words(
-                layer_pattern(spec, layer, axis),
-                sizes=sizes,
-                max_length=canvas + spec.solver.tolerance,
-                transparent=transparent,
-                counters=counters,
-            )
-            scanned = list(itertools.islice(found, SCAN_LIMIT))
-            scanned.sort(key=lambda item: 0.0 if item.elastic else abs(canvas - item.length))
-            previews.append(
-                WordPreview(layer.name, axis, canvas, tuple(scanned[:limit]), len(scanned))
-            )
-    return previews
+    """For every enabled layer and axis, the first ``limit`` distinct words of the solver's
+    candidates (the order in which it tries them), and the word it picks."""
+    previews: dict[tuple[str, Axis], WordPreview] = {}
+    for axis in AXES:
+        canvas = spec.canvas.width if axis == "x" else spec.canvas.height
+        uses = pattern_uses(spec, axis_words(spec, axis))
+        candidates = generate_candidates(spec, uses, canvas, CANDIDATE_LIMIT)
+        try:
+            chosen = dict(solve_axis(spec, axis, canvas, time.perf_counter() + 60).words)
+        except FacadeError:
+            chosen = {}
+        for use in uses:
+            distinct: dict[str, Enumerated] = {}
+            for candidate in candidates:
+                item = candidate.words[use.key]
+                distinct.setdefault(format_word(item.word), item)
+            shown = list(distinct.values())[:limit]
+            picked = distinct.get(chosen.get(use.key, ""))
+            if picked is not None and picked not in shown:
+                shown.append(picked)
+            for layer, _ in use.layers:
+                name = spec.layers[layer].name
+                previews[(name, axis)] = WordPreview(
+                    name, axis, canvas, tuple(shown), chosen.get(use.key), len(distinct)
+                )
+    return [
+        previews[(layer.name, axis)] for layer in spec.layers if layer.enabled for axis in AXES
+    ]

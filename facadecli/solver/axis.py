@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, replace
 
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.patterns import CompiledPattern, Enumerated, Word, format_word
-from facadecli.solver import exact, sizing
+from facadecli.solver import columns, exact, sizing
 from facadecli.solver.alignment import (
     INF,
     MAX_NODES,
@@ -23,9 +23,9 @@ from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
 EXACT_WORK = 60_000  # work units of the exact searches of one axis (see solver.exact)
-SMALL_NETWORK = 20_000  # alignment states up to which a candidate is searched exactly
-REFINE_CANDIDATES = 60  # candidates that may be searched exactly to beat the best layout
-REFINE_RESERVE = 1_000  # work units an exact refinement needs at least to start
+LOOK_FURTHER = 16  # candidates past the tolerance's tier tried by the heuristic
+EXACT_SHARE = 8_000  # work units at most of one candidate's exact search
+EXACT_ROWS = 6  # rows of a group up to which a candidate is searched exactly
 CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
@@ -121,7 +121,7 @@ def _beyond_tier(candidate: Candidate, first: Candidate, step: float) -> bool:
     )
 
 
-def _axis_words(spec: Spec, axis: Axis) -> list[tuple[int, str, str, CompiledPattern]]:
+def axis_words(spec: Spec, axis: Axis) -> list[tuple[int, str, str, CompiledPattern]]:
     """(layer index, alignment group, pattern key, pattern) of every enabled layer."""
     found = []
     for index, layer in enumerate(spec.layers):
@@ -191,16 +191,15 @@ def solve_axis_alternatives(
     """The best layouts of one axis, best first: the best, and up to ``alternatives`` - 1
     others whose sizing objective is within NEAR_EQUAL of it (for ``facade vary``).
 
-    Candidates go first through the heuristic alignment; a candidate it cannot align is
-    searched exactly, and so are small candidates that could still beat the best layout
-    found (:mod:`facadecli.solver.exact`). Every budget is counted in work, so the answer
-    does not depend on the machine; ``deadline`` (wall clock) is only a safety net, and
-    when it fires the layout says so.
+    Candidates go first through the heuristic alignment, then through the exact search
+    (:mod:`facadecli.solver.exact`) while they could still beat the best layout found.
+    Every budget is counted in work, so the answer does not depend on the machine;
+    ``deadline`` (wall clock) is only a safety net, and when it fires the layout says so.
 
     Raises :class:`InfeasibleError` when no layout exists (proven), and
     :class:`SearchLimitError` when the search stopped before it found one."""
     started = time.perf_counter()
-    uses = pattern_uses(spec, _axis_words(spec, axis))
+    uses = pattern_uses(spec, axis_words(spec, axis))
     candidates = generate_candidates(spec, uses, canvas, CANDIDATE_LIMIT)
     generated = time.perf_counter()
     if not candidates:
@@ -217,73 +216,89 @@ def solve_axis_alternatives(
     effort = MAX_NODES  # once something aligned, a candidate that needs far more search
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     compare = max(FEASIBLE_TO_COMPARE, alternatives)
-    searched: set[int] = set()  # candidates searched exactly
 
-    def search_exactly(candidate: Candidate, incumbent: float) -> bool:
-        """Search a candidate exactly; True when it gave a layout."""
-        nonlocal unproven
-        searched.add(candidate.order)
+    def search_exactly(candidate: Candidate, incumbent: float) -> None:
+        """Search a candidate exactly for a layout better than ``incumbent``."""
+        nonlocal unproven, timed_out
         if not _small(uses, candidate):  # too large a network to search exactly
             unproven = True
-            return False
-        outcome = exact.align_exactly(
-            spec, _candidate_rows(spec, uses, candidate, memory), canvas, budget, incumbent
+            return
+        share = exact.Budget(min(budget.left, EXACT_SHARE), deadline)  # no candidate
+        outcome = exact.align_exactly(  # may starve the others
+            spec, _candidate_rows(spec, uses, candidate, memory), canvas, share, incumbent
         )
-        nonlocal timed_out
-        timed_out = timed_out or budget.timed_out
+        budget.used += share.used
+        timed_out = timed_out or share.timed_out
+        unproven = unproven or not outcome.complete
         if outcome.found is None:
-            unproven = unproven or not outcome.complete
             failures.append(outcome.reason)
-            return False
+            return
         found = outcome.found
         evaluated.append(_Evaluated(candidate, found.groups, found.program, found.sizing))
+
+    def align_heuristically(candidate: Candidate, most: int = MAX_NODES) -> bool:
+        """The heuristic alignment of a candidate, sized; True when it gave a layout."""
+        nonlocal tried, timed_out, effort
+        tried += 1
+        nodes = min(effort, most)
+        attempt = _align_candidate(spec, uses, candidate, canvas, deadline, nodes, memory)
+        timed_out = timed_out or attempt.timed_out
+        if attempt.groups is None:
+            return False
+        program = sizing.build_program(spec, attempt.groups, canvas)
+        estimate = sizing.estimate(program) or sizing.search_solve(program)
+        if estimate is None:
+            return False
+        finest = columns.finest(spec, canvas, attempt.groups, program, estimate)
+        evaluated.append(_Evaluated(candidate, *finest))
+        effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
         return True
 
+    def best_objective() -> float:
+        return min((e.estimate.objective for e in evaluated), default=INF)
+
+    # 1. the heuristic alignment, candidates in the order of the tolerance they need: the
+    # tolerance is raised only until something aligns (the paper's order, and its ties)
+    looked_at: set[int] = set()
     for candidate in candidates[:CANDIDATES_TO_TRY]:
-        if len(evaluated) >= compare or worse >= 2:
+        if len(evaluated) >= compare or worse >= 2 or time.perf_counter() > deadline:
+            timed_out = timed_out or time.perf_counter() > deadline
             break
         if (
             alternatives == 1
             and evaluated
             and _beyond_tier(candidate, evaluated[0].candidate, step)
         ):
-            break  # mu is raised only until something aligns (variations look further)
-        if time.perf_counter() > deadline:
-            timed_out = True
-            break
-        tried += 1
-        attempt = _align_candidate(spec, uses, candidate, canvas, deadline, effort, memory)
-        timed_out = timed_out or attempt.timed_out
-        if attempt.groups is not None:
-            program = sizing.build_program(spec, attempt.groups, canvas)
-            estimate = sizing.estimate(program) or sizing.search_solve(program)
-            if estimate is not None:
-                best = min((e.estimate.objective for e in evaluated), default=None)
-                evaluated.append(_Evaluated(candidate, attempt.groups, program, estimate))
-                worse = worse + 1 if best is not None and estimate.objective > best + 1e-9 else 0
-                effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
-                continue
-        # the heuristic found no sizable alignment: only the exact search can tell
-        if not timed_out and search_exactly(candidate, INF):
-            worse = 0
-            continue
-        worse += 1 if evaluated else 0
-    if len(candidates) > tried:
-        unproven = unproven or not evaluated
-    # small candidates that could still beat the best layout by more than a tie are searched
-    # exactly
-    best_objective = min((e.estimate.objective for e in evaluated), default=INF)
+            break  # variations look further
+        looked_at.add(candidate.order)
+        before = best_objective()
+        if align_heuristically(candidate):
+            worse = worse + 1 if best_objective() > before + 1e-9 < INF else 0
+        else:
+            worse += 1 if evaluated else 0
+    # 2. candidates that could still beat the best layout by more than a tie, by the least
+    # objective they could have: first the heuristic (cheap), then the exact search until
+    # none could; with nothing found that is every candidate, and a search that ends is a
+    # proof
     bounds = sorted(
-        (exact.candidate_bound(spec, _candidate_words(uses, c), canvas), c.key, c)
-        for c in candidates[:REFINE_CANDIDATES]
+        (exact.candidate_bound(_candidate_rows(spec, uses, c, memory), canvas), c.key, c)
+        for c in candidates
     )
+    first_pass = len(looked_at)
     for bound, _, candidate in bounds:
-        if timed_out or bound >= best_objective - TIE or budget.left < REFINE_RESERVE:
+        if timed_out or bound >= best_objective() - TIE:
             break
-        if candidate.order in searched:
-            continue
-        if search_exactly(candidate, best_objective - TIE):
-            best_objective = min(best_objective, evaluated[-1].estimate.objective)
+        if candidate.order not in looked_at and len(looked_at) < first_pass + LOOK_FURTHER:
+            looked_at.add(candidate.order)
+            align_heuristically(candidate, EFFORT_FLOOR)
+            timed_out = timed_out or time.perf_counter() > deadline
+    for bound, _, candidate in bounds:
+        if timed_out or bound >= best_objective() - TIE:
+            break
+        if budget.left == 0:
+            unproven = True
+            break
+        search_exactly(candidate, best_objective() - TIE)
     aligned_at = time.perf_counter()
     ranked = _by_rank(evaluated)
     layouts: list[AxisLayout] = []
@@ -335,19 +350,14 @@ def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
     return [*good, *rest]
 
 
-def _candidate_words(uses: Sequence[PatternUse], candidate: Candidate) -> list[list[str]]:
-    return [[letter.symbol for letter in candidate.words[use.key].word] for use in uses]
-
-
 def _small(uses: Sequence[PatternUse], candidate: Candidate) -> bool:
-    """Whether the exact search over a candidate's words stays small: the number of states
-    of its alignment network (positions of every word, per group)."""
-    states: dict[str, int] = {}
+    """Whether a candidate's groups have few enough rows to search exactly (the columns
+    out of a state grow exponentially with the rows)."""
+    rows: dict[str, set[str]] = {}
     for use in uses:
-        letters = len(candidate.words[use.key].word)
         for _, group in use.layers:
-            states[group] = states.get(group, 1) * (2 * letters + 1)
-    return max(states.values(), default=1) <= SMALL_NETWORK
+            rows.setdefault(group, set()).add(use.key)
+    return max((len(keys) for keys in rows.values()), default=0) <= EXACT_ROWS
 
 
 def _candidate_rows(
@@ -516,4 +526,4 @@ def _no_candidate_reason(spec: Spec, axis: Axis, uses: Sequence[PatternUse], can
 
 def _no_layout_reason(axis: Axis, failures: list[str]) -> str:
     common = max(set(failures), key=failures.count) if failures else "nothing aligns"
-    return f"{axis} axis: no candidate aligns: {common}"
+    return f"{axis} axis: no layout exists: {common}"

@@ -213,9 +213,12 @@ def _max_room_above(
 
 def _estimate(
     spec: Spec, option: Mapping[str, Enumerated], canvas: float, room: Mapping[str, float]
-) -> tuple[float, float]:
+) -> tuple[float, float, float]:
+    """Tolerance needed, misfit; then how far the words are from the canvas (among words
+    that layers in front could make room for, the ones that fill it come first)."""
     needs = [word_need(i.length, i.elastic, canvas, room[key]) for key, i in option.items()]
-    return (max(needs, default=0.0), sum(n * n for n in needs))
+    gap = sum(abs(canvas - i.length) for i in option.values() if not i.elastic)
+    return (max(needs, default=0.0), sum(n * n for n in needs), round(gap, 9))
 
 
 def _best_combinations(

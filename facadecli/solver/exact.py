@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from facadecli.solver import sizing
+from facadecli.solver import columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row
 from facadecli.solver.rows import Row
 from facadecli.spec.model import Spec
@@ -39,6 +39,7 @@ Length = tuple[dict[int, float], dict[int, float]]  # an entry's length: sized, 
 Column = tuple[Move | None, ...]
 LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
 COMBINATION_WORK = 64  # partial columns built per work unit
+WORK_PER_UNIT = 512  # matrix entries of a bound per extra work unit
 SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
 
 
@@ -114,7 +115,7 @@ class _Equalities:
         self.sized_index = {name: i for i, name in enumerate(sorted(sized))}
         self.target = np.array([sized[name] for name in sorted(sized)])
         self.free_index: dict[object, int] = {}
-        self.rows: list[tuple[dict[int, float], dict[int, float], float]] = []
+        self.work = 0  # work units of the last bound: it grows with the equalities
 
     def free(self, key: object) -> int:
         return self.free_index.setdefault(key, len(self.free_index))
@@ -123,6 +124,7 @@ class _Equalities:
         """Least sum of squared deviations of the sized symbols under ``rows`` (INF when the
         equalities conflict), and the sizes that reach it (unique: the objective is
         strictly convex in them)."""
+        self.work = 1
         if not rows:
             return 0.0, self.target
         n_sized, n_free = len(self.target), len(self.free_index)
@@ -135,6 +137,7 @@ class _Equalities:
             for j, value in free.items():
                 b[i, j] += value
             d[i] = rhs
+        self.work = 1 + len(rows) * (n_sized + n_free) // WORK_PER_UNIT
         scale = max(1.0, float(np.abs(d).max(initial=0.0)))
         if n_free:  # only what the free variables cannot absorb constrains the sizes
             u, s, _ = np.linalg.svd(b, full_matrices=True)
@@ -193,42 +196,73 @@ class _Search:
     incumbent: float
     equalities: _Equalities
     best: Found | None = None
-    rejections: dict[str, int] = field(default_factory=dict)
+    rejections: dict[str, tuple[int, int]] = field(default_factory=dict)  # (progress, count)
+    progress: int = 0  # how far the state being expanded is (sum of positions)
     remaining_cache: dict[tuple[int, int, int], np.ndarray] = field(default_factory=dict)
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
 
     # -- the rules of SPEC 2.4 on one column ----------------------------------------------
     def reject(self, why: str) -> bool:
-        self.rejections[why] = self.rejections.get(why, 0) + 1
+        progress, count = self.rejections.get(why, (0, 0))
+        self.rejections[why] = (max(progress, self.progress), count + 1)
         return False
 
     def valid(self, group: _Group, entries: Sequence[Move | None], memory: Sequence[int]) -> bool:
         if not any(m is not None for m in entries):
             return False
-        opaque = [r for r, m in enumerate(entries) if m is not None and m.opaque]
-        if not opaque:
-            return self.reject("a column with no opaque entry (a hole)")
+        if not any(_opaque(m) for m in entries):
+            r = next(r for r, m in enumerate(entries) if m is not None)
+            return self.reject(
+                f"nothing opaque would stand behind or in front of "
+                f"{self.text(group, r, entries[r])} of {self.layer(group, r)} (every column "
+                "needs an opaque layer: mark a symbol opaque, or let the layers fit)"
+            )
         for r, move in enumerate(entries):
             if move is None:
                 if memory[r] == AFTER_ATTACHED:
-                    return self.reject("an attached letter separated from its neighbour")
+                    return self.reject(
+                        f"an attached letter of {self.layer(group, r)} would be separated from "
+                        "its neighbour by a gap"
+                    )
                 if not any(_opaque(entries[a]) for a in group.covering[r]):
-                    return self.reject("a gap in a layer with no opaque letter in front of it")
+                    return self.reject(
+                        f"{self.layer(group, r)} would need a gap where no layer in front of it "
+                        "has an opaque letter (only opaque letters of layers in front may make "
+                        "a layer give way)"
+                    )
                 continue
             if move.first_attached and memory[r] == AFTER_EMPTY:
-                return self.reject("an attached letter separated from its neighbour")
+                return self.reject(
+                    f"{self.text(group, r, move)} of {self.layer(group, r)} is attached, but a "
+                    "gap would open before it"
+                )
             if move.unoccludable:
                 for above in group.above[r]:
                     other = entries[above]
                     if other is not None and not other.transparent:
-                        return self.reject("an unoccludable letter covered by a layer in front")
+                        return self.reject(
+                            f"{self.layer(group, above)} would cover unoccludable "
+                            f"{self.text(group, r, move)} of {self.layer(group, r)}"
+                        )
         return True
+
+    def layer(self, group: _Group, r: int) -> str:
+        names = [f"'{self.spec.layers[i].name}'" for i in group.rows[r].row.layers]
+        return ("layer " if len(names) == 1 else "layers ") + ", ".join(names)
+
+    def text(self, group: _Group, r: int, move: Move | None) -> str:
+        if move is None:
+            return "a gap"
+        whole, parts = sizing.entry_parts(move)
+        word = group.rows[r].row.word
+        return "'" + " ".join(word[k].symbol for k in sorted({*whole, *parts})) + "'"
 
     def columns(
         self, group: _Group, positions: tuple[int, ...], memory: tuple[int, ...]
     ) -> Iterator[tuple[Move | None, ...]]:
         """Every valid column out of a state."""
+        self.progress = sum(positions)
         options: list[list[Move | None]] = []
         for r, row in enumerate(group.rows):
             position = positions[r]
@@ -345,7 +379,7 @@ class _Search:
         if positions == group.ends:
             total = [*rows, _sum(widths, self.canvas)]
             bound = self.equalities.bound(total)[0]
-            self.budget.spend()
+            self.budget.spend(self.equalities.work)
             if bound > self.incumbent + SAME:
                 return
             finished = [*done, list(path)]
@@ -356,7 +390,9 @@ class _Search:
                 self.leaf(finished)
             return
         span = self.span_of(widths)
-        children: list[tuple[float, float, int, int, Column, list[Equality], Length]] = []
+        children: list[
+            tuple[tuple[float, float, int, int, int, int], Column, list[Equality], Length]
+        ] = []
         for entries in self.columns(group, positions, memory):
             added, width = self.column_rows(g, len(path), entries, path)
             extended = rows + added
@@ -364,26 +400,25 @@ class _Search:
             grown = span + self.sized_vector(width[0])
             spans = [grown + self.remaining(g, r, p) for r, p in enumerate(after)]
             bound = self.equalities.bound_within(extended, [grown, *spans], self.canvas)
-            self.budget.spend()
+            self.budget.spend(self.equalities.work)
             if bound > self.incumbent + SAME:
                 continue
-            letters = sum(m.letters for m in entries if m is not None)
-            children.append(
-                (
-                    round(bound, 9),
-                    _spread(entries),
-                    letters,
-                    len(children),
-                    entries,
-                    extended,
-                    width,
-                )
+            present = [m for m in entries if m is not None]
+            rank = (
+                round(bound, 9),
+                _spread(entries),
+                sum((m.piece_of is not None) + (m.tail is not None) for m in present),
+                len(entries) - len(present),
+                sum(m.letters for m in present),
+                len(children),
             )
+            children.append((rank, entries, extended, width))
         # most promising first: least bound, then the columns that fit at preferred sizes
-        # (the paper's column error), then fewer letters (more columns)
-        children.sort(key=lambda child: child[:4])
-        for bound, _, _, _, entries, extended, width in children:
-            if bound > self.incumbent + SAME:
+        # (the paper's column error), whole letters before pieces (split only where
+        # needed), no room made before room made, fewer letters (more columns)
+        children.sort(key=lambda child: child[0])
+        for rank, entries, extended, width in children:
+            if rank[0] > self.incumbent + SAME:
                 break
             self.dfs(
                 g,
@@ -432,7 +467,7 @@ class _Search:
         if solved is None:
             self.sizing_failure = sizing.explain_infeasible(program)
             return
-        found = Found(groups, program, solved)
+        found = Found(*columns.finest(self.spec, self.canvas, groups, program, solved))
         if self.best is None or found.rank < self.best.rank:
             self.best = found
             self.incumbent = min(self.incumbent, solved.objective)
@@ -549,25 +584,37 @@ def align_exactly(
         return Outcome(search.best, False, "the search budget ran out")
     reason = ""
     if search.best is None:
-        counts = sorted(search.rejections.items(), key=lambda item: (-item[1], item[0]))
+        # the rule that stopped the search furthest along, then the most often
+        counts = sorted(
+            search.rejections.items(), key=lambda item: (-item[1][0], -item[1][1], item[0])
+        )
         reason = search.sizing_failure or (
             counts[0][0] if counts else "the words cannot be cut into matching columns"
         )
     return Outcome(search.best, True, reason)
 
 
-def candidate_bound(spec: Spec, words: Sequence[Sequence[str]], canvas: float) -> float:
-    """A lower bound on the objective of any layout of these words (one per row): a word
-    longer than the canvas at preferred sizes must shrink (placeholders can only grow)."""
+def candidate_bound(groups: Mapping[str, Sequence[Row]], canvas: float) -> float:
+    """A lower bound on the objective of any layout of a candidate's rows. A row longer
+    than the canvas at preferred sizes must shrink (placeholders only grow); a shorter one
+    must grow unless it has a placeholder or a row in front may cover a gap in it."""
     best = 0.0
-    for word in words:
-        counts: dict[str, int] = {}
-        length = 0.0
-        for symbol in word:
-            size = spec.size(symbol)
-            if size is not None:
-                counts[symbol] = counts.get(symbol, 0) + 1
-                length += size
-        if length > canvas and counts:
-            best = max(best, (length - canvas) ** 2 / sum(c * c for c in counts.values()))
-    return best if math.isfinite(best) else INF
+    for rows in groups.values():
+        for row in rows:
+            counts: dict[str, int] = {}
+            length = 0.0
+            for letter, traits in zip(row.word, row.traits, strict=True):
+                if traits.size is not None:
+                    counts[letter.symbol] = counts.get(letter.symbol, 0) + 1
+                    length += traits.size
+            if not counts:
+                continue
+            elastic = any(traits.size is None for traits in row.traits)
+            coverable = any(
+                other.covers(row) and any(t.opaque for t in other.traits) for other in rows
+            )
+            short = canvas - length if not (elastic or coverable) else 0.0
+            miss = max(length - canvas, short)
+            if miss > 0.0:
+                best = max(best, miss * miss / sum(c * c for c in counts.values()))
+    return best
