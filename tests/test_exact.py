@@ -379,3 +379,23 @@ def test_dropping_attached_never_loses_the_layout() -> None:
     tight_layout = solve(parse_spec(text))
     loose_layout = solve(parse_spec(loose))  # a looser spec: never "no layout"
     assert loose_layout.x.objective <= tight_layout.x.objective + 1e-9
+
+
+def test_words_lists_what_the_solver_picks() -> None:
+    from pathlib import Path
+
+    from facadecli import load_spec
+    from facadecli.patterns import format_word
+    from facadecli.preview import preview_words
+
+    spec = load_spec(Path(__file__).parent.parent / "specs" / "residential-house.yaml")
+    layout = solve(spec)
+    for preview in preview_words(spec, limit=2):
+        layer = [layer.name for layer in spec.layers].index(preview.layer)
+        word = " ".join(
+            f"[{p.symbol}]" if p.transparent else p.symbol
+            for p in layout.letters(layer, preview.axis)
+        )
+        assert preview.chosen == word
+        assert word in [format_word(item.word) for item in preview.words]
+        assert any(line.startswith(" *") for line in preview.lines())
