@@ -68,6 +68,4 @@ def preview_words(spec: Spec, limit: int = 5) -> list[WordPreview]:
                 previews[(name, axis)] = WordPreview(
                     name, axis, canvas, tuple(shown), chosen.get(use.key), len(distinct)
                 )
-    return [
-        previews[(layer.name, axis)] for layer in spec.layers if layer.enabled for axis in AXES
-    ]
+    return [previews[(layer.name, axis)] for layer in spec.layers if layer.enabled for axis in AXES]

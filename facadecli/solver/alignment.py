@@ -34,7 +34,7 @@ from facadecli.solver.rows import LetterTraits, Row
 INF = math.inf
 EPS = 1e-9
 TARGETS_PER_STATE = 24  # target widths tried from one state, smallest first
-MAX_NODES = 20_000  # states one search may visit before it gives up on a candidate
+MAX_NODES = 5_000  # states one search may visit before it gives up on a candidate
 JOINT_ROWS = 2  # rows searched together; more are added one at a time
 REFINE_NODES = 200  # least extra effort spent looking for a cheaper path than the first
 BUDGET_STEP = 0.01  # least deepening of the error budget, as a share of the canvas

@@ -23,9 +23,13 @@ from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
 EXACT_WORK = 60_000  # work units of the exact searches of one axis (see solver.exact)
-LOOK_FURTHER = 16  # candidates past the tolerance's tier tried by the heuristic
+LOOK_FURTHER = 8  # candidates past the tolerance's tier tried by the heuristic
+FURTHER_NODES = 500  # ... each with at most this many search states
 EXACT_SHARE = 8_000  # work units at most of one candidate's exact search
+IMPROVE_WORK = 4_000  # work units spent improving on a layout already found
+IMPROVE_SHARE = 2_000  # ... and on one candidate
 EXACT_ROWS = 6  # rows of a group up to which a candidate is searched exactly
+IMPROVE_ROWS = 3  # ... and searched to improve on a layout found
 CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
@@ -220,10 +224,12 @@ def solve_axis_alternatives(
     def search_exactly(candidate: Candidate, incumbent: float) -> None:
         """Search a candidate exactly for a layout better than ``incumbent``."""
         nonlocal unproven, timed_out
-        if not _small(uses, candidate):  # too large a network to search exactly
-            unproven = True
+        if _rows_per_group(uses) > (EXACT_ROWS if incumbent == INF else IMPROVE_ROWS):
+            unproven = True  # too large a network to search exactly
             return
-        share = exact.Budget(min(budget.left, EXACT_SHARE), deadline)  # no candidate
+        # no candidate may starve the others; improving on a layout found gets less
+        most = EXACT_SHARE if incumbent == INF else IMPROVE_SHARE
+        share = exact.Budget(min(budget.left, most), deadline)
         outcome = exact.align_exactly(  # may starve the others
             spec, _candidate_rows(spec, uses, candidate, memory), canvas, share, incumbent
         )
@@ -290,12 +296,12 @@ def solve_axis_alternatives(
             break
         if candidate.order not in looked_at and len(looked_at) < first_pass + LOOK_FURTHER:
             looked_at.add(candidate.order)
-            align_heuristically(candidate, EFFORT_FLOOR)
+            align_heuristically(candidate, FURTHER_NODES)
             timed_out = timed_out or time.perf_counter() > deadline
     for bound, _, candidate in bounds:
         if timed_out or bound >= best_objective() - TIE:
             break
-        if budget.left == 0:
+        if budget.left == 0 or (best_objective() < INF and budget.used >= IMPROVE_WORK):
             unproven = True
             break
         search_exactly(candidate, best_objective() - TIE)
@@ -350,14 +356,14 @@ def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
     return [*good, *rest]
 
 
-def _small(uses: Sequence[PatternUse], candidate: Candidate) -> bool:
-    """Whether a candidate's groups have few enough rows to search exactly (the columns
-    out of a state grow exponentially with the rows)."""
+def _rows_per_group(uses: Sequence[PatternUse]) -> int:
+    """The most rows a group can have (the columns out of a state of the exact search grow
+    exponentially with them)."""
     rows: dict[str, set[str]] = {}
     for use in uses:
         for _, group in use.layers:
             rows.setdefault(group, set()).add(use.key)
-    return max((len(keys) for keys in rows.values()), default=0) <= EXACT_ROWS
+    return max((len(keys) for keys in rows.values()), default=0)
 
 
 def _candidate_rows(

@@ -595,26 +595,43 @@ def align_exactly(
 
 
 def candidate_bound(groups: Mapping[str, Sequence[Row]], canvas: float) -> float:
-    """A lower bound on the objective of any layout of a candidate's rows. A row longer
-    than the canvas at preferred sizes must shrink (placeholders only grow); a shorter one
-    must grow unless it has a placeholder or a row in front may cover a gap in it."""
+    """A lower bound on the objective of any layout of a candidate's rows, from one row at
+    a time (the paper's Eq. 7 with sizes free): a row longer than the canvas at preferred
+    sizes must shrink (placeholders only grow); a row without placeholders that is
+    shorter must grow, unless opaque letters of the rows in front may cover its gaps: then
+    its letters and theirs together must reach the canvas."""
     best = 0.0
     for rows in groups.values():
         for row in rows:
-            counts: dict[str, int] = {}
-            length = 0.0
-            for letter, traits in zip(row.word, row.traits, strict=True):
-                if traits.size is not None:
-                    counts[letter.symbol] = counts.get(letter.symbol, 0) + 1
-                    length += traits.size
-            if not counts:
+            own = _sized_counts(row, opaque_only=False)
+            if not own:
                 continue
-            elastic = any(traits.size is None for traits in row.traits)
-            coverable = any(
-                other.covers(row) and any(t.opaque for t in other.traits) for other in rows
-            )
-            short = canvas - length if not (elastic or coverable) else 0.0
-            miss = max(length - canvas, short)
-            if miss > 0.0:
-                best = max(best, miss * miss / sum(c * c for c in counts.values()))
+            longer = _excess(own, canvas)
+            best = max(best, longer)
+            if any(traits.size is None for traits in row.traits):
+                continue  # a placeholder takes up any shortfall
+            reach = dict(own)
+            for other in rows:
+                if other.covers(row):
+                    for name, (count, size) in _sized_counts(other, opaque_only=True).items():
+                        reach[name] = (reach.get(name, (0, size))[0] + count, size)
+            best = max(best, _excess(reach, canvas, shorter=True))
     return best
+
+
+def _sized_counts(row: Row, opaque_only: bool) -> dict[str, tuple[int, float]]:
+    counts: dict[str, tuple[int, float]] = {}
+    for letter, traits in zip(row.word, row.traits, strict=True):
+        if traits.size is not None and (traits.opaque or not opaque_only):
+            counts[letter.symbol] = (counts.get(letter.symbol, (0, 0.0))[0] + 1, traits.size)
+    return counts
+
+
+def _excess(counts: Mapping[str, tuple[int, float]], canvas: float, shorter: bool = False) -> float:
+    """Least squared deviation that brings sum(count * size) to the canvas (from above, or
+    from below with ``shorter``), all else free."""
+    length = sum(count * size for count, size in counts.values())
+    miss = canvas - length if shorter else length - canvas
+    if miss <= 0.0 or not counts:
+        return 0.0
+    return miss * miss / sum(count * count for count, _ in counts.values())
