@@ -145,37 +145,55 @@ def test_the_exact_search_finds_the_oracles_optimum(text: str) -> None:
 # -- planted layouts: drawn first, then written as patterns they satisfy --------------------
 @st.composite
 def planted_specs(draw: st.DrawFn) -> str:
-    """A wall ``P (B P)^k`` on exactly the canvas its preferred sizes fill, and ornament
-    layers ``l X r`` whose X stands over some inner run of the wall's letters (the
-    ornament symbols have those letters' sizes): a layout with zero deviation exists."""
+    """A layout drawn first, then written as patterns it satisfies with zero deviation.
+
+    A wall ``P (B P)^k`` fills the canvas exactly at preferred sizes (its windows B are
+    unoccludable in some draws), floors ``G S^f T`` fill the height, and ornament layers
+    stand over runs of the wall's inner letters with symbols of those letters' sizes:
+    ``l X r`` anywhere, ``c X c`` when the run is centred (one placeholder, one size), or
+    a whole second wall sharing the counter k."""
     pier = draw(st.sampled_from([0.5, 0.8, 1.0]))
     bay = draw(st.sampled_from([1.2, 1.5, 2.0]))
-    k = draw(st.integers(1, 6))
+    windows = draw(st.booleans())  # B unoccludable: ornaments keep to the inner piers
+    k = draw(st.integers(2 if windows else 1, 6))
+    floors = draw(st.integers(1, 4))
     wall = ["P"] + ["B", "P"] * k
     canvas = pier * (k + 1) + bay * k
-    sizes = {"P": pier, "B": bay, "F": 3.0}
-    patterns = {"f": "F"}
-    layers = ["  - {name: wall, x: 'P (B P)^k', y: f}"]
+    sizes = {"P": str(pier), "B": f"{{size: {bay}, unoccludable: {str(windows).lower()}}}"}
+    sizes |= {"G": "1.5", "S": "3.0", "T": "1.0"}
+    patterns = {"storeys": "'G S^f T'"}
+    layers = ["  - {name: wall, x: 'P (B P)^k', y: storeys}"]
     for index in range(draw(st.integers(1, 4))):
-        # placeholders are longer than zero: the run keeps off the wall's ends
-        start = draw(st.integers(1, len(wall) - 2))
-        end = draw(st.integers(start + 1, min(len(wall) - 1, start + 3)))
-        run = [f"{letter}{index}" for letter in wall[start:end]]
-        for letter, name in zip(wall[start:end], run, strict=True):
-            sizes[name] = sizes[letter]
-        patterns[f"o{index}"] = (
-            f"{{control: 'l{index} x r{index}', where: {{x: '{' '.join(run)}'}}}}"
-        )
-        layers.append(f"  - {{name: ornament{index}, x: o{index}, y: f}}")
+        kind = draw(st.sampled_from(["run", "centred", "whole"]))
+        if kind == "whole" and not windows:
+            sizes |= {f"P{index}": str(pier), f"B{index}": str(bay)}
+            patterns[f"o{index}"] = f"'P{index} (B{index} P{index})^k'"
+        else:
+            if kind == "centred":  # placeholders are longer than zero: off the wall's ends
+                half = draw(st.integers(0, k - 1))
+                start, end = k - half, k + half + 1
+            else:
+                start = draw(st.integers(1, len(wall) - 2))
+                end = draw(st.integers(start + 1, min(len(wall) - 1, start + 3)))
+            if windows:  # an inner pier alone, never over a window
+                start = 2 * draw(st.integers(1, max(1, k - 1)))
+                end = start + 1
+                kind = "run"
+            run = [f"{letter}{index}" for letter in wall[start:end]]
+            for letter, name in zip(wall[start:end], run, strict=True):
+                sizes[name] = str(pier if letter == "P" else bay)
+            control = f"c{index} x c{index}" if kind == "centred" else f"l{index} x r{index}"
+            patterns[f"o{index}"] = f"{{control: '{control}', where: {{x: '{' '.join(run)}'}}}}"
+        layers.append(f"  - {{name: ornament{index}, x: o{index}, y: storeys}}")
     return (
         "\n".join(
             [
                 "version: 1",
                 "name: planted",
-                f"canvas: {{width: {canvas!r}, height: 3}}",
+                f"canvas: {{width: {canvas!r}, height: {2.5 + 3.0 * floors!r}}}",
                 "symbol_defaults: {opaque: true}",
                 "symbols: {" + ", ".join(f"{n}: {v}" for n, v in sizes.items()) + "}",
-                "counters: {k: {min: 1}}",
+                "counters: {k: {min: 1}, f: {min: 1}}",
                 "patterns: {" + ", ".join(f"{n}: {v}" for n, v in patterns.items()) + "}",
                 "layers:",
                 *layers,
@@ -185,7 +203,9 @@ def planted_specs(draw: st.DrawFn) -> str:
     )
 
 
-@SETTINGS
+@settings(
+    derandomize=True, max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
 @given(planted_specs())
 def test_every_planted_layout_is_found_with_zero_deviation(text: str) -> None:
     layout = solve(parse_spec(text, "planted.yaml"))

@@ -26,10 +26,9 @@ EXACT_WORK = 60_000  # work units of the exact searches of one axis (see solver.
 LOOK_FURTHER = 8  # candidates past the tolerance's tier tried by the heuristic
 FURTHER_NODES = 500  # ... each with at most this many search states
 EXACT_SHARE = 8_000  # work units at most of one candidate's exact search
-IMPROVE_WORK = 4_000  # work units spent improving on a layout already found
-IMPROVE_SHARE = 2_000  # ... and on one candidate
+IMPROVE_WORK = 8_000  # work units spent improving on a layout already found
+IMPROVE_SHARE = 4_000  # ... and on one candidate
 EXACT_ROWS = 6  # rows of a group up to which a candidate is searched exactly
-IMPROVE_ROWS = 3  # ... and searched to improve on a layout found
 CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
@@ -224,7 +223,7 @@ def solve_axis_alternatives(
     def search_exactly(candidate: Candidate, incumbent: float) -> None:
         """Search a candidate exactly for a layout better than ``incumbent``."""
         nonlocal unproven, timed_out
-        if _rows_per_group(uses) > (EXACT_ROWS if incumbent == INF else IMPROVE_ROWS):
+        if _rows_per_group(uses) > EXACT_ROWS:
             unproven = True  # too large a network to search exactly
             return
         # no candidate may starve the others; improving on a layout found gets less
@@ -252,7 +251,7 @@ def solve_axis_alternatives(
         if attempt.groups is None:
             return False
         program = sizing.build_program(spec, attempt.groups, canvas)
-        estimate = sizing.estimate(program) or sizing.search_solve(program)
+        estimate = sizing.search_solve(program)
         if estimate is None:
             return False
         finest = columns.finest(spec, canvas, attempt.groups, program, estimate)

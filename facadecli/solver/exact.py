@@ -359,7 +359,22 @@ class _Search:
     # -- the search -------------------------------------------------------------------------
     def run(self) -> None:
         start = self.start_of(0)
-        self.dfs(0, start[0], start[1], [], [], [], [])
+        self.dfs(0, start[0], start[1], self.filling(), [], [], [])
+
+    def filling(self) -> list[Equality]:
+        """A row that no row in front may make room for has no gap: its letters fill the
+        canvas, whatever the alignment (known before the first column)."""
+        rows: list[Equality] = []
+        for group in self.groups:
+            for r, prepared in enumerate(group.rows):
+                if group.covering[r]:
+                    continue
+                sized: dict[int, float] = {}
+                free: dict[int, float] = {}
+                for letter in prepared.row.word:
+                    self.add_symbol(letter.symbol, sized, free)
+                rows.append((sized, free, self.canvas))
+        return rows
 
     def start_of(self, g: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
         count = len(self.groups[g].rows)

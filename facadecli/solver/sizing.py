@@ -7,8 +7,9 @@ the pieces of a split letter add up to its symbol's size. Objective: the sum ove
 symbols of (size - preferred)^2, plus a tiny weight on everything else so that the
 solution is unique (a placeholder covers as little as it can).
 
-``estimate`` solves the equality-constrained problem in closed form (a few hundred
-microseconds) to rank alignments; ``solve`` is the cvxpy QP with every bound.
+When no bound is active the optimum is the equality-constrained problem's, solved in
+closed form (a few hundred microseconds); otherwise ``solve`` is the cvxpy QP with every
+bound, and ``search_solve`` calls Clarabel directly for the searches' many small QPs.
 """
 
 from __future__ import annotations
@@ -177,15 +178,6 @@ def _equality_solution(program: Program) -> np.ndarray | None:
         return None
     solution: np.ndarray = z
     return solution
-
-
-def estimate(program: Program) -> Sizing | None:
-    """Equality-constrained least squares in closed form; None when the equalities conflict
-    or the solution breaks a bound by more than a millimetre (the QP would then differ)."""
-    z = _equality_solution(program)
-    if z is None or (z < program.lower - 1e-3).any() or (z > program.upper + 1e-3).any():
-        return None
-    return _result(program, z)
 
 
 def _closed_form(program: Program) -> Sizing | np.ndarray | None:
