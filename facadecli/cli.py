@@ -25,7 +25,6 @@ from facadecli.export import (
     write_atomic,
     write_outputs,
 )
-from facadecli.export.contact import Variant, contact_sheet
 from facadecli.preview import preview_words
 from facadecli.solve import retarget, solve, solve_variants
 from facadecli.spec import Spec, load_spec, spec_schema_text
@@ -219,6 +218,8 @@ def vary(
     width_list = _sizes(widths, "--widths")
     height_list = _sizes(heights, "--heights")
     spec = load_spec(spec_path)
+    from facadecli.export.contact import Variant, contact_sheet  # only vary draws sheets
+
     rows: list[list[Variant]] = []
     failed = 0
     for width in width_list:
