@@ -229,7 +229,7 @@ def solve_axis_alternatives(
         # no candidate may starve the others; improving on a layout found gets less
         most = EXACT_SHARE if incumbent == INF else IMPROVE_SHARE
         share = exact.Budget(min(budget.left, most), deadline)
-        outcome = exact.align_exactly(  # may starve the others
+        outcome = exact.align_exactly(
             spec, _candidate_rows(spec, uses, candidate, memory), canvas, share, incumbent
         )
         budget.used += share.used
@@ -241,23 +241,23 @@ def solve_axis_alternatives(
         found = outcome.found
         evaluated.append(_Evaluated(candidate, found.groups, found.program, found.sizing))
 
-    def align_heuristically(candidate: Candidate, most: int = MAX_NODES) -> bool:
-        """The heuristic alignment of a candidate, sized; True when it gave a layout."""
+    def align_heuristically(candidate: Candidate, most: int = MAX_NODES) -> float | None:
+        """The heuristic alignment of a candidate, sized: its objective, None if none."""
         nonlocal tried, timed_out, effort
         tried += 1
         nodes = min(effort, most)
         attempt = _align_candidate(spec, uses, candidate, canvas, deadline, nodes, memory)
         timed_out = timed_out or attempt.timed_out
         if attempt.groups is None:
-            return False
+            return None
         program = sizing.build_program(spec, attempt.groups, canvas)
         estimate = sizing.search_solve(program)
         if estimate is None:
-            return False
+            return None
         finest = columns.finest(spec, canvas, attempt.groups, program, estimate)
         evaluated.append(_Evaluated(candidate, *finest))
         effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
-        return True
+        return estimate.objective
 
     def best_objective() -> float:
         return min((e.estimate.objective for e in evaluated), default=INF)
@@ -277,10 +277,11 @@ def solve_axis_alternatives(
             break  # variations look further
         looked_at.add(candidate.order)
         before = best_objective()
-        if align_heuristically(candidate):
-            worse = worse + 1 if best_objective() > before + 1e-9 < INF else 0
-        else:
+        objective = align_heuristically(candidate)
+        if objective is None:
             worse += 1 if evaluated else 0
+        else:
+            worse = worse + 1 if before < INF and objective > before + 1e-9 else 0
     # 2. candidates that could still beat the best layout by more than a tie, by the least
     # objective they could have: first the heuristic (cheap), then the exact search until
     # none could; with nothing found that is every candidate, and a search that ends is a
