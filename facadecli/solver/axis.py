@@ -23,6 +23,7 @@ from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
 EXACT_WORK = 60_000  # work units of the exact searches of one axis (see solver.exact)
+HEURISTIC_WORK = 60_000  # search states of the heuristic alignment per axis
 LOOK_FURTHER = 8  # candidates past the tolerance's tier tried by the heuristic
 FURTHER_NODES = 500  # ... each with at most this many search states
 EXACT_SHARE = 8_000  # work units at most of one candidate's exact search
@@ -247,6 +248,7 @@ def solve_axis_alternatives(
         tried += 1
         nodes = min(effort, most)
         attempt = _align_candidate(spec, uses, candidate, canvas, deadline, nodes, memory)
+        visited.append(attempt.nodes)
         timed_out = timed_out or attempt.timed_out
         if attempt.groups is None:
             return None
@@ -265,7 +267,10 @@ def solve_axis_alternatives(
     # 1. the heuristic alignment, candidates in the order of the tolerance they need: the
     # tolerance is raised only until something aligns (the paper's order, and its ties)
     looked_at: set[int] = set()
+    visited: list[int] = []  # search states of each heuristic alignment
     for candidate in candidates[:CANDIDATES_TO_TRY]:
+        if sum(visited) > HEURISTIC_WORK:
+            break  # the exact search takes over
         if len(evaluated) >= compare or worse >= 2 or time.perf_counter() > deadline:
             timed_out = timed_out or time.perf_counter() > deadline
             break
@@ -293,6 +298,8 @@ def solve_axis_alternatives(
     first_pass = len(looked_at)
     for bound, _, candidate in bounds:
         if timed_out or bound >= best_objective() - TIE:
+            break
+        if sum(visited) > HEURISTIC_WORK:
             break
         if candidate.order not in looked_at and len(looked_at) < first_pass + LOOK_FURTHER:
             looked_at.add(candidate.order)
