@@ -18,18 +18,19 @@ from facadecli.solver.alignment import (
     align,
 )
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
-from facadecli.solver.rows import Row, full_layers, make_rows
+from facadecli.solver.rows import LetterTraits, Row, full_layers, make_rows
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
-EXACT_WORK = 60_000  # work units of the exact searches of one axis (see solver.exact)
-HEURISTIC_WORK = 60_000  # search states of the heuristic alignment per axis
+EXACT_WORK = 30_000  # work units of the exact searches of one axis (see solver.exact)
+HEURISTIC_WORK = 20_000  # search states of the heuristic alignment per axis
 LOOK_FURTHER = 8  # candidates past the tolerance's tier tried by the heuristic
 FURTHER_NODES = 500  # ... each with at most this many search states
 EXACT_SHARE = 8_000  # work units at most of one candidate's exact search
 IMPROVE_WORK = 8_000  # work units spent improving on a layout already found
 IMPROVE_SHARE = 4_000  # ... and on one candidate
 EXACT_ROWS = 6  # rows of a group up to which a candidate is searched exactly
+EXACT_LETTERS = 40  # ... and letters of its longest word
 CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
@@ -151,6 +152,7 @@ class _SearchMemory:
     """Alignments already searched in one axis solve, shared by its candidates."""
 
     full: frozenset[int]  # layers that show all along the other axis
+    traits: dict[Word, tuple[LetterTraits, ...]] = field(default_factory=dict)
     groups: dict[tuple[str, tuple[Word, ...]], AlignmentResult] = field(default_factory=dict)
     prefixes: Prefixes = field(default_factory=dict)
 
@@ -177,7 +179,7 @@ def _align_candidate(
     aligned: dict[str, Alignment] = {}
     nodes = 0
     for group, members in sorted(_group_rows(spec, uses, candidate.words).items()):
-        rows = make_rows(spec, members, memory.full)
+        rows = make_rows(spec, members, memory.full, memory.traits)
         key = (group, tuple(row.word for row in rows))
         if key not in memory.groups:
             memory.groups[key] = align(rows, canvas, mu, deadline, effort, memory.prefixes)
@@ -224,7 +226,8 @@ def solve_axis_alternatives(
     def search_exactly(candidate: Candidate, incumbent: float) -> None:
         """Search a candidate exactly for a layout better than ``incumbent``."""
         nonlocal unproven, timed_out
-        if _rows_per_group(uses) > EXACT_ROWS:
+        longest = max(len(item.word) for item in candidate.words.values())
+        if _rows_per_group(uses) > EXACT_ROWS or longest > EXACT_LETTERS:
             unproven = True  # too large a network to search exactly
             return
         # no candidate may starve the others; improving on a layout found gets less
@@ -377,7 +380,7 @@ def _candidate_rows(
     spec: Spec, uses: Sequence[PatternUse], candidate: Candidate, memory: _SearchMemory
 ) -> dict[str, list[Row]]:
     return {
-        group: make_rows(spec, members, memory.full)
+        group: make_rows(spec, members, memory.full, memory.traits)
         for group, members in _group_rows(spec, uses, candidate.words).items()
     }
 

@@ -39,7 +39,7 @@ Length = tuple[dict[int, float], dict[int, float]]  # an entry's length: sized, 
 Column = tuple[Move | None, ...]
 LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
 COMBINATION_WORK = 64  # partial columns built per work unit
-WORK_PER_UNIT = 512  # matrix entries of a bound per extra work unit
+WORK_PER_UNIT = 256  # matrix entries of a bound per extra work unit
 SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
 
 

@@ -68,24 +68,25 @@ class Row:
 
 
 def make_rows(
-    spec: Spec, words: list[tuple[int, Word]], full: frozenset[int] = frozenset()
+    spec: Spec,
+    words: list[tuple[int, Word]],
+    full: frozenset[int] = frozenset(),
+    known: dict[Word, tuple[LetterTraits, ...]] | None = None,
 ) -> list[Row]:
     """Rows of one group from (layer index, word) pairs; identical words share a row.
-    ``full``: the layers that show all along the other axis."""
+    ``full``: the layers that show all along the other axis; ``known``: the traits of
+    words met before (a cache the caller keeps)."""
+    known = {} if known is None else known
     by_word: dict[tuple[Word, int], list[int]] = {}
     for layer, word in sorted(words, key=lambda item: item[0]):
-        traits = [letter_traits(spec, letter) for letter in word]
+        if word not in known:
+            known[word] = tuple(letter_traits(spec, letter) for letter in word)
         # a word with an unoccludable letter keeps a row of its own in every layer: the same
         # word in front would cover it, so the front layer must be free to make room
-        alone = layer if any(t.unoccludable for t in traits) else -1
+        alone = layer if any(t.unoccludable for t in known[word]) else -1
         by_word.setdefault((word, alone), []).append(layer)
     rows = [
-        Row(
-            tuple(layers),
-            word,
-            tuple(letter_traits(spec, letter) for letter in word),
-            full_height=all(layer in full for layer in layers),
-        )
+        Row(tuple(layers), word, known[word], full_height=all(layer in full for layer in layers))
         for (word, _), layers in by_word.items()
     ]
     return sorted(rows, key=lambda row: row.lowest)
