@@ -30,7 +30,7 @@ EXACT_SHARE = 8_000  # work units at most of one candidate's exact search
 IMPROVE_WORK = 8_000  # work units spent improving on a layout already found
 IMPROVE_SHARE = 4_000  # ... and on one candidate
 EXACT_ROWS = 6  # rows of a group up to which a candidate is searched exactly
-EXACT_LETTERS = 40  # ... and letters of its longest word
+EXACT_LETTERS = 120  # ... and letters of all its words
 CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
@@ -226,8 +226,8 @@ def solve_axis_alternatives(
     def search_exactly(candidate: Candidate, incumbent: float) -> None:
         """Search a candidate exactly for a layout better than ``incumbent``."""
         nonlocal unproven, timed_out
-        longest = max(len(item.word) for item in candidate.words.values())
-        if _rows_per_group(uses) > EXACT_ROWS or longest > EXACT_LETTERS:
+        letters = sum(len(item.word) for item in candidate.words.values())
+        if _rows_per_group(uses) > EXACT_ROWS or letters > EXACT_LETTERS:
             unproven = True  # too large a network to search exactly
             return
         # no candidate may starve the others; improving on a layout found gets less
