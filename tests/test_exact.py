@@ -382,13 +382,13 @@ layers:
 """
 
 
-@pytest.mark.parametrize("width", [24.0, 36.0])
+@pytest.mark.parametrize("width", [24.0, 40.0])
 def test_a_curtain_wall_with_a_centred_entrance_solves_at_every_width(width: float) -> None:
     layout = solve(retarget(parse_spec(textwrap.dedent(CURTAIN_WALL)), width))
     # the entrance stands over glass, mullion, glass, in the middle
     (entrance,) = [p for p in letters(layout, "entrance", "x") if p.symbol == "E"]
     assert entrance.start + entrance.end == pytest.approx(width, abs=1e-6)
-    assert layout.counters["n"] % 2 == 0 and layout.x.objective < 0.001
+    assert layout.counters["n"] % 2 == 0 and layout.x.objective < 0.002
 
 
 def test_dropping_attached_never_loses_the_layout() -> None:

@@ -22,11 +22,11 @@ from facadecli.solver.rows import LetterTraits, Row, full_layers, make_rows
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
-EXACT_WORK = 30_000  # work units of the exact searches of one axis (see solver.exact)
+EXACT_WORK = 40_000  # work units of the exact searches of one axis (see solver.exact)
 HEURISTIC_WORK = 20_000  # search states of the heuristic alignment per axis
 LOOK_FURTHER = 8  # candidates past the tolerance's tier tried by the heuristic
 FURTHER_NODES = 500  # ... each with at most this many search states
-EXACT_SHARE = 8_000  # work units at most of one candidate's exact search
+EXACT_SHARE = 16_000  # work units at most of one candidate's exact search
 IMPROVE_WORK = 8_000  # work units spent improving on a layout already found
 IMPROVE_SHARE = 4_000  # ... and on one candidate
 EXACT_ROWS = 6  # rows of a group up to which a candidate is searched exactly
@@ -232,12 +232,17 @@ def solve_axis_alternatives(
             return
         # no candidate may starve the others; improving on a layout found gets less
         most = EXACT_SHARE if incumbent == INF else IMPROVE_SHARE
-        share = exact.Budget(min(budget.left, most), deadline)
-        outcome = exact.align_exactly(
-            spec, _candidate_rows(spec, uses, candidate, memory), canvas, share, incumbent
-        )
-        budget.used += share.used
-        timed_out = timed_out or share.timed_out
+        rows = _candidate_rows(spec, uses, candidate, memory)
+        # two forms of the same search, half the share each: only columns that do not
+        # merge with the one before, then every column (each finds layouts the other
+        # reaches late); either one that ends is a proof
+        for merge in (True, False):
+            share = exact.Budget(min(budget.left, most // 2), deadline)
+            outcome = exact.align_exactly(spec, rows, canvas, share, incumbent, merge)
+            budget.used += share.used
+            timed_out = timed_out or share.timed_out
+            if outcome.found is not None or outcome.complete or timed_out:
+                break
         unproven = unproven or not outcome.complete
         if outcome.found is None:
             failures.append(outcome.reason)

@@ -201,6 +201,7 @@ class _Search:
     remaining_cache: dict[tuple[int, int, int], np.ndarray] = field(default_factory=dict)
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
+    merge: bool = True  # search only columns that do not merge with the one before
 
     # -- the rules of SPEC 2.4 on one column ----------------------------------------------
     def reject(self, why: str) -> bool:
@@ -246,6 +247,35 @@ class _Search:
                             f"{self.text(group, r, move)} of {self.layer(group, r)}"
                         )
         return True
+
+    def merges(self, group: _Group, last: Column, entries: Column, before: tuple[int, ...]) -> bool:
+        """Whether two columns in a row make one valid column. Then a path through both is
+        never needed: the path through the one column meets fewer equalities and the same
+        rules (and the finest cut of its layout gives the columns back). Without this, a
+        placeholder over a long wall is split letter by letter in every possible way."""
+        merged: list[Move | None] = []
+        for r, (a, b) in enumerate(zip(last, entries, strict=True)):
+            if a is None or b is None:
+                if a is not b:
+                    return False
+                merged.append(None)
+                continue
+            middle = a.start == b.end
+            joined = next(
+                (
+                    m
+                    for m in group.rows[r].moves(a.start)[0]
+                    if m.end == b.end and (m.start == m.end) == middle
+                ),
+                None,
+            )
+            if joined is None:
+                return False
+            merged.append(joined)
+        kept = dict(self.rejections)
+        fits = self.valid(group, merged, before)
+        self.rejections = kept
+        return fits
 
     def layer(self, group: _Group, r: int) -> str:
         names = [f"'{self.spec.layers[i].name}'" for i in group.rows[r].row.layers]
@@ -389,7 +419,9 @@ class _Search:
         widths: list[tuple[dict[int, float], dict[int, float]]],
         path: list[tuple[Move | None, ...]],
         done: list[list[tuple[Move | None, ...]]],
+        before: tuple[int, ...] = (),
     ) -> None:
+        """``before``: the attached rule's memory before the last column of ``path``."""
         group = self.groups[g]
         if positions == group.ends:
             total = [*rows, _sum(widths, self.canvas)]
@@ -409,6 +441,8 @@ class _Search:
             tuple[tuple[float, float, int, int, int, int], Column, list[Equality], Length]
         ] = []
         for entries in self.columns(group, positions, memory):
+            if self.merge and path and self.merges(group, path[-1], entries, before):
+                continue  # the one column they make is searched too, and is looser
             added, width = self.column_rows(g, len(path), entries, path)
             extended = rows + added
             after = _advance(entries, positions)
@@ -443,6 +477,7 @@ class _Search:
                 [*widths, width],
                 [*path, entries],
                 done,
+                memory,
             )
 
     def sized_vector(self, coefficients: Mapping[int, float]) -> np.ndarray:
@@ -573,6 +608,7 @@ def align_exactly(
     canvas: float,
     budget: Budget,
     incumbent: float = INF,
+    merge: bool = True,
 ) -> Outcome:
     """The best layout of a candidate's groups (one set of rows per group), searched
     exactly; only layouts with an objective at most ``incumbent`` are looked for."""
@@ -591,6 +627,7 @@ def align_exactly(
         name: size for name, symbol in spec.symbols.items() if (size := symbol.size) is not None
     }
     search = _Search(spec, canvas, prepared, budget, incumbent, _Equalities(sized))
+    search.merge = merge
     try:
         search.run()
     except _Perfect:
