@@ -271,6 +271,7 @@ def test_identical_words_in_two_layers_never_cover_an_unoccludable_letter() -> N
 MERGED_COLUMNS = """
 version: 1
 name: merged
+solver: {time_limit: 120}  # the work budget decides; no safety net on a loaded CI
 canvas: {width: 17.13, height: 3.0}
 symbol_defaults: {opaque: true}
 symbols: {A: 1.0, B: 1.5, C: 0.8, D: 1.2, F: 3.0}
@@ -343,6 +344,7 @@ def test_six_ornament_layers_solve_as_five_do(count: int) -> None:
 DECORATION = """
 version: 1
 name: decoration
+solver: {time_limit: 120}  # the work budget decides; no safety net on a loaded CI
 canvas: {width: 36.8, height: 3.0}
 symbol_defaults: {opaque: true}
 symbols: {Q: 1.6, M: 1.2, N: 1.5, V: 1.5, F: 3.0}
@@ -368,6 +370,7 @@ def test_decoration_layers_find_the_zero_deviation_layout() -> None:
 CURTAIN_WALL = """
 version: 1
 name: curtain-wall
+solver: {time_limit: 120}  # the work budget decides; no safety net on a loaded CI
 canvas: {width: 36.0, height: 4.0}
 symbol_defaults: {opaque: true}
 symbols: {P: 0.2, G: 1.3, E: {size: 2.8, unoccludable: true}, F: 4.0}
