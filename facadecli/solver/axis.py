@@ -23,14 +23,11 @@ from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
 EXACT_WORK = 40_000  # work units of the exact searches of one axis (see solver.exact)
-HEURISTIC_WORK = 20_000  # search states of the heuristic alignment per axis
-LOOK_FURTHER = 8  # candidates past the tolerance's tier tried by the heuristic
-FURTHER_NODES = 500  # ... each with at most this many search states
-EXACT_SHARE = 16_000  # work units at most of one candidate's exact search
-IMPROVE_WORK = 8_000  # work units spent improving on a layout already found
-IMPROVE_SHARE = 4_000  # ... and on one candidate
-EXACT_ROWS = 6  # rows of a group up to which a candidate is searched exactly
-EXACT_LETTERS = 120  # ... and letters of all its words
+HEURISTIC_WORK = 5_000  # search states of the heuristic alignment per axis
+EXACT_SHARE = 16_000  # work units at most of one candidate's search in one pass
+TIE_SHARE = 500  # ... and of a search for a layout that can only tie with the best
+# objectives (m^2) the passes of the exact search look within, the last one without limit
+DEEPENING = (0.05, 0.2, 0.8, 3.2, 12.8, 51.2, INF)
 CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
@@ -106,14 +103,15 @@ class _Evaluated:
         )
 
     @property
-    def rank(self) -> tuple[float, int, float, int, int, tuple[float, ...]]:
-        """Least deviation; then fewest sized letters split; placeholders covering least;
-        fewest holes made; most columns; then the candidate order."""
+    def rank(self) -> tuple[float, int, int, float, int, tuple[float, ...]]:
+        """Least deviation; then fewest sized letters split; fewest holes made (room made
+        by layers in front); placeholders covering least; most columns; then the
+        candidate order."""
         return (
             round(self.estimate.objective, 8),
             self.splits,
-            round(self.estimate.coverage, 6),
             self.empties,
+            round(self.estimate.coverage, 6),
             -self.columns,
             self.candidate.key,
         )
@@ -223,27 +221,17 @@ def solve_axis_alternatives(
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     compare = max(FEASIBLE_TO_COMPARE, alternatives)
 
-    def search_exactly(candidate: Candidate, incumbent: float) -> None:
-        """Search a candidate exactly for a layout better than ``incumbent``."""
+    def search_exactly(candidate: Candidate, target: float, tie: bool) -> None:
+        """Search a candidate exactly for a layout with an objective at most ``target``;
+        ``tie``: it cannot beat the best found, only tie with it (a search for the
+        tie-breaks, with less work, which proves nothing when it stops short)."""
         nonlocal unproven, timed_out
-        letters = sum(len(item.word) for item in candidate.words.values())
-        if _rows_per_group(uses) > EXACT_ROWS or letters > EXACT_LETTERS:
-            unproven = True  # too large a network to search exactly
-            return
-        # no candidate may starve the others; improving on a layout found gets less
-        most = EXACT_SHARE if incumbent == INF else IMPROVE_SHARE
         rows = _candidate_rows(spec, uses, candidate, memory)
-        # two forms of the same search, half the share each: only columns that do not
-        # merge with the one before, then every column (each finds layouts the other
-        # reaches late); either one that ends is a proof
-        for merge in (True, False):
-            share = exact.Budget(min(budget.left, most // 2), deadline)
-            outcome = exact.align_exactly(spec, rows, canvas, share, incumbent, merge)
-            budget.used += share.used
-            timed_out = timed_out or share.timed_out
-            if outcome.found is not None or outcome.complete or timed_out:
-                break
-        unproven = unproven or not outcome.complete
+        share = exact.Budget(min(budget.left, TIE_SHARE if tie else EXACT_SHARE), deadline)
+        outcome = exact.align_exactly(spec, rows, canvas, share, target)
+        budget.used += share.used
+        timed_out = timed_out or share.timed_out
+        unproven = unproven or not (outcome.complete or tie)
         if outcome.found is None:
             failures.append(outcome.reason)
             return
@@ -272,54 +260,55 @@ def solve_axis_alternatives(
     def best_objective() -> float:
         return min((e.estimate.objective for e in evaluated), default=INF)
 
-    # 1. the heuristic alignment, candidates in the order of the tolerance they need: the
-    # tolerance is raised only until something aligns (the paper's order, and its ties)
-    looked_at: set[int] = set()
+    def heuristic_pass() -> None:
+        """The heuristic alignment, candidates in the order of the tolerance they need: the
+        tolerance is raised only until something aligns (the paper's order and ties)."""
+        nonlocal timed_out, worse
+        visited.clear()
+        for candidate in candidates[:CANDIDATES_TO_TRY]:
+            if sum(visited) > HEURISTIC_WORK:
+                break
+            if len(evaluated) >= compare or worse >= 2 or time.perf_counter() > deadline:
+                timed_out = timed_out or time.perf_counter() > deadline
+                break
+            if alternatives == 1 and evaluated:
+                break
+            if evaluated and _beyond_tier(candidate, evaluated[0].candidate, step):
+                break
+            before = best_objective()
+            objective = align_heuristically(candidate)
+            if objective is None:
+                worse += 1 if evaluated else 0
+            else:
+                worse = worse + 1 if before < INF and objective > before + 1e-9 else 0
+
     visited: list[int] = []  # search states of each heuristic alignment
-    for candidate in candidates[:CANDIDATES_TO_TRY]:
-        if sum(visited) > HEURISTIC_WORK:
-            break  # the exact search takes over
-        if len(evaluated) >= compare or worse >= 2 or time.perf_counter() > deadline:
-            timed_out = timed_out or time.perf_counter() > deadline
-            break
-        if (
-            alternatives == 1
-            and evaluated
-            and _beyond_tier(candidate, evaluated[0].candidate, step)
-        ):
-            break  # variations look further
-        looked_at.add(candidate.order)
-        before = best_objective()
-        objective = align_heuristically(candidate)
-        if objective is None:
-            worse += 1 if evaluated else 0
-        else:
-            worse = worse + 1 if before < INF and objective > before + 1e-9 else 0
-    # 2. candidates that could still beat the best layout by more than a tie, by the least
-    # objective they could have: first the heuristic (cheap), then the exact search until
-    # none could; with nothing found that is every candidate, and a search that ends is a
-    # proof
+    if alternatives > 1:  # variations: layouts near the best, as the heuristic meets them
+        heuristic_pass()
+    # the exact search, in passes (the paper's iterative deepening, on the exact
+    # objective): a pass searches every candidate whose lower bound is within its
+    # threshold for a layout within it, in the order of those bounds, and ends the solve
+    # once the best layout found is within it: nothing better can exist. Low thresholds cut
+    # hopeless columns at once, so the first passes are cheap.
     bounds = sorted(
         (exact.candidate_bound(_candidate_rows(spec, uses, c, memory), canvas), c.key, c)
         for c in candidates
     )
-    first_pass = len(looked_at)
-    for bound, _, candidate in bounds:
-        if timed_out or bound >= best_objective() - TIE:
+    for threshold in DEEPENING:
+        failures.clear()  # each pass searches again every candidate it reaches: the last
+        unproven = len(candidates) >= CANDIDATE_LIMIT  # one run says what is proven
+        for bound, _, candidate in bounds:
+            target = min(threshold, best_objective() + TIE)  # ties too: SPEC 2.7 breaks them
+            if timed_out or bound > target:
+                break
+            if budget.left == 0:
+                unproven = True
+                break
+            search_exactly(candidate, target, bound > best_objective() - TIE)
+        if timed_out or budget.left == 0 or best_objective() <= threshold:
             break
-        if sum(visited) > HEURISTIC_WORK:
-            break
-        if candidate.order not in looked_at and len(looked_at) < first_pass + LOOK_FURTHER:
-            looked_at.add(candidate.order)
-            align_heuristically(candidate, FURTHER_NODES)
-            timed_out = timed_out or time.perf_counter() > deadline
-    for bound, _, candidate in bounds:
-        if timed_out or bound >= best_objective() - TIE:
-            break
-        if budget.left == 0 or (best_objective() < INF and budget.used >= IMPROVE_WORK):
-            unproven = True
-            break
-        search_exactly(candidate, best_objective() - TIE)
+    if not evaluated and unproven and not timed_out:
+        heuristic_pass()  # the exact search ran out of work: the heuristic may still align
     aligned_at = time.perf_counter()
     ranked = _by_rank(evaluated)
     layouts: list[AxisLayout] = []
@@ -369,16 +358,6 @@ def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
         (e for e in evaluated if e.estimate.objective > least + TIE), key=lambda e: e.rank
     )
     return [*good, *rest]
-
-
-def _rows_per_group(uses: Sequence[PatternUse]) -> int:
-    """The most rows a group can have (the columns out of a state of the exact search grow
-    exponentially with them)."""
-    rows: dict[str, set[str]] = {}
-    for use in uses:
-        for _, group in use.layers:
-            rows.setdefault(group, set()).add(use.key)
-    return max((len(keys) for keys in rows.values()), default=0)
 
 
 def _candidate_rows(

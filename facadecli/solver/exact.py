@@ -1,21 +1,22 @@
 """The exact alignment of one candidate: branch and bound over the alignment decision network.
 
-The heuristic search (:mod:`facadecli.solver.alignment`) costs columns with *preferred*
-sizes; it is fast but may miss a layout whose sizes differ from them, or settle on columns
-that no sizes can realise. This search is its exact counterpart, used when the heuristic
-finds nothing for a candidate, to look for a better layout than the heuristic's, and to
-prove that a candidate has no layout at all.
+This is how every axis is solved (:mod:`facadecli.solver.axis` calls it candidate by
+candidate, in passes of growing objective thresholds); the heuristic search of
+:mod:`facadecli.solver.alignment`, which costs columns with *preferred* sizes, only offers
+variations and is a last resort when this search runs out of work.
 
 Every path through the network (a column per step, SPEC 2.4's rules on every column) is an
 alignment; its value is the sizing objective (SPEC 2.7). A partial path implies linear
-equalities (the entries of a column are as long as each other, the pieces of a split letter
-add up to its size); the least squared deviation that meets them is a lower bound on every
-completion, because completing a path only adds equalities and bounds. A node is cut when
-its bound is no better than the best complete layout found, or when its equalities have no
-solution at all. Nothing is cut on preferred lengths, so the search is exact: when it runs
-to the end, the layout it returns is optimal and "none" is a proof.
+equalities over the symbols (the entries of a column are as long as each other, a split
+letter is as long as the columns it spans); the least squared deviation that meets them is a
+lower bound on every completion, because completing a path only adds equalities and bounds.
+It is kept up to date row by row (:class:`_System`), and strengthened by what every row
+still has to lay out within the canvas. A node is cut when its bound exceeds the threshold
+or the best complete layout found, or when its equalities have no solution. Nothing is cut
+on preferred lengths, so the search is exact: when it runs to the end, the layout it returns
+is optimal and "none" is a proof.
 
-All work is counted in *work units* (bounds computed, layouts sized), never in seconds, so
+All work is counted in *work units* (columns bounded, layouts sized), never in seconds, so
 the same input gives the same answer on any machine.
 """
 
@@ -34,12 +35,9 @@ from facadecli.solver.rows import Row
 from facadecli.spec.model import Spec
 
 FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2
-Equality = tuple[dict[int, float], dict[int, float], float]  # sized, free coefficients, rhs
-Length = tuple[dict[int, float], dict[int, float]]  # an entry's length: sized, free parts
 Column = tuple[Move | None, ...]
 LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
 COMBINATION_WORK = 64  # partial columns built per work unit
-WORK_PER_UNIT = 256  # matrix entries of a bound per extra work unit
 SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
 
 
@@ -84,9 +82,9 @@ class Found:
     sizing: sizing.Sizing
 
     @property
-    def rank(self) -> tuple[float, int, float, int, int]:
-        """Least deviation; fewest split letters; placeholders covering least; fewest
-        holes; most columns (SPEC 2.7 and its tie-breaks)."""
+    def rank(self) -> tuple[float, int, int, float, int]:
+        """Least deviation; fewest split letters; fewest holes; placeholders covering
+        least; most columns (SPEC 2.7 and its tie-breaks)."""
         entries = [e for a in self.groups.values() for column in a.entries for e in column]
         splits = sum(e is not None and e.tail is not None and e.tail != INF for e in entries)
         empties = sum(e is None for e in entries)
@@ -94,8 +92,8 @@ class Found:
         return (
             round(self.sizing.objective, 8),
             splits,
-            round(self.sizing.coverage, 6),
             empties,
+            round(self.sizing.coverage, 6),
             -columns,
         )
 
@@ -107,75 +105,123 @@ class Outcome:
     reason: str = ""  # why nothing was found (the rule that rejected most columns)
 
 
-class _Equalities:
-    """The linear equalities a partial path implies, over sized symbols (with a preferred
-    size) and free variables (placeholders, pieces of split letters)."""
+class _System:
+    """The linear equalities a partial path implies, kept reduced, and the least squared
+    deviation of the sized symbols under them (the bound).
 
-    def __init__(self, sized: Mapping[str, float]):
-        self.sized_index = {name: i for i, name in enumerate(sorted(sized))}
-        self.target = np.array([sized[name] for name in sorted(sized)])
-        self.free_index: dict[object, int] = {}
-        self.work = 0  # work units of the last bound: it grows with the equalities
+    Variables are the symbols of the axis: sized ones (with a preferred size) first, then
+    placeholders. A row that holds a placeholder is solved for it (a *pivot*): whatever the
+    sized symbols are, the placeholder can meet it, so it does not constrain them. The other
+    rows constrain the sized symbols alone; they are kept orthonormal, and the bound is the
+    squared distance from the preferred sizes to the affine subspace they span, updated
+    row by row. Immutable: a child node adds rows to a copy."""
 
-    def free(self, key: object) -> int:
-        return self.free_index.setdefault(key, len(self.free_index))
+    __slots__ = ("basis", "pivots", "point", "probes", "rhs", "sized", "value")
 
-    def bound(self, rows: Sequence[Equality]) -> tuple[float, np.ndarray]:
-        """Least sum of squared deviations of the sized symbols under ``rows`` (INF when the
-        equalities conflict), and the sizes that reach it (unique: the objective is
-        strictly convex in them)."""
-        self.work = 1
-        if not rows:
-            return 0.0, self.target
-        n_sized, n_free = len(self.target), len(self.free_index)
-        a = np.zeros((len(rows), n_sized))
-        b = np.zeros((len(rows), n_free))
-        d = np.zeros(len(rows))
-        for i, (sized, free, rhs) in enumerate(rows):
-            for j, value in sized.items():
-                a[i, j] += value
-            for j, value in free.items():
-                b[i, j] += value
-            d[i] = rhs
-        self.work = 1 + len(rows) * (n_sized + n_free) // WORK_PER_UNIT
-        scale = max(1.0, float(np.abs(d).max(initial=0.0)))
-        if n_free:  # only what the free variables cannot absorb constrains the sizes
-            u, s, _ = np.linalg.svd(b, full_matrices=True)
-            rank = int((s > 1e-9 * max(1.0, s.max(initial=0.0))).sum())
-            q = u[:, rank:]
-            a, d = q.T @ a, q.T @ d
-            if a.shape[0] == 0:
-                return 0.0, self.target
-        residual = d - a @ self.target
-        if n_sized == 0:
-            ok = float(np.abs(residual).max(initial=0.0)) <= 1e-9 * scale
-            return (0.0 if ok else INF), self.target
-        step, *_ = np.linalg.lstsq(a, residual, rcond=None)
-        if float(np.abs(a @ step - residual).max(initial=0.0)) > 1e-7 * scale:
-            return INF, self.target
-        return float(step @ step), self.target + step
+    def __init__(
+        self,
+        sized: int,
+        pivots: tuple[tuple[int, np.ndarray, float], ...],
+        basis: np.ndarray,
+        rhs: np.ndarray,
+        point: np.ndarray,
+        value: float,
+    ):
+        self.sized = sized
+        self.pivots = pivots
+        self.basis = basis  # orthonormal rows over the sized symbols
+        self.rhs = rhs
+        self.point = point  # the sizes nearest the preferred ones under the rows
+        self.value = value
+        self.probes: dict[bytes, float] = {}  # probe() of rows already asked about
 
-    def bound_within(
-        self, rows: Sequence[Equality], spans: Sequence[np.ndarray], canvas: float
-    ) -> float:
-        """:meth:`bound` strengthened by the inequalities ``span @ sizes <= canvas`` (what a
-        row has laid out and still has to lay out must fit the canvas). The most violated
-        one is made an equality: with a strictly convex objective, that is where the
-        optimum under it lies, so the bound stays a lower bound."""
-        value, sizes = self.bound(rows)
-        if value == INF or not spans:
-            return value
-        worst, chosen = 1e-9, None
-        for span in spans:
-            norm = float(span @ span)
-            if norm > 0.0:
-                violation = (float(span @ sizes) - canvas) / math.sqrt(norm)
-                if violation > worst:
-                    worst, chosen = violation, span
-        if chosen is None:
-            return value
-        tight: Equality = ({i: float(v) for i, v in enumerate(chosen) if v}, {}, canvas)
-        return max(value, self.bound([*rows, tight])[0])
+    @classmethod
+    def empty(cls, target: np.ndarray) -> _System:
+        return cls(len(target), (), np.zeros((0, len(target))), np.zeros(0), target.copy(), 0.0)
+
+    def add(self, row: np.ndarray, rhs: float, scale: float) -> _System | None:
+        """The system with ``row @ symbols == rhs`` added; None when it conflicts."""
+        row, rhs = self._reduce(row, rhs)
+        free = np.abs(row[self.sized :])
+        if free.size and free.max() > 1e-9:
+            v = self.sized + int(free.argmax())
+            pivot = row / row[v]
+            pivot_rhs = rhs / row[v]
+            pivots = [
+                (u, r - r[v] * pivot, r_rhs - r[v] * pivot_rhs) if r[v] != 0.0 else (u, r, r_rhs)
+                for u, r, r_rhs in self.pivots
+            ]
+            pivots.append((v, pivot, pivot_rhs))
+            return _System(self.sized, tuple(pivots), self.basis, self.rhs, self.point, self.value)
+        a, rhs = self._orthogonal(row[: self.sized], rhs)
+        norm = math.sqrt(float(a @ a))
+        if norm <= 1e-9:
+            return self if abs(rhs) <= 1e-7 * scale else None
+        q = a / norm
+        residual = rhs / norm - float(q @ self.point)
+        return _System(
+            self.sized,
+            self.pivots,
+            np.vstack([self.basis, q]),
+            np.append(self.rhs, rhs / norm),
+            self.point + residual * q,
+            self.value + residual * residual,
+        )
+
+    def probe(self, row: np.ndarray, scale: float) -> float:
+        """The bound with ``row @ symbols == 0`` added (INF when it conflicts)."""
+        key = row.tobytes()
+        value = self.probes.get(key)
+        if value is None:
+            value = self.probes[key] = self._probe(row, scale)
+        return value
+
+    def _probe(self, row: np.ndarray, scale: float) -> float:
+        row, rhs = self._reduce(row, 0.0)
+        free = np.abs(row[self.sized :])
+        if free.size and free.max() > 1e-9:
+            return self.value
+        a, rhs = self._orthogonal(row[: self.sized], rhs)
+        norm2 = float(a @ a)
+        if norm2 <= 1e-18:
+            return self.value if abs(rhs) <= 1e-7 * scale else INF
+        residual = rhs - float(a @ self.point)
+        return self.value + residual * residual / norm2
+
+    def _reduce(self, row: np.ndarray, rhs: float) -> tuple[np.ndarray, float]:
+        """The row with the pivot placeholders solved out."""
+        for v, pivot, pivot_rhs in self.pivots:
+            c = row[v]
+            if c != 0.0:
+                row = row - c * pivot
+                rhs -= c * pivot_rhs
+        return row, rhs
+
+    def _orthogonal(self, a: np.ndarray, rhs: float) -> tuple[np.ndarray, float]:
+        """The part of a row over the sized symbols that the basis does not span."""
+        if len(self.rhs):
+            for _ in range(2):  # twice: Gram-Schmidt loses orthogonality once
+                c = self.basis @ a
+                a = a - c @ self.basis
+                rhs -= float(c @ self.rhs)
+        return a, rhs
+
+    def bound_within(self, spans: Sequence[tuple[np.ndarray, float]], canvas: float) -> float:
+        """The bound strengthened by inequalities ``span @ sizes <= most`` (what a row has
+        laid out and still has to lay out must fit the canvas): the most binding one is
+        made an equality: with a strictly convex objective, that is where the optimum under
+        it lies, so the bound stays a lower bound."""
+        best = self.value
+        for span, most in spans:
+            violation = float(span @ self.point) - most
+            if violation <= 1e-9 * max(1.0, canvas):
+                continue
+            a = span - (self.basis @ span) @ self.basis if len(self.rhs) else span
+            norm = float(a @ a)
+            if norm <= 1e-12:
+                return INF  # the rows fix this span, beyond the canvas
+            best = max(best, self.value + violation * violation / norm)
+        return best
 
 
 @dataclass
@@ -187,6 +233,22 @@ class _Group:
     ends: tuple[int, ...]
 
 
+@dataclass(frozen=True)
+class _Node:
+    """A state of the search: where each row stands in its group, the attached rule's
+    memory (before and after the last column), the equalities so far, where the last
+    column ends (over the symbols) and what each row has used of the letter it is inside."""
+
+    group: int
+    positions: tuple[int, ...]
+    memory: tuple[int, ...]
+    system: _System
+    x: np.ndarray
+    used: tuple[np.ndarray | None, ...]
+    path: tuple[Column, ...] = ()
+    before: tuple[int, ...] = ()
+
+
 @dataclass
 class _Search:
     spec: Spec
@@ -194,14 +256,18 @@ class _Search:
     groups: list[_Group]
     budget: Budget
     incumbent: float
-    equalities: _Equalities
+    variables: dict[str, int]  # symbol -> index: sized symbols first, then placeholders
+    target: np.ndarray  # preferred sizes of the sized symbols
     best: Found | None = None
     rejections: dict[str, tuple[int, int]] = field(default_factory=dict)  # (progress, count)
     progress: int = 0  # how far the state being expanded is (sum of positions)
-    remaining_cache: dict[tuple[int, int, int], np.ndarray] = field(default_factory=dict)
+    remaining_cache: dict[tuple[int, int, int], tuple[np.ndarray, list[tuple[int, int]]]] = field(
+        default_factory=dict
+    )
+    whole_cache: dict[tuple[int, int, int, int], np.ndarray] = field(default_factory=dict)
+    gaps: bool = True  # rows may make room for the opaque letters of rows in front
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
-    merge: bool = True  # search only columns that do not merge with the one before
 
     # -- the rules of SPEC 2.4 on one column ----------------------------------------------
     def reject(self, why: str) -> bool:
@@ -289,9 +355,11 @@ class _Search:
         return "'" + " ".join(word[k].symbol for k in sorted({*whole, *parts})) + "'"
 
     def columns(
-        self, group: _Group, positions: tuple[int, ...], memory: tuple[int, ...]
+        self, g: int, positions: tuple[int, ...], memory: tuple[int, ...], node: _Node | None = None
     ) -> Iterator[tuple[Move | None, ...]]:
-        """Every valid column out of a state."""
+        """Every valid column out of a state; with ``node``, not those where two entries of
+        known length could not be as long as each other within the incumbent."""
+        group = self.groups[g]
         self.progress = sum(positions)
         options: list[list[Move | None]] = []
         for r, row in enumerate(group.rows):
@@ -300,210 +368,259 @@ class _Search:
                 options.append([None])
                 continue
             moves: list[Move | None] = list(row.moves(position)[0])
-            if position % 2 == 0:  # inside a split letter a row cannot pause
-                moves.append(None)
+            if self.gaps and position % 2 == 0 and group.covering[r]:
+                moves.append(None)  # a gap (not inside a split letter; only under cover)
             options.append(moves)
+        fits: dict[tuple[int, int, int, int, int, int], bool] = {}
+        # rows with the fewest options first: the first entry of known length is the one
+        # the others are checked against
+        order = sorted(range(len(options)), key=lambda r: (len(options[r]), r))
+        chosen: list[Move | None] = [None] * len(options)
 
-        def extend(r: int, chosen: list[Move | None]) -> Iterator[tuple[Move | None, ...]]:
+        def fit(
+            first: tuple[int, Move, np.ndarray], r: int, move: Move, length: np.ndarray
+        ) -> bool:
+            r0, m0, l0 = first
+            key = (r0, m0.start, m0.end, r, move.start, move.end)
+            known = fits.get(key)
+            if known is None:
+                difference = length - l0
+                value = 0.0
+                if not difference[self.sized :].any():  # alone, it costs at least this
+                    norm = float(difference @ difference)
+                    miss = float(difference[: self.sized] @ self.target)
+                    value = miss * miss / norm if norm else 0.0
+                if value <= self.incumbent + SAME:
+                    value = node.system.probe(difference, self.canvas)  # type: ignore[union-attr]
+                known = fits[key] = value <= self.incumbent + SAME
+            return known
+
+        def extend(
+            i: int, first: tuple[int, Move, np.ndarray] | None
+        ) -> Iterator[tuple[Move | None, ...]]:
             self.combinations += 1
             if self.combinations % COMBINATION_WORK == 0:
                 self.budget.spend()
-            if r == len(options):
+            if i == len(order):
                 if self.valid(group, chosen, memory):
                     yield tuple(chosen)
                 return
+            r = order[i]
             for move in options[r]:
-                chosen.append(move)
-                yield from extend(r + 1, chosen)
-                chosen.pop()
+                known = first
+                length = None if node is None or move is None else self.known(g, r, move, node)
+                if length is not None and move is not None:
+                    if first is None:
+                        known = (r, move, length)
+                    elif not fit(first, r, move, length):
+                        continue
+                chosen[r] = move
+                yield from extend(i + 1, known)
+            chosen[r] = None
 
-        yield from extend(0, [])
+        yield from extend(0, None)
 
     # -- equalities -------------------------------------------------------------------------
-    def content(
-        self, group: int, r: int, j: int, move: Move, word: Sequence[str]
-    ) -> tuple[dict[int, float], dict[int, float]]:
-        """The length of an entry as (sized coefficients, free coefficients)."""
-        sized: dict[int, float] = {}
-        free: dict[int, float] = {}
-        whole, parts = sizing.entry_parts(move)
-        for k in whole:
-            self.add_symbol(word[k], sized, free)
-        for k in parts:
-            index = self.equalities.free(("piece", group, r, k, j))
-            free[index] = free.get(index, 0.0) + 1.0
-        return sized, free
+    # A column's entries are as long as each other; the width of a column is the length of
+    # an entry of whole letters (an opaque one always is). A row inside a split letter
+    # carries the length it has used of it so far; the entry that finishes the letter holds
+    # what is left. So lengths are linear in the symbols alone, with no variable per piece.
+    @property
+    def sized(self) -> int:
+        return len(self.target)
 
-    def add_symbol(self, name: str, sized: dict[int, float], free: dict[int, float]) -> None:
-        if name in self.equalities.sized_index:
-            index = self.equalities.sized_index[name]
-            sized[index] = sized.get(index, 0.0) + 1.0
-        else:
-            index = self.equalities.free(("symbol", name))
-            free[index] = free.get(index, 0.0) + 1.0
+    def whole(self, g: int, r: int, move: Move) -> np.ndarray:
+        """The length of the letters an entry holds whole, over the symbols."""
+        key = (g, r, move.start, move.end)
+        vector = self.whole_cache.get(key)
+        if vector is None:
+            vector = np.zeros(len(self.variables))
+            word = self.groups[g].rows[r].row.word
+            for k in sizing.entry_parts(move)[0]:
+                vector[self.variables[word[k].symbol]] += 1.0
+            self.whole_cache[key] = vector
+        return vector
 
-    def column_rows(
-        self, g: int, j: int, entries: Sequence[Move | None], path: Sequence[Sequence[Move | None]]
-    ) -> tuple[list[Equality], Length]:
-        """The equalities a column adds, and its width (the first entry's length)."""
-        group = self.groups[g]
-        added: list[tuple[dict[int, float], dict[int, float], float]] = []
-        width: tuple[dict[int, float], dict[int, float]] | None = None
+    def letter(self, g: int, r: int, k: int) -> int:
+        return self.variables[self.groups[g].rows[r].row.word[k].symbol]
+
+    def known(self, g: int, r: int, move: Move, node: _Node) -> np.ndarray | None:
+        """The length of an entry when it does not depend on the column's width: whole
+        letters, and what is left of a split letter it finishes (None for pieces)."""
+        if move.tail is not None or move.start == move.end:
+            return None
+        length = self.whole(g, r, move)
+        if move.piece_of is not None:
+            length = length.copy()
+            length[self.letter(g, r, move.start // 2)] += 1.0
+            length -= node.used[r]
+        return length
+
+    def child(
+        self, g: int, entries: Column, node: _Node
+    ) -> tuple[_System | None, np.ndarray, tuple[np.ndarray | None, ...]]:
+        """The system, the column's width and what each row has used of the letter it is
+        inside, after a column."""
+        width = next(
+            self.whole(g, r, m)
+            for r, m in enumerate(entries)
+            if m is not None and m.piece_of is None and m.tail is None
+        )
+        used = list(node.used)
+        system: _System | None = node.system
         for r, move in enumerate(entries):
             if move is None:
                 continue
-            word = [letter.symbol for letter in group.rows[r].row.word]
-            length = self.content(g, r, j, move, word)
-            if width is None:
-                width = length
-            else:
-                added.append(_difference(length, width))
-            if move.start % 2 == 1 and move.end > move.start:  # a split letter is finished
-                added.append(self.finished_letter(g, r, j, move, word, path))
-        assert width is not None
-        return added, width
+            known = self.whole(g, r, move)
+            if move.piece_of is not None:  # inside letter k since an earlier column
+                if move.start == move.end:
+                    used[r] = used[r] + width
+                    continue
+                known = known.copy()
+                known[self.letter(g, r, move.start // 2)] += 1.0
+                known -= used[r]
+                used[r] = None
+            if move.tail is not None:  # a split letter starts: this column has a piece of it
+                used[r] = width - known
+            elif known is not width and system is not None:
+                system = system.add(known - width, 0.0, self.canvas)
+        return system, width, tuple(used)
 
-    def finished_letter(
-        self,
-        g: int,
-        r: int,
-        j: int,
-        move: Move,
-        word: Sequence[str],
-        path: Sequence[Sequence[Move | None]],
-    ) -> tuple[dict[int, float], dict[int, float], float]:
-        """Its pieces (this column's and the earlier ones where the row was inside it) add
-        up to its symbol's size."""
-        k = move.start // 2
-        sized: dict[int, float] = {}
-        free: dict[int, float] = {}
-        self.add_symbol(word[k], sized, free)
-        sized = {i: -v for i, v in sized.items()}
-        free = {i: -v for i, v in free.items()}
-        earlier = [c for c, entries in enumerate(path) if _holds_piece(entries[r], k)]
-        for column in [*earlier, j]:
-            index = self.equalities.free(("piece", g, r, k, column))
-            free[index] = free.get(index, 0.0) + 1.0
-        return sized, free, 0.0
+    def filling(self, system: _System | None) -> _System | None:
+        """A row that no row in front may make room for has no gap: its letters fill the
+        canvas, whatever the alignment (known before the first column)."""
+        for group in self.groups:
+            for r, prepared in enumerate(group.rows):
+                if group.covering[r] or system is None:
+                    continue
+                total = np.zeros(len(self.variables))
+                for letter in prepared.row.word:
+                    total[self.variables[letter.symbol]] += 1.0
+                system = system.add(total, self.canvas, self.canvas)
+        return system
 
     # -- the search -------------------------------------------------------------------------
     def run(self) -> None:
-        start = self.start_of(0)
-        self.dfs(0, start[0], start[1], self.filling(), [], [], [])
+        system = self.filling(_System.empty(self.target))
+        if system is None:
+            return
+        self.dfs(self.start_of(0, system), [])
 
-    def filling(self) -> list[Equality]:
-        """A row that no row in front may make room for has no gap: its letters fill the
-        canvas, whatever the alignment (known before the first column)."""
-        rows: list[Equality] = []
-        for group in self.groups:
-            for r, prepared in enumerate(group.rows):
-                if group.covering[r]:
-                    continue
-                sized: dict[int, float] = {}
-                free: dict[int, float] = {}
-                for letter in prepared.row.word:
-                    self.add_symbol(letter.symbol, sized, free)
-                rows.append((sized, free, self.canvas))
-        return rows
-
-    def start_of(self, g: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    def start_of(self, g: int, system: _System) -> _Node:
         count = len(self.groups[g].rows)
-        return (0,) * count, (FREE,) * count
+        return _Node(
+            g, (0,) * count, (FREE,) * count, system, np.zeros(len(self.variables)), (None,) * count
+        )
 
-    def dfs(
-        self,
-        g: int,
-        positions: tuple[int, ...],
-        memory: tuple[int, ...],
-        rows: list[Equality],
-        widths: list[tuple[dict[int, float], dict[int, float]]],
-        path: list[tuple[Move | None, ...]],
-        done: list[list[tuple[Move | None, ...]]],
-        before: tuple[int, ...] = (),
-    ) -> None:
-        """``before``: the attached rule's memory before the last column of ``path``."""
+    def dfs(self, node: _Node, done: list[list[Column]]) -> None:
+        g = node.group
         group = self.groups[g]
+        positions = node.positions
+        path = node.path
         if positions == group.ends:
-            total = [*rows, _sum(widths, self.canvas)]
-            bound = self.equalities.bound(total)[0]
-            self.budget.spend(self.equalities.work)
-            if bound > self.incumbent + SAME:
+            closed = node.system.add(node.x, self.canvas, self.canvas)
+            self.budget.spend()
+            if closed is None or closed.value > self.incumbent + SAME:
                 return
             finished = [*done, list(path)]
             if g + 1 < len(self.groups):
-                start = self.start_of(g + 1)
-                self.dfs(g + 1, start[0], start[1], total, [], [], finished)
+                self.dfs(self.start_of(g + 1, closed), finished)
             else:
                 self.leaf(finished)
             return
-        span = self.span_of(widths)
-        children: list[
-            tuple[tuple[float, float, int, int, int, int], Column, list[Equality], Length]
-        ] = []
-        for entries in self.columns(group, positions, memory):
-            if self.merge and path and self.merges(group, path[-1], entries, before):
+        children: list[tuple[tuple[float, int, float, int, int, int], _Node]] = []
+        for entries in self.columns(g, positions, node.memory, node):
+            if path and self.merges(group, path[-1], entries, node.before):
                 continue  # the one column they make is searched too, and is looser
-            added, width = self.column_rows(g, len(path), entries, path)
-            extended = rows + added
+            self.budget.spend()
+            system, width, used = self.child(g, entries, node)
+            if system is None:
+                continue
             after = _advance(entries, positions)
-            grown = span + self.sized_vector(width[0])
-            spans = [grown + self.remaining(g, r, p) for r, p in enumerate(after)]
-            bound = self.equalities.bound_within(extended, [grown, *spans], self.canvas)
-            self.budget.spend(self.equalities.work)
+            x = node.x + width
+            bound = system.bound_within(self.spans(g, system, x, used, after), self.canvas)
             if bound > self.incumbent + SAME:
                 continue
             present = [m for m in entries if m is not None]
             rank = (
                 round(bound, 9),
+                len(entries) - len(present),
                 _spread(entries),
                 sum((m.piece_of is not None) + (m.tail is not None) for m in present),
-                len(entries) - len(present),
                 sum(m.letters for m in present),
                 len(children),
             )
-            children.append((rank, entries, extended, width))
+            memory = _remember(group, entries, node.memory)
+            children.append(
+                (rank, _Node(g, after, memory, system, x, used, (*path, entries), node.memory))
+            )
         # most promising first: least bound, then the columns that fit at preferred sizes
         # (the paper's column error), whole letters before pieces (split only where
         # needed), no room made before room made, fewer letters (more columns)
         children.sort(key=lambda child: child[0])
-        for rank, entries, extended, width in children:
+        for rank, child in children:
             if rank[0] > self.incumbent + SAME:
                 break
-            self.dfs(
-                g,
-                _advance(entries, positions),
-                _remember(group, entries, memory),
-                extended,
-                [*widths, width],
-                [*path, entries],
-                done,
-                memory,
-            )
+            self.dfs(child, done)
 
-    def sized_vector(self, coefficients: Mapping[int, float]) -> np.ndarray:
-        vector = np.zeros(len(self.equalities.target))
-        for i, v in coefficients.items():
-            vector[i] += v
-        return vector
+    def spans(
+        self,
+        g: int,
+        system: _System,
+        x: np.ndarray,
+        used: Sequence[np.ndarray | None],
+        positions: Sequence[int],
+    ) -> list[tuple[np.ndarray, float]]:
+        """Inequalities ``span @ sizes <= rhs`` over the sized symbols: where the column ends
+        is within the canvas, and so is it plus what each row still has to lay out. A
+        placeholder still to come is as long as its expression once the equalities fix it,
+        and at least what a row inside it has used so far (the rest is >= 0)."""
+        sized = self.sized
+        fixed: dict[int, tuple[np.ndarray, float]] = {}
+        for v, pivot, rhs in system.pivots:  # v + pivot[sized] @ sizes == rhs
+            if np.count_nonzero(pivot[sized:]) == 1:
+                fixed[v] = (-pivot[:sized], rhs)
+        least: dict[int, tuple[np.ndarray, float]] = {}
+        for r, amount in enumerate(used):
+            if amount is None:
+                continue
+            v = self.letter(g, r, positions[r] // 2)
+            if (
+                v >= sized
+                and v not in fixed
+                and (amount[sized:] >= -1e-12).all()
+                and (v not in least or amount[:sized] @ self.target > least[v][0] @ self.target)
+            ):
+                least[v] = (amount[:sized], 0.0)
+        least.update(fixed)
+        grown = x[:sized]
+        spans = [(grown, self.canvas)]
+        for r, position in enumerate(positions):
+            sized_part, counts = self.remaining(g, r, position)
+            span, rhs = grown + sized_part, self.canvas
+            for v, count in counts:
+                if v in least:
+                    span = span + count * least[v][0]
+                    rhs -= count * least[v][1]
+            spans.append((span, rhs))
+        return spans
 
-    def span_of(self, widths: Sequence[tuple[dict[int, float], dict[int, float]]]) -> np.ndarray:
-        """The sized part of the columns laid out so far (their free parts are >= 0)."""
-        total = np.zeros(len(self.equalities.target))
-        for sized, _ in widths:
-            total += self.sized_vector(sized)
-        return total
-
-    def remaining(self, g: int, r: int, position: int) -> np.ndarray:
-        """The sized letters a row still has to lay out whole from ``position``."""
+    def remaining(self, g: int, r: int, position: int) -> tuple[np.ndarray, list[tuple[int, int]]]:
+        """The sized letters a row still has to lay out whole from ``position``, and how many
+        of each placeholder."""
         key = (g, r, position)
         cached = self.remaining_cache.get(key)
         if cached is None:
+            vector = np.zeros(self.sized)
+            counts: dict[int, int] = {}
             word = self.groups[g].rows[r].row.word
-            sized: dict[int, float] = {}
-            first = (position + 1) // 2
-            for letter in word[first:]:
-                self.add_symbol(letter.symbol, sized, {})
-            cached = self.remaining_cache[key] = self.sized_vector(sized)
+            for letter in word[(position + 1) // 2 :]:
+                index = self.variables[letter.symbol]
+                if index < self.sized:
+                    vector[index] += 1.0
+                else:
+                    counts[index] = counts.get(index, 0) + 1
+            cached = self.remaining_cache[key] = (vector, sorted(counts.items()))
         return cached
 
     def leaf(self, paths: list[list[tuple[Move | None, ...]]]) -> None:
@@ -525,41 +642,17 @@ class _Search:
             raise _Perfect  # nothing deviates less: the search order broke the tie
 
 
+def _has_opaque(row: Row) -> bool:
+    """Only an opaque letter makes a row behind give way (SPEC 2.4)."""
+    return any(traits.opaque for traits in row.traits)
+
+
 def _opaque(move: Move | None) -> bool:
     return move is not None and move.opaque
 
 
 def _advance(entries: Sequence[Move | None], positions: tuple[int, ...]) -> tuple[int, ...]:
     return tuple(m.end if m is not None else p for m, p in zip(entries, positions, strict=True))
-
-
-def _holds_piece(move: Move | None, k: int) -> bool:
-    return move is not None and k in sizing.entry_parts(move)[1]
-
-
-def _difference(
-    a: tuple[dict[int, float], dict[int, float]], b: tuple[dict[int, float], dict[int, float]]
-) -> tuple[dict[int, float], dict[int, float], float]:
-    sized = dict(a[0])
-    for i, v in b[0].items():
-        sized[i] = sized.get(i, 0.0) - v
-    free = dict(a[1])
-    for i, v in b[1].items():
-        free[i] = free.get(i, 0.0) - v
-    return sized, free, 0.0
-
-
-def _sum(
-    widths: Sequence[tuple[dict[int, float], dict[int, float]]], canvas: float
-) -> tuple[dict[int, float], dict[int, float], float]:
-    sized: dict[int, float] = {}
-    free: dict[int, float] = {}
-    for width_sized, width_free in widths:
-        for i, v in width_sized.items():
-            sized[i] = sized.get(i, 0.0) + v
-        for i, v in width_free.items():
-            free[i] = free.get(i, 0.0) + v
-    return sized, free, canvas
 
 
 def _remember(
@@ -608,7 +701,6 @@ def align_exactly(
     canvas: float,
     budget: Budget,
     incumbent: float = INF,
-    merge: bool = True,
 ) -> Outcome:
     """The best layout of a candidate's groups (one set of rows per group), searched
     exactly; only layouts with an objective at most ``incumbent`` are looked for."""
@@ -619,16 +711,36 @@ def align_exactly(
                 name,
                 [_Row(row) for row in rows],
                 [[j for j, other in enumerate(rows) if other.is_above(row)] for row in rows],
-                [[j for j, other in enumerate(rows) if other.covers(row)] for row in rows],
+                [
+                    [j for j, other in enumerate(rows) if other.covers(row) and _has_opaque(other)]
+                    for row in rows
+                ],
                 tuple(2 * len(row.word) for row in rows),
             )
         )
-    sized = {
-        name: size for name, symbol in spec.symbols.items() if (size := symbol.size) is not None
-    }
-    search = _Search(spec, canvas, prepared, budget, incumbent, _Equalities(sized))
-    search.merge = merge
+    sized = sorted(
+        {
+            letter.symbol
+            for group in prepared
+            for row in group.rows
+            for letter in row.row.word
+            if spec.size(letter.symbol) is not None
+        }
+    )
+    placeholders = sorted(
+        {letter.symbol for group in prepared for row in group.rows for letter in row.row.word}
+        - set(sized)
+    )
+    variables = {name: i for i, name in enumerate([*sized, *placeholders])}
+    target = np.array([spec.size(name) for name in sized], dtype=float)
+    search = _Search(spec, canvas, prepared, budget, incumbent, variables, target)
+    # first without gaps (most layouts have none, and gaps multiply the columns out of
+    # every state), then with them, looking only for better layouts than that one
     try:
+        if any(any(group.covering) for group in prepared):
+            search.gaps = False
+            search.run()
+            search.gaps = True
         search.run()
     except _Perfect:
         pass
