@@ -487,11 +487,12 @@ class _Search:
         return system, width, tuple(used)
 
     def filling(self, system: _System | None) -> _System | None:
-        """A row that no row in front may make room for has no gap: its letters fill the
-        canvas, whatever the alignment (known before the first column)."""
+        """A row without gaps (no row in front may make room for it, or the run allows
+        none) has letters that fill the canvas, whatever the alignment (known before the
+        first column)."""
         for group in self.groups:
             for r, prepared in enumerate(group.rows):
-                if group.covering[r] or system is None:
+                if (self.gaps and group.covering[r]) or system is None:
                     continue
                 total = np.zeros(len(self.variables))
                 for letter in prepared.row.word:
