@@ -423,3 +423,62 @@ def test_words_lists_what_the_solver_picks() -> None:
         assert preview.chosen == word
         assert word in [format_word(item.word) for item in preview.words]
         assert any(line.startswith(" *") for line in preview.lines())
+
+
+PLANTED_BEFORE = [
+    # a second wall sharing k in front, and two centred runs: a near layout came first,
+    # then the work ran out
+    (
+        """
+version: 1
+name: planted
+canvas: {width: 10.5, height: 5.5}
+symbol_defaults: {opaque: true}
+symbols: {P: 0.5, B: 1.5, G: 1.5, S: 3.0, T: 1.0, B0: 1.5, P0: 0.5, P1: 0.5, B1: 1.5,
+  P2: 0.5, B2: 1.5, P3: 0.5}
+counters: {k: {min: 1}, f: {min: 1}}
+patterns:
+  storeys: G S^f T
+  o0: {control: c0 x c0, where: {x: B0 P0 B0 P0 B0 P0 B0 P0 B0}}
+  o1: P1 (B1 P1)^k
+  o2: {control: c2 x c2, where: {x: P2 B2 P2 B2 P2 B2 P2}}
+  o3: {control: l3 x r3, where: {x: P3}}
+layers:
+  - {name: wall, x: P (B P)^k, y: storeys}
+  - {name: ornament0, x: o0, y: storeys}
+  - {name: ornament1, x: o1, y: storeys}
+  - {name: ornament2, x: o2, y: storeys}
+  - {name: ornament3, x: o3, y: storeys}
+""",
+        5,
+    ),
+    # two centred runs and a free one: the zero layout was lost among gaps
+    (
+        """
+version: 1
+name: planted
+canvas: {width: 10.5, height: 5.5}
+symbol_defaults: {opaque: true}
+symbols: {P: 0.5, B: 2.0, G: 1.5, S: 3.0, T: 1.0, P0: 0.5, P1: 0.5, B1: 2.0, B2: 2.0}
+counters: {k: {min: 1}, f: {min: 1}}
+patterns:
+  storeys: G S^f T
+  o0: {control: c0 x c0, where: {x: P0}}
+  o1: {control: c1 x c1, where: {x: P1 B1 P1 B1 P1}}
+  o2: {control: l2 x r2, where: {x: B2}}
+layers:
+  - {name: wall, x: P (B P)^k, y: storeys}
+  - {name: ornament0, x: o0, y: storeys}
+  - {name: ornament1, x: o1, y: storeys}
+  - {name: ornament2, x: o2, y: storeys}
+""",
+        4,
+    ),
+]
+
+
+@pytest.mark.parametrize(("text", "bays"), PLANTED_BEFORE)
+def test_planted_layouts_the_generator_once_missed(text: str, bays: int) -> None:
+    layout = solve(parse_spec(text, "planted.yaml"))
+    assert layout.counters["k"] == bays
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
