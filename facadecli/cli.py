@@ -7,6 +7,7 @@ limit) before it found a layout. No traceback reaches a user unless ``--debug``.
 
 from __future__ import annotations
 
+import math
 import sys
 import traceback
 from collections.abc import Iterator
@@ -22,9 +23,13 @@ from facadecli.export import (
     DEFAULT_FORMATS,
     WRITERS,
     OutputOptions,
+    check_output_file,
+    check_output_folder,
+    staged,
     write_atomic,
     write_outputs,
 )
+from facadecli.limits import CANVAS_MAX
 from facadecli.preview import preview_words
 from facadecli.solve import retarget, solve, solve_variants
 from facadecli.spec import Spec, load_spec, spec_schema_text
@@ -156,6 +161,9 @@ def solve_command(
 ) -> None:
     """Solve specs into layouts and write their outputs to OUTDIR."""
     chosen = _formats(formats)
+    width = _length(width, "--width")
+    height = _length(height, "--height")
+    check_output_folder(outdir)
     run = _Run(specs)
     for path, spec in run.specs():
         try:
@@ -178,6 +186,16 @@ def solve_command(
     run.finish()
 
 
+def _length(value: float | None, option: str) -> float | None:
+    """A canvas length given on the command line: finite, positive, within the limit."""
+    if value is not None and not (math.isfinite(value) and 0 < value <= CANVAS_MAX):
+        raise typer.BadParameter(
+            f"{value:g} is not a canvas length: give metres above 0 and at most {CANVAS_MAX:g}",
+            param_hint=option,
+        )
+    return value
+
+
 def _sizes(text: str | None, option: str) -> list[float | None]:
     if text is None:
         return [None]
@@ -185,11 +203,13 @@ def _sizes(text: str | None, option: str) -> list[float | None]:
         sizes = [float(part) for part in text.split(",") if part.strip()]
     except ValueError:
         raise typer.BadParameter(
-            f"{option} takes metres separated by commas, e.g. 8,10,12"
+            "takes metres separated by commas, e.g. 8,10,12", param_hint=option
         ) from None
-    if not sizes or any(size <= 0 for size in sizes):
-        raise typer.BadParameter(f"{option} takes positive sizes, e.g. 8,10,12")
-    return list(sizes)
+    if not sizes:
+        raise typer.BadParameter(
+            "takes metres separated by commas, e.g. 8,10,12", param_hint=option
+        )
+    return [_length(size, option) for size in sizes]
 
 
 @app.command()
@@ -217,36 +237,41 @@ def vary(
     chosen = _formats(formats)
     width_list = _sizes(widths, "--widths")
     height_list = _sizes(heights, "--heights")
+    check_output_folder(outdir)
     spec = load_spec(spec_path)
     from facadecli.export.contact import Variant, contact_sheet  # only vary draws sheets
 
     rows: list[list[Variant]] = []
     failed = 0
-    for width in width_list:
-        for height in height_list:
-            sized = retarget(spec, width, height, seed)
-            size = (sized.canvas.width, sized.canvas.height)
-            stem = f"{spec.name}-{size[0]:g}x{size[1]:g}"
-            try:
-                layouts = solve_variants(sized, count)
-            except (InfeasibleError, SearchLimitError) as error:
-                typer.echo(
-                    f"{spec_path}: {size[0]:g} x {size[1]:g} m: no layout: {error}", err=True
-                )
-                rows.append([Variant(None, size, sized.solver.seed, 0, "no layout")])
-                failed += 1
-                continue
-            row = []
-            for index, layout in enumerate(layouts):
-                named = replace(layout, spec=retarget(layout.spec, name=f"{stem}-{index}"))
-                options = OutputOptions(base_dir=spec_path.parent)
-                written = write_outputs(named, outdir, chosen, options)
-                row.append(Variant(named, size, sized.solver.seed, index))
-                typer.echo(f"{size[0]:g} x {size[1]:g} m #{index}: " + ", ".join(map(str, written)))
-            rows.append(row)
-    sheet = outdir / "contact-sheet.svg"
-    write_atomic(sheet, contact_sheet(rows, spec.name))
-    typer.echo(f"contact sheet: {sheet}")
+    lines: list[str] = []  # printed once every file is in place
+    with staged(outdir) as stage:  # the whole run's files appear together or not at all
+        for width in width_list:
+            for height in height_list:
+                sized = retarget(spec, width, height, seed)
+                size = (sized.canvas.width, sized.canvas.height)
+                stem = f"{spec.name}-{size[0]:g}x{size[1]:g}"
+                try:
+                    layouts = solve_variants(sized, count)
+                except (InfeasibleError, SearchLimitError) as error:
+                    typer.echo(
+                        f"{spec_path}: {size[0]:g} x {size[1]:g} m: no layout: {error}", err=True
+                    )
+                    rows.append([Variant(None, size, sized.solver.seed, 0, "no layout")])
+                    failed += 1
+                    continue
+                row = []
+                for index, layout in enumerate(layouts):
+                    named = replace(layout, spec=retarget(layout.spec, name=f"{stem}-{index}"))
+                    options = OutputOptions(base_dir=spec_path.parent)
+                    written = write_outputs(named, stage, chosen, options)
+                    row.append(Variant(named, size, sized.solver.seed, index))
+                    lines.append(
+                        f"{size[0]:g} x {size[1]:g} m #{index}: "
+                        + ", ".join(str(outdir / path.name) for path in written)
+                    )
+                rows.append(row)
+        write_atomic(stage / "contact-sheet.svg", contact_sheet(rows, spec.name))
+    typer.echo("\n".join([*lines, f"contact sheet: {outdir / 'contact-sheet.svg'}"]))
     if failed:
         raise typer.Exit(1)
 
@@ -301,13 +326,21 @@ def city(
 
         report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler)
     summary = report["summary"]
-    for entry in (*report["rejected"], *(b for b in report["buildings"] if b["status"] != "ok")):
-        typer.echo(f"{manifest}: building {entry['id']}: {entry['error']}", err=True)
+    for entry in report["rejected"]:  # rejected by design: reported, not a failure
+        where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
+        if entry["line"] is None:
+            where = f"{loaded.footprints}: features[{entry['feature']}]"
+        typer.echo(f"{where}: rejected: feature '{entry['id']}': {entry['error']}", err=True)
+    for entry in report["buildings"]:
+        if entry["status"] != "ok":
+            typer.echo(f"{manifest}: building {entry['id']}: {entry['error']}", err=True)
+    rejected = f", {summary['rejected']} footprints rejected" if summary["rejected"] else ""
     typer.echo(
-        f"{summary['ok']} of {summary['buildings']} buildings built in {summary['seconds']} s "
-        f"-> {outdir}/{report['name']}.glb, {outdir}/{report['name']}.report.json"
+        f"{summary['ok']} of {summary['buildings']} buildings built{rejected} in "
+        f"{summary['seconds']} s -> {outdir}/{report['name']}.glb, "
+        f"{outdir}/{report['name']}.report.json"
     )
-    if summary["failed"]:
+    if summary["failed"]:  # exit 1 only when a building that should build did not
         raise typer.Exit(1)
 
 
@@ -316,8 +349,12 @@ def _size(text: str, option: str = "--derive") -> tuple[float, float]:
         width, height = (float(v) for v in text.lower().split("x"))
     except ValueError:
         width = height = -1.0
-    if not (width > 0 and height > 0):
-        raise typer.BadParameter(f"{text!r} is not WIDTHxHEIGHT, e.g. 12x9", param_hint=option)
+    if not all(math.isfinite(v) and 0 < v <= CANVAS_MAX for v in (width, height)):
+        raise typer.BadParameter(
+            f"{text!r} is not WIDTHxHEIGHT in metres (each above 0 and at most "
+            f"{CANVAS_MAX:g}), e.g. 12x9",
+            param_hint=option,
+        )
     return width, height
 
 
@@ -487,6 +524,8 @@ def schema(
     ] = None,
 ) -> None:
     """Print the JSON Schema of the spec format (point your editor's YAML plugin at it)."""
+    if output is not None:
+        check_output_file(output)
     text = spec_schema_text()
     if output is None:
         sys.stdout.write(text)

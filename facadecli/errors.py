@@ -78,3 +78,10 @@ class SearchLimitError(FacadeError):
     exist."""
 
     exit_code = 4
+
+
+class OutputError(FacadeError):
+    """The outputs could not be written (a full disk, a folder removed meanwhile): exit
+    code 1, and nothing of the run is left behind."""
+
+    exit_code = 1

@@ -423,7 +423,8 @@ def test_derived_glb_passes_the_khronos_validator(tmp_path: Path) -> None:
         (("--extensions", "zigzag"), "repeatABA"),
         (("--method", "best"), "adp or greedy"),
         (("--size", "ax2"), "WIDTHxHEIGHT"),
-        (("-n", "200", "--derive", "9000x9000"), "more than 200,000 pieces"),
+        (("-n", "200", "--derive", "9000x9000"), "at most 1000"),
+        (("-n", "200", "--derive", "1000x1000"), "more than 200,000 pieces"),
     ],
 )
 def test_grammar_rejects_bad_options(tmp_path: Path, args: tuple[str, ...], message: str) -> None:

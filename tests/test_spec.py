@@ -131,8 +131,10 @@ def test_checked_in_schema_is_current() -> None:
 
 
 def test_mesh_files_next_to_the_spec_are_accepted(tmp_path: Path) -> None:
+    import trimesh
+
     (tmp_path / "assets").mkdir()
-    (tmp_path / "assets" / "door.glb").write_bytes(b"glTF")
+    (tmp_path / "assets" / "door.glb").write_bytes(trimesh.creation.box().export(file_type="glb"))
     text = (CASES / "valid" / "spec-md-example.yaml").read_text()
     text = text.replace("mesh: column ", "mesh: assets/door.glb ")
     (tmp_path / "spec.yaml").write_text(text)

@@ -33,7 +33,7 @@ WALL = Material(color="#cfc6b8", roughness=0.9)
 ROOF = Material(color="#6b4f43", roughness=0.8)
 GROUND = Material(color="#808080", roughness=1.0)
 SLAB = 0.2  # metres: thickness of flat roofs and plain walls
-MIN_EDGE = 0.05  # metres: shorter edges are slivers, skipped
+MIN_EDGE = 0.05  # metres: shorter edges are slivers, merged into the next wall
 
 
 @dataclass
@@ -75,13 +75,22 @@ MAP_TO_WORLD = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]
 
 
 def _edges(part: Polygon) -> list[tuple[tuple[float, float], tuple[float, float]]]:
-    edges = []
+    edges: list[tuple[tuple[float, float], tuple[float, float]]] = []
     for ring in (part.exterior, *part.interiors):  # outer ring CCW, holes CW: outwards is right
-        points = list(ring.coords)
-        for a, b in itertools.pairwise(points):
-            if math.dist(a, b) >= MIN_EDGE:
-                edges.append((a[:2], b[:2]))
+        edges.extend(itertools.pairwise(_corners(list(ring.coords))))
     return edges
+
+
+def _corners(ring: list[tuple[float, ...]]) -> list[tuple[float, float]]:
+    """A closed ring's points without those closer than MIN_EDGE to the last one kept: short
+    edges merge into the next wall instead of leaving a gap, so walls always close."""
+    kept = [(ring[0][0], ring[0][1])]
+    for point in ring[1:-1]:
+        if math.dist(kept[-1], point[:2]) >= MIN_EDGE:
+            kept.append((point[0], point[1]))
+    while len(kept) > 1 and math.dist(kept[-1], kept[0]) < MIN_EDGE:
+        kept.pop()
+    return [*kept, kept[0]] if len(kept) >= 3 else []
 
 
 def build_building(

@@ -2,17 +2,19 @@
 
 RFC 7946 lon/lat is projected with pyproj to a transverse Mercator centred on the data (a
 few millimetres of distortion across a district); a projected CRS named in the file's
-legacy ``crs`` member is used as it is. Either way coordinates are then shifted so the
-data's south-west corner is the origin, which keeps glTF's 32-bit floats precise.
-Invalid rings are repaired with shapely's make_valid; what cannot be used is reported per
-building, never raised.
+legacy ``crs`` member is used as it is (scaled to metres if its unit is not). Either way
+coordinates are then shifted so the data's south-west corner is the origin, which keeps
+glTF's 32-bit floats precise. Invalid rings are repaired with shapely's make_valid;
+outlines of more than MAX_VERTICES vertices are simplified. What cannot be used is
+reported per feature (id, index, line), never raised; what makes the run ambiguous
+(two features with one id) or empty (no usable feature) is a SpecError before any work.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import re
+import statistics
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,13 +22,35 @@ from typing import Any
 import pyproj
 import shapely
 import shapely.affinity
-import shapely.errors
-from shapely.geometry import MultiPolygon, Polygon, shape
+from shapely.geometry import MultiPolygon, Polygon
 from shapely.geometry.polygon import orient
 
-from facadecli.errors import SpecError
+from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
+from facadecli.errors import Problem, SpecError
+from facadecli.limits import (
+    BUILDING_HEIGHT_MAX,
+    BUILDING_LEVELS_MAX,
+    FOOTPRINT_REACH_MAX,
+    FOOTPRINT_VERTICES_MAX,
+)
 
 MIN_AREA = 1.0  # m²: smaller parts are slivers, not buildings
+MAX_VERTICES = FOOTPRINT_VERTICES_MAX  # more are simplified (hip roofs grow with the square)
+SIMPLIFY_TOLERANCE = 0.05  # metres: the first tolerance tried; doubled up to MAX_TOLERANCE
+MAX_TOLERANCE = 0.8  # metres
+MAX_REACH = FOOTPRINT_REACH_MAX  # metres from the middle of the data: a wrong coordinate
+MAX_LISTED = 20  # rejected features listed in the error when none is usable
+MAX_HEIGHT = BUILDING_HEIGHT_MAX  # metres (the tallest building: 828)
+MAX_LEVELS = BUILDING_LEVELS_MAX
+
+
+@dataclass(frozen=True)
+class Simplified:
+    """An outline simplified to MAX_VERTICES: vertex counts before and after, tolerance (m)."""
+
+    before: int
+    after: int
+    tolerance: float
 
 
 @dataclass(frozen=True)
@@ -37,14 +61,18 @@ class Footprint:
     parts: tuple[Polygon, ...]
     properties: dict[str, Any] = field(default_factory=dict)
     repaired: bool = False
+    simplified: Simplified | None = None
 
 
 @dataclass(frozen=True)
 class Rejected:
-    """A feature that yields no building, and why."""
+    """A feature that yields no building, why, and where it is in the file."""
 
     id: str
     reason: str
+    index: int  # in the file's features
+    line: int | None
+    column: int | None
 
 
 @dataclass(frozen=True)
@@ -55,84 +83,160 @@ class FootprintSet:
     origin: tuple[float, float]  # where local (0, 0) is, in the projected CRS
 
 
-def feature_id(feature: dict[str, Any], index: int) -> str:
-    properties = feature.get("properties") or {}
+def feature_id(feature: Any, index: int) -> str:
+    """The feature's id, else its osm_id or id property, else ``feature-<index>``."""
+    if not isinstance(feature, dict):
+        return f"feature-{index}"
+    properties = feature.get("properties")
+    if not isinstance(properties, dict):
+        properties = {}
     for value in (feature.get("id"), properties.get("osm_id"), properties.get("id")):
-        if value not in (None, ""):
-            return str(value)
+        if isinstance(value, (str, int, float)) and not isinstance(value, bool) and value != "":
+            return printable(str(value))
     return f"feature-{index}"
 
 
-def _crs(data: dict[str, Any]) -> pyproj.CRS:
-    named = ((data.get("crs") or {}).get("properties") or {}).get("name")
-    return pyproj.CRS.from_user_input(named) if named else pyproj.CRS.from_epsg(4326)
+Found = tuple[int, str, dict[str, Any], Any]  # index, id, properties, geometry
 
 
 def read_footprints(path: Path) -> FootprintSet:
-    """Footprints of every usable feature; rejected features with a reason."""
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as error:
-        raise SpecError.at(
-            str(path),
-            error.lineno,
-            error.colno,
-            f"invalid GeoJSON: {error.msg}",
-            "check the file's JSON syntax",
-        ) from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise SpecError.at(
-            str(path),
-            None,
-            None,
-            f"cannot read the footprints: {error}",
-            "check the path in the manifest",
-        ) from None
-    if not isinstance(data, dict) or not isinstance(data.get("features"), list):
-        raise SpecError.at(
-            str(path),
-            1,
-            1,
-            "not a GeoJSON FeatureCollection",
-            'write {"type": "FeatureCollection", "features": [...]}',
-        )
-    features = data["features"]
-    source = _crs(data)
-    geometries: list[tuple[str, dict[str, Any], Any]] = []
+    """Footprints of every usable feature; rejected features with a reason and place."""
+    document = read_geojson(path)
+    ids = [feature_id(feature, index) for index, feature in enumerate(document.features)]
+    _check_unique(document, ids)
     rejected: list[Rejected] = []
-    for index, feature in enumerate(features):
-        fid = feature_id(feature, index)
-        try:
-            geometry = shape(feature["geometry"])
-        except (KeyError, TypeError, ValueError, shapely.errors.GEOSException) as error:
-            rejected.append(Rejected(fid, f"unreadable geometry: {error}"))
-            continue
-        if geometry.geom_type not in ("Polygon", "MultiPolygon"):
-            rejected.append(Rejected(fid, f"a {geometry.geom_type}, not a polygon"))
-            continue
-        geometries.append((fid, feature.get("properties") or {}, geometry))
-    if not geometries:
-        return FootprintSet((), tuple(rejected), source.to_string(), (0.0, 0.0))
-    transform = _projection(source, [g for _, _, g in geometries])
-    projected = [
-        (fid, props, shapely.transform(g, transform, interleaved=False))
-        for fid, props, g in geometries
-    ]
-    minx = min(g.bounds[0] for _, _, g in projected)
-    miny = min(g.bounds[1] for _, _, g in projected)
+    found = _in_metres(document, _readable(document, ids, rejected), rejected)
+    minx = min((geometry.bounds[0] for *_, geometry in found), default=0.0)
+    miny = min((geometry.bounds[1] for *_, geometry in found), default=0.0)
     footprints = []
-    for fid, properties, geometry in projected:
-        local = shapely.affinity.translate(geometry, -minx, -miny)
-        repaired = False
-        if not local.is_valid:
-            local = shapely.make_valid(local)
-            repaired = True
-        parts = tuple(orient(part, sign=1.0) for part in _polygons(local) if part.area >= MIN_AREA)
-        if not parts:
-            rejected.append(Rejected(fid, "no part of at least 1 m² (degenerate footprint)"))
+    for index, fid, properties, geometry in found:
+        footprint = _footprint(fid, properties, shapely.affinity.translate(geometry, -minx, -miny))
+        if isinstance(footprint, str):
+            rejected.append(_rejected(document, index, fid, footprint))
+        else:
+            footprints.append(footprint)
+    rejected.sort(key=lambda r: r.index)
+    if rejected and not footprints:
+        raise _nothing_usable(document, rejected)
+    return FootprintSet(tuple(footprints), tuple(rejected), document.crs.to_string(), (minx, miny))
+
+
+def _readable(document: GeoJSON, ids: list[str], rejected: list[Rejected]) -> list[Found]:
+    """The features that are polygons with plausible properties, in the file's CRS."""
+    found = []
+    for index, (fid, feature) in enumerate(zip(ids, document.features, strict=True)):
+        read = read_feature(feature, document.crs)
+        if not isinstance(read, str):
+            read = _implausible(read[0]) or read
+        if isinstance(read, str):
+            rejected.append(_rejected(document, index, fid, read))
+        else:
+            found.append((index, fid, *read))
+    return found
+
+
+def _in_metres(document: GeoJSON, found: list[Found], rejected: list[Rejected]) -> list[Found]:
+    """The features projected to metres, without those far from the others."""
+    transform = _projection(document.crs, [geometry for *_, geometry in found])
+    projected = [
+        (index, fid, properties, shapely.transform(geometry, transform, interleaved=False))
+        for index, fid, properties, geometry in found
+    ]
+    middle = _middle([geometry for *_, geometry in projected])
+    near = []
+    for index, fid, properties, geometry in projected:
+        far = _far(geometry, middle)
+        if far:
+            rejected.append(_rejected(document, index, fid, far))
+        else:
+            near.append((index, fid, properties, geometry))
+    return near
+
+
+def _footprint(fid: str, properties: dict[str, Any], local: Any) -> Footprint | str:
+    """The footprint of a feature's polygons in local metres, or why there is none."""
+    repaired = False
+    if not local.is_valid:
+        local = shapely.make_valid(local)
+        repaired = True
+    parts = tuple(orient(part, sign=1.0) for part in _polygons(local) if part.area >= MIN_AREA)
+    if not parts:
+        return "no part of at least 1 m² (degenerate footprint)"
+    parts, simplified = _simplify(parts)
+    return Footprint(fid, parts, dict(properties), repaired, simplified)
+
+
+def _vertices(parts: tuple[Polygon, ...]) -> int:
+    rings = [ring for part in parts for ring in (part.exterior, *part.interiors)]
+    return sum(len(ring.coords) - 1 for ring in rings)
+
+
+def _simplify(parts: tuple[Polygon, ...]) -> tuple[tuple[Polygon, ...], Simplified | None]:
+    """Parts with at most MAX_VERTICES vertices in all: simplified (topology kept) with
+    the smallest tolerance, from 5 cm doubling up to MAX_TOLERANCE, that gets there; at
+    MAX_TOLERANCE whatever the count is then."""
+    before = _vertices(parts)
+    if before <= MAX_VERTICES:
+        return parts, None
+    tolerance = SIMPLIFY_TOLERANCE
+    while True:
+        simpler = [part.simplify(tolerance, preserve_topology=True) for part in parts]
+        kept = tuple(
+            orient(p, sign=1.0) for s in simpler for p in _polygons(s) if p.area >= MIN_AREA
+        )
+        if kept and (_vertices(kept) <= MAX_VERTICES or tolerance * 2 > MAX_TOLERANCE):
+            return kept, Simplified(before, _vertices(kept), tolerance)
+        if not kept:  # simplified away: keep the outline as it is
+            return parts, None
+        tolerance *= 2
+
+
+def _rejected(document: GeoJSON, index: int, fid: str, reason: str) -> Rejected:
+    line, column = document.places.feature(index) or (None, None)
+    return Rejected(fid, reason, index, line, column)
+
+
+def _check_unique(document: GeoJSON, ids: list[str]) -> None:
+    """Two features with one id would share a file and a report entry: an error."""
+    first: dict[str, int] = {}
+    problems = []
+    for index, fid in enumerate(ids):
+        if fid not in first:
+            first[fid] = index
             continue
-        footprints.append(Footprint(fid, parts, dict(properties), repaired))
-    return FootprintSet(tuple(footprints), tuple(rejected), source.to_string(), (minx, miny))
+        line, col = document.places.feature(index) or (None, None)
+        earlier = document.places.feature(first[fid])
+        at = f" (line {earlier[0]})" if earlier else ""
+        problems.append(
+            Problem(
+                document.file,
+                line,
+                col,
+                f"features[{index}] has the id '{fid}' of features[{first[fid]}]{at}",
+                "give every feature its own id",
+            )
+        )
+    if problems:
+        raise SpecError(problems)
+
+
+def _nothing_usable(document: GeoJSON, rejected: list[Rejected]) -> SpecError:
+    problems = [
+        Problem(document.file, r.line, r.column, f"feature '{r.id}' is not a footprint: {r.reason}")
+        for r in rejected[:MAX_LISTED]
+    ]
+    more = len(rejected) - MAX_LISTED
+    problems.append(
+        Problem(
+            document.file,
+            None,
+            None,
+            "no feature is a usable footprint"
+            + (f" ({more} more rejected features not listed)" if more > 0 else ""),
+            "give building polygons (Polygon or MultiPolygon features)",
+        )
+    )
+    return SpecError(problems)
 
 
 def _polygons(geometry: Any) -> list[Polygon]:
@@ -146,17 +250,50 @@ def _polygons(geometry: Any) -> list[Polygon]:
 
 
 def _projection(source: pyproj.CRS, geometries: list[Any]) -> Any:
-    """A function (x, y) -> (x, y) in metres."""
+    """A function (x, y) -> (x, y) in metres: lon/lat to a transverse Mercator centred on
+    the middle of the data; a projected CRS as it is, scaled from its unit to metres."""
     if not source.is_geographic:
-        return lambda x, y: (x, y)
-    bounds = shapely.GeometryCollection(geometries).bounds
-    lon = (bounds[0] + bounds[2]) / 2
-    lat = (bounds[1] + bounds[3]) / 2
+        scale = source.axis_info[0].unit_conversion_factor if source.axis_info else 1.0
+        if scale == 1.0:
+            return lambda x, y: (x, y)
+        return lambda x, y: (x * scale, y * scale)
+    lon, lat = _middle(geometries)
     local = pyproj.CRS.from_proj4(
         f"+proj=tmerc +lat_0={lat:.7f} +lon_0={lon:.7f} +k=1 +x_0=0 +y_0=0 +ellps=WGS84 +units=m"
     )
     transformer = pyproj.Transformer.from_crs(source, local, always_xy=True)
     return transformer.transform
+
+
+def _middle(geometries: list[Any]) -> tuple[float, float]:
+    """The (low) median of the geometries' bounding-box centres: stray features cannot
+    move it, and of two features it is one of them."""
+    if not geometries:
+        return 0.0, 0.0
+    boxes = [g.bounds for g in geometries]
+    return (
+        statistics.median_low((b[0] + b[2]) / 2 for b in boxes),
+        statistics.median_low((b[1] + b[3]) / 2 for b in boxes),
+    )
+
+
+def _far(geometry: Any, middle: tuple[float, float]) -> str | None:
+    """Why a projected geometry is no place for a building of this city, if it is not."""
+    bounds = geometry.bounds
+    if not all(math.isfinite(v) for v in bounds):
+        return "coordinates that cannot be projected"
+    reach = max(
+        abs(bounds[0] - middle[0]),
+        abs(bounds[2] - middle[0]),
+        abs(bounds[1] - middle[1]),
+        abs(bounds[3] - middle[1]),
+    )
+    if reach <= MAX_REACH:
+        return None
+    return (
+        f"{reach / 1000:.0f} km from the middle of the other footprints "
+        f"(at most {MAX_REACH / 1000:.0f} km): a wrong coordinate?"
+    )
 
 
 _NUMBER = re.compile(r"[-+]?\d+(?:[.,]\d+)?")
@@ -170,6 +307,20 @@ def number(value: Any) -> float | None:
         return float(value) if math.isfinite(value) else None
     match = _NUMBER.search(str(value))
     return float(match.group().replace(",", ".")) if match else None
+
+
+def _implausible(properties: dict[str, Any]) -> str | None:
+    """Why the feature's height or levels cannot be a building's, if they cannot."""
+    for key, most, unit in (
+        ("height", MAX_HEIGHT, " m"),
+        ("measuredHeight", MAX_HEIGHT, " m"),
+        ("levels", MAX_LEVELS, ""),
+        ("building:levels", MAX_LEVELS, ""),
+    ):
+        value = number(properties.get(key))
+        if value is not None and value > most:
+            return f"{key} {value:g}{unit} is not a building's (at most {most:g}{unit})"
+    return None
 
 
 def building_height(properties: dict[str, Any], default: float, floor_height: float) -> float:

@@ -12,11 +12,11 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, StringConstraints
 
-from facadecli.city.footprints import building_height, number
+from facadecli.city.footprints import MAX_HEIGHT, building_height, number
 from facadecli.errors import Problem, SpecError
 from facadecli.spec import load_spec
 from facadecli.spec.load import validate_model
-from facadecli.spec.model import NAME_RE, Model, PositiveLength, Spec
+from facadecli.spec.model import NAME_RE, Model, Spec
 from facadecli.spec.source import Path as DataPath
 from facadecli.spec.source import SourceMap, read_document
 
@@ -35,10 +35,13 @@ class Range(Model):
     max: float | None = None
 
 
+Height = Annotated[float, Field(gt=0, le=MAX_HEIGHT, allow_inf_nan=False)]  # metres
+
+
 class Defaults(Model):
     facade: str
-    height: PositiveLength = 9.0
-    floor_height: PositiveLength = 3.0
+    height: Height = 9.0
+    floor_height: Annotated[float, Field(gt=0, le=20, allow_inf_nan=False)] = 3.0
     roof: Roof = Roof()
     min_facade_width: Annotated[float, Field(ge=0)] = 2.0
 
@@ -47,7 +50,7 @@ class Rule(Model):
     when: dict[str, str | float | bool | Range]
     facade: str | None = None
     roof: Roof | None = None
-    height: PositiveLength | None = None
+    height: Height | None = None
 
 
 class Manifest(Model):

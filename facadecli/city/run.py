@@ -3,12 +3,16 @@
 The unit of work is a building; each writes ``buildings/<id>.glb`` through a temporary
 file, so an interrupted run resumes (``--resume``) where it stopped. Results are gathered
 in the manifest's order, so the report and the merged model do not depend on scheduling.
+Everything a user can fix (the output folder, the GeoJSON file, duplicate ids) is checked
+before the first building. Features that are not footprints are listed as rejected, apart
+from the buildings: they do not fail the run; a building that fails to build does.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import os
 import re
 import time
 from collections.abc import Callable, Iterator
@@ -18,9 +22,10 @@ from pathlib import Path
 from typing import Any
 
 from facadecli.city.building import AxisCache, build_building
-from facadecli.city.footprints import Footprint, read_footprints
+from facadecli.city.footprints import Footprint, Rejected, Simplified, read_footprints
 from facadecli.city.manifest import City, Roof
-from facadecli.export.atomic import write_atomic
+from facadecli.errors import SpecError
+from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.glb_merge import merge_glb
 from facadecli.export.gltf import glb_bytes
 from facadecli.spec.model import Spec
@@ -38,13 +43,20 @@ class Task:
     spec_dir: Path  # the spec's folder: its mesh and texture paths are relative to it
 
 
+PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
+READABLE = 100  # characters of any other id kept, made safe, in front of its hash
+
+
 def safe_name(building_id: str) -> str:
-    """A file name for an id (OSM ids hold '/'): unsafe characters replaced, and a short
-    hash added when anything was replaced, so two ids never share a file."""
-    cleaned = re.sub(r"[^A-Za-z0-9._-]", "_", building_id).strip("._") or "building"
-    if cleaned != building_id:
-        cleaned += "-" + hashlib.sha1(building_id.encode()).hexdigest()[:8]
-    return cleaned[:120]
+    """A file name for an id, never the same for two ids, on case-insensitive file systems
+    too. A short, lower-case, plain id is its own name; any other id (OSM ids hold '/')
+    gives its first READABLE characters with unsafe ones replaced, then '~' and a hash of
+    the whole id. No plain name holds '~', so the two kinds never meet."""
+    if PLAIN_NAME.fullmatch(building_id):
+        return building_id
+    readable = re.sub(r"[^A-Za-z0-9._-]", "_", building_id[:READABLE]).strip("._") or "building"
+    digest = hashlib.sha256(building_id.encode("utf-8", "surrogatepass")).hexdigest()[:16]
+    return f"{readable}~{digest}"
 
 
 _CACHE: dict[str, AxisCache] = {}  # per worker process: axes solved for earlier buildings
@@ -81,15 +93,39 @@ def build(task: Task) -> dict[str, Any]:
         "plain_walls": result.plain_walls,
         "height": round(task.height, 3),
         "repaired": task.footprint.repaired,
+        **_simplified(task.footprint.simplified),
         "time_ms": round((time.perf_counter() - started) * 1000, 1),
     }
 
 
+def _simplified(simplified: Simplified | None) -> dict[str, Any]:
+    if simplified is None:
+        return {}
+    return {
+        "simplified": {
+            "vertices_before": simplified.before,
+            "vertices_after": simplified.after,
+            "tolerance_m": simplified.tolerance,
+        }
+    }
+
+
 def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
+    """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
+    outdir = outdir.resolve()
     tasks = []
+    owners: dict[str, str] = {}  # file name -> building id
     for footprint in footprints:
         key, roof, height = city.choose(footprint.properties)
-        target = outdir / "buildings" / f"{safe_name(footprint.id)}.glb"
+        name = safe_name(footprint.id)
+        if owners.setdefault(name, footprint.id) != footprint.id:
+            raise SpecError.at(
+                str(city.footprints),
+                None,
+                None,
+                f"ids '{owners[name]}' and '{footprint.id}' give one file name '{name}'",
+                "change one of the ids",
+            )
         tasks.append(
             Task(
                 footprint,
@@ -98,11 +134,28 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
                 height,
                 roof,
                 city.manifest.defaults.min_facade_width,
-                target,
-                (city.folder / key).parent,
+                outdir / "buildings" / f"{name}.glb",
+                (city.folder / key).parent.resolve(),
             )
         )
     return tasks
+
+
+def check_output(outdir: Path, name: str) -> None:
+    """Before any work: the outputs can be written in ``outdir`` (SpecError, exit 2, for
+    ``--output`` if not); nothing is created here."""
+    check_output_folder(outdir)
+    problem = None
+    buildings = outdir / "buildings"
+    if os.path.lexists(buildings) and not os.path.isdir(buildings):
+        problem = f"'{buildings}' is a file, where the buildings' folder goes"
+    elif os.path.isdir(buildings) and not os.access(buildings, os.W_OK | os.X_OK):
+        problem = f"cannot write in '{buildings}' (permission denied)"
+    for output in (outdir / f"{name}.glb", outdir / f"{name}.report.json"):
+        if os.path.isdir(output):
+            problem = f"'{output}' is a folder, where an output file goes"
+    if problem is not None:
+        raise SpecError.at("--output", None, None, problem, "give another folder, or move it")
 
 
 def run_city(
@@ -120,6 +173,8 @@ def run_city(
     scheduler's address), on that Dask cluster: the same tasks and the same ``build``
     function either way, so both give the same files."""
     started = time.perf_counter()
+    check_output(outdir, city.manifest.name)
+    outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
     found = read_footprints(city.footprints)
     footprints = list(found.footprints)[: limit if limit is not None else None]
     tasks = plan(city, footprints, outdir)
@@ -157,16 +212,29 @@ def run_city(
         "crs": found.crs,
         "origin": list(found.origin),
         "buildings": results,
-        "rejected": [{"id": r.id, "status": "rejected", "error": r.reason} for r in found.rejected],
+        "rejected": [_rejected(r) for r in found.rejected],
         "summary": {
             "buildings": len(tasks),
             "ok": len(results) - len(failed),
-            "failed": len(failed) + len(found.rejected),
+            "failed": len(failed),
+            "rejected": len(found.rejected),
             "seconds": round(time.perf_counter() - started, 2),
         },
     }
     write_atomic(outdir / f"{city.manifest.name}.report.json", json.dumps(report, indent=2) + "\n")
     return report
+
+
+def _rejected(rejected: Rejected) -> dict[str, Any]:
+    """A rejected feature's report entry: its id, why, and where it is in the GeoJSON."""
+    return {
+        "id": rejected.id,
+        "status": "rejected",
+        "error": rejected.reason,
+        "feature": rejected.index,
+        "line": rejected.line,
+        "column": rejected.column,
+    }
 
 
 def _map_dask(

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from facadecli.export.atomic import write_atomic
+from facadecli.export.atomic import check_output_file, check_output_folder, staged, write_atomic
 
 if TYPE_CHECKING:  # trimesh takes half a second to import: only the mesh writers need it
     import trimesh
@@ -80,10 +80,21 @@ DEFAULT_FORMATS = ("glb", "obj", "json", "svg")
 def write_outputs(
     layout: Layout, outdir: Path, formats: list[str], options: OutputOptions
 ) -> list[Path]:
+    """Write a layout in every format into ``outdir``: all the files or none."""
     written: list[Path] = []
-    for name in formats:
-        written.extend(WRITERS[name](layout, outdir, options))
+    with staged(outdir) as stage:
+        for name in formats:
+            written.extend(outdir / path.name for path in WRITERS[name](layout, stage, options))
     return written
 
 
-__all__ = ["DEFAULT_FORMATS", "WRITERS", "OutputOptions", "write_atomic", "write_outputs"]
+__all__ = [
+    "DEFAULT_FORMATS",
+    "WRITERS",
+    "OutputOptions",
+    "check_output_file",
+    "check_output_folder",
+    "staged",
+    "write_atomic",
+    "write_outputs",
+]

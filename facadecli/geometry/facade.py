@@ -14,8 +14,10 @@ import numpy as np
 import trimesh
 from trimesh.visual.material import PBRMaterial
 
+from facadecli.errors import SpecError
 from facadecli.geometry.primitives import PRIMITIVES, Cell, asset
 from facadecli.layout import Layout, Shape
+from facadecli.limits import SCENE_FACES_MAX
 from facadecli.spec.model import Material
 
 FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
@@ -97,6 +99,8 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     scene = trimesh.Scene()
     world = scene.graph.base_frame
     shared: dict[tuple[object, ...], str] = {}
+    faces: dict[str, int] = {}  # triangles of each shared mesh
+    total = 0  # triangles of the whole model (every node)
     for layer in spec.layers:
         if not layer.enabled:
             continue
@@ -112,6 +116,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             node = f"{layer.name}/{shape.x}.{shape.y}/{count}"
             count += 1
             if key in shared:
+                total = _count(spec.name, total, faces[shared[key]])
                 scene.graph.update(
                     frame_to=node, frame_from=layer_node, matrix=placement, geometry=shared[key]
                 )
@@ -127,6 +132,8 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
                 mesh.visual = trimesh.visual.TextureVisuals(material=material)
             name = f"{shape.mesh.replace('/', '_')}-{shape.material}-{len(shared)}"
             shared[key] = name
+            faces[name] = len(mesh.faces)
+            total = _count(spec.name, total, faces[name])
             scene.add_geometry(
                 mesh,
                 geom_name=name,
@@ -135,6 +142,20 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
                 transform=placement,
             )
     return scene
+
+
+def _count(name: str, total: int, more: int) -> int:
+    """Triangles of the model so far, within :data:`SCENE_FACES_MAX`."""
+    total += more
+    if total > SCENE_FACES_MAX:
+        raise SpecError.at(
+            name,
+            None,
+            None,
+            f"the model would have more than {SCENE_FACES_MAX:,} triangles",
+            "use a lighter mesh file, or fewer cells that show it (masks, counters)",
+        )
+    return total
 
 
 def _build(

@@ -13,6 +13,7 @@ from pathlib import Path as FilePath
 from facadecli.errors import Problem
 from facadecli.patterns import PatternSyntaxError, parse_pattern
 from facadecli.patterns.ast import Named, Node, Repeat, Sym, named_counters, symbols, walk
+from facadecli.spec.assets import mesh_problem, texture_problem
 from facadecli.spec.model import BUILTIN_MESHES, ShapeRule, Spec
 from facadecli.spec.resolve import (
     AXES,
@@ -300,7 +301,15 @@ class Checker:
         self.check_file(path, mesh, MESH_SUFFIXES, "mesh")
 
     def check_file(self, path: Path, value: str, suffixes: tuple[str, ...], kind: str) -> None:
-        """A file named in the spec: of a known kind, inside the spec's folder, present."""
+        """A file named in the spec: of a known kind, inside the spec's folder, present,
+        readable as its kind and within the limits (:mod:`facadecli.spec.assets`)."""
+        if any(ord(c) < 32 for c in value):
+            self.report(
+                path,
+                f"{kind} path {value!r} holds a control character",
+                "write the file name without NUL, tab or line breaks",
+            )
+            return
         candidate = FilePath(value)
         if candidate.suffix.lower() not in suffixes:
             self.report(
@@ -318,19 +327,34 @@ class Checker:
             return
         if self.base_dir is None:
             return
-        base = self.base_dir.resolve()
-        resolved = (base / candidate).resolve()
-        if not resolved.is_relative_to(base):
+        try:
+            base = self.base_dir.resolve()
+            resolved = (base / candidate).resolve()
+            if not resolved.is_relative_to(base):
+                self.report(
+                    path,
+                    f"{kind} path '{value}' leaves the spec's folder (through a link)",
+                    f"copy the {kind} into the spec's folder",
+                )
+            elif not resolved.is_file():
+                self.report(
+                    path,
+                    f"{kind} file '{value}' does not exist",
+                    f"put it at {resolved} or fix the path (relative to the spec file)",
+                )
+            else:
+                problem = (mesh_problem if kind == "mesh" else texture_problem)(resolved)
+                if problem is not None:
+                    self.report(
+                        path,
+                        f"{kind} file '{value}' {problem}",
+                        f"export the {kind} again, lighter, or name another file",
+                    )
+        except OSError as error:
             self.report(
                 path,
-                f"{kind} path '{value}' leaves the spec's folder (through a link)",
-                f"copy the {kind} into the spec's folder",
-            )
-        elif not resolved.is_file():
-            self.report(
-                path,
-                f"{kind} file '{value}' does not exist",
-                f"put it at {resolved} or fix the path (relative to the spec file)",
+                f"{kind} file '{value}' cannot be read: {error.strerror or error}",
+                "check the path and its permissions",
             )
 
 

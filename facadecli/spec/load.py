@@ -16,6 +16,7 @@ from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
 
 from facadecli.errors import Problem, SpecError
+from facadecli.limits import SPEC_BYTES_MAX
 from facadecli.spec.check import check_spec
 from facadecli.spec.model import Spec
 from facadecli.spec.source import Path, SourceMap, format_path, read_document
@@ -44,7 +45,8 @@ def load_spec(path: str | FilePath) -> Spec:
     """Read, validate and cross-check a spec file; raises :class:`SpecError`."""
     file = FilePath(path)
     try:
-        raw = file.read_bytes()
+        with file.open("rb") as handle:  # at most one byte past the limit (a device never ends)
+            raw = handle.read(SPEC_BYTES_MAX + 1)
     except FileNotFoundError:
         raise SpecError.at(str(path), None, None, "no such file", "check the path") from None
     except IsADirectoryError:
@@ -59,6 +61,14 @@ def load_spec(path: str | FilePath) -> Spec:
             f"cannot read: {error.strerror}",
             "check the path and its permissions",
         ) from None
+    if len(raw) > SPEC_BYTES_MAX:
+        raise SpecError.at(
+            str(path),
+            None,
+            None,
+            f"the file is longer than specs are limited to ({SPEC_BYTES_MAX:,} bytes)",
+            "a spec is a page of YAML: generate repeated layers with patterns",
+        )
     return parse_spec(raw, str(path), base_dir=file.parent)
 
 

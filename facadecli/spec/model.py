@@ -22,6 +22,8 @@ from pydantic import (
     model_validator,
 )
 
+from facadecli.limits import CANVAS_MAX
+
 NAME_RE = r"^[A-Za-z0-9_.-]+$"
 IDENT_RE = r"^[A-Za-z_][A-Za-z0-9_]*$"
 COLOR_RE = r"^#(?:[0-9a-fA-F]{6}|[0-9a-fA-F]{8})$"
@@ -50,11 +52,14 @@ def _shorthand_schema(shorthand: dict[str, Any]) -> Any:
     return extend
 
 
+CanvasLength = Annotated[float, Field(gt=0, le=CANVAS_MAX, allow_inf_nan=False)]
+
+
 class Canvas(Model):
     """The façade's extent in metres."""
 
-    width: PositiveLength
-    height: PositiveLength
+    width: CanvasLength
+    height: CanvasLength
 
 
 class Qualifiers(Model):

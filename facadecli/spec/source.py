@@ -15,10 +15,11 @@ from typing import Any
 import yaml
 
 from facadecli.errors import Problem, SpecError
+from facadecli.limits import SPEC_BYTES_MAX, SPEC_DEPTH_MAX, SPEC_VALUES_MAX
 
-MAX_BYTES = 512 * 1024
-MAX_NODES = 100_000
-MAX_DEPTH = 64
+MAX_BYTES = SPEC_BYTES_MAX
+MAX_NODES = SPEC_VALUES_MAX
+MAX_DEPTH = SPEC_DEPTH_MAX
 
 try:  # libyaml is about three times faster; the pure-Python loader gives the same nodes
     _Loader: type = yaml.CSafeLoader

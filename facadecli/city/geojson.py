@@ -1,0 +1,360 @@
+"""Reading GeoJSON defensively: RFC 7946, plus the legacy ``crs`` member.
+
+A file that is not GeoJSON (not JSON, no FeatureCollection or Feature at the top, an
+unusable ``crs``) is a SpecError at its line and column. A feature that is not a usable
+polygon is a reason (a string) for the caller to report with the feature's place; nothing
+here raises anything else, whatever the file holds.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import pyproj
+import pyproj.exceptions
+import shapely.errors
+from shapely.geometry import MultiPolygon, Polygon
+
+from facadecli.errors import SpecError
+from facadecli.limits import PROJECTED_MAX
+
+GEOMETRY_TYPES = (
+    "Point",
+    "MultiPoint",
+    "LineString",
+    "MultiLineString",
+    "Polygon",
+    "MultiPolygon",
+    "GeometryCollection",
+)
+MAX_PROJECTED = PROJECTED_MAX  # farther from a CRS's origin is no place
+LON_LAT = pyproj.CRS.from_epsg(4326)
+CRS_HINT = (
+    'write "crs": {"type": "name", "properties": {"name": "EPSG:28992"}}, '
+    "or leave 'crs' out for lon/lat (RFC 7946)"
+)
+COLLECTION_HINT = 'write {"type": "FeatureCollection", "features": [...]}'
+
+
+class Places:
+    """Line and column of the file's top-level members and of each feature. The text is
+    scanned only when a place is first asked for: a file without problems costs nothing."""
+
+    def __init__(self, text: str, lone: bool = False):
+        self.text = text
+        self.lone = lone  # the file is one Feature, not a collection
+
+    @cached_property
+    def _scan(self) -> tuple[int, dict[str, int], list[int]]:
+        return _scan(self.text)
+
+    @cached_property
+    def _features(self) -> list[tuple[int, int]]:
+        start, _, features = self._scan
+        return _line_cols(self.text, [start] if self.lone else features)
+
+    def start(self) -> tuple[int, int]:
+        return _line_cols(self.text, [self._scan[0]])[0]
+
+    def member(self, key: str) -> tuple[int, int]:
+        """Where the value of a top-level key starts (the file's start if it has none)."""
+        start, members = self._scan[:2]
+        return _line_cols(self.text, [members.get(key, start)])[0]
+
+    def feature(self, index: int) -> tuple[int, int] | None:
+        places = self._features
+        return places[index] if 0 <= index < len(places) else None
+
+
+@dataclass(frozen=True)
+class GeoJSON:
+    file: str
+    features: list[Any]  # as read: each may be anything
+    crs: pyproj.CRS
+    places: Places
+
+
+def read_geojson(path: Path) -> GeoJSON:
+    """The file's features and CRS; raises SpecError (exit 2) when it is not GeoJSON."""
+    file = str(path)
+    text = _text(path)
+    data = _parse(text, file)
+    places = Places(text, lone=isinstance(data, dict) and data.get("type") == "Feature")
+    features = _features(data, file, places)
+    return GeoJSON(file, features, _crs(data, file, places), places)
+
+
+def read_feature(
+    feature: Any, crs: pyproj.CRS
+) -> tuple[dict[str, Any], Polygon | MultiPolygon] | str:
+    """(properties, polygons in the file's CRS), or why the feature is not a footprint."""
+    if not isinstance(feature, dict):
+        return f"not a GeoJSON Feature but {_kind(feature)}"
+    properties = feature.get("properties")
+    if properties is None:
+        properties = {}
+    if not isinstance(properties, dict):
+        return f"'properties' is {_kind(properties)}, not an object"
+    geometry = _geometry(feature.get("geometry"))
+    if isinstance(geometry, str):
+        return geometry
+    return _out_of_range(geometry, crs) or (properties, geometry)
+
+
+def _text(path: Path) -> str:
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise SpecError.at(
+            str(path),
+            None,
+            None,
+            f"cannot read the footprints: {error.strerror}",
+            "check the path in the manifest",
+        ) from None
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        line = raw.count(b"\n", 0, error.start) + 1
+        col = error.start - raw.rfind(b"\n", 0, error.start)
+        raise SpecError.at(
+            str(path), line, col, "not UTF-8 text", "save the GeoJSON as UTF-8 (RFC 7946)"
+        ) from None
+
+
+def _parse(text: str, file: str) -> Any:
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as error:
+        raise SpecError.at(
+            file,
+            error.lineno,
+            error.colno,
+            f"invalid GeoJSON: {error.msg}",
+            "check the file's JSON syntax",
+        ) from None
+    except RecursionError:
+        raise SpecError.at(
+            file, None, None, "invalid GeoJSON: nested too deeply", "check the file's brackets"
+        ) from None
+    except ValueError as error:  # e.g. an integer of more than 4300 digits
+        raise SpecError.at(
+            file, None, None, f"invalid GeoJSON: {error}", "check the file's numbers"
+        ) from None
+
+
+def _features(data: Any, file: str, places: Places) -> list[Any]:
+    if places.lone:
+        return [data]
+    features = data.get("features") if isinstance(data, dict) else None
+    if isinstance(features, list):
+        return features
+    if isinstance(data, dict) and "features" in data:
+        line, col = places.member("features")
+        message = f"'features' is {_kind(data['features'])}, not a list"
+        raise SpecError.at(file, line, col, message, COLLECTION_HINT)
+    line, col = places.start()
+    if isinstance(data, dict) and data.get("type") in GEOMETRY_TYPES:
+        raise SpecError.at(
+            file,
+            line,
+            col,
+            f"a bare {data['type']} geometry, not a FeatureCollection",
+            'wrap it: {"type": "Feature", "properties": {}, "geometry": ...}',
+        )
+    raise SpecError.at(
+        file, line, col, f"not a GeoJSON FeatureCollection but {_kind(data)}", COLLECTION_HINT
+    )
+
+
+def _crs(data: Any, file: str, places: Places) -> pyproj.CRS:
+    """The legacy ``crs`` member's CRS; lon/lat (RFC 7946) without one."""
+    member = data.get("crs") if isinstance(data, dict) else None
+    if member is None:
+        return LON_LAT
+    line, col = places.member("crs")
+    name = _crs_name(member)
+    if name is None:
+        raise SpecError.at(file, line, col, f"'crs' is {_kind(member)} without a name", CRS_HINT)
+    try:
+        crs = pyproj.CRS.from_user_input(name)
+    except pyproj.exceptions.CRSError:
+        raise SpecError.at(file, line, col, f"unknown CRS {_show(name)}", CRS_HINT) from None
+    if not (crs.is_geographic or crs.is_projected):
+        message = f"CRS {_show(name)} is neither lon/lat nor a map projection"
+        raise SpecError.at(file, line, col, message, CRS_HINT)
+    return crs
+
+
+def _crs_name(member: Any) -> str | None:
+    """The name in {"type": "name", "properties": {"name": ...}} (or an EPSG "code")."""
+    properties = member.get("properties") if isinstance(member, dict) else None
+    if not isinstance(properties, dict):
+        return None
+    name, code = properties.get("name"), properties.get("code")
+    if isinstance(name, str) and name.strip():
+        return name.strip()
+    if isinstance(code, int) and not isinstance(code, bool):
+        return f"EPSG:{code}"
+    return None
+
+
+def _geometry(value: Any) -> Polygon | MultiPolygon | str:
+    if value is None:
+        return "no geometry (null)"
+    if not isinstance(value, dict):
+        return f"'geometry' is {_kind(value)}, not an object"
+    kind, coordinates = value.get("type"), value.get("coordinates")
+    if kind not in ("Polygon", "MultiPolygon"):
+        if kind in GEOMETRY_TYPES:
+            return f"a {kind}, not a polygon"
+        return f"unknown geometry type {_show(kind)}"
+    polygons = [coordinates] if kind == "Polygon" else coordinates
+    if not isinstance(polygons, list) or not polygons:
+        return f"the {kind} has no coordinates"
+    made = []
+    for number, polygon in enumerate(polygons):
+        rings = _rings(polygon)
+        if isinstance(rings, str):
+            return rings if kind == "Polygon" else f"polygon {number}: {rings}"
+        try:
+            made.append(Polygon(rings[0], rings[1:]))
+        except (ValueError, shapely.errors.GEOSException) as error:
+            return f"not a polygon: {error}"
+    return made[0] if kind == "Polygon" else MultiPolygon(made)
+
+
+def _rings(polygon: Any) -> list[list[tuple[float, float]]] | str:
+    if not isinstance(polygon, list) or not polygon:
+        return "coordinates are not a list of rings"
+    rings = []
+    for number, ring in enumerate(polygon):
+        if not isinstance(ring, list):
+            return f"ring {number} is {_kind(ring)}, not a list of positions"
+        points = []
+        for position in ring:
+            x, y = _xy(position)
+            if x is None or y is None:
+                return (
+                    f"ring {number}: {_show(position)} is not a position [x, y] of finite numbers"
+                )
+            points.append((x, y))
+        if len(set(points)) < 3:
+            return f"ring {number} has fewer than 3 distinct points"
+        rings.append(points)
+    return rings
+
+
+def _xy(position: Any) -> tuple[float | None, float | None]:
+    if not isinstance(position, list) or len(position) < 2:
+        return None, None
+    return _finite(position[0]), _finite(position[1])
+
+
+def _finite(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond any float
+        return None
+    return number if math.isfinite(number) else None
+
+
+def _out_of_range(geometry: Polygon | MultiPolygon, crs: pyproj.CRS) -> str | None:
+    minx, miny, maxx, maxy = geometry.bounds
+    if crs.is_geographic:
+        if max(abs(minx), abs(maxx)) <= 180 and max(abs(miny), abs(maxy)) <= 90:
+            return None
+        return "lon/lat beyond ±180/±90 (projected coordinates without a 'crs' member?)"
+    if max(abs(minx), abs(miny), abs(maxx), abs(maxy)) <= MAX_PROJECTED:
+        return None
+    return f"coordinates beyond ±{MAX_PROJECTED:.0e} of the CRS's origin"
+
+
+def _kind(value: Any) -> str:
+    """What a JSON value is, for a message: 'a list', 'a string', 'null', ..."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    kinds = {dict: "an object", list: "a list", str: "a string", int: "a number", float: "a number"}
+    return kinds.get(type(value), "a value")
+
+
+def _show(value: Any, width: int = 60) -> str:
+    text = printable(json.dumps(value, ensure_ascii=False, default=str))
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def printable(text: str) -> str:
+    """Text any terminal and file can take: lone surrogates (JSON allows "\\ud800") and
+    control characters written as escapes."""
+    text = text.encode("utf-8", "backslashreplace").decode("utf-8")
+    return _CONTROL.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), text)
+
+
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+
+
+_SPACE = re.compile(r"[ \t\n\r]*")
+
+
+def _skip(text: str, at: int) -> int:
+    match = _SPACE.match(text, at)
+    return match.end() if match else at
+
+
+def _scan(text: str) -> tuple[int, dict[str, int], list[int]]:
+    """Offsets of the top-level value, of each top-level member's value, and of each
+    element of ``features``: the file is walked with the json module's own decoder, value by
+    value (C speed). The text is valid JSON (it was parsed before)."""
+    decoder = json.JSONDecoder()
+    start = at = _skip(text, 0)
+    members: dict[str, int] = {}
+    features: list[int] = []
+    if not text.startswith("{", at):
+        return start, members, features
+    at = _skip(text, at + 1)
+    while text.startswith('"', at):
+        key, at = decoder.raw_decode(text, at)
+        at = _skip(text, _skip(text, at) + 1)  # past the ':'
+        members[key] = at
+        if key == "features" and text.startswith("[", at):
+            features, at = _elements(text, at, decoder)
+        else:
+            at = decoder.raw_decode(text, at)[1]
+        at = _skip(text, at)
+        at = _skip(text, at + 1) if text.startswith(",", at) else at
+    return start, members, features
+
+
+def _elements(text: str, at: int, decoder: json.JSONDecoder) -> tuple[list[int], int]:
+    """Offsets of the elements of the array at ``at``, and the offset past it."""
+    offsets = []
+    at = _skip(text, at + 1)
+    while not text.startswith("]", at):
+        offsets.append(at)
+        at = _skip(text, decoder.raw_decode(text, at)[1])
+        at = _skip(text, at + 1) if text.startswith(",", at) else at
+    return offsets, at + 1
+
+
+def _line_cols(text: str, offsets: list[int]) -> list[tuple[int, int]]:
+    """1-based (line, column) of ascending offsets, in one pass over the text."""
+    places = []
+    line, line_start, previous = 1, 0, 0
+    for offset in offsets:
+        newlines = text.count("\n", previous, offset)
+        if newlines:
+            line += newlines
+            line_start = text.rfind("\n", previous, offset) + 1
+        places.append((line, offset - line_start + 1))
+        previous = offset
+    return places

@@ -1,0 +1,22 @@
+"""Resource limits: what facadecli accepts, in one place (the README's table lists them).
+
+Each limit keeps one bad input from taking the machine down (memory, time) and is enforced
+where the input is read, with a message that names the limit.
+"""
+
+from __future__ import annotations
+
+CANVAS_MAX = 1000.0  # metres: the longest side of a façade canvas
+SPEC_BYTES_MAX = 512 * 1024  # bytes of one spec file (or a city manifest)
+SPEC_VALUES_MAX = 100_000  # values a spec's YAML may expand to (aliases count each time)
+SPEC_DEPTH_MAX = 64  # nesting of a spec's YAML
+MESH_BYTES_MAX = 32_000_000  # bytes of one mesh file named by a spec
+MESH_FACES_MAX = 200_000  # triangles of one mesh file
+SCENE_FACES_MAX = 5_000_000  # triangles of one façade's model (every shape, every cell)
+TEXTURE_PIXELS_MAX = 4096 * 4096  # pixels of one texture image
+TEXTURE_SIDE_MAX = 8192  # pixels of a texture's longer side
+FOOTPRINT_VERTICES_MAX = 1000  # vertices of one footprint: more are simplified
+FOOTPRINT_REACH_MAX = 100_000.0  # metres from the (low) median of the others: a wrong value
+PROJECTED_MAX = 1e8  # a projected coordinate (in its CRS's unit)
+BUILDING_HEIGHT_MAX = 1000.0  # metres: a taller ``height`` property is a wrong value
+BUILDING_LEVELS_MAX = 300  # a ``levels`` property above this is a wrong value

@@ -1,0 +1,127 @@
+"""The files a spec names (meshes, textures), checked before anything uses them: readable,
+of their kind, finite, not empty, and within the limits of :mod:`facadecli.limits`.
+
+Counts are read from the files' headers first (cheap, no allocation of the geometry), so a
+file beyond the limits is refused before it is loaded."""
+
+from __future__ import annotations
+
+import json
+import re
+import struct
+from pathlib import Path
+
+from facadecli.limits import (
+    MESH_BYTES_MAX,
+    MESH_FACES_MAX,
+    TEXTURE_PIXELS_MAX,
+    TEXTURE_SIDE_MAX,
+)
+
+
+def mesh_problem(path: Path) -> str | None:
+    """What is wrong with a mesh file, or None."""
+    size = path.stat().st_size
+    if size == 0:
+        return "is empty"
+    if size > MESH_BYTES_MAX:
+        return f"is {size:,} bytes, more than a mesh file may be ({MESH_BYTES_MAX:,})"
+    data = path.read_bytes()
+    counted = _declared_faces(path.suffix.lower(), data)
+    if isinstance(counted, str):
+        return counted
+    if counted is not None and counted > MESH_FACES_MAX:
+        return f"has {counted:,} triangles, more than a mesh may have ({MESH_FACES_MAX:,})"
+    import numpy as np
+    import trimesh  # only for specs that name mesh files
+
+    try:
+        mesh = trimesh.load(path, force="mesh")
+    except Exception as error:  # a file trimesh cannot read, whatever the reason
+        return f"cannot be read as a mesh ({type(error).__name__}: {error})"
+    faces = getattr(mesh, "faces", None)
+    vertices = getattr(mesh, "vertices", None)
+    if faces is None or vertices is None or len(faces) == 0:
+        return "holds no triangles"
+    if len(faces) > MESH_FACES_MAX:
+        return f"has {len(faces):,} triangles, more than a mesh may have ({MESH_FACES_MAX:,})"
+    if not np.isfinite(vertices).all():
+        return "has vertices that are not finite numbers (NaN or infinity)"
+    return None
+
+
+def _declared_faces(suffix: str, data: bytes) -> int | str | None:
+    """The triangle count a mesh file's header declares (None when it does not say), or
+    what is wrong with the header."""
+    if suffix == ".obj":
+        if re.search(rb"(?mi)^[ \t]*v[ \t][^\n]*\b(nan|inf)", data):
+            return "has vertices that are not finite numbers (NaN or infinity)"
+        return len(re.findall(rb"(?m)^[ \t]*f[ \t]", data))
+    if suffix == ".stl":
+        if data[:5].lower() == b"solid" and b"facet" in data[:1024]:
+            return data.count(b"facet normal")
+        if len(data) < 84:
+            return "is too short to be an STL file"
+        (count,) = struct.unpack_from("<I", data, 80)
+        if 84 + 50 * count != len(data):
+            return f"declares {count:,} triangles but holds {(len(data) - 84) // 50:,}"
+        return int(count)
+    if suffix == ".ply":
+        found = re.search(rb"element face (\d+)", data[:4096])
+        return int(found.group(1)) if found else "has no 'element face' in its header"
+    if suffix in (".glb", ".gltf"):
+        return _gltf_faces(suffix, data)
+    return None
+
+
+def _gltf_faces(suffix: str, data: bytes) -> int | str:
+    if suffix == ".glb":
+        if len(data) < 20 or data[:4] != b"glTF":
+            return "is not a binary glTF file (no 'glTF' header)"
+        length, chunk_length, chunk_type = struct.unpack_from("<I I I", data, 8)
+        if length != len(data) or chunk_type != 0x4E4F534A or 20 + chunk_length > len(data):
+            return "has a glTF header that does not match its length"
+        text = data[20 : 20 + chunk_length]
+    else:
+        text = data
+    try:
+        document = json.loads(text)
+        accessors = document.get("accessors", [])
+        total = 0
+        for mesh in document.get("meshes", []):
+            for primitive in mesh.get("primitives", []):
+                if "indices" in primitive:
+                    total += int(accessors[primitive["indices"]]["count"]) // 3
+                else:
+                    position = primitive["attributes"]["POSITION"]
+                    total += int(accessors[position]["count"]) // 3
+    except (ValueError, KeyError, IndexError, TypeError, AttributeError, RecursionError):
+        return "has a glTF JSON part that is not valid glTF"
+    return total
+
+
+def texture_problem(path: Path) -> str | None:
+    """What is wrong with a texture image, or None."""
+    import warnings
+
+    from PIL import Image, UnidentifiedImageError
+
+    if path.stat().st_size == 0:
+        return "is empty"
+    try:
+        with warnings.catch_warnings():  # the size is checked here, against our own limit
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            image = Image.open(path)
+        with image:
+            width, height = image.size
+            if max(width, height) > TEXTURE_SIDE_MAX or width * height > TEXTURE_PIXELS_MAX:
+                return (
+                    f"is {width:,} x {height:,} pixels, more than a texture may be "
+                    f"({TEXTURE_SIDE_MAX:,} a side, {TEXTURE_PIXELS_MAX:,} in all)"
+                )
+            image.load()  # the pixels, within the limit: a truncated or corrupt file fails
+    except UnidentifiedImageError:
+        return "is not a PNG or JPEG image"
+    except (OSError, ValueError, SyntaxError, Image.DecompressionBombError) as error:
+        return f"cannot be read as an image ({error})"
+    return None
