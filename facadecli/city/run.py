@@ -24,7 +24,7 @@ from typing import Any
 from facadecli.city.building import AxisCache, build_building
 from facadecli.city.footprints import Footprint, Rejected, Simplified, read_footprints
 from facadecli.city.manifest import City, Roof
-from facadecli.errors import SpecError
+from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.glb_merge import merge_glb
 from facadecli.export.gltf import glb_bytes
@@ -201,10 +201,16 @@ def run_city(
             progress(done, len(tasks))
     order = {task.footprint.id: i for i, task in enumerate(tasks)}
     results.sort(key=lambda r: order[r["id"]])
-    merge_glb(
-        ((r["id"], outdir / r["file"]) for r in results if r["status"] == "ok"),
-        outdir / f"{city.manifest.name}.glb",
-    )
+    try:
+        merge_glb(
+            ((r["id"], outdir / r["file"]) for r in results if r["status"] == "ok"),
+            outdir / f"{city.manifest.name}.glb",
+        )
+    except OSError as error:  # a full disk: the buildings stay, for --resume
+        raise OutputError(
+            f"{outdir}: cannot write the merged model: {error.strerror or error}; the "
+            "buildings built are kept: run again with --resume"
+        ) from None
     failed = [r for r in results if r["status"] != "ok"]
     report = {
         "version": 1,
@@ -221,7 +227,14 @@ def run_city(
             "seconds": round(time.perf_counter() - started, 2),
         },
     }
-    write_atomic(outdir / f"{city.manifest.name}.report.json", json.dumps(report, indent=2) + "\n")
+    try:
+        write_atomic(
+            outdir / f"{city.manifest.name}.report.json", json.dumps(report, indent=2) + "\n"
+        )
+    except OSError as error:
+        raise OutputError(
+            f"{outdir}: cannot write the report: {error.strerror or error}; run again with --resume"
+        ) from None
     return report
 
 

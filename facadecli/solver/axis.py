@@ -15,6 +15,7 @@ from facadecli.solver.alignment import (
     Alignment,
     AlignmentResult,
     Prefixes,
+    _Row,
     align,
 )
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
@@ -153,6 +154,8 @@ class _SearchMemory:
     traits: dict[Word, tuple[LetterTraits, ...]] = field(default_factory=dict)
     groups: dict[tuple[str, tuple[Word, ...]], AlignmentResult] = field(default_factory=dict)
     prefixes: Prefixes = field(default_factory=dict)
+    rows: dict[int, dict[str, list[Row]]] = field(default_factory=dict)  # by candidate order
+    prepared: dict[Row, _Row] = field(default_factory=dict)  # rows with their moves cached
 
 
 @dataclass(frozen=True)
@@ -228,7 +231,7 @@ def solve_axis_alternatives(
         nonlocal unproven, timed_out
         rows = _candidate_rows(spec, uses, candidate, memory)
         share = exact.Budget(min(budget.left, TIE_SHARE if tie else EXACT_SHARE), deadline)
-        outcome = exact.align_exactly(spec, rows, canvas, share, target)
+        outcome = exact.align_exactly(spec, rows, canvas, share, target, memory.prepared)
         budget.used += share.used
         timed_out = timed_out or share.timed_out
         unproven = unproven or not (outcome.complete or tie)
@@ -363,10 +366,13 @@ def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
 def _candidate_rows(
     spec: Spec, uses: Sequence[PatternUse], candidate: Candidate, memory: _SearchMemory
 ) -> dict[str, list[Row]]:
-    return {
-        group: make_rows(spec, members, memory.full, memory.traits)
-        for group, members in _group_rows(spec, uses, candidate.words).items()
-    }
+    rows = memory.rows.get(candidate.order)
+    if rows is None:
+        rows = memory.rows[candidate.order] = {
+            group: make_rows(spec, members, memory.full, memory.traits)
+            for group, members in _group_rows(spec, uses, candidate.words).items()
+        }
+    return rows
 
 
 def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:

@@ -643,6 +643,14 @@ class _Search:
             raise _Perfect  # nothing deviates less: the search order broke the tie
 
 
+def _prepared(row: Row, known: dict[Row, _Row]) -> _Row:
+    """A row with its moves cached, shared by the searches of one axis."""
+    found = known.get(row)
+    if found is None:
+        found = known[row] = _Row(row)
+    return found
+
+
 def _has_opaque(row: Row) -> bool:
     """Only an opaque letter makes a row behind give way (SPEC 2.4)."""
     return any(traits.opaque for traits in row.traits)
@@ -702,15 +710,17 @@ def align_exactly(
     canvas: float,
     budget: Budget,
     incumbent: float = INF,
+    prepared_rows: dict[Row, _Row] | None = None,
 ) -> Outcome:
     """The best layout of a candidate's groups (one set of rows per group), searched
     exactly; only layouts with an objective at most ``incumbent`` are looked for."""
+    known = {} if prepared_rows is None else prepared_rows
     prepared = []
     for name, rows in sorted(groups.items()):
         prepared.append(
             _Group(
                 name,
-                [_Row(row) for row in rows],
+                [_prepared(row, known) for row in rows],
                 [[j for j, other in enumerate(rows) if other.is_above(row)] for row in rows],
                 [
                     [j for j, other in enumerate(rows) if other.covers(row) and _has_opaque(other)]
