@@ -444,8 +444,8 @@ def grammar(
         typer.Option(
             "--time-limit",
             min=0.1,
-            help="Seconds of search at most; the best grammar so far is kept (reached, the "
-            "result depends on the machine's speed).",
+            help="Seconds for the whole run, reading included; the search keeps the best "
+            "grammar so far (reached, the result depends on the machine's speed).",
         ),
     ] = 120.0,
     timings: Annotated[
@@ -468,6 +468,7 @@ def grammar(
             )
     sizes = [_size(text) for text in derive or []]
     kinds = _formats(formats)
+    check_output_folder(outdir)
     options = Options(
         method,
         iterations,
@@ -505,11 +506,14 @@ def grammar(
                 raise typer.BadParameter(str(error), param_hint="--derive") from None
             for warning in derived[-1].warnings:
                 typer.echo(f"{layout}: warning: {width:g}x{height:g}: {warning}", err=True)
-    for file, text in outputs.items():
-        write_atomic(outdir / file, text)
     written = [outdir / file for file in outputs]
-    for result in derived:
-        written += write_outputs(result, outdir, kinds, OutputOptions())
+    with staged(outdir) as stage:  # the grammar and every derived size together, or nothing
+        for file, text in outputs.items():
+            write_atomic(stage / file, text)
+        for result in derived:
+            written += [
+                outdir / path.name for path in write_outputs(result, stage, kinds, OutputOptions())
+            ]
     typer.echo(
         f"{layout}: {len(found.rules)} rules, cost {found.cost:.1f} "
         f"(greedy {extraction.found.greedy_cost:.1f}) -> " + ", ".join(str(p) for p in written)

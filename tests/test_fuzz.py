@@ -227,3 +227,50 @@ def test_mutated_geojson_builds_rejects_or_fails_with_its_place(
         if code == 2:
             assert "f.geojson" in err and files(out) == [], err
     assert codes.get(2, 0) > 20 and codes.get(0, 0) > 10, codes  # both kinds met
+
+
+def _cmp_facade() -> str:
+    from tests.test_grammar_inputs import cmp_object
+
+    objects = [cmp_object("0.0", "1.0", "0.0", "1.0", "facade")]
+    for row in range(3):
+        for column in range(3):
+            top, left = 0.1 + 0.3 * row, 0.1 + 0.3 * column
+            objects.append(
+                cmp_object(f"{top:.2f}", f"{top + 0.15:.2f}", f"{left:.2f}", f"{left + 0.12:.2f}")
+            )
+    return "\n".join(objects) + "\n"
+
+
+def _rectangles() -> str:
+    rects = [{"label": "wall", "x0": 0, "y0": 0, "x1": 12, "y1": 9}]
+    for row in range(3):
+        for column in range(4):
+            x, y = 1 + 3 * column, 1 + 3 * row
+            rects.append({"label": "window", "x0": x, "y0": y, "x1": x + 1.2, "y1": y + 1.5})
+    return json.dumps({"canvas": {"width": 12, "height": 9}, "rects": rects}, indent=1)
+
+
+@pytest.mark.parametrize(("name", "make"), [("f.xml", _cmp_facade), ("f.json", _rectangles)])
+def test_mutated_layouts_give_a_grammar_or_fail_with_their_place(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, name: str, make: object
+) -> None:
+    text = make()  # type: ignore[operator]
+    rng = random.Random(11)
+    codes: dict[int, int] = {}
+    for case in range(60):
+        if name.endswith(".json") and case % 2:
+            mutated = mutate_json(text, rng)
+        else:
+            mutated = mutate(text, rng, edits=2)
+        path = tmp_path / name
+        path.write_text(mutated, errors="surrogatepass")
+        out = tmp_path / f"out{case}"
+        code, _, err = facade(capsys, "grammar", str(path), "-o", str(out), "-n", "20")
+        codes[code] = codes.get(code, 0) + 1
+        assert code in (0, 2), err
+        if code == 2:
+            assert name in err and files(out) == [], err
+        else:
+            assert len(files(out)) == 4
+    assert codes.get(2, 0) > 10 and codes.get(0, 0) > 2, codes

@@ -3,7 +3,9 @@ report (cost, rules, time)."""
 
 from __future__ import annotations
 
+import itertools
 import json
+import re
 from dataclasses import asdict
 from typing import Any
 from xml.sax.saxutils import escape
@@ -14,6 +16,23 @@ from facadecli.grammar.split import Grammar, derive_tree
 from facadecli.grammar.tiling import Tiling
 
 SCALE = 600.0  # pixels for the longer side of the façade
+NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def xml_text(text: str) -> str:
+    """Text for an XML element: markup escaped, and characters XML cannot hold (control
+    characters, lone surrogates, U+FFFE/U+FFFF) replaced by U+FFFD."""
+    return escape(NOT_XML.sub("\ufffd", text))
+
+
+def _runs(row: tuple[str, ...]) -> list[tuple[int, int, str]]:
+    """Runs of equal labels in a row of cells: (first column, column after, label)."""
+    runs, start = [], 0
+    for label, cells in itertools.groupby(row):
+        stop = start + sum(1 for _ in cells)
+        runs.append((start, stop, label))
+        start = stop
+    return runs
 
 
 def grammar_json(grammar: Grammar) -> str:
@@ -56,12 +75,12 @@ def tiling_svg(tiling: Tiling, grammar: Grammar, title: str) -> str:
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{total_w:.0f}" height="{total_h:.0f}">',
-        f"<title>{escape(title)}: tiling and grammar regions</title>",
+        f"<title>{xml_text(title)}: tiling and grammar regions</title>",
         f'<rect width="{total_w:.0f}" height="{total_h:.0f}" fill="#ffffff"/>',
     ]
     for r, row in enumerate(tiling.labels):
-        for c, label in enumerate(row):
-            box = rect(tiling.xs[c], tiling.ys[r], tiling.xs[c + 1], tiling.ys[r + 1], 10)
+        for c0, c1, label in _runs(row):  # a run of one label is one rectangle
+            box = rect(tiling.xs[c0], tiling.ys[r], tiling.xs[c1], tiling.ys[r + 1], 10)
             lines.append(f'<rect {box} fill="{label_colour(label)}"/>')
     right = 10 + w + gap
     parents: list[str] = []
@@ -82,7 +101,7 @@ def tiling_svg(tiling: Tiling, grammar: Grammar, title: str) -> str:
         if depth <= 2 and (x1 - x0) * scale > 30 and (y1 - y0) * scale > 14:
             names.append(
                 f'<text x="{right + x0 * scale + 3:.1f}" y="{10 + (height - y1) * scale + 12:.1f}" '
-                f'font-family="sans-serif" font-size="11" fill="#000000">{escape(symbol)}</text>'
+                f'font-family="sans-serif" font-size="11" fill="#000000">{xml_text(symbol)}</text>'
             )
     lines += outlines + names
     for i, label in enumerate(labels):
@@ -92,7 +111,7 @@ def tiling_svg(tiling: Tiling, grammar: Grammar, title: str) -> str:
         )
         lines.append(
             f'<text x="28" y="{y + 11:.0f}" font-family="sans-serif" font-size="12">'
-            f"{escape(label)}</text>"
+            f"{xml_text(label)}</text>"
         )
     lines.append(
         f'<text x="{right:.0f}" y="{h + 35:.0f}" font-family="sans-serif" font-size="12">'

@@ -20,6 +20,9 @@ import itertools
 from collections import defaultdict
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
+from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.tiling import LabelledLayout, Rect, Tiling, snap, tile
 
 DEFAULT_TOLERANCE = 0.01  # of the façade's extent along the axis
@@ -94,12 +97,11 @@ def _pairs_of(
 ) -> tuple[dict[str, list[list[tuple[float, float]]]], dict[str, list[list[tuple[float, float]]]]]:
     """Spans (start, end) to be equal along an axis: element groups and strip groups."""
     elements: dict[str, list[list[tuple[float, float]]]] = {}
-    by_label: dict[str, list[tuple[float, float]]] = defaultdict(list)
-    for rect in rects:
-        span = (rect.x0, rect.x1) if axis == "x" else (rect.y0, rect.y1)
-        if span not in by_label[rect.label]:
-            by_label[rect.label].append(span)
-    for label, spans in sorted(by_label.items()):
+    by_label: dict[str, dict[tuple[float, float], None]] = defaultdict(dict)
+    for rect in rects:  # each label's distinct spans, in order (a dict as an ordered set)
+        by_label[rect.label][(rect.x0, rect.x1) if axis == "x" else (rect.y0, rect.y1)] = None
+    for label, distinct in sorted(by_label.items()):
+        spans = list(distinct)
         sizes = [(b - a, i) for i, (a, b) in enumerate(spans)]
         elements[label] = [
             [spans[i] for i in group] for group in _clusters(sizes, tolerance * extent)
@@ -128,22 +130,27 @@ def _solve_axis(
     import cvxpy as cp  # imported here: it takes half a second
 
     index = {value: i for i, value in enumerate(edges)}
-    v = cp.Variable(len(edges))
-    constraints = [v[0] == 0.0, v[len(edges) - 1] == extent]
-    constraints += [v[i + 1] - v[i] >= 0 for i in range(len(edges) - 1)]
-    for a, b in set(elements):  # every element keeps at least half its size
-        constraints.append(v[index[b]] - v[index[a]] >= (b - a) / 2)
-    for group in groups:
-        (a0, b0), rest = group[0], group[1:]
-        for a, b in rest:
-            constraints.append(v[index[b]] - v[index[a]] == v[index[b0]] - v[index[a0]])
     kept = sorted(set(elements))  # elements keep their sizes as well as they can
-    starts = [index[a] for a, _ in kept]
-    stops = [index[b] for _, b in kept]
-    drawn = [b - a for a, b in kept]
-    objective = cp.sum_squares(v - edges)
-    if kept:
+    starts = np.array([index[a] for a, _ in kept], dtype=int)
+    stops = np.array([index[b] for _, b in kept], dtype=int)
+    drawn = np.array([b - a for a, b in kept])
+    equal = np.array(  # (a0, b0, a, b): b - a == b0 - a0
+        [
+            (index[group[0][0]], index[group[0][1]], index[a], index[b])
+            for group in groups
+            for a, b in group[1:]
+        ],
+        dtype=int,
+    ).reshape(-1, 4)
+    v = cp.Variable(len(edges))
+    # constraints as a few vector expressions: building one per pair is slow in cvxpy
+    constraints = [v[0] == 0.0, v[len(edges) - 1] == extent, cp.diff(v) >= 0]
+    objective = cp.sum_squares(v - np.array(edges))
+    if kept:  # every element keeps at least half its size
+        constraints.append(v[stops] - v[starts] >= drawn / 2)
         objective += cp.sum_squares(v[stops] - v[starts] - drawn)
+    if len(equal):
+        constraints.append(v[equal[:, 3]] - v[equal[:, 2]] == v[equal[:, 1]] - v[equal[:, 0]])
     problem = cp.Problem(cp.Minimize(objective), constraints)
     try:
         problem.solve(solver=cp.CLARABEL)
@@ -155,14 +162,19 @@ def _solve_axis(
 
 
 def regularize(
-    layout: LabelledLayout, tolerance: float = DEFAULT_TOLERANCE, background: str = "facade"
+    layout: LabelledLayout,
+    tolerance: float = DEFAULT_TOLERANCE,
+    background: str = "facade",
+    deadline: Deadline | None = None,
 ) -> tuple[LabelledLayout, Regularization]:
     """The layout with repeated elements made equal (see the module); its edges must be
-    snapped already (``tile`` snaps, ``snap_layout`` gives the snapped layout)."""
+    snapped already (``tile`` snaps, ``snap_layout`` gives the snapped layout). The
+    deadline is checked before each QP (a QP itself cannot be stopped)."""
     result = Regularization(tolerance)
     if tolerance <= 0:
         return layout, result
-    tiling = tile(layout, tolerance=0.0, background=background)
+    deadline = deadline or Deadline()
+    tiling = tile(layout, tolerance=0.0, background=background, deadline=deadline)
     rects = [r for r in layout.rects if r.label != background]
     mapping: dict[str, dict[float, float]] = {}
     for axis, extent in (("x", layout.width), ("y", layout.height)):
@@ -171,12 +183,14 @@ def regularize(
         element_groups = [g for groups in elements.values() for g in groups]
         strip_groups = [g for groups in strips.values() for g in groups]
         spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
-        spans = [(a, b) for a, b in spans if a in edges and b in edges]
+        cuts = set(edges)
+        spans = [(a, b) for a, b in spans if a in cuts and b in cuts]
         solved = None
         for kept, used in (
             (element_groups + strip_groups, True),
             (element_groups, False),
         ):
+            deadline.check("regularising")
             solved = _solve_axis(edges, extent, kept, spans)
             if solved is not None:
                 break

@@ -1,27 +1,28 @@
 """``facade grammar``'s pipeline, without the writing: read a labelled layout, snap and
-regularise it, tile it, find a grammar, and check that it derives the tiling exactly."""
+regularise it, tile it, find a grammar, and check that it derives the tiling exactly.
+
+Every number reaching the stages is finite: the readers check the file's, ``check_options``
+the options'. The work is bounded before it starts (``RECTS_MAX`` rectangles when reading,
+``CELLS_MAX`` cells of the snapped tiling) and while it runs (one ``Deadline`` for all
+stages, from ``--time-limit``)."""
 
 from __future__ import annotations
 
 import bisect
-import json
+import math
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from facadecli.errors import SpecError
+from facadecli.errors import Problem, SpecError
+from facadecli.grammar.cmp_xml import read_cmp
+from facadecli.grammar.deadline import Deadline
+from facadecli.grammar.inputs import EXTENT_MAX, LabelledLayout
+from facadecli.grammar.json_layouts import read_plain, read_report
 from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
-from facadecli.grammar.tiling import (
-    LabelledLayout,
-    Tiling,
-    read_cmp,
-    read_plain,
-    read_report,
-    snap_layout,
-    tile,
-)
+from facadecli.grammar.tiling import Tiling, snap_layout, tile
 
 # How much each kind of input is tidied, as fractions of the façade's size: edges closer
 # than ``snap`` become one, and repeated elements closer in size than ``tolerance`` get one
@@ -29,6 +30,10 @@ from facadecli.grammar.tiling import (
 # be measured or detected; facadecli layouts are exact.
 TIDY = {"cmp": (0.005, 0.01), "plain": (0.001, 0.005), "report": (0.0, 0.0)}
 REDERIVE_TOLERANCE = 1e-4  # x the façade's size: a derived edge this near a tiling edge is on it
+CELLS_MAX = 1_000_000  # cells of the snapped tiling (1000 x 1000: a plain list at its snap)
+TIDY_MAX = 0.1  # the largest snap and tolerance
+TIME_LIMIT_MAX = 86_400.0  # seconds
+COST_MAX = 1e6  # of a rule
 
 
 @dataclass(frozen=True)
@@ -41,7 +46,7 @@ class Options:
     snap: float | None = None  # None: by the kind of input (``TIDY``)
     tolerance: float | None = None  # regularisation; None: by the kind of input (``TIDY``)
     size: tuple[float, float] | None = None  # the façade's real size: the layout is scaled
-    time_limit: float = 120.0  # seconds of ADP; the best grammar so far is kept
+    time_limit: float = 120.0  # seconds for the whole run (see ``deadline``)
 
 
 @dataclass
@@ -54,6 +59,7 @@ class Extraction:
     options: Options
     time_ms: float = 0.0
     problems: list[str] = field(default_factory=list)
+    vanished: tuple[int, int, float] = (0, 0, 0.0)  # rectangles snapping removed, of, snap
 
     @property
     def grammar(self) -> Grammar:
@@ -62,11 +68,24 @@ class Extraction:
     @property
     def warnings(self) -> list[str]:
         found = list(self.regularization.warnings)
+        lost, total, snap = self.vanished
+        if lost:
+            found.append(
+                f"snapping edges closer than {snap:g} of the façade removed {lost} of {total} "
+                "rectangles (edges in a row closer than that join into one): give a smaller "
+                "--snap to keep them"
+            )
         if self.found.method == "adp" and self.found.iterations < self.options.iterations:
             found.append(
                 f"time limit of {self.options.time_limit:g} s reached after "
                 f"{self.found.iterations} of {self.options.iterations} iterations: the best "
                 "grammar so far is kept, and it depends on the machine's speed"
+            )
+        if not self.found.repeats_complete:
+            found.append(
+                f"time limit of {self.options.time_limit:g} s: the search for repeated regions "
+                f"stopped at {self.found.repeats} kinds; the grammar depends on the machine's "
+                "speed"
             )
         return found
 
@@ -76,24 +95,48 @@ def read_layout(path: Path) -> tuple[LabelledLayout, str]:
     if not path.is_file():
         raise SpecError.at(str(path), None, None, "no such file", "check the path")
     name = path.name
-    try:
-        if name.endswith(".xml"):
-            return read_cmp(path), "cmp"
-        if name.endswith(".layout.json"):
-            return read_report(path), "report"
-        return read_plain(path), "plain"
-    except json.JSONDecodeError as error:
-        raise SpecError.at(
-            str(path), error.lineno, error.colno, f"not JSON: {error.msg}", "fix the JSON syntax"
-        ) from None
-    except (ValueError, KeyError, TypeError) as error:
+    if name.endswith(".xml"):
+        return read_cmp(path), "cmp"
+    if name.endswith(".layout.json"):
+        return read_report(path), "report"
+    return read_plain(path), "plain"
+
+
+def check_options(options: Options) -> None:
+    """Every number of the options finite and in its range (the option named on error)."""
+    problems = []
+    ranges = [
+        ("--snap", options.snap, 0.0, TIDY_MAX),
+        ("--tolerance", options.tolerance, 0.0, TIDY_MAX),
+        ("--split-cost", options.costs.split, 0.0, COST_MAX),
+        ("--repeat-cost", options.costs.repeat, 0.0, COST_MAX),
+        ("--time-limit", options.time_limit, 0.0, TIME_LIMIT_MAX),
+    ]
+    for size in options.size or ():
+        ranges.append(("--size", size, 0.0, EXTENT_MAX))
+    for option, value, low, high in ranges:
+        if value is not None and not (math.isfinite(value) and low <= value <= high):
+            problems.append(
+                Problem(option, None, None, f"{value:g} is not from {low:g} to {high:g}")
+            )
+    if options.size is not None and min(options.size) <= 0:
+        problems.append(Problem("--size", None, None, "a size must be above 0"))
+    if problems:
+        raise SpecError(problems)
+
+
+def check_cells(path: Path, layout: LabelledLayout, snap: float) -> None:
+    """The tiling of the (snapped) layout has at most ``CELLS_MAX`` cells."""
+    columns = len({0.0, layout.width, *(v for r in layout.rects for v in (r.x0, r.x1))}) - 1
+    rows = len({0.0, layout.height, *(v for r in layout.rects for v in (r.y0, r.y1))}) - 1
+    if columns * rows > CELLS_MAX:
         raise SpecError.at(
             str(path),
             None,
             None,
-            f"not a labelled layout: {error}",
-            "give a CMP .xml, a .layout.json, or [{label, x0, y0, x1, y1}, ...]",
-        ) from None
+            f"the tiling would have {columns:,} x {rows:,} cells; at most {CELLS_MAX:,}",
+            f"join nearby edges with a larger --snap (now {snap:g}), or give fewer rectangles",
+        )
 
 
 def resize(layout: LabelledLayout, width: float, height: float) -> LabelledLayout:
@@ -111,6 +154,8 @@ def stem(path: Path) -> str:
 
 
 def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
+    check_options(options)
+    deadline = Deadline(options.time_limit, str(path))
     layout, kind = read_layout(path)
     if not layout.rects:
         raise SpecError.at(str(path), None, None, "no rectangles", "label some elements")
@@ -119,8 +164,18 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
     snap = options.snap if options.snap is not None else TIDY[kind][0]
     tolerance = options.tolerance if options.tolerance is not None else TIDY[kind][1]
     snapped = snap_layout(layout, snap) if snap > 0 else layout
-    regular, regularization = regularize(snapped, tolerance)
-    tiling = tile(regular, tolerance=0.0)
+    if not snapped.rects:
+        raise SpecError.at(
+            str(path),
+            None,
+            None,
+            f"snapping edges closer than {snap:g} of the façade removed every rectangle "
+            "(edges in a row closer than that join into one)",
+            "give a smaller --snap",
+        )
+    check_cells(path, snapped, snap)
+    regular, regularization = regularize(snapped, tolerance, deadline=deadline)
+    tiling = tile(regular, tolerance=0.0, deadline=deadline)
     started = time.perf_counter()
     found = extract(
         tiling,
@@ -129,36 +184,42 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
         options.seed,
         options.costs,
         options.extensions,
-        time_limit=options.time_limit,
+        deadline=deadline,
     )
     elapsed = (time.perf_counter() - started) * 1000
     extraction = Extraction(path.name, regular, tiling, found, regularization, options, elapsed)
     extraction.problems = rederivation_problems(found.grammar, tiling)
+    extraction.vanished = (len(layout.rects) - len(snapped.rects), len(layout.rects), snap)
     return extraction
 
 
 def rederivation_problems(grammar: Grammar, tiling: Tiling, limit: int = 5) -> list[str]:
     """Where the grammar's derivation differs from the tiling (empty when exact): every
     derived rectangle must cover cells of its own label only, and together they must cover
-    the façade once. Positions are compared to ``REDERIVE_TOLERANCE`` of the façade's
-    size: regions that share a rule are equal to within the size quantum of ``regions``, and
-    repeats add those differences up."""
+    the façade once. Each derived edge is taken to the nearest cut of the tiling, which must
+    be within ``REDERIVE_TOLERANCE`` of the façade's size: regions that share a rule are
+    equal to within the size quantum of ``regions``, and repeats add those differences up
+    (cells may be thinner than that tolerance, so the nearest cut is the one meant)."""
     width, height = tiling.xs[-1], tiling.ys[-1]
     eps = REDERIVE_TOLERANCE * max(width, height)
     problems = []
     area = 0.0
     for label, x0, y0, x1, y1 in derive(grammar, width, height):
         area += (x1 - x0) * (y1 - y0)
-        c0 = bisect.bisect_left(tiling.xs, x0 - eps)
-        c1 = bisect.bisect_left(tiling.xs, x1 - eps)
-        r0 = bisect.bisect_left(tiling.ys, y0 - eps)
-        r1 = bisect.bisect_left(tiling.ys, y1 - eps)
+        c0, c1 = _nearest(tiling.xs, x0), _nearest(tiling.xs, x1)
+        r0, r1 = _nearest(tiling.ys, y0), _nearest(tiling.ys, y1)
         cells = {
             tiling.labels[r][c]
             for r in range(r0, max(r1, r0 + 1))
             for c in range(c0, max(c1, c0 + 1))
         }
-        if cells != {label}:
+        off = max(
+            abs(tiling.xs[c0] - x0),
+            abs(tiling.xs[c1] - x1),
+            abs(tiling.ys[r0] - y0),
+            abs(tiling.ys[r1] - y1),
+        )
+        if cells != {label} or off > eps:
             problems.append(
                 f"{label} at ({x0:.4g}, {y0:.4g})-({x1:.4g}, {y1:.4g}) covers {sorted(cells)}"
             )
@@ -169,4 +230,19 @@ def rederivation_problems(grammar: Grammar, tiling: Tiling, limit: int = 5) -> l
     return problems
 
 
-__all__ = ["Extraction", "Options", "extract_grammar", "rederivation_problems"]
+def _nearest(cuts: tuple[float, ...], value: float) -> int:
+    """The index of the cut nearest to the value."""
+    i = bisect.bisect_left(cuts, value)
+    if i == len(cuts) or (i > 0 and value - cuts[i - 1] < cuts[i] - value):
+        return i - 1
+    return i
+
+
+__all__ = [
+    "CELLS_MAX",
+    "Extraction",
+    "Options",
+    "check_options",
+    "extract_grammar",
+    "rederivation_problems",
+]

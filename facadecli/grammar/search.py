@@ -23,6 +23,9 @@ the repeated regions that line cuts through over the cells of the region.
   teaches nothing new and is skipped. The first iteration is the greedy one, so the result
   is never worse than greedy's; the cheapest grammar of all iterations is returned. A seed
   makes it reproducible; a time limit stops early with the best grammar so far.
+
+The run's ``Deadline`` bounds the work: the greedy grammar checks its hard limit at every
+region (exit 4 when it passes), ADP stops at the soft limit, even within an iteration.
 """
 
 from __future__ import annotations
@@ -31,12 +34,12 @@ import heapq
 import itertools
 import math
 import random
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.regions import Grid, Region
 from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Part, Rule
 from facadecli.grammar.symmetry import Repeats, find_repeats
@@ -72,6 +75,7 @@ class SearchResult:
     greedy_cost: float
     regions: int  # distinct regions given actions
     repeats: int  # repeated regions found by hashing (kinds)
+    repeats_complete: bool = True  # False when the time limit stopped their search
 
 
 class Search:
@@ -81,11 +85,13 @@ class Search:
         costs: Costs = DEFAULT_COSTS,
         extensions: tuple[str, ...] = (),
         background: str = BACKGROUND,
+        deadline: Deadline | None = None,
     ):
+        self.deadline = deadline or Deadline()
         self.grid = Grid(tiling, background)
         self.costs = costs
         self.extensions = set(extensions)
-        self.repeats: Repeats = find_repeats(self.grid)
+        self.repeats: Repeats = find_repeats(self.grid, deadline=self.deadline)
         self._actions: dict[Region, list[Action]] = {}
         self._greedy: dict[int, Action] | None = None
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
@@ -162,7 +168,7 @@ class Search:
     def _line_costs(self, region: Region, axis: Axis) -> dict[int, float]:
         """The heuristic's cost of each line of an axis inside the region (section 4.4)."""
         r0, r1, c0, c1 = region
-        rep = self.repeats
+        rep = self.repeats.starting_in(r0, r1)
         inside = (rep.r0 >= r0) & (rep.r1 <= r1) & (rep.c0 >= c0) & (rep.c1 <= c1)
         lo, hi = (c0, c1) if axis == "x" else (r0, r1)
         lines = np.arange(lo + 1, hi)
@@ -170,9 +176,13 @@ class Search:
             return {}
         start = (rep.c0 if axis == "x" else rep.r0)[inside]
         stop = (rep.c1 if axis == "x" else rep.r1)[inside]
-        cut = (start[:, None] < lines[None, :]) & (lines[None, :] < stop[:, None])
+        weights = rep.cells[inside].astype(float)
+        # a repeat's cells count for the lines strictly inside its span: summed as
+        # differences (+ after its start, - at its end), linear in repeats plus lines
+        size = hi - lo + 1
+        steps = np.bincount(start + 1 - lo, weights, size) - np.bincount(stop - lo, weights, size)
         cells = (r1 - r0) * (c1 - c0)
-        costs = rep.cells[inside] @ cut / cells
+        costs = np.cumsum(steps)[1 : hi - lo] / cells
         return {int(line): float(c) for line, c in zip(lines, costs, strict=True) if c > 0}
 
     def _runs(self, region: Region, axis: Axis, full: tuple[int, ...]) -> list[tuple[int, ...]]:
@@ -202,7 +212,7 @@ class Search:
     def _repeated(self, region: Region, axis: Axis, full: tuple[int, ...]) -> list[tuple[int, ...]]:
         """Bounds that keep whole the repeated regions spanning the region across the axis."""
         r0, r1, c0, c1 = region
-        rep = self.repeats
+        rep = self.repeats.starting_in(r0, r1)
         if axis == "x":
             spans = (rep.r0 == r0) & (rep.r1 == r1) & (rep.c0 >= c0) & (rep.c1 <= c1)
             start, stop = rep.c0[spans], rep.c1[spans]
@@ -380,16 +390,20 @@ class Search:
     def greedy(self) -> dict[int, Action]:
         """The greedy baseline's rules (built once: ADP starts from them too)."""
         if self._greedy is None:
-            self._greedy = self.build(lambda region, cid, rules, pending: self.actions(region)[0])
+
+            def best(
+                region: Region, cid: int, rules: dict[int, Action], pending: set[int]
+            ) -> Action:
+                self.deadline.check("building the greedy grammar")
+                return self.actions(region)[0]
+
+            self._greedy = self.build(best)
         return self._greedy
 
-    def adp(
-        self, iterations: int, seed: int, time_limit: float = math.inf
-    ) -> tuple[dict[int, Action], int, int]:
+    def adp(self, iterations: int, seed: int) -> tuple[dict[int, Action], int, int]:
         """The cheapest grammar of ``iterations`` (see the module), the iteration it was
-        found in (0 is the greedy one), and the iterations done: fewer when ``time_limit``
-        seconds run out first."""
-        deadline = time.perf_counter() + time_limit
+        found in (0 is the greedy one), and the iterations done: fewer when the deadline's
+        soft limit passes first."""
         rng = random.Random(seed)
         values: dict[int, float] = {}
         below: dict[int, frozenset[int]] = {}  # content -> the contents its best rules split
@@ -403,6 +417,8 @@ class Search:
         get_value, get_below, draw = values.get, below.get, rng.random
 
         def choose(region: Region, cid: int, rules: dict[int, Action], pending: set[int]) -> Action:
+            if self.deadline.passed():
+                raise _TimeUp
             actions = self.actions(region)
             if len(actions) == 1:
                 return actions[0]
@@ -434,11 +450,12 @@ class Search:
         seen: set[tuple[tuple[int, int], ...]] = set()  # grammars built already: nothing new
         done = iterations
         for t in range(1, iterations):
-            if time.perf_counter() > deadline:
+            epsilon = 1.0 - t / iterations
+            try:
+                rules = self.build(choose)
+            except _TimeUp:
                 done = t
                 break
-            epsilon = 1.0 - t / iterations
-            rules = self.build(choose)
             signature = tuple((cid, id(action)) for cid, action in rules.items())
             if signature in seen:
                 continue
@@ -539,6 +556,10 @@ class Search:
         return Rule(action.op, action.axis, tuple(parts), action.count, action.centre)
 
 
+class _TimeUp(Exception):
+    """The soft time limit passed during an ADP iteration: the iteration is dropped."""
+
+
 def _cells(region: Region) -> int:
     return (region[1] - region[0]) * (region[3] - region[2])
 
@@ -553,15 +574,18 @@ def extract(
     background: str = BACKGROUND,
     *,
     time_limit: float = math.inf,
+    deadline: Deadline | None = None,
 ) -> SearchResult:
-    """A split grammar for the tiling, by ``greedy`` or ``adp`` (see the module)."""
-    search = Search(tiling, costs, extensions, background)
+    """A split grammar for the tiling, by ``greedy`` or ``adp`` (see the module), within
+    the run's deadline (else one of ``time_limit`` seconds from now)."""
+    deadline = deadline or Deadline(time_limit)
+    search = Search(tiling, costs, extensions, background, deadline)
     greedy = search.greedy()
     greedy_cost = search.cost(greedy)
     if method == "greedy" or iterations <= 1:
         rules, best_at, done = greedy, 0, 1
     else:
-        rules, best_at, done = search.adp(iterations, seed, time_limit)
+        rules, best_at, done = search.adp(iterations, seed)
     return SearchResult(
         search.grammar(rules),
         method,
@@ -570,6 +594,7 @@ def extract(
         greedy_cost,
         search.regions_explored,
         search.repeats.kinds,
+        search.repeats.complete,
     )
 
 

@@ -8,6 +8,9 @@ joins the table. Growing in four directions finds repeats that are not grids (Fi
 
 Only the largest repeats are kept for the splitting heuristic: a repeated region whose every
 occurrence lies inside an occurrence of a larger one, as often repeated, says nothing more.
+
+Growing stops after ``MAX_REPEATS`` repeated regions, or when the run's deadline says the
+share of the time limit for it has passed (``Repeats.complete`` is then False).
 """
 
 from __future__ import annotations
@@ -16,14 +19,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.regions import Grid, Region
 
 MAX_REPEATS = 1000  # repeated regions explored before the search stops growing
+TIME_SHARE = 0.5  # of the time limit: growing stops when it has passed
 
 
 @dataclass(frozen=True)
 class Repeats:
-    """Occurrences of the repeated regions as arrays, for the heuristic's sums."""
+    """Occurrences of the repeated regions as arrays, for the heuristic's sums, sorted by
+    their first row."""
 
     r0: np.ndarray
     r1: np.ndarray
@@ -31,10 +37,25 @@ class Repeats:
     c1: np.ndarray
     cells: np.ndarray
     kinds: int  # how many different repeated regions
+    complete: bool = True  # False when the time limit stopped the growing
 
     @property
     def count(self) -> int:
         return int(self.r0.size)
+
+    def starting_in(self, r0: int, r1: int) -> Repeats:
+        """The occurrences whose first row is one of ``r0 .. r1 - 1``: those that can lie
+        in a region of those rows (the arrays are sorted by first row)."""
+        a, b = np.searchsorted(self.r0, [r0, r1]).tolist()
+        return Repeats(
+            self.r0[a:b],
+            self.r1[a:b],
+            self.c0[a:b],
+            self.c1[a:b],
+            self.cells[a:b],
+            self.kinds,
+            self.complete,
+        )
 
 
 def _seeds(grid: Grid) -> list[Region]:
@@ -93,36 +114,63 @@ def _grow(grid: Grid, region: Region, direction: str) -> Region | None:
     return None
 
 
-def _disjoint(regions: list[Region]) -> list[Region]:
+def _disjoint(regions: list[Region], taken: np.ndarray) -> list[Region]:
+    """The regions in order, each kept unless it shares a cell with one kept before
+    (``taken`` marks the kept cells meanwhile; it is all False before and after)."""
     kept: list[Region] = []
     for r in sorted(set(regions)):
-        if all(r[1] <= k[0] or k[1] <= r[0] or r[3] <= k[2] or k[3] <= r[2] for k in kept):
+        cells = taken[r[0] : r[1], r[2] : r[3]]
+        if not cells.any():
+            cells[...] = True
             kept.append(r)
+    for r in kept:
+        taken[r[0] : r[1], r[2] : r[3]] = False
     return kept
 
 
-def _inside(inner: Region, outer: Region) -> bool:
+def _held(regions: list[Region], kept: list[list[Region]]) -> bool:
+    """Whether every region lies in an occurrence of one kept kind that is at least as
+    often repeated (checked for the first region against all kept kinds at once, then in
+    full for the kinds that hold it)."""
+    if not kept:
+        return False
+    boxes = np.array([r for kind in kept for r in kind], dtype=int)
+    owner = np.repeat(np.arange(len(kept)), [len(kind) for kind in kept])
+    inner = np.array(regions, dtype=int)
+    for index in np.unique(owner[_within(inner[:1], boxes)[0]]).tolist():
+        if len(kept[index]) >= len(regions) and _within(inner, boxes[owner == index]).any(1).all():
+            return True
+    return False
+
+
+def _within(inner: np.ndarray, outer: np.ndarray) -> np.ndarray:
+    """``[i, j]``: region ``inner[i]`` lies inside region ``outer[j]``."""
+    a, b = inner[:, None, :], outer[None, :, :]
     return (
-        outer[0] <= inner[0]
-        and inner[1] <= outer[1]
-        and outer[2] <= inner[2]
-        and inner[3] <= outer[3]
+        (b[..., 0] <= a[..., 0])
+        & (a[..., 1] <= b[..., 1])
+        & (b[..., 2] <= a[..., 2])
+        & (a[..., 3] <= b[..., 3])
     )
 
 
-def find_repeats(grid: Grid, limit: int = MAX_REPEATS) -> Repeats:
+def find_repeats(grid: Grid, limit: int = MAX_REPEATS, deadline: Deadline | None = None) -> Repeats:
     table: dict[int, list[Region]] = {}
     by_content: dict[int, list[Region]] = {}
+    taken = np.zeros(grid.labels.shape, dtype=bool)
     for region in _seeds(grid):
         by_content.setdefault(grid.content(region), []).append(region)
     queue = []
     for cid, regions in sorted(by_content.items()):
-        kept = _disjoint(regions)
+        kept = _disjoint(regions, taken)
         if len(kept) >= 2:
             table[cid] = kept
             queue.append(cid)
-    head = 0
+    head, complete = 0, True
     while head < len(queue) and len(table) < limit:
+        if deadline is not None and deadline.passed(TIME_SHARE):
+            complete = False
+            break
         occurrences = table[queue[head]]
         head += 1
         for direction in ("left", "right", "down", "up"):
@@ -134,7 +182,7 @@ def find_repeats(grid: Grid, limit: int = MAX_REPEATS) -> Repeats:
             for cid, regions in grown.items():
                 if cid in table or grid.content(regions[0]) in grid.terminal:
                     continue
-                kept = _disjoint(regions)
+                kept = _disjoint(regions, taken)
                 if len(kept) >= 2:
                     table[cid] = kept
                     queue.append(cid)
@@ -142,14 +190,11 @@ def find_repeats(grid: Grid, limit: int = MAX_REPEATS) -> Repeats:
     kinds = sorted(table.items(), key=lambda item: -_cells(item[1][0]))
     kept_kinds: list[list[Region]] = []
     for _, regions in kinds:
-        if any(
-            len(bigger) >= len(regions) and all(any(_inside(r, b) for b in bigger) for r in regions)
-            for bigger in kept_kinds
-        ):
-            continue
-        kept_kinds.append(regions)
+        if not _held(regions, kept_kinds):
+            kept_kinds.append(regions)
     flat = [r for regions in kept_kinds for r in regions]
     array = np.array(flat, dtype=int).reshape(-1, 4)
+    array = array[np.argsort(array[:, 0], kind="stable")]  # by first row (``starting_in``)
     return Repeats(
         array[:, 0],
         array[:, 1],
@@ -157,6 +202,7 @@ def find_repeats(grid: Grid, limit: int = MAX_REPEATS) -> Repeats:
         array[:, 3],
         (array[:, 1] - array[:, 0]) * (array[:, 3] - array[:, 2]),
         len(kept_kinds),
+        complete,
     )
 
 

@@ -1,63 +1,41 @@
 """Labelled layouts in, a tiling of terminal regions out (issue 6, step 1).
 
-A labelled layout is a set of rectangles with labels and a z-order, on a façade of a given
-size: x left to right, y bottom to top (SPEC 2.1). Rectangles overlap and do not tile; the
-tiling cuts the façade at every rectangle edge, gives each cell the label of the top-most
-rectangle covering it (later ones win among equals) or the background, after snapping
-nearly equal edges together so that hand-drawn annotations line up.
+A labelled layout (``inputs``) is a set of rectangles with labels and a z-order; they
+overlap and do not tile. The tiling cuts the façade at every rectangle edge, gives each cell
+the label of the top-most rectangle covering it (later ones win among equals) or the
+background, after snapping nearly equal edges together so that hand-drawn annotations line
+up.
 
-Readers: CMP Facade Database XML (a sequence of ``<object>`` elements without a root;
-its two ``<x>`` values are the normalised *row* bounds, its two ``<y>`` values the
-normalised *column* bounds, origin top-left), a plain JSON list of
-``{label, x0, y0, x1, y1}``, and facadecli's own ``<name>.layout.json`` (visible shapes).
+The readers live in ``cmp_xml`` (CMP Facade Database XML) and ``json_layouts`` (a plain
+JSON list of ``{label, x0, y0, x1, y1}``, and facadecli's own ``<name>.layout.json``); they
+are named here too.
 """
 
 from __future__ import annotations
 
 import bisect
-import itertools
-import json
-import re
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
 
-from facadecli.errors import SpecError
+import numpy as np
 
-BACKGROUND = "facade"
+from facadecli.grammar.cmp_xml import read_cmp
+from facadecli.grammar.deadline import Deadline
+from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
+from facadecli.grammar.json_layouts import read_plain, read_report
 
-# CMP labels and their z-order (label_names.txt of the database: higher is drawn over lower)
-CMP_Z_ORDER = {
-    "background": 1,
-    "facade": 2,
-    "molding": 7,
-    "cornice": 11,
-    "pillar": 12,
-    "window": 10,
-    "door": 5,
-    "sill": 3,
-    "blind": 6,
-    "balcony": 4,
-    "shop": 9,
-    "deco": 8,
-}
-
-
-@dataclass(frozen=True)
-class Rect:
-    label: str
-    x0: float
-    y0: float
-    x1: float
-    y1: float
-    z: float = 0.0
-
-
-@dataclass(frozen=True)
-class LabelledLayout:
-    width: float
-    height: float
-    rects: tuple[Rect, ...]
+__all__ = [
+    "BACKGROUND",
+    "CMP_Z_ORDER",
+    "LabelledLayout",
+    "Rect",
+    "Tiling",
+    "read_cmp",
+    "read_plain",
+    "read_report",
+    "snap",
+    "snap_layout",
+    "tile",
+]
 
 
 @dataclass(frozen=True)
@@ -72,84 +50,6 @@ class Tiling:
         column = min(max(bisect.bisect_right(self.xs, x) - 1, 0), len(self.xs) - 2)
         row = min(max(bisect.bisect_right(self.ys, y) - 1, 0), len(self.ys) - 2)
         return self.labels[row][column]
-
-
-def read_cmp(path: Path) -> LabelledLayout:
-    """A CMP annotation, on a unit façade (the images' pixel size is not in the XML)."""
-    text = path.read_text(encoding="utf-8")
-    rects = []
-    for number, block in enumerate(re.findall(r"<object>(.*?)</object>", text, re.S)):
-        xs = [float(v) for v in re.findall(r"<x>([^<]+)</x>", block)]
-        ys = [float(v) for v in re.findall(r"<y>([^<]+)</y>", block)]
-        name = re.search(r"<labelname>([^<]+)</labelname>", block)
-        if len(xs) != 2 or len(ys) != 2 or name is None:
-            raise SpecError.at(
-                str(path),
-                None,
-                None,
-                f"object {number + 1} is incomplete",
-                "each <object> needs two <x>, two <y> and a <labelname>",
-            )
-        label = name.group(1).strip()
-        top, bottom = sorted(xs)  # rows, from the top
-        left, right = sorted(ys)
-        rects.append(
-            Rect(
-                label,
-                left,
-                1.0 - bottom,
-                right,
-                1.0 - top,
-                CMP_Z_ORDER.get(label, 0) + number * 1e-6,
-            )
-        )
-    return LabelledLayout(1.0, 1.0, tuple(rects))
-
-
-def read_plain(path: Path) -> LabelledLayout:
-    """A JSON list of ``{label, x0, y0, x1, y1}`` (later entries drawn over earlier), or an
-    object with that list under ``rects`` and the façade size under ``canvas``."""
-    data: Any = json.loads(path.read_text(encoding="utf-8"))
-    entries = data["rects"] if isinstance(data, dict) else data
-    rects = tuple(
-        Rect(
-            str(e["label"]),
-            float(e["x0"]),
-            float(e["y0"]),
-            float(e["x1"]),
-            float(e["y1"]),
-            float(e.get("z", i)),
-        )
-        for i, e in enumerate(entries)
-    )
-    for i, r in enumerate(rects):
-        if not (r.x1 > r.x0 and r.y1 > r.y0):
-            raise SpecError.at(
-                str(path),
-                None,
-                None,
-                f"rectangle {i + 1} ({r.label}) has no area: x {r.x0:g}..{r.x1:g}, "
-                f"y {r.y0:g}..{r.y1:g}",
-                "give x0 < x1 and y0 < y1",
-            )
-    if isinstance(data, dict) and "canvas" in data:
-        width, height = float(data["canvas"]["width"]), float(data["canvas"]["height"])
-    else:
-        width = max((r.x1 for r in rects), default=1.0)
-        height = max((r.y1 for r in rects), default=1.0)
-    return LabelledLayout(width, height, rects)
-
-
-def read_report(path: Path) -> LabelledLayout:
-    """The visible shapes of a facadecli layout report, labelled ``<x symbol>.<y symbol>``."""
-    report = json.loads(path.read_text(encoding="utf-8"))
-    order = {layer["name"]: i for i, layer in enumerate(report["layers"])}
-    rects = tuple(
-        Rect(f"{s['x']}.{s['y']}", s["x0"], s["y0"], s["x1"], s["y1"], order[s["layer"]])
-        for s in report["shapes"]
-        if s["visible"]
-    )
-    return LabelledLayout(report["canvas"]["width"], report["canvas"]["height"], rects)
 
 
 def snap(
@@ -191,9 +91,17 @@ def snap_layout(layout: LabelledLayout, tolerance: float = 0.005) -> LabelledLay
     return LabelledLayout(w, h, rects)
 
 
-def tile(layout: LabelledLayout, tolerance: float = 0.005, background: str = BACKGROUND) -> Tiling:
+def tile(
+    layout: LabelledLayout,
+    tolerance: float = 0.005,
+    background: str = BACKGROUND,
+    deadline: Deadline | None = None,
+) -> Tiling:
     """The tiling of a labelled layout, snapped first (``snap_layout``): cuts at every edge,
-    and each cell the label of the top-most rectangle covering it, else the background."""
+    and each cell the label of the top-most rectangle covering it, else the background.
+    Rectangles are painted bottom up over the cells they cover (numpy), so the work is the
+    cells covered, not the cells times the rectangles."""
+    deadline = deadline or Deadline()
     layout = snap_layout(layout, tolerance) if tolerance > 0 else layout
     w, h = layout.width, layout.height
     clip = [
@@ -203,17 +111,13 @@ def tile(layout: LabelledLayout, tolerance: float = 0.005, background: str = BAC
     rects = [r for r in clip if r.x1 > r.x0 and r.y1 > r.y0]
     xs = sorted({0.0, w, *(v for r in rects for v in (r.x0, r.x1))})
     ys = sorted({0.0, h, *(v for r in rects for v in (r.y0, r.y1))})
-    ranked = sorted(rects, key=lambda r: r.z)
-    labels = []
-    for y0, y1 in itertools.pairwise(ys):
-        row = []
-        cy = (y0 + y1) / 2
-        for x0, x1 in itertools.pairwise(xs):
-            cx = (x0 + x1) / 2
-            label = background
-            for rect in ranked:  # the last (top-most) covering rectangle wins
-                if rect.x0 <= cx <= rect.x1 and rect.y0 <= cy <= rect.y1:
-                    label = rect.label
-            row.append(label)
-        labels.append(tuple(row))
-    return Tiling(tuple(xs), tuple(ys), tuple(labels))
+    column = {x: i for i, x in enumerate(xs)}
+    row = {y: i for i, y in enumerate(ys)}
+    names = [background, *sorted({r.label for r in rects} - {background})]
+    code = {name: i for i, name in enumerate(names)}
+    cells = np.zeros((len(ys) - 1, len(xs) - 1), dtype=np.int32)
+    for r in sorted(rects, key=lambda r: r.z):  # stable: among equals the later wins
+        deadline.check("tiling")
+        cells[row[r.y0] : row[r.y1], column[r.x0] : column[r.x1]] = code[r.label]
+    labels = np.array(names, dtype=object)[cells].tolist()
+    return Tiling(tuple(xs), tuple(ys), tuple(tuple(line) for line in labels))

@@ -32,6 +32,7 @@ THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
 SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
 MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
+NAME_MAX = 150  # characters of the source's name in a derived layout's name
 
 
 class TooLarge(ValueError):
@@ -376,7 +377,9 @@ def pieces_layout(
 def derive_layout(
     grammar: Grammar, tiling: Tiling, width: float, height: float, name: str
 ) -> Layout:
-    """The grammar at a new size, aligned, as a layout named ``<name>-<W>x<H>``."""
+    """The grammar at a new size, aligned, as a layout named ``<name>-<W>x<H>`` (the name
+    with every character a layout name cannot hold made ``_``)."""
     source = (tiling.xs[-1], tiling.ys[-1])
     pieces, warnings = align(derive_at(grammar, source, width, height), width, height)
-    return pieces_layout(pieces, width, height, f"{name}-{width:g}x{height:g}", warnings)
+    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", name)[:NAME_MAX] or "layout"
+    return pieces_layout(pieces, width, height, f"{safe}-{width:g}x{height:g}", warnings)
