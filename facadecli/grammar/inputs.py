@@ -17,6 +17,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from facadecli.errors import SpecError
+from facadecli.limits import (
+    LABEL_CHARS_MAX,
+    LAYOUT_BYTES_MAX,
+    LAYOUT_EXTENT_MAX,
+    LAYOUT_RECTS_MAX,
+)
 
 BACKGROUND = "facade"
 
@@ -36,11 +42,11 @@ CMP_Z_ORDER = {
     "deco": 8,
 }
 
-FILE_BYTES_MAX = 32_000_000  # bytes of one layout file
-RECTS_MAX = 20_000  # rectangles of one layout
-EXTENT_MAX = 1e6  # a façade's size and any coordinate, in the file's own units
+FILE_BYTES_MAX = LAYOUT_BYTES_MAX  # bytes of one layout file
+RECTS_MAX = LAYOUT_RECTS_MAX  # rectangles of one layout
+EXTENT_MAX = LAYOUT_EXTENT_MAX  # a façade's size and any coordinate, in the file's own units
 EXTENT_MIN = 1e-6  # a façade's size, in the file's own units
-LABEL_MAX = 100  # characters of a label
+LABEL_MAX = LABEL_CHARS_MAX  # characters of a label
 EDGE_SLACK = 0.01  # x the façade's extent: edges this far outside it are clipped, not refused
 PROBLEMS_MAX = 20  # problems reported at once; reading stops at the next one
 

@@ -23,6 +23,7 @@ from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
 from facadecli.grammar.tiling import Tiling, snap_layout, tile
+from facadecli.limits import LAYOUT_CELLS_MAX
 
 # How much each kind of input is tidied, as fractions of the façade's size: edges closer
 # than ``snap`` become one, and repeated elements closer in size than ``tolerance`` get one
@@ -30,7 +31,7 @@ from facadecli.grammar.tiling import Tiling, snap_layout, tile
 # be measured or detected; facadecli layouts are exact.
 TIDY = {"cmp": (0.005, 0.01), "plain": (0.001, 0.005), "report": (0.0, 0.0)}
 REDERIVE_TOLERANCE = 1e-4  # x the façade's size: a derived edge this near a tiling edge is on it
-CELLS_MAX = 1_000_000  # cells of the snapped tiling (1000 x 1000: a plain list at its snap)
+CELLS_MAX = LAYOUT_CELLS_MAX  # cells of the snapped tiling (a plain list at its snap)
 TIDY_MAX = 0.1  # the largest snap and tolerance
 TIME_LIMIT_MAX = 86_400.0  # seconds
 COST_MAX = 1e6  # of a rule
