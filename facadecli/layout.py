@@ -140,18 +140,31 @@ def build_shapes(spec: Spec, x: AxisLayout, y: AxisLayout) -> tuple[Shape, ...]:
     return _cull(shapes)
 
 
+# meshes that fill their whole cell, from the depth given here up to their front: only
+# they can hide what is behind them (a frame, an arch or a column leaves gaps to see through)
+SOLID_BACK = {"box": "z0", "ledge": "z0", "panel": "z1"}
+
+
 def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
-    """Mark shapes whose cell is covered by opaque shapes of later layers in front of them."""
+    """Mark shapes hidden from every viewpoint in front: their cell is covered by opaque,
+    solid shapes of later layers that stand flush on them (no gap between, so no oblique
+    view sees behind them). A shape behind one that stands proud stays."""
     order = {name: i for i, name in enumerate(dict.fromkeys(s.layer for s in shapes))}
-    opaque = [s for s in shapes if s.opaque]
+    opaque = [s for s in shapes if s.opaque and s.mesh in SOLID_BACK]
     if not opaque:
         return tuple(shapes)
-    boxes = np.array([(s.x0, s.x1, s.y0, s.y1, s.z1, order[s.layer]) for s in opaque])
+    boxes = np.array(
+        [
+            (s.x0, s.x1, s.y0, s.y1, s.z1, order[s.layer], getattr(s, SOLID_BACK[s.mesh]))
+            for s in opaque
+        ]
+    )
     result = []
     for shape in shapes:
         near = (
             (boxes[:, 5] > order[shape.layer])
             & (boxes[:, 4] >= shape.z1)
+            & (boxes[:, 6] <= shape.z1 + 1e-9)
             & (boxes[:, 0] < shape.x1)
             & (boxes[:, 1] > shape.x0)
             & (boxes[:, 2] < shape.y1)

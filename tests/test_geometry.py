@@ -7,6 +7,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 import trimesh
 
@@ -15,6 +16,7 @@ from facadecli.export.gltf import glb_bytes
 from facadecli.export.obj import obj_files
 from facadecli.geometry.facade import facade_scene
 from facadecli.geometry.primitives import PRIMITIVES, Cell, asset
+from tests.rays import directions, missing
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "specs").glob("*.yaml"))
@@ -164,23 +166,51 @@ def test_textures_get_uvs_in_metres(tmp_path: Path) -> None:
     assert "brick.png" in files and b"map_Kd brick.png" in files["wall.mtl"]
 
 
-def test_hidden_shapes_are_culled_from_the_mesh_not_the_report() -> None:
-    text = """
+HIDDEN = """
 version: 1
 name: hidden
-canvas: {width: 4, height: 3}
-symbol_defaults: {opaque: true}
-symbols: {A: 1, B: 2, H: 3, F: 4}
-patterns: {back: "A B A", front: F}
+canvas: {{width: 4, height: 3}}
+symbol_defaults: {{opaque: true}}
+symbols: {{A: 1, B: 2, H: 3, F: 4}}
+patterns: {{back: "A B A", front: F}}
+defaults: {{thickness: 0.3}}
 layers:
-  - {name: back, x: back, y: H}
-  - {name: front, x: front, y: H, offset: 0.5}
+  - {{name: back, x: back, y: H}}
+  - {{name: front, x: front, y: H, offset: {offset}{mesh}}}
 """
-    layout = solve(parse_spec(text))
+
+
+def test_hidden_shapes_are_culled_from_the_mesh_not_the_report() -> None:
+    layout = solve(parse_spec(HIDDEN.format(offset=0.3, mesh="")))
     back = [s for s in layout.shapes if s.layer == "back"]
-    assert len(back) == 3 and not any(s.visible for s in back)  # all behind the front wall
+    assert len(back) == 3 and not any(s.visible for s in back)  # flush behind the front wall
     scene = facade_scene(layout)
     assert len(scene.graph.nodes_geometry) == 1  # only the front wall is built
+
+
+@pytest.mark.parametrize(
+    ("offset", "mesh"),
+    [(0.5, ""), (0.3, ", shapes: [{match: {x: F, y: H}, mesh: frame}]")],
+)
+def test_what_an_oblique_view_sees_is_never_culled(offset: float, mesh: str) -> None:
+    """A wall behind a layer that stands proud of it (air between), or behind a frame (open
+    in the middle), can be seen from the side: it stays."""
+    layout = solve(parse_spec(HIDDEN.format(offset=offset, mesh=mesh)))
+    assert all(s.visible for s in layout.shapes if s.layer == "back")
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_no_ray_at_35_degrees_passes_through_an_example(path: Path) -> None:
+    """Rays at 35° from the normal, from eight directions, at a 0.5 m grid over the façade:
+    every one meets geometry (no see-through holes, slots or missing walls)."""
+    layout = solve(load_spec(path))
+    triangles = facade_scene(layout, path.parent).to_geometry().triangles
+    xs = np.arange(0.25, layout.width - 0.2, 0.5)
+    ys = np.arange(0.25, layout.height - 0.2, 0.5)
+    targets = np.array([(x, y, 0.0) for x in xs for y in ys])
+    for direction in directions():
+        through = targets[missing(triangles, targets, direction)]
+        assert len(through) == 0, f"rays along {direction} pass at {through[:5].tolist()}"
 
 
 def test_a_mesh_file_next_to_the_spec_is_scaled_into_its_cells(tmp_path: Path) -> None:

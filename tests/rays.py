@@ -1,0 +1,61 @@
+"""Rays cast at a built façade, as a viewer sees it: which of them pass through it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+TILT = math.radians(35)  # from the façade's normal
+
+
+def directions(count: int = 8, tilt: float = TILT) -> np.ndarray:
+    """Unit vectors pointing *into* the façade (−z) from ``count`` directions around it."""
+    angles = [2 * math.pi * k / count for k in range(count)]
+    return np.array(
+        [
+            (-math.sin(tilt) * math.cos(a), -math.sin(tilt) * math.sin(a), -math.cos(tilt))
+            for a in angles
+        ]
+    )
+
+
+def missing(
+    triangles: np.ndarray, targets: np.ndarray, direction: np.ndarray, tile: float = 1.0
+) -> np.ndarray:
+    """For rays along ``direction`` through each target point (x, y, 0), whether the ray
+    meets no triangle at all (a hole). Rays are taken tile by tile, each against the
+    triangles near its tile (Möller-Trumbore, both faces)."""
+    top = float(triangles[:, :, 2].max()) + 0.1
+    bottom = float(triangles[:, :, 2].min()) - 0.1
+    # a ray enters above the highest point and leaves below the lowest
+    origins = targets - direction * ((top - targets[:, 2]) / -direction[2])[:, None]
+    reach = (top - bottom) / -direction[2] * np.linalg.norm(direction[:2]) + 1e-6
+    low = triangles.min(axis=1)
+    high = triangles.max(axis=1)
+    result = np.ones(len(targets), dtype=bool)
+    keys = np.floor(targets[:, :2] / tile).astype(int)
+    for key in np.unique(keys, axis=0):
+        rays = np.flatnonzero((keys == key).all(axis=1))
+        x0, y0 = key * tile - reach
+        x1, y1 = (key + 1) * tile + reach
+        near = (high[:, 0] >= x0) & (low[:, 0] <= x1) & (high[:, 1] >= y0) & (low[:, 1] <= y1)
+        if near.any():
+            result[rays] = ~_hits(triangles[near], origins[rays], direction)
+    return result
+
+
+def _hits(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2 = b - a, c - a
+    p = np.cross(direction, e2)  # (T, 3)
+    det = (e1 * p).sum(axis=1)  # (T,)
+    usable = np.abs(det) > 1e-12
+    inv = np.where(usable, 1.0 / np.where(usable, det, 1.0), 0.0)
+    s = origins[:, None, :] - a[None, :, :]  # (R, T, 3)
+    u = (s * p[None]).sum(axis=2) * inv[None]
+    q = np.cross(s, e1[None])
+    v = (q * direction).sum(axis=2) * inv[None]
+    t = (q * e2[None]).sum(axis=2) * inv[None]
+    inside = usable[None] & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & (t > 0)
+    return inside.any(axis=1)
