@@ -12,6 +12,7 @@ from facadecli.solver.axis import AxisLayout, PlacedLetter
 from facadecli.spec.model import Layer, ShapeRule, Spec
 
 DEFAULT_MATERIAL = "default"  # the built-in neutral grey when no material is named
+PANE_MATERIAL = "glass"  # the panes of frames and arches: the spec's glass, else a built-in
 
 
 @dataclass(frozen=True)
@@ -23,6 +24,7 @@ class Appearance:
     frame_width: float | None = None
     pane_depth: float | None = None
     segments: int | None = None
+    pane_material: str = PANE_MATERIAL
 
 
 @dataclass(frozen=True)
@@ -80,6 +82,7 @@ def appearance(spec: Spec, layer: Layer, x: str, y: str) -> Appearance:
         "frame_width": None,
         "pane_depth": None,
         "segments": None,
+        "pane_material": PANE_MATERIAL,
     }
     for rule in (*spec.shapes, *layer.shapes):
         if _matches(rule, x, y):

@@ -59,3 +59,22 @@ def _hits(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> 
     t = (q * e2[None]).sum(axis=2) * inv[None]
     inside = usable[None] & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & (t > 0)
     return inside.any(axis=1)
+
+
+def nearest(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """For each ray, the index of the first triangle it meets (−1 for none)."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2 = b - a, c - a
+    p = np.cross(direction, e2)
+    det = (e1 * p).sum(axis=1)
+    usable = np.abs(det) > 1e-12
+    inv = np.where(usable, 1.0 / np.where(usable, det, 1.0), 0.0)
+    s = origins[:, None, :] - a[None, :, :]
+    u = (s * p[None]).sum(axis=2) * inv[None]
+    q = np.cross(s, e1[None])
+    v = (q * direction).sum(axis=2) * inv[None]
+    t = (q * e2[None]).sum(axis=2) * inv[None]
+    inside = usable[None] & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & (t > 0)
+    t = np.where(inside, t, np.inf)
+    first = t.argmin(axis=1)
+    return np.where(np.isfinite(t.min(axis=1)), first, -1)

@@ -15,8 +15,8 @@ from facadecli import load_spec, parse_spec, solve
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.obj import obj_files
 from facadecli.geometry.facade import facade_scene
-from facadecli.geometry.primitives import PRIMITIVES, Cell, asset
-from tests.rays import directions, missing
+from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
+from tests.rays import directions, missing, nearest
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "specs").glob("*.yaml"))
@@ -47,7 +47,11 @@ def test_frame_has_a_recessed_pane() -> None:
         & (v[:, 1] < 1.9 - 1e-6)
     )
     assert not opening.any()  # nothing stands in the opening: bars are around it
-    assert (abs(v[:, 2] + 0.08) < 1e-9).sum() >= 4  # the pane's front, 8 cm back
+    pane = PANES["frame"](
+        Cell(width=1.0, height=2.0, thickness=0.2, frame_width=0.1, pane_depth=0.08)
+    )
+    assert (abs(pane.vertices[:, 2] + 0.08) < 1e-9).sum() >= 4  # the pane's front, 8 cm back
+    assert np.allclose(pane.bounds, [[0.1, 0.1, -0.09], [0.9, 1.9, -0.08]])  # the opening
 
 
 def test_mesh_assets_are_scaled_into_the_cell() -> None:
@@ -72,7 +76,8 @@ def test_glb_and_obj_load_back_with_the_canvas_bounds(path: Path, tmp_path: Path
     assert loaded.bounds[0][:2] == pytest.approx([0.0, 0.0], abs=1e-5)
     assert loaded.bounds[1][:2] == pytest.approx([width, height], abs=1e-5)
     instances = loaded.graph.nodes_geometry
-    assert len(instances) == len(visible)  # one node per visible shape
+    panes = [s for s in visible if s.mesh in PANES]
+    assert len(instances) == len(visible) + len(panes)  # a node per shape, and per pane
     assert all(len(loaded.geometry[loaded.graph[n][1]].faces) >= 1 for n in instances)
     text, files = obj_files(scene, "f")
     (tmp_path / "f.obj").write_text(text)
@@ -231,3 +236,25 @@ def test_a_mesh_file_next_to_the_spec_is_scaled_into_its_cells(tmp_path: Path) -
     ]
     assert len(placed) == 1
     assert placed[0].flatten().tolist() == pytest.approx([1, 0, -0.5, 2, 3, 0], abs=1e-6)
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_a_ray_at_the_middle_of_a_window_meets_glass_first(path: Path) -> None:
+    """Straight at the middle of every frame or arch, the first thing met is see-through:
+    its pane, or glass the spec put there (never a frame's solid panel)."""
+    layout = solve(load_spec(path))
+    windows = [s for s in layout.shapes if s.visible and s.mesh in PANES]
+    if not windows:
+        pytest.skip("no frame or arch in this example")
+    scene = facade_scene(layout, path.parent)
+    parts, see_through = [], []
+    for node in scene.graph.nodes_geometry:
+        transform, geometry = scene.graph[node]
+        mesh = scene.geometry[geometry]
+        parts.append(mesh.copy().apply_transform(transform).triangles)
+        alpha = mesh.visual.material.baseColorFactor[3]
+        see_through.extend([alpha < 255] * len(mesh.faces))
+    triangles = np.concatenate(parts)
+    origins = np.array([((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, 50.0) for s in windows])
+    first = nearest(triangles, origins, np.array([0.0, 0.0, -1.0]))
+    assert (first >= 0).all() and np.array(see_through)[first].all()

@@ -7,7 +7,8 @@ along the façade, y up, z towards the viewer (SPEC 2.1), metres: glTF's own fra
 
 from __future__ import annotations
 
-from functools import lru_cache
+from collections.abc import Callable
+from functools import lru_cache, partial
 from pathlib import Path
 
 import numpy as np
@@ -15,12 +16,13 @@ import trimesh
 from trimesh.visual.material import PBRMaterial
 
 from facadecli.errors import SpecError
-from facadecli.geometry.primitives import PRIMITIVES, Cell, asset
-from facadecli.layout import Layout, Shape
+from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
+from facadecli.layout import PANE_MATERIAL, Layout, Shape
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.spec.model import Material
 
 FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
+GLASS = Material(color="#a9c8e4", metallic=0.0, roughness=0.05, opacity=0.35)
 
 
 @lru_cache(maxsize=256)
@@ -92,56 +94,70 @@ def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
 
 
 def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
-    """The visible shapes of a layout as a scene (hidden ones are culled)."""
+    """The visible shapes of a layout as a scene (hidden ones are culled). A frame or an
+    arch is two meshes: its bars in the shape's material and its pane in the pane's."""
     spec = layout.spec
     materials = {name: pbr(name, m, base_dir) for name, m in spec.materials.items()}
     assets: dict[str, trimesh.Trimesh] = {}
     scene = trimesh.Scene()
     world = scene.graph.base_frame
-    shared: dict[tuple[object, ...], str] = {}
+    shared: dict[tuple[object, ...], str] = {}  # a part already built -> its geometry
     faces: dict[str, int] = {}  # triangles of each shared mesh
     total = 0  # triangles of the whole model (every node)
+
+    def place(
+        shape: Shape, part: str, material: str, build: Callable[[], trimesh.Trimesh], node: str
+    ) -> None:
+        nonlocal total
+        cell = _cell(shape)
+        key = (shape.mesh, part, cell, material, shape.reflected_x, shape.reflected_y)
+        placement = trimesh.transformations.translation_matrix((shape.x0, shape.y0, shape.z1))
+        parent = f"layer:{shape.layer}"
+        if key in shared:
+            total = _count(spec.name, total, faces[shared[key]])
+            scene.graph.update(
+                frame_to=node, frame_from=parent, matrix=placement, geometry=shared[key]
+            )
+            return
+        mesh = build()
+        _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
+        declared = spec.materials.get(material)
+        look = materials.get(material) or pbr(material, _builtin(material))
+        if declared is not None and declared.texture is not None:
+            mesh = metric_uv(mesh, declared.texture_size)
+            mesh.visual.material = look
+        else:
+            mesh.visual = trimesh.visual.TextureVisuals(material=look)
+        name = f"{shape.mesh.replace('/', '_')}-{material}-{len(shared)}"
+        shared[key] = name
+        faces[name] = len(mesh.faces)
+        total = _count(spec.name, total, faces[name])
+        scene.add_geometry(
+            mesh, geom_name=name, node_name=node, parent_node_name=parent, transform=placement
+        )
+
     for layer in spec.layers:
         if not layer.enabled:
             continue
-        layer_node = f"layer:{layer.name}"
-        scene.graph.update(frame_to=layer_node, frame_from=world)
+        scene.graph.update(frame_to=f"layer:{layer.name}", frame_from=world)
         count = 0
         for shape in layout.shapes:
             if shape.layer != layer.name or not shape.visible:
                 continue
-            cell = _cell(shape)
-            key = (shape.mesh, cell, shape.material, shape.reflected_x, shape.reflected_y)
-            placement = trimesh.transformations.translation_matrix((shape.x0, shape.y0, shape.z1))
             node = f"{layer.name}/{shape.x}.{shape.y}/{count}"
             count += 1
-            if key in shared:
-                total = _count(spec.name, total, faces[shared[key]])
-                scene.graph.update(
-                    frame_to=node, frame_from=layer_node, matrix=placement, geometry=shared[key]
-                )
-                continue
-            mesh = _build(shape, cell, base_dir, assets)
-            _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
-            material = materials.get(shape.material) or pbr(shape.material, FALLBACK_MATERIAL)
-            declared = spec.materials.get(shape.material)
-            if declared is not None and declared.texture is not None:
-                mesh = metric_uv(mesh, declared.texture_size)
-                mesh.visual.material = material
-            else:
-                mesh.visual = trimesh.visual.TextureVisuals(material=material)
-            name = f"{shape.mesh.replace('/', '_')}-{shape.material}-{len(shared)}"
-            shared[key] = name
-            faces[name] = len(mesh.faces)
-            total = _count(spec.name, total, faces[name])
-            scene.add_geometry(
-                mesh,
-                geom_name=name,
-                node_name=node,
-                parent_node_name=layer_node,
-                transform=placement,
-            )
+            cell = _cell(shape)
+            place(shape, "", shape.material, partial(_build, shape, cell, base_dir, assets), node)
+            pane = PANES.get(shape.mesh)
+            if pane is not None:
+                glass = shape.look.pane_material if shape.look else PANE_MATERIAL
+                place(shape, "pane", glass, partial(pane, cell), f"{node}/pane")
     return scene
+
+
+def _builtin(material: str) -> Material:
+    """The built-in material of a name a spec does not define."""
+    return GLASS if material == PANE_MATERIAL else FALLBACK_MATERIAL
 
 
 def _count(name: str, total: int, more: int) -> int:

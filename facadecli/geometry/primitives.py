@@ -62,17 +62,22 @@ def panel(cell: Cell) -> trimesh.Trimesh:
 
 
 def frame(cell: Cell) -> trimesh.Trimesh:
-    """A window or door frame: four bars and a pane recessed behind them."""
+    """A window or door frame: four bars (its pane is :func:`frame_pane`)."""
     w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
-    pane_z = -min(cell.pane, t)
     parts = [
         _block(0, w, 0, f, -t, 0),  # sill
         _block(0, w, h - f, h, -t, 0),  # head
         _block(0, f, f, h - f, -t, 0),  # jambs
         _block(w - f, w, f, h - f, -t, 0),
-        _block(f, w - f, f, h - f, pane_z - 0.01, pane_z),  # the pane
     ]
     return trimesh.util.concatenate(parts)
+
+
+def frame_pane(cell: Cell) -> trimesh.Trimesh:
+    """The pane of a frame, 1 cm thick, recessed ``pane_depth`` behind its front."""
+    w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
+    pane_z = -min(cell.pane, t)
+    return _block(f, w - f, f, h - f, pane_z - 0.01, pane_z)
 
 
 def arch(cell: Cell) -> trimesh.Trimesh:
@@ -81,17 +86,14 @@ def arch(cell: Cell) -> trimesh.Trimesh:
     radius = min(w / 2, h - f)
     spring = h - radius  # where the arch starts
     segments = max(3, cell.segments or DEFAULT_SEGMENTS)
-    pane_z = -min(cell.pane, t)
     parts = [
         _block(0, w, 0, f, -t, 0),
         _block(0, f, f, spring, -t, 0),
         _block(w - f, w, f, spring, -t, 0),
-        _block(f, w - f, f, spring, pane_z - 0.01, pane_z),
     ]
     centre = (w / 2, spring)
     inner = max(radius - f, 1e-3)
     ring = []
-    pane = []
     for i in range(segments):
         a0 = math.pi * i / segments
         a1 = math.pi * (i + 1) / segments
@@ -104,8 +106,24 @@ def arch(cell: Cell) -> trimesh.Trimesh:
         ring.append(
             _prism([outer_points[0], outer_points[1], inner_points[1], inner_points[0]], -t, 0)
         )
-        pane.append(_prism([centre, inner_points[0], inner_points[1]], pane_z - 0.01, pane_z))
-    return trimesh.util.concatenate(parts + ring + pane)
+    return trimesh.util.concatenate(parts + ring)
+
+
+def arch_pane(cell: Cell) -> trimesh.Trimesh:
+    """The pane of an arch: a rectangle up to the springing line and a half disc above."""
+    w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
+    radius = min(w / 2, h - f)
+    spring = h - radius
+    segments = max(3, cell.segments or DEFAULT_SEGMENTS)
+    pane_z = -min(cell.pane, t)
+    inner = max(radius - f, 1e-3)
+    centre = (w / 2, spring)
+    parts = [_block(f, w - f, f, spring, pane_z - 0.01, pane_z)]
+    for i in range(segments):
+        a0, a1 = math.pi * i / segments, math.pi * (i + 1) / segments
+        rim = [(centre[0] + inner * math.cos(a), centre[1] + inner * math.sin(a)) for a in (a0, a1)]
+        parts.append(_prism([centre, rim[0], rim[1]], pane_z - 0.01, pane_z))
+    return trimesh.util.concatenate(parts)
 
 
 def _prism(outline: list[tuple[float, float]], z0: float, z1: float) -> trimesh.Trimesh:
@@ -153,6 +171,9 @@ def ledge(cell: Cell) -> trimesh.Trimesh:
         ]
     )
 
+
+#: the panes of the primitives that have one, in the shape rule's ``pane_material``
+PANES: dict[str, Callable[[Cell], trimesh.Trimesh]] = {"frame": frame_pane, "arch": arch_pane}
 
 PRIMITIVES: dict[str, Callable[[Cell], trimesh.Trimesh]] = {
     "box": box,

@@ -270,6 +270,8 @@ class Checker:
                 )
         if rule.material is not None:
             self.check_material((*path, "material"), rule.material)
+        if rule.pane_material is not None and rule.pane_material != "glass":
+            self.check_material((*path, "pane_material"), rule.pane_material)
         if rule.mesh is not None:
             self.check_mesh((*path, "mesh"), rule.mesh)
 

@@ -198,6 +198,7 @@ class ShapeRule(Model):
     frame_width: PositiveLength | None = None  # frame and arch: width of the frame's bars
     pane_depth: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None  # pane recess
     segments: Annotated[int, Field(ge=3, le=128)] | None = None  # arch and column smoothness
+    pane_material: Ident | None = None  # frame and arch: the pane's (default: glass)
 
 
 class Layer(Model):
