@@ -258,3 +258,14 @@ def test_a_ray_at_the_middle_of_a_window_meets_glass_first(path: Path) -> None:
     origins = np.array([((s.x0 + s.x1) / 2, (s.y0 + s.y1) / 2, 50.0) for s in windows])
     first = nearest(triangles, origins, np.array([0.0, 0.0, -1.0]))
     assert (first >= 0).all() and np.array(see_through)[first].all()
+
+
+@pytest.mark.parametrize(("width", "height"), [(1.2, 2.4), (3.0, 1.2)])
+def test_an_arch_fills_its_cell(width: float, height: float) -> None:
+    """Straight rays anywhere over an arch's cell meet the arch or its pane: the spandrels
+    above the round top are wall, tall arches and low wide ones alike."""
+    cell = Cell(width=width, height=height, thickness=0.2, frame_width=0.1, segments=12)
+    triangles = np.concatenate([PRIMITIVES["arch"](cell).triangles, PANES["arch"](cell).triangles])
+    xs, ys = np.linspace(0.01, width - 0.01, 30), np.linspace(0.01, height - 0.01, 40)
+    origins = np.array([(x, y, 5.0) for x in xs for y in ys])
+    assert (nearest(triangles, origins, np.array([0.0, 0.0, -1.0])) >= 0).all()

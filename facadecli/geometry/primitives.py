@@ -106,7 +106,24 @@ def arch(cell: Cell) -> trimesh.Trimesh:
         ring.append(
             _prism([outer_points[0], outer_points[1], inner_points[1], inner_points[0]], -t, 0)
         )
+        ring.append(_spandrel(outer_points, h, t))
+    for x0, x1 in ((0.0, centre[0] - radius), (centre[0] + radius, w)):
+        if x1 - x0 > 1e-9:  # an arch lower than half its width leaves strips at the sides
+            ring.append(_block(x0, x1, spring, h, -t, 0))
     return trimesh.util.concatenate(parts + ring)
+
+
+def _spandrel(chord: list[tuple[float, float]], top: float, t: float) -> trimesh.Trimesh:
+    """The wall between one segment of an arch's outer edge and the top of its cell, so
+    the arch fills its cell (no open corners above a round top)."""
+    (xa, ya), (xb, yb) = chord
+    outline = [(xa, ya), (xb, yb)]
+    outline += [
+        point
+        for point in ((xb, top), (xa, top))
+        if abs(point[1] - (yb if point[0] == xb else ya)) > 1e-9
+    ]
+    return _prism(outline, -t, 0)
 
 
 def arch_pane(cell: Cell) -> trimesh.Trimesh:
