@@ -9,10 +9,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from facadecli.solver.axis import AxisLayout, PlacedLetter
-from facadecli.spec.model import Layer, ShapeRule, Spec
+from facadecli.spec.model import Layer, Material, ShapeRule, Spec
 
 DEFAULT_MATERIAL = "default"  # the built-in neutral grey when no material is named
-PANE_MATERIAL = "glass"  # the panes of frames and arches: the spec's glass, else a built-in
+PANE_MATERIAL = "glass"  # the panes of frames and arches: the spec's glass, else this one
+BUILTIN_GLASS = Material(color="#a9c8e4", metallic=0.0, roughness=0.05, opacity=0.35)
 
 
 @dataclass(frozen=True)

@@ -269,3 +269,58 @@ def test_an_arch_fills_its_cell(width: float, height: float) -> None:
     xs, ys = np.linspace(0.01, width - 0.01, 30), np.linspace(0.01, height - 0.01, 40)
     origins = np.array([(x, y, 5.0) for x in xs for y in ys])
     assert (nearest(triangles, origins, np.array([0.0, 0.0, -1.0])) >= 0).all()
+
+
+ARCHES = """
+version: 1
+name: arches
+canvas: {width: 9.0, height: 4.0}
+symbol_defaults: {opaque: true}
+symbols: {E: 1.0, W: 1.6, G: 3.0, T: 1.0}
+counters: {n: {min: 1}}
+patterns: {x: "E (W E)^n", y: "G T"}
+materials: {stone: {color: "#bdb3a1"}, white: {color: "#f4f1ea"}}
+layers:
+  - name: wall
+    x: x
+    y: y
+    shapes:
+      - {match: {x: W, y: G}, mesh: arch, material: stone, frame_width: 0.12}
+      - {match: {x: W, y: T}, mesh: frame, material: white}
+"""
+
+
+def test_the_elevation_draws_frames_and_arches_with_their_panes() -> None:
+    from xml.etree import ElementTree
+
+    from facadecli.export.svg import svg_text
+
+    layout = solve(parse_spec(ARCHES))
+    root = ElementTree.fromstring(svg_text(layout))
+    ns = "{http://www.w3.org/2000/svg}"
+    arches = [p for p in root.iter(f"{ns}path") if " A " in p.get("d", "")]
+    panes = [r for r in root.iter(f"{ns}rect") if r.get("fill") == "#a9c8e4"]
+    windows = [s for s in layout.shapes if s.x == "W"]
+    assert len(arches) == len(panes) == len(windows) // 2  # a round top, a glass pane each
+    assert all(p.get("fill") == "#a9c8e4" and p.get("fill-opacity") for p in arches)
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_labels_never_print_over_each_other(path: Path) -> None:
+    from facadecli.export.svg import LABEL_CHAR, LABEL_LINE, PIXELS_PER_METRE, _labels
+
+    layout = solve(load_spec(path))
+    boxes = []
+    for x, y, text in _labels(layout, PIXELS_PER_METRE):
+        half = LABEL_CHAR * len(text) / PIXELS_PER_METRE / 2
+        line = LABEL_LINE / PIXELS_PER_METRE
+        boxes.append((x - half, x + half, y - line / 2, y + line / 2))
+    assert len(boxes) >= len({(s.x0, s.y0) for s in layout.shapes if s.visible}) // 2
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1 :]:
+            assert not (
+                a[0] < b[1] - 1e-9
+                and b[0] < a[1] - 1e-9
+                and a[2] < b[3] - 1e-9
+                and b[2] < a[3] - 1e-9
+            )

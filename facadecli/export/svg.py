@@ -3,13 +3,18 @@ back to front, and with ``labels`` the symbol names and the alignment's column l
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from xml.sax.saxutils import escape
 
-from facadecli.layout import Layout
+from facadecli.geometry.cell import Cell, arch_radius
+from facadecli.layout import BUILTIN_GLASS, PANE_MATERIAL, Layout, Shape
+from facadecli.spec.model import Spec
 
 PIXELS_PER_METRE = 40.0
 MARGIN = 20.0
 FALLBACK_COLOUR = "#bfbfbf"
+LABEL_CHAR = 5.4  # pixels a character of a 9 px label takes, at most
+LABEL_LINE = 11.0  # pixels a label line takes
 
 
 def _number(value: float) -> str:
@@ -45,18 +50,7 @@ def svg_text(layout: Layout, labels: bool = False) -> str:
             continue
         lines.append(f'<g id="layer-{escape(layer.name)}">')
         for shape in shapes:
-            material = spec.materials.get(shape.material)
-            colour = material.color[:7] if material else FALLBACK_COLOUR
-            opacity = material.opacity if material else 1.0
-            lines.append(
-                f'<rect x="{px(shape.x0)}" y="{py(shape.y1)}" '
-                f'width="{_number((shape.x1 - shape.x0) * scale)}" '
-                f'height="{_number((shape.y1 - shape.y0) * scale)}" fill="{colour}" '
-                + (f'fill-opacity="{_number(opacity)}" ' if opacity < 1 else "")
-                + 'stroke="#333333" stroke-width="0.5">'
-                f"<title>{escape(shape.layer)}: {escape(shape.x)} x {escape(shape.y)}</title>"
-                "</rect>"
-            )
+            lines.extend(_shape(shape, spec, px, py, scale))
         lines.append("</g>")
     if labels:
         lines.append('<g id="labels" font-family="sans-serif" font-size="9" fill="#c00000">')
@@ -75,14 +69,96 @@ def svg_text(layout: Layout, labels: bool = False) -> str:
                             f'y2="{py(boundary)}" stroke="#c00000" stroke-width="0.5" '
                             'stroke-dasharray="2 2"/>'
                         )
-        for shape in layout.shapes:
-            if shape.visible:
-                cx = (shape.x0 + shape.x1) / 2
-                cy = (shape.y0 + shape.y1) / 2
-                lines.append(
-                    f'<text x="{px(cx)}" y="{py(cy)}" text-anchor="middle">'
-                    f"{escape(shape.x)}{escape(shape.y)}</text>"
-                )
+        for x, y, text in _labels(layout, scale):
+            lines.append(
+                f'<text x="{px(x)}" y="{py(y)}" text-anchor="middle" dominant-baseline="middle">'
+                f"{escape(text)}</text>"
+            )
         lines.append("</g>")
     lines.append("</svg>")
     return "\n".join(lines) + "\n"
+
+
+def _colour(spec: Spec, name: str) -> tuple[str, float]:
+    material = spec.materials.get(name)
+    if material is not None:
+        return material.color[:7], material.opacity
+    if name == PANE_MATERIAL:
+        return BUILTIN_GLASS.color, BUILTIN_GLASS.opacity
+    return FALLBACK_COLOUR, 1.0
+
+
+def _fill(spec: Spec, name: str) -> str:
+    colour, opacity = _colour(spec, name)
+    return f'fill="{colour}"' + (f' fill-opacity="{_number(opacity)}"' if opacity < 1 else "")
+
+
+def _shape(
+    shape: Shape, spec: Spec, px: Callable[[float], str], py: Callable[[float], str], scale: float
+) -> list[str]:
+    """A shape as the front view of its mesh: a frame's bars around its pane, an arch's
+    curve over its pane, anything else its cell."""
+    title = f"<title>{escape(shape.layer)}: {escape(shape.x)} x {escape(shape.y)}</title>"
+    outline = 'stroke="#333333" stroke-width="0.5"'
+    parts = [
+        f'<rect x="{px(shape.x0)}" y="{py(shape.y1)}" '
+        f'width="{_number((shape.x1 - shape.x0) * scale)}" '
+        f'height="{_number((shape.y1 - shape.y0) * scale)}" {_fill(spec, shape.material)} '
+        f"{outline}>{title}</rect>"
+    ]
+    look = shape.look
+    if look is None or shape.mesh not in ("frame", "arch"):
+        return parts
+    w, h = shape.x1 - shape.x0, shape.y1 - shape.y0
+    f = Cell(w, h, shape.z1 - shape.z0, look.frame_width).frame
+    pane = _fill(spec, look.pane_material)
+    x0, x1, y0 = shape.x0 + f, shape.x1 - f, shape.y0 + f
+    if shape.mesh == "frame":
+        parts.append(
+            f'<rect x="{px(x0)}" y="{py(shape.y1 - f)}" width="{_number((x1 - x0) * scale)}" '
+            f'height="{_number((h - 2 * f) * scale)}" {pane} {outline}/>'
+        )
+        return parts
+    radius = arch_radius(w, h, f)
+    spring = shape.y1 - radius
+    inner = max(radius - f, 1e-3)
+    centre = (shape.x0 + shape.x1) / 2
+    path = (
+        f"M {px(x0)} {py(y0)} L {px(x1)} {py(y0)} L {px(x1)} {py(spring)} "
+        f"L {px(centre + inner)} {py(spring)} "
+        f"A {_number(inner * scale)} {_number(inner * scale)} 0 0 0 "
+        f"{px(centre - inner)} {py(spring)} L {px(x0)} {py(spring)} Z"
+    )
+    parts.append(f'<path d="{path}" {pane} {outline}/>')
+    return parts
+
+
+def _labels(layout: Layout, scale: float) -> list[tuple[float, float, str]]:
+    """Symbol names of the visible shapes, front layers first, each where it fits: a label
+    that would overlap one already placed moves up or down its cell by a line, or is left
+    out, so labels never print over each other."""
+    line = LABEL_LINE / scale
+    front = {layer.name: -i for i, layer in enumerate(layout.spec.layers)}
+    placed: list[tuple[float, float, float, float]] = []
+    found = []
+    for shape in sorted(
+        (s for s in layout.shapes if s.visible),
+        key=lambda s: (front[s.layer], s.x0, s.y0),
+    ):
+        text = f"{shape.x}{shape.y}"
+        half_width = LABEL_CHAR * len(text) / scale / 2
+        cx, cy = (shape.x0 + shape.x1) / 2, (shape.y0 + shape.y1) / 2
+        for step in (0, 1, -1, 2, -2):
+            y = cy + step * line
+            box = (cx - half_width, cx + half_width, y - line / 2, y + line / 2)
+            if box[2] < shape.y0 or box[3] > shape.y1:
+                continue
+            if not any(_overlap(box, other) for other in placed):
+                placed.append(box)
+                found.append((cx, y, text))
+                break
+    return found
+
+
+def _overlap(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    return a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]

@@ -17,12 +17,11 @@ from trimesh.visual.material import PBRMaterial
 
 from facadecli.errors import SpecError
 from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
-from facadecli.layout import PANE_MATERIAL, Layout, Shape
+from facadecli.layout import BUILTIN_GLASS, PANE_MATERIAL, Layout, Shape
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.spec.model import Material
 
 FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
-GLASS = Material(color="#a9c8e4", metallic=0.0, roughness=0.05, opacity=0.35)
 
 
 @lru_cache(maxsize=256)
@@ -157,7 +156,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
 
 def _builtin(material: str) -> Material:
     """The built-in material of a name a spec does not define."""
-    return GLASS if material == PANE_MATERIAL else FALLBACK_MATERIAL
+    return BUILTIN_GLASS if material == PANE_MATERIAL else FALLBACK_MATERIAL
 
 
 def _count(name: str, total: int, more: int) -> int:

@@ -9,36 +9,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import trimesh
 
-DEFAULT_SEGMENTS = 12
+from facadecli.geometry.cell import DEFAULT_SEGMENTS, Cell, arch_radius
 
-
-@dataclass(frozen=True)
-class Cell:
-    """What a primitive is sized from: the cell and the shape rule's parameters."""
-
-    width: float
-    height: float
-    thickness: float
-    frame_width: float | None = None
-    pane_depth: float | None = None
-    segments: int | None = None
-
-    @property
-    def frame(self) -> float:
-        """Frame width: the rule's, or a tenth of the smaller side (at most 12 cm)."""
-        default = min(0.12, 0.1 * min(self.width, self.height))
-        wanted = self.frame_width if self.frame_width is not None else default
-        return max(1e-3, min(wanted, 0.45 * min(self.width, self.height)))
-
-    @property
-    def pane(self) -> float:
-        """How far the pane sits behind the frame's front."""
-        return self.pane_depth if self.pane_depth is not None else max(0.02, 0.5 * self.thickness)
+__all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset"]
 
 
 def _block(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> trimesh.Trimesh:
@@ -83,7 +60,7 @@ def frame_pane(cell: Cell) -> trimesh.Trimesh:
 def arch(cell: Cell) -> trimesh.Trimesh:
     """A frame whose top is a round arch (a semicircle as wide as the cell, when it fits)."""
     w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
-    radius = min(w / 2, h - f)
+    radius = arch_radius(w, h, f)
     spring = h - radius  # where the arch starts
     segments = max(3, cell.segments or DEFAULT_SEGMENTS)
     parts = [
@@ -129,7 +106,7 @@ def _spandrel(chord: list[tuple[float, float]], top: float, t: float) -> trimesh
 def arch_pane(cell: Cell) -> trimesh.Trimesh:
     """The pane of an arch: a rectangle up to the springing line and a half disc above."""
     w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
-    radius = min(w / 2, h - f)
+    radius = arch_radius(w, h, f)
     spring = h - radius
     segments = max(3, cell.segments or DEFAULT_SEGMENTS)
     pane_z = -min(cell.pane, t)
