@@ -65,6 +65,17 @@ def _write_obj(layout: Layout, outdir: Path, options: OutputOptions) -> list[Pat
     return write_obj(_scene(layout, options), outdir / f"{layout.spec.name}.obj")
 
 
+def _write_html(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
+    from facadecli.export.gltf import glb_bytes
+    from facadecli.export.svg import svg_text
+    from facadecli.viewer import page
+
+    path = outdir / f"{layout.spec.name}.html"
+    glb = glb_bytes(_scene(layout, options))
+    write_atomic(path, page(layout.spec.name, glb, svg_text(layout, labels=options.labels)))
+    return [path]
+
+
 #: format name -> writer(layout, outdir, options) returning the files it wrote; the
 #: default set of ``facade solve`` is SPEC 4's: glb, obj, json, svg
 WRITERS: dict[str, Writer] = {
@@ -73,6 +84,7 @@ WRITERS: dict[str, Writer] = {
     "json": _write_json,
     "svg": _write_svg,
     "gltf": _write_gltf,
+    "html": _write_html,
 }
 DEFAULT_FORMATS = ("glb", "obj", "json", "svg")
 
