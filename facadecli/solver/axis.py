@@ -297,6 +297,7 @@ def solve_axis_alternatives(
         (exact.candidate_bound(_candidate_rows(spec, uses, c, memory), canvas), c.key, c)
         for c in candidates
     )
+    heuristic_done = alternatives > 1
     for threshold in DEEPENING:
         failures.clear()  # each pass searches again every candidate it reaches: the last
         unproven = len(candidates) >= CANDIDATE_LIMIT  # one run says what is proven
@@ -310,7 +311,12 @@ def solve_axis_alternatives(
             search_exactly(candidate, target, bound > best_objective() - TIE)
         if timed_out or budget.left == 0 or best_objective() <= threshold:
             break
-    if not evaluated and unproven and not timed_out:
+        if not evaluated and not heuristic_done:
+            # nothing within the first threshold: the heuristic's layout, if it finds one,
+            # bounds the next passes (they then only look for better ones)
+            heuristic_done = True
+            heuristic_pass()
+    if not evaluated and unproven and not timed_out and not heuristic_done:
         heuristic_pass()  # the exact search ran out of work: the heuristic may still align
     aligned_at = time.perf_counter()
     ranked = _by_rank(evaluated)
