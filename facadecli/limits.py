@@ -15,6 +15,7 @@ MESH_FACES_MAX = 200_000  # triangles of one mesh file
 SCENE_FACES_MAX = 5_000_000  # triangles of one façade's model (every shape, every cell)
 TEXTURE_PIXELS_MAX = 4096 * 4096  # pixels of one texture image
 TEXTURE_SIDE_MAX = 8192  # pixels of a texture's longer side
+GEOJSON_BYTES_MAX = 500_000_000  # bytes of a city's footprints file (read whole, as JSON)
 FOOTPRINT_VERTICES_MAX = 1000  # vertices of one footprint: more are simplified
 FOOTPRINT_REACH_MAX = 100_000.0  # metres from the (low) median of the others: a wrong value
 PROJECTED_MAX = 1e8  # a projected coordinate (in its CRS's unit)

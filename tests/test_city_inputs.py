@@ -297,3 +297,15 @@ def test_workers_get_absolute_paths(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     (task,) = plan(loaded, list(found.footprints), Path("relative/out"))
     assert task.target == tmp_path / "relative" / "out" / "buildings" / "a.glb"
     assert task.spec_dir == manifest.parent and task.spec_dir.is_absolute()
+
+
+def test_a_footprints_file_beyond_the_limit_is_refused_before_it_is_read(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from facadecli.city import geojson
+
+    monkeypatch.setattr(geojson, "GEOJSON_BYTES_MAX", 100)
+    manifest = town(tmp_path, [square("a"), square("b", x=20)])
+    code, _, err = city(capsys, manifest)
+    assert code == 2 and "longer than 100 bytes" in err and "f.geojson" in err
+    assert not (tmp_path / "out").exists()

@@ -22,7 +22,7 @@ import shapely.errors
 from shapely.geometry import MultiPolygon, Polygon
 
 from facadecli.errors import SpecError
-from facadecli.limits import PROJECTED_MAX
+from facadecli.limits import GEOJSON_BYTES_MAX, PROJECTED_MAX
 
 GEOMETRY_TYPES = (
     "Point",
@@ -109,7 +109,8 @@ def read_feature(
 
 def _text(path: Path) -> str:
     try:
-        raw = path.read_bytes()
+        with path.open("rb") as handle:  # at most one byte past the limit
+            raw = handle.read(GEOJSON_BYTES_MAX + 1)
     except OSError as error:
         raise SpecError.at(
             str(path),
@@ -118,6 +119,14 @@ def _text(path: Path) -> str:
             f"cannot read the footprints: {error.strerror}",
             "check the path in the manifest",
         ) from None
+    if len(raw) > GEOJSON_BYTES_MAX:
+        raise SpecError.at(
+            str(path),
+            None,
+            None,
+            f"the footprints file is longer than {GEOJSON_BYTES_MAX:,} bytes",
+            "split the district into several manifests, or cut the extract to a bounding box",
+        )
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as error:
