@@ -22,6 +22,7 @@ import shapely.errors
 from shapely.geometry import MultiPolygon, Polygon
 
 from facadecli.errors import SpecError
+from facadecli.files import decode_utf8, read_at_most
 from facadecli.limits import GEOJSON_BYTES_MAX, PROJECTED_MAX
 
 GEOMETRY_TYPES = (
@@ -109,8 +110,7 @@ def read_feature(
 
 def _text(path: Path) -> str:
     try:
-        with path.open("rb") as handle:  # at most one byte past the limit
-            raw = handle.read(GEOJSON_BYTES_MAX + 1)
+        raw = read_at_most(path, GEOJSON_BYTES_MAX)
     except OSError as error:
         raise SpecError.at(
             str(path),
@@ -119,7 +119,7 @@ def _text(path: Path) -> str:
             f"cannot read the footprints: {error.strerror}",
             "check the path in the manifest",
         ) from None
-    if len(raw) > GEOJSON_BYTES_MAX:
+    if raw is None:
         raise SpecError.at(
             str(path),
             None,
@@ -127,14 +127,7 @@ def _text(path: Path) -> str:
             f"the footprints file is longer than {GEOJSON_BYTES_MAX:,} bytes",
             "split the district into several manifests, or cut the extract to a bounding box",
         )
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        line = raw.count(b"\n", 0, error.start) + 1
-        col = error.start - raw.rfind(b"\n", 0, error.start)
-        raise SpecError.at(
-            str(path), line, col, "not UTF-8 text", "save the GeoJSON as UTF-8 (RFC 7946)"
-        ) from None
+    return decode_utf8(raw, str(path), "save the GeoJSON as UTF-8 (RFC 7946)")
 
 
 def _parse(text: str, file: str) -> Any:

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from facadecli.errors import SpecError
+from facadecli.files import decode_utf8, read_at_most
 from facadecli.limits import (
     LABEL_CHARS_MAX,
     LAYOUT_BYTES_MAX,
@@ -72,26 +73,19 @@ def read_text(path: Path) -> str:
     """The file's text: UTF-8, at most ``FILE_BYTES_MAX`` bytes, a leading BOM dropped."""
     file = str(path)
     try:
-        size = path.stat().st_size
-        if size > FILE_BYTES_MAX:
-            raise SpecError.at(
-                file,
-                None,
-                None,
-                f"the file is {size:,} bytes; at most {FILE_BYTES_MAX:,} are read",
-                "split the layout, or give fewer rectangles",
-            )
-        data = path.read_bytes()
+        data = read_at_most(path, FILE_BYTES_MAX)
     except OSError as error:
         message = f"cannot read: {error.strerror}"
         raise SpecError.at(file, None, None, message, "check the path") from None
-    try:
-        return data.decode("utf-8").removeprefix("\ufeff")
-    except UnicodeDecodeError as error:
-        line = data.count(b"\n", 0, error.start) + 1
-        start = data.rfind(b"\n", 0, error.start) + 1
-        col = len(data[start : error.start].decode("utf-8", "replace")) + 1
-        raise SpecError.at(file, line, col, "not UTF-8 text", "save the file as UTF-8") from None
+    if data is None:
+        raise SpecError.at(
+            file,
+            None,
+            None,
+            f"the file is longer than {FILE_BYTES_MAX:,} bytes, the most that is read",
+            "split the layout, or give fewer rectangles",
+        )
+    return decode_utf8(data, file, "save the file as UTF-8")
 
 
 def label_problem(label: str) -> str | None:

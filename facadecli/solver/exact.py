@@ -354,12 +354,11 @@ class _Search:
         word = group.rows[r].row.word
         return "'" + " ".join(word[k].symbol for k in sorted({*whole, *parts})) + "'"
 
-    def columns(
-        self, g: int, positions: tuple[int, ...], memory: tuple[int, ...], node: _Node | None = None
-    ) -> Iterator[tuple[Move | None, ...]]:
-        """Every valid column out of a state; with ``node``, not those where two entries of
+    def columns(self, g: int, node: _Node) -> Iterator[tuple[Move | None, ...]]:
+        """Every valid column out of a state, but not those where two entries of
         known length could not be as long as each other within the incumbent."""
         group = self.groups[g]
+        positions, memory = node.positions, node.memory
         self.progress = sum(positions)
         options: list[list[Move | None]] = []
         for r, row in enumerate(group.rows):
@@ -391,7 +390,7 @@ class _Search:
                     miss = float(difference[: self.sized] @ self.target)
                     value = miss * miss / norm if norm else 0.0
                 if value <= self.incumbent + SAME:
-                    value = node.system.probe(difference, self.canvas)  # type: ignore[union-attr]
+                    value = node.system.probe(difference, self.canvas)
                 known = fits[key] = value <= self.incumbent + SAME
             return known
 
@@ -408,7 +407,7 @@ class _Search:
             r = order[i]
             for move in options[r]:
                 known = first
-                length = None if node is None or move is None else self.known(g, r, move, node)
+                length = None if move is None else self.known(g, r, move, node)
                 if length is not None and move is not None:
                     if first is None:
                         known = (r, move, length)
@@ -530,7 +529,7 @@ class _Search:
                 self.leaf(finished)
             return
         children: list[tuple[tuple[float, int, float, int, int, int], _Node]] = []
-        for entries in self.columns(g, positions, node.memory, node):
+        for entries in self.columns(g, node):
             if path and self.merges(group, path[-1], entries, node.before):
                 continue  # the one column they make is searched too, and is looser
             self.budget.spend()

@@ -16,6 +16,7 @@ from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
 
 from facadecli.errors import Problem, SpecError
+from facadecli.files import read_at_most
 from facadecli.limits import SPEC_BYTES_MAX
 from facadecli.spec.check import check_spec
 from facadecli.spec.model import Spec
@@ -45,8 +46,7 @@ def load_spec(path: str | FilePath) -> Spec:
     """Read, validate and cross-check a spec file; raises :class:`SpecError`."""
     file = FilePath(path)
     try:
-        with file.open("rb") as handle:  # at most one byte past the limit (a device never ends)
-            raw = handle.read(SPEC_BYTES_MAX + 1)
+        raw = read_at_most(file, SPEC_BYTES_MAX)
     except FileNotFoundError:
         raise SpecError.at(str(path), None, None, "no such file", "check the path") from None
     except IsADirectoryError:
@@ -61,7 +61,7 @@ def load_spec(path: str | FilePath) -> Spec:
             f"cannot read: {error.strerror}",
             "check the path and its permissions",
         ) from None
-    if len(raw) > SPEC_BYTES_MAX:
+    if raw is None:
         raise SpecError.at(
             str(path),
             None,
