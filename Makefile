@@ -9,7 +9,7 @@ OUT    ?= out
 VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 
 .DEFAULT_GOAL := help
-.PHONY: help install demo test lint format bench schema golden grammar city clean
+.PHONY: help install demo test lint format bench schema golden grammar city pictures clean
 
 help: ## Show the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-8s %s\n", $$1, $$2}'
@@ -36,8 +36,8 @@ test: $(STAMP) $(VALIDATOR) ## Run the whole test suite
 	$(BIN)/python -m pytest
 
 lint: $(STAMP) ## ruff (lint + format check) and mypy
-	$(BIN)/ruff check facadecli tests
-	$(BIN)/ruff format --check facadecli tests
+	$(BIN)/ruff check facadecli tests docs
+	$(BIN)/ruff format --check facadecli tests docs
 	$(BIN)/mypy
 
 format: $(STAMP) ## Reformat the code with ruff
@@ -66,6 +66,9 @@ city: $(STAMP) ## Build a city: the generated demo district, or CITY=path/to/man
 
 golden: $(STAMP) ## Regenerate the golden SVG elevations of the examples (tests/cases/golden)
 	$(BIN)/python tests/golden.py
+
+pictures: $(STAMP) ## Render the README's pictures into docs/pictures (needs chromium)
+	$(BIN)/python docs/pictures.py
 
 clean: ## Remove the venv, caches and outputs
 	rm -rf $(VENV) $(OUT) .pytest_cache .mypy_cache .ruff_cache .hypothesis

@@ -538,6 +538,31 @@ def schema(
 
 
 @app.command()
+def view(
+    folder: Annotated[
+        Path,
+        typer.Argument(
+            help="A folder of models (the output of facade solve, vary or city).",
+            metavar="FOLDER",
+        ),
+    ],
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output", "-o", metavar="PAGE", help="The page to write [default: FOLDER/index.html]."
+        ),
+    ] = None,
+) -> None:
+    """Write one self-contained HTML page of every model in FOLDER: a list of them with
+    their elevations beside a 3D viewer; click one to see it."""
+    from facadecli.viewer.gallery import write_gallery
+
+    written = write_gallery(folder, output)
+    count = len(written.models)
+    typer.echo(f"{count} model{'' if count == 1 else 's'} -> {written.page}")
+
+
+@app.command()
 def words(
     specs: SpecPaths,
     limit: Annotated[int, typer.Option("--limit", "-n", min=1, help="Words per layer axis.")] = 5,

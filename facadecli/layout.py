@@ -13,7 +13,9 @@ from facadecli.spec.model import Layer, Material, ShapeRule, Spec
 
 DEFAULT_MATERIAL = "default"  # the built-in neutral grey when no material is named
 PANE_MATERIAL = "glass"  # the panes of frames and arches: the spec's glass, else this one
-BUILTIN_GLASS = Material(color="#a9c8e4", metallic=0.0, roughness=0.05, opacity=0.35)
+BUILTIN_GLASS = Material(
+    color="#a9c8e4", metallic=0.0, roughness=0.05, opacity=0.35, transmission=0.9
+)
 
 
 @dataclass(frozen=True)
@@ -26,6 +28,10 @@ class Appearance:
     pane_depth: float | None = None
     segments: int | None = None
     pane_material: str = PANE_MATERIAL
+    sill: float | None = None
+    panels: int | None = None
+    glazing: float | None = None
+    spacing: float | None = None
 
 
 @dataclass(frozen=True)
@@ -84,6 +90,10 @@ def appearance(spec: Spec, layer: Layer, x: str, y: str) -> Appearance:
         "pane_depth": None,
         "segments": None,
         "pane_material": PANE_MATERIAL,
+        "sill": None,
+        "panels": None,
+        "glazing": None,
+        "spacing": None,
     }
     for rule in (*spec.shapes, *layer.shapes):
         if _matches(rule, x, y):

@@ -1,17 +1,24 @@
 """``--format html``: one self-contained page a run, the model with orbit controls beside
-the elevation, read in a real browser where one is installed."""
+the elevation; ``facade view``: one page of every model in a folder. Both read in a real
+browser where one is installed."""
 
 from __future__ import annotations
 
+import base64
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
+from urllib.parse import quote
 
 import pytest
 
 from facadecli import load_spec, solve
+from facadecli.cli import main
 from facadecli.export import OutputOptions, write_outputs
+from facadecli.viewer import gallery
+from tests.running import facade, files
 
 ROOT = Path(__file__).resolve().parent.parent
 BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -31,11 +38,8 @@ def test_the_page_holds_everything_it_shows(tmp_path: Path) -> None:
     assert not re.search(r"(src|href)=[\"']https?://", text)  # nothing fetched at view time
 
 
-@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-def test_a_browser_shows_the_model(tmp_path: Path) -> None:
-    from PIL import Image, ImageStat
-
-    page = _page(tmp_path)
+def _browse(tmp_path: Path, url: str) -> tuple[Path, str]:
+    """A screenshot (1000 x 600) of the page at ``url`` and its DOM once its scripts ran."""
     flags = [
         "--headless", "--no-sandbox", "--disable-gpu", "--use-gl=swiftshader",
         "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
@@ -44,11 +48,148 @@ def test_a_browser_shows_the_model(tmp_path: Path) -> None:
     ]  # fmt: skip
     shot = tmp_path / "shot.png"
     run = [str(BROWSER), *flags]
-    subprocess.run([*run, f"--screenshot={shot}", page.as_uri()], timeout=120, check=False)
-    dom = subprocess.run(
-        [*run, "--dump-dom", page.as_uri()], timeout=120, capture_output=True, text=True
-    )
-    assert "<title>townhouse</title>" in dom.stdout  # the model loaded ("loading: " is gone)
+    subprocess.run([*run, f"--screenshot={shot}", url], timeout=120, check=False)
+    dom = subprocess.run([*run, "--dump-dom", url], timeout=120, capture_output=True, text=True)
+    return shot, dom.stdout
+
+
+def _drawn(shot: Path, left: float, right: float) -> bool:
+    """Whether the screenshot's columns from ``left`` to ``right`` (fractions of its width)
+    hold a picture, not a blank canvas."""
+    from PIL import Image, ImageStat
+
     with Image.open(shot) as image:
-        model = image.convert("L").crop((0, 0, image.width * 3 // 5, image.height))
-        assert ImageStat.Stat(model).stddev[0] > 10  # not a blank canvas
+        box = (int(image.width * left), 0, int(image.width * right), image.height)
+        return bool(ImageStat.Stat(image.convert("L").crop(box)).stddev[0] > 10)
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_browser_shows_the_model(tmp_path: Path) -> None:
+    shot, dom = _browse(tmp_path, _page(tmp_path).as_uri())
+    assert "<title>townhouse</title>" in dom  # the model loaded ("loading: " is gone)
+    assert _drawn(shot, 0, 3 / 5)
+
+
+# ``facade view``: a gallery of a folder's models
+
+
+@pytest.fixture(scope="module")
+def varied(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder written by ``facade vary``: 3 variants (glb + svg; one layout exists at
+    8 m) and a contact sheet."""
+    folder = tmp_path_factory.mktemp("vary") / "out"
+    argv = sys.argv
+    sys.argv = ["facade", "vary", str(ROOT / "specs" / "residential-house.yaml")]
+    sys.argv += ["--widths", "8,12", "--count", "2", "--seed", "7", "-f", "glb,svg"]
+    sys.argv += ["-o", str(folder)]
+    try:
+        with pytest.raises(SystemExit) as stop:
+            main()
+    finally:
+        sys.argv = argv
+    assert stop.value.code in (0, None)
+    assert len(list(folder.glob("*.glb"))) == 3 and (folder / "contact-sheet.svg").exists()
+    return folder
+
+
+def test_view_lists_every_model_of_a_vary_folder(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path
+) -> None:
+    page = tmp_path / "page.html"
+    code, out, err = facade(capsys, "view", varied, "-o", page)
+    assert code == 0, err
+    assert out.strip() == f"3 models -> {page}"
+    text = page.read_text()
+    names = re.findall(r'data-name="([^"]+)"', text)
+    assert names == [  # every model once, numbers in order (8 before 12)
+        "residential-house-8x3-0",
+        "residential-house-12x3-0",
+        "residential-house-12x3-1",
+    ]
+    for index, name in enumerate(names):  # each glb and its elevation, byte for byte
+        glb = re.search(rf'<script id="glb-{index}" type="application/octet-stream">([^<]*)<', text)
+        assert glb and base64.b64decode(glb[1]) == (varied / f"{name}.glb").read_bytes()
+        svg = base64.b64encode((varied / f"{name}.svg").read_bytes()).decode()
+        assert f'<img src="data:image/svg+xml;base64,{svg}"' in text
+    assert "contact-sheet" not in text
+    assert '<script type="importmap">' in text and "MIT licence" in text
+    assert not re.search(r"(src|href)=[\"']https?://", text)  # nothing fetched at view time
+
+
+def test_view_writes_index_html_and_the_same_bytes_each_time(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path
+) -> None:
+    folder = tmp_path / "copy"
+    shutil.copytree(varied, folder)
+    code, out, _ = facade(capsys, "view", folder)
+    assert code == 0 and out.strip() == f"3 models -> {folder / 'index.html'}"
+    first = (folder / "index.html").read_bytes()
+    assert facade(capsys, "view", folder)[0] == 0
+    assert (folder / "index.html").read_bytes() == first
+    assert not [p for p in folder.iterdir() if p.name.startswith(".")]  # no temporary left
+
+
+def test_view_shows_a_citys_buildings_when_the_folder_has_no_other_model(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path
+) -> None:
+    (tmp_path / "buildings").mkdir()
+    model = varied / "residential-house-8x3-0.glb"
+    for name in ("b10", "b9"):
+        shutil.copy(model, tmp_path / "buildings" / f"{name}.glb")
+    code, out, err = facade(capsys, "view", tmp_path)
+    assert code == 0 and out.strip() == f"2 models -> {tmp_path / 'index.html'}", err
+    text = (tmp_path / "index.html").read_text()
+    assert re.findall(r'data-name="([^"]+)"', text) == ["b9", "b10"]
+    assert "2 models in buildings/" in text and "<img" not in text  # no elevations
+    shutil.copy(varied / "residential-house-12x3-0.glb", tmp_path / "district.glb")
+    assert facade(capsys, "view", tmp_path)[0] == 0  # the merged model, not the buildings
+    text = (tmp_path / "index.html").read_text()
+    assert re.findall(r'data-name="([^"]+)"', text) == ["district"]
+
+
+def test_view_refuses_a_folder_without_models(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path
+) -> None:
+    code, out, err = facade(capsys, "view", tmp_path / "missing")
+    assert code == 2 and out == ""
+    assert f"{tmp_path / 'missing'}: error: no such folder" in err and "facade solve" in err
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    shutil.copy(varied / "contact-sheet.svg", empty)  # an elevation is not a model
+    code, _, err = facade(capsys, "view", empty)
+    assert code == 2 and f"{empty}: error: no models (.glb files)" in err
+    assert "facade solve" in err and files(empty) == ["contact-sheet.svg"]
+    code, _, err = facade(capsys, "view", empty / "contact-sheet.svg")
+    assert code == 2 and "not a folder" in err
+
+
+def test_view_refuses_more_than_the_page_limit(
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+    varied: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    total = sum(p.stat().st_size for p in varied.iterdir() if p.suffix in (".glb", ".svg"))
+    total -= (varied / "contact-sheet.svg").stat().st_size  # no model of its stem
+    monkeypatch.setattr(gallery, "GALLERY_BYTES_MAX", total - 1)
+    code, out, err = facade(capsys, "view", varied, "-o", tmp_path / "page.html")
+    assert code == 2 and out == ""
+    assert f"more than {total - 1:,} bytes" in err and "GALLERY_BYTES_MAX" in err
+    assert "fewer models" in err and files(tmp_path) == []
+    monkeypatch.setattr(gallery, "GALLERY_BYTES_MAX", total)  # exactly the limit is fine
+    assert facade(capsys, "view", varied, "-o", tmp_path / "page.html")[0] == 0
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_browser_shows_the_gallery(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path
+) -> None:
+    page = tmp_path / "gallery.html"
+    assert facade(capsys, "view", varied, "-o", page)[0] == 0
+    shot, dom = _browse(tmp_path, page.as_uri() + "#" + quote("residential-house-12x3-1"))
+    assert f"<title>{varied.name}</title>" in dom  # a model loaded ("loading: " is gone)
+    assert '<h3 id="name">residential-house-12x3-1</h3>' in dom  # the one the address names
+    assert re.findall(r'aria-pressed="true" title="([^"]+)"', dom) == ["residential-house-12x3-1"]
+    assert '<img src="data:image/svg+xml;base64,' in dom.split('id="elevation"')[1]
+    assert '<p id="status">drag to orbit, scroll to zoom</p>' in dom  # not "cannot show"
+    assert _drawn(shot, 0.25, 0.65)  # the viewer, between the list and the elevation

@@ -28,6 +28,7 @@ from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.glb_merge import merge_glb
 from facadecli.export.gltf import glb_bytes
+from facadecli.geometry.facade import transmissions
 from facadecli.spec.model import Spec
 
 
@@ -77,7 +78,7 @@ def build(task: Task) -> dict[str, Any]:
             cache,
             task.spec_dir,
         )
-        write_atomic(task.target, glb_bytes(result.scene))
+        write_atomic(task.target, glb_bytes(result.scene, transmissions(task.spec)))
     except Exception as error:
         return {
             "id": task.footprint.id,

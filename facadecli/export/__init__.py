@@ -49,14 +49,18 @@ def _scene(layout: Layout, options: OutputOptions) -> trimesh.Scene:
 
 def _write_glb(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.gltf import write_glb
+    from facadecli.geometry.facade import transmissions
 
-    return write_glb(_scene(layout, options), outdir / f"{layout.spec.name}.glb")
+    path = outdir / f"{layout.spec.name}.glb"
+    return write_glb(_scene(layout, options), path, transmissions(layout.spec))
 
 
 def _write_gltf(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.gltf import write_gltf
+    from facadecli.geometry.facade import transmissions
 
-    return write_gltf(_scene(layout, options), outdir / f"{layout.spec.name}.gltf")
+    path = outdir / f"{layout.spec.name}.gltf"
+    return write_gltf(_scene(layout, options), path, transmissions(layout.spec))
 
 
 def _write_obj(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
@@ -68,10 +72,11 @@ def _write_obj(layout: Layout, outdir: Path, options: OutputOptions) -> list[Pat
 def _write_html(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.gltf import glb_bytes
     from facadecli.export.svg import svg_text
+    from facadecli.geometry.facade import transmissions
     from facadecli.viewer import page
 
     path = outdir / f"{layout.spec.name}.html"
-    glb = glb_bytes(_scene(layout, options))
+    glb = glb_bytes(_scene(layout, options), transmissions(layout.spec))
     write_atomic(path, page(layout.spec.name, glb, svg_text(layout, labels=options.labels)))
     return [path]
 

@@ -58,7 +58,10 @@ def merge_glb(parts: Iterable[tuple[str, Path]], target: Path) -> None:
     """Write one glb holding every (name, file) part under a root node of that name."""
     merged: dict[str, Any] = {key: [] for key in _REFERENCES}
     merged.update(
-        asset={"version": "2.0", "generator": "facadecli"}, scenes=[{"nodes": []}], scene=0
+        asset={"version": "2.0", "generator": "facadecli"},
+        scenes=[{"nodes": []}],
+        scene=0,
+        extensionsUsed=[],
     )
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, binary_path = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".bin", dir=target.parent)
@@ -94,6 +97,9 @@ def _append(merged: dict[str, Any], document: dict[str, Any], name: str, offset:
             if key == "meshes":
                 entry["primitives"] = [_primitive(p, base) for p in entry["primitives"]]
             merged[key].append(entry)
+    for extension in document.get("extensionsUsed", []):
+        if extension not in merged["extensionsUsed"]:
+            merged["extensionsUsed"].append(extension)
     scene = document.get("scenes", [{}])[document.get("scene", 0)]
     roots = [node + base["nodes"] for node in scene.get("nodes", [])]
     merged["nodes"].append({"name": name, "children": roots})

@@ -2,29 +2,61 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
 import trimesh
 
 from facadecli.export.atomic import write_atomic
 
+TRANSMISSION = "KHR_materials_transmission"
 
-def glb_bytes(scene: trimesh.Scene) -> bytes:
+
+def glb_bytes(scene: trimesh.Scene, transmission: Mapping[str, float] | None = None) -> bytes:
     """The scene as a .glb. Normals are left out: viewers derive flat ones (glTF 3.7.2.1),
-    which suits a façade's flat faces and keeps the file small."""
-    data: bytes = scene.export(file_type="glb", include_normals=False)
+    which suits a façade's flat faces and keeps the file small. ``transmission`` maps
+    material names to how much light passes through them (glass)."""
+    data: bytes = scene.export(
+        file_type="glb", include_normals=False, tree_postprocessor=_extensions(transmission)
+    )
     return data
 
 
-def write_glb(scene: trimesh.Scene, path: Path) -> list[Path]:
-    write_atomic(path, glb_bytes(scene))
+def _extensions(transmission: Mapping[str, float] | None) -> Callable[[dict[str, Any]], None]:
+    """A glTF tree post-processor that gives the named materials their transmission
+    (``KHR_materials_transmission``: viewers that know it render glass that lets light
+    through; the others fall back to the material's opacity)."""
+
+    def finish(tree: dict[str, Any]) -> None:
+        used = False
+        for material in tree.get("materials", []):
+            factor = (transmission or {}).get(material.get("name", ""), 0.0)
+            if factor > 0:
+                material.setdefault("extensions", {})[TRANSMISSION] = {"transmissionFactor": factor}
+                used = True
+        if used:
+            tree["extensionsUsed"] = sorted({*tree.get("extensionsUsed", []), TRANSMISSION})
+
+    return finish
+
+
+def write_glb(
+    scene: trimesh.Scene, path: Path, transmission: Mapping[str, float] | None = None
+) -> list[Path]:
+    write_atomic(path, glb_bytes(scene, transmission))
     return [path]
 
 
-def write_gltf(scene: trimesh.Scene, path: Path) -> list[Path]:
+def write_gltf(
+    scene: trimesh.Scene, path: Path, transmission: Mapping[str, float] | None = None
+) -> list[Path]:
     """``name.gltf`` and its buffer, named after it."""
     files: dict[str, bytes] = scene.export(
-        file_type="gltf", include_normals=False, merge_buffers=True
+        file_type="gltf",
+        include_normals=False,
+        merge_buffers=True,
+        tree_postprocessor=_extensions(transmission),
     )
     written = []
     renames = {

@@ -6,7 +6,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from xml.sax.saxutils import escape
 
-from facadecli.geometry.cell import Cell, arch_radius
+from facadecli.geometry.cell import (
+    Cell,
+    Rect,
+    arch_radius,
+    door_plan,
+    railing_plan,
+    shutter_plan,
+)
+from facadecli.geometry.runs import built
 from facadecli.layout import BUILTIN_GLASS, PANE_MATERIAL, Layout, Shape
 from facadecli.spec.model import Spec
 
@@ -44,8 +52,9 @@ def svg_text(layout: Layout, labels: bool = False) -> str:
         f'height="{_number(layout.height * scale)}" fill="none" stroke="#999999" '
         'stroke-dasharray="4 3"/>',
     ]
+    pieces = built(layout.shapes)
     for layer in spec.layers:
-        shapes = [s for s in layout.shapes if s.layer == layer.name and s.visible]
+        shapes = [s for s in pieces if s.layer == layer.name]
         if not shapes:
             continue
         lines.append(f'<g id="layer-{escape(layer.name)}">')
@@ -96,28 +105,55 @@ def _fill(spec: Spec, name: str) -> str:
 def _shape(
     shape: Shape, spec: Spec, px: Callable[[float], str], py: Callable[[float], str], scale: float
 ) -> list[str]:
-    """A shape as the front view of its mesh: a frame's bars around its pane, an arch's
-    curve over its pane, anything else its cell."""
+    """A shape as the front view of its mesh, from the same plans as the meshes: a frame's
+    bars around its pane, an arch's curve over its pane, a door's leaf, panels and glazing,
+    a railing's bars, a shutter's slats, a ledge's corona; anything else its cell."""
     title = f"<title>{escape(shape.layer)}: {escape(shape.x)} x {escape(shape.y)}</title>"
     outline = 'stroke="#333333" stroke-width="0.5"'
-    parts = [
-        f'<rect x="{px(shape.x0)}" y="{py(shape.y1)}" '
-        f'width="{_number((shape.x1 - shape.x0) * scale)}" '
-        f'height="{_number((shape.y1 - shape.y0) * scale)}" {_fill(spec, shape.material)} '
-        f"{outline}>{title}</rect>"
-    ]
-    look = shape.look
-    if look is None or shape.mesh not in ("frame", "arch"):
-        return parts
+    fill = _fill(spec, shape.material)
+
+    def rect(r: Rect, paint: str, extra: str = "") -> str:
+        x0, x1, y0, y1 = _placed(shape, r)
+        return (
+            f'<rect x="{px(x0)}" y="{py(y1)}" width="{_number((x1 - x0) * scale)}" '
+            f'height="{_number((y1 - y0) * scale)}" {paint} {outline}>{extra}</rect>'
+        )
+
     w, h = shape.x1 - shape.x0, shape.y1 - shape.y0
-    f = Cell(w, h, shape.z1 - shape.z0, look.frame_width).frame
+    look = shape.look
+    cell = Cell.of(shape)
+    whole = (0.0, w, 0.0, h)
+    if look is None or shape.mesh not in _DRAWN:
+        return [rect(whole, fill, title)]
     pane = _fill(spec, look.pane_material)
+    if shape.mesh == "door":
+        plan = door_plan(cell)
+        parts = [f"<g>{title}"]
+        parts += [rect(r, fill) for r in plan.frame + plan.leaf + plan.panels]
+        if plan.glass is not None:
+            parts.append(rect(plan.glass, pane))
+        return [*parts, "</g>"]
+    if shape.mesh in ("railing", "balcony"):
+        slab = min(0.15, 0.2 * h) if shape.mesh == "balcony" else 0.0
+        bars = railing_plan(w, h - slab, look.spacing)
+        parts = [f"<g>{title}"]
+        if slab:
+            parts.append(rect((0.0, w, 0.0, slab), fill))
+        parts += [rect((x0, x1, y0 + slab, y1 + slab), fill) for x0, x1, y0, y1 in bars.rails]
+        parts += [rect((x0, x1, y0 + slab, y1 + slab), fill) for x0, x1, y0, y1 in bars.bars]
+        return [*parts, "</g>"]
+    if shape.mesh == "shutter":
+        louvres = shutter_plan(cell)
+        parts = [rect(whole, fill, title)]
+        parts += [rect((x0, x1, y0, y0 + 0.3 * (y1 - y0)), fill) for x0, x1, y0, y1 in louvres.bars]
+        return parts
+    if shape.mesh == "ledge":
+        return [rect(whole, fill, title), rect((0.0, w, 0.6 * h, 0.9 * h), fill)]
+    f = cell.frame
+    parts = [rect(whole, fill, title)]
     x0, x1, y0 = shape.x0 + f, shape.x1 - f, shape.y0 + f
     if shape.mesh == "frame":
-        parts.append(
-            f'<rect x="{px(x0)}" y="{py(shape.y1 - f)}" width="{_number((x1 - x0) * scale)}" '
-            f'height="{_number((h - 2 * f) * scale)}" {pane} {outline}/>'
-        )
+        parts.append(rect((f, w - f, f, h - f), pane))
         return parts
     radius = arch_radius(w, h, f)
     spring = shape.y1 - radius
@@ -131,6 +167,20 @@ def _shape(
     )
     parts.append(f'<path d="{path}" {pane} {outline}/>')
     return parts
+
+
+_DRAWN = frozenset({"frame", "arch", "door", "railing", "balcony", "shutter", "ledge"})
+
+
+def _placed(shape: Shape, part: Rect) -> Rect:
+    """A rectangle of a cell's plan on the façade, mirrored as the shape's mesh is."""
+    x0, x1, y0, y1 = part
+    w, h = shape.x1 - shape.x0, shape.y1 - shape.y0
+    if shape.reflected_x:
+        x0, x1 = w - x1, w - x0
+    if shape.reflected_y:
+        y0, y1 = h - y1, h - y0
+    return (shape.x0 + x0, shape.x0 + x1, shape.y0 + y0, shape.y0 + y1)
 
 
 def _labels(layout: Layout, scale: float) -> list[tuple[float, float, str]]:

@@ -17,9 +17,10 @@ from trimesh.visual.material import PBRMaterial
 
 from facadecli.errors import SpecError
 from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
+from facadecli.geometry.runs import built
 from facadecli.layout import BUILTIN_GLASS, PANE_MATERIAL, Layout, Shape
 from facadecli.limits import SCENE_FACES_MAX
-from facadecli.spec.model import Material
+from facadecli.spec.model import Material, Spec
 
 FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
 
@@ -49,6 +50,15 @@ def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMater
     )
 
 
+def transmissions(spec: Spec) -> dict[str, float]:
+    """The materials of a spec's model that let light through, by name (the built-in glass
+    when the spec defines none of that name)."""
+    found = {name: m.transmission for name, m in spec.materials.items() if m.transmission > 0}
+    if PANE_MATERIAL not in spec.materials and BUILTIN_GLASS.transmission > 0:
+        found[PANE_MATERIAL] = BUILTIN_GLASS.transmission
+    return found
+
+
 def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
     """Texture coordinates in metres (one texture copy per ``size`` metres), projected on
     each face's dominant plane, so brick stays brick-sized in a cell of any size."""
@@ -65,19 +75,6 @@ def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
         uv[vertex, 1] = flat.vertices[vertex, planes[rows, 1]]
     flat.visual = trimesh.visual.TextureVisuals(uv=uv / size)
     return flat
-
-
-def _cell(shape: Shape) -> Cell:
-    look = shape.look
-    assert look is not None
-    return Cell(
-        width=round(shape.x1 - shape.x0, 6),
-        height=round(shape.y1 - shape.y0, 6),
-        thickness=round(shape.z1 - shape.z0, 6),
-        frame_width=look.frame_width,
-        pane_depth=look.pane_depth,
-        segments=look.segments,
-    )
 
 
 def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
@@ -100,25 +97,36 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     assets: dict[str, trimesh.Trimesh] = {}
     scene = trimesh.Scene()
     world = scene.graph.base_frame
-    shared: dict[tuple[object, ...], str] = {}  # a part already built -> its geometry
+    shared: dict[tuple[object, ...], str | None] = {}  # a part already built -> its geometry
     faces: dict[str, int] = {}  # triangles of each shared mesh
     total = 0  # triangles of the whole model (every node)
 
     def place(
-        shape: Shape, part: str, material: str, build: Callable[[], trimesh.Trimesh], node: str
+        shape: Shape,
+        part: str,
+        material: str,
+        build: Callable[[], trimesh.Trimesh | None],
+        node: str,
     ) -> None:
+        """Add a node for a part of a shape (nothing when its builder makes none), sharing
+        the mesh of an identical part already built."""
         nonlocal total
-        cell = _cell(shape)
+        cell = Cell.of(shape)
         key = (shape.mesh, part, cell, material, shape.reflected_x, shape.reflected_y)
         placement = trimesh.transformations.translation_matrix((shape.x0, shape.y0, shape.z1))
         parent = f"layer:{shape.layer}"
         if key in shared:
-            total = _count(spec.name, total, faces[shared[key]])
-            scene.graph.update(
-                frame_to=node, frame_from=parent, matrix=placement, geometry=shared[key]
-            )
+            existing = shared[key]
+            if existing is not None:
+                total = _count(spec.name, total, faces[existing])
+                scene.graph.update(
+                    frame_to=node, frame_from=parent, matrix=placement, geometry=existing
+                )
             return
         mesh = build()
+        if mesh is None:
+            shared[key] = None
+            return
         _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
         declared = spec.materials.get(material)
         look = materials.get(material) or pbr(material, _builtin(material))
@@ -135,17 +143,18 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             mesh, geom_name=name, node_name=node, parent_node_name=parent, transform=placement
         )
 
+    pieces = built(layout.shapes)
     for layer in spec.layers:
         if not layer.enabled:
             continue
         scene.graph.update(frame_to=f"layer:{layer.name}", frame_from=world)
         count = 0
-        for shape in layout.shapes:
-            if shape.layer != layer.name or not shape.visible:
+        for shape in pieces:
+            if shape.layer != layer.name:
                 continue
             node = f"{layer.name}/{shape.x}.{shape.y}/{count}"
             count += 1
-            cell = _cell(shape)
+            cell = Cell.of(shape)
             place(shape, "", shape.material, partial(_build, shape, cell, base_dir, assets), node)
             pane = PANES.get(shape.mesh)
             if pane is not None:

@@ -10,10 +10,19 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+import mapbox_earcut
 import numpy as np
 import trimesh
 
-from facadecli.geometry.cell import DEFAULT_SEGMENTS, Cell, arch_radius
+from facadecli.geometry.cell import (
+    DEFAULT_SEGMENTS,
+    BarPlan,
+    Cell,
+    arch_radius,
+    door_plan,
+    railing_plan,
+    shutter_plan,
+)
 
 __all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset"]
 
@@ -42,12 +51,17 @@ def frame(cell: Cell) -> trimesh.Trimesh:
     """A window or door frame: four bars (its pane is :func:`frame_pane`)."""
     w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
     parts = [
-        _block(0, w, 0, f, -t, 0),  # sill
+        _sill(cell),
         _block(0, w, h - f, h, -t, 0),  # head
         _block(0, f, f, h - f, -t, 0),  # jambs
         _block(w - f, w, f, h - f, -t, 0),
     ]
     return trimesh.util.concatenate(parts)
+
+
+def _sill(cell: Cell) -> trimesh.Trimesh:
+    """The bottom bar of a frame or an arch, standing ``sill`` metres proud of its front."""
+    return _block(0, cell.width, 0, cell.frame, -cell.thickness, cell.sill or 0.0)
 
 
 def frame_pane(cell: Cell) -> trimesh.Trimesh:
@@ -64,7 +78,7 @@ def arch(cell: Cell) -> trimesh.Trimesh:
     spring = h - radius  # where the arch starts
     segments = max(3, cell.segments or DEFAULT_SEGMENTS)
     parts = [
-        _block(0, w, 0, f, -t, 0),
+        _sill(cell),
         _block(0, f, f, spring, -t, 0),
         _block(w - f, w, f, spring, -t, 0),
     ]
@@ -104,24 +118,31 @@ def _spandrel(chord: list[tuple[float, float]], top: float, t: float) -> trimesh
 
 
 def arch_pane(cell: Cell) -> trimesh.Trimesh:
-    """The pane of an arch: a rectangle up to the springing line and a half disc above."""
+    """The pane of an arch: one flat piece, a rectangle up to the springing line and the
+    inside of the curve above it (no seams to show through the glass)."""
     w, h, t, f = cell.width, cell.height, cell.thickness, cell.frame
     radius = arch_radius(w, h, f)
     spring = h - radius
     segments = max(3, cell.segments or DEFAULT_SEGMENTS)
     pane_z = -min(cell.pane, t)
     inner = max(radius - f, 1e-3)
-    centre = (w / 2, spring)
-    parts = [_block(f, w - f, f, spring, pane_z - 0.01, pane_z)]
-    for i in range(segments):
-        a0, a1 = math.pi * i / segments, math.pi * (i + 1) / segments
-        rim = [(centre[0] + inner * math.cos(a), centre[1] + inner * math.sin(a)) for a in (a0, a1)]
-        parts.append(_prism([centre, rim[0], rim[1]], pane_z - 0.01, pane_z))
-    return trimesh.util.concatenate(parts)
+    centre = w / 2
+    curve = [
+        (
+            centre + inner * math.cos(math.pi * i / segments),
+            spring + inner * math.sin(math.pi * i / segments),
+        )
+        for i in range(segments + 1)
+    ]
+    outline = [(f, f), (w - f, f), (w - f, spring), *curve, (f, spring)]
+    unique = [p for i, p in enumerate(outline) if i == 0 or math.dist(p, outline[i - 1]) > 1e-9]
+    if math.dist(unique[0], unique[-1]) <= 1e-9:
+        unique.pop()
+    return _prism(unique, pane_z - 0.01, pane_z)
 
 
 def _prism(outline: list[tuple[float, float]], z0: float, z1: float) -> trimesh.Trimesh:
-    """A convex polygon (counter-clockwise or not) extruded from z0 to z1."""
+    """A simple polygon (convex or not, either winding) extruded from z0 to z1."""
     points = np.array(outline, dtype=float)
     area = 0.5 * np.sum(
         points[:, 0] * np.roll(points[:, 1], -1) - np.roll(points[:, 0], -1) * points[:, 1]
@@ -132,15 +153,37 @@ def _prism(outline: list[tuple[float, float]], z0: float, z1: float) -> trimesh.
     bottom = np.column_stack([points, np.full(n, z0)])
     top = np.column_stack([points, np.full(n, z1)])
     vertices = np.vstack([bottom, top])
+    if n == 3 or _convex(points):
+        caps = [(0, i, i + 1) for i in range(1, n - 1)]
+    else:
+        flat = mapbox_earcut.triangulate_float64(points, np.array([n], dtype=np.uint32))
+        caps = [(int(flat[i]), int(flat[i + 1]), int(flat[i + 2])) for i in range(0, len(flat), 3)]
     faces = []
-    for i in range(1, n - 1):
-        faces.append((n, n + i, n + i + 1))  # front (z1), counter-clockwise seen from +z
-        faces.append((0, i + 1, i))  # back
+    for a, b, c in caps:
+        faces.append((n + a, n + b, n + c))  # front (z1), counter-clockwise seen from +z
+        faces.append((a, c, b))  # back
     for i in range(n):
         j = (i + 1) % n
         faces.append((i, j, n + j))
         faces.append((i, n + j, n + i))
     return trimesh.Trimesh(vertices, np.array(faces), process=False)
+
+
+def _convex(points: np.ndarray) -> bool:
+    edges = np.roll(points, -1, axis=0) - points
+    turns = edges[:, 0] * np.roll(edges[:, 1], -1) - edges[:, 1] * np.roll(edges[:, 0], -1)
+    return bool(np.all(turns >= -1e-12))
+
+
+# a cyclic change of axes (x, y, z) <- (z, x, y): a prism built along z runs along x
+_ALONG_X = np.array([(0, 0, 1, 0), (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 0, 1)], dtype=float)
+
+
+def _extrude_x(profile: list[tuple[float, float]], x0: float, x1: float) -> trimesh.Trimesh:
+    """A profile given as (y, z) points, extruded along x from x0 to x1."""
+    mesh = _prism(profile, x0, x1)
+    mesh.apply_transform(_ALONG_X)
+    return mesh
 
 
 def column(cell: Cell) -> trimesh.Trimesh:
@@ -155,19 +198,124 @@ def column(cell: Cell) -> trimesh.Trimesh:
 
 
 def ledge(cell: Cell) -> trimesh.Trimesh:
-    """A profiled horizontal band: three steps, each standing further out than the one below."""
-    w, h, t = cell.width, cell.height, cell.thickness
-    return trimesh.util.concatenate(
-        [
-            _block(0, w, 0, 0.3 * h, -t, -0.4 * t),
-            _block(0, w, 0.3 * h, 0.6 * h, -t, -0.2 * t),
-            _block(0, w, 0.6 * h, h, -t, 0),
+    """A moulded horizontal band, one profile extruded along the cell (runs of ledges along
+    a floor are merged into one before they are built, see :mod:`.runs`): a fillet, a cove
+    out to a corona, a sloped top that sheds rain; its back fills the cell."""
+    return _extrude_x(ledge_profile(cell), 0.0, cell.width)
+
+
+def ledge_profile(cell: Cell) -> list[tuple[float, float]]:
+    """The outline of a ledge as (y, z) points, counter-clockwise seen from +x."""
+    h, t = cell.height, cell.thickness
+    segments = max(2, (cell.segments or DEFAULT_SEGMENTS) // 2)
+    cove = [
+        (0.6 * h - 0.4 * h * math.cos(a), -0.55 * t + 0.5 * t * math.sin(a))
+        for a in (0.5 * math.pi * i / segments for i in range(segments + 1))
+    ]
+    return [
+        (0.0, -t),
+        (h, -t),
+        (h, -0.2 * t),
+        (0.9 * h, 0.0),
+        (0.6 * h, 0.0),
+        *cove[::-1][1:],
+        (0.0, -0.55 * t),
+    ]
+
+
+def door(cell: Cell) -> trimesh.Trimesh:
+    """A door: jambs and head like a frame's (no sill), a leaf recessed ``pane_depth`` with
+    ``panels`` rows of raised panels, and the upper ``glazing`` share of it open for glass
+    (the glass is :func:`door_pane`)."""
+    plan = door_plan(cell)
+    t = cell.thickness
+    front = -min(cell.pane, t)
+    back = max(front - 0.04, -t)
+    parts = [_block(*r, -t, 0) for r in plan.frame]
+    parts += [_block(*r, back, front) for r in plan.leaf]
+    parts += [_block(*r, front, min(front + 0.015, 0.0)) for r in plan.panels]
+    return trimesh.util.concatenate(parts)
+
+
+def door_pane(cell: Cell) -> trimesh.Trimesh | None:
+    """The glass of a glazed door, inside its leaf; None for a door with no glazing."""
+    glass = door_plan(cell).glass
+    if glass is None:
+        return None
+    front = -min(cell.pane, cell.thickness)
+    back = max(front - 0.04, -cell.thickness)
+    middle = (front + back) / 2
+    return _block(*glass, middle - 0.005, middle + 0.005)
+
+
+def _bars(plan: BarPlan, z0: float, z1: float, bar_depth: float) -> list[trimesh.Trimesh]:
+    """Rails at full depth, bars ``bar_depth`` deep in the middle of it."""
+    middle = (z0 + z1) / 2
+    parts = [_block(*r, z0, z1) for r in plan.rails]
+    parts += [_block(*r, middle - bar_depth / 2, middle + bar_depth / 2) for r in plan.bars]
+    return parts
+
+
+def railing(cell: Cell) -> trimesh.Trimesh:
+    """A railing as high as its cell: end posts, handrail, bottom rail and square bars every
+    ``spacing`` metres; you see through it."""
+    t = max(cell.thickness, 0.01)
+    plan = railing_plan(cell.width, cell.height, cell.spacing)
+    return trimesh.util.concatenate(_bars(plan, -t, 0, min(0.02, t)))
+
+
+def balcony(cell: Cell) -> trimesh.Trimesh:
+    """A balcony standing ``thickness`` out of the wall: a floor slab at the bottom of the
+    cell and a railing along its front and both sides, up to the top of the cell."""
+    w, h, t = cell.width, cell.height, max(cell.thickness, 0.01)
+    slab = min(0.15, 0.2 * h)
+    depth = min(0.05, t / 4)  # of the railing
+    parts = [_block(0, w, 0, slab, -t, 0)]
+    front = railing_plan(w, h - slab, cell.spacing)
+    for part in _bars(front, -depth, 0, min(0.02, depth)):
+        part.apply_translation((0, slab, 0))
+        parts.append(part)
+    side = railing_plan(t - depth, h - slab, cell.spacing)
+    for x in (0.0, w - depth):
+        for part in _bars(side, -depth, 0, min(0.02, depth)):  # built along x, turned onto z
+            part.apply_transform(_SIDEWAYS)
+            part.apply_translation((x, slab, -t))
+            parts.append(part)
+    return trimesh.util.concatenate(parts)
+
+
+# a quarter turn about y: what ran along +x runs along +z (and its front faces -x)
+_SIDEWAYS = np.array([(0, 0, -1, 0), (0, 1, 0, 0), (1, 0, 0, 0), (0, 0, 0, 1)], dtype=float)
+
+
+def shutter(cell: Cell) -> trimesh.Trimesh:
+    """A louvred shutter filling its cell: stiles and rails as deep as the cell around
+    slats ``spacing`` apart in its front 5 cm, each tilted to shed rain, and a board
+    behind them, so the shutter is closed from every side."""
+    t = max(cell.thickness, 0.01)
+    louvre = min(0.05, 0.8 * t)
+    plan = shutter_plan(cell)
+    parts = [_block(*r, -t, 0) for r in plan.rails]
+    x0, x1, y0, y1 = plan.rails[2][0], plan.rails[2][1], plan.rails[2][3], plan.rails[3][2]
+    parts.append(_block(x0, x1, y0, y1, max(-t, -louvre - 0.01), -louvre))
+    for x0, x1, y0, y1 in plan.bars:
+        board = min(0.01, 0.2 * (y1 - y0))
+        profile = [
+            (y0, -0.1 * louvre),
+            (y0 + board, -0.1 * louvre),
+            (y1 + board, -0.9 * louvre),
+            (y1, -0.9 * louvre),
         ]
-    )
+        parts.append(_extrude_x(profile, x0, x1))
+    return trimesh.util.concatenate(parts)
 
 
 #: the panes of the primitives that have one, in the shape rule's ``pane_material``
-PANES: dict[str, Callable[[Cell], trimesh.Trimesh]] = {"frame": frame_pane, "arch": arch_pane}
+PANES: dict[str, Callable[[Cell], trimesh.Trimesh | None]] = {
+    "frame": frame_pane,
+    "arch": arch_pane,
+    "door": door_pane,
+}
 
 PRIMITIVES: dict[str, Callable[[Cell], trimesh.Trimesh]] = {
     "box": box,
@@ -176,6 +324,10 @@ PRIMITIVES: dict[str, Callable[[Cell], trimesh.Trimesh]] = {
     "arch": arch,
     "column": column,
     "ledge": ledge,
+    "door": door,
+    "railing": railing,
+    "balcony": balcony,
+    "shutter": shutter,
 }
 
 

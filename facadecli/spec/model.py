@@ -29,7 +29,18 @@ IDENT_RE = r"^[A-Za-z_][A-Za-z0-9_]*$"
 COLOR_RE = r"^#(?:[0-9a-fA-F]{6}|[0-9a-fA-F]{8})$"
 
 #: Built-in parametric meshes; anything else in ``mesh`` is a file path next to the spec.
-BUILTIN_MESHES = ("box", "panel", "frame", "arch", "column", "ledge")
+BUILTIN_MESHES = (
+    "box",
+    "panel",
+    "frame",
+    "arch",
+    "column",
+    "ledge",
+    "door",
+    "railing",
+    "balcony",
+    "shutter",
+)
 
 Ident = Annotated[str, StringConstraints(pattern=IDENT_RE)]
 Length = Annotated[float, Field(allow_inf_nan=False)]
@@ -198,7 +209,11 @@ class ShapeRule(Model):
     frame_width: PositiveLength | None = None  # frame and arch: width of the frame's bars
     pane_depth: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None  # pane recess
     segments: Annotated[int, Field(ge=3, le=128)] | None = None  # arch and column smoothness
-    pane_material: Ident | None = None  # frame and arch: the pane's (default: glass)
+    pane_material: Ident | None = None  # frame, arch, door: the pane's (default: glass)
+    sill: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None  # frame, arch
+    panels: Annotated[int, Field(ge=0, le=12)] | None = None  # door: rows of raised panels
+    glazing: Annotated[float, Field(ge=0, le=0.9, allow_inf_nan=False)] | None = None  # door
+    spacing: Annotated[float, Field(ge=0.03, le=2, allow_inf_nan=False)] | None = None  # bars
 
 
 class Layer(Model):
@@ -221,6 +236,7 @@ class Material(Model):
     metallic: Unit = 0.0
     roughness: Unit = 0.8
     opacity: Unit = 1.0
+    transmission: Unit = 0.0  # light passing through (glass): KHR_materials_transmission
     texture: str | None = None  # a PNG or JPEG next to the spec, tinted by color
     texture_size: PositiveLength = 1.0  # metres of façade one copy of the texture covers
 

@@ -1,0 +1,108 @@
+"""Render the README's pictures with facadecli itself (``make pictures``).
+
+Each picture is a spec solved with ``facade solve -f html,svg`` and a screenshot of the
+page (the model alone, ``?bare``, from the camera ``?view=`` gives) or of the SVG
+elevation, taken by a headless Chromium (software WebGL). Needs ``chromium`` on the PATH
+(or CHROME=/path/to/browser); run from the project's root.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+TARGET = ROOT / "docs" / "pictures"
+WINDOW = "900,560"
+
+# picture name -> (spec, what: "model" or "elevation", camera: around, up, zoom, x, y)
+PICTURES: dict[str, tuple[str, str, str]] = {
+    "centred-bay": ("centred-bay", "model", "35,10,1.3,0.5,0.5"),
+    "qualifiers": ("qualifiers", "model", "35,10,1.3,0.5,0.5"),
+    "residential-house": ("residential-house", "model", "35,10,1.3,0.5,0.5"),
+    "shop-front": ("shop-front", "model", "35,10,1.3,0.5,0.5"),
+    "terraced-house": ("terraced-house", "model", "35,10,1.3,0.5,0.5"),
+    "townhouse": ("townhouse", "model", "35,10,1.3,0.5,0.5"),
+    "parts": ("parts", "model", "35,10,1.5,0.5,0.5"),
+    "parts-elevation": ("parts", "elevation", ""),
+    "part-door": ("parts", "model", "25,5,5,0.17,0.25"),
+    "part-arch-shutters": ("parts", "model", "-30,5,4.5,0.45,0.27"),
+    "part-balcony": ("parts", "model", "45,20,4.5,0.82,0.5"),
+    "part-sill": ("parts", "model", "50,25,5,0.25,0.65"),
+    "part-ledge": ("parts", "model", "-60,-15,4,0.15,0.9"),
+}
+
+
+def browser() -> str:
+    found = os.environ.get("CHROME") or shutil.which("chromium")
+    found = found or shutil.which("chromium-browser")
+    if not found:
+        sys.exit("make pictures needs Chromium: apt install chromium (or CHROME=/path/to/it)")
+    return found
+
+
+def screenshot(chrome: str, url: str, target: Path, window: str, profile: Path) -> None:
+    subprocess.run(
+        [
+            chrome,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--use-gl=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+            "--hide-scrollbars",
+            f"--user-data-dir={profile}",
+            f"--window-size={window}",
+            "--virtual-time-budget=15000",
+            f"--screenshot={target}",
+            url,
+        ],
+        check=True,
+        capture_output=True,
+        timeout=180,
+    )
+
+
+def svg_size(svg: Path) -> str:
+    text = svg.read_text(encoding="utf-8")
+    width = text.split('width="', 1)[1].split('"', 1)[0]
+    height = text.split('height="', 1)[1].split('"', 1)[0]
+    return f"{round(float(width))},{round(float(height))}"
+
+
+def main(names: list[str]) -> None:
+    chrome = browser()
+    facade = Path(sys.executable).parent / "facade"
+    chosen = names or list(PICTURES)
+    TARGET.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as scratch:
+        out = Path(scratch)
+        for spec in sorted({PICTURES[name][0] for name in chosen}):
+            path = ROOT / "specs" / f"{spec}.yaml"
+            subprocess.run(
+                [str(facade), "solve", str(path), "-o", str(out), "-f", "html,svg"],
+                check=True,
+                capture_output=True,
+            )
+        for name in chosen:
+            spec, what, view = PICTURES[name]
+            target = TARGET / f"{name}.png"
+            if what == "elevation":
+                svg = out / f"{spec}.svg"
+                screenshot(chrome, svg.as_uri(), target, svg_size(svg), out / "profile")
+            else:
+                url = f"{(out / f'{spec}.html').as_uri()}?bare&view={view}"
+                screenshot(chrome, url, target, WINDOW, out / "profile")
+            print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,223 @@
+"""``facade view``: one self-contained HTML page of every model in an output folder (of
+``facade solve``, ``vary`` or ``city``): a list of the models, each with its elevation as a
+thumbnail, beside the shared three.js viewer; a click shows that model and its elevation.
+
+The models are the folder's top-level ``*.glb`` files (a city's ``buildings/*.glb`` only
+when there are none), each with the ``.svg`` of the same stem when there is one, in
+natural order (``8x3`` before ``12x3``). What the page inlines is capped at
+:data:`~facadecli.limits.GALLERY_BYTES_MAX`; the same folder gives the same bytes."""
+
+from __future__ import annotations
+
+import base64
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from html import escape
+from pathlib import Path
+
+from facadecli.errors import OutputError, SpecError
+from facadecli.export.atomic import atomic_output, check_output_file
+from facadecli.files import read_at_most
+from facadecli.limits import GALLERY_BYTES_MAX
+from facadecli.viewer import document_parts, glb_element
+
+PAGE_NAME = "index.html"
+BUILDINGS = "buildings"  # where ``facade city`` writes one glb per building
+HINT = (
+    "run 'facade solve SPEC -o FOLDER' first, or facade vary or facade city: "
+    "they write the .glb models this page shows"
+)
+
+
+@dataclass(frozen=True)
+class Model:
+    """One model of a folder: its glb and the SVG elevation of the same stem, if any."""
+
+    name: str
+    glb: Path
+    svg: Path | None
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """A model's bytes, read."""
+
+    model: Model
+    glb: bytes
+    svg: bytes | None
+
+
+def natural_key(name: str) -> tuple[tuple[str | int, ...], str]:
+    """Sorts numbers by value: ``house-8x3-0`` before ``house-12x3-0``; ties by the name."""
+    parts = re.split(r"(\d+)", name)
+    return tuple(int(part) if i % 2 else part for i, part in enumerate(parts)), name
+
+
+def _glbs(folder: Path) -> list[Path]:
+    found = [
+        path
+        for path in folder.glob("*.glb")
+        if path.is_file() and not path.name.startswith(".")  # not a run's temporary file
+    ]
+    return sorted(found, key=lambda path: natural_key(path.name))
+
+
+def find_models(folder: Path) -> list[Model]:
+    """The models of ``folder``, in order; a SpecError (exit 2) when there are none or the
+    folder cannot be read."""
+    where = str(folder)
+    if not folder.exists():
+        raise SpecError.at(where, None, None, "no such folder", HINT)
+    if not folder.is_dir():
+        raise SpecError.at(
+            where, None, None, "is a file, not a folder", "give the folder the models are in"
+        )
+    try:
+        glbs = _glbs(folder) or (_glbs(folder / BUILDINGS) if (folder / BUILDINGS).is_dir() else [])
+    except OSError as error:
+        raise SpecError.at(
+            where, None, None, f"cannot read: {error.strerror}", "check its permissions"
+        ) from None
+    if not glbs:
+        raise SpecError.at(where, None, None, "no models (.glb files) in this folder", HINT)
+    models = []
+    for glb in glbs:
+        svg = glb.with_suffix(".svg")
+        models.append(Model(glb.stem, glb, svg if svg.is_file() else None))
+    return models
+
+
+def read_models(models: list[Model], folder: Path, limit: int | None = None) -> list[Loaded]:
+    """Every model's bytes, never more than ``limit`` (:data:`GALLERY_BYTES_MAX`) in all:
+    past it, a SpecError naming the limit, having read at most one byte more."""
+    cap = GALLERY_BYTES_MAX if limit is None else limit
+    used = 0
+
+    def read(path: Path) -> bytes:
+        nonlocal used
+        try:
+            data = read_at_most(path, cap - used)
+        except OSError as error:
+            raise SpecError.at(
+                str(path), None, None, f"cannot read: {error.strerror}", "check its permissions"
+            ) from None
+        if data is None:
+            raise SpecError.at(
+                str(folder),
+                None,
+                None,
+                f"the models and elevations hold more than {cap:,} bytes, the most one "
+                "page inlines (GALLERY_BYTES_MAX)",
+                "view a folder with fewer models (move some out), or open the .glb files "
+                "one at a time",
+            )
+        used += len(data)
+        return data
+
+    return [
+        Loaded(model, read(model.glb), read(model.svg) if model.svg else None) for model in models
+    ]
+
+
+STYLE = (
+    "#list{flex:none;width:220px;overflow:auto;padding:8px;box-sizing:border-box;"
+    "background:#fff;border-right:1px solid #ccc}"
+    "#count{margin:0 0 8px;font-size:12px;color:#555}"
+    "#list button{display:block;width:100%;margin:0 0 6px;padding:4px;text-align:left;"
+    "font:inherit;font-size:12px;background:#f8f8f8;border:2px solid transparent;"
+    "cursor:pointer}"
+    "#list button[aria-pressed=true]{border-color:#2a6fdb;background:#e8f0fd}"
+    "#list img{display:block;width:100%;height:auto;max-height:120px;object-fit:contain;"
+    "margin-bottom:3px}"
+    "#list span{overflow-wrap:anywhere}"
+)
+
+# the page's own code: a click (or the arrow keys) shows an entry's model and elevation;
+# the address ends #NAME of the model shown, and a page opened at #NAME shows that model
+SCRIPT = """
+const entries = [...document.querySelectorAll('#list button')];
+const heading = document.getElementById('name');
+const elevation = document.getElementById('elevation');
+function pick(entry) {
+  for (const other of entries) other.setAttribute('aria-pressed', String(other === entry));
+  heading.textContent = entry.dataset.name;
+  const thumbnail = entry.querySelector('img');
+  elevation.replaceChildren();
+  if (thumbnail) {
+    const image = new Image();
+    image.src = thumbnail.src;
+    image.alt = 'front elevation of ' + entry.dataset.name;
+    elevation.append(image);
+  } else elevation.textContent = 'no elevation (.svg) beside this model';
+  show(entry.dataset.glb);
+  history.replaceState(null, '', '#' + encodeURIComponent(entry.dataset.name));
+}
+for (const entry of entries) entry.addEventListener('click', () => pick(entry));
+document.addEventListener('keydown', event => {
+  const step = {ArrowDown: 1, ArrowUp: -1}[event.key];
+  if (!step) return;
+  const now = entries.findIndex(entry => entry.getAttribute('aria-pressed') === 'true');
+  const next = entries[Math.min(Math.max(now + step, 0), entries.length - 1)];
+  event.preventDefault();
+  if (next === entries[now]) return;
+  pick(next); next.focus(); next.scrollIntoView({block: 'nearest'});
+});
+const wanted = decodeURIComponent(location.hash.slice(1));
+pick(entries.find(entry => entry.dataset.name === wanted) || entries[0]);
+"""
+
+
+def _entry(index: int, loaded: Loaded) -> str:
+    name = escape(loaded.model.name)
+    thumbnail = ""
+    if loaded.svg is not None:
+        data = base64.b64encode(loaded.svg).decode()
+        thumbnail = f'<img src="data:image/svg+xml;base64,{data}" alt="">'
+    return (
+        f'<button type="button" data-glb="glb-{index}" data-name="{name}" '
+        f'aria-pressed="false" title="{name}">{thumbnail}<span>{name}</span></button>'
+    )
+
+
+def gallery_parts(title: str, models: list[Loaded], note: str = "") -> Iterator[str]:
+    """The gallery page, piece by piece (one model's base64 at a time)."""
+    count = f"{len(models)} model{'s' if len(models) != 1 else ''}{note}"
+
+    def body() -> Iterator[str]:
+        yield f'<nav id="list"><p id="count">{escape(count)}</p>'
+        yield from (_entry(index, loaded) for index, loaded in enumerate(models))
+        yield (
+            '</nav><div id="model"></div><div id="side"><h3 id="name"></h3>'
+            '<p id="status">loading the model</p><div id="elevation"></div></div>'
+        )
+        for index, loaded in enumerate(models):
+            yield glb_element(f"glb-{index}", loaded.glb)
+
+    return document_parts(title, STYLE, body(), SCRIPT)
+
+
+@dataclass(frozen=True)
+class Written:
+    """What ``facade view`` wrote: the page and the models it shows."""
+
+    page: Path
+    models: list[Model]
+
+
+def write_gallery(folder: Path, page: Path | None = None) -> Written:
+    """``facade view``: the gallery of ``folder``'s models, written atomically to ``page``
+    (default ``FOLDER/index.html``)."""
+    target = folder / PAGE_NAME if page is None else page
+    models = find_models(folder)
+    check_output_file(target)
+    loaded = read_models(models, folder)
+    title = folder.resolve().name or str(folder)
+    note = f" in {BUILDINGS}/" if models[0].glb.parent != folder else ""
+    try:
+        with atomic_output(target) as handle:
+            for part in gallery_parts(title, loaded, note):
+                handle.write(part.encode("utf-8"))
+    except OSError as error:
+        raise OutputError(f"{target}: cannot write the page: {error.strerror}") from None
+    return Written(target, models)
