@@ -338,7 +338,7 @@ def city(
     typer.echo(
         f"{summary['ok']} of {summary['buildings']} buildings built{rejected} in "
         f"{summary['seconds']} s -> {outdir}/{report['name']}.glb, "
-        f"{outdir}/{report['name']}.report.json"
+        f"{outdir}/{report['name']}.city.json, {outdir}/{report['name']}.report.json"
     )
     if summary["failed"]:  # exit 1 only when a building that should build did not
         raise typer.Exit(1)

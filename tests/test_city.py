@@ -14,10 +14,11 @@ from shapely.geometry.polygon import orient
 
 from facadecli import SpecError
 from facadecli.city.demo import district, write_demo
-from facadecli.city.footprints import building_height, read_footprints
+from facadecli.city.footprints import read_footprints
 from facadecli.city.manifest import Roof, load_city
 from facadecli.city.roofs import roof_meshes
 from facadecli.city.run import run_city, safe_name
+from facadecli.city.s3db import tagged_heights, volume
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -96,7 +97,9 @@ def test_broken_footprints_are_reported_not_raised(tmp_path: Path) -> None:
     ],
 )
 def test_heights_from_properties(properties: dict[str, object], height: float) -> None:
-    assert building_height(properties, 9.0, 3.0) == pytest.approx(height)
+    part = Polygon([(0, 0), (10, 0), (10, 8), (0, 8)])
+    heights = tagged_heights(properties, 3.0, 9.0)
+    assert volume(part, heights, Roof(type="flat")).top == pytest.approx(height)
 
 
 def test_safe_names_never_collide() -> None:
@@ -112,7 +115,7 @@ def test_a_manifest_naming_a_missing_or_bad_spec_is_rejected_first(tmp_path: Pat
         load_city(manifest)
     messages = " ".join(p.message for p in caught.value.problems)
     assert "missing.yaml" in messages
-    manifest.write_text(text + "  - when: {building: yes}\n    roof: {type: dome}\n")
+    manifest.write_text(text + "  - when: {building: yes}\n    roof: {type: igloo}\n")
     with pytest.raises(SpecError) as caught:
         load_city(manifest)
     assert "roof.type" in caught.value.problems[0].message
@@ -193,8 +196,8 @@ def test_sloped_roofs_cover_any_footprint(kind: str, name: str) -> None:
     assert plan.area == pytest.approx(part.area, rel=1e-6)  # covered once, no gaps or overlaps
     assert (roof.face_normals[:, 2] > 0).all()  # every face looks up
     assert roof.bounds[0][2] == pytest.approx(9.0, abs=1e-6)  # down to the eaves
-    if kind == "hip":
-        assert not walls  # a hip roof meets the walls at the eaves all round
+    if kind == "hip" or (kind == "gable" and name in ("concave", "courtyard")):
+        assert not walls  # at the eaves all round: a hip, or a gable without wing ends
     else:
         assert walls and all(w.bounds[0][2] == pytest.approx(9.0) for w in walls)
 
@@ -215,14 +218,11 @@ def test_roof_heights_follow_the_pitch() -> None:
 
 def test_osm_roof_tags_pick_the_roof(tmp_path: Path) -> None:
     city = load_city(write_demo(tmp_path / "city", ROOT / "specs", blocks=1))
-    _, roof, height = city.choose(
-        {"roof:shape": "hipped", "roof:angle": "40", "building:levels": "3"}
-    )
-    assert (roof.type, roof.pitch) == ("hip", 40.0) and height == pytest.approx(9.6)
-    _, roof, _ = city.choose({"roof:shape": "skillion"})
-    assert roof.type == "shed"
-    _, roof, _ = city.choose({"roof:shape": "onion"})
-    assert roof.type == "gable"  # unknown shapes: the manifest's default
+    roof = city.choose({"roof:shape": "hipped", "roof:angle": "40", "building:levels": "3"}).roof
+    assert (roof.type, roof.pitch) == ("hip", 40.0)
+    assert city.choose({"roof:shape": "skillion"}).roof.type == "shed"
+    assert city.choose({"roof:shape": "onion"}).roof.type == "onion"
+    assert city.choose({"roof:shape": "igloo"}).roof.type == "gable"  # the manifest's default
 
 
 def test_broken_geojson_files_are_located(tmp_path: Path) -> None:

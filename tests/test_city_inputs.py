@@ -114,7 +114,8 @@ def test_a_feature_that_cannot_be_built_is_rejected_by_id_and_line(
     assert f"{tmp_path / 'f.geojson'}:4:1: rejected: feature '{fid}': {entry['error']}" in err
     summary = report(manifest)["summary"]
     assert summary == {**summary, "buildings": 1, "ok": 1, "failed": 0, "rejected": 1}
-    assert [p.name for p in (tmp_path / "out" / "buildings").iterdir()] == ["good.glb"]
+    built = sorted(p.name for p in (tmp_path / "out" / "buildings").iterdir())
+    assert built == ["good.city.jsonl", "good.glb"]
 
 
 NOT_GEOJSON = {

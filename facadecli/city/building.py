@@ -15,14 +15,17 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import trimesh
 from shapely.geometry import Polygon
+from trimesh.visual.material import PBRMaterial
 
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof
 from facadecli.city.roofs import roof_meshes
+from facadecli.city.s3db import Heights, Volume, blind, volume
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
 from facadecli.layout import Layout, build_shapes
@@ -32,32 +35,87 @@ from facadecli.spec.model import Material, Spec
 WALL = Material(color="#cfc6b8", roughness=0.9)
 ROOF = Material(color="#6b4f43", roughness=0.8)
 GROUND = Material(color="#808080", roughness=1.0)
+WALL_NAME, ROOF_NAME, GROUND_NAME = "wall", "roof", "ground"  # a spec may define them
 SLAB = 0.2  # metres: thickness of flat roofs and plain walls
 MIN_EDGE = 0.05  # metres: shorter edges are slivers, merged into the next wall
 
 
+STRETCH = 0.02  # rungs of the ladder of wall lengths are this share apart
+
+
+def rung(length: float) -> int:
+    """The step of the ladder of lengths STRETCH apart nearest to ``length``."""
+    return round(math.log(length) / math.log1p(STRETCH))
+
+
+def rung_length(step: int) -> float:
+    return round(math.exp(step * math.log1p(STRETCH)), 6)
+
+
+FacadeMeshes = tuple[tuple[str, np.ndarray, np.ndarray], ...]  # (material, vertices, faces)
+
+
 @dataclass
 class AxisCache:
-    """Solved axes of a run, shared by all buildings of a worker: (spec key, axis, length)."""
+    """Solved axes and built façades of a run, shared by all buildings of a worker.
 
-    axes: dict[tuple[str, str, float], AxisLayout | None] = field(default_factory=dict)
+    Walls are solved at the nearest of a ladder of lengths STRETCH apart (2 % steps: 3 m
+    to 60 m is 150 rungs) and stretched to their own size (by at most half a step, 1 %:
+    a 1.3 m window grows or shrinks 13 mm); a façade's meshes are built once per pair of
+    rungs, merged per material, and scaled onto each wall. A city of thousands of walls
+    of as many lengths solves and builds a few hundred. Every worker makes a rung the
+    same way, so the files do not depend on which worker built what."""
+
+    axes: dict[tuple[str, str, int], AxisLayout | None] = field(default_factory=dict)
+    facades: dict[tuple[str, int, int], FacadeMeshes] = field(default_factory=dict)
 
     def get(self, key: str, spec: Spec, axis: str, length: float) -> AxisLayout | None:
-        slot = (key, axis, round(length, 2))
+        """The axis solved at the rung of ``length`` (None: no layout, a plain wall)."""
+        slot = (key, axis, rung(length))
         if slot not in self.axes:
             try:
                 deadline = time.perf_counter() + spec.solver.time_limit / 2
-                self.axes[slot] = solve_axis(spec, axis, round(length, 2), deadline)  # type: ignore[arg-type]
+                canvas = rung_length(slot[2])
+                self.axes[slot] = solve_axis(spec, axis, canvas, deadline)  # type: ignore[arg-type]
             except (InfeasibleError, SearchLimitError):  # a plain wall there
                 self.axes[slot] = None
         return self.axes[slot]
+
+    def facade(
+        self, key: str, spec: Spec, width: float, height: float, base_dir: Path | None
+    ) -> list[tuple[str, trimesh.Trimesh]] | None:
+        """The façade of a wall ``width`` x ``height`` in its own frame (x along, y up, z
+        out), one mesh per material; None where no layout fits (a plain wall)."""
+        horizontal = self.get(key, spec, "x", width)
+        vertical = self.get(key, spec, "y", height)
+        if horizontal is None or vertical is None:
+            return None
+        slot = (key, rung(width), rung(height))
+        if slot not in self.facades:
+            layout = _facade(spec, horizontal, vertical)
+            merged: dict[str, list[trimesh.Trimesh]] = {}
+            for mesh in _placed(facade_scene(layout, base_dir)):
+                merged.setdefault(mesh.visual.material.name, []).append(mesh)
+            self.facades[slot] = tuple(
+                (name, joined.vertices.copy(), joined.faces.copy())
+                for name, meshes in sorted(merged.items())
+                for joined in [trimesh.util.concatenate(meshes)]
+            )
+        scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
+        return [
+            (name, trimesh.Trimesh(vertices * scale, faces, process=False))
+            for name, vertices, faces in self.facades[slot]
+        ]
 
 
 @dataclass(frozen=True)
 class BuildingResult:
     scene: trimesh.Scene
     facades: int  # walls with a solved façade
-    plain_walls: int
+    plain_walls: int  # walls without one (too short, no layout, or party walls)
+    party_walls: int  # walls along a neighbour: blind
+    top: float  # metres: the highest roof
+    volumes: tuple[Volume, ...] = ()  # the parts as built: walls and roofs
 
 
 def _to_world(origin: tuple[float, float], direction: tuple[float, float]) -> np.ndarray:
@@ -93,72 +151,74 @@ def _corners(ring: list[tuple[float, ...]]) -> list[tuple[float, float]]:
     return [*kept, kept[0]] if len(kept) >= 3 else []
 
 
+@dataclass(frozen=True)
+class Looks:
+    """Colours the tags give the building (None: the spec's, else the built-in ones)."""
+
+    wall: str | None = None
+    roof: str | None = None
+
+
 def build_building(
     footprint: Footprint,
     spec: Spec,
     spec_key: str,
-    height: float,
+    heights: Heights,
     roof: Roof,
     min_facade_width: float,
     cache: AxisCache,
     base_dir: Path | None = None,
+    looks: Looks = Looks(),
+    shared: Any = None,
+    tolerance: float = 0.3,
 ) -> BuildingResult:
-    """The building's scene: façades on every wall, the roof, the ground. ``base_dir`` is
-    the spec's folder, where its mesh and texture files are."""
+    """The building's scene: a volume a part of its footprint, as the heights say (walls
+    from ``base`` to the eaves, the roof on them); façades on every wall but the party
+    walls along a neighbour (``shared``, within ``tolerance``), which are blind; the
+    ground under the parts that stand on it. ``base_dir`` is the spec's folder, where its
+    mesh and texture files are."""
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
-    wall_height = height + (roof.parapet if roof.type == "flat" else 0.0)
-    vertical = cache.get(spec_key, spec, "y", wall_height)
-    facades = plain = 0
-    for part in footprint.parts:
-        for a, b in _edges(part):
+    facades = plain = party = 0
+    volumes = [volume(part, heights, roof) for part in footprint.parts]
+    for block in volumes:
+        wall_height = block.eaves - block.base
+        if block.roof.type == "flat":
+            wall_height += block.roof.parapet
+        lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
+        for a, b in _edges(block.part):
             length = math.dist(a, b)
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
-            placement = _to_world(a, direction)
-            horizontal = (
-                cache.get(spec_key, spec, "x", length) if length >= min_facade_width else None
+            placement = lift @ _to_world(a, direction)
+            party_wall = blind(a, b, shared, tolerance)
+            meshes = (
+                cache.facade(spec_key, spec, length, wall_height, base_dir)
+                if length >= min_facade_width and not party_wall
+                else None
             )
-            if horizontal is None or vertical is None:
+            if meshes is None:
                 wall = trimesh.creation.box(extents=(length, wall_height, SLAB))
                 wall.apply_translation((length / 2, wall_height / 2, -SLAB / 2))
                 wall.apply_transform(placement)
-                parts.setdefault("wall", []).append(wall)
+                parts.setdefault(WALL_NAME, []).append(wall)
                 plain += 1
+                party += party_wall
                 continue
             facades += 1
-            sized = spec.model_copy(
-                update={
-                    "canvas": spec.canvas.model_copy(
-                        update={"width": horizontal.canvas, "height": vertical.canvas}
-                    )
-                }
-            )
-            layout = Layout(
-                sized,
-                horizontal.canvas,
-                vertical.canvas,
-                horizontal,
-                vertical,
-                build_shapes(sized, horizontal, vertical),
-                0.0,
-            )
-            for mesh in _placed(facade_scene(layout, base_dir)):
+            for name, mesh in meshes:
                 mesh.apply_transform(placement)
-                parts.setdefault(mesh.visual.material.name, []).append(mesh)
-        cover, infill = roof_meshes(part, height, roof)
+                parts.setdefault(name, []).append(mesh)
+        cover, infill = roof_meshes(block.part, block.eaves, block.roof)
         cover.apply_transform(MAP_TO_WORLD)
-        parts.setdefault("roof", []).append(cover)
+        parts.setdefault(ROOF_NAME, []).append(cover)
         for piece in infill:
             piece.apply_transform(MAP_TO_WORLD)
-            parts.setdefault("wall", []).append(piece)
-        ground = trimesh.creation.extrude_polygon(part, 0.01)
-        ground.apply_translation((0, 0, -0.01))
-        ground.apply_transform(MAP_TO_WORLD)
-        parts.setdefault("ground", []).append(ground)
-    materials = {name: pbr(name, m, base_dir) for name, m in spec.materials.items()}
-    materials.update(
-        {"wall": pbr("wall", WALL), "roof": pbr("roof", ROOF), "ground": pbr("ground", GROUND)}
-    )
+            parts.setdefault(WALL_NAME, []).append(piece)
+        bottom = trimesh.creation.extrude_polygon(block.part, 0.01)
+        bottom.apply_translation((0, 0, block.base - 0.01))
+        bottom.apply_transform(MAP_TO_WORLD)
+        parts.setdefault(GROUND_NAME if block.base <= 0 else WALL_NAME, []).append(bottom)
+    materials = _materials(spec, base_dir, looks)
     for name in sorted(parts):
         merged = trimesh.util.concatenate(parts[name])
         material = materials.get(name) or pbr(name, Material())
@@ -166,7 +226,46 @@ def build_building(
         scene.add_geometry(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"
         )
-    return BuildingResult(scene, facades, plain)
+    top = max(block.top for block in volumes)
+    return BuildingResult(scene, facades, plain, party, round(top, 3), tuple(volumes))
+
+
+def _facade(spec: Spec, horizontal: AxisLayout, vertical: AxisLayout) -> Layout:
+    sized = spec.model_copy(
+        update={
+            "canvas": spec.canvas.model_copy(
+                update={"width": horizontal.canvas, "height": vertical.canvas}
+            )
+        }
+    )
+    return Layout(
+        sized,
+        horizontal.canvas,
+        vertical.canvas,
+        horizontal,
+        vertical,
+        build_shapes(sized, horizontal, vertical),
+        0.0,
+    )
+
+
+def _materials(spec: Spec, base_dir: Path | None, looks: Looks) -> dict[str, PBRMaterial]:
+    """The materials by name: the spec's, the building's own (a spec material of that
+    name wins over the built-in one), and the tags' colours over both."""
+    declared = dict(spec.materials)
+    for name, builtin in ((WALL_NAME, WALL), (ROOF_NAME, ROOF), (GROUND_NAME, GROUND)):
+        declared.setdefault(name, builtin)
+    if looks.wall is not None:
+        walls = [WALL_NAME] + ([spec.defaults.material] if spec.defaults.material else [])
+        for name in walls:
+            declared[name] = declared.get(name, WALL).model_copy(
+                update={"color": looks.wall, "texture": None}
+            )
+    if looks.roof is not None:
+        declared[ROOF_NAME] = declared[ROOF_NAME].model_copy(
+            update={"color": looks.roof, "texture": None}
+        )
+    return {name: pbr(name, m, base_dir) for name, m in declared.items()}
 
 
 def _placed(scene: trimesh.Scene) -> list[trimesh.Trimesh]:

@@ -12,7 +12,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, StringConstraints
 
-from facadecli.city.footprints import MAX_HEIGHT, building_height, number
+from facadecli.city.footprints import MAX_HEIGHT, number
 from facadecli.errors import Problem, SpecError
 from facadecli.spec import load_spec
 from facadecli.spec.load import validate_model
@@ -20,13 +20,36 @@ from facadecli.spec.model import NAME_RE, Model, Spec
 from facadecli.spec.source import Path as DataPath
 from facadecli.spec.source import SourceMap, read_document
 
-ROOF_TYPES = ("flat", "shed", "gable", "hip")
-SUPPORTED_ROOFS = ROOF_TYPES
+RoofType = Literal[
+    "flat",
+    "shed",
+    "gable",
+    "hip",
+    "pyramidal",
+    "half_hip",
+    "gambrel",
+    "mansard",
+    "saltbox",
+    "dome",
+    "round",
+    "onion",
+]
 
 
 class Roof(Model):
-    type: Literal["flat", "shed", "gable", "hip"] = "flat"
+    """A roof over every part of a footprint (OSM Simple 3D Buildings' roof shapes).
+
+    ``pitch`` sets the slope of pitched roofs unless ``height`` (metres from the eaves to
+    the top) is given; ``direction`` (compass degrees the main slope faces, downhill) turns
+    shed and saltbox roofs and the ridge of gabled ones (the ridge runs across it);
+    ``orientation`` puts the ridge along the footprint's long side (the default) or across.
+    """
+
+    type: RoofType = "flat"
     pitch: Annotated[float, Field(gt=0, lt=90)] = 30.0  # degrees, for sloped roofs
+    height: Annotated[float, Field(gt=0, le=MAX_HEIGHT, allow_inf_nan=False)] | None = None
+    direction: Annotated[float, Field(ge=0, lt=360, allow_inf_nan=False)] | None = None
+    orientation: Literal["along", "across"] = "along"
     parapet: Annotated[float, Field(ge=0, le=5)] = 0.0  # metres of wall above a flat roof
 
 
@@ -38,12 +61,17 @@ class Range(Model):
 Height = Annotated[float, Field(gt=0, le=MAX_HEIGHT, allow_inf_nan=False)]  # metres
 
 
+Colours = Literal["tags", "spec"]  # who colours the walls and roof: the OSM tags, or the spec
+
+
 class Defaults(Model):
     facade: str
-    height: Height = 9.0
+    height: Height = 9.0  # the top of the roof, when a feature has no height and no levels
     floor_height: Annotated[float, Field(gt=0, le=20, allow_inf_nan=False)] = 3.0
     roof: Roof = Roof()
     min_facade_width: Annotated[float, Field(ge=0)] = 2.0
+    colours: Colours = "tags"
+    party_wall_tolerance: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] = 0.3
 
 
 class Rule(Model):
@@ -51,6 +79,32 @@ class Rule(Model):
     facade: str | None = None
     roof: Roof | None = None
     height: Height | None = None
+    colours: Colours | None = None
+
+
+class Source(Model):
+    """A property holding a number, and the factor to metres (or levels)."""
+
+    name: Annotated[str, StringConstraints(min_length=1, max_length=200)]
+    scale: Annotated[float, Field(gt=0, allow_inf_nan=False)] = 1.0
+
+
+class Properties(Model):
+    """Where a dataset that is not OSM keeps heights and levels: ``height`` (the top of the
+    roof), ``eaves`` (the top of the walls: the roof goes on top), ``levels`` (below the
+    roof), ``min_height`` (the bottom of the walls)."""
+
+    height: Source | None = None
+    eaves: Source | None = None
+    levels: Source | None = None
+    min_height: Source | None = None
+
+    def names(self) -> dict[str, tuple[str, float]]:
+        return {
+            key: (source.name, source.scale)
+            for key in ("height", "eaves", "levels", "min_height")
+            if (source := getattr(self, key)) is not None
+        }
 
 
 class Manifest(Model):
@@ -59,6 +113,7 @@ class Manifest(Model):
     footprints: str
     defaults: Defaults
     rules: list[Rule] = Field(default_factory=list)
+    properties: Properties = Properties()
 
 
 @dataclass(frozen=True)
@@ -70,29 +125,50 @@ class City:
     footprints: Path
     specs: dict[str, Spec]  # by the path the manifest gives
 
-    def choose(self, properties: dict[str, Any]) -> tuple[str, Roof, float]:
-        """(façade spec path, roof, height) for a building: the first matching rule wins;
-        else the feature's own OSM ``roof:shape`` (and ``roof:angle``); else the defaults."""
+    def choose(self, properties: dict[str, Any]) -> Choice:
+        """What a building gets: the first matching rule wins; else the feature's own OSM
+        ``roof:shape`` (and ``roof:angle``); else the defaults."""
         defaults = self.manifest.defaults
         facade, roof = defaults.facade, _tagged_roof(properties) or defaults.roof
-        height = building_height(properties, defaults.height, defaults.floor_height)
+        height, colours = None, defaults.colours
         for rule in self.manifest.rules:
             if all(_matches(properties, key, want) for key, want in rule.when.items()):
                 facade = rule.facade or facade
                 roof = rule.roof or roof
-                height = rule.height or height
+                height = rule.height
+                colours = rule.colours or colours
                 break
-        return facade, roof, height
+        return Choice(facade, roof, height, colours)
 
 
-RoofType = Literal["flat", "shed", "gable", "hip"]
-OSM_ROOFS: dict[str, RoofType] = {
+@dataclass(frozen=True)
+class Choice:
+    """The manifest's choice for one building."""
+
+    facade: str  # the spec's path, as the manifest gives it
+    roof: Roof
+    height: float | None  # the top of the roof a rule sets, if one does
+    colours: str  # "tags" or "spec"
+
+
+OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "flat": "flat",
     "skillion": "shed",
     "lean_to": "shed",
     "gabled": "gable",
     "hipped": "hip",
-    "pyramidal": "hip",
+    "side_hipped": "hip",
+    "pyramidal": "pyramidal",
+    "cone": "pyramidal",
+    "half-hipped": "half_hip",
+    "half_hipped": "half_hip",
+    "side_half-hipped": "half_hip",
+    "gambrel": "gambrel",
+    "mansard": "mansard",
+    "saltbox": "saltbox",
+    "dome": "dome",
+    "round": "round",
+    "onion": "onion",
 }
 
 
@@ -144,22 +220,10 @@ def load_city(path: Path) -> City:
                 "give a GeoJSON path relative to the manifest",
             )
         )
-    roofs: list[tuple[DataPath, Roof]] = [(("defaults", "roof"), manifest.defaults.roof)]
     facades: list[tuple[DataPath, str]] = [(("defaults", "facade"), manifest.defaults.facade)]
     for index, rule in enumerate(manifest.rules):
         if rule.facade is not None:
             facades.append((("rules", index, "facade"), rule.facade))
-        if rule.roof is not None:
-            roofs.append((("rules", index, "roof"), rule.roof))
-    for where, roof in roofs:
-        if roof.type not in SUPPORTED_ROOFS:
-            problems.append(
-                source.problem(
-                    (*where, "type"),
-                    f"roof type '{roof.type}' is not supported yet",
-                    "use 'flat' (with a parapet)",
-                )
-            )
     specs: dict[str, Spec] = {}
     for where, facade in facades:
         if facade in specs:

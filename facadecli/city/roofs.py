@@ -1,152 +1,1299 @@
-"""Roofs on any footprint polygon, holes included (SPEC 5): flat, shed, gable, hip.
+"""Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
+(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, gambrel, mansard, saltbox, dome,
+round, onion.
 
-Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``:
-- flat: a slab (walls carry the parapet);
-- shed: one plane rising across the footprint's main direction;
-- gable: two planes meeting at a ridge along the main direction (the long axis of the
-  footprint's minimum rotated rectangle); walls are filled up to the roof, which gives
-  gable ends their triangle;
-- hip: every wall edge slopes up at the pitch; the faces come from the straight skeleton
-  (py-straight-skeleton), so L, T, U shapes and courtyards get proper valleys and ridges.
+Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
+
+Every sloped roof but the shed and the pyramid is cut from a *weighted straight skeleton*
+of the footprint, computed here by simulating its wavefront: each wall edge moves inwards
+at its weight (speed), and the roof over a point is the time the wavefront reaches it.
+Weight 1 everywhere gives the hip roof; weight 0 keeps an edge where it is, so the roof
+planes next to it run on to the wall and a vertical gable end rises above it. Gable ends
+are the short "caps" of a wing (an edge between two convex corners whose neighbours run
+back parallel): on a convex footprint those across the ridge direction (the long side, or
+``orientation: across``, or across ``direction``), on any other the ends of its wings,
+which the unweighted skeleton shows as triangles under one ridge point. So an L gets a
+cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all round.
+
+- flat: a slab (the walls carry the parapet);
+- shed: one plane, its low side facing ``direction`` (else across the main direction);
+- gable: the skeleton with weight 0 on the gable ends; half_hip: the same, the ends
+  turning to weight 1 at two thirds of their height (hipped over the top third);
+- hip: the plain skeleton; pyramidal: every edge slopes to one apex (hip on concave
+  outlines and courtyards);
+- saltbox: a gable whose side facing ``direction`` moves twice as fast: its slope runs
+  twice as far, at half the pitch;
+- gambrel and mansard: gable and hip with two slopes (steep to a third of the way in and
+  two thirds of the height, then shallow);
+- dome, onion and round: hip, hip and gable roofs whose height is a curve of the
+  skeleton time: a quarter circle (round: a barrel with a half-circle section), an onion
+  (a bulb that narrows to a point), in flat bands.
+
+Heights: ``pitch`` is the slope of a plane moving at weight 1, unless ``height`` sets the
+top; domes and barrels rise by their half width, onions by twice that. ``roof_height``
+gives the rise of what ``roof_meshes`` builds. A shape that cannot be built on some
+outline (a degenerate skeleton; more than MAX_SKELETON vertices) falls back to hip, then
+flat; nothing raises. Results are cached per (outline, roof shape), so asking for the
+height and then the mesh builds the skeleton once.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
-from collections.abc import Callable
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import trimesh
-from shapely.geometry import LineString, Polygon
-from shapely.ops import split
+from shapely.geometry import Polygon
+from shapely.geometry.polygon import orient
 
 from facadecli.city.manifest import Roof
 
-SLAB = 0.2
+SLAB = 0.2  # metres: a flat roof's thickness
+MAX_TRIANGLES = 2000  # a curved roof's bands are chosen to stay below this
+SIDE_TURN = math.radians(10)  # edges turning less than this make one side of a footprint
+CAP_CORNER = math.radians(20)  # a gable end's corners turn at least this, at most 180 - it
+CAP_PARALLEL = -0.7  # the sides next to a gable end run back: cosine below this
+ACROSS = 0.7072  # a gable end lies across the ridge: |cos| of their angle at most this (45°)
+PYRAMID_HULL = 0.9  # a pyramid's outline fills this much of its convex hull at least
+FACING = 0.5  # a saltbox's long slope: the sides facing its direction within 60°
+HALF_HIP = 2 / 3  # a half hip's gable end goes up to this part of its height
+BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
+CURVED = ("dome", "round", "onion")
+GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox")
+MAX_EVENTS = 20  # skeleton steps per vertex before giving up
+MAX_SKELETON = 200  # vertices: larger outlines get the roofs that need no skeleton, or flat
 
-Surface = Callable[[np.ndarray], np.ndarray]  # (n, 2) map points -> roof heights
+
+class _Degenerate(Exception):
+    """A skeleton or shape that cannot be built here: the caller falls back."""
+
+
+# ---------------------------------------------------------------------------------------
+# the public interface
 
 
 def roof_meshes(
     part: Polygon, height: float, roof: Roof
 ) -> tuple[trimesh.Trimesh, list[trimesh.Trimesh]]:
-    """(the roof, walls filling the space between the eaves and the roof)."""
-    if roof.type == "flat":
+    """(the roof, walls filling the space between the eaves and the roof: gable ends)."""
+    shape = _shape(part.wkb, *_key(roof))
+    if shape.kind == "flat":
+        return _slab(part, height), []
+    return _mesh(shape, height, _rise(shape, roof))
+
+
+def roof_height(part: Polygon, roof: Roof) -> float:
+    """The roof's top above the eaves: ``roof.height`` if set, else from the pitch and the
+    footprint (0 for flat roofs); the top of what ``roof_meshes`` builds."""
+    shape = _shape(part.wkb, *_key(roof))
+    return _rise(shape, roof)
+
+
+def _key(roof: Roof) -> tuple[str, float | None, str]:
+    """What the shape depends on (not the pitch or height: they scale it)."""
+    if roof.type == "shed":
+        return roof.type, roof.direction, "along"
+    if roof.type in GABLED:
+        return roof.type, roof.direction, roof.orientation
+    return roof.type, None, "along"
+
+
+def _rise(shape: _Shape, roof: Roof) -> float:
+    if shape.kind == "flat" or shape.top <= 0:
+        return 0.0
+    if roof.height is not None:
+        return float(roof.height)
+    if shape.kind in ("dome", "round"):
+        return shape.top
+    if shape.kind == "onion":
+        return 2 * shape.top
+    return math.tan(math.radians(roof.pitch)) * shape.top
+
+
+# ---------------------------------------------------------------------------------------
+# shapes: a roof as nodes (x, y, t) with t the height in skeleton time, before a profile
+
+
+@dataclass(frozen=True)
+class _Shape:
+    """A roof before its heights: ``t`` rises from 0 at the eaves to ``top``; ``cover``
+    faces are lists of rings (outer first) of node indices, planar in (x, y, t);
+    ``walls`` are vertical loops with their edge direction (gable ends, a shed's sides)."""
+
+    kind: str
+    xy: np.ndarray
+    t: np.ndarray
+    cover: tuple[tuple[tuple[int, ...], ...], ...]
+    walls: tuple[tuple[tuple[int, ...], tuple[float, float]], ...]
+    top: float
+
+
+FLAT = _Shape("flat", np.zeros((0, 2)), np.zeros(0), (), (), 0.0)
+
+
+@lru_cache(maxsize=512)
+def _shape(wkb: bytes, kind: str, direction: float | None, orientation: str) -> _Shape:
+    """The shape built for a footprint (as WKB, so it can be a cache key), falling back
+    to a hip roof, then to a flat one, rather than raising."""
+    import shapely
+
+    part = shapely.from_wkb(wkb)
+    if kind == "flat" or not isinstance(part, Polygon) or part.is_empty or part.area <= 0:
+        return FLAT
+    tries = [kind] if kind == "hip" else [kind, "hip"]
+    with np.errstate(all="ignore"):
+        for attempt in tries:
+            try:
+                return _build(part, attempt, direction, orientation)
+            except Exception:  # a degenerate skeleton, or worse: the simpler shape
+                continue
+    return FLAT
+
+
+def _build(part: Polygon, kind: str, direction: float | None, orientation: str) -> _Shape:
+    outline = _Outline(part)
+    if kind == "shed":
+        return outline.shed(direction)
+    if kind == "pyramidal":
+        return outline.pyramid()
+    if kind in GABLED:
+        return outline.gabled(kind, direction, orientation)
+    if kind in ("hip", "mansard", "dome", "onion"):
+        return outline.hipped(kind)
+    raise _Degenerate(kind)
+
+
+@dataclass(frozen=True)
+class _Side:
+    """A run of nearly collinear edges of one ring: its edges, its chord's ends, where it
+    is."""
+
+    edges: tuple[int, ...]
+    start: np.ndarray
+    end: np.ndarray
+    ring: int
+    index: int  # in its ring's sides
+
+
+class _Outline:
+    """A footprint's rings, cleaned, relative to an origin (for precision), with its
+    sides and main direction."""
+
+    def __init__(self, part: Polygon) -> None:
+        part = orient(part, sign=1.0)  # exterior counter-clockwise, holes clockwise
+        minx, miny, maxx, maxy = part.bounds
+        self.origin = np.array([minx, miny])
+        self.scale = max(maxx - minx, maxy - miny, 1e-9)
+        self.eps = 1e-8 * max(self.scale, 1.0)
+        self.rings: list[np.ndarray] = []
+        for k, ring in enumerate((part.exterior, *part.interiors)):
+            points = _clean(np.array(ring.coords)[:-1, :2], self.eps * 10)
+            if len(points) < 3:
+                if k == 0:
+                    raise _Degenerate("outline")
+                continue
+            self.rings.append(points)
+        self.exact = np.concatenate(self.rings)  # map coordinates of the eave nodes
+        self.local = [ring - self.origin for ring in self.rings]
+        points = np.concatenate(self.local)
+        self.count = len(points)
+        sizes = [len(ring) for ring in self.local]
+        self.heads = [sum(sizes[:k]) for k in range(len(sizes))]  # each ring's first edge
+        nxt = np.concatenate(
+            [np.roll(np.arange(h, h + n), -1) for h, n in zip(self.heads, sizes, strict=True)]
+        )
+        prv = np.concatenate(
+            [np.roll(np.arange(h, h + n), 1) for h, n in zip(self.heads, sizes, strict=True)]
+        )
+        vectors = points[nxt] - points
+        lengths = np.hypot(vectors[:, 0], vectors[:, 1])
+        self.points, self.next, self.prev = points, nxt, prv
+        self.direction = vectors / lengths[:, None]
+        self.area = float(part.area)
+        self.convex = len(self.local) == 1 and bool(
+            (_cross(self.direction[prv], self.direction) >= -1e-9).all()
+        )
+        centre, main, normal = _axes(part)
+        self.centre, self.main, self.normal = centre - self.origin, main, normal
+
+    # -- shapes -----------------------------------------------------------------------
+
+    def shed(self, direction: float | None) -> _Shape:
+        """One plane rising away from ``direction`` (its low side faces it)."""
+        down = _compass(direction) if direction is not None else -self.normal
+        rise = self.points @ -down
+        t = rise - rise.min()
+        t[t < self.eps] = 0.0
+        top = float(t.max())
+        if top <= self.eps:
+            raise _Degenerate("shed")
+        xy = [*self.points]
+        ts = [*([0.0] * self.count)]
+        lifted = list(range(self.count))
+        for i in range(self.count):
+            if t[i] > 0:
+                lifted[i] = len(xy)
+                xy.append(self.points[i])
+                ts.append(float(t[i]))
+        rings = tuple(
+            tuple(lifted[head + k] for k in range(len(ring)))
+            for head, ring in zip(self.heads, self.local, strict=True)
+        )
+        walls = []
+        for i in range(self.count):
+            j = int(self.next[i])
+            if t[i] == 0 and t[j] == 0:
+                continue
+            loop = [i, j] + [lifted[j]] * int(t[j] > 0) + [lifted[i]] * int(t[i] > 0)
+            walls.append((tuple(loop), (float(self.direction[i, 0]), float(self.direction[i, 1]))))
+        return self._finish("shed", np.array(xy), np.array(ts), (rings,), walls, top)
+
+    def pyramid(self) -> _Shape:
+        """Every edge slopes up to one apex, which must see the whole outline."""
+        polygon = Polygon(self.points)
+        if len(self.local) != 1 or polygon.area < PYRAMID_HULL * polygon.convex_hull.area:
+            return self.hipped("hip")  # a courtyard or a concave outline
+        import shapely.ops
+
+        for apex in (
+            np.array(polygon.centroid.coords[0]),
+            np.array(shapely.ops.polylabel(polygon, self.scale * 1e-3).coords[0]),
+        ):
+            reach = _cross(self.direction, apex - self.points)  # distance in from each edge
+            if (reach > self.scale * 1e-3).all():
+                break
+        else:
+            return self.hipped("hip")
+        top = float(reach.min())
+        xy = np.vstack([self.points, apex])
+        t = np.concatenate([np.zeros(self.count), [top]])
+        faces = [((i, int(self.next[i]), self.count),) for i in range(self.count)]
+        return self._finish("pyramidal", xy, t, faces, [], top)
+
+    def hipped(self, kind: str) -> _Shape:
+        skeleton = _Skeleton(self, [1.0] * self.count, {})
+        return self._from_skeleton(kind, skeleton, {})
+
+    def gabled(self, kind: str, direction: float | None, orientation: str) -> _Shape:
+        sides = self._sides()
+        caps = [side for side in sides if self._is_cap(side, sides)]
+        if direction is not None:
+            ridge = _perpendicular(_compass(direction))
+        elif orientation == "across":
+            ridge = self.normal
+        else:
+            ridge = self.main
+        plain: _Skeleton | None = None
+        if direction is not None or orientation == "across" or self.convex:
+            caps = [side for side in caps if abs(float(_chord(side) @ ridge)) < ACROSS]
+        elif caps:  # the ends of the wings: triangles of the plain skeleton under one point
+            plain = _Skeleton(self, [1.0] * self.count, {})
+            caps = [side for side in caps if self._under_one_point(side, plain)]
+        caps.sort(key=lambda side: (round(abs(float(_chord(side) @ ridge)), 9), side.edges[0]))
+        chosen: list[_Side] = []
+        for side in caps:
+            ring = [s for s in sides if s.ring == side.ring]
+            neighbours = {ring[side.index - 1].edges, ring[(side.index + 1) % len(ring)].edges}
+            if not any(other.edges in neighbours for other in chosen):
+                chosen.append(side)
+        weights = [1.0] * self.count
+        if kind == "saltbox":
+            facing = _compass(direction) if direction is not None else _north(self.normal)
+            for side in sides:
+                outward = -_perpendicular(_chord(side))
+                if float(outward @ facing) > FACING:
+                    for e in side.edges:
+                        weights[e] = 2.0
+        switches: dict[int, float] = {}
+        for side in chosen:
+            for e in side.edges:
+                weights[e] = 0.0
+            if kind == "half_hip":
+                apex = self._gable_apex(side)
+                if apex is not None:
+                    for e in side.edges:
+                        switches[e] = HALF_HIP * apex
+        if plain is not None and all(w == 1.0 for w in weights):  # no gable ends after all
+            return self._from_skeleton(kind, plain, {})
+        skeleton = _Skeleton(self, weights, switches)
+        return self._from_skeleton(kind, skeleton, switches)
+
+    # -- sides and gable ends ---------------------------------------------------------
+
+    def _sides(self) -> list[_Side]:
+        sides: list[_Side] = []
+        for k, (head, ring) in enumerate(zip(self.heads, self.local, strict=True)):
+            size = len(ring)
+            edges = list(range(head, head + size))
+            turns = [_angle(self.direction[int(self.prev[e])], self.direction[e]) for e in edges]
+            corners = [i for i, turn in enumerate(turns) if abs(turn) >= SIDE_TURN]
+            if not corners:
+                runs = [[e] for e in edges]
+            else:
+                first = corners[0]
+                runs = []
+                for step in range(size):
+                    e = edges[(first + step) % size]
+                    if runs and (
+                        abs(turns[e - head]) < SIDE_TURN
+                        and abs(_angle(self.direction[runs[-1][0]], self.direction[e])) < SIDE_TURN
+                    ):
+                        runs[-1].append(e)
+                    else:
+                        runs.append([e])
+            for index, run in enumerate(runs):
+                start = self.points[run[0]]
+                end = self.points[int(self.next[run[-1]])]
+                sides.append(_Side(tuple(run), start, end, k, index))
+        return sides
+
+    def _is_cap(self, side: _Side, sides: list[_Side]) -> bool:
+        ring = [s for s in sides if s.ring == side.ring]
+        if len(ring) < 3:
+            return False
+        before, after = ring[side.index - 1], ring[(side.index + 1) % len(ring)]
+        into = _angle(self.direction[before.edges[-1]], self.direction[side.edges[0]])
+        out = _angle(self.direction[side.edges[-1]], self.direction[after.edges[0]])
+        convex = all(CAP_CORNER <= turn <= math.pi - CAP_CORNER for turn in (into, out))
+        back = float(self.direction[before.edges[-1]] @ self.direction[after.edges[0]])
+        return convex and back < CAP_PARALLEL
+
+    def _under_one_point(self, side: _Side, plain: _Skeleton) -> bool:
+        """Whether the plain skeleton's faces over the side make one triangle."""
+        loops = [loop for e in side.edges for loop in plain.faces[e]]
+        nodes = {n for loop in loops for n in loop} - set(range(self.count))
+        if not nodes:
+            return False
+        apex = max(nodes, key=lambda n: (plain.t[n], -n))
+        triangle = _area(np.array([side.start, side.end, plain.xy[apex]]))
+        total = sum(_area(plain.xy[list(loop)]) for loop in loops)
+        return triangle > 0 and abs(total - triangle) <= 1e-6 * self.scale**2 + 1e-3 * triangle
+
+    def _gable_apex(self, side: _Side) -> float | None:
+        """The skeleton time where the roof planes of the sides next to a gable end meet
+        above it (the top of the gable end), if they do above the side."""
+        before = int(self.prev[side.edges[0]])
+        after = int(self.next[side.edges[-1]])
+        n1, n2 = _perpendicular(self.direction[before]), _perpendicular(self.direction[after])
+        p1, p2 = self.points[before], self.points[after]
+
+        def gap(p: np.ndarray) -> float:
+            return float(n1 @ (p - p1) - n2 @ (p - p2))
+
+        g0, g1 = gap(side.start), gap(side.end)
+        if g0 * g1 >= 0:
+            return None
+        apex = side.start + g0 / (g0 - g1) * (side.end - side.start)
+        height = float(n1 @ (apex - p1))
+        return height if height > self.eps else None
+
+    # -- from a skeleton to a shape ----------------------------------------------------
+
+    def _from_skeleton(self, kind: str, skeleton: _Skeleton, switches: dict[int, float]) -> _Shape:
+        """The skeleton's faces as roof faces, and as walls where edges stood still;
+        each roof face must lie in its edge's plane: t = its start + distance / weight."""
+        cover: list[tuple[tuple[int, ...], ...]] = []
+        walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
+        xy, t = skeleton.xy, skeleton.t
+        for e in range(self.count):
+            d = (float(self.direction[e, 0]), float(self.direction[e, 1]))
+            slopes = skeleton.weights[e] > 0 and e not in switches
+            start, weight = switches.get(e, 0.0), skeleton.weights[e] if slopes else 1.0
+            for face in skeleton.faces[e]:
+                wall, roofs = (
+                    (None, [face]) if slopes else self._split_face(e, face, xy, t, switches.get(e))
+                )
+                if wall is not None:
+                    walls.append((wall, d))
+                for roof in roofs:
+                    distance = _cross(self.direction[e], xy[list(roof)] - self.points[e])
+                    if np.abs(t[list(roof)] - start - distance / weight).max() > 1e3 * self.eps:
+                        raise _Degenerate(f"{kind}: a face is not flat")
+                    cover.append((roof,))
+        top = float(t.max()) if len(t) else 0.0
+        if top <= self.eps:
+            raise _Degenerate("no rise")
+        return self._finish(kind, xy, t, cover, walls, top)
+
+    def _split_face(
+        self, e: int, loop: tuple[int, ...], xy: np.ndarray, t: np.ndarray, switch: float | None
+    ) -> tuple[tuple[int, ...] | None, list[tuple[int, ...]]]:
+        """A face of an edge that first stood still: (its vertical part, its sloped
+        parts). The wall is the face's nodes reached before the edge began to move (on
+        its line), in order; each run of later nodes, with the nodes on either side, is a
+        sloped part (a half hip's top; two, if the roof came down to the wall between)."""
+        if e not in loop:
+            return None, [loop] if abs(_area(xy[list(loop)])) > self.eps * self.scale else []
+        start = loop.index(e)
+        loop = loop[start:] + loop[:start]
+        if switch is None:
+            return loop, []
+        on = t[list(loop)] <= switch + self.eps
+        wall = tuple(n for n, kept in zip(loop, on.tolist(), strict=True) if kept)
+        slopes: list[tuple[int, ...]] = []
+        size, i = len(loop), 1
+        while i < size:
+            if on[i]:
+                i += 1
+                continue
+            j = i
+            while j < size and not on[j]:
+                j += 1
+            piece = (loop[i - 1], *loop[i:j], loop[j % size])
+            if len(set(piece)) >= 3:
+                slopes.append(piece)
+            i = j
+        return (wall if len(set(wall)) >= 3 else None), slopes
+
+    def _finish(
+        self,
+        kind: str,
+        xy: np.ndarray,
+        t: np.ndarray,
+        cover: Sequence[tuple[tuple[int, ...], ...]],
+        walls: Sequence[tuple[tuple[int, ...], tuple[float, float]]],
+        top: float,
+    ) -> _Shape:
+        """Check that the cover tiles the footprint once, and go back to map coordinates."""
+        signed = sum(
+            _area(xy[list(face[0])]) - sum(abs(_area(xy[list(h)])) for h in face[1:])
+            for face in cover
+        )
+        folded = sum(abs(_area(xy[list(face[0])])) for face in cover if len(face) == 1)
+        tolerance = 1e-6 * self.area + 1e-9
+        if abs(signed - self.area) > tolerance or (
+            all(len(face) == 1 for face in cover) and abs(folded - self.area) > tolerance
+        ):
+            raise _Degenerate(f"{kind}: the faces do not tile the footprint")
+        cover, walls = self._mend(xy, t, cover, walls)
+        world = xy + self.origin
+        world[: self.count] = self.exact  # the eaves exactly where the walls are
+        return _Shape(kind, world, t, tuple(cover), tuple(walls), top)
+
+    def _mend(
+        self,
+        xy: np.ndarray,
+        t: np.ndarray,
+        cover: Sequence[tuple[tuple[int, ...], ...]],
+        walls: Sequence[tuple[tuple[int, ...], tuple[float, float]]],
+    ) -> tuple[
+        list[tuple[tuple[int, ...], ...]], list[tuple[tuple[int, ...], tuple[float, float]]]
+    ]:
+        """Put into every loop the nodes that lie on its edges (where two faces meet a
+        third along one line), so that faces share their edges and the mesh is closed."""
+        loops = [ring for face in cover for ring in face] + [loop for loop, _ in walls]
+        used = np.array(sorted({n for loop in loops for n in loop}))
+        if not len(used):
+            return list(cover), list(walls)
+        points = np.column_stack([xy[used], t[used]])
+        starts = np.array([p for loop in loops for p in loop])
+        ends = np.array([loop[(i + 1) % len(loop)] for loop in loops for i in range(len(loop))])
+        lookup = {int(n): i for i, n in enumerate(used.tolist())}
+        a = points[[lookup[int(n)] for n in starts]]
+        v = points[[lookup[int(n)] for n in ends]] - a
+        length2 = np.maximum((v * v).sum(axis=1), 1e-300)
+        offset = points[None, :, :] - a[:, None, :]  # (segments, nodes, 3)
+        u = (offset * v[:, None, :]).sum(axis=2) / length2[:, None]
+        miss = offset - u[..., None] * v[:, None, :]
+        tolerance = 300 * self.eps
+        on = (u > 1e-9) & (u < 1 - 1e-9) & ((miss * miss).sum(axis=2) < tolerance**2)
+        if not on.any():
+            return list(cover), list(walls)
+        inserts: dict[tuple[int, int], list[int]] = {}
+        for segment, node in np.argwhere(on).tolist():
+            key = (int(starts[segment]), int(ends[segment]))
+            inserts.setdefault(key, []).append(node)
+
+        def mended(loop: tuple[int, ...]) -> tuple[int, ...]:
+            out: list[int] = []
+            for i, p in enumerate(loop):
+                q = loop[(i + 1) % len(loop)]
+                out.append(p)
+                found = inserts.get((p, q), [])
+                if found:
+                    segment = np.flatnonzero((starts == p) & (ends == q))[0]
+                    found = sorted(found, key=lambda n: float(u[segment, n]))
+                    out.extend(int(used[n]) for n in found if int(used[n]) not in (p, q))
+            return tuple(out)
+
+        faces: list[tuple[tuple[int, ...], ...]] = []
+        for face in cover:
+            if len(face) == 1:  # a face pinched at a node: two faces
+                faces.extend((ring,) for ring in _pinched(mended(face[0])))
+            else:
+                faces.append(tuple(mended(ring) for ring in face))
+        return faces, [(mended(loop), d) for loop, d in walls]
+
+
+# ---------------------------------------------------------------------------------------
+# the weighted straight skeleton
+
+
+@dataclass
+class _Vertex:
+    """A vertex of the wavefront: where it is now, its edges, the node its arc left."""
+
+    x: float
+    y: float
+    a: int  # the edge coming in
+    b: int  # the edge going out
+    node: int
+
+
+class _Skeleton:
+    """The weighted straight skeleton of an outline, by simulating its wavefront from
+    event to event; ``faces[e]``: the loops of nodes under edge ``e`` (counter-clockwise,
+    the edge's start first), ``t`` the time each node was reached.
+
+    Each step moves every vertex to the earliest event (an edge shrinking to nothing, a
+    reflex vertex reaching another edge, an edge changing weight), then tidies the
+    wavefront: vertices closer than ``eps`` merge, spikes fold, rings without area die,
+    vertices lying on another edge split it. Whatever happens at one time is handled
+    together, which copes with the many simultaneous events of rectilinear outlines."""
+
+    def __init__(
+        self, outline: _Outline, weights: Sequence[float], switches: dict[int, float]
+    ) -> None:
+        if outline.count > MAX_SKELETON:
+            raise _Degenerate("too many vertices for a skeleton here")
+        self.outline = outline
+        self.eps = outline.eps
+        self.normal = np.column_stack([-outline.direction[:, 1], outline.direction[:, 0]])
+        self.dirs = outline.direction
+        self.unit = [(float(x), float(y)) for x, y in outline.direction]
+        self.weights = list(weights)
+        self.weight = np.array(weights, dtype=float)
+        self.pending = sorted((time, e) for e, time in switches.items())
+        self.x: list[float] = []
+        self.y: list[float] = []
+        self.times: list[float] = []
+        self.segments: dict[int, list[tuple[int, int]]] = defaultdict(list)
+        self.time = 0.0
+        self.rings: list[list[_Vertex]] = []
+        for head, ring in zip(outline.heads, outline.local, strict=True):
+            vertices = []
+            for k, (x, y) in enumerate(ring):
+                e = head + k
+                node = self._node(float(x), float(y))
+                vertices.append(_Vertex(float(x), float(y), int(outline.prev[e]), e, node))
+                self.segments[e].append((e, int(outline.next[e])))
+            self.rings.append(vertices)
+        self._run()
+        self.xy = np.column_stack([self.x, self.y]) if self.x else np.zeros((0, 2))
+        self.t = np.array(self.times)
+        self.faces = self._faces()
+
+    def _node(self, x: float, y: float) -> int:
+        self.x.append(x)
+        self.y.append(y)
+        self.times.append(self.time)
+        return len(self.x) - 1
+
+    def _close(self, v: _Vertex) -> int:
+        """End the vertex's arc here (a node now), and start a new one from it."""
+        if self.times[v.node] == self.time and self.x[v.node] == v.x and self.y[v.node] == v.y:
+            return v.node
+        node = self._node(v.x, v.y)
+        self._arc(v.node, node, v.a, v.b)
+        v.node = node
+        return node
+
+    def _arc(self, low: int, high: int, a: int, b: int) -> None:
+        if low != high:
+            self.segments[a].append((low, high))
+            self.segments[b].append((high, low))
+
+    # -- the simulation ---------------------------------------------------------------
+
+    def _run(self) -> None:
+        limit = MAX_EVENTS * self.outline.count + 50
+        for _ in range(limit):
+            self._settle()
+            if not self.rings:
+                return
+            vertices, px, py, a, b, nxt = self._snapshot()
+            vx, vy = self._speeds(a, b)
+            step = self._next_event(px, py, vx, vy, a, b, nxt)
+            if not math.isfinite(step):
+                raise _Degenerate("the wavefront stopped")
+            for v, x, y in zip(
+                vertices, (px + vx * step).tolist(), (py + vy * step).tolist(), strict=True
+            ):
+                v.x, v.y = x, y
+            self.time += step
+            while self.pending and self.pending[0][0] <= self.time + self.eps:
+                _, e = self.pending.pop(0)
+                self.weight[e] = 1.0
+                for v in vertices:
+                    if e in (v.a, v.b):
+                        self._close(v)
+        raise _Degenerate("too many events")
+
+    def _snapshot(
+        self,
+    ) -> tuple[list[_Vertex], np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The wavefront as arrays: vertices, x, y, edges in and out, the next vertex."""
+        vertices = [v for ring in self.rings for v in ring]
+        data = np.array([(v.x, v.y, v.a, v.b) for v in vertices]).reshape(-1, 4)
+        nxt: list[int] = []
+        for ring in self.rings:
+            start = len(nxt)
+            nxt.extend(range(start + 1, start + len(ring)))
+            nxt.append(start)
+        a, b = data[:, 2].astype(int), data[:, 3].astype(int)
+        return vertices, data[:, 0], data[:, 1], a, b, np.array(nxt)
+
+    def _speeds(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each vertex's velocity: it stays on both its edges as they move at their
+        weights (along the bisector when the weights are equal)."""
+        ax, ay = self.normal[a, 0], self.normal[a, 1]
+        bx, by = self.normal[b, 0], self.normal[b, 1]
+        wa, wb = self.weight[a], self.weight[b]
+        dot = ax * bx + ay * by
+        det = ax * by - ay * bx
+        scale = np.where(dot > -1 + 1e-12, wa / np.where(dot > -1 + 1e-12, 1 + dot, 1), 0.0)
+        vx, vy = (ax + bx) * scale, (ay + by) * scale
+        uneven = np.abs(wa - wb) >= 1e-12
+        if uneven.any():
+            ok = uneven & (np.abs(det) > 1e-9)
+            safe = np.where(ok, det, 1.0)
+            vx = np.where(ok, (wa * by - ay * wb) / safe, vx)
+            vy = np.where(ok, (ax * wb - wa * bx) / safe, vy)
+            flat = uneven & ~ok  # parallel edges of unequal weights: their mean
+            vx = np.where(flat, (ax + bx) * (wa + wb) / 4, vx)
+            vy = np.where(flat, (ay + by) * (wa + wb) / 4, vy)
+        return vx, vy
+
+    def _next_event(
+        self,
+        px: np.ndarray,
+        py: np.ndarray,
+        vx: np.ndarray,
+        vy: np.ndarray,
+        a: np.ndarray,
+        b: np.ndarray,
+        nxt: np.ndarray,
+    ) -> float:
+        """Time to the earliest event: an edge shrinking to nothing, a reflex vertex
+        reaching another edge, an edge changing weight."""
+        dx, dy = self.dirs[b, 0], self.dirs[b, 1]
+        length = (px[nxt] - px) * dx + (py[nxt] - py) * dy
+        rate = (vx[nxt] - vx) * dx + (vy[nxt] - vy) * dy
+        shrinking = rate < -1e-12
+        best = math.inf
+        if shrinking.any():
+            best = float((np.maximum(length[shrinking], 0) / -rate[shrinking]).min())
+        reflex = np.flatnonzero(self.dirs[a, 0] * dy - self.dirs[a, 1] * dx < -1e-9)
+        if len(reflex):
+            rows = np.arange(len(reflex))
+            nx, ny, w = -dy, dx, self.weight[b]
+            ox = px[reflex][:, None] - px[None, :]
+            oy = py[reflex][:, None] - py[None, :]
+            gap = ox * nx + oy * ny  # how far each reflex vertex is in front of each edge
+            closing = vx[reflex][:, None] * nx + vy[reflex][:, None] * ny - w
+            ok = (closing < -1e-12) & (gap > -self.eps)
+            ok[rows, reflex] = False  # its own edges
+            ok[rows, np.argsort(nxt)[reflex]] = False
+            if ok.any():
+                when = np.where(ok, np.maximum(gap, 0) / np.where(ok, -closing, 1), np.inf)
+                # where along the edge it arrives, and how long the edge is by then
+                along = (
+                    ox * dx
+                    + oy * dy
+                    + when * ((vx[reflex][:, None] - vx) * dx + (vy[reflex][:, None] - vy) * dy)
+                )
+                reach = length + rate * when
+                ok &= (along > -self.eps) & (along < reach + self.eps)
+                if ok.any():
+                    best = min(best, float(when[ok].min()))
+        if self.pending:
+            best = min(best, max(self.pending[0][0] - self.time, 0.0))
+        return best
+
+    # -- tidying the wavefront at one time -------------------------------------------
+
+    def _settle(self) -> None:
+        for _ in range(4 * self.outline.count + 20):
+            if not (self._merge() or self._fold() or self._die() or self._split()):
+                return
+        raise _Degenerate("the wavefront does not settle")
+
+    def _merge(self) -> bool:
+        for index, ring in enumerate(self.rings):
+            size = len(ring)
+            for i in range(size):
+                v, w = ring[i], ring[(i + 1) % size]
+                dx, dy = self.unit[v.b]  # the edge from v to w has shrunk to nothing
+                if size > 1 and (
+                    (w.x - v.x) * dx + (w.y - v.y) * dy < self.eps
+                    or math.hypot(w.x - v.x, w.y - v.y) < self.eps
+                ):
+                    x, y = (v.x + w.x) / 2, (v.y + w.y) / 2
+                    node = self._node(x, y)
+                    self._arc(v.node, node, v.a, v.b)
+                    self._arc(w.node, node, w.a, w.b)
+                    if size <= 2:
+                        del self.rings[index]
+                        return True
+                    if v.a == w.b:  # a notch on one edge closed: the edge runs on through
+                        del ring[max(i, (i + 1) % size)]
+                        del ring[min(i, (i + 1) % size)]
+                        return True
+                    ring[i] = _Vertex(x, y, v.a, w.b, node)
+                    del ring[(i + 1) % size]
+                    return True
+        return False
+
+    def _fold(self) -> bool:
+        """A spike (a vertex whose edges run back along each other) zips up."""
+        for ring in self.rings:
+            size = len(ring)
+            if size < 3:
+                continue
+            for i in range(size):
+                x = ring[i]
+                (ax, ay), (bx, by) = self.unit[x.a], self.unit[x.b]
+                if ax * bx + ay * by > -1 + 1e-6:
+                    continue
+                before, after = ring[i - 1], ring[(i + 1) % size]
+                if (  # not a spike unless its sides lie on one line: a sharp corner, then
+                    abs(bx * (before.y - x.y) - by * (before.x - x.x)) >= self.eps
+                    or abs(ax * (after.y - x.y) - ay * (after.x - x.x)) >= self.eps
+                ):
+                    continue
+                tip = self._close(x)
+                if math.hypot(x.x - before.x, x.y - before.y) <= math.hypot(
+                    x.x - after.x, x.y - after.y
+                ):
+                    other = self._close(before)
+                    self.segments[x.a].append((tip, other))
+                    self.segments[x.b].append((other, tip))
+                    before.b = x.b
+                else:
+                    other = self._close(after)
+                    self.segments[x.a].append((tip, other))
+                    self.segments[x.b].append((other, tip))
+                    after.a = x.a
+                del ring[i]
+                return True
+        return False
+
+    def _die(self) -> bool:
+        """A ring without area (a ridge) ends: its edges' faces close along it."""
+        for index, ring in enumerate(self.rings):
+            size = len(ring)
+            if size > 2:
+                twice = perimeter = 0.0
+                for i in range(size):
+                    v, w = ring[i - 1], ring[i]
+                    twice += v.x * w.y - w.x * v.y
+                    perimeter += math.hypot(w.x - v.x, w.y - v.y)
+                if abs(twice) >= 2 * self.eps * perimeter:
+                    continue
+            nodes = [self._close(v) for v in ring]
+            for i, v in enumerate(ring):
+                self.segments[v.b].append((nodes[(i + 1) % size], nodes[i]))
+            del self.rings[index]
+            return True
+        return False
+
+    def _split(self) -> bool:
+        """A reflex vertex lying on another edge splits the ring (or joins two rings)."""
+        vertices, px, py, a, b, nxt = self._snapshot()
+        dx, dy = self.dirs[b, 0], self.dirs[b, 1]
+        reflex = np.flatnonzero(self.dirs[a, 0] * dy - self.dirs[a, 1] * dx < -1e-9)
+        if not len(reflex):
+            return False
+        length = (px[nxt] - px) * dx + (py[nxt] - py) * dy
+        ox = px[reflex][:, None] - px[None, :]
+        oy = py[reflex][:, None] - py[None, :]
+        along = ox * dx + oy * dy
+        # on the edge: the test that ends a reflex vertex's step towards it
+        near = (np.abs(oy * dx - ox * dy) < self.eps) & (along > -self.eps)
+        near &= along < length + self.eps
+        rows = np.arange(len(reflex))
+        near[rows, reflex] = False  # the reflex vertex's own edges
+        near[rows, np.argsort(nxt)[reflex]] = False
+        nodes = np.array([v.node for v in vertices])
+        twins = nodes[reflex][:, None]  # the other half of the split that made it
+        near &= (nodes[None, :] != twins) & (nodes[nxt][None, :] != twins)
+        hits = np.argwhere(near)
+        if not len(hits):
+            return False
+        row, j = hits[0].tolist()
+        where = [(k, i) for k, ring in enumerate(self.rings) for i in range(len(ring))]
+        self._split_at(*where[int(reflex[row])], *where[j])
+        return True
+
+    def _split_at(self, k: int, i: int, k2: int, i2: int) -> None:
+        ring = self.rings[k]
+        r = ring[i]
+        q = self._close(r)
+        e = self.rings[k2][i2].b
+        first = _Vertex(r.x, r.y, r.a, e, q)  # comes in on r's edge, goes out along e
+        second = _Vertex(r.x, r.y, e, r.b, q)  # comes in along e, goes out on r's edge
+        if k == k2:
+            turned = ring[i:] + ring[:i]
+            at = turned.index(ring[i2])
+            one = [second, *turned[1 : at + 1]]
+            two = [first, *turned[at + 1 :]]
+            self.rings[k : k + 1] = [one, two]
+        else:
+            other = self.rings[k2]
+            there = other[i2 + 1 :] + other[: i2 + 1]  # from the edge's end round to its start
+            here = ring[i + 1 :] + ring[:i]
+            joined = [first, *there, second, *here]
+            self.rings = [rg for n, rg in enumerate(self.rings) if n not in (k, k2)] + [joined]
+
+    # -- faces -----------------------------------------------------------------------
+
+    def _faces(self) -> dict[int, list[tuple[int, ...]]]:
+        """Each edge's face: its segments chained into loops, after merging nodes that
+        coincide (in x, y and time) and dropping segments that cancel out."""
+        xyt = np.column_stack([self.x, self.y, self.times])
+        alias = _dedupe(xyt, self.eps * 300)
+        faces: dict[int, list[tuple[int, ...]]] = {}
+        for e in range(self.outline.count):
+            segments = [(int(alias[p]), int(alias[q])) for p, q in self.segments[e]]
+            segments = [(p, q) for p, q in segments if p != q]
+            counts: dict[tuple[int, int], int] = defaultdict(int)
+            for seg in segments:
+                counts[seg] += 1
+            kept = []
+            for p, q in segments:
+                if counts[(q, p)] > 0 and counts[(p, q)] > 0:
+                    counts[(q, p)] -= 1
+                    counts[(p, q)] -= 1
+                    continue
+                if counts[(p, q)] > 0:
+                    kept.append((p, q))
+                    counts[(p, q)] -= 1
+            faces[e] = _chain(kept, list(zip(self.x, self.y, strict=True)), e)
+        return faces
+
+
+def _chain(
+    segments: list[tuple[int, int]], where: list[tuple[float, float]], first: int
+) -> list[tuple[int, ...]]:
+    """Directed segments into closed loops; at a node with several ways on, the leftmost
+    turn (which keeps the face on the left)."""
+    outgoing: dict[int, list[int]] = defaultdict(list)
+    for p, q in segments:
+        outgoing[p].append(q)
+    loops: list[tuple[int, ...]] = []
+    remaining = len(segments)
+    while remaining:
+        starts = [first] if outgoing.get(first) else sorted(n for n, qs in outgoing.items() if qs)
+        start = starts[0]
+        loop = [start]
+        before, here = -1, start
+        while True:
+            options = outgoing[here]
+            if not options:
+                raise _Degenerate("a face does not close")
+            if len(options) == 1 or before < 0:
+                step = options[0]
+            else:
+                bx, by = where[before]
+                hx, hy = where[here]
+                din = math.atan2(hy - by, hx - bx)
+
+                def turn(n: int, hx: float = hx, hy: float = hy, din: float = din) -> float:
+                    nx, ny = where[n]
+                    angle = math.atan2(ny - hy, nx - hx) - din
+                    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+                step = max(options, key=lambda n: (turn(n), -n))
+            options.remove(step)
+            remaining -= 1
+            if step == start:
+                break
+            if len(loop) > len(segments):
+                raise _Degenerate("a face runs in circles")
+            loop.append(step)
+            before, here = here, step
+        if len(loop) >= 3:
+            loops.append(tuple(loop))
+    return loops
+
+
+# ---------------------------------------------------------------------------------------
+# meshes
+
+
+def _slab(part: Polygon, height: float) -> trimesh.Trimesh:
+    try:
         slab = trimesh.creation.extrude_polygon(part, SLAB)
-        slab.apply_translation((0, 0, height - SLAB))
-        return slab, []
-    if roof.type == "hip":
-        return _hip(part, height, math.tan(math.radians(roof.pitch))), []
-    surface, pieces = _planes(part, height, roof)
-    faces = [_surface(piece, surface) for piece in pieces]
-    return trimesh.util.concatenate(faces), _infill(part, height, surface, roof)
+    except Exception:  # a sliver that cannot be triangulated: nothing to see
+        return trimesh.Trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=int), process=False)
+    slab.apply_translation((0, 0, height - SLAB))
+    return slab
 
 
-def _axes(part: Polygon) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """Centre, main direction, its normal and the width across it (minimum rectangle)."""
+def _profile(kind: str, bands: int) -> tuple[np.ndarray, np.ndarray]:
+    """The roof's section, from the eaves (0, 0) to the top (1, 1): (in, up) fractions."""
+    if kind in ("gambrel", "mansard"):
+        return np.array([0.0, BREAK[0], 1.0]), np.array([0.0, BREAK[1], 1.0])
+    if kind in ("dome", "round"):
+        angle = np.linspace(0, math.pi / 2, bands + 1)
+        return 1 - np.cos(angle), np.sin(angle)
+    if kind == "onion":  # the section narrows from the eaves, convex then concave, to a point
+        up = np.linspace(0, 1, bands + 1)
+        return (1 - np.cos(math.pi * up**1.5)) / 2, up
+    return np.array([0.0, 1.0]), np.array([0.0, 1.0])
+
+
+def _mesh(
+    shape: _Shape, eaves: float, rise: float
+) -> tuple[trimesh.Trimesh, list[trimesh.Trimesh]]:
+    """The shape's faces in triangles (a curved roof's cut in as many bands as keep it
+    under MAX_TRIANGLES), its heights from the eaves up to ``eaves + rise``, and its
+    walls closed up to the roof."""
+    xy = [tuple(p) for p in shape.xy.tolist()]
+    t = shape.t.tolist()
+    triangles: list[tuple[int, int, int]] = []
+    for face in shape.cover:
+        triangles.extend(_triangulate(face, shape.xy))
+    bands = 1
+    if shape.kind in CURVED:
+        span = np.array([[t[i] for i in tri] for tri in triangles]).reshape(-1, 3)
+        for bands in (24, 16, 12, 8, 6, 4, 3, 2, 1):
+            edges = _profile(shape.kind, bands)[0][1:-1] * shape.top
+            crossing = (
+                np.searchsorted(edges, span.max(axis=1)) - np.searchsorted(edges, span.min(axis=1))
+            ).sum()
+            if len(triangles) + 2 * crossing <= MAX_TRIANGLES - 200:
+                break
+    inward, upward = _profile(shape.kind, bands)
+    levels = inward[1:-1] * shape.top
+    cuts: dict[tuple[int, int], list[int]] = defaultdict(list)
+    if len(levels):
+        triangles = _slice(triangles, xy, t, levels, cuts)
+    z = eaves + rise * np.interp(np.array(t) / shape.top, inward, upward)
+    vertices = np.column_stack([np.array(xy), z])
+    cover = _trimesh(vertices, triangles)
+    walls: list[tuple[int, int, int]] = []
+    for loop, direction in shape.walls:
+        walls.extend(_wall(loop, direction, vertices, t, cuts))
+    return cover, ([_trimesh(vertices, walls)] if walls else [])
+
+
+def _trimesh(vertices: np.ndarray, triangles: list[tuple[int, int, int]]) -> trimesh.Trimesh:
+    if not triangles:
+        return trimesh.Trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=int), process=False)
+    faces = np.array(triangles, dtype=np.int64)
+    used, inverse = np.unique(faces, return_inverse=True)
+    return trimesh.Trimesh(vertices[used], inverse.reshape(-1, 3), process=False)
+
+
+def _triangulate(face: tuple[tuple[int, ...], ...], xy: np.ndarray) -> list[tuple[int, int, int]]:
+    """A planar face (rings of nodes) in triangles turning counter-clockwise in plan."""
+    if len(face) == 1:
+        loop = list(face[0])
+        if _area(xy[loop]) < 0:
+            loop.reverse()
+        return _ears(loop, xy[loop])
+    import mapbox_earcut
+
+    rings = [list(r) for r in face]
+    nodes = [n for r in rings for n in r]
+    ends = np.cumsum([len(r) for r in rings]).astype(np.uint32)
+    found = mapbox_earcut.triangulate_float64(xy[nodes].astype(np.float64), ends)
+    result = []
+    for i, j, k in np.asarray(found).reshape(-1, 3).tolist():
+        tri = (nodes[i], nodes[j], nodes[k])
+        if _area(xy[list(tri)]) < 0:
+            tri = (tri[0], tri[2], tri[1])
+        result.append(tri)
+    return _through(result, nodes, xy)
+
+
+def _through(
+    triangles: list[tuple[int, int, int]], nodes: list[int], xy: np.ndarray
+) -> list[tuple[int, int, int]]:
+    """Triangles split where a node lies on one of their edges (earcut may run an edge
+    through vertices of rings in line with it), so that the walls meet every vertex."""
+    points = xy[nodes]
+    tolerance = 1e-9 * max(1.0, float(np.abs(points).max()))
+    done: list[tuple[int, int, int]] = []
+    todo = list(triangles)
+    while todo:
+        tri = todo.pop()
+        for n in range(3):
+            a, b, c = tri[n], tri[(n + 1) % 3], tri[(n + 2) % 3]
+            v = xy[b] - xy[a]
+            offset = points - xy[a]
+            u = (offset @ v) / max(float(v @ v), 1e-300)
+            gap = np.abs(offset[:, 0] * v[1] - offset[:, 1] * v[0]) / max(math.hypot(*v), 1e-300)
+            on = np.flatnonzero((u > 1e-9) & (u < 1 - 1e-9) & (gap < tolerance))
+            if len(on):
+                m = nodes[int(on[np.argmin(u[on])])]
+                todo.extend([(a, m, c), (m, b, c)])
+                break
+        else:
+            done.append(tri)
+    return done
+
+
+def _ears(loop: list[int], points: np.ndarray) -> list[tuple[int, int, int]]:
+    """Ear clipping of a counter-clockwise loop that keeps every vertex, collinear ones
+    too (so faces meet without cracks). It cuts a well-shaped ear when there is one, the
+    best there is otherwise, so that slivers along a straight run of vertices stay out."""
+    index = list(range(len(loop)))
+    pts = points.tolist()
+    tiny = 1e-14 * max(1.0, float(np.abs(points).max())) ** 2
+    result: list[tuple[int, int, int]] = []
+    while len(index) > 3:
+        size = len(index)
+        best, chosen = 0.0, -1
+        for k in range(size):
+            i0, i1, i2 = index[k - 1], index[k], index[(k + 1) % size]
+            (ax, ay), (bx, by), (cx, cy) = pts[i0], pts[i1], pts[i2]
+            cross = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+            if cross <= tiny:
+                continue
+            longest = max((bx - ax) ** 2 + (by - ay) ** 2, (cx - bx) ** 2 + (cy - by) ** 2)
+            shape = cross / max(longest, (ax - cx) ** 2 + (ay - cy) ** 2)
+            if shape <= best:
+                continue
+            blocked = False
+            for m in index:
+                if m in (i0, i1, i2):
+                    continue
+                px, py = pts[m]
+                if (px, py) in ((ax, ay), (bx, by), (cx, cy)):
+                    continue
+                if (
+                    (bx - ax) * (py - ay) - (by - ay) * (px - ax) >= -tiny
+                    and (cx - bx) * (py - by) - (cy - by) * (px - bx) >= -tiny
+                    and (ax - cx) * (py - cy) - (ay - cy) * (px - cx) >= -tiny
+                ):
+                    blocked = True
+                    break
+            if not blocked:
+                best, chosen = shape, k
+                if shape > 0.1:  # good enough: no need to look further
+                    break
+        if chosen < 0:  # only degenerate ears left: a fan keeps the loop closed
+            break
+        k = chosen
+        result.append((loop[index[k - 1]], loop[index[k]], loop[index[(k + 1) % len(index)]]))
+        del index[k]
+    for k in range(1, len(index) - 1):
+        result.append((loop[index[0]], loop[index[k]], loop[index[k + 1]]))
+    return result
+
+
+def _slice(
+    triangles: list[tuple[int, int, int]],
+    xy: list[tuple[float, ...]],
+    t: list[float],
+    levels: np.ndarray,
+    cuts: dict[tuple[int, int], list[int]],
+) -> list[tuple[int, int, int]]:
+    """Cut triangles along the profile's levels (lines of equal skeleton time), so each
+    piece lies in one band. A cut point is made once per edge and level, so triangles
+    (and gable walls) sharing an edge share its cut points."""
+    made: dict[tuple[int, int, int], int] = {}
+    tol = 1e-9 * max(1.0, float(levels.max()))  # a node this near a level lies on it
+    bounds = [-math.inf, *levels.tolist(), math.inf]
+
+    def cut(p: int, q: int, k: int) -> int:
+        low, high = (p, q) if p < q else (q, p)
+        key = (low, high, k)
+        if key not in made:
+            f = (float(levels[k]) - t[low]) / (t[high] - t[low])
+            (x0, y0), (x1, y1) = xy[low], xy[high]
+            made[key] = len(xy)
+            xy.append((x0 + f * (x1 - x0), y0 + f * (y1 - y0)))
+            t.append(float(levels[k]))
+            cuts[(low, high)].append(made[key])
+        return made[key]
+
+    result: list[tuple[int, int, int]] = []
+    for tri in triangles:
+        ts = [t[n] for n in tri]
+        first = int(np.searchsorted(levels, min(ts) + tol, side="left"))
+        last = int(np.searchsorted(levels, max(ts) - tol, side="right"))
+        if first >= last:
+            result.append(tri)
+            continue
+        ring: list[int] = []  # the triangle's outline with its cut points
+        for n, p in enumerate(tri):
+            q = tri[(n + 1) % 3]
+            ring.append(p)
+            lo, hi = min(t[p], t[q]) + tol, max(t[p], t[q]) - tol
+            ks = [k for k in range(first, last) if lo < levels[k] < hi]
+            ring.extend(cut(p, q, k) for k in (ks if t[p] < t[q] else ks[::-1]))
+        for k in range(first, last + 1):  # the band from level k - 1 to level k
+            low, high = bounds[k] - tol, bounds[k + 1] + tol
+            band = [n for n in ring if low <= t[n] <= high]
+            result.extend(_fan(band, xy))
+    return result
+
+
+def _fan(poly: list[int], xy: list[tuple[float, ...]]) -> list[tuple[int, int, int]]:
+    """A convex counter-clockwise polygon in triangles, from a corner that makes none flat
+    (its collinear points stay vertices, so neighbours meet them)."""
+    size = len(poly)
+    if size < 3:
+        return []
+    if size == 3:
+        return [(poly[0], poly[1], poly[2])]
+    for apex in range(size):
+        fan = [
+            (poly[apex], poly[(apex + k) % size], poly[(apex + k + 1) % size])
+            for k in range(1, size - 1)
+        ]
+        if all(_flat_area(xy, tri) > 1e-14 for tri in fan):
+            return fan
+    return [(poly[0], poly[k], poly[k + 1]) for k in range(1, size - 1)]
+
+
+def _flat_area(xy: list[tuple[float, ...]], tri: tuple[int, int, int]) -> float:
+    (ax, ay), (bx, by), (cx, cy) = xy[tri[0]], xy[tri[1]], xy[tri[2]]
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+def _wall(
+    loop: tuple[int, ...],
+    direction: tuple[float, float],
+    vertices: np.ndarray,
+    t: list[float],
+    cuts: dict[tuple[int, int], list[int]],
+) -> list[tuple[int, int, int]]:
+    """A vertical wall loop (with the cut points of the roof bands on its edges) in
+    triangles facing out of the building."""
+    nodes: list[int] = []
+    for n, p in enumerate(loop):
+        q = loop[(n + 1) % len(loop)]
+        nodes.append(p)
+        between = cuts.get((min(p, q), max(p, q)), [])
+        nodes.extend(sorted(between, key=lambda c: t[c], reverse=t[p] > t[q]))
+    d = np.array(direction)
+    plane = np.column_stack([vertices[nodes, :2] @ d, vertices[nodes, 2]])
+    if _area(plane) < 0:
+        nodes.reverse()
+        plane = plane[::-1]
+    return [(nodes[i], nodes[j], nodes[k]) for i, j, k in _ears(list(range(len(nodes))), plane)]
+
+
+# ---------------------------------------------------------------------------------------
+# small geometry
+
+
+def _clean(points: np.ndarray, eps: float) -> np.ndarray:
+    """A ring without repeated points and spikes (edges turning right back)."""
+    pts = [tuple(p) for p in points.tolist()]
+    changed = True
+    while changed and len(pts) >= 3:
+        changed = False
+        for i in range(len(pts)):
+            a, b, c = np.array(pts[i - 1]), np.array(pts[i]), np.array(pts[(i + 1) % len(pts)])
+            if np.hypot(*(b - a)) < eps:
+                del pts[i]
+                changed = True
+                break
+            u, v = b - a, c - b
+            lu, lv = np.hypot(*u), np.hypot(*v)
+            if lv >= eps and float(u @ v) / (lu * lv) < -1 + 1e-9:
+                del pts[i]
+                changed = True
+                break
+    return np.array(pts, dtype=float)
+
+
+def _pinched(loop: tuple[int, ...]) -> list[tuple[int, ...]]:
+    """A loop that passes a node twice, as the simple loops it is made of."""
+    seen: dict[int, int] = {}
+    for i, n in enumerate(loop):
+        if n in seen:
+            inner = loop[seen[n] : i]
+            outer = loop[: seen[n]] + loop[i:]
+            return [part for piece in (outer, inner) if len(piece) >= 3 for part in _pinched(piece)]
+        seen[n] = i
+    return [loop]
+
+
+def _dedupe(points: np.ndarray, eps: float) -> np.ndarray:
+    """For each point the smallest index of the points within ``eps`` of it (chained)."""
+    count = len(points)
+    parent = list(range(count))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    if count:
+        order = np.argsort(points[:, 0], kind="stable")
+        xs = points[order, 0]
+        ends = np.searchsorted(xs, xs + eps, side="right")
+        for position, i in enumerate(order.tolist()):
+            for j in order[position + 1 : int(ends[position])].tolist():
+                if np.abs(points[j] - points[i]).max() < eps:
+                    ri, rj = root(i), root(j)
+                    if ri != rj:
+                        parent[max(ri, rj)] = min(ri, rj)
+    return np.array([root(i) for i in range(count)], dtype=int)
+
+
+def _area(points: np.ndarray) -> float:
+    """Signed area of a ring (counter-clockwise positive)."""
+    if len(points) < 3:
+        return 0.0
+    x, y = points[:, 0], points[:, 1]
+    return float((x[:-1] @ y[1:] - x[1:] @ y[:-1] + x[-1] * y[0] - x[0] * y[-1]) / 2)
+
+
+def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return np.asarray(u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0])
+
+
+def _cross1(u: np.ndarray | tuple[float, float], v: np.ndarray | tuple[float, float]) -> float:
+    return float(u[0] * v[1] - u[1] * v[0])
+
+
+def _angle(u: np.ndarray, v: np.ndarray) -> float:
+    """The turn from direction u to v (left positive), in radians."""
+    return math.atan2(_cross1(u, v), float(u @ v))
+
+
+def _perpendicular(v: np.ndarray) -> np.ndarray:
+    """Turned a quarter left (the inward normal of an edge along v)."""
+    return np.array([-v[1], v[0]])
+
+
+def _chord(side: _Side) -> np.ndarray:
+    v = side.end - side.start
+    return np.asarray(v / max(float(np.hypot(*v)), 1e-300))
+
+
+def _compass(degrees: float) -> np.ndarray:
+    """A compass bearing (0 north, 90 east) as a map vector (x east, y north)."""
+    a = math.radians(degrees)
+    return np.array([math.sin(a), math.cos(a)])
+
+
+def _north(normal: np.ndarray) -> np.ndarray:
+    """The normal, or its opposite, whichever faces north (east if neither)."""
+    if abs(normal[1]) > 1e-9:
+        return normal if normal[1] > 0 else -normal
+    return normal if normal[0] > 0 else -normal
+
+
+def _axes(part: Polygon) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre, main direction (the long side of the minimum rotated rectangle) and its
+    normal; the direction points east-ish (north for a north-south building)."""
     corners = np.array(part.minimum_rotated_rectangle.exterior.coords)[:4]
     sides = [corners[1] - corners[0], corners[2] - corners[1]]
-    long_side, short_side = sorted(sides, key=lambda v: -float(np.hypot(*v)))
-    direction = long_side / np.hypot(*long_side)
-    normal = np.array([-direction[1], direction[0]])
-    return corners.mean(axis=0), direction, normal, float(np.hypot(*short_side))
-
-
-def _planes(part: Polygon, height: float, roof: Roof) -> tuple[Surface, list[Polygon]]:
-    centre, direction, normal, width = _axes(part)
-    slope = math.tan(math.radians(roof.pitch))
-    if roof.type == "shed":
-        low = float(np.min((np.array(part.exterior.coords) - centre) @ normal))
-
-        def shed(points: np.ndarray) -> np.ndarray:
-            return np.asarray(height + slope * ((points - centre) @ normal - low), dtype=float)
-
-        return shed, [part]
-
-    def gable(points: np.ndarray) -> np.ndarray:
-        across = np.abs((points - centre) @ normal)
-        return np.asarray(height + slope * np.maximum(0.0, width / 2 - across), dtype=float)
-
-    reach = 2 * max(part.bounds[2] - part.bounds[0], part.bounds[3] - part.bounds[1]) + 1
-    ridge = LineString([centre - reach * direction, centre + reach * direction])
-    pieces = [g for g in split(part, ridge).geoms if isinstance(g, Polygon) and g.area > 1e-6]
-    return gable, pieces or [part]
-
-
-def _surface(piece: Polygon, surface: Surface) -> trimesh.Trimesh:
-    vertices, faces = trimesh.creation.triangulate_polygon(piece)
-    mesh = trimesh.Trimesh(np.column_stack([vertices, surface(vertices)]), faces, process=False)
-    _face_up(mesh)
-    return mesh
-
-
-def _face_up(mesh: trimesh.Trimesh) -> None:
-    down = mesh.face_normals[:, 2] < 0
-    if down.any():
-        faces = mesh.faces.copy()
-        faces[down] = faces[down][:, ::-1]
-        mesh.faces = faces
-
-
-def _infill(part: Polygon, height: float, surface: Surface, roof: Roof) -> list[trimesh.Trimesh]:
-    """Wall pieces from the eaves up to the roof along every edge (gable ends included)."""
-    centre, _, normal, _ = _axes(part)
-    walls = []
-    for ring in (part.exterior, *part.interiors):
-        points = np.array(ring.coords)
-        for a, b in itertools.pairwise(points):
-            profile = [a, b]
-            if roof.type == "gable":  # the ridge may cross the edge: a kink in the profile
-                da, db = (a - centre) @ normal, (b - centre) @ normal
-                if da * db < 0:
-                    t = da / (da - db)
-                    profile = [a, a + t * (b - a), b]
-            tops = surface(np.array(profile))
-            if float(np.max(tops)) <= height + 1e-6:
-                continue
-            vertices = [(*a, height), (*b, height)] + [
-                (*p, z) for p, z in reversed(list(zip(profile, tops, strict=True)))
-            ]
-            fan = [(0, i, i + 1) for i in range(1, len(vertices) - 1)]
-            wall = trimesh.Trimesh(np.array(vertices, dtype=float), np.array(fan), process=False)
-            outward = np.array([b[1] - a[1], a[0] - b[0], 0.0])
-            flip = wall.face_normals @ outward < 0
-            if flip.any():
-                faces = wall.faces.copy()
-                faces[flip] = faces[flip][:, ::-1]
-                wall.faces = faces
-            walls.append(wall)
-    return walls
-
-
-def _hip(part: Polygon, height: float, slope: float) -> trimesh.Trimesh:
-    import py_straight_skeleton as skeletons
-
-    exterior = [tuple(p) for p in np.array(part.exterior.coords)[:-1]]
-    holes = [[tuple(p) for p in np.array(r.coords)[:-1]] for r in part.interiors]
-    skeleton = skeletons.compute_skeleton(exterior, holes)
-    nodes = skeleton.nodes
-    meshes = []
-    for face in skeleton.get_faces():
-        loop = face[:-1] if face[0] == face[-1] else face
-        flat = Polygon([(nodes[i].position.x, nodes[i].position.y) for i in loop])
-        if not flat.is_valid or flat.area < 1e-9:
-            continue
-        vertices, faces = trimesh.creation.triangulate_polygon(flat)
-        heights = np.array([height + slope * _time_at(nodes, loop, v) for v in vertices])
-        mesh = trimesh.Trimesh(np.column_stack([vertices, heights]), faces, process=False)
-        _face_up(mesh)
-        meshes.append(mesh)
-    return trimesh.util.concatenate(meshes)
-
-
-def _time_at(nodes: list[object], loop: list[int], point: np.ndarray) -> float:
-    """The skeleton time (offset) of a face vertex: that of the node at the same place."""
-    best, time = math.inf, 0.0
-    for i in loop:
-        node = nodes[i]
-        distance = math.hypot(node.position.x - point[0], node.position.y - point[1])  # type: ignore[attr-defined]
-        if distance < best:
-            best, time = distance, float(node.time)  # type: ignore[attr-defined]
-    return time
+    long_side = max(sides, key=lambda v: (round(float(np.hypot(*v)), 9), float(v[0])))
+    direction = long_side / max(float(np.hypot(*long_side)), 1e-300)
+    if direction[0] < -1e-9 or (abs(direction[0]) <= 1e-9 and direction[1] < 0):
+        direction = -direction
+    return corners.mean(axis=0), direction, _perpendicular(direction)

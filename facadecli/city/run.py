@@ -17,13 +17,29 @@ import re
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from facadecli.city.building import AxisCache, build_building
+from facadecli.city.building import AxisCache, Looks, build_building
+from facadecli.city.cityjson import (
+    BuildingSolids,
+    CityJSONWriter,
+    building_object,
+    write_cityjson,
+)
 from facadecli.city.footprints import Footprint, Rejected, Simplified, read_footprints
 from facadecli.city.manifest import City, Roof
+from facadecli.city.s3db import (
+    Heights,
+    replaced_outlines,
+    roof_colour,
+    shared_edges,
+    tagged_heights,
+    tagged_roof,
+    volume,
+    wall_colour,
+)
 from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.glb_merge import merge_glb
@@ -37,11 +53,15 @@ class Task:
     footprint: Footprint
     spec_key: str
     spec: Spec
-    height: float
+    heights: Heights
     roof: Roof
     min_facade_width: float
     target: Path
     spec_dir: Path  # the spec's folder: its mesh and texture paths are relative to it
+    looks: Looks = field(default_factory=Looks)
+    shared: Any = None  # the lines of the outline along a neighbour: party walls
+    tolerance: float = 0.3  # metres: how near a neighbour's wall makes a party wall
+    cache_key: str = ""  # the spec's identity in a worker's caches: its path and content
 
 
 PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
@@ -71,13 +91,18 @@ def build(task: Task) -> dict[str, Any]:
         result = build_building(
             task.footprint,
             task.spec,
-            task.spec_key,
-            task.height,
+            task.cache_key or task.spec_key,
+            task.heights,
             task.roof,
             task.min_facade_width,
             cache,
             task.spec_dir,
+            task.looks,
+            task.shared,
+            task.tolerance,
         )
+        solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
+        write_cityjson(_feature_file(task.target), building_object(solids))
         write_atomic(task.target, glb_bytes(result.scene, transmissions(task.spec)))
     except Exception as error:
         return {
@@ -92,11 +117,40 @@ def build(task: Task) -> dict[str, Any]:
         "file": f"buildings/{task.target.name}",
         "facades": result.facades,
         "plain_walls": result.plain_walls,
-        "height": round(task.height, 3),
+        "party_walls": result.party_walls,
+        "height": result.top,
         "repaired": task.footprint.repaired,
         **_simplified(task.footprint.simplified),
         "time_ms": round((time.perf_counter() - started) * 1000, 1),
     }
+
+
+def _feature_file(target: Path) -> Path:
+    """Where a building's CityJSON feature goes, beside its glb (written before the glb,
+    which marks the building done for --resume)."""
+    return target.with_suffix(".city.jsonl")
+
+
+def _attributes(task: Task, top: float) -> dict[str, Any]:
+    """A building's CityJSON attributes: its tags, how tall it is, its roof and spec."""
+    return {
+        **task.footprint.properties,
+        "measuredHeight": top,
+        "roofType": task.roof.type,
+        "facade": task.spec_key,
+    }
+
+
+def _feature(task: Task) -> dict[str, Any]:
+    """A building's CityJSON feature: the one its worker wrote, or (a building resumed from
+    a run before features were written) made here from its volumes."""
+    path = _feature_file(task.target)
+    if path.is_file():
+        loaded: dict[str, Any] = json.loads(path.read_bytes())
+        return loaded
+    volumes = [volume(part, task.heights, task.roof) for part in task.footprint.parts]
+    top = max(v.top for v in volumes)
+    return building_object(BuildingSolids(task.footprint.id, volumes, _attributes(task, top)))
 
 
 def _simplified(simplified: Simplified | None) -> dict[str, Any]:
@@ -114,10 +168,15 @@ def _simplified(simplified: Simplified | None) -> dict[str, Any]:
 def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
     """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
+    defaults = city.manifest.defaults
+    names = city.manifest.properties.names()
+    tolerance = defaults.party_wall_tolerance
+    shared = shared_edges(footprints, tolerance) if tolerance > 0 else {}
     tasks = []
     owners: dict[str, str] = {}  # file name -> building id
+    identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
     for footprint in footprints:
-        key, roof, height = city.choose(footprint.properties)
+        choice = city.choose(footprint.properties)
         name = safe_name(footprint.id)
         if owners.setdefault(name, footprint.id) != footprint.id:
             raise SpecError.at(
@@ -127,16 +186,31 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
                 f"ids '{owners[name]}' and '{footprint.id}' give one file name '{name}'",
                 "change one of the ids",
             )
+        properties = footprint.properties
+        heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
+        if choice.height is not None:  # a rule's height wins over the tags'
+            heights = replace(heights, top=choice.height, eaves=None)
+        if choice.facade not in identities:  # workers outlive a run: tell specs apart
+            content = city.specs[choice.facade].model_dump_json().encode("utf-8")
+            digest = hashlib.sha256(content).hexdigest()[:16]
+            identities[choice.facade] = f"{(city.folder / choice.facade).resolve()}#{digest}"
+        looks = Looks()
+        if choice.colours == "tags":
+            looks = Looks(wall_colour(properties), roof_colour(properties))
         tasks.append(
             Task(
                 footprint,
-                key,
-                city.specs[key],
-                height,
-                roof,
-                city.manifest.defaults.min_facade_width,
+                choice.facade,
+                city.specs[choice.facade],
+                heights,
+                tagged_roof(properties, choice.roof),
+                defaults.min_facade_width,
                 outdir / "buildings" / f"{name}.glb",
-                (city.folder / key).parent.resolve(),
+                (city.folder / choice.facade).parent.resolve(),
+                looks,
+                shared.get(footprint.id),
+                tolerance,
+                identities[choice.facade],
             )
         )
     return tasks
@@ -152,7 +226,11 @@ def check_output(outdir: Path, name: str) -> None:
         problem = f"'{buildings}' is a file, where the buildings' folder goes"
     elif os.path.isdir(buildings) and not os.access(buildings, os.W_OK | os.X_OK):
         problem = f"cannot write in '{buildings}' (permission denied)"
-    for output in (outdir / f"{name}.glb", outdir / f"{name}.report.json"):
+    for output in (
+        outdir / f"{name}.glb",
+        outdir / f"{name}.report.json",
+        outdir / f"{name}.city.json",
+    ):
         if os.path.isdir(output):
             problem = f"'{output}' is a folder, where an output file goes"
     if problem is not None:
@@ -177,7 +255,9 @@ def run_city(
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
     found = read_footprints(city.footprints)
-    footprints = list(found.footprints)[: limit if limit is not None else None]
+    replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
+    footprints = [f for f in found.footprints if f.id not in replaced]
+    footprints = footprints[: limit if limit is not None else None]
     tasks = plan(city, footprints, outdir)
     results: list[dict[str, Any]] = []
     todo = []
@@ -212,6 +292,18 @@ def run_city(
             f"{outdir}: cannot write the merged model: {error.strerror or error}; the "
             "buildings built are kept: run again with --resume"
         ) from None
+    by_id = {task.footprint.id: task for task in tasks}
+    cityjson = outdir / f"{city.manifest.name}.city.json"
+    try:
+        with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:
+            for result in results:
+                if result["status"] == "ok":
+                    writer.add(_feature(by_id[result["id"]]))
+    except OSError as error:
+        raise OutputError(
+            f"{outdir}: cannot write the CityJSON: {error.strerror or error}; the "
+            "buildings built are kept: run again with --resume"
+        ) from None
     failed = [r for r in results if r["status"] != "ok"]
     report = {
         "version": 1,
@@ -220,11 +312,14 @@ def run_city(
         "origin": list(found.origin),
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
+        "replaced": [{"id": key, "parts": ids} for key, ids in sorted(replaced.items())],
         "summary": {
             "buildings": len(tasks),
             "ok": len(results) - len(failed),
             "failed": len(failed),
             "rejected": len(found.rejected),
+            "replaced": len(replaced),
+            "party_walls": sum(r.get("party_walls", 0) for r in results),
             "seconds": round(time.perf_counter() - started, 2),
         },
     }

@@ -41,10 +41,19 @@ def _write_svg(layout: Layout, outdir: Path, options: OutputOptions) -> list[Pat
     return [path]
 
 
+_last_scene: list[tuple[Layout, Path | None, trimesh.Scene]] = []  # the latest scene built
+
+
 def _scene(layout: Layout, options: OutputOptions) -> trimesh.Scene:
+    """The layout's scene, built once for all the mesh formats of one layout."""
     from facadecli.geometry.facade import facade_scene
 
-    return facade_scene(layout, options.base_dir)
+    for built, base_dir, scene in _last_scene:
+        if built is layout and base_dir == options.base_dir:
+            return scene
+    scene = facade_scene(layout, options.base_dir)
+    _last_scene[:] = [(layout, options.base_dir, scene)]
+    return scene
 
 
 def _write_glb(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:

@@ -75,6 +75,28 @@ class AxisLayout:
     warnings: tuple[str, ...] = ()
     timings: Mapping[str, float] = field(default_factory=dict)
 
+    def stretched(self, canvas: float) -> AxisLayout:
+        """This layout scaled uniformly to another canvas length: every letter, column and
+        solved size times ``canvas / self.canvas`` (the words and alignment kept)."""
+        k = canvas / self.canvas
+
+        def at(value: float) -> float:
+            return round(value * k, PRECISION)
+
+        return replace(
+            self,
+            canvas=canvas,
+            letters={
+                layer: tuple(replace(p, start=at(p.start), end=at(p.end)) for p in placed)
+                for layer, placed in self.letters.items()
+            },
+            symbols={name: (pref, at(size)) for name, (pref, size) in self.symbols.items()},
+            groups={
+                name: replace(g, boundaries=tuple(at(b) for b in g.boundaries))
+                for name, g in self.groups.items()
+            },
+        )
+
 
 @dataclass
 class _Evaluated:

@@ -1,0 +1,607 @@
+"""CityJSON 2.0 of a city's buildings: LOD2.2 solids with semantic surfaces.
+
+Each building becomes a ``Building`` CityObject (with ``BuildingPart`` children when it has
+several volumes), each volume one closed ``Solid`` whose surfaces face outwards: a
+GroundSurface at its base (an OuterCeilingSurface when the base is above the ground, as
+under a part lifted by ``min_height``), a WallSurface per footprint edge (base to eaves),
+WallSurfaces for the roof's infill (gable ends), and RoofSurfaces (the roof's coplanar
+triangles merged into polygons; a flat roof is the footprint at the eaves, without the
+parapet the glb's walls carry).
+
+Vertices are integer millimetres: ``transform`` scales by 0.001 and translates by the run's
+origin, so a footprint's local metres (relative to that origin) become vertices directly.
+A building is first a CityJSONFeature (its CityObjects and its own vertices, indices from
+0), which a worker can make and keep on its own; features are then merged, each one's
+indices offset by the vertices before it: in memory (:func:`cityjson_document`) or
+streamed to a file one at a time (:class:`CityJSONWriter`), both in linear time and to the
+same bytes. Key order is fixed by construction, so the same input gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import json
+import math
+import os
+import re
+import shutil
+import tempfile
+from collections import Counter, deque
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import TracebackType
+from typing import Any, BinaryIO
+
+import numpy as np
+import pyproj
+import trimesh
+
+from facadecli.city.roofs import roof_meshes
+from facadecli.city.s3db import Volume
+from facadecli.export.atomic import atomic_output, write_atomic
+
+VERSION = "2.0"
+LOD = "2.2"
+UNITS = 1000  # vertex units a metre: millimetres
+SCALE = 1 / UNITS
+NEAR = 1.0  # squared vertex units: a vertex this close to an edge lies on it (T-junction)
+APART = 4.0  # squared vertex units: ... unless this close to an end (a sliver's corner)
+COPLANAR = 1e-10  # 1 - cos of the angle between normals of triangles merged into a polygon
+SURFACE_TYPES = ("GroundSurface", "OuterCeilingSurface", "WallSurface", "RoofSurface")
+
+Ring = list[int]  # vertex indices, not closed
+Surface = list[Ring]  # the exterior ring, then the holes
+Point = tuple[int, int, int]
+
+
+@dataclass(frozen=True)
+class BuildingSolids:
+    """A building's input: its id, its volumes, and JSON-safe attributes (height, roof type,
+    status, OSM tags, ...), written as they are (keys sorted)."""
+
+    id: str
+    volumes: Sequence[Volume]
+    attributes: dict[str, Any] = field(default_factory=dict)
+
+
+def building_object(building: BuildingSolids) -> dict[str, Any]:
+    """The building as a CityJSONFeature: ``{"type": "CityJSONFeature", "id",
+    "CityObjects", "vertices"}``, vertex indices into its own integer vertices (mm from the
+    run's origin). One volume: a ``Building`` with the solid. Several: a ``Building``
+    holding the attributes, with a ``BuildingPart`` child ``<id>-part<n>`` per volume (its
+    attributes: roofType, minHeight, eavesHeight and measuredHeight, the top's height above
+    the ground). A volume whose surfaces do not close into a shell (a roof shape this
+    module cannot stitch) is written as a MultiSurface with the same semantics."""
+    if not building.volumes:
+        raise ValueError(f"building '{building.id}' has no volume")
+    vertices = _Vertices()
+    geometries = [_geometry(volume, vertices) for volume in building.volumes]
+    attributes = dict(sorted(_json_safe(dict(building.attributes)).items()))
+    objects: dict[str, Any] = {}
+    if len(geometries) == 1:
+        objects[building.id] = _object("Building", attributes, geometry=geometries[0])
+    else:
+        children = [f"{building.id}-part{n}" for n in range(1, len(geometries) + 1)]
+        objects[building.id] = _object("Building", attributes, children=children)
+        for child, volume, geometry in zip(children, building.volumes, geometries, strict=True):
+            objects[child] = _object(
+                "BuildingPart",
+                _part_attributes(volume, geometry, vertices.points),
+                geometry=geometry,
+                parents=[building.id],
+            )
+    return {
+        "type": "CityJSONFeature",
+        "id": building.id,
+        "CityObjects": objects,
+        "vertices": [list(p) for p in vertices.points],
+    }
+
+
+def reference_system(crs: str) -> str | None:
+    """The OGC URL (``https://www.opengis.net/def/crs/EPSG/0/<code>``) of ``crs`` when it is
+    an EPSG code of a projected CRS in metres; None otherwise, and the metadata then has no
+    referenceSystem: lon/lat input is projected to a local transverse Mercator for the run
+    (not an EPSG CRS), and a CRS in feet was scaled to metres, so neither describes the
+    vertices. Heights are metres above the buildings' ground, in no vertical datum."""
+    match = re.fullmatch(r"(?:EPSG:|urn:ogc:def:crs:EPSG::)(\d+)", crs.strip(), re.IGNORECASE)
+    if match is None:
+        return None
+    try:
+        found = pyproj.CRS.from_epsg(int(match.group(1)))
+    except pyproj.exceptions.CRSError:
+        return None
+    units = {axis.unit_name for axis in found.axis_info}
+    if not found.is_projected or units != {"metre"}:
+        return None
+    return f"https://www.opengis.net/def/crs/EPSG/0/{match.group(1)}"
+
+
+def cityjson_header(crs: str, origin: tuple[float, float], name: str) -> dict[str, Any]:
+    """The document without CityObjects nor vertices: type, version, transform (0.001,
+    translated to ``origin``), metadata (title; referenceSystem, see
+    :func:`reference_system`)."""
+    metadata: dict[str, Any] = {}
+    system = reference_system(crs)
+    if system is not None:
+        metadata["referenceSystem"] = system
+    metadata["title"] = name
+    return {
+        "type": "CityJSON",
+        "version": VERSION,
+        "transform": {
+            "scale": [SCALE, SCALE, SCALE],
+            "translate": [float(origin[0]), float(origin[1]), 0.0],
+        },
+        "metadata": metadata,
+    }
+
+
+def cityjson_document(
+    buildings: Iterable[BuildingSolids], crs: str, origin: tuple[float, float], name: str
+) -> dict[str, Any]:
+    """The CityJSON 2.0 document of ``buildings``, in their order (see
+    :func:`cityjson_header` for the metadata; the geographicalExtent is the vertices').
+    Raises ValueError for two CityObjects with one id."""
+    objects: dict[str, Any] = {}
+    vertices: list[list[int]] = []
+    extent = _Extent()
+    for building in buildings:
+        feature = building_object(building)
+        offset = len(vertices)
+        for key, value in feature["CityObjects"].items():
+            if key in objects:
+                raise ValueError(f"two CityObjects with the id '{key}'")
+            objects[key] = _shifted(value, offset)
+        vertices.extend(feature["vertices"])
+        extent.add(feature["vertices"])
+    document = cityjson_header(crs, origin, name)
+    document["metadata"] = extent.metadata(document)
+    document["CityObjects"] = objects
+    document["vertices"] = vertices
+    return document
+
+
+def cityjson_bytes(document: dict[str, Any]) -> bytes:
+    """Compact JSON (ASCII, no NaN) of a document or a feature, in its keys' order."""
+    return json.dumps(document, separators=(",", ":"), allow_nan=False).encode("ascii")
+
+
+def write_cityjson(path: str | Path, document: dict[str, Any]) -> None:
+    """Write a document, or a feature, as compact JSON on one line, atomically. A feature's
+    file is then a line of a CityJSON Text Sequence (CityJSONL) too."""
+    write_atomic(path, cityjson_bytes(document) + b"\n")
+
+
+class CityJSONWriter:
+    """The document written a feature (:func:`building_object`) at a time, in flat memory:
+    CityObjects and vertices go to temporary files beside ``path`` as they come, and the
+    document is assembled into ``path`` (atomically) when the block ends without an error.
+    Its bytes are those of :func:`cityjson_document` for the same buildings in the same
+    order, so add the features in a fixed order (the manifest's)::
+
+        with CityJSONWriter(path, crs, origin, name) as writer:
+            for feature in features:
+                writer.add(feature)
+    """
+
+    def __init__(self, path: str | Path, crs: str, origin: tuple[float, float], name: str):
+        self.path = Path(path)
+        self.header = cityjson_header(crs, origin, name)
+        self._ids: set[str] = set()
+        self._count = 0
+        self._extent = _Extent()
+        self._stack = contextlib.ExitStack()
+        try:
+            self._objects = self._spool(".objects")
+            self._vertices = self._spool(".vertices")
+        except BaseException:
+            self._stack.close()
+            raise
+
+    def _spool(self, suffix: str) -> BinaryIO:
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, name = tempfile.mkstemp(
+            prefix=f".{self.path.name}.", suffix=suffix, dir=self.path.parent
+        )
+        self._stack.callback(_unlink, name)
+        return self._stack.enter_context(os.fdopen(fd, "w+b"))
+
+    def add(self, feature: dict[str, Any]) -> None:
+        """Append one building's feature; ValueError for an id already written."""
+        for key, value in feature["CityObjects"].items():
+            if key in self._ids:
+                raise ValueError(f"two CityObjects with the id '{key}'")
+            self._ids.add(key)
+            self._objects.write(b"," if len(self._ids) > 1 else b"")
+            self._objects.write(cityjson_bytes({key: _shifted(value, self._count)})[1:-1])
+        for point in feature["vertices"]:
+            self._vertices.write(b"," if self._count else b"")
+            self._vertices.write(cityjson_bytes(point))
+            self._count += 1
+        self._extent.add(feature["vertices"])
+
+    def close(self) -> None:
+        """Assemble the document into ``path`` and remove the temporary files."""
+        try:
+            header = dict(self.header)
+            header["metadata"] = self._extent.metadata(header)
+            head = cityjson_bytes(header)[:-1]
+            with atomic_output(self.path) as out:
+                out.write(head + b',"CityObjects":{')
+                self._copy(self._objects, out)
+                out.write(b'},"vertices":[')
+                self._copy(self._vertices, out)
+                out.write(b"]}\n")
+        finally:
+            self._stack.close()
+
+    @staticmethod
+    def _copy(spool: BinaryIO, out: BinaryIO) -> None:
+        spool.flush()
+        spool.seek(0)
+        shutil.copyfileobj(spool, out, 1 << 20)
+
+    def __enter__(self) -> CityJSONWriter:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        if kind is None:
+            self.close()
+        else:
+            self._stack.close()
+
+
+def _unlink(name: str) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(name)
+
+
+class _Extent:
+    """The bounding box of integer vertices, as the metadata's geographicalExtent."""
+
+    def __init__(self) -> None:
+        self.low: np.ndarray | None = None
+        self.high: np.ndarray | None = None
+
+    def add(self, points: list[list[int]]) -> None:
+        if not points:
+            return
+        array = np.asarray(points, dtype=np.int64)
+        low, high = array.min(axis=0), array.max(axis=0)
+        self.low = low if self.low is None else np.minimum(self.low, low)
+        self.high = high if self.high is None else np.maximum(self.high, high)
+
+    def metadata(self, header: dict[str, Any]) -> dict[str, Any]:
+        """The header's metadata with the extent first (in real coordinates)."""
+        if self.low is None or self.high is None:
+            return dict(header["metadata"])
+        translate = header["transform"]["translate"]
+        real = [
+            round(translate[i % 3] + value * SCALE, 3)
+            for i, value in enumerate([*self.low.tolist(), *self.high.tolist()])
+        ]
+        return {"geographicalExtent": real, **header["metadata"]}
+
+
+def _json_safe(value: Any) -> Any:
+    """An attribute value as JSON can hold it: NaN and infinities become null, tuples
+    lists, keys strings, and anything else not JSON its text."""
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {str(key): _json_safe(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(item) for item in value]
+    return str(value)
+
+
+def _shifted(value: dict[str, Any], offset: int) -> dict[str, Any]:
+    """A CityObject with its geometries' vertex indices moved by ``offset``."""
+    if "geometry" not in value or offset == 0:
+        return value
+    shifted = dict(value)
+    shifted["geometry"] = [
+        {**g, "boundaries": _add(g["boundaries"], offset)} for g in value["geometry"]
+    ]
+    return shifted
+
+
+def _add(boundaries: Any, offset: int) -> Any:
+    if isinstance(boundaries, list):
+        return [_add(item, offset) for item in boundaries]
+    return boundaries + offset
+
+
+def _object(kind: str, attributes: dict[str, Any], **members: Any) -> dict[str, Any]:
+    result: dict[str, Any] = {"type": kind}
+    if attributes:
+        result["attributes"] = attributes
+    for key in ("children", "geometry", "parents"):
+        if key in members:
+            result[key] = [members[key]] if key == "geometry" else members[key]
+    return result
+
+
+def _part_attributes(
+    volume: Volume, geometry: dict[str, Any], points: list[Point]
+) -> dict[str, Any]:
+    used = {i for surface in _surfaces_of(geometry) for ring in surface for i in ring}
+    top = max(points[i][2] for i in used) * SCALE
+    return {
+        "eavesHeight": round(volume.eaves, 3),
+        "measuredHeight": round(top, 3),
+        "minHeight": round(volume.base, 3),
+        "roofType": volume.roof.type,
+    }
+
+
+def _surfaces_of(geometry: dict[str, Any]) -> list[Surface]:
+    boundaries = geometry["boundaries"]
+    return [s for shell in boundaries for s in shell] if geometry["type"] == "Solid" else boundaries
+
+
+class _Vertices:
+    """A building's vertices, one index per integer point."""
+
+    def __init__(self) -> None:
+        self.index: dict[Point, int] = {}
+        self.points: list[Point] = []
+
+    def add(self, point: Point) -> int:
+        found = self.index.get(point)
+        if found is None:
+            found = self.index[point] = len(self.points)
+            self.points.append(point)
+        return found
+
+    def add_all(self, array: np.ndarray) -> tuple[list[int], np.ndarray]:
+        """Indices of (n, 3) points in metres, and the points in units."""
+        units = np.rint(np.asarray(array, dtype=float) * UNITS).astype(np.int64)
+        return [self.add((int(x), int(y), int(z))) for x, y, z in units.tolist()], units
+
+
+def _geometry(volume: Volume, vertices: _Vertices) -> dict[str, Any]:
+    """The volume's Solid (or MultiSurface when its surfaces do not close)."""
+    if not volume.eaves > volume.base:
+        raise ValueError(f"eaves at {volume.eaves} m are not above the base at {volume.base} m")
+    kinds, surfaces = zip(*_surfaces(volume, vertices), strict=True)
+    split = _split_edges(list(surfaces), vertices.points)
+    oriented = _orient(split, vertices.points)
+    types = [t for t in SURFACE_TYPES if t in kinds]
+    values = [types.index(kind) for kind in kinds]
+    semantics = {"surfaces": [{"type": t} for t in types], "values": values}
+    if oriented is None:
+        return {"type": "MultiSurface", "lod": LOD, "boundaries": split, "semantics": semantics}
+    semantics["values"] = [values]
+    return {"type": "Solid", "lod": LOD, "boundaries": [oriented], "semantics": semantics}
+
+
+def _surfaces(volume: Volume, vertices: _Vertices) -> Iterator[tuple[str, Surface]]:
+    """Ground, walls and roof: rings of vertex indices, facing outwards as built."""
+    base, eaves = round(volume.base * UNITS), round(volume.eaves * UNITS)
+    exterior = _plan_ring(volume.part.exterior)
+    if not exterior:
+        raise ValueError("a footprint part with no area at millimetre precision")
+    rings = [exterior, *(r for r in map(_plan_ring, volume.part.interiors) if r)]
+
+    def at(ring: list[tuple[int, int]], z: int) -> Ring:
+        return [vertices.add((x, y, z)) for x, y in ring]
+
+    # the outer ring is counter-clockwise seen from above, holes clockwise: the bottom
+    # faces down, so its rings turn the other way; off the ground it is a ceiling outside
+    bottom = "GroundSurface" if base <= 0 else "OuterCeilingSurface"
+    yield bottom, [at(ring[::-1], base) for ring in rings]
+    for ring in rings:
+        for (ax, ay), (bx, by) in itertools.pairwise([*ring, ring[0]]):
+            a0, b0 = vertices.add((ax, ay, base)), vertices.add((bx, by, base))
+            a1, b1 = vertices.add((ax, ay, eaves)), vertices.add((bx, by, eaves))
+            yield "WallSurface", [[a0, b0, b1, a1]]  # outwards is right of a -> b
+    flat = volume.roof.type == "flat"
+    if not flat:
+        cover, infill = roof_meshes(volume.part, volume.eaves, volume.roof)
+        # a roof that rises nowhere (roofs may fall back to a flat slab) is flat here
+        flat = len(cover.vertices) == 0 or float(np.max(cover.vertices[:, 2])) * UNITS < eaves + 1
+    if flat:
+        yield "RoofSurface", [at(ring, eaves) for ring in rings]
+        return
+    for surface in _polygons(cover, vertices):
+        yield "RoofSurface", surface
+    for piece in infill:
+        for surface in _polygons(piece, vertices):
+            yield "WallSurface", surface
+
+
+def _plan_ring(ring: Any) -> list[tuple[int, int]]:
+    """A ring's points in integer units, without repeats (nor the closing point); empty
+    when fewer than 3 are left."""
+    units = np.rint(np.asarray(ring.coords, dtype=float)[:, :2] * UNITS).astype(np.int64)
+    points = [(int(x), int(y)) for x, y in units.tolist()]
+    kept = [p for p, q in itertools.pairwise(points) if p != q]  # also drops the closing point
+    while len(kept) > 1 and kept[-1] == kept[0]:
+        kept.pop()
+    return kept if len(kept) >= 3 else []
+
+
+def _polygons(mesh: trimesh.Trimesh, vertices: _Vertices) -> list[Surface]:
+    """A mesh's triangles as polygons: each set of edge-adjacent triangles with the same
+    normal becomes one polygon when its outline is one simple ring, else stays triangles.
+    Triangles degenerate at millimetre precision are left out."""
+    if len(mesh.faces) == 0:
+        return []
+    points = np.asarray(mesh.vertices, dtype=float)
+    ids, rounded = vertices.add_all(points)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    corners = np.asarray(ids, dtype=np.int64)[faces]  # (n, 3) vertex indices
+    units = rounded[faces].astype(float)  # (n, 3, 3) integer points
+    twice = np.linalg.norm(np.cross(units[:, 1] - units[:, 0], units[:, 2] - units[:, 0]), axis=1)
+    spans = points[faces]
+    normal = np.cross(spans[:, 1] - spans[:, 0], spans[:, 2] - spans[:, 0])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    keep = twice >= 1.0  # at least half a square unit (three distinct points, not in line)
+    triangles = [(a, b, c) for a, b, c in corners[keep].tolist()]
+    normals = normal[keep]
+    parent = list(range(len(triangles)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    by_edge: dict[tuple[int, int], list[int]] = {}
+    for index, triangle in enumerate(triangles):
+        for u, v in _ring_edges(list(triangle)):
+            by_edge.setdefault((min(u, v), max(u, v)), []).append(index)
+    for sharing in by_edge.values():
+        for i, j in itertools.combinations(sharing, 2):
+            if float(normals[i] @ normals[j]) > 1 - COPLANAR:
+                parent[root(j)] = root(i)
+    groups: dict[int, list[int]] = {}
+    for index in range(len(triangles)):
+        groups.setdefault(root(index), []).append(index)
+    surfaces: list[Surface] = []
+    for members in groups.values():
+        group = [triangles[i] for i in members]
+        outline = _outline(group)
+        surfaces.extend([[outline]] if outline else [[list(t)] for t in group])
+    return surfaces
+
+
+def _ring_edges(ring: Ring) -> Iterator[tuple[int, int]]:
+    return zip(ring, ring[1:] + ring[:1], strict=True)
+
+
+def _outline(triangles: list[tuple[int, int, int]]) -> Ring | None:
+    """The one simple ring around consistently oriented triangles, or None."""
+    if len(triangles) == 1:
+        return list(triangles[0])
+    edges = [e for t in triangles for e in _ring_edges(list(t))]
+    present = set(edges)
+    if len(present) < len(edges):
+        return None  # a repeated edge: not one consistent sheet
+    following: dict[int, int] = {}
+    first: int | None = None
+    for u, v in edges:
+        if (v, u) in present:
+            continue
+        if u in following:
+            return None  # the outline touches itself
+        following[u] = v
+        first = u if first is None else first
+    if first is None:
+        return None
+    ring = [first]
+    while (nxt := following.get(ring[-1])) != first:
+        if nxt is None or len(ring) >= len(following):
+            return None
+        ring.append(nxt)
+    return ring if len(ring) == len(following) else None  # else holes: keep the triangles
+
+
+def _split_edges(surfaces: list[Surface], points: list[Point]) -> list[Surface]:
+    """Surfaces whose ring edges pass through other vertices of the shell (closer than
+    NEAR, and not within APART of the edge's ends) get those vertices inserted, so that
+    every edge is shared whole. Only vertices within an edge's span of x are tried."""
+    used = np.asarray(sorted({i for s in surfaces for ring in s for i in ring}), dtype=np.int64)
+    where = np.asarray([points[i] for i in used.tolist()], dtype=float)
+    edges = np.asarray([e for s in surfaces for ring in s for e in _ring_edges(ring)])
+    position = {int(vertex): row for row, vertex in enumerate(used.tolist())}
+    starts = where[[position[i] for i in edges[:, 0].tolist()]]
+    steps = where[[position[i] for i in edges[:, 1].tolist()]] - starts
+    by_x = np.argsort(where[:, 0], kind="stable")
+    xs = where[by_x, 0]
+    low = np.searchsorted(xs, np.minimum(starts[:, 0], starts[:, 0] + steps[:, 0]) - 1, "left")
+    high = np.searchsorted(xs, np.maximum(starts[:, 0], starts[:, 0] + steps[:, 0]) + 1, "right")
+    counts = high - low
+    edge = np.repeat(np.arange(len(edges)), counts)  # (edge, candidate vertex) pairs
+    within = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts)
+    candidate = by_x[np.repeat(low, counts) + within]
+    relative = where[candidate] - starts[edge]
+    length2 = (steps[edge] ** 2).sum(axis=1)
+    t = (relative * steps[edge]).sum(axis=1) / length2  # along the edge, 0 to 1
+    off = relative - t[:, None] * steps[edge]  # across it
+    on = ((off**2).sum(axis=1) <= NEAR) & (t > 0) & (t < 1)
+    on &= (t * t * length2 > APART) & ((1 - t) ** 2 * length2 > APART)
+    inserted: dict[int, list[int]] = {}
+    for row in np.lexsort((t[on], edge[on])).tolist():  # by edge, then along it
+        inserted.setdefault(int(edge[on][row]), []).append(int(used[candidate[on][row]]))
+    result: list[Surface] = []
+    index = 0
+    for surface in surfaces:
+        rings = []
+        for ring in surface:
+            out: Ring = []
+            for u in ring:
+                out.append(u)
+                out.extend(inserted.get(index, ()))
+                index += 1
+            rings.append(out)
+        result.append(rings)
+    return result
+
+
+def _orient(surfaces: list[Surface], points: list[Point]) -> list[Surface] | None:
+    """The surfaces turned to face outwards, each edge used by exactly two of them in
+    opposite directions; None when they do not close into one such shell. The first
+    surface (the bottom) sets the orientation, the enclosed volume checks it."""
+    edges = [[e for ring in surface for e in _ring_edges(ring)] for surface in surfaces]
+    runs = [set(surface_edges) for surface_edges in edges]
+    sharing: dict[tuple[int, int], list[int]] = {}
+    for index, surface_edges in enumerate(edges):
+        for u, v in surface_edges:
+            sharing.setdefault((min(u, v), max(u, v)), []).append(index)
+    if any(len(set(owners)) != 2 or len(owners) != 2 for owners in sharing.values()):
+        return None
+    flip: list[bool | None] = [None] * len(surfaces)
+    flip[0] = False
+    queue = deque([0])
+    while queue:
+        index = queue.popleft()
+        for u, v in edges[index]:
+            for other in sharing[(min(u, v), max(u, v))]:
+                if other == index:
+                    continue
+                # the neighbour must run this edge the other way: flipped if it runs along
+                same = (u, v) in runs[other]
+                want = same != bool(flip[index])
+                if flip[other] is None:
+                    flip[other] = want
+                    queue.append(other)
+                elif flip[other] != want:
+                    return None
+    if any(f is None for f in flip):
+        return None
+    oriented = [
+        [ring[::-1] for ring in surface] if flipped else surface
+        for surface, flipped in zip(surfaces, flip, strict=True)
+    ]
+    directed = Counter(e for surface in oriented for ring in surface for e in _ring_edges(ring))
+    if any(n != 1 or directed[(v, u)] != 1 for (u, v), n in directed.items()):
+        return None
+    return oriented if _volume(oriented, points) > 0 else None
+
+
+def _volume(surfaces: list[Surface], points: list[Point]) -> float:
+    """The signed volume a closed shell of planar polygons encloses (divergence theorem:
+    a third of the sum of each polygon's vector area dotted with one of its points)."""
+    where = np.asarray(points, dtype=float)
+    heads, tails, owners = [], [], []
+    for index, surface in enumerate(surfaces):
+        for ring in surface:
+            heads.extend(ring)
+            tails.extend(ring[1:] + ring[:1])
+            owners.extend([index] * len(ring))
+    areas = np.zeros((len(surfaces), 3))
+    np.add.at(areas, np.asarray(owners), np.cross(where[heads], where[tails]) / 2)
+    anchors = where[[surface[0][0] for surface in surfaces]]
+    return float(np.einsum("ij,ij->", anchors, areas)) / 3

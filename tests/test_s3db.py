@@ -1,0 +1,274 @@
+"""Cities as OpenStreetMap maps them (Simple 3D Buildings): heights including the roof,
+parts replacing their outline, lifted parts, colours, party walls, heights from any
+property. One small hand-made district, one building a tag."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+import trimesh
+from shapely.geometry import Polygon
+
+from facadecli.city.footprints import Footprint
+from facadecli.city.manifest import Roof, load_city
+from facadecli.city.run import run_city, safe_name
+from facadecli.city.s3db import (
+    Heights,
+    blind,
+    colour,
+    compass,
+    replaced_outlines,
+    shared_edges,
+    tagged_heights,
+    volume,
+)
+
+SPEC = """
+version: 1
+name: plain
+canvas: {width: 6, height: 6}
+symbol_defaults: {opaque: true}
+symbols: {E: 1.0, W: 1.2, F: 3.0}
+counters: {n: {min: 1}, f: {min: 1}}
+patterns: {x: "E (W E)^n", y: "F^f"}
+layers: [{name: wall, x: x, y: y}]
+shapes: [{match: {x: W}, material: glass, depth: -0.1, thickness: 0.02}]
+materials:
+  render: {color: "#e0d8c8"}
+  glass: {color: "#8fb3d9", opacity: 0.5}
+defaults: {material: render}
+solver: {tolerance: 0.5}
+"""
+
+MANIFEST = """
+version: 1
+name: tags
+footprints: tags.geojson
+defaults:
+  facade: plain.yaml
+  height: 9.0
+  floor_height: 3.0
+  roof: {{type: flat}}
+  min_facade_width: 2.0
+{extra}
+"""
+
+
+def _feature(fid: str, ring: list[tuple[float, float]], **tags: Any) -> dict[str, Any]:
+    closed = [[x + 100000.0, y + 400000.0] for x, y in [*ring, ring[0]]]
+    return {
+        "type": "Feature",
+        "id": fid,
+        "properties": tags,
+        "geometry": {"type": "Polygon", "coordinates": [closed]},
+    }
+
+
+def _box(x: float, y: float, w: float, d: float) -> list[tuple[float, float]]:
+    return [(x, y), (x + w, y), (x + w, y + d), (x, y + d)]
+
+
+FEATURES = [
+    # height is the top of the roof: a 12 m gabled house with a 4 m roof has 8 m walls
+    _feature(
+        "gabled",
+        _box(0, 0, 12, 8),
+        building="house",
+        height="12",
+        **{"roof:shape": "gabled", "roof:height": "4"},
+    ),
+    # levels below the roof: 3 x 3 m of wall, the roof on top at its pitch
+    _feature(
+        "levels",
+        _box(30, 0, 10, 8),
+        building="yes",
+        **{"building:levels": "3", "roof:shape": "hipped", "roof:angle": "45"},
+    ),
+    # lifted off the ground: walls from 5 m to 10 m
+    _feature(
+        "lifted", _box(60, 0, 8, 8), **{"building:part": "yes", "min_height": "5", "height": "10"}
+    ),
+    # an outline and its two parts: the parts are built, the outline is not
+    _feature("outline", _box(0, 40, 20, 10), building="yes", height="30"),
+    _feature("low", _box(0, 40, 10, 10), **{"building:part": "yes", "height": "6"}),
+    _feature(
+        "tower",
+        _box(10, 40, 10, 10),
+        **{
+            "building:part": "yes",
+            "height": "15",
+            "building:colour": "red",
+            "roof:colour": "#00ff00",
+        },
+    ),
+    # a terrace of three: the walls between them are party walls, blind
+    _feature("t1", _box(40, 40, 7, 10), building="terrace", height="9"),
+    _feature("t2", _box(47, 40, 7, 10), building="terrace", height="9"),
+    _feature("t3", _box(54, 40, 7, 10), building="terrace", height="9"),
+    # a national dataset's property: decimetres
+    _feature("dataset", _box(80, 40, 10, 10), HAUTEUR=180),
+]
+
+
+def _run(tmp_path: Path, extra: str = "") -> dict[str, Any]:
+    (tmp_path / "plain.yaml").write_text(SPEC)
+    data = {
+        "type": "FeatureCollection",
+        "features": FEATURES,
+        "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}},
+    }
+    (tmp_path / "tags.geojson").write_text(json.dumps(data))
+    (tmp_path / "tags.yaml").write_text(MANIFEST.format(extra=extra))
+    return run_city(load_city(tmp_path / "tags.yaml"), tmp_path / "out")
+
+
+def _model(tmp_path: Path, fid: str) -> trimesh.Scene:
+    return trimesh.load(tmp_path / "out" / "buildings" / f"{safe_name(fid)}.glb", force="scene")
+
+
+@pytest.fixture(scope="module")
+def district(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    folder = tmp_path_factory.mktemp("tags")
+    return folder, _run(folder, "properties:\n  height: {name: HAUTEUR, scale: 0.1}\n")
+
+
+def _entry(report: dict[str, Any], fid: str) -> dict[str, Any]:
+    return next(b for b in report["buildings"] if b["id"] == fid)
+
+
+def test_height_is_the_top_of_the_roof(district: tuple[Path, dict[str, Any]]) -> None:
+    folder, report = district
+    scene = _model(folder, "gabled")
+    assert scene.bounds[1][1] == pytest.approx(12.0, abs=1e-3)  # y is up
+    walls = scene.geometry["gabled/render"].bounds  # the façades' wall material
+    assert walls[1][1] == pytest.approx(8.0, abs=0.05)  # 12 m less the 4 m roof
+    assert _entry(report, "gabled")["height"] == pytest.approx(12.0)
+
+
+def test_levels_are_below_the_roof(district: tuple[Path, dict[str, Any]]) -> None:
+    folder, report = district
+    scene = _model(folder, "levels")
+    walls = scene.geometry["levels/render"].bounds
+    assert walls[1][1] == pytest.approx(9.0, abs=0.05)  # 3 levels of 3 m
+    assert scene.bounds[1][1] == pytest.approx(9.0 + 4.0, abs=1e-3)  # 45°, 8 m deep: 4 m
+    assert _entry(report, "levels")["height"] == pytest.approx(13.0)
+
+
+def test_min_height_lifts_the_walls(district: tuple[Path, dict[str, Any]]) -> None:
+    folder, _ = district
+    scene = _model(folder, "lifted")
+    assert scene.bounds[0][1] == pytest.approx(5.0 - 0.01, abs=1e-3)  # its floor slab
+    assert scene.bounds[1][1] == pytest.approx(10.0, abs=1e-3)
+    assert "lifted/ground" not in scene.geometry  # nothing on the ground
+
+
+def test_parts_replace_their_outline(district: tuple[Path, dict[str, Any]]) -> None:
+    folder, report = district
+    built = {b["id"] for b in report["buildings"]}
+    assert "outline" not in built and {"low", "tower"} <= built
+    assert report["replaced"] == [{"id": "outline", "parts": ["low", "tower"]}]
+    assert report["summary"]["replaced"] == 1
+    assert _model(folder, "tower").bounds[1][1] == pytest.approx(15.0, abs=1e-3)
+    assert _model(folder, "low").bounds[1][1] == pytest.approx(6.0, abs=1e-3)
+
+
+def test_colour_tags_colour_walls_and_roof(district: tuple[Path, dict[str, Any]]) -> None:
+    folder, _ = district
+    document = json.loads(_json_chunk(folder / "out" / "buildings" / "tower.glb"))
+    colours = {
+        m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
+    }
+    assert colours["roof"][:3] == pytest.approx([0.0, 1.0, 0.0])
+    assert colours["render"][:3] == pytest.approx([1.0, 0.0, 0.0])  # the façade's wall too
+    assert colours["glass"][:3] != pytest.approx([1.0, 0.0, 0.0])  # not the windows
+
+
+def _json_chunk(path: Path) -> bytes:
+    data = path.read_bytes()
+    length = int.from_bytes(data[12:16], "little")
+    return data[20 : 20 + length]
+
+
+def test_party_walls_of_a_terrace_are_blind(district: tuple[Path, dict[str, Any]]) -> None:
+    _, report = district
+    assert [_entry(report, t)["party_walls"] for t in ("t1", "t2", "t3")] == [1, 2, 1]
+    assert _entry(report, "t2")["facades"] == 2  # street and garden only
+    # the tower and the low part share a wall too: inside one building, blind
+    assert _entry(report, "low")["party_walls"] == 1
+    assert report["summary"]["party_walls"] == 1 + 2 + 1 + 1 + 1
+
+
+def test_heights_from_any_property_with_a_scale(district: tuple[Path, dict[str, Any]]) -> None:
+    folder, report = district
+    assert _entry(report, "dataset")["height"] == pytest.approx(18.0)
+    assert _model(folder, "dataset").bounds[1][1] == pytest.approx(18.0, abs=1e-3)
+
+
+def test_colours_spec_keeps_the_spec_materials(tmp_path: Path) -> None:
+    _run(tmp_path, "rules:\n  - when: {building:part: 'yes'}\n    colours: spec\n")
+    document = json.loads(_json_chunk(tmp_path / "out" / "buildings" / "tower.glb"))
+    colours = {
+        m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
+    }
+    assert colours["render"][:3] != pytest.approx([1.0, 0.0, 0.0])
+
+
+def test_a_spec_material_named_wall_is_used_for_plain_walls(tmp_path: Path) -> None:
+    (tmp_path / "plain.yaml").write_text(
+        SPEC.replace(
+            'render: {color: "#e0d8c8"}', 'render: {color: "#e0d8c8"}\n  wall: {color: "#123456"}'
+        )
+    )
+    data = {
+        "type": "FeatureCollection",
+        "features": [_feature("a", _box(0, 0, 1.5, 1.5))],
+        "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}},
+    }
+    (tmp_path / "tags.geojson").write_text(json.dumps(data))
+    (tmp_path / "tags.yaml").write_text(MANIFEST.format(extra=""))
+    run_city(load_city(tmp_path / "tags.yaml"), tmp_path / "out")
+    document = json.loads(_json_chunk(tmp_path / "out" / "buildings" / "a.glb"))
+    wall = next(m for m in document["materials"] if m["name"] == "wall")
+    expected = [0x12 / 255, 0x34 / 255, 0x56 / 255]
+    assert wall["pbrMetallicRoughness"]["baseColorFactor"][:3] == pytest.approx(expected, abs=0.01)
+
+
+def test_the_roof_is_lowered_to_leave_a_wall() -> None:
+    part = Polygon(_box(0, 0, 10, 10))
+    tall = volume(
+        part, Heights(top=5.0, eaves=None, base=0.0, roof=8.0, default=9.0), Roof(type="gable")
+    )
+    assert tall.eaves == pytest.approx(0.5) and tall.top == pytest.approx(5.0)
+    flat = volume(part, Heights(None, None, 0.0, None, 9.0), Roof(type="flat"))
+    assert (flat.eaves, flat.roof.type) == (9.0, "flat")
+
+
+def test_tags_read_as_osm_writes_them() -> None:
+    heights = tagged_heights(
+        {"height": "15 m", "building:levels": "4", "building:min_level": "1"}, 3.0, 9.0
+    )
+    assert (heights.top, heights.eaves, heights.base, heights.roof) == (15.0, 12.0, 3.0, 3.0)
+    assert colour("#ABC") == "#aabbcc" and colour("Light Grey") == "#d3d3d3"
+    assert colour("no such colour") is None
+    assert compass("SW") == 225.0 and compass("90") == 90.0 and compass(None) is None
+
+
+def test_shared_edges_and_replaced_outlines_are_found() -> None:
+    def footprint(fid: str, ring: list[tuple[float, float]], **tags: Any) -> Footprint:
+        return Footprint(fid, (Polygon(ring),), tags)
+
+    a = footprint("a", _box(0, 0, 5, 5))
+    b = footprint("b", _box(5.1, 0, 5, 5))  # 10 cm apart: still a party wall
+    c = footprint("c", _box(20, 0, 5, 5))
+    shared = shared_edges([a, b, c], 0.3)
+    assert set(shared) == {"a", "b"}
+    assert blind((5, 0), (5, 5), shared["a"], 0.3)  # the wall facing b
+    assert not blind((0, 0), (5, 0), shared["a"], 0.3)  # a street wall, 0.2 m of it near b
+    outline = footprint("o", _box(0, 0, 10, 10), building="yes")
+    part = footprint("p", _box(1, 1, 3, 3), **{"building:part": "yes"})
+    other = footprint("q", _box(30, 30, 3, 3), **{"building:part": "yes"})
+    assert replaced_outlines([outline, part, other]) == {"o": ["p"]}
+    assert blind((5.1, 5), (5.1, 0), shared["b"], 0.3)
