@@ -44,9 +44,10 @@ format: $(STAMP) ## Reformat the code with ruff
 	$(BIN)/ruff check --fix facadecli tests
 	$(BIN)/ruff format facadecli tests
 
-bench: $(STAMP) ## Time solving the examples, a generated 24-layer façade, and grammar extraction on CMP
+bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extraction on CMP, and cities
 	$(BIN)/python tests/benchmarks/bench.py
 	$(BIN)/python tests/benchmarks/grammar_bench.py
+	$(BIN)/python tests/benchmarks/city_bench.py
 
 schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json

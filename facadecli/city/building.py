@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -52,6 +53,15 @@ def rung_length(step: int) -> float:
     return round(math.exp(step * math.log1p(STRETCH)), 6)
 
 
+def solve_rung(spec: Spec, axis: str, canvas: float) -> AxisLayout | None:
+    """An axis solved at a rung's length; None where no layout fits (a plain wall)."""
+    try:
+        deadline = time.perf_counter() + spec.solver.time_limit / 2
+        return solve_axis(spec, axis, canvas, deadline)  # type: ignore[arg-type]
+    except (InfeasibleError, SearchLimitError):
+        return None
+
+
 FacadeMeshes = tuple[tuple[str, np.ndarray, np.ndarray], ...]  # (material, vertices, faces)
 
 
@@ -73,12 +83,7 @@ class AxisCache:
         """The axis solved at the rung of ``length`` (None: no layout, a plain wall)."""
         slot = (key, axis, rung(length))
         if slot not in self.axes:
-            try:
-                deadline = time.perf_counter() + spec.solver.time_limit / 2
-                canvas = rung_length(slot[2])
-                self.axes[slot] = solve_axis(spec, axis, canvas, deadline)  # type: ignore[arg-type]
-            except (InfeasibleError, SearchLimitError):  # a plain wall there
-                self.axes[slot] = None
+            self.axes[slot] = solve_rung(spec, axis, rung_length(slot[2]))
         return self.axes[slot]
 
     def facade(
@@ -182,15 +187,11 @@ def build_building(
     facades = plain = party = 0
     volumes = [volume(part, heights, roof) for part in footprint.parts]
     for block in volumes:
-        wall_height = block.eaves - block.base
-        if block.roof.type == "flat":
-            wall_height += block.roof.parapet
+        wall_height = _wall_height(block)
         lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
-        for a, b in _edges(block.part):
-            length = math.dist(a, b)
+        for a, b, length, party_wall in _walls(block, shared, tolerance):
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
-            party_wall = blind(a, b, shared, tolerance)
             meshes = (
                 cache.facade(spec_key, spec, length, wall_height, base_dir)
                 if length >= min_facade_width and not party_wall
@@ -228,6 +229,40 @@ def build_building(
         )
     top = max(block.top for block in volumes)
     return BuildingResult(scene, facades, plain, party, round(top, 3), tuple(volumes))
+
+
+Wall = tuple[tuple[float, float], tuple[float, float], float, bool]  # a, b, length, party
+
+
+def _walls(block: Volume, shared: Any, tolerance: float) -> Iterator[Wall]:
+    """The walls of a volume: ends, length, and whether it is a party wall."""
+    for a, b in _edges(block.part):
+        yield a, b, math.dist(a, b), blind(a, b, shared, tolerance)
+
+
+def _wall_height(block: Volume) -> float:
+    """From the base to the eaves, and the parapet of a flat roof."""
+    height = block.eaves - block.base
+    return height + (block.roof.parapet if block.roof.type == "flat" else 0.0)
+
+
+def facade_axes(
+    footprint: Footprint,
+    heights: Heights,
+    roof: Roof,
+    min_facade_width: float,
+    shared: Any,
+    tolerance: float,
+) -> set[tuple[str, int]]:
+    """The axes a building's façades need, as (axis, rung): what a run can solve ahead,
+    in parallel, before the buildings (see :meth:`AxisCache.get`)."""
+    needed: set[tuple[str, int]] = set()
+    for block in (volume(part, heights, roof) for part in footprint.parts):
+        walls = [w for w in _walls(block, shared, tolerance) if w[2] >= min_facade_width]
+        if any(not party for *_, party in walls):
+            needed.add(("y", rung(_wall_height(block))))
+        needed.update(("x", rung(length)) for _, _, length, party in walls if not party)
+    return needed
 
 
 def _facade(spec: Spec, horizontal: AxisLayout, vertical: AxisLayout) -> Layout:

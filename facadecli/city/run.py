@@ -21,7 +21,14 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from facadecli.city.building import AxisCache, Looks, build_building
+from facadecli.city.building import (
+    AxisCache,
+    Looks,
+    build_building,
+    facade_axes,
+    rung_length,
+    solve_rung,
+)
 from facadecli.city.cityjson import (
     BuildingSolids,
     CityJSONWriter,
@@ -45,6 +52,7 @@ from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.glb_merge import merge_glb
 from facadecli.export.gltf import glb_bytes
 from facadecli.geometry.facade import transmissions
+from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
 
 
@@ -81,6 +89,31 @@ def safe_name(building_id: str) -> str:
 
 
 _CACHE: dict[str, AxisCache] = {}  # per worker process: axes solved for earlier buildings
+
+Slot = tuple[str, str, int]  # a spec's cache key, an axis, a rung of wall lengths
+
+
+def _needs(task: Task) -> list[Slot]:
+    """The axes a building will solve, to solve them all ahead, once each."""
+    found = facade_axes(
+        task.footprint,
+        task.heights,
+        task.roof,
+        task.min_facade_width,
+        task.shared,
+        task.tolerance,
+    )
+    return sorted((task.cache_key, axis, step) for axis, step in found)
+
+
+def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, AxisLayout | None]:
+    spec, slot = job
+    return slot, solve_rung(spec, slot[1], rung_length(slot[2]))
+
+
+def _seed(axes: dict[Slot, AxisLayout | None]) -> None:
+    """A worker's cache, filled with the axes solved ahead."""
+    _CACHE["axes"] = AxisCache(axes=dict(axes))
 
 
 def build(task: Task) -> dict[str, Any]:
@@ -274,7 +307,8 @@ def run_city(
         else:
             todo.append(task)
     done = len(results)
-    mapped = _map(build, todo, jobs) if scheduler is None else _map_dask(build, todo, scheduler)
+    local = scheduler is None
+    mapped = _map_local(todo, jobs) if local else _map_dask(build, todo, str(scheduler))
     for result in mapped:
         results.append(result)
         done += 1
@@ -358,13 +392,19 @@ def _map_dask(
             yield future.result()
 
 
-def _map(
-    function: Callable[[Task], dict[str, Any]], tasks: list[Task], jobs: int
-) -> Iterator[dict[str, Any]]:
+def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
+    """The buildings in ``jobs`` local processes, results in task order. With several
+    processes, the axes every building needs are solved first, each once, spread over
+    the processes, and handed to each; one process solves them as it goes."""
     if jobs <= 1 or len(tasks) < 2:
         for task in tasks:
-            yield function(task)
+            yield build(task)
         return
     chunk = max(1, min(16, len(tasks) // (jobs * 4)))
+    specs = {task.cache_key: task.spec for task in tasks}
     with ProcessPoolExecutor(max_workers=jobs) as pool:
-        yield from pool.map(function, tasks, chunksize=chunk)
+        slots = sorted({slot for need in pool.map(_needs, tasks, chunksize=chunk) for slot in need})
+        jobs_ahead = [(specs[slot[0]], slot) for slot in slots]
+        solved = dict(pool.map(_solve, jobs_ahead, chunksize=1))
+    with ProcessPoolExecutor(max_workers=jobs, initializer=_seed, initargs=(solved,)) as pool:
+        yield from pool.map(build, tasks, chunksize=chunk)
