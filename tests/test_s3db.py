@@ -272,3 +272,49 @@ def test_shared_edges_and_replaced_outlines_are_found() -> None:
     other = footprint("q", _box(30, 30, 3, 3), **{"building:part": "yes"})
     assert replaced_outlines([outline, part, other]) == {"o": ["p"]}
     assert blind((5.1, 5), (5.1, 0), shared["b"], 0.3)
+
+
+def test_walls_are_front_back_and_sides() -> None:
+    from facadecli.city.sides import facing, sides
+
+    ring = _box(0, 0, 12, 8)  # counter-clockwise: south, east, north, west walls
+    walls = [(ring[i], ring[(i + 1) % 4], False) for i in range(4)]
+    assert [facing(a, b) for a, b, _ in walls] == pytest.approx([180.0, 90.0, 0.0, 270.0])
+    assert sides(walls) == ["front", "side", "back", "side"]
+    walls[0] = (*walls[0][:2], True)  # the south wall along a neighbour
+    assert sides(walls) == ["party", "front", "side", "back"]  # not parallel to it
+    walls[0], walls[1] = (*walls[0][:2], False), (*walls[1][:2], True)  # a terrace's end
+    assert sides(walls) == ["front", "party", "back", "side"]  # the long end wall: a side
+
+
+def test_a_wall_rule_gives_some_walls_another_facade(tmp_path: Path) -> None:
+    blank = SPEC.replace("name: plain", "name: blank").replace("#e0d8c8", "#224466")
+    blank = blank.replace("render:", "blank_render:").replace(
+        "material: render", "material: blank_render"
+    )
+    (tmp_path / "blank.yaml").write_text(blank)
+    rule = (
+        "rules:\n  - when: {building: terrace}\n    walls:\n"
+        "      - {side: side, facade: blank.yaml}\n"
+    )
+    report = _run(tmp_path, rule)
+    assert _entry(report, "t1")["facades"] == 3
+    ends = _model(tmp_path, "t1").geometry
+    middle = _model(tmp_path, "t2").geometry
+    assert "t1/blank_render" in ends  # its end wall is a side: the blank façade
+    assert "t2/blank_render" not in middle  # front and back only: the building's own
+    assert "gabled/blank_render" not in _model(tmp_path, "gabled").geometry  # no rule
+
+
+def test_a_wall_rule_picks_walls_by_the_way_they_face_and_their_length(tmp_path: Path) -> None:
+    blank = SPEC.replace("name: plain", "name: blank").replace("render", "blank_render")
+    (tmp_path / "blank.yaml").write_text(blank)
+    rule = (
+        "rules:\n  - when: {building: house}\n    walls:\n"
+        "      - {facing: {min: 170, max: 190}, length: {min: 10}, facade: blank.yaml}\n"
+    )
+    _run(tmp_path, rule)
+    scene = _model(tmp_path, "gabled")  # 12 x 8 m: the south wall is 12 m long
+    low, high = scene.geometry["gabled/blank_render"].bounds
+    assert (low[2], high[2]) == pytest.approx((0.0, 0.0), abs=0.35)  # on the south wall (z=0)
+    assert (low[0], high[0]) == pytest.approx((0.0, 12.0), abs=0.01)

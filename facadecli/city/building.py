@@ -13,7 +13,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -24,9 +24,10 @@ from shapely.geometry import Polygon
 from trimesh.visual.material import PBRMaterial
 
 from facadecli.city.footprints import Footprint
-from facadecli.city.manifest import Roof
+from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import roof_meshes
 from facadecli.city.s3db import Heights, Volume, blind, volume
+from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
 from facadecli.layout import Layout, build_shapes
@@ -176,12 +177,15 @@ def build_building(
     looks: Looks = Looks(),
     shared: Any = None,
     tolerance: float = 0.3,
+    walls: Sequence[tuple[WallRule, Facade]] = (),
 ) -> BuildingResult:
     """The building's scene: a volume a part of its footprint, as the heights say (walls
     from ``base`` to the eaves, the roof on them); façades on every wall but the party
     walls along a neighbour (``shared``, within ``tolerance``), which are blind; the
-    ground under the parts that stand on it. ``base_dir`` is the spec's folder, where its
-    mesh and texture files are."""
+    ground under the parts that stand on it. A wall gets the façade of the first of
+    ``walls`` that matches it (its side, the way it faces, its length), else ``spec``'s.
+    ``base_dir`` is the spec's folder, where its mesh and texture files are."""
+    main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
     facades = plain = party = 0
@@ -189,11 +193,11 @@ def build_building(
     for block in volumes:
         wall_height = _wall_height(block)
         lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
-        for a, b, length, party_wall in _walls(block, shared, tolerance):
+        for a, b, length, party_wall, chosen in _walls(block, shared, tolerance, main, walls):
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
             meshes = (
-                cache.facade(spec_key, spec, length, wall_height, base_dir)
+                cache.facade(chosen.key, chosen.spec, length, wall_height, chosen.base_dir)
                 if length >= min_facade_width and not party_wall
                 else None
             )
@@ -219,7 +223,10 @@ def build_building(
         bottom.apply_translation((0, 0, block.base - 0.01))
         bottom.apply_transform(MAP_TO_WORLD)
         parts.setdefault(GROUND_NAME if block.base <= 0 else WALL_NAME, []).append(bottom)
-    materials = _materials(spec, base_dir, looks)
+    materials = {}
+    for _, other in walls:  # the building's own spec wins where two name one material
+        materials.update(_materials(other.spec, other.base_dir, looks))
+    materials.update(_materials(spec, base_dir, looks))
     for name in sorted(parts):
         merged = trimesh.util.concatenate(parts[name])
         material = materials.get(name) or pbr(name, Material())
@@ -231,13 +238,32 @@ def build_building(
     return BuildingResult(scene, facades, plain, party, round(top, 3), tuple(volumes))
 
 
-Wall = tuple[tuple[float, float], tuple[float, float], float, bool]  # a, b, length, party
+@dataclass(frozen=True)
+class Facade:
+    """A façade spec, its key in the caches, and its folder (for its mesh files)."""
+
+    spec: Spec
+    key: str
+    base_dir: Path | None = None
 
 
-def _walls(block: Volume, shared: Any, tolerance: float) -> Iterator[Wall]:
-    """The walls of a volume: ends, length, and whether it is a party wall."""
-    for a, b in _edges(block.part):
-        yield a, b, math.dist(a, b), blind(a, b, shared, tolerance)
+Wall = tuple[tuple[float, float], tuple[float, float], float, bool, Facade]
+
+
+def _walls(
+    block: Volume,
+    shared: Any,
+    tolerance: float,
+    main: Facade,
+    rules: Sequence[tuple[WallRule, Facade]],
+) -> Iterator[Wall]:
+    """The walls of a volume: ends, length, whether it is a party wall, and its façade
+    (the first rule matching its side, the way it faces and its length, else ``main``)."""
+    edges = [(a, b, blind(a, b, shared, tolerance)) for a, b in _edges(block.part)]
+    for (a, b, party), side in zip(edges, sides(edges), strict=True):
+        length = math.dist(a, b)
+        chosen = next((f for rule, f in rules if rule.matches(side, facing(a, b), length)), main)
+        yield a, b, length, party, chosen
 
 
 def _wall_height(block: Volume) -> float:
@@ -253,15 +279,17 @@ def facade_axes(
     min_facade_width: float,
     shared: Any,
     tolerance: float,
-) -> set[tuple[str, int]]:
-    """The axes a building's façades need, as (axis, rung): what a run can solve ahead,
-    in parallel, before the buildings (see :meth:`AxisCache.get`)."""
-    needed: set[tuple[str, int]] = set()
+    main: Facade,
+    rules: Sequence[tuple[WallRule, Facade]] = (),
+) -> set[tuple[str, str, int]]:
+    """The axes a building's façades need, as (spec key, axis, rung): what a run can solve
+    ahead, in parallel, before the buildings (see :meth:`AxisCache.get`)."""
+    needed: set[tuple[str, str, int]] = set()
     for block in (volume(part, heights, roof) for part in footprint.parts):
-        walls = [w for w in _walls(block, shared, tolerance) if w[2] >= min_facade_width]
-        if any(not party for *_, party in walls):
-            needed.add(("y", rung(_wall_height(block))))
-        needed.update(("x", rung(length)) for _, _, length, party in walls if not party)
+        height = rung(_wall_height(block))
+        for _, _, length, party, chosen in _walls(block, shared, tolerance, main, rules):
+            if length >= min_facade_width and not party:
+                needed.update({(chosen.key, "y", height), (chosen.key, "x", rung(length))})
     return needed
 
 

@@ -53,15 +53,42 @@ class Roof(Model):
     parapet: Annotated[float, Field(ge=0, le=5)] = 0.0  # metres of wall above a flat roof
 
 
+Height = Annotated[float, Field(gt=0, le=MAX_HEIGHT, allow_inf_nan=False)]  # metres
+
+
 class Range(Model):
     min: float | None = None
     max: float | None = None
 
 
-Height = Annotated[float, Field(gt=0, le=MAX_HEIGHT, allow_inf_nan=False)]  # metres
-
-
 Colours = Literal["tags", "spec"]  # who colours the walls and roof: the OSM tags, or the spec
+Side = Literal["front", "back", "side"]
+
+
+class WallRule(Model):
+    """A façade spec for some walls of a building: ``side`` (front: the longest free wall
+    and those facing its way; back: facing the other way; side: the rest), ``facing``
+    (compass degrees the wall looks at, a range: 135 to 225 is south), ``length`` (metres).
+    Every condition given must hold; the first rule that matches wins."""
+
+    side: Side | list[Side] | None = None
+    facing: Range | None = None
+    length: Range | None = None
+    facade: str
+
+    def matches(self, side: str, facing: float, length: float) -> bool:
+        sides = [self.side] if isinstance(self.side, str) else self.side
+        return (
+            (sides is None or side in sides)
+            and (self.facing is None or _within(facing, self.facing))
+            and (self.length is None or _within(length, self.length))
+        )
+
+
+def _within(value: float, bounds: Range) -> bool:
+    return (bounds.min is None or value >= bounds.min) and (
+        bounds.max is None or value <= bounds.max
+    )
 
 
 class Defaults(Model):
@@ -71,6 +98,7 @@ class Defaults(Model):
     roof: Roof = Roof()
     min_facade_width: Annotated[float, Field(ge=0)] = 2.0
     colours: Colours = "tags"
+    walls: list[WallRule] = Field(default_factory=list)  # façades for some walls
     party_wall_tolerance: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] = 0.3
 
 
@@ -80,6 +108,7 @@ class Rule(Model):
     roof: Roof | None = None
     height: Height | None = None
     colours: Colours | None = None
+    walls: list[WallRule] | None = None  # instead of the defaults' walls
 
 
 class Source(Model):
@@ -130,15 +159,16 @@ class City:
         ``roof:shape`` (and ``roof:angle``); else the defaults."""
         defaults = self.manifest.defaults
         facade, roof = defaults.facade, _tagged_roof(properties) or defaults.roof
-        height, colours = None, defaults.colours
+        height, colours, walls = None, defaults.colours, defaults.walls
         for rule in self.manifest.rules:
             if all(_matches(properties, key, want) for key, want in rule.when.items()):
                 facade = rule.facade or facade
                 roof = rule.roof or roof
                 height = rule.height
                 colours = rule.colours or colours
+                walls = rule.walls if rule.walls is not None else walls
                 break
-        return Choice(facade, roof, height, colours)
+        return Choice(facade, roof, height, colours, tuple(walls))
 
 
 @dataclass(frozen=True)
@@ -149,6 +179,7 @@ class Choice:
     roof: Roof
     height: float | None  # the top of the roof a rule sets, if one does
     colours: str  # "tags" or "spec"
+    walls: tuple[WallRule, ...] = ()  # façades for some walls, the first match wins
 
 
 OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
@@ -221,9 +252,13 @@ def load_city(path: Path) -> City:
             )
         )
     facades: list[tuple[DataPath, str]] = [(("defaults", "facade"), manifest.defaults.facade)]
+    for index, wall in enumerate(manifest.defaults.walls):
+        facades.append((("defaults", "walls", index, "facade"), wall.facade))
     for index, rule in enumerate(manifest.rules):
         if rule.facade is not None:
             facades.append((("rules", index, "facade"), rule.facade))
+        for position, wall in enumerate(rule.walls or []):
+            facades.append((("rules", index, "walls", position, "facade"), wall.facade))
     specs: dict[str, Spec] = {}
     for where, facade in facades:
         if facade in specs:

@@ -23,6 +23,7 @@ from typing import Any
 
 from facadecli.city.building import (
     AxisCache,
+    Facade,
     Looks,
     build_building,
     facade_axes,
@@ -36,7 +37,7 @@ from facadecli.city.cityjson import (
     write_cityjson,
 )
 from facadecli.city.footprints import Footprint, Rejected, Simplified, read_footprints
-from facadecli.city.manifest import City, Roof
+from facadecli.city.manifest import City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
     replaced_outlines,
@@ -70,6 +71,7 @@ class Task:
     shared: Any = None  # the lines of the outline along a neighbour: party walls
     tolerance: float = 0.3  # metres: how near a neighbour's wall makes a party wall
     cache_key: str = ""  # the spec's identity in a worker's caches: its path and content
+    walls: tuple[tuple[WallRule, Facade], ...] = ()  # façades for some walls
 
 
 PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
@@ -102,8 +104,10 @@ def _needs(task: Task) -> list[Slot]:
         task.min_facade_width,
         task.shared,
         task.tolerance,
+        Facade(task.spec, task.cache_key, task.spec_dir),
+        task.walls,
     )
-    return sorted((task.cache_key, axis, step) for axis, step in found)
+    return sorted(found)
 
 
 def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, AxisLayout | None]:
@@ -133,6 +137,7 @@ def build(task: Task) -> dict[str, Any]:
             task.looks,
             task.shared,
             task.tolerance,
+            task.walls,
         )
         solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
         write_cityjson(_feature_file(task.target), building_object(solids))
@@ -223,10 +228,22 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
         heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
         if choice.height is not None:  # a rule's height wins over the tags'
             heights = replace(heights, top=choice.height, eaves=None)
-        if choice.facade not in identities:  # workers outlive a run: tell specs apart
-            content = city.specs[choice.facade].model_dump_json().encode("utf-8")
-            digest = hashlib.sha256(content).hexdigest()[:16]
-            identities[choice.facade] = f"{(city.folder / choice.facade).resolve()}#{digest}"
+        for path in (choice.facade, *(rule.facade for rule in choice.walls)):
+            if path not in identities:  # workers outlive a run: tell specs apart
+                content = city.specs[path].model_dump_json().encode("utf-8")
+                digest = hashlib.sha256(content).hexdigest()[:16]
+                identities[path] = f"{(city.folder / path).resolve()}#{digest}"
+        walls = tuple(
+            (
+                rule,
+                Facade(
+                    city.specs[rule.facade],
+                    identities[rule.facade],
+                    (city.folder / rule.facade).parent.resolve(),
+                ),
+            )
+            for rule in choice.walls
+        )
         looks = Looks()
         if choice.colours == "tags":
             looks = Looks(wall_colour(properties), roof_colour(properties))
@@ -244,6 +261,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
                 shared.get(footprint.id),
                 tolerance,
                 identities[choice.facade],
+                walls,
             )
         )
     return tasks
@@ -402,6 +420,7 @@ def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
         return
     chunk = max(1, min(16, len(tasks) // (jobs * 4)))
     specs = {task.cache_key: task.spec for task in tasks}
+    specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
     with ProcessPoolExecutor(max_workers=jobs) as pool:
         slots = sorted({slot for need in pool.map(_needs, tasks, chunksize=chunk) for slot in need})
         jobs_ahead = [(specs[slot[0]], slot) for slot in slots]
