@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import trimesh
 from shapely.geometry import Polygon
@@ -318,3 +319,20 @@ def test_a_wall_rule_picks_walls_by_the_way_they_face_and_their_length(tmp_path:
     low, high = scene.geometry["gabled/blank_render"].bounds
     assert (low[2], high[2]) == pytest.approx((0.0, 0.0), abs=0.35)  # on the south wall (z=0)
     assert (low[0], high[0]) == pytest.approx((0.0, 12.0), abs=0.01)
+
+
+def test_outside_corners_get_a_corner_post() -> None:
+    from facadecli.city.building import _corner_posts
+
+    ell = [(0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (5.0, 6.0), (5.0, 10.0), (0.0, 10.0)]
+    ends, starts = [], {}
+    for a, b in zip(ell, ell[1:] + ell[:1], strict=True):
+        length = float(np.hypot(b[0] - a[0], b[1] - a[1]))
+        starts[a] = (((b[0] - a[0]) / length, (b[1] - a[1]) / length), 0.25, "render")
+        ends.append((a, b, 0.25))
+    posts = list(_corner_posts(starts, ends, 2.0, 9.0))
+    assert len(posts) == 5  # six corners, one of them inside
+    corner = next(p for _, p in posts if p.bounds[0][0] > 9.9 and p.bounds[0][2] > -0.1)
+    # the corner at map (10, 0): a 25 cm post out east and south (world z is map -y)
+    assert corner.bounds.flatten().tolist() == pytest.approx([10.0, 2.0, 0.0, 10.25, 11.0, 0.25])
+    assert all(name == "render" for name, _ in posts)

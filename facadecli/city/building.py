@@ -30,7 +30,7 @@ from facadecli.city.s3db import Heights, Volume, blind, volume
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
-from facadecli.layout import Layout, build_shapes
+from facadecli.layout import DEFAULT_MATERIAL, Layout, build_shapes
 from facadecli.solver.axis import AxisLayout, solve_axis
 from facadecli.spec.model import Material, Spec
 
@@ -193,6 +193,8 @@ def build_building(
     for block in volumes:
         wall_height = _wall_height(block)
         lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
+        proud: dict[tuple[float, float], tuple[tuple[float, float], float, str]] = {}
+        ends: list[tuple[tuple[float, float], tuple[float, float], float]] = []
         for a, b, length, party_wall, chosen in _walls(block, shared, tolerance, main, walls):
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
@@ -210,9 +212,14 @@ def build_building(
                 party += party_wall
                 continue
             facades += 1
+            out = max(float(mesh.vertices[:, 2].max(initial=0.0)) for _, mesh in meshes)
+            proud[a] = (direction, out, _wall_material(chosen.spec))
+            ends.append((a, b, out))
             for name, mesh in meshes:
                 mesh.apply_transform(placement)
                 parts.setdefault(name, []).append(mesh)
+        for name, post in _corner_posts(proud, ends, block.base, wall_height):
+            parts.setdefault(name, []).append(post)
         cover, infill = roof_meshes(block.part, block.eaves, block.roof)
         cover.apply_transform(MAP_TO_WORLD)
         parts.setdefault(ROOF_NAME, []).append(cover)
@@ -291,6 +298,48 @@ def facade_axes(
             if length >= min_facade_width and not party:
                 needed.update({(chosen.key, "y", height), (chosen.key, "x", rung(length))})
     return needed
+
+
+CORNER_MIN = 0.01  # metres: façades standing out less than this need no corner post
+
+
+def _wall_material(spec: Spec) -> str:
+    return spec.defaults.material or DEFAULT_MATERIAL
+
+
+def _corner_posts(
+    starts: dict[tuple[float, float], tuple[tuple[float, float], float, str]],
+    ends: list[tuple[tuple[float, float], tuple[float, float], float]],
+    base: float,
+    height: float,
+) -> Iterator[tuple[str, trimesh.Trimesh]]:
+    """A corner piece where two façades meet at an outside corner: a post filling the
+    notch their ledges, pilasters and frames leave there (each stops at its wall's end),
+    as far out as the prouder of the two, in the wall material of the wall it ends."""
+    for a, b, out in ends:
+        following = starts.get(b)
+        if following is None:
+            continue
+        (dx, dy), after, material = following
+        ax, ay = b[0] - a[0], b[1] - a[1]
+        if ax * dy - ay * dx <= 1e-9:  # not a left turn: an inside corner
+            continue
+        depth = max(out, after)
+        if depth < CORNER_MIN:
+            continue
+        length = math.hypot(ax, ay)
+        first = (ay / length, -ax / length)  # outward normals: right of each wall
+        second = (dy, -dx)
+        outline = [
+            b,
+            (b[0] + depth * first[0], b[1] + depth * first[1]),
+            (b[0] + depth * (first[0] + second[0]), b[1] + depth * (first[1] + second[1])),
+            (b[0] + depth * second[0], b[1] + depth * second[1]),
+        ]
+        post = trimesh.creation.extrude_polygon(Polygon(outline).buffer(0), height)
+        post.apply_translation((0, 0, base))
+        post.apply_transform(MAP_TO_WORLD)
+        yield material, post
 
 
 def _facade(spec: Spec, horizontal: AxisLayout, vertical: AxisLayout) -> Layout:
