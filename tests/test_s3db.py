@@ -336,3 +336,57 @@ def test_outside_corners_get_a_corner_post() -> None:
     # the corner at map (10, 0): a 25 cm post out east and south (world z is map -y)
     assert corner.bounds.flatten().tolist() == pytest.approx([10.0, 2.0, 0.0, 10.25, 11.0, 0.25])
     assert all(name == "render" for name, _ in posts)
+
+
+VARIED = SPEC.replace(
+    'patterns: {x: "E (W E)^n", y: "F^f"}', 'patterns: {x: "E (W E)^n | E (V E)^n", y: "F^f"}'
+)
+VARIED = VARIED.replace(
+    "symbols: {E: 1.0, W: 1.2, F: 3.0}", "symbols: {E: 1.0, W: 1.2, V: 1.2, F: 3.0}"
+)
+VARIED = VARIED.replace(
+    "shapes: [{match: {x: W}, material: glass, depth: -0.1, thickness: 0.02}]",
+    "shapes: [{match: {x: W}, material: glass, depth: -0.1, thickness: 0.02},"
+    " {match: {x: V}, material: shutters, depth: 0.05, thickness: 0.05}]",
+)
+VARIED = VARIED.replace("  glass:", '  shutters: {color: "#3f6b4a"}\n  glass:')
+
+
+def _varied(tmp_path: Path, seed: int) -> dict[str, Any]:
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    (tmp_path / "plain.yaml").write_text(VARIED)
+    row = [_feature(f"h{i}", _box(i * 20, 0, 10, 8), building="house") for i in range(8)]
+    data = {
+        "type": "FeatureCollection",
+        "features": row,
+        "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}},
+    }
+    (tmp_path / "tags.geojson").write_text(json.dumps(data))
+    extra = (
+        f"seed: {seed}\nrules:\n  - when: {{building: house}}\n    variants: 2\n"
+        '    palette: ["#ff0000", "#00ff00", "#0000ff"]\n'
+    )
+    (tmp_path / "tags.yaml").write_text(MANIFEST.format(extra=extra))
+    return run_city(load_city(tmp_path / "tags.yaml"), tmp_path / "out")
+
+
+def _looks(tmp_path: Path, fid: str) -> tuple[tuple[float, ...], bool]:
+    document = json.loads(_json_chunk(tmp_path / "out" / "buildings" / f"{fid}.glb"))
+    colours = {
+        m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
+    }
+    return tuple(round(c, 3) for c in colours["render"][:3]), "shutters" in colours
+
+
+def test_a_seed_varies_layouts_and_colours_per_building(tmp_path: Path) -> None:
+    _varied(tmp_path / "a", 0)
+    first = [_looks(tmp_path / "a", f"h{i}") for i in range(8)]
+    assert {colour for colour, _ in first} <= {(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)}
+    assert len({colour for colour, _ in first}) >= 2  # eight identical houses, not alike
+    assert len({shutters for _, shutters in first}) == 2  # both layouts of the alternation
+    _varied(tmp_path / "b", 0)
+    for i in range(8):  # the same seed: the same files
+        a = (tmp_path / "a" / "out" / "buildings" / f"h{i}.glb").read_bytes()
+        assert a == (tmp_path / "b" / "out" / "buildings" / f"h{i}.glb").read_bytes()
+    _varied(tmp_path / "c", 1)
+    assert [_looks(tmp_path / "c", f"h{i}") for i in range(8)] != first  # another seed

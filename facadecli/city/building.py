@@ -31,7 +31,7 @@ from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
 from facadecli.layout import DEFAULT_MATERIAL, Layout, build_shapes
-from facadecli.solver.axis import AxisLayout, solve_axis
+from facadecli.solver.axis import AxisLayout, solve_axis_alternatives
 from facadecli.spec.model import Material, Spec
 
 WALL = Material(color="#cfc6b8", roughness=0.9)
@@ -54,16 +54,19 @@ def rung_length(step: int) -> float:
     return round(math.exp(step * math.log1p(STRETCH)), 6)
 
 
-def solve_rung(spec: Spec, axis: str, canvas: float) -> AxisLayout | None:
-    """An axis solved at a rung's length; None where no layout fits (a plain wall)."""
+def solve_rung(spec: Spec, axis: str, canvas: float, variants: int = 1) -> tuple[AxisLayout, ...]:
+    """An axis solved at a rung's length: the best layout and up to ``variants`` - 1 others
+    nearly as good (as ``facade vary`` draws them); none where no layout fits."""
     try:
         deadline = time.perf_counter() + spec.solver.time_limit / 2
-        return solve_axis(spec, axis, canvas, deadline)  # type: ignore[arg-type]
+        found = solve_axis_alternatives(spec, axis, canvas, deadline, variants)  # type: ignore[arg-type]
     except (InfeasibleError, SearchLimitError):
-        return None
+        return ()
+    return tuple(found)
 
 
 FacadeMeshes = tuple[tuple[str, np.ndarray, np.ndarray], ...]  # (material, vertices, faces)
+Slot = tuple[str, str, int, int]  # a spec's cache key, an axis, a rung, how many variants
 
 
 @dataclass
@@ -77,26 +80,39 @@ class AxisCache:
     of as many lengths solves and builds a few hundred. Every worker makes a rung the
     same way, so the files do not depend on which worker built what."""
 
-    axes: dict[tuple[str, str, int], AxisLayout | None] = field(default_factory=dict)
-    facades: dict[tuple[str, int, int], FacadeMeshes] = field(default_factory=dict)
+    axes: dict[Slot, tuple[AxisLayout, ...]] = field(default_factory=dict)
+    facades: dict[tuple[str, int, int, int, int], FacadeMeshes] = field(default_factory=dict)
 
-    def get(self, key: str, spec: Spec, axis: str, length: float) -> AxisLayout | None:
-        """The axis solved at the rung of ``length`` (None: no layout, a plain wall)."""
-        slot = (key, axis, rung(length))
+    def get(
+        self, key: str, spec: Spec, axis: str, length: float, variants: int = 1, pick: int = 0
+    ) -> AxisLayout | None:
+        """The axis solved at the rung of ``length``, the ``pick``-th of its layouts (modulo
+        how many there are); None: no layout, a plain wall."""
+        slot = (key, axis, rung(length), variants)
         if slot not in self.axes:
-            self.axes[slot] = solve_rung(spec, axis, rung_length(slot[2]))
-        return self.axes[slot]
+            self.axes[slot] = solve_rung(spec, axis, rung_length(slot[2]), variants)
+        found = self.axes[slot]
+        return found[pick % len(found)] if found else None
 
     def facade(
-        self, key: str, spec: Spec, width: float, height: float, base_dir: Path | None
+        self,
+        key: str,
+        spec: Spec,
+        width: float,
+        height: float,
+        base_dir: Path | None,
+        variants: int = 1,
+        pick: int = 0,
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """The façade of a wall ``width`` x ``height`` in its own frame (x along, y up, z
         out), one mesh per material; None where no layout fits (a plain wall)."""
-        horizontal = self.get(key, spec, "x", width)
-        vertical = self.get(key, spec, "y", height)
+        horizontal = self.get(key, spec, "x", width, variants, pick)
+        vertical = self.get(key, spec, "y", height, variants, pick)
         if horizontal is None or vertical is None:
             return None
-        slot = (key, rung(width), rung(height))
+        x = self.axes[(key, "x", rung(width), variants)].index(horizontal)
+        y = self.axes[(key, "y", rung(height), variants)].index(vertical)
+        slot = (key, rung(width), rung(height), x, y)
         if slot not in self.facades:
             layout = _facade(spec, horizontal, vertical)
             merged: dict[str, list[trimesh.Trimesh]] = {}
@@ -178,13 +194,16 @@ def build_building(
     shared: Any = None,
     tolerance: float = 0.3,
     walls: Sequence[tuple[WallRule, Facade]] = (),
+    variants: int = 1,
+    pick: int = 0,
 ) -> BuildingResult:
     """The building's scene: a volume a part of its footprint, as the heights say (walls
     from ``base`` to the eaves, the roof on them); façades on every wall but the party
     walls along a neighbour (``shared``, within ``tolerance``), which are blind; the
     ground under the parts that stand on it. A wall gets the façade of the first of
     ``walls`` that matches it (its side, the way it faces, its length), else ``spec``'s.
-    ``base_dir`` is the spec's folder, where its mesh and texture files are."""
+    ``base_dir`` is the spec's folder, where its mesh and texture files are. Each axis is
+    the ``pick``-th of up to ``variants`` layouts, the same for all the building's walls."""
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
@@ -199,7 +218,9 @@ def build_building(
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
             meshes = (
-                cache.facade(chosen.key, chosen.spec, length, wall_height, chosen.base_dir)
+                cache.facade(
+                    chosen.key, chosen.spec, length, wall_height, chosen.base_dir, variants, pick
+                )
                 if length >= min_facade_width and not party_wall
                 else None
             )
@@ -288,15 +309,17 @@ def facade_axes(
     tolerance: float,
     main: Facade,
     rules: Sequence[tuple[WallRule, Facade]] = (),
-) -> set[tuple[str, str, int]]:
-    """The axes a building's façades need, as (spec key, axis, rung): what a run can solve
-    ahead, in parallel, before the buildings (see :meth:`AxisCache.get`)."""
-    needed: set[tuple[str, str, int]] = set()
+    variants: int = 1,
+) -> set[Slot]:
+    """The axes a building's façades need, as cache slots: what a run can solve ahead, in
+    parallel, before the buildings (see :meth:`AxisCache.get`)."""
+    needed: set[Slot] = set()
     for block in (volume(part, heights, roof) for part in footprint.parts):
         height = rung(_wall_height(block))
         for _, _, length, party, chosen in _walls(block, shared, tolerance, main, rules):
             if length >= min_facade_width and not party:
-                needed.update({(chosen.key, "y", height), (chosen.key, "x", rung(length))})
+                needed.add((chosen.key, "y", height, variants))
+                needed.add((chosen.key, "x", rung(length), variants))
     return needed
 
 

@@ -16,7 +16,7 @@ from facadecli.city.footprints import MAX_HEIGHT, number
 from facadecli.errors import Problem, SpecError
 from facadecli.spec import load_spec
 from facadecli.spec.load import validate_model
-from facadecli.spec.model import NAME_RE, Model, Spec
+from facadecli.spec.model import COLOR_RE, NAME_RE, Model, Spec
 from facadecli.spec.source import Path as DataPath
 from facadecli.spec.source import SourceMap, read_document
 
@@ -99,6 +99,10 @@ class Defaults(Model):
     min_facade_width: Annotated[float, Field(ge=0)] = 2.0
     colours: Colours = "tags"
     walls: list[WallRule] = Field(default_factory=list)  # façades for some walls
+    variants: Annotated[int, Field(ge=1, le=8)] = 1  # layouts a wall length may take
+    palette: list[Annotated[str, StringConstraints(pattern=COLOR_RE)]] = Field(
+        default_factory=list
+    )  # wall colours a building may take (when its tags give none)
     party_wall_tolerance: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] = 0.3
 
 
@@ -109,6 +113,8 @@ class Rule(Model):
     height: Height | None = None
     colours: Colours | None = None
     walls: list[WallRule] | None = None  # instead of the defaults' walls
+    variants: Annotated[int, Field(ge=1, le=8)] | None = None
+    palette: list[Annotated[str, StringConstraints(pattern=COLOR_RE)]] | None = None
 
 
 class Source(Model):
@@ -143,6 +149,7 @@ class Manifest(Model):
     defaults: Defaults
     rules: list[Rule] = Field(default_factory=list)
     properties: Properties = Properties()
+    seed: Annotated[int, Field(ge=0)] = 0  # varies each building's picks, reproducibly
 
 
 @dataclass(frozen=True)
@@ -160,6 +167,7 @@ class City:
         defaults = self.manifest.defaults
         facade, roof = defaults.facade, _tagged_roof(properties) or defaults.roof
         height, colours, walls = None, defaults.colours, defaults.walls
+        variants, palette = defaults.variants, defaults.palette
         for rule in self.manifest.rules:
             if all(_matches(properties, key, want) for key, want in rule.when.items()):
                 facade = rule.facade or facade
@@ -167,8 +175,10 @@ class City:
                 height = rule.height
                 colours = rule.colours or colours
                 walls = rule.walls if rule.walls is not None else walls
+                variants = rule.variants or variants
+                palette = rule.palette if rule.palette is not None else palette
                 break
-        return Choice(facade, roof, height, colours, tuple(walls))
+        return Choice(facade, roof, height, colours, tuple(walls), variants, tuple(palette))
 
 
 @dataclass(frozen=True)
@@ -180,6 +190,8 @@ class Choice:
     height: float | None  # the top of the roof a rule sets, if one does
     colours: str  # "tags" or "spec"
     walls: tuple[WallRule, ...] = ()  # façades for some walls, the first match wins
+    variants: int = 1  # layouts a wall may take; each building picks one by its seed
+    palette: tuple[str, ...] = ()  # wall colours a building may take
 
 
 OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built

@@ -25,6 +25,7 @@ from facadecli.city.building import (
     AxisCache,
     Facade,
     Looks,
+    Slot,
     build_building,
     facade_axes,
     rung_length,
@@ -72,6 +73,8 @@ class Task:
     tolerance: float = 0.3  # metres: how near a neighbour's wall makes a party wall
     cache_key: str = ""  # the spec's identity in a worker's caches: its path and content
     walls: tuple[tuple[WallRule, Facade], ...] = ()  # façades for some walls
+    variants: int = 1  # layouts each axis may take
+    pick: int = 0  # which of them this building takes (from the seed and its id)
 
 
 PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
@@ -92,8 +95,6 @@ def safe_name(building_id: str) -> str:
 
 _CACHE: dict[str, AxisCache] = {}  # per worker process: axes solved for earlier buildings
 
-Slot = tuple[str, str, int]  # a spec's cache key, an axis, a rung of wall lengths
-
 
 def _needs(task: Task) -> list[Slot]:
     """The axes a building will solve, to solve them all ahead, once each."""
@@ -106,16 +107,17 @@ def _needs(task: Task) -> list[Slot]:
         task.tolerance,
         Facade(task.spec, task.cache_key, task.spec_dir),
         task.walls,
+        task.variants,
     )
     return sorted(found)
 
 
-def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, AxisLayout | None]:
+def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, tuple[AxisLayout, ...]]:
     spec, slot = job
-    return slot, solve_rung(spec, slot[1], rung_length(slot[2]))
+    return slot, solve_rung(spec, slot[1], rung_length(slot[2]), slot[3])
 
 
-def _seed(axes: dict[Slot, AxisLayout | None]) -> None:
+def _seed(axes: dict[Slot, tuple[AxisLayout, ...]]) -> None:
     """A worker's cache, filled with the axes solved ahead."""
     _CACHE["axes"] = AxisCache(axes=dict(axes))
 
@@ -138,6 +140,8 @@ def build(task: Task) -> dict[str, Any]:
             task.shared,
             task.tolerance,
             task.walls,
+            task.variants,
+            task.pick,
         )
         solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
         write_cityjson(_feature_file(task.target), building_object(solids))
@@ -161,6 +165,13 @@ def build(task: Task) -> dict[str, Any]:
         **_simplified(task.footprint.simplified),
         "time_ms": round((time.perf_counter() - started) * 1000, 1),
     }
+
+
+def _pick(seed: int, building_id: str) -> int:
+    """A building's own number from the manifest's seed and its id: which of the variants
+    and palette colours it takes, the same on every run and machine."""
+    digest = hashlib.sha256(f"{seed}/{building_id}".encode("utf-8", "surrogatepass"))
+    return int.from_bytes(digest.digest()[:4], "big")
 
 
 def _feature_file(target: Path) -> Path:
@@ -244,9 +255,12 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
             )
             for rule in choice.walls
         )
+        pick = _pick(city.manifest.seed, footprint.id)
         looks = Looks()
         if choice.colours == "tags":
             looks = Looks(wall_colour(properties), roof_colour(properties))
+        if choice.palette and looks.wall is None:
+            looks = replace(looks, wall=choice.palette[pick % len(choice.palette)])
         tasks.append(
             Task(
                 footprint,
@@ -262,6 +276,8 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
                 tolerance,
                 identities[choice.facade],
                 walls,
+                choice.variants,
+                pick,
             )
         )
     return tasks

@@ -381,6 +381,12 @@ def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
     and among them the tie-breaks decide (placeholders covering least, more columns)."""
     if not evaluated:
         return []
+    best: dict[object, _Evaluated] = {}  # one layout a candidate (the heuristic and the
+    for e in evaluated:  # exact search may both have aligned it): its best
+        kept = best.get(e.candidate.key)
+        if kept is None or e.estimate.objective < kept.estimate.objective - 1e-12:
+            best[e.candidate.key] = e
+    evaluated = list(best.values())
     least = min(e.estimate.objective for e in evaluated)
     good = sorted(
         (e for e in evaluated if e.estimate.objective <= least + TIE), key=lambda e: e.rank[1:]
