@@ -390,3 +390,23 @@ def test_a_seed_varies_layouts_and_colours_per_building(tmp_path: Path) -> None:
         assert a == (tmp_path / "b" / "out" / "buildings" / f"h{i}.glb").read_bytes()
     _varied(tmp_path / "c", 1)
     assert [_looks(tmp_path / "c", f"h{i}") for i in range(8)] != first  # another seed
+
+
+def test_a_city_in_tiles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    report = _run(tmp_path, "tiles: 50\n")
+    index = json.loads((tmp_path / "out" / "tags.tiles.json").read_text())
+    assert report["models"] == {"merged": "tags.glb", "tiles": "tags.tiles.json"}
+    assert sum(t["buildings"] for t in index["tiles"]) == report["summary"]["ok"]
+    names = {(t["column"], t["row"]) for t in index["tiles"]}
+    assert names == {(0, 0), (1, 0)}  # centroids at x 4-85 m, y 4-45 m: two 50 m tiles
+    first = trimesh.load(tmp_path / "out" / index["tiles"][0]["file"], force="scene")
+    assert len(first.graph.nodes_geometry) > 0
+    assert index["tiles"][0]["bounds_crs"][:2] == [100000.0, 400000.0]
+    # a district too big for one glb: tiles only
+    import facadecli.city.tiles as tiles
+
+    monkeypatch.setattr(tiles, "MERGED_GLB_MAX", 1000)
+    (tmp_path / "big").mkdir()
+    report = _run(tmp_path / "big", "")
+    assert report["models"] == {"merged": None, "tiles": "tags.tiles.json"}
+    assert not (tmp_path / "big" / "out" / "tags.glb").exists()

@@ -150,6 +150,7 @@ class Manifest(Model):
     rules: list[Rule] = Field(default_factory=list)
     properties: Properties = Properties()
     seed: Annotated[int, Field(ge=0)] = 0  # varies each building's picks, reproducibly
+    tiles: Annotated[float, Field(gt=0, le=100_000, allow_inf_nan=False)] | None = None  # m
 
 
 @dataclass(frozen=True)

@@ -49,9 +49,9 @@ from facadecli.city.s3db import (
     volume,
     wall_colour,
 )
+from facadecli.city.tiles import merge_city
 from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
-from facadecli.export.glb_merge import merge_glb
 from facadecli.export.gltf import glb_bytes
 from facadecli.geometry.facade import transmissions
 from facadecli.solver.axis import AxisLayout
@@ -174,6 +174,12 @@ def _pick(seed: int, building_id: str) -> int:
     return int.from_bytes(digest.digest()[:4], "big")
 
 
+def _centroid(footprint: Footprint) -> tuple[float, float]:
+    """Where a building is, for its tile: the centroid of its largest part."""
+    largest = max(footprint.parts, key=lambda part: part.area)
+    return largest.centroid.x, largest.centroid.y
+
+
 def _feature_file(target: Path) -> Path:
     """Where a building's CityJSON feature goes, beside its glb (written before the glb,
     which marks the building done for --resume)."""
@@ -293,10 +299,14 @@ def check_output(outdir: Path, name: str) -> None:
         problem = f"'{buildings}' is a file, where the buildings' folder goes"
     elif os.path.isdir(buildings) and not os.access(buildings, os.W_OK | os.X_OK):
         problem = f"cannot write in '{buildings}' (permission denied)"
+    tiles = outdir / "tiles"
+    if os.path.lexists(tiles) and not os.path.isdir(tiles):
+        problem = f"'{tiles}' is a file, where the tiles' folder goes"
     for output in (
         outdir / f"{name}.glb",
         outdir / f"{name}.report.json",
         outdir / f"{name}.city.json",
+        outdir / f"{name}.tiles.json",
     ):
         if os.path.isdir(output):
             problem = f"'{output}' is a folder, where an output file goes"
@@ -350,17 +360,24 @@ def run_city(
             progress(done, len(tasks))
     order = {task.footprint.id: i for i, task in enumerate(tasks)}
     results.sort(key=lambda r: order[r["id"]])
+    by_id = {task.footprint.id: task for task in tasks}
     try:
-        merge_glb(
-            ((r["id"], outdir / r["file"]) for r in results if r["status"] == "ok"),
-            outdir / f"{city.manifest.name}.glb",
+        written = merge_city(
+            (
+                (r["id"], outdir / r["file"], _centroid(by_id[r["id"]].footprint))
+                for r in results
+                if r["status"] == "ok"
+            ),
+            outdir,
+            city.manifest.name,
+            city.manifest.tiles,
+            found.origin,
         )
     except OSError as error:  # a full disk: the buildings stay, for --resume
         raise OutputError(
             f"{outdir}: cannot write the merged model: {error.strerror or error}; the "
             "buildings built are kept: run again with --resume"
         ) from None
-    by_id = {task.footprint.id: task for task in tasks}
     cityjson = outdir / f"{city.manifest.name}.city.json"
     try:
         with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:
@@ -381,6 +398,7 @@ def run_city(
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
         "replaced": [{"id": key, "parts": ids} for key, ids in sorted(replaced.items())],
+        "models": written,
         "summary": {
             "buildings": len(tasks),
             "ok": len(results) - len(failed),

@@ -1,0 +1,69 @@
+"""A city's merged models: one ``<name>.glb`` of every building while it stays within a
+glb's limits, and with ``tiles`` (or when it would not fit) one glb a square tile of the
+map, so a district of any size loads in pieces (a glb's lengths are 32-bit: 4 GiB).
+
+A building belongs to the tile its footprint's centroid lies in; tiles are named by their
+column and row from the run's origin (``tiles/<name>_<i>_<j>.glb``) and listed, with
+their bounds in local metres and in the footprints' CRS, in ``<name>.tiles.json``."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+from facadecli.export.atomic import write_atomic
+from facadecli.export.glb_merge import merge_glb
+from facadecli.limits import MERGED_GLB_MAX
+
+DEFAULT_TILE = 1000.0  # metres: the tiles' side when a merged model would not fit
+
+
+def tile_of(centroid: tuple[float, float], size: float) -> tuple[int, int]:
+    return math.floor(centroid[0] / size), math.floor(centroid[1] / size)
+
+
+def merge_city(
+    buildings: Iterable[tuple[str, Path, tuple[float, float]]],
+    outdir: Path,
+    name: str,
+    size: float | None,
+    origin: tuple[float, float],
+) -> dict[str, Any]:
+    """Write the merged model(s) of the built buildings (id, glb file, centroid in local
+    metres); returns what was written for the report: ``merged`` (the one glb, or None
+    when it would pass MERGED_GLB_MAX) and ``tiles`` (the index file, or None)."""
+    buildings = list(buildings)
+    total = sum(path.stat().st_size for _, path, _ in buildings)
+    merged: str | None = f"{name}.glb"
+    if total <= MERGED_GLB_MAX:
+        merge_glb(((bid, path) for bid, path, _ in buildings), outdir / f"{name}.glb")
+    else:
+        merged = None
+        size = size or DEFAULT_TILE
+    if size is None:
+        return {"merged": merged, "tiles": None}
+    groups: dict[tuple[int, int], list[tuple[str, Path]]] = {}
+    for bid, path, centroid in buildings:
+        groups.setdefault(tile_of(centroid, size), []).append((bid, path))
+    index = []
+    for (i, j), members in sorted(groups.items()):
+        file = f"tiles/{name}_{i}_{j}.glb"
+        merge_glb(members, outdir / file)
+        x0, y0 = i * size, j * size
+        ox, oy = origin
+        index.append(
+            {
+                "file": file,
+                "column": i,
+                "row": j,
+                "buildings": len(members),
+                "bounds": [x0, y0, x0 + size, y0 + size],
+                "bounds_crs": [ox + x0, oy + y0, ox + x0 + size, oy + y0 + size],
+            }
+        )
+    document = {"name": name, "size": size, "origin": list(origin), "tiles": index}
+    write_atomic(outdir / f"{name}.tiles.json", json.dumps(document, indent=2) + "\n")
+    return {"merged": merged, "tiles": f"{name}.tiles.json"}
