@@ -243,6 +243,10 @@ def test_the_roof_is_lowered_to_leave_a_wall() -> None:
         part, Heights(top=5.0, eaves=None, base=0.0, roof=8.0, default=9.0), Roof(type="gable")
     )
     assert tall.eaves == pytest.approx(0.5) and tall.top == pytest.approx(5.0)
+    wide = volume(
+        Polygon(_box(0, 0, 40, 30)), Heights(9.0, None, 0.0, None, 9.0), Roof(type="gable")
+    )  # its pitch would make the roof 8.7 m high: half the building at most
+    assert (wide.eaves, wide.top) == pytest.approx((4.5, 9.0))
     flat = volume(part, Heights(None, None, 0.0, None, 9.0), Roof(type="flat"))
     assert (flat.eaves, flat.roof.type) == (9.0, "flat")
 

@@ -29,6 +29,7 @@ from facadecli.city.manifest import Roof
 from facadecli.city.roofs import roof_height
 
 MIN_WALL = 0.5  # metres: a roof taller than its building leaves at least this much wall
+ROOF_SHARE = 0.5  # of a building's height, at most, for a roof no tag gives a height
 
 
 @dataclass(frozen=True)
@@ -58,9 +59,11 @@ class Volume:
 
 
 def volume(part: Polygon, heights: Heights, roof: Roof) -> Volume:
-    """The part's walls and roof as the heights say. A roof too tall for the building is
-    lowered to leave MIN_WALL of wall (none for a part lifted off the ground to its top,
-    such as a canopy); a roof of no height is flat."""
+    """The part's walls and roof as the heights say. A roof whose height comes from its
+    pitch alone (no ``roof:height``, ``roof:levels`` or roof ``height``) takes at most
+    ROOF_SHARE of the building's height (a wide footprint gets a flatter roof, not walls
+    half a metre high); a roof too tall for the building is lowered to leave MIN_WALL of
+    wall; a roof of no height is flat."""
     own = 0.0 if roof.type == "flat" else roof_height(part, roof)
     rise = heights.roof if heights.roof is not None else own
     if roof.type == "flat":
@@ -72,6 +75,8 @@ def volume(part: Polygon, heights: Heights, roof: Roof) -> Volume:
     else:
         top = heights.default
     top = max(top, heights.base + MIN_WALL)
+    if heights.roof is None and roof.height is None:  # a roof from its pitch alone: at
+        rise = min(rise, ROOF_SHARE * (top - heights.base))  # most a share of the building
     eaves = max(top - rise, min(heights.base + MIN_WALL, top))
     rise = top - eaves
     if rise <= 1e-6:
