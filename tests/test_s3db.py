@@ -414,3 +414,25 @@ def test_a_city_in_tiles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     report = _run(tmp_path / "big", "")
     assert report["models"] == {"merged": None, "tiles": "tags.tiles.json"}
     assert not (tmp_path / "big" / "out" / "tags.glb").exists()
+
+
+def test_the_report_grows_as_buildings_end(district: tuple[Path, dict[str, Any]]) -> None:
+    folder, report = district
+    lines = (folder / "out" / "tags.report.jsonl").read_text().splitlines()
+    assert sorted(json.loads(line)["id"] for line in lines) == sorted(
+        b["id"] for b in report["buildings"]
+    )
+
+
+def test_a_bounded_stream_of_tasks_gives_the_same_files(
+    district: tuple[Path, dict[str, Any]], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import facadecli.city.run as run
+
+    folder, _ = district
+    monkeypatch.setattr(run, "IN_FLIGHT", 1)  # one chunk at a time
+    for name in ("plain.yaml", "tags.geojson", "tags.yaml"):
+        (tmp_path / name).write_bytes((folder / name).read_bytes())
+    run_city(load_city(tmp_path / "tags.yaml"), tmp_path / "out", jobs=2)
+    for built in sorted((folder / "out" / "buildings").glob("*.glb")):
+        assert built.read_bytes() == (tmp_path / "out" / "buildings" / built.name).read_bytes()

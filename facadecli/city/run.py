@@ -15,11 +15,12 @@ import json
 import os
 import re
 import time
-from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from facadecli.city.building import (
     AxisCache,
@@ -93,6 +94,7 @@ def safe_name(building_id: str) -> str:
     return f"{readable}~{digest}"
 
 
+IN_FLIGHT = 64  # chunks of tasks handed to the workers at once, at most
 _CACHE: dict[str, AxisCache] = {}  # per worker process: axes solved for earlier buildings
 
 
@@ -307,6 +309,7 @@ def check_output(outdir: Path, name: str) -> None:
         outdir / f"{name}.report.json",
         outdir / f"{name}.city.json",
         outdir / f"{name}.tiles.json",
+        outdir / f"{name}.report.jsonl",
     ):
         if os.path.isdir(output):
             problem = f"'{output}' is a folder, where an output file goes"
@@ -353,11 +356,24 @@ def run_city(
     done = len(results)
     local = scheduler is None
     mapped = _map_local(todo, jobs) if local else _map_dask(build, todo, str(scheduler))
-    for result in mapped:
-        results.append(result)
-        done += 1
-        if progress is not None:
-            progress(done, len(tasks))
+    log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+        with open(log, "w", encoding="utf-8") as lines:
+            for result in results:
+                lines.write(json.dumps(result) + "\n")
+            for result in mapped:
+                results.append(result)
+                lines.write(json.dumps(result) + "\n")
+                lines.flush()
+                done += 1
+                if progress is not None:
+                    progress(done, len(tasks))
+    except OSError as error:
+        raise OutputError(
+            f"{outdir}: cannot write the report: {error.strerror or error}; the buildings "
+            "built are kept: run again with --resume"
+        ) from None
     order = {task.footprint.id: i for i, task in enumerate(tasks)}
     results.sort(key=lambda r: order[r["id"]])
     by_id = {task.footprint.id: task for task in tasks}
@@ -439,9 +455,13 @@ def _map_dask(
     from distributed import Client
 
     with Client(scheduler, set_as_default=False) as client:
-        futures = client.map(function, tasks, pure=False)
-        for future in futures:
-            yield future.result()
+        pending: deque[Any] = deque()
+        for task in tasks:  # a bounded stream: at most IN_FLIGHT tasks handed out at once
+            pending.append(client.submit(function, task, pure=False))
+            if len(pending) >= IN_FLIGHT:
+                yield pending.popleft().result()
+        while pending:
+            yield pending.popleft().result()
 
 
 def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
@@ -456,8 +476,32 @@ def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
     specs = {task.cache_key: task.spec for task in tasks}
     specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
     with ProcessPoolExecutor(max_workers=jobs) as pool:
-        slots = sorted({slot for need in pool.map(_needs, tasks, chunksize=chunk) for slot in need})
+        needs = _bounded(pool, _needs, tasks, chunk)
+        slots = sorted({slot for need in needs for slot in need})
         jobs_ahead = [(specs[slot[0]], slot) for slot in slots]
-        solved = dict(pool.map(_solve, jobs_ahead, chunksize=1))
+        solved = dict(_bounded(pool, _solve, jobs_ahead, 1))
     with ProcessPoolExecutor(max_workers=jobs, initializer=_seed, initargs=(solved,)) as pool:
-        yield from pool.map(build, tasks, chunksize=chunk)
+        yield from _bounded(pool, build, tasks, chunk)
+
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+
+def _bounded(
+    pool: ProcessPoolExecutor, function: Callable[[T], R], items: Sequence[T], chunk: int
+) -> Iterator[R]:
+    """``pool.map`` as a bounded stream: results in order, with at most IN_FLIGHT chunks
+    of ``chunk`` items handed to the workers at once (``Executor.map`` would queue every
+    item first, and a city of a million buildings with it)."""
+    pending: deque[Future[list[R]]] = deque()
+    for start in range(0, len(items), chunk):
+        pending.append(pool.submit(_each, function, items[start : start + chunk]))
+        if len(pending) >= IN_FLIGHT:
+            yield from pending.popleft().result()
+    while pending:
+        yield from pending.popleft().result()
+
+
+def _each(function: Callable[[T], R], items: Sequence[T]) -> list[R]:
+    return [function(item) for item in items]
