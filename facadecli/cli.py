@@ -452,8 +452,10 @@ def grammar(
         bool, typer.Option("--timings", help="Record the time in the report (not reproducible).")
     ] = False,
 ) -> None:
-    """Derive a split grammar from a labelled façade (Wu et al. 2014): writes it as text
-    and JSON, the tiling as SVG and a report; with --derive, the grammar at new sizes."""
+    """Derive a split grammar from a labelled façade (Wu et al. 2014): writes it as text,
+    JSON and CityEngine CGA, the tiling as SVG and a report; with --derive, the grammar at
+    new sizes."""
+    from facadecli.grammar.cga import grammar_cga
     from facadecli.grammar.outputs import grammar_json, grammar_report, tiling_svg
     from facadecli.grammar.run import Options, extract_grammar, stem
     from facadecli.grammar.split import EXTENSIONS, Costs
@@ -492,6 +494,7 @@ def grammar(
     outputs = {
         f"{name}.grammar.txt": found.text(),
         f"{name}.grammar.json": grammar_json(found),
+        f"{name}.cga": grammar_cga(found, extraction.tiling.xs[-1], extraction.tiling.ys[-1], name),
         f"{name}.tiling.svg": tiling_svg(extraction.tiling, found, name),
         f"{name}.grammar-report.json": grammar_report(extraction, timings),
     }

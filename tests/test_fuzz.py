@@ -272,5 +272,5 @@ def test_mutated_layouts_give_a_grammar_or_fail_with_their_place(
         if code == 2:
             assert name in err and files(out) == [], err
         else:
-            assert len(files(out)) == 4
+            assert len(files(out)) == 5  # text, JSON, CGA, tiling, report
     assert codes.get(2, 0) > 10 and codes.get(0, 0) > 2, codes

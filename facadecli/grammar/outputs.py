@@ -146,6 +146,7 @@ def grammar_report(extraction: Extraction, timings: bool = False) -> str:
         "regions_explored": found.regions,
         "repeated_regions": found.repeats,
         "rederives_exactly": not extraction.problems,
+        "snapping": extraction.snapping.summary(),
         "regularization": extraction.regularization.summary(),
         "warnings": extraction.warnings,
         "time_ms": round(extraction.time_ms, 3) if timings else None,

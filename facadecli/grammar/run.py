@@ -22,7 +22,7 @@ from facadecli.grammar.json_layouts import read_plain, read_report
 from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
-from facadecli.grammar.tiling import Tiling, snap_layout, tile
+from facadecli.grammar.tiling import NO_SNAPPING, Snapping, Tiling, snap_and_count, tile
 from facadecli.limits import LAYOUT_CELLS_MAX
 
 # How much each kind of input is tidied, as fractions of the façade's size: edges closer
@@ -60,7 +60,7 @@ class Extraction:
     options: Options
     time_ms: float = 0.0
     problems: list[str] = field(default_factory=list)
-    vanished: tuple[int, int, float] = (0, 0, 0.0)  # rectangles snapping removed, of, snap
+    snapping: Snapping = NO_SNAPPING  # what snapping changed
 
     @property
     def grammar(self) -> Grammar:
@@ -69,13 +69,9 @@ class Extraction:
     @property
     def warnings(self) -> list[str]:
         found = list(self.regularization.warnings)
-        lost, total, snap = self.vanished
-        if lost:
-            found.append(
-                f"snapping edges closer than {snap:g} of the façade removed {lost} of {total} "
-                "rectangles (edges in a row closer than that join into one): give a smaller "
-                "--snap to keep them"
-            )
+        snapped = self.snapping.warning()
+        if snapped:
+            found.append(snapped)
         if self.found.method == "adp" and self.found.iterations < self.options.iterations:
             found.append(
                 f"time limit of {self.options.time_limit:g} s reached after "
@@ -164,16 +160,7 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
         layout = resize(layout, *options.size)
     snap = options.snap if options.snap is not None else TIDY[kind][0]
     tolerance = options.tolerance if options.tolerance is not None else TIDY[kind][1]
-    snapped = snap_layout(layout, snap) if snap > 0 else layout
-    if not snapped.rects:
-        raise SpecError.at(
-            str(path),
-            None,
-            None,
-            f"snapping edges closer than {snap:g} of the façade removed every rectangle "
-            "(edges in a row closer than that join into one)",
-            "give a smaller --snap",
-        )
+    snapped, snapping = snap_and_count(layout, snap, deadline)
     check_cells(path, snapped, snap)
     regular, regularization = regularize(snapped, tolerance, deadline=deadline)
     tiling = tile(regular, tolerance=0.0, deadline=deadline)
@@ -190,7 +177,7 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
     elapsed = (time.perf_counter() - started) * 1000
     extraction = Extraction(path.name, regular, tiling, found, regularization, options, elapsed)
     extraction.problems = rederivation_problems(found.grammar, tiling)
-    extraction.vanished = (len(layout.rects) - len(snapped.rects), len(layout.rects), snap)
+    extraction.snapping = snapping
     return extraction
 
 

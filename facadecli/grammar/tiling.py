@@ -14,7 +14,11 @@ are named here too.
 from __future__ import annotations
 
 import bisect
-from dataclasses import dataclass
+import itertools
+import math
+from collections import Counter
+from collections.abc import Iterable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -26,13 +30,16 @@ from facadecli.grammar.json_layouts import read_plain, read_report
 __all__ = [
     "BACKGROUND",
     "CMP_Z_ORDER",
+    "NO_SNAPPING",
     "LabelledLayout",
     "Rect",
+    "Snapping",
     "Tiling",
     "read_cmp",
     "read_plain",
     "read_report",
     "snap",
+    "snap_and_count",
     "snap_layout",
     "tile",
 ]
@@ -52,43 +59,277 @@ class Tiling:
         return self.labels[row][column]
 
 
+WIDE = 24  # candidate starts of a cluster above which numpy weighs them, not a loop
+
+
+def _chain_starts(
+    values: list[float],
+    weights: list[int],
+    tolerance: float,
+    pairs: list[tuple[int, int]],
+    deadline: Deadline,
+) -> list[int]:
+    """The first index of each cluster of one chain of sorted distinct values (each within
+    the tolerance of the next), clustered into the fewest clusters that are each at most
+    ``tolerance`` wide and hold no ``pairs`` (index pairs kept apart), and among those the
+    clustering that moves edges least: the sum of each value's weight times its distance
+    to its cluster's weighted median. A dynamic programme over the chain: the best
+    clustering of the first ``e`` values ends in a cluster from some ``s`` to ``e - 1``,
+    which must start at or after the first value within the tolerance of value ``e - 1``
+    and after the first end of every pair that ends by ``e - 1``; the fewest clusters
+    before ``e`` never fall as ``e`` grows, so the candidates are a run from that first
+    start. The first of equal choices (the longest last cluster) is kept: deterministic.
+    Widths are of the values as given; sums of moves are from the chain's first value."""
+    n = len(values)
+    shifted = [v - values[0] for v in values]
+    after = [0] * n
+    for i, j in pairs:
+        after[j] = max(after[j], i + 1)
+    total = [0, *itertools.accumulate(weights)]  # the weight before each index
+    moment = [0.0, *itertools.accumulate(w * v for w, v in zip(weights, shifted, strict=True))]
+    double = [2 * t for t in total]
+    arrays = None
+    count = [0] * (n + 1)  # clusters of the best clustering of the first e values
+    cost = [0.0] * (n + 1)
+    back = [0] * (n + 1)
+    first = barrier = 0
+    for e in range(1, n + 1):
+        if e % 1024 == 0:
+            deadline.check("snapping edges")
+        t = e - 1
+        while values[t] - values[first] > tolerance:
+            first += 1
+        barrier = max(barrier, after[t])
+        lo = max(first, barrier)
+        hi = bisect.bisect_right(count, count[lo], lo, e)
+        if hi - lo <= WIDE:
+            best, least = lo, math.inf
+            for s in range(lo, hi):
+                q = bisect.bisect_left(double, total[e] + total[s], s + 1, e + 1) - 1
+                m = shifted[q]
+                spread = (
+                    m * (total[q + 1] - total[s])
+                    - (moment[q + 1] - moment[s])
+                    + (moment[e] - moment[q + 1])
+                    - m * (total[e] - total[q + 1])
+                )
+                if cost[s] + spread < least:
+                    best, least = s, cost[s] + spread
+        else:
+            if arrays is None:
+                arrays = [np.array(a) for a in (shifted, total, moment, double)]
+            v, tot, mom, dbl = arrays
+            s_ = np.arange(lo, hi)
+            q_ = np.searchsorted(dbl, tot[e] + tot[s_], side="left") - 1
+            m_ = v[q_]
+            spreads = (
+                m_ * (tot[q_ + 1] - tot[s_])
+                - (mom[q_ + 1] - mom[s_])
+                + (mom[e] - mom[q_ + 1])
+                - m_ * (tot[e] - tot[q_ + 1])
+            )
+            k = int(np.argmin(np.array(cost[lo:hi]) + spreads))
+            best, least = lo + k, cost[lo + k] + float(spreads[k])
+        back[e], count[e], cost[e] = best, count[best] + 1, least
+    starts = []
+    e = n
+    while e > 0:
+        e = back[e]
+        starts.append(e)
+    return starts[::-1]
+
+
+def _starts(
+    values: list[float],
+    weights: list[int],
+    tolerance: float,
+    pairs: list[tuple[int, int]],
+    deadline: Deadline,
+) -> list[int]:
+    """``_chain_starts`` over every chain of the sorted distinct values (a chain ends
+    where the next value is further than the tolerance: no cluster reaches across)."""
+    bounds = [0]
+    bounds += [k + 1 for k, (a, b) in enumerate(itertools.pairwise(values)) if b - a > tolerance]
+    inside: dict[int, list[tuple[int, int]]] = {}
+    for i, j in pairs:
+        chain = bisect.bisect_right(bounds, i) - 1
+        if j < (bounds[chain + 1] if chain + 1 < len(bounds) else len(values)):
+            inside.setdefault(chain, []).append((i - bounds[chain], j - bounds[chain]))
+    bounds.append(len(values))
+    starts = []
+    for chain, (lo, hi) in enumerate(itertools.pairwise(bounds)):
+        deadline.check("snapping edges")
+        pairs = inside.get(chain, [])
+        found = _chain_starts(values[lo:hi], weights[lo:hi], tolerance, pairs, deadline)
+        starts += [lo + s for s in found]
+    return starts
+
+
+def _representative(cluster: list[float], weights: Counter[float]) -> float:
+    """The weighted median of a cluster's values (each weighs the number of edges on it):
+    the value with half the edges on either side, or the middle of the two values where
+    the edges split exactly in half. Most edges stay where they are."""
+    total = sum(weights[value] for value in cluster)
+    below = 0
+    for k, value in enumerate(cluster):
+        below += weights[value]
+        if 2 * below == total and k + 1 < len(cluster):
+            return (value + cluster[k + 1]) / 2
+        if 2 * below >= total:
+            return value
+    return cluster[-1]
+
+
+def _snap_axis(
+    values: list[float],
+    tolerance: float,
+    anchors: tuple[float, ...] = (),
+    apart: Iterable[tuple[float, float]] = (),
+    deadline: Deadline | None = None,
+) -> tuple[dict[float, float], set[tuple[float, float]]]:
+    """``snap``, and the pairs of ``apart`` (the two edges of one element) that the
+    clustering would have joined and that were kept in different clusters instead.
+
+    An anchor weighs as much as every value together (a cluster's median is its anchor,
+    and moving it costs most); two anchors are never joined."""
+    deadline = deadline or Deadline()
+    weights = Counter(values)
+    ordered = sorted(set(values) | set(anchors))
+    index = {value: i for i, value in enumerate(ordered)}
+    heavy = len(values) + 1
+    mass = [weights[v] + (heavy if v in anchors else 0) for v in ordered]
+    held = sorted({index[a] for a in anchors})
+    pinned = list(itertools.pairwise(held))
+    starts = _starts(ordered, mass, tolerance, pinned, deadline)
+    firsts = set(starts)
+    cluster = list(itertools.accumulate(int(k in firsts) for k in range(len(ordered))))
+    pairs = sorted({(index[a], index[b]) for a, b in apart if index[a] < index[b]})
+    joined = [(i, j) for i, j in pairs if cluster[i] == cluster[j]]
+    if joined:  # cluster again, keeping every pair apart
+        starts = _starts(ordered, mass, tolerance, pinned + pairs, deadline)
+    kept = {(ordered[i], ordered[j]) for i, j in joined}
+    mapping = {}
+    for lo, hi in itertools.pairwise([*starts, len(ordered)]):
+        members = ordered[lo:hi]
+        anchored = [a for a in anchors if a in members]
+        target = anchored[0] if anchored else _representative(members, weights)
+        for value in members:
+            mapping[value] = target
+    return mapping, kept
+
+
 def snap(
     values: list[float], tolerance: float, anchors: tuple[float, ...] = ()
 ) -> dict[float, float]:
-    """Each value mapped to the mean of its cluster (values within ``tolerance`` in a row),
-    or to the anchor in its cluster if it holds one (the façade's edges stay put)."""
-    ordered = sorted(set(values) | set(anchors))
-    clusters: list[list[float]] = []
-    for value in ordered:
-        if clusters and value - clusters[-1][-1] <= tolerance:
-            clusters[-1].append(value)
-        else:
-            clusters.append([value])
-    mapping = {}
-    for cluster in clusters:
-        held = [a for a in anchors if a in cluster]
-        target = held[0] if held else sum(cluster) / len(cluster)
-        for value in cluster:
-            mapping[value] = target
-    return mapping
+    """Each value mapped to the representative of its cluster: values are clustered so
+    that no two in a cluster are further apart than ``tolerance`` (never a chain of values
+    each near the next joined end to end), into as few clusters as that allows, moving
+    values least (``_chain_starts``); a cluster goes to the anchor it holds (the façade's
+    edges stay put), else to its weighted median (``_representative``)."""
+    return _snap_axis(values, tolerance, anchors)[0]
+
+
+@dataclass(frozen=True)
+class Snapping:
+    """What snapping changed (the report's ``snapping``). Snapping removes no rectangle:
+    ``rectangles`` went in and came out."""
+
+    snap: float  # the tolerance, a share of the façade's size along each axis (0: none)
+    rectangles: int
+    edges: int  # distinct edge coordinates of the rectangles, x and y together
+    edges_moved: int
+    max_move: float  # in the layout's units
+    max_move_share: float  # of the façade's size along the edge's axis: at most ``snap``
+    kept: tuple[str, ...] = ()  # labels of the rectangles kept from collapsing, in order
+
+    def summary(self) -> dict[str, object]:
+        return {
+            "snap": self.snap,
+            "rectangles": self.rectangles,
+            "edges": self.edges,
+            "edges_moved": self.edges_moved,
+            "max_move": round(self.max_move, 6),
+            "max_move_share": round(self.max_move_share, 6),
+            "kept_from_collapsing": len(self.kept),
+            "kept_by_label": dict(sorted(Counter(self.kept).items())),
+        }
+
+    def warning(self) -> str | None:
+        """What users are told when snapping kept elements from collapsing, else None."""
+        if not self.kept:
+            return None
+        labels = ", ".join(f"{label} {n}" for label, n in sorted(Counter(self.kept).items()))
+        return (
+            f"snapping edges closer than {self.snap:g} of the façade moved {self.edges_moved} "
+            f"of {self.edges} edges (by at most {self.max_move_share:.2g} of the façade) and "
+            f"kept {len(self.kept)} of {self.rectangles} rectangles thinner than that from "
+            f"collapsing ({labels}): their own two edges stay apart; a smaller --snap "
+            "joins fewer edges"
+        )
+
+
+NO_SNAPPING = Snapping(0.0, 0, 0, 0, 0.0, 0.0)  # before anything was snapped
+
+
+def snap_and_count(
+    layout: LabelledLayout, tolerance: float = 0.005, deadline: Deadline | None = None
+) -> tuple[LabelledLayout, Snapping]:
+    """``snap_layout``, and what it changed. The deadline is checked as the clustering
+    goes (a dense layout at a large snap takes seconds)."""
+    rects = layout.rects
+    extents = {"x": layout.width, "y": layout.height}
+    spans = {"x": [(r.x0, r.x1) for r in rects], "y": [(r.y0, r.y1) for r in rects]}
+    edges = sum(len({v for span in spans[axis] for v in span}) for axis in spans)
+    if tolerance <= 0:
+        return layout, Snapping(0.0, len(rects), edges, 0, 0.0, 0.0)
+    moves: dict[tuple[str, float], tuple[float, float]] = {}  # (axis, from): (by, share)
+    kept: set[int] = set()
+    for axis, extent in extents.items():
+
+        def clip(value: float, extent: float = extent) -> float:
+            return min(max(value, 0.0), extent)
+
+        # a span wholly off the façade (within the readers' slack) stays as drawn
+        on = [i for i, (a, b) in enumerate(spans[axis]) if clip(a) < clip(b)]
+        clipped = [(clip(a), clip(b)) for a, b in (spans[axis][i] for i in on)]
+        thin = {(a, b) for a, b in clipped if b - a <= tolerance * extent}
+        values = [v for span in clipped for v in span]
+        mapping, joined = _snap_axis(values, tolerance * extent, (0.0, extent), thin, deadline)
+        for i, (a, b) in zip(on, clipped, strict=True):
+            if (a, b) in joined:
+                kept.add(i)
+            for value in spans[axis][i]:
+                to = mapping[clip(value)]
+                if to != value:
+                    moves[axis, value] = (abs(to - value), abs(to - value) / extent)
+            spans[axis][i] = (mapping[a], mapping[b])
+    snapped = tuple(
+        replace(r, x0=x0, x1=x1, y0=y0, y1=y1)
+        for r, (x0, x1), (y0, y1) in zip(rects, spans["x"], spans["y"], strict=True)
+    )
+    snapping = Snapping(
+        tolerance,
+        len(rects),
+        edges,
+        len(moves),
+        max((move for move, _ in moves.values()), default=0.0),
+        max((share for _, share in moves.values()), default=0.0),
+        tuple(rects[i].label for i in sorted(kept)),
+    )
+    return replace(layout, rects=snapped), snapping
 
 
 def snap_layout(layout: LabelledLayout, tolerance: float = 0.005) -> LabelledLayout:
-    """The layout with edges closer than ``tolerance`` x the façade's size moved to their
-    mean (the façade's own edges stay where they are), clipped to the façade; rectangles
-    that vanish are dropped."""
-    w, h = layout.width, layout.height
-    xmap = snap([v for r in layout.rects for v in (r.x0, r.x1)], tolerance * w, (0.0, w))
-    ymap = snap([v for r in layout.rects for v in (r.y0, r.y1)], tolerance * h, (0.0, h))
-    for mapping, extent in ((xmap, w), (ymap, h)):
-        for value, target in mapping.items():
-            mapping[value] = min(max(target, 0.0), extent)
-    rects = tuple(
-        Rect(r.label, xmap[r.x0], ymap[r.y0], xmap[r.x1], ymap[r.y1], r.z)
-        for r in layout.rects
-        if xmap[r.x1] > xmap[r.x0] and ymap[r.y1] > ymap[r.y0]
-    )
-    return LabelledLayout(w, h, rects)
+    """The layout with nearby edges joined: per axis, edge coordinates are clustered so
+    that no two in a cluster lie further apart than ``tolerance`` x the façade's size
+    (edges in a row each near the next are never joined end to end), into the fewest
+    clusters, moving edges least, and each cluster is moved to one value (``snap``: the
+    façade's edge if it holds one, else its weighted median). The two edges of an element
+    never share a cluster (an element thinner than the tolerance is clustered again with
+    its edges kept apart), so every rectangle keeps its label and an area, and no edge
+    moves further than the tolerance. Edges are clipped to the façade first; a rectangle
+    wholly off it (within the readers' slack) stays as drawn on that axis."""
+    return snap_and_count(layout, tolerance)[0]
 
 
 def tile(
@@ -102,7 +343,7 @@ def tile(
     Rectangles are painted bottom up over the cells they cover (numpy), so the work is the
     cells covered, not the cells times the rectangles."""
     deadline = deadline or Deadline()
-    layout = snap_layout(layout, tolerance) if tolerance > 0 else layout
+    layout = snap_and_count(layout, tolerance, deadline)[0] if tolerance > 0 else layout
     w, h = layout.width, layout.height
     clip = [
         Rect(r.label, max(r.x0, 0.0), max(r.y0, 0.0), min(r.x1, w), min(r.y1, h), r.z)
