@@ -377,7 +377,9 @@ def grammar(
     iterations: Annotated[
         int, typer.Option("--iterations", "-n", min=1, help="ADP iterations.")
     ] = 2000,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="ADP's random seed.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", min=0, help="ADP's random seed, and --variations'.")
+    ] = 0,
     extensions: Annotated[
         str,
         typer.Option(
@@ -433,6 +435,17 @@ def grammar(
             show_default=False,
         ),
     ] = None,
+    variations: Annotated[
+        int,
+        typer.Option(
+            "--variations",
+            min=1,
+            max=64,
+            help="Layouts per --derive size: the best fit and others with repeat counts "
+            "within 1 of it, drawn by --seed (Bao et al. 2013); writes <name>-<W>x<H>-v<K>.* "
+            "and <name>.variations.svg when above 1.",
+        ),
+    ] = 1,
     formats: Annotated[
         str | None,
         typer.Option(
@@ -499,16 +512,32 @@ def grammar(
         f"{name}.grammar-report.json": grammar_report(extraction, timings),
     }
     derived = []  # every size is derived before anything is written
+    rows = []
     if sizes:
-        from facadecli.grammar.variation import TooLarge, derive_layout
+        from facadecli.export.contact import Variant
+        from facadecli.grammar.variation import TooLarge, derive_variations
 
         for width, height in sizes:
             try:
-                derived.append(derive_layout(found, extraction.tiling, width, height, name))
+                drawn, notes = derive_variations(
+                    found, extraction.tiling, width, height, name, variations, seed
+                )
             except TooLarge as error:
                 raise typer.BadParameter(str(error), param_hint="--derive") from None
-            for warning in derived[-1].warnings:
-                typer.echo(f"{layout}: warning: {width:g}x{height:g}: {warning}", err=True)
+            for note in notes:
+                typer.echo(f"{layout}: warning: {width:g}x{height:g}: {note}", err=True)
+            for k, variation in enumerate(drawn):
+                derived.append(variation.layout)
+                which = f" v{k}" if variations > 1 else ""
+                for warning in variation.layout.warnings:
+                    typer.echo(
+                        f"{layout}: warning: {width:g}x{height:g}{which}: {warning}", err=True
+                    )
+            rows.append([Variant(v.layout, (width, height), seed, k) for k, v in enumerate(drawn)])
+    if variations > 1 and rows:
+        from facadecli.export.contact import contact_sheet
+
+        outputs[f"{name}.variations.svg"] = contact_sheet(rows, f"{name} (grammar variations)")
     written = [outdir / file for file in outputs]
     with staged(outdir) as stage:  # the grammar and every derived size together, or nothing
         for file, text in outputs.items():

@@ -17,6 +17,8 @@ all hold are dropped (alignment first, then equal sizes) with a warning.
 from __future__ import annotations
 
 import itertools
+import math
+import random
 import re
 from collections import defaultdict
 from dataclasses import dataclass
@@ -32,6 +34,9 @@ THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
 SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
 MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
+STRETCH = 0.5  # a varied repeat's copies stay within 1/(1 + this) to 1 + this of their size
+CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fewer: 3^6)
+TEMPERATURE = 0.1  # of the score: how strongly variations near the source's sizes are preferred
 NAME_MAX = 150  # characters of the source's name in a derived layout's name
 
 
@@ -96,9 +101,18 @@ def distribute(
 
 
 def derive_at(
-    grammar: Grammar, source: tuple[float, float], width: float, height: float
+    grammar: Grammar,
+    source: tuple[float, float],
+    width: float,
+    height: float,
+    offsets: dict[str, int] | None = None,
+    used: set[str] | None = None,
 ) -> list[Piece]:
-    """The grammar applied to a façade of a new size (see the module)."""
+    """The grammar applied to a façade of a new size (see the module). ``offsets`` adds to
+    the best-fitting count of each repeat rule named (every region the rule makes gets the
+    same offset, except where the count would be below one or stretch its copies beyond
+    ``STRETCH``: there it keeps the best fit); ``used`` collects the repeat rules the
+    derivation applies."""
     elastic = _elastic(grammar)
     thin = {"x": THIN * source[0], "y": THIN * source[1]}
     out: list[Piece] = []
@@ -121,7 +135,9 @@ def derive_at(
             return
         axis = rule.axis
         extent = (x1 - x0) if axis == "x" else (y1 - y0)
-        sequence = _fit(rule, extent)
+        if used is not None and rule.op in ("repeat", "repeatABA"):
+            used.add(symbol)
+        sequence = _fit(rule, extent, (offsets or {}).get(symbol, 0))
         sizes = distribute(
             [p.size for p in sequence],
             [p.size < thin[axis] for p in sequence],
@@ -141,17 +157,28 @@ def derive_at(
     return out
 
 
-def _fit(rule: Rule, extent: float) -> tuple[Part, ...]:
-    """The rule's parts in order, with as many repeats as fit best."""
+def _fit(rule: Rule, extent: float, offset: int = 0) -> tuple[Part, ...]:
+    """The rule's parts in order, with as many repeats as fit best (plus ``offset``)."""
     period = sum(p.size for p in rule.parts)
     if rule.op == "repeat":
-        count = max(1, round(extent / period))
+        count = _count(extent, period, offset)
         return rule.parts * count
     if rule.op == "repeatABA":
         a, b = rule.parts
-        count = max(1, round((extent - a.size) / period))
+        count = _count(extent - a.size, period, offset)
         return (a, *((b, a) * count))
     return rule.sequence()
+
+
+def _count(length: float, period: float, offset: int) -> int:
+    best = max(1, round(length / period))
+    if offset == 0:
+        return best
+    count = best + offset
+    stretch = length / (count * period) if count >= 1 else 0.0
+    if count < 1 or not 1 / (1 + STRETCH) <= stretch <= 1 + STRETCH:
+        return best
+    return count
 
 
 def _grid(rule: Rule, box: tuple[float, float, float, float], expand: object) -> None:
@@ -374,6 +401,10 @@ def pieces_layout(
     return Layout(spec, width, height, axes[0], axes[1], tuple(shapes), 0.0)
 
 
+def _safe(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", name)[:NAME_MAX] or "layout"
+
+
 def derive_layout(
     grammar: Grammar, tiling: Tiling, width: float, height: float, name: str
 ) -> Layout:
@@ -381,5 +412,124 @@ def derive_layout(
     with every character a layout name cannot hold made ``_``)."""
     source = (tiling.xs[-1], tiling.ys[-1])
     pieces, warnings = align(derive_at(grammar, source, width, height), width, height)
-    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", name)[:NAME_MAX] or "layout"
-    return pieces_layout(pieces, width, height, f"{safe}-{width:g}x{height:g}", warnings)
+    return pieces_layout(pieces, width, height, f"{_safe(name)}-{width:g}x{height:g}", warnings)
+
+
+# -- variations (Bao et al. 2013) ---------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Variation:
+    """One derived layout of a size: ``offsets`` to the best-fitting repeat counts (rule,
+    offset; empty for the best fit), and its ``score``, the mean squared log-ratio of its
+    elements' sizes to their sizes in the source (lower is nearer the source)."""
+
+    layout: Layout
+    offsets: tuple[tuple[str, int], ...]
+    score: float
+
+
+def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
+    """How far the elements' sizes are from the source's (0: the same)."""
+    terms = [
+        math.log((p.x1 - p.x0) / p.source_w) ** 2 + math.log((p.y1 - p.y0) / p.source_h) ** 2
+        for p in pieces
+        if p.label != background and p.x1 > p.x0 and p.y1 > p.y0
+    ]
+    return sum(terms) / len(terms) if terms else 0.0
+
+
+def _key(pieces: list[Piece]) -> tuple[tuple[str, float, float, float, float], ...]:
+    """The pieces as they would be written (to tell two derivations apart)."""
+    return tuple(
+        sorted(
+            (p.label, round(p.x0, 9), round(p.y0, 9), round(p.x1, 9), round(p.y1, 9))
+            for p in pieces
+        )
+    )
+
+
+def derive_variations(
+    grammar: Grammar,
+    tiling: Tiling,
+    width: float,
+    height: float,
+    name: str,
+    count: int,
+    seed: int,
+) -> tuple[list[Variation], list[str]]:
+    """Up to ``count`` different layouts of the grammar at a size, and warnings (fewer than
+    asked). Variation 0 is ``derive_layout``'s; the others vary the best-fitting count of
+    each repeat rule by -1, 0 or +1 (one offset per rule, so a rule's copies stay equal and
+    the two halves of a mirrored split stay alike; one offset for all repeats of one period
+    along one axis, so columns of windows and of their sills stay lined up), where the
+    copies stretch by at most ``STRETCH`` (elsewhere the best fit stays). They are drawn at
+    random (``seed``), favouring low scores, and ordered by score. Named ``<name>-<W>x<H>``
+    when ``count`` is 1, else ``<name>-<W>x<H>-v<K>``."""
+    source = (tiling.xs[-1], tiling.ys[-1])
+    stem = f"{_safe(name)}-{width:g}x{height:g}"
+
+    def named(k: int) -> str:
+        return stem if count == 1 else f"{stem}-v{k}"
+
+    used: set[str] = set()
+    best = derive_at(grammar, source, width, height, used=used)
+    aligned, warnings = align(best, width, height)
+    found = [Variation(pieces_layout(aligned, width, height, named(0), warnings), (), score(best))]
+    if count == 1:
+        return found, []
+    rng = random.Random(seed)
+    linked: dict[tuple[str, float], list[str]] = defaultdict(list)
+    for symbol in sorted(used):  # repeats of one period along one axis vary together
+        rule = grammar.rules[symbol]
+        linked[(rule.axis, round(sum(p.size for p in rule.parts), 6))].append(symbol)
+    groups = [linked[k] for k in sorted(linked)]
+    if 3 ** len(groups) <= CANDIDATES_MAX:
+        choices = list(itertools.product((-1, 0, 1), repeat=len(groups)))
+    else:
+        choices = sorted(
+            {tuple(rng.choice((-1, 0, 1)) for _ in groups) for _ in range(CANDIDATES_MAX)}
+        )
+    seen = {_key(best)}
+    candidates = []
+    for choice in choices:
+        offsets = {s: o for g, o in zip(groups, choice, strict=True) if o for s in g}
+        if not offsets:
+            continue
+        try:
+            pieces = derive_at(grammar, source, width, height, offsets)
+        except TooLarge:
+            continue
+        key = _key(pieces)
+        if key not in seen:
+            seen.add(key)
+            candidates.append((score(pieces), tuple(sorted(offsets.items())), pieces))
+    # a weighted draw without replacement (Efraimidis and Spirakis): keys u^(1/w)
+    floor = found[0].score
+    drawn = sorted(
+        candidates,
+        key=lambda c: (
+            -math.log(rng.random() or 1e-300) * math.exp(min((c[0] - floor) / TEMPERATURE, 700.0))
+        ),
+    )
+    kept: list[tuple[float, tuple[tuple[str, int], ...], list[Piece], list[str]]] = []
+    aligned_seen = {_key(aligned)}
+    for value, changes, pieces in drawn:  # aligned, two could still coincide: skip the second
+        if len(kept) == count - 1:
+            break
+        moved, moved_warnings = align(pieces, width, height)
+        key = _key(moved)
+        if key not in aligned_seen:
+            aligned_seen.add(key)
+            kept.append((value, changes, moved, moved_warnings))
+    kept.sort(key=lambda c: (c[0], c[1]))
+    for k, (value, changes, moved, moved_warnings) in enumerate(kept, start=1):
+        layout = pieces_layout(moved, width, height, named(k), moved_warnings)
+        found.append(Variation(layout, changes, value))
+    notes = []
+    if len(found) < count:
+        notes.append(
+            f"only {len(found)} of {count} variations exist (repeat counts within 1 of the "
+            f"best fit whose copies stretch by at most {STRETCH:.0%})"
+        )
+    return found, notes

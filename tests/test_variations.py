@@ -1,0 +1,178 @@
+"""``facade grammar --derive WxH --variations N --seed S``: several layouts per size, drawn
+by varying repeat counts (Bao et al. 2013)."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import pytest
+
+from facadecli.grammar.run import Extraction, Options, extract_grammar
+from facadecli.grammar.tiling import LabelledLayout, Rect
+from facadecli.grammar.variation import Variation, derive_layout, derive_variations
+from facadecli.layout import Layout
+from tests.test_grammar import _facade, _floors, _write_plain
+
+Box = tuple[str, float, float, float, float]
+
+
+def _symmetric() -> LabelledLayout:
+    """Three floors of a wide window at each end and three narrow ones each side of a
+    door in the middle, mirrored about x = 10."""
+    rects = [Rect("door", 9.25, 0.0, 10.75, 2.5, 1)]
+    for j in range(3):
+        y = 1.0 + 3 * j
+        rects += [
+            Rect("window", 0.5, y, 2.5, y + 1.5, 1),
+            Rect("window", 17.5, y, 19.5, y + 1.5, 1),
+        ]
+        for x in (3.5, 5.5, 7.5):
+            rects += [Rect("window", x, y, x + 1, y + 1.5, 1)]
+            rects += [Rect("window", 20 - x - 1, y, 20 - x, y + 1.5, 1)]
+    return LabelledLayout(20.0, 10.0, tuple(rects))
+
+
+def _extract(tmp_path: Path, layout: LabelledLayout, *extensions: str) -> Extraction:
+    source = tmp_path / "facade.json"
+    _write_plain(source, layout)
+    return extract_grammar(source, Options(iterations=50, extensions=extensions))
+
+
+def _boxes(layout: Layout) -> list[Box]:
+    labels = {name: symbol.label for name, symbol in layout.spec.symbols.items()}
+    return sorted(
+        (str(labels[s.x]), *(round(float(v), 6) for v in (s.x0, s.y0, s.x1, s.y1)))
+        for s in layout.shapes
+    )
+
+
+def _draw(
+    extraction: Extraction, size: tuple[float, float], count: int, seed: int = 0
+) -> list[Variation]:
+    variations, _ = derive_variations(
+        extraction.grammar, extraction.tiling, *size, "facade", count, seed
+    )
+    return variations
+
+
+def test_n_variations_are_distinct_and_the_first_is_the_single_derivation(
+    tmp_path: Path,
+) -> None:
+    extraction = _extract(tmp_path, _floors(6, 4))
+    variations = _draw(extraction, (16.0, 17.0), 3)
+    assert len(variations) == 3
+    boxes = [_boxes(v.layout) for v in variations]
+    assert all(a != b for a, b in itertools.combinations(boxes, 2))
+    single = derive_layout(extraction.grammar, extraction.tiling, 16.0, 17.0, "facade")
+    assert variations[0].offsets == ()
+    assert variations[0].layout.shapes == single.shapes
+    assert [v.layout.spec.name for v in variations] == [f"facade-16x17-v{k}" for k in range(3)]
+    (one,) = _draw(extraction, (16.0, 17.0), 1)
+    assert one.layout == single  # N = 1 is today's derivation, name and all
+    assert [v.score for v in variations[1:]] == sorted(v.score for v in variations[1:])
+
+
+def test_fewer_variations_than_asked_come_with_a_warning(tmp_path: Path) -> None:
+    extraction = _extract(tmp_path, _floors(6, 4))
+    variations, notes = derive_variations(
+        extraction.grammar, extraction.tiling, 16.0, 17.0, "facade", 64, 0
+    )
+    assert 1 < len(variations) < 64
+    assert len({tuple(_boxes(v.layout)) for v in variations}) == len(variations)
+    assert notes and f"only {len(variations)} of 64 variations" in notes[0]
+    assert derive_variations(extraction.grammar, extraction.tiling, 16.0, 17.0, "f", 3, 0)[1] == []
+
+
+def test_variations_are_deterministic_per_seed_and_seeds_differ(tmp_path: Path) -> None:
+    extraction = _extract(tmp_path, _floors(6, 4))
+
+    def drawn(seed: int) -> list[list[Box]]:
+        return [_boxes(v.layout) for v in _draw(extraction, (16.0, 17.0), 3, seed)]
+
+    assert drawn(1) == drawn(1)
+    assert len({str(drawn(seed)) for seed in range(6)}) > 1
+    assert all(d[0] == drawn(0)[0] for d in map(drawn, range(3)))  # the best fit is fixed
+
+
+def test_symmetric_input_stays_symmetric_in_every_variation(tmp_path: Path) -> None:
+    extraction = _extract(tmp_path, _symmetric(), "symsplit")
+    assert any(rule.op == "symsplit" for rule in extraction.grammar.rules.values())
+    width = 26.0
+    variations = _draw(extraction, (width, 14.0), 5)
+    assert len(variations) >= 2
+    for variation in variations:
+        boxes = _boxes(variation.layout)
+        mirrored = sorted(
+            (b[0], round(width - b[3], 6), b[2], round(width - b[1], 6), b[4]) for b in boxes
+        )
+        assert [b[0] for b in boxes] == [m[0] for m in mirrored]
+        for b, m in zip(boxes, mirrored, strict=True):
+            assert b[1:] == pytest.approx(m[1:], abs=1e-4)
+
+
+@pytest.mark.parametrize(
+    ("layout", "size", "extensions"),
+    [
+        (_floors(6, 4), (16.0, 17.0), ()),
+        (_floors(3, 3), (11.0, 14.0), ()),
+        (_symmetric(), (26.0, 14.0), ("symsplit",)),
+        (_symmetric(), (15.0, 8.0), ("symsplit", "repeatABA")),
+    ],
+)
+def test_every_variation_tiles_the_canvas_with_the_grammars_labels(
+    tmp_path: Path, layout: LabelledLayout, size: tuple[float, float], extensions: tuple[str, ...]
+) -> None:
+    extraction = _extract(tmp_path, layout, *extensions)
+    width, height = size
+    for variation in _draw(extraction, size, 6):
+        boxes = _boxes(variation.layout)
+        assert {b[0] for b in boxes} <= extraction.grammar.terminals
+        assert all(0 <= b[1] < b[3] <= width and 0 <= b[2] < b[4] <= height for b in boxes)
+        area = sum((b[3] - b[1]) * (b[4] - b[2]) for b in boxes)
+        assert area == pytest.approx(width * height, rel=1e-6)
+        for a, b in itertools.combinations(boxes, 2):  # no overlaps: together, exactly once
+            overlap_w = min(a[3], b[3]) - max(a[1], b[1])
+            overlap_h = min(a[4], b[4]) - max(a[2], b[2])
+            assert overlap_w <= 1e-5 or overlap_h <= 1e-5
+
+
+def test_the_command_writes_each_variation_and_a_contact_sheet(tmp_path: Path) -> None:
+    source = tmp_path / "floors.json"
+    _write_plain(source, _floors(6, 4))
+    # --seed seeds the grammar's search too: today's run takes the same one
+    base = (
+        "grammar",
+        str(source),
+        "-n",
+        "50",
+        "--seed",
+        "4",
+        "--derive",
+        "16x17",
+        "-f",
+        "svg,json",
+    )
+    today, single, many = tmp_path / "today", tmp_path / "single", tmp_path / "many"
+    assert _facade(*base, "-o", str(today)).returncode == 0
+    assert _facade(*base, "-o", str(single), "--variations", "1").returncode == 0
+    read = {p.name: p.read_bytes() for p in today.iterdir()}
+    assert {p.name: p.read_bytes() for p in single.iterdir()} == read  # N = 1 is today's
+    assert "floors.variations.svg" not in read
+    args = (*base, "-o", str(many), "--variations", "3", "--derive", "8x7")
+    result = _facade(*args)
+    assert result.returncode == 0, result.stderr
+    names = {p.name for p in many.iterdir()}
+    assert {f"floors-16x17-v{k}.svg" for k in range(3)} <= names
+    assert "floors-16x17.svg" not in names and "floors.variations.svg" in names
+    for suffix in (".svg", ".layout.json"):  # variation 0 is today's, but for its name
+        v0 = (many / f"floors-16x17-v0{suffix}").read_text().replace("16x17-v0", "16x17")
+        assert v0 == (today / f"floors-16x17{suffix}").read_text()
+    sheet = (many / "floors.variations.svg").read_text()
+    assert sheet.count("<svg x=") == len([n for n in names if n.endswith(".svg") and "-v" in n])
+    assert "seed 4, #2" in sheet
+    first = {p.name: p.read_bytes() for p in many.iterdir()}
+    assert _facade(*args).returncode == 0
+    assert {p.name: p.read_bytes() for p in many.iterdir()} == first  # same seed, same bytes
+    if "8x7-v1.svg" not in " ".join(names):
+        assert "only" in result.stderr and "8x7" in result.stderr
