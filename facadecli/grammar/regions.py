@@ -11,12 +11,15 @@ sides of it; such lines are not cut while a clean one exists.
 
 from __future__ import annotations
 
+import struct
+
 import numpy as np
 
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
 Region = tuple[int, int, int, int]
 SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's extent)
+_SHAPE = struct.Struct("=ii")  # a content key's shape: two native int32, as numpy writes them
 
 
 class Grid:
@@ -29,6 +32,7 @@ class Grid:
         self.names = names
         ids = {name: i for i, name in enumerate(names)}
         self.labels = np.array([[ids[label] for label in row] for row in tiling.labels], dtype=int)
+        self._labels32 = self.labels.astype(np.int32)  # as content keys hold them
         self.rows, self.columns = self.labels.shape
         self.widths = self._sizes(tiling.xs)
         self.heights = self._sizes(tiling.ys)
@@ -59,19 +63,20 @@ class Grid:
         if cid is not None:
             return cid
         r0, r1, c0, c1 = region
-        block = self.labels[r0:r1, c0:c1]
-        keep_c = np.ones(block.shape[1], dtype=bool)
-        keep_c[1:] = (block[:, 1:] != block[:, :-1]).any(axis=0)
-        keep_r = np.ones(block.shape[0], dtype=bool)
-        keep_r[1:] = (block[1:, :] != block[:-1, :]).any(axis=1)
-        starts_c, starts_r = np.nonzero(keep_c)[0], np.nonzero(keep_r)[0]
-        reduced = block[np.ix_(starts_r, starts_c)]
+        block = self._labels32[r0:r1, c0:c1]
+        # a column (row) starts a new one where the labels change across the line before it
+        keep_c = np.ones(c1 - c0, dtype=bool)
+        keep_c[1:] = self._change_x[r1, c0 : c1 - 1] != self._change_x[r0, c0 : c1 - 1]
+        keep_r = np.ones(r1 - r0, dtype=bool)
+        keep_r[1:] = self._change_y[r0 : r1 - 1, c1] != self._change_y[r0 : r1 - 1, c0]
+        starts_c, starts_r = keep_c.nonzero()[0], keep_r.nonzero()[0]
+        reduced = block[starts_r][:, starts_c]
         widths = np.add.reduceat(self.widths[c0:c1], starts_c) / self.quantum_x
         heights = np.add.reduceat(self.heights[r0:r1], starts_r) / self.quantum_y
         key = b"".join(
             (
-                np.array(reduced.shape, dtype=np.int32).tobytes(),
-                reduced.astype(np.int32).tobytes(),
+                _SHAPE.pack(*reduced.shape),
+                reduced.tobytes(),
                 np.rint(widths).astype(np.int64).tobytes(),
                 np.rint(heights).astype(np.int64).tobytes(),
             )

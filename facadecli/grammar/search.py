@@ -30,10 +30,12 @@ region (exit 4 when it passes), ADP stops at the soft limit, even within an iter
 
 from __future__ import annotations
 
+import bisect
 import heapq
 import itertools
 import math
 import random
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -50,7 +52,11 @@ GRID_CELLS = 48  # a gridsplit of more cells than this costs more than it can sa
 TOP_ACTIONS = 8  # actions per region the search chooses among (the heuristic's best)
 
 
-@dataclass(frozen=True)
+Entry = tuple[int, int, int, int, int]  # a region to split and its content (``_entry``)
+Rank = tuple[float, float, Axis, tuple[int, ...]]  # heuristic, cost, axis, bounds: least first
+
+
+@dataclass(frozen=True, slots=True)
 class Action:
     op: Op
     axis: Axis
@@ -64,6 +70,8 @@ class Action:
     centre: bool = False
     across: tuple[int, ...] = ()  # gridsplit: the column bounds
     form: tuple[object, ...] = ()  # the rule without its symbols: op, axis, sizes
+    form_number: int = -1  # equal for equal forms (``Search._forms``)
+    entries: tuple[Entry, ...] = ()  # the non-terminal written parts, to split next
 
 
 @dataclass
@@ -92,8 +100,17 @@ class Search:
         self.costs = costs
         self.extensions = set(extensions)
         self.repeats: Repeats = find_repeats(self.grid, deadline=self.deadline)
+        rep = self.repeats  # their occurrences as rows r0, r1, c0, c1, cells, by first row
+        self._repeat_rows = np.stack([rep.r0, rep.r1, rep.c0, rep.c1, rep.cells], axis=1)
+        self._repeat_first = rep.r0.tolist()
         self._actions: dict[Region, list[Action]] = {}
         self._greedy: dict[int, Action] | None = None
+        # rule kinds: (form number, symbols) -> a number, the symbols being terminal labels
+        # or kind numbers, so that two contents read the same iff their kinds are equal
+        self._kinds: dict[tuple[int, tuple[object, ...]], int] = {}
+        self._forms: dict[tuple[object, ...], int] = {}
+        self._actions_at: dict[Entry, list[Action]] = {}
+        self._quanta: dict[tuple[str, int, int], int] = {}  # (axis, start, stop) -> size
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
 
     @property
@@ -131,12 +148,18 @@ class Search:
             axis = min(fallback, key=lambda a: (fallback[a][0], a))
             usable[axis] = fallback[axis][1]
         found: dict[tuple[object, ...], Action] = {}  # cuts that keep structure whole
-        halves: dict[tuple[object, ...], Action] = {}  # cuts in two
+        halves: dict[tuple[object, ...], Rank] = {}  # cuts in two, ranked before they are made
+        inside = self._repeats_inside(region)
+        line_costs: dict[Axis, dict[int, float]] = {
+            "x": self._line_costs(region, "x", inside),
+            "y": self._line_costs(region, "y", inside),
+        }
         for axis, lines in usable.items():
             lo, hi = (c0, c1) if axis == "x" else (r0, r1)
-            cost_of_line = self._line_costs(region, axis)
+            cost_of_line = line_costs[axis]
             full = (lo, *lines, hi)
-            options = [full, *self._runs(region, axis, full), *self._repeated(region, axis, full)]
+            options = [full, *self._runs(region, axis, full)]
+            options += self._repeated(region, axis, full, inside)
             for bounds in options:
                 action = self._action(region, axis, bounds, cost_of_line)
                 if action is not None:
@@ -144,39 +167,67 @@ class Search:
             # cuts in two: only the lines the heuristic likes best are worth making rules of
             cheapest = sorted(lines, key=lambda ln: (cost_of_line.get(ln, 0.0), ln))
             for line in cheapest[:TOP_ACTIONS] if len(lines) > 1 else ():
-                action = self._action(region, axis, (lo, line, hi), cost_of_line)
-                if action is not None and (axis, action.bounds) not in found:
-                    halves[(axis, action.bounds)] = action
+                bounds = (lo, line, hi)
+                if (axis, bounds) not in found:
+                    halves[(axis, bounds)] = self._rank_in_two(region, axis, bounds, cost_of_line)
         if (
             "gridsplit" in self.extensions
             and "x" in usable
             and "y" in usable
             and (len(usable["x"]) + 1) * (len(usable["y"]) + 1) <= GRID_CELLS
         ):
-            grid = self._gridsplit(region, usable)
+            grid = self._gridsplit(region, usable, line_costs)
             if grid is not None:
                 found[("xy", grid.bounds, grid.across)] = grid
 
-        def rank(a: Action) -> tuple[object, ...]:
+        def rank(a: Action) -> Rank:
             return (a.heuristic, a.cost, a.axis, a.bounds)
 
         # every structural cut, and the heuristic's best cuts in two to fill up the choice
         kept = sorted(found.values(), key=rank)[:TOP_ACTIONS]
-        kept += sorted(halves.values(), key=rank)[: max(TOP_ACTIONS - len(kept), TOP_ACTIONS // 2)]
+        best_halves = sorted(halves.values())[: max(TOP_ACTIONS - len(kept), TOP_ACTIONS // 2)]
+        for _, _, axis, bounds in best_halves:
+            action = self._action(region, axis, bounds, line_costs[axis])
+            assert action is not None  # two parts
+            kept.append(action)
         return sorted(kept, key=rank)
 
-    def _line_costs(self, region: Region, axis: Axis) -> dict[int, float]:
-        """The heuristic's cost of each line of an axis inside the region (section 4.4)."""
+    def _rank_in_two(
+        self, region: Region, axis: Axis, bounds: tuple[int, ...], cost_of_line: dict[int, float]
+    ) -> Rank:
+        """The rank ``_action`` would give the cut in two, without making the action: it is
+        a repeat of one part when both parts read the same, else a split of two."""
+        a, line, b = bounds
+        first, second = self._part(region, axis, a, line), self._part(region, axis, line, b)
+        same = self._may_read_same(axis, first, second, b - a) and (
+            self.grid.content(first) == self.grid.content(second)
+        )
+        rule_cost = self.costs.repeat + 1 if same else self.costs.split + 2
+        return (_heuristic(rule_cost, bounds, cost_of_line), rule_cost, axis, bounds)
+
+    def _repeats_inside(self, region: Region) -> np.ndarray:
+        """The occurrences of repeated regions inside the region: rows r0, r1, c0, c1, cells
+        (in the order of ``Repeats``)."""
         r0, r1, c0, c1 = region
-        rep = self.repeats.starting_in(r0, r1)
-        inside = (rep.r0 >= r0) & (rep.r1 <= r1) & (rep.c0 >= c0) & (rep.c1 <= c1)
+        first = self._repeat_first
+        rows = self._repeat_rows[bisect.bisect_left(first, r0) : bisect.bisect_left(first, r1)]
+        return rows[(rows[:, 1] <= r1) & (rows[:, 2] >= c0) & (rows[:, 3] <= c1)]
+
+    def _line_costs(
+        self, region: Region, axis: Axis, inside: np.ndarray | None = None
+    ) -> dict[int, float]:
+        """The heuristic's cost of each line of an axis inside the region (section 4.4);
+        ``inside`` is ``_repeats_inside(region)`` when known."""
+        r0, r1, c0, c1 = region
+        if inside is None:
+            inside = self._repeats_inside(region)
         lo, hi = (c0, c1) if axis == "x" else (r0, r1)
-        lines = np.arange(lo + 1, hi)
-        if not inside.any() or lines.size == 0:
+        if len(inside) == 0 or hi - lo < 2:
             return {}
-        start = (rep.c0 if axis == "x" else rep.r0)[inside]
-        stop = (rep.c1 if axis == "x" else rep.r1)[inside]
-        weights = rep.cells[inside].astype(float)
+        lines = np.arange(lo + 1, hi)
+        start = inside[:, 2] if axis == "x" else inside[:, 0]
+        stop = inside[:, 3] if axis == "x" else inside[:, 1]
+        weights = inside[:, 4].astype(float)
         # a repeat's cells count for the lines strictly inside its span: summed as
         # differences (+ after its start, - at its end), linear in repeats plus lines
         size = hi - lo + 1
@@ -209,16 +260,18 @@ class Search:
                     i += 1
         return out
 
-    def _repeated(self, region: Region, axis: Axis, full: tuple[int, ...]) -> list[tuple[int, ...]]:
-        """Bounds that keep whole the repeated regions spanning the region across the axis."""
+    def _repeated(
+        self, region: Region, axis: Axis, full: tuple[int, ...], inside: np.ndarray
+    ) -> list[tuple[int, ...]]:
+        """Bounds that keep whole the repeated regions spanning the region across the axis
+        (``inside``: the repeated regions inside the region, ``_repeats_inside``)."""
         r0, r1, c0, c1 = region
-        rep = self.repeats.starting_in(r0, r1)
         if axis == "x":
-            spans = (rep.r0 == r0) & (rep.r1 == r1) & (rep.c0 >= c0) & (rep.c1 <= c1)
-            start, stop = rep.c0[spans], rep.c1[spans]
+            spans = inside[(inside[:, 0] == r0) & (inside[:, 1] == r1)]
+            start, stop = spans[:, 2], spans[:, 3]
         else:
-            spans = (rep.c0 == c0) & (rep.c1 == c1) & (rep.r0 >= r0) & (rep.r1 <= r1)
-            start, stop = rep.r0[spans], rep.r1[spans]
+            spans = inside[(inside[:, 2] == c0) & (inside[:, 3] == c1)]
+            start, stop = spans[:, 0], spans[:, 1]
         lo, hi = full[0], full[-1]
         blocks: list[tuple[int, int]] = []
         for a, b in sorted(
@@ -269,9 +322,10 @@ class Search:
         rule_cost = (
             self.costs.repeat if op in ("repeat", "repeatABA") else self.costs.split
         ) + len(written)
-        heuristic = rule_cost + sum(cost_of_line.get(line, 0.0) for line in bounds[1:-1])
+        heuristic = _heuristic(rule_cost, bounds, cost_of_line)
         sizes = tuple(self._quantum(axis, p) for p in written)
         kept = cids[: len(written)]
+        form = (op, axis, count, centre, sizes)
         return Action(
             op,
             axis,
@@ -283,22 +337,51 @@ class Search:
             heuristic,
             count,
             centre,
-            form=(op, axis, count, centre, sizes),
+            form=form,
+            form_number=self._forms.setdefault(form, len(self._forms)),
+            entries=self._entries(written, kept),
         )
+
+    def _may_read_same(self, axis: Axis, first: Region, second: Region, cells: int) -> bool:
+        """False when two parts of ``cells`` rows or columns along the axis together cannot
+        have the same content (``Grid.content``) because their sizes differ: a content's
+        size along the axis is a sum of at most ``cells`` rounded steps, each off by at
+        most half a step (so the test needs no content, which takes time)."""
+        return abs(self._quantum(axis, first) - self._quantum(axis, second)) <= cells + 2
 
     def _quantum(self, axis: Axis, part: Region) -> int:
         """A part's size along an axis in steps of the grid's size quantum."""
         a, b = (part[2], part[3]) if axis == "x" else (part[0], part[1])
-        step = self.grid.quantum_x if axis == "x" else self.grid.quantum_y
-        return round(self.grid.size(axis, a, b) / step)
+        key = (axis, a, b)
+        found = self._quanta.get(key)
+        if found is None:
+            step = self.grid.quantum_x if axis == "x" else self.grid.quantum_y
+            found = self._quanta[key] = round(self.grid.size(axis, a, b) / step)
+        return found
 
     def _needs(self, written: Sequence[Region], cids: Sequence[int]) -> tuple[int, ...]:
         """The non-terminal contents among the parts, once each, larger parts first."""
         terminal = self.grid.terminal
-        pairs = sorted(zip(written, cids, strict=True), key=lambda pc: -_cells(pc[0]))
-        return tuple(dict.fromkeys(c for _, c in pairs if c not in terminal))
+        smaller = [-_cells(part) for part in written]
+        order = sorted(range(len(written)), key=smaller.__getitem__)  # stable: ties in order
+        return tuple(dict.fromkeys(cids[i] for i in order if cids[i] not in terminal))
 
-    def _gridsplit(self, region: Region, usable: dict[Axis, list[int]]) -> Action | None:
+    def _entries(self, written: Sequence[Region], cids: Sequence[int]) -> tuple[Entry, ...]:
+        """The written parts that are not terminals, in order, as heap entries
+        (``_entry``)."""
+        terminal = self.grid.terminal
+        return tuple(
+            (r0, c0, -r1, -c1, cid)
+            for (r0, r1, c0, c1), cid in zip(written, cids, strict=True)
+            if cid not in terminal
+        )
+
+    def _gridsplit(
+        self,
+        region: Region,
+        usable: dict[Axis, list[int]],
+        line_costs: dict[Axis, dict[int, float]],
+    ) -> Action | None:
         r0, r1, c0, c1 = region
         rows = (r0, *usable["y"], r1)
         columns = (c0, *usable["x"], c1)
@@ -309,7 +392,7 @@ class Search:
         ]
         cids = [self.grid.content(cell) for cell in cells]
         cost = self.costs.split + len(cells)
-        cost_x, cost_y = self._line_costs(region, "x"), self._line_costs(region, "y")
+        cost_x, cost_y = line_costs["x"], line_costs["y"]
         heuristic = cost + sum(cost_x.get(v, 0.0) for v in columns[1:-1])
         heuristic += sum(cost_y.get(v, 0.0) for v in rows[1:-1])
         form = (
@@ -328,35 +411,42 @@ class Search:
             heuristic,
             across=columns,
             form=form,
+            form_number=self._forms.setdefault(form, len(self._forms)),
+            entries=self._entries(cells, cids),
         )
 
     # -- building grammars ---------------------------------------------------------------
 
     def build(
-        self, choose: Callable[[Region, int, dict[int, Action], set[int]], Action]
+        self, choose: Callable[[Entry, dict[int, Action], set[int]], Action]
     ) -> dict[int, Action]:
         """One grammar: regions bottom to top, left to right, each content split once."""
-        grid = self.grid
-        terminal = grid.terminal
         rules: dict[int, Action] = {}
-        start = grid.content(self.whole)
-        if start in grid.terminal:
+        start = self.grid.content(self.whole)
+        if start in self.grid.terminal:
             return rules
         pending = {start}
-        r0, r1, c0, c1 = self.whole
-        heap = [(r0, c0, -r1, -c1, start)]
+        heap = [_entry(self.whole, start)]
+        pop, push = heapq.heappop, heapq.heappush
         while heap:
-            r0, c0, neg_r1, neg_c1, cid = heapq.heappop(heap)
-            region = (r0, -neg_r1, c0, -neg_c1)
+            entry = pop(heap)
+            cid = entry[4]
             pending.discard(cid)
-            action = choose(region, cid, rules, pending)
-            rules[cid] = action
-            for part, sub in zip(action.written, action.cids, strict=True):
-                if sub in terminal or sub in rules or sub in pending:
+            action = rules[cid] = choose(entry, rules, pending)
+            for part in action.entries:
+                sub = part[4]
+                if sub in rules or sub in pending:
                     continue
                 pending.add(sub)
-                heapq.heappush(heap, (part[0], part[2], -part[1], -part[3], sub))
+                push(heap, part)
         return rules
+
+    def actions_at(self, entry: Entry) -> list[Action]:
+        """The actions of a heap entry's region."""
+        found = self._actions_at.get(entry)
+        if found is None:
+            found = self._actions_at[entry] = self.actions(_region(entry))
+        return found
 
     def canonical(self, rules: dict[int, Action]) -> dict[int, int]:
         """Each content's rule, merged with every other rule that reads the same (the same
@@ -384,18 +474,53 @@ class Search:
 
     def cost(self, rules: dict[int, Action]) -> float:
         """Eq. 1 over the merged rules."""
-        same = self.canonical(rules)
-        return sum(rules[cid].cost for cid in rules if same[cid] == cid)
+        return self._survey(rules)[0]
+
+    def _survey(self, rules: dict[int, Action]) -> tuple[float, list[int]]:
+        """Eq. 1 over the merged rules, and for each rule (in order) the rules it reaches,
+        itself included, as bits of the rules' positions.
+
+        Rules merge as in ``canonical``: each gets a kind, a number for its form and the
+        kinds or labels of its parts, so that rules that read the same have one kind; a
+        kind's cost counts once, for the rule met first with it (the same sum, to the bit,
+        as over ``canonical``'s map)."""
+        terminal = self.grid.terminal
+        kinds = self._kinds
+        position = {cid: i for i, cid in enumerate(rules)}
+        kind_of: dict[int, int] = {}
+        reach: dict[int, int] = {}
+        first: dict[int, int] = {}  # kind -> the content met first with it
+
+        def visit(cid: int) -> int:
+            kind = kind_of.get(cid)
+            if kind is None:
+                action = rules[cid]
+                bits = 1 << position[cid]
+                symbols: list[object] = []
+                for sub in action.cids:
+                    if sub in terminal:
+                        symbols.append(terminal[sub])
+                    else:
+                        symbols.append(visit(sub))
+                        bits |= reach[sub]
+                kind = kinds.setdefault((action.form_number, tuple(symbols)), len(kinds))
+                kind_of[cid] = kind
+                reach[cid] = bits
+                first.setdefault(kind, cid)
+            return kind
+
+        for cid in rules:
+            visit(cid)
+        cost = sum(rules[cid].cost for cid in rules if first[kind_of[cid]] == cid)
+        return cost, [reach[cid] for cid in rules]
 
     def greedy(self) -> dict[int, Action]:
         """The greedy baseline's rules (built once: ADP starts from them too)."""
         if self._greedy is None:
 
-            def best(
-                region: Region, cid: int, rules: dict[int, Action], pending: set[int]
-            ) -> Action:
+            def best(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
                 self.deadline.check("building the greedy grammar")
-                return self.actions(region)[0]
+                return self.actions_at(entry)[0]
 
             self._greedy = self.build(best)
         return self._greedy
@@ -405,32 +530,39 @@ class Search:
         found in (0 is the greedy one), and the iterations done: fewer when the deadline's
         soft limit passes first."""
         rng = random.Random(seed)
-        values: dict[int, float] = {}
-        below: dict[int, frozenset[int]] = {}  # content -> the contents its best rules split
+        # content -> the least cost found for it, and the contents its best rules split
+        learned: dict[int, tuple[float, frozenset[int]]] = {}
         optimistic = min(self.costs.split + 2, self.costs.repeat + 1)
         best = self.greedy()
-        best_cost, best_at = self.cost(best), 0
-        self._learn(best, values, below)
+        best_cost, reach = self._survey(best)
+        best_at = 0
+        self._learn(best, reach, learned)
         epsilon = 1.0
 
-        odds: dict[Region, list[float]] = {}  # cumulative exp(-H) of a region's actions
-        get_value, get_below, draw = values.get, below.get, rng.random
+        # a region's cumulative exp(-H) over its actions, and their total
+        odds: dict[Entry, tuple[list[float], float]] = {}
+        get_learned, draw = learned.get, rng.random
 
-        def choose(region: Region, cid: int, rules: dict[int, Action], pending: set[int]) -> Action:
-            if self.deadline.passed():
+        start, seconds = self.deadline.start, self.deadline.seconds  # ``Deadline.passed()``
+        clock, by_entry = time.perf_counter, self._actions_at
+
+        def choose(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
+            if clock() - start > seconds:
                 raise _TimeUp
-            actions = self.actions(region)
+            actions = by_entry.get(entry) or self.actions_at(entry)
             if len(actions) == 1:
                 return actions[0]
             if draw() < epsilon:  # exploration: the heuristic's odds
-                weights = odds.get(region)
-                if weights is None:
+                found = odds.get(entry)
+                if found is None:
                     low = actions[0].heuristic
                     weights = list(
                         itertools.accumulate(math.exp(low - a.heuristic) for a in actions)
                     )
-                    odds[region] = weights
-                return rng.choices(actions, cum_weights=weights)[0]
+                    found = odds[entry] = (weights, weights[-1] + 0.0)
+                # ``rng.choices(actions, cum_weights=weights)[0]``, to the draw
+                weights, total = found
+                return actions[bisect.bisect(weights, draw() * total, 0, len(actions) - 1)]
             chosen, least = actions[0], math.inf
             for action in actions:  # exploitation: Eq. 4 with the value table
                 score, covered = action.cost, EMPTY
@@ -439,15 +571,17 @@ class Search:
                         break  # values only add up
                     if need in rules or need in pending or need in covered:
                         continue
-                    score += get_value(need, optimistic)
-                    held = get_below(need)
-                    if held:
-                        covered = covered | held
+                    known = get_learned(need)
+                    if known is None:
+                        score += optimistic
+                    else:
+                        score += known[0]
+                        covered = covered | known[1] if covered else known[1]
                 if score < least:
                     chosen, least = action, score
             return chosen
 
-        seen: set[tuple[tuple[int, int], ...]] = set()  # grammars built already: nothing new
+        seen: set[tuple[int, ...]] = set()  # grammars built already: nothing new
         done = iterations
         for t in range(1, iterations):
             epsilon = 1.0 - t / iterations
@@ -456,12 +590,13 @@ class Search:
             except _TimeUp:
                 done = t
                 break
-            signature = tuple((cid, id(action)) for cid, action in rules.items())
+            # each action is one region's, so the actions tell the contents too
+            signature = tuple(map(id, rules.values()))
             if signature in seen:
                 continue
             seen.add(signature)
-            cost = self.cost(rules)
-            self._learn(rules, values, below)
+            cost, reach = self._survey(rules)
+            self._learn(rules, reach, learned)
             if cost < best_cost - 1e-9:
                 best, best_cost, best_at = rules, cost, t
         return best, best_at, done
@@ -469,40 +604,22 @@ class Search:
     def _learn(
         self,
         rules: dict[int, Action],
-        values: dict[int, float],
-        below: dict[int, frozenset[int]],
+        reach: list[int],
+        learned: dict[int, tuple[float, frozenset[int]]],
     ) -> None:
         """Each content's cost to describe, with the rules below it counted once each, kept
-        in the value table when it is the least yet, with the contents it took."""
+        in the value table when it is the least yet, with the contents it took (``reach``:
+        per rule, the rules below it as bits, from ``_survey``)."""
         order = list(rules)
-        position = {cid: i for i, cid in enumerate(order)}
-        by_cost: dict[float, int] = {}  # rule cost -> the rules with it, as bits
-        for i, cid in enumerate(order):
-            cost = rules[cid].cost
-            by_cost[cost] = by_cost.get(cost, 0) | 1 << i
-        reach: dict[int, int] = {}
-
-        def within(cid: int) -> int:
-            found = reach.get(cid)
-            if found is None:
-                found = 1 << position[cid]
-                for need in rules[cid].needs:
-                    if need in rules:
-                        found |= within(need)
-                reach[cid] = found
-            return found
-
-        for cid in order:
-            bits = within(cid)
-            total = sum(cost * (bits & mask).bit_count() for cost, mask in by_cost.items())
-            if total < values.get(cid, math.inf) - 1e-12:
-                values[cid] = total
-                contents = []
-                while bits:
-                    low = bits & -bits
-                    contents.append(order[low.bit_length() - 1])
-                    bits ^= low
-                below[cid] = frozenset(contents)
+        if not order:
+            return
+        reached = _bit_rows(reach, len(order))
+        totals = _reached_costs(reached, [rules[cid].cost for cid in order])
+        unknown = (math.inf, EMPTY)
+        known = np.array([learned.get(cid, unknown)[0] for cid in order])
+        contents = np.array(order)
+        for i in np.flatnonzero(totals < known - 1e-12).tolist():
+            learned[order[i]] = (float(totals[i]), frozenset(contents[reached[i]].tolist()))
 
     # -- the grammar ---------------------------------------------------------------------
 
@@ -558,6 +675,46 @@ class Search:
 
 class _TimeUp(Exception):
     """The soft time limit passed during an ADP iteration: the iteration is dropped."""
+
+
+def _bit_rows(bits: list[int], n: int) -> np.ndarray:
+    """Sets of ``0 .. n - 1`` given as bits of integers, as the rows of a boolean matrix."""
+    width = (n + 7) // 8
+    packed = np.frombuffer(b"".join(b.to_bytes(width, "little") for b in bits), dtype=np.uint8)
+    rows = np.unpackbits(packed.reshape(len(bits), width), axis=1, count=n, bitorder="little")
+    return rows.view(bool)
+
+
+def _reached_costs(reached: np.ndarray, costs: list[float]) -> np.ndarray:
+    """Per row, the sum of the costs of the rules it reaches, added up the way
+    ``sum(cost * count for each distinct cost, in order met)`` does, to the bit."""
+    distinct = list(dict.fromkeys(costs))
+    index = {c: i for i, c in enumerate(distinct)}
+    group = np.array([index[c] for c in costs])
+    members = np.zeros((len(costs), len(distinct)))
+    members[np.arange(len(costs)), group] = 1.0
+    counts = reached.astype(float) @ members  # whole numbers: exact in floats
+    totals = np.zeros(len(costs))
+    for j, cost in enumerate(distinct):
+        totals += cost * counts[:, j]
+    return totals
+
+
+def _heuristic(rule_cost: float, bounds: tuple[int, ...], cost_of_line: dict[int, float]) -> float:
+    """Eq. 5: the rule's cost plus the cost of each line it cuts."""
+    return rule_cost + sum(cost_of_line.get(line, 0.0) for line in bounds[1:-1])
+
+
+def _entry(region: Region, cid: int) -> Entry:
+    """A region to split as a heap entry: the heap gives regions bottom to top, then left to
+    right, then the larger first."""
+    r0, r1, c0, c1 = region
+    return (r0, c0, -r1, -c1, cid)
+
+
+def _region(entry: Entry) -> Region:
+    r0, c0, neg_r1, neg_c1, _ = entry
+    return (r0, -neg_r1, c0, -neg_c1)
 
 
 def _cells(region: Region) -> int:

@@ -1,0 +1,107 @@
+"""The search's fast tables give what the plain definitions give, to the bit: the merged
+cost (``Search.canonical``), the value table's costs (bit counts per rule cost), the rank of
+a cut in two, and the size test that spares computing contents."""
+
+from __future__ import annotations
+
+import itertools
+import random
+
+import pytest
+
+from facadecli.grammar.search import Action, Entry, Search, _bit_rows, _reached_costs
+from facadecli.grammar.split import Axis
+from facadecli.grammar.tiling import LabelledLayout, Rect, tile
+
+
+def _layout(seed: int) -> LabelledLayout:
+    """Rectangles of a few labels on an 8 x 6 façade, on a coarse grid so that repeats
+    occur, plus a row of equal windows."""
+    rng = random.Random(seed)
+    rects = [Rect("window", 1.0 + 2 * i, 4.0, 2.0 + 2 * i, 5.0, 0.5) for i in range(3)]
+    for i in range(rng.randint(3, 12)):
+        x0, y0 = rng.randint(0, 14) / 2, rng.randint(0, 6) / 2
+        w, h = rng.randint(1, 4) / 2, rng.randint(1, 3) / 2
+        label = rng.choice(["window", "door", "sill"])
+        rects.append(Rect(label, x0, y0, min(x0 + w, 8.0), min(y0 + h, 3.5), rng.random() + i))
+    return LabelledLayout(8.0, 6.0, tuple(rects))
+
+
+def _grammars(search: Search, seed: int, count: int) -> list[dict[int, Action]]:
+    """The greedy grammar and ``count`` grammars of random actions."""
+    rng = random.Random(seed)
+
+    def any_action(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
+        return rng.choice(search.actions_at(entry))
+
+    return [search.greedy(), *(search.build(any_action) for _ in range(count))]
+
+
+def _plain_cost(search: Search, rules: dict[int, Action]) -> float:
+    same = search.canonical(rules)
+    return sum(rules[cid].cost for cid in rules if same[cid] == cid)
+
+
+def _plain_totals(rules: dict[int, Action], reach: list[int]) -> list[float]:
+    """Per rule, the costs of the rules it reaches: bit counts per distinct cost."""
+    order = list(rules)
+    by_cost: dict[float, int] = {}
+    for i, cid in enumerate(order):
+        by_cost[rules[cid].cost] = by_cost.get(rules[cid].cost, 0) | 1 << i
+    return [
+        sum(cost * (bits & mask).bit_count() for cost, mask in by_cost.items()) for bits in reach
+    ]
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("extensions", [(), ("repeatABA", "symsplit", "gridsplit")])
+def test_the_survey_gives_the_merged_cost_and_the_costs_below_each_rule(
+    seed: int, extensions: tuple[str, ...]
+) -> None:
+    search = Search(tile(_layout(seed), 0), extensions=extensions)
+    for rules in _grammars(search, seed, 20):
+        cost, reach = search._survey(rules)
+        assert cost == _plain_cost(search, rules)  # the same sum, in the same order
+        assert search.cost(rules) == cost
+        if not rules:
+            continue
+        totals = _reached_costs(_bit_rows(reach, len(rules)), [a.cost for a in rules.values()])
+        assert totals.tolist() == _plain_totals(rules, reach)
+
+
+def test_bit_rows_are_the_sets_the_bits_hold() -> None:
+    bits = [0b1, 0b1011, 0, 1 << 9 | 1 << 2]
+    rows = _bit_rows(bits, 10)
+    assert rows.shape == (4, 10)
+    assert [set(row.nonzero()[0].tolist()) for row in rows] == [{0}, {0, 1, 3}, set(), {2, 9}]
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_a_cut_in_two_is_ranked_as_its_action_would_be(seed: int) -> None:
+    search = Search(tile(_layout(seed), 0), extensions=("repeatABA", "symsplit"))
+    _grammars(search, seed, 5)  # to visit regions
+    for region in [search.whole, *search._actions]:
+        r0, r1, c0, c1 = region
+        spans: tuple[tuple[Axis, int, int], ...] = (("x", c0, c1), ("y", r0, r1))
+        for axis, lo, hi in spans:
+            costs = search._line_costs(region, axis)
+            for line in range(lo + 1, hi):
+                bounds = (lo, line, hi)
+                action = search._action(region, axis, bounds, costs)
+                assert action is not None
+                rank = (action.heuristic, action.cost, action.axis, action.bounds)
+                assert search._rank_in_two(region, axis, bounds, costs) == rank
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_parts_of_one_content_are_never_told_apart_by_size(seed: int) -> None:
+    search = Search(tile(_layout(seed), 0))
+    grid = search.grid
+    axes: tuple[tuple[Axis, int], ...] = (("x", grid.columns), ("y", grid.rows))
+    for axis, cells in axes:
+        spans = list(itertools.combinations(range(cells + 1), 2))
+        for (a, b), (c, d) in itertools.product(spans, spans):
+            first = (0, grid.rows, a, b) if axis == "x" else (a, b, 0, grid.columns)
+            second = (0, grid.rows, c, d) if axis == "x" else (c, d, 0, grid.columns)
+            if grid.content(first) == grid.content(second):
+                assert search._may_read_same(axis, first, second, (b - a) + (d - c))
