@@ -468,10 +468,16 @@ def grammar(
     """Derive a split grammar from a labelled façade (Wu et al. 2014): writes it as text,
     JSON and CityEngine CGA, the tiling as SVG and a report; with --derive, the grammar at
     new sizes."""
-    from facadecli.grammar.cga import grammar_cga
-    from facadecli.grammar.outputs import grammar_json, grammar_report, tiling_svg
-    from facadecli.grammar.run import Options, extract_grammar, stem
+    from facadecli.grammar.run import (
+        Options,
+        derive_sizes,
+        extract_grammar,
+        grammar_files,
+        stem,
+        variations_sheet,
+    )
     from facadecli.grammar.split import EXTENSIONS, Costs
+    from facadecli.grammar.variation import TooLarge
 
     if method not in ("adp", "greedy"):
         raise typer.BadParameter(f"{method!r}: use adp or greedy", param_hint="--method")
@@ -504,45 +510,26 @@ def grammar(
     name = stem(layout)
     for warning in extraction.warnings:
         typer.echo(f"{layout}: warning: {warning}", err=True)
-    outputs = {
-        f"{name}.grammar.txt": found.text(),
-        f"{name}.grammar.json": grammar_json(found),
-        f"{name}.cga": grammar_cga(found, extraction.tiling.xs[-1], extraction.tiling.ys[-1], name),
-        f"{name}.tiling.svg": tiling_svg(extraction.tiling, found, name),
-        f"{name}.grammar-report.json": grammar_report(extraction, timings),
-    }
-    derived = []  # every size is derived before anything is written
-    rows = []
-    if sizes:
-        from facadecli.export.contact import Variant
-        from facadecli.grammar.variation import TooLarge, derive_variations
-
-        for width, height in sizes:
-            try:
-                drawn, notes = derive_variations(
-                    found, extraction.tiling, width, height, name, variations, seed
-                )
-            except TooLarge as error:
-                raise typer.BadParameter(str(error), param_hint="--derive") from None
-            for note in notes:
-                typer.echo(f"{layout}: warning: {width:g}x{height:g}: {note}", err=True)
-            for k, variation in enumerate(drawn):
-                derived.append(variation.layout)
-                which = f" v{k}" if variations > 1 else ""
-                for warning in variation.layout.warnings:
-                    typer.echo(
-                        f"{layout}: warning: {width:g}x{height:g}{which}: {warning}", err=True
-                    )
-            rows.append([Variant(v.layout, (width, height), seed, k) for k, v in enumerate(drawn)])
-    if variations > 1 and rows:
-        from facadecli.export.contact import contact_sheet
-
-        outputs[f"{name}.variations.svg"] = contact_sheet(rows, f"{name} (grammar variations)")
+    outputs = grammar_files(extraction, name, timings)
+    try:  # every size is derived before anything is written
+        derived = derive_sizes(extraction, name, sizes, variations, seed)
+    except TooLarge as error:
+        raise typer.BadParameter(str(error), param_hint="--derive") from None
+    for new in derived:
+        at = f"{layout}: warning: {new.width:g}x{new.height:g}"
+        for note in new.notes:
+            typer.echo(f"{at}: {note}", err=True)
+        for k, result in enumerate(new.layouts):
+            which = f" v{k}" if variations > 1 else ""
+            for warning in result.warnings:
+                typer.echo(f"{at}{which}: {warning}", err=True)
+    if variations > 1 and derived:
+        outputs[f"{name}.variations.svg"] = variations_sheet(derived, name, seed)
     written = [outdir / file for file in outputs]
     with staged(outdir) as stage:  # the grammar and every derived size together, or nothing
         for file, text in outputs.items():
             write_atomic(stage / file, text)
-        for result in derived:
+        for result in (built for new in derived for built in new.layouts):
             written += [
                 outdir / path.name for path in write_outputs(result, stage, kinds, OutputOptions())
             ]

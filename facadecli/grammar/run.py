@@ -13,6 +13,7 @@ import math
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from facadecli.errors import Problem, SpecError
 from facadecli.grammar.cmp_xml import read_cmp
@@ -24,6 +25,9 @@ from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
 from facadecli.grammar.tiling import NO_SNAPPING, Snapping, Tiling, snap_and_count, tile
 from facadecli.limits import LAYOUT_CELLS_MAX
+
+if TYPE_CHECKING:
+    from facadecli.layout import Layout
 
 # How much each kind of input is tidied, as fractions of the façade's size: edges closer
 # than ``snap`` become one, and repeated elements closer in size than ``tolerance`` get one
@@ -234,3 +238,65 @@ __all__ = [
     "extract_grammar",
     "rederivation_problems",
 ]
+
+
+def grammar_files(extraction: Extraction, name: str, timings: bool = False) -> dict[str, str]:
+    """The grammar's own files by name: text, JSON, CityEngine CGA, the tiling as SVG and
+    the report."""
+    from facadecli.grammar.cga import grammar_cga
+    from facadecli.grammar.outputs import grammar_json, grammar_report, tiling_svg
+
+    found = extraction.grammar
+    tiling = extraction.tiling
+    return {
+        f"{name}.grammar.txt": found.text(),
+        f"{name}.grammar.json": grammar_json(found),
+        f"{name}.cga": grammar_cga(found, tiling.xs[-1], tiling.ys[-1], name),
+        f"{name}.tiling.svg": tiling_svg(tiling, found, name),
+        f"{name}.grammar-report.json": grammar_report(extraction, timings),
+    }
+
+
+@dataclass(frozen=True)
+class DerivedSize:
+    """The grammar at one new size: its layouts (the best fit first, then the variations)
+    and the warnings of the draw (fewer variations than asked)."""
+
+    width: float
+    height: float
+    layouts: list[Layout]
+    notes: list[str]
+
+
+def derive_sizes(
+    extraction: Extraction,
+    name: str,
+    sizes: list[tuple[float, float]],
+    variations: int = 1,
+    seed: int = 0,
+) -> list[DerivedSize]:
+    """The grammar derived at every size, with up to ``variations`` layouts each (raises
+    :class:`~facadecli.grammar.variation.TooLarge` for a size too large to derive)."""
+    from facadecli.grammar.variation import derive_variations
+
+    derived = []
+    for width, height in sizes:
+        drawn, notes = derive_variations(
+            extraction.grammar, extraction.tiling, width, height, name, variations, seed
+        )
+        derived.append(DerivedSize(width, height, [v.layout for v in drawn], notes))
+    return derived
+
+
+def variations_sheet(derived: list[DerivedSize], name: str, seed: int) -> str:
+    """A contact sheet of every size's layouts, a row a size (``<name>.variations.svg``)."""
+    from facadecli.export.contact import Variant, contact_sheet
+
+    rows = [
+        [
+            Variant(layout, (size.width, size.height), seed, k)
+            for k, layout in enumerate(size.layouts)
+        ]
+        for size in derived
+    ]
+    return contact_sheet(rows, f"{name} (grammar variations)")
