@@ -1,9 +1,12 @@
-"""A whole building: every wall edge of its footprint a façade facing outwards, a roof,
-and the ground, as meshes in one scene (SPEC 5; DESIGN "Buildings and cities").
+"""A whole building: a volume a part of its footprint (s3db.py: walls from their base to
+the eaves, the roof on them), every wall edge a façade facing outwards (the spec its wall
+rule gives), corner posts where two façades meet outside, the roof and the ground, as
+meshes in one scene (SPEC 5; DESIGN "Buildings and cities").
 
-The vertical axis of a spec is solved once per building height, so floor lines meet at
-the corners; the horizontal axis once per (spec, wall length) for the whole run. Walls
-shorter than ``min_facade_width``, or that no layout fits, are plain walls.
+The vertical axis of a spec is solved once per wall height, so floor lines meet at the
+corners; the horizontal axis once per (spec, rung of wall lengths) for the whole run
+(see :class:`AxisCache`). Party walls, walls shorter than ``min_facade_width``, and walls
+no layout fits are plain walls.
 
 World frame: glTF's, metres: x east, y up, z south (map north is -z).
 """
