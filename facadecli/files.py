@@ -7,13 +7,21 @@ from pathlib import Path
 
 from facadecli.errors import SpecError
 
+CHUNK = 1 << 20  # bytes read at a time
+
 
 def read_at_most(path: Path, limit: int) -> bytes | None:
     """The file's bytes, or None when it holds more than ``limit``: at most one byte past
     the limit is read (a device such as /dev/zero never ends). OSError propagates."""
-    with path.open("rb") as handle:
-        data = handle.read(limit + 1)
-    return None if len(data) > limit else data
+    chunks, size = [], 0
+    with path.open("rb") as handle:  # in chunks: one read of limit + 1 bytes would claim
+        while size <= limit:  # that much memory first, however small the file
+            chunk = handle.read(min(CHUNK, limit + 1 - size))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+    return None if size > limit else b"".join(chunks)
 
 
 def decode_utf8(data: bytes, file: str, hint: str) -> str:

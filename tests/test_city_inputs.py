@@ -310,3 +310,16 @@ def test_a_footprints_file_beyond_the_limit_is_refused_before_it_is_read(
     code, _, err = city(capsys, manifest)
     assert code == 2 and "longer than 100 bytes" in err and "f.geojson" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_feature_collection_is_read_one_feature_at_a_time(tmp_path: Path) -> None:
+    from facadecli.city.geojson import Features, read_geojson
+
+    features = [square(f"b{i}", x=20 * i) for i in range(3)]
+    path = tmp_path / "f.geojson"
+    path.write_text('{"type": "FeatureCollection",\n "features": [\n' + ",\n".join(features) + "]}")
+    document = read_geojson(path)
+    assert isinstance(document.features, Features)  # decoded when read, not all at once
+    assert list(document.features) == json.loads(path.read_text())["features"]
+    assert document.features[1:] == json.loads(path.read_text())["features"][1:]
+    assert document.places.feature(2) == (5, 1)

@@ -11,10 +11,11 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Any, overload
 
 import pyproj
 import pyproj.exceptions
@@ -76,15 +77,26 @@ class Places:
 @dataclass(frozen=True)
 class GeoJSON:
     file: str
-    features: list[Any]  # as read: each may be anything
+    features: Sequence[Any]  # as read: each may be anything
     crs: pyproj.CRS
     places: Places
 
 
 def read_geojson(path: Path) -> GeoJSON:
-    """The file's features and CRS; raises SpecError (exit 2) when it is not GeoJSON."""
+    """The file's features and CRS; raises SpecError (exit 2) when it is not GeoJSON.
+
+    A FeatureCollection is read as a stream: its features are found, checked as JSON and
+    decoded again one at a time when they are read (:class:`Features`), so only one
+    feature's objects exist at a time, not the whole file's tree. Anything else (a lone
+    Feature, a file that is not valid JSON, ...) is parsed whole, which also locates the
+    problem."""
     file = str(path)
     text = _text(path)
+    streamed = _stream(text)
+    if streamed is not None:
+        members, offsets = streamed
+        places = Places(text)
+        return GeoJSON(file, Features(text, offsets), _crs(members, file, places), places)
     data = _parse(text, file)
     places = Places(text, lone=isinstance(data, dict) and data.get("type") == "Feature")
     features = _features(data, file, places)
@@ -128,6 +140,66 @@ def _text(path: Path) -> str:
             "split the district into several manifests, or cut the extract to a bounding box",
         )
     return decode_utf8(raw, str(path), "save the GeoJSON as UTF-8 (RFC 7946)")
+
+
+class Features(Sequence[Any]):
+    """The features of a FeatureCollection, each decoded from the text when it is read."""
+
+    def __init__(self, text: str, offsets: list[int]):
+        self.text = text
+        self.offsets = offsets
+        self.decoder = json.JSONDecoder()
+
+    def __len__(self) -> int:
+        return len(self.offsets)
+
+    @overload
+    def __getitem__(self, index: int) -> Any: ...
+    @overload
+    def __getitem__(self, index: slice) -> list[Any]: ...
+    def __getitem__(self, index: int | slice) -> Any:
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        return self.decoder.raw_decode(self.text, self.offsets[index])[0]
+
+
+def _stream(text: str) -> tuple[dict[str, Any], list[int]] | None:
+    """A FeatureCollection's members but its features, and where each feature starts, its
+    JSON checked value by value; None for anything else or any problem (the caller then
+    parses the file whole, which says where the problem is)."""
+    decoder = json.JSONDecoder()
+    try:
+        at = _skip(text, 0)
+        if not text.startswith("{", at):
+            return None
+        at = _skip(text, at + 1)
+        members: dict[str, Any] = {}
+        offsets: list[int] | None = None
+        while text.startswith('"', at):
+            key, at = decoder.raw_decode(text, at)
+            at = _skip(text, at)
+            if not text.startswith(":", at):
+                return None
+            at = _skip(text, at + 1)
+            if key == "features" and text.startswith("[", at):
+                offsets, at = _elements(text, at, decoder)
+                members.pop(key, None)
+            else:
+                members[key], at = decoder.raw_decode(text, at)
+                if key == "features":
+                    offsets = None  # a later 'features' that is not a list wins, as in json
+            at = _skip(text, at)
+            if text.startswith(",", at):
+                at = _skip(text, at + 1)
+            elif not text.startswith("}", at):
+                return None
+        if not text.startswith("}", at) or _skip(text, at + 1) != len(text):
+            return None
+    except (json.JSONDecodeError, RecursionError, ValueError, IndexError):
+        return None
+    if offsets is None or members.get("type") == "Feature":
+        return None
+    return members, offsets
 
 
 def _parse(text: str, file: str) -> Any:
@@ -338,13 +410,19 @@ def _scan(text: str) -> tuple[int, dict[str, int], list[int]]:
 
 
 def _elements(text: str, at: int, decoder: json.JSONDecoder) -> tuple[list[int], int]:
-    """Offsets of the elements of the array at ``at``, and the offset past it."""
+    """Offsets of the elements of the array at ``at``, and the offset past it; a
+    JSONDecodeError (at the offending place) when it is not a valid JSON array."""
     offsets = []
     at = _skip(text, at + 1)
     while not text.startswith("]", at):
         offsets.append(at)
         at = _skip(text, decoder.raw_decode(text, at)[1])
-        at = _skip(text, at + 1) if text.startswith(",", at) else at
+        if text.startswith(",", at):
+            at = _skip(text, at + 1)
+            if text.startswith("]", at):  # a trailing comma is not JSON
+                raise json.JSONDecodeError("trailing comma", text, at)
+        elif not text.startswith("]", at):
+            raise json.JSONDecodeError("expected ',' or ']'", text, at)
     return offsets, at + 1
 
 
