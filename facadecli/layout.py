@@ -4,7 +4,7 @@ transparency, appearance rules) and occlusion flags (SPEC 2.5, 2.8)."""
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, replace
+from dataclasses import MISSING, dataclass, fields, replace
 
 import numpy as np
 
@@ -81,19 +81,12 @@ class Layout:
 def appearance(spec: Spec, layer: Layer, x: str, y: str) -> Appearance:
     """The last matching rule wins, field by field: defaults, global rules, layer rules."""
     defaults = spec.defaults
-    current: dict[str, object] = {
+    current: dict[str, object] = {  # the parameters' own defaults, then the spec's
+        **{f.name: f.default for f in fields(Appearance) if f.default is not MISSING},
         "material": defaults.material or DEFAULT_MATERIAL,
         "mesh": defaults.mesh,
         "depth": defaults.depth,
         "thickness": defaults.thickness,
-        "frame_width": None,
-        "pane_depth": None,
-        "segments": None,
-        "pane_material": PANE_MATERIAL,
-        "sill": None,
-        "panels": None,
-        "glazing": None,
-        "spacing": None,
     }
     for rule in (*spec.shapes, *layer.shapes):
         if _matches(rule, x, y):

@@ -29,7 +29,7 @@ from trimesh.visual.material import PBRMaterial
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import roof_meshes
-from facadecli.city.s3db import Heights, Volume, blind, volume
+from facadecli.city.s3db import Heights, Volume, along, party_zone, volume
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
@@ -91,11 +91,16 @@ class AxisCache:
     ) -> AxisLayout | None:
         """The axis solved at the rung of ``length``, the ``pick``-th of its layouts (modulo
         how many there are); None: no layout, a plain wall."""
+        found = self._layouts(key, spec, axis, length, variants)
+        return found[pick % len(found)] if found else None
+
+    def _layouts(
+        self, key: str, spec: Spec, axis: str, length: float, variants: int
+    ) -> tuple[AxisLayout, ...]:
         slot = (key, axis, rung(length), variants)
         if slot not in self.axes:
             self.axes[slot] = solve_rung(spec, axis, rung_length(slot[2]), variants)
-        found = self.axes[slot]
-        return found[pick % len(found)] if found else None
+        return self.axes[slot]
 
     def facade(
         self,
@@ -109,12 +114,12 @@ class AxisCache:
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """The façade of a wall ``width`` x ``height`` in its own frame (x along, y up, z
         out), one mesh per material; None where no layout fits (a plain wall)."""
-        horizontal = self.get(key, spec, "x", width, variants, pick)
-        vertical = self.get(key, spec, "y", height, variants, pick)
-        if horizontal is None or vertical is None:
+        across = self._layouts(key, spec, "x", width, variants)
+        up = self._layouts(key, spec, "y", height, variants)
+        if not across or not up:
             return None
-        x = self.axes[(key, "x", rung(width), variants)].index(horizontal)
-        y = self.axes[(key, "y", rung(height), variants)].index(vertical)
+        x, y = pick % len(across), pick % len(up)
+        horizontal, vertical = across[x], up[y]
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.facades:
             layout = _facade(spec, horizontal, vertical)
@@ -290,7 +295,8 @@ def _walls(
 ) -> Iterator[Wall]:
     """The walls of a volume: ends, length, whether it is a party wall, and its façade
     (the first rule matching its side, the way it faces and its length, else ``main``)."""
-    edges = [(a, b, blind(a, b, shared, tolerance)) for a, b in _edges(block.part)]
+    zone = party_zone(shared, tolerance)  # widened once for all the walls
+    edges = [(a, b, along(a, b, zone)) for a, b in _edges(block.part)]
     for (a, b, party), side in zip(edges, sides(edges), strict=True):
         length = math.dist(a, b)
         chosen = next((f for rule, f in rules if rule.matches(side, facing(a, b), length)), main)

@@ -230,11 +230,7 @@ def _matches(properties: dict[str, Any], key: str, want: str | float | bool | Ra
         value = properties.get("building:levels")
     if isinstance(want, Range):
         found = number(value)
-        return (
-            found is not None
-            and (want.min is None or found >= want.min)
-            and (want.max is None or found <= want.max)
-        )
+        return found is not None and _within(found, want)
     if isinstance(want, bool) or isinstance(value, bool):
         return value == want
     if isinstance(want, float) or isinstance(value, (int, float)):

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from shapely import STRtree
-from shapely.geometry import Polygon
+from shapely.geometry import LineString, Polygon
 
 from facadecli.city.footprints import Footprint, number
 from facadecli.city.manifest import Roof
@@ -279,7 +279,7 @@ def replaced_outlines(footprints: Iterable[Footprint]) -> dict[str, list[str]]:
     parts = [f for f in footprints if is_part(f.properties)]
     if not parts:
         return {}
-    points = [Polygon(p.parts[0]).representative_point() for p in parts]
+    points = [p.parts[0].representative_point() for p in parts]
     tree = STRtree(points)
     replaced: dict[str, list[str]] = {}
     for outline in footprints:
@@ -313,14 +313,20 @@ def shared_edges(footprints: list[Footprint], tolerance: float) -> dict[str, Any
     return shared
 
 
+def party_zone(shared: Any, tolerance: float) -> Any:
+    """The area along a footprint's neighbours (``shared``, from :func:`shared_edges`,
+    widened by ``tolerance``): a wall mostly inside it is a party wall. None: none."""
+    return None if shared is None else shared.buffer(tolerance)
+
+
+def along(a: tuple[float, float], b: tuple[float, float], zone: Any) -> bool:
+    """Is most of the wall from a to b inside the party zone (a party wall)?"""
+    length = math.dist(a, b)
+    if zone is None or length <= 0:
+        return False
+    return bool(LineString([a, b]).intersection(zone).length >= 0.5 * length)
+
+
 def blind(a: tuple[float, float], b: tuple[float, float], shared: Any, tolerance: float) -> bool:
     """Is most of the wall from a to b along a neighbour (a party wall)?"""
-    if shared is None:
-        return False
-    length = math.dist(a, b)
-    if length <= 0:
-        return False
-    from shapely.geometry import LineString
-
-    wall = LineString([a, b])
-    return bool(wall.intersection(shared.buffer(tolerance)).length >= 0.5 * length)
+    return along(a, b, party_zone(shared, tolerance))

@@ -7,9 +7,11 @@ from collections.abc import Callable
 from xml.sax.saxutils import escape
 
 from facadecli.geometry.cell import (
+    CORONA,
     Cell,
     Rect,
     arch_radius,
+    balcony_slab,
     door_plan,
     railing_plan,
     shutter_plan,
@@ -134,7 +136,7 @@ def _shape(
             parts.append(rect(plan.glass, pane))
         return [*parts, "</g>"]
     if shape.mesh in ("railing", "balcony"):
-        slab = min(0.15, 0.2 * h) if shape.mesh == "balcony" else 0.0
+        slab = balcony_slab(h) if shape.mesh == "balcony" else 0.0
         bars = railing_plan(w, h - slab, look.spacing)
         parts = [f"<g>{title}"]
         if slab:
@@ -148,7 +150,8 @@ def _shape(
         parts += [rect((x0, x1, y0, y0 + 0.3 * (y1 - y0)), fill) for x0, x1, y0, y1 in louvres.bars]
         return parts
     if shape.mesh == "ledge":
-        return [rect(whole, fill, title), rect((0.0, w, 0.6 * h, 0.9 * h), fill)]
+        corona = (0.0, w, CORONA[0] * h, CORONA[1] * h)
+        return [rect(whole, fill, title), rect(corona, fill)]
     f = cell.frame
     parts = [rect(whole, fill, title)]
     x0, x1, y0 = shape.x0 + f, shape.x1 - f, shape.y0 + f

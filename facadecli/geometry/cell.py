@@ -3,7 +3,7 @@ mesh library needed to read it)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -33,17 +33,12 @@ class Cell:
         """The cell of a placed shape, with its rule's parameters."""
         look = shape.look
         assert look is not None
+        parameters = {name: getattr(look, name) for name in PARAMETERS}
         return cls(
             width=round(shape.x1 - shape.x0, 6),
             height=round(shape.y1 - shape.y0, 6),
             thickness=round(shape.z1 - shape.z0, 6),
-            frame_width=look.frame_width,
-            pane_depth=look.pane_depth,
-            segments=look.segments,
-            sill=look.sill,
-            panels=look.panels,
-            glazing=look.glazing,
-            spacing=look.spacing,
+            **parameters,
         )
 
     @property
@@ -57,6 +52,16 @@ class Cell:
     def pane(self) -> float:
         """How far the pane sits behind the frame's front."""
         return self.pane_depth if self.pane_depth is not None else max(0.02, 0.5 * self.thickness)
+
+
+#: a cell's parameters beyond its size: the shape rule's, by the same names
+PARAMETERS = tuple(f.name for f in fields(Cell) if f.name not in ("width", "height", "thickness"))
+CORONA = (0.6, 0.9)  # where a ledge's vertical front runs, as shares of its height
+
+
+def balcony_slab(height: float) -> float:
+    """How thick a balcony's floor slab is: 15 cm, at most a fifth of its cell's height."""
+    return min(0.15, 0.2 * height)
 
 
 def arch_radius(width: float, height: float, frame: float) -> float:

@@ -15,10 +15,12 @@ import numpy as np
 import trimesh
 
 from facadecli.geometry.cell import (
+    CORONA,
     DEFAULT_SEGMENTS,
     BarPlan,
     Cell,
     arch_radius,
+    balcony_slab,
     door_plan,
     railing_plan,
     shutter_plan,
@@ -208,16 +210,17 @@ def ledge_profile(cell: Cell) -> list[tuple[float, float]]:
     """The outline of a ledge as (y, z) points, counter-clockwise seen from +x."""
     h, t = cell.height, cell.thickness
     segments = max(2, (cell.segments or DEFAULT_SEGMENTS) // 2)
+    low, high = CORONA[0] * h, CORONA[1] * h
     cove = [
-        (0.6 * h - 0.4 * h * math.cos(a), -0.55 * t + 0.5 * t * math.sin(a))
+        (low - 0.4 * h * math.cos(a), -0.55 * t + 0.5 * t * math.sin(a))
         for a in (0.5 * math.pi * i / segments for i in range(segments + 1))
     ]
     return [
         (0.0, -t),
         (h, -t),
         (h, -0.2 * t),
-        (0.9 * h, 0.0),
-        (0.6 * h, 0.0),
+        (high, 0.0),
+        (low, 0.0),
         *cove[::-1][1:],
         (0.0, -0.55 * t),
     ]
@@ -268,7 +271,7 @@ def balcony(cell: Cell) -> trimesh.Trimesh:
     """A balcony standing ``thickness`` out of the wall: a floor slab at the bottom of the
     cell and a railing along its front and both sides, up to the top of the cell."""
     w, h, t = cell.width, cell.height, max(cell.thickness, 0.01)
-    slab = min(0.15, 0.2 * h)
+    slab = balcony_slab(h)
     depth = min(0.05, t / 4)  # of the railing
     parts = [_block(0, w, 0, slab, -t, 0)]
     front = railing_plan(w, h - slab, cell.spacing)
