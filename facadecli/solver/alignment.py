@@ -137,6 +137,7 @@ class _Row:
         self.row = row
         self.n = len(row.word)
         self.cache: dict[int, tuple[list[Move], list[float]]] = {}
+        self.spans: dict[tuple[int, int], Move | None] = {}  # spanning(), cached
         self.has_attached = any(t.attached for t in row.traits)
         # from each letter on: preferred length of the sized letters, and the unsized ones
         self.fixed_after = [0.0] * (self.n + 1)
@@ -169,6 +170,17 @@ class _Row:
             moves = sorted(self._moves(position), key=lambda m: (m.fixed, m.letters, m.end))
             cached = self.cache[position] = (moves, [m.fixed for m in moves])
         return cached
+
+    def spanning(self, start: int, end: int) -> Move | None:
+        """The entry from ``start`` to ``end`` (a middle piece when they are equal), if any."""
+        key = (start, end)
+        found = self.spans.get(key, self)
+        if found is self:
+            found = self.spans[key] = next(
+                (m for m in self.moves(start)[0] if m.end == end and m.middle == (start == end)),
+                None,
+            )
+        return found  # type: ignore[return-value]
 
     def size(self, k: int) -> float:
         size = self.row.traits[k].size

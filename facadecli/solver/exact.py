@@ -36,6 +36,8 @@ from facadecli.spec.model import Spec
 
 FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2
 Column = tuple[Move | None, ...]
+Option = tuple[Move | None, np.ndarray | None]  # an entry (None: a gap), its length if known
+Options = tuple[list[Option], list[int], np.ndarray]  # see _Search.options()
 LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
 COMBINATION_WORK = 64  # partial columns built per work unit
 SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
@@ -265,6 +267,7 @@ class _Search:
         default_factory=dict
     )
     whole_cache: dict[tuple[int, int, int, int], np.ndarray] = field(default_factory=dict)
+    options_cache: dict[tuple[int, int, int, bool], Options] = field(default_factory=dict)
     gaps: bool = True  # rows may make room for the opaque letters of rows in front
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
@@ -326,15 +329,7 @@ class _Search:
                     return False
                 merged.append(None)
                 continue
-            middle = a.start == b.end
-            joined = next(
-                (
-                    m
-                    for m in group.rows[r].moves(a.start)[0]
-                    if m.end == b.end and (m.start == m.end) == middle
-                ),
-                None,
-            )
+            joined = group.rows[r].spanning(a.start, b.end)
             if joined is None:
                 return False
             merged.append(joined)
@@ -360,39 +355,28 @@ class _Search:
         group = self.groups[g]
         positions, memory = node.positions, node.memory
         self.progress = sum(positions)
-        options: list[list[Move | None]] = []
-        for r, row in enumerate(group.rows):
-            position = positions[r]
-            if position >= group.ends[r]:
-                options.append([None])
-                continue
-            moves: list[Move | None] = list(row.moves(position)[0])
-            if self.gaps and position % 2 == 0 and group.covering[r]:
-                moves.append(None)  # a gap (not inside a split letter; only under cover)
-            options.append(moves)
-        fits: dict[tuple[int, int, int, int, int, int], bool] = {}
+        # each option with its length when known (None: a gap, or a piece as long as the
+        # column); the options of a row that fit the first known entry, once per node
+        sized = [self.options(g, r, position, node) for r, position in enumerate(positions)]
+        fitting: dict[tuple[int, int, int, int], list[Option]] = {}
         # rows with the fewest options first: the first entry of known length is the one
         # the others are checked against
-        order = sorted(range(len(options)), key=lambda r: (len(options[r]), r))
-        chosen: list[Move | None] = [None] * len(options)
+        order = sorted(range(len(sized)), key=lambda r: (len(sized[r][0]), r))
+        chosen: list[Move | None] = [None] * len(sized)
 
-        def fit(
-            first: tuple[int, Move, np.ndarray], r: int, move: Move, length: np.ndarray
-        ) -> bool:
-            r0, m0, l0 = first
-            key = (r0, m0.start, m0.end, r, move.start, move.end)
-            known = fits.get(key)
-            if known is None:
-                difference = length - l0
-                value = 0.0
-                if not difference[self.sized :].any():  # alone, it costs at least this
-                    norm = float(difference @ difference)
-                    miss = float(difference[: self.sized] @ self.target)
-                    value = miss * miss / norm if norm else 0.0
-                if value <= self.incumbent + SAME:
-                    value = node.system.probe(difference, self.canvas)
-                known = fits[key] = value <= self.incumbent + SAME
-            return known
+        def choices(r: int, first: tuple[int, Move, np.ndarray] | None) -> list[Option]:
+            options, known, lengths = sized[r]
+            if first is None:
+                return options
+            key = (first[0], first[1].start, first[1].end, r)
+            kept = fitting.get(key)
+            if kept is None:
+                fit = self.fitting(lengths, first[2], node.system)
+                fine = {j for j, ok in zip(known, fit, strict=True) if ok}
+                kept = fitting[key] = [
+                    option for j, option in enumerate(options) if option[1] is None or j in fine
+                ]
+            return kept
 
         def extend(
             i: int, first: tuple[int, Move, np.ndarray] | None
@@ -405,19 +389,63 @@ class _Search:
                     yield tuple(chosen)
                 return
             r = order[i]
-            for move in options[r]:
-                known = first
-                length = None if move is None else self.known(g, r, move, node)
-                if length is not None and move is not None:
-                    if first is None:
-                        known = (r, move, length)
-                    elif not fit(first, r, move, length):
-                        continue
+            for move, length in choices(r, first):
                 chosen[r] = move
-                yield from extend(i + 1, known)
+                if first is None and length is not None and move is not None:
+                    yield from extend(i + 1, (r, move, length))
+                else:
+                    yield from extend(i + 1, first)
             chosen[r] = None
 
         yield from extend(0, None)
+
+    def options(self, g: int, r: int, position: int, node: _Node) -> Options:
+        """The entries of a row out of ``position`` (None: a gap) with their lengths when
+        known, the indices of those, and those lengths as a matrix. At a letter boundary
+        this depends on the position alone (cached); inside a split letter, the piece that
+        finishes it is as long as what the row has not used of it yet."""
+        inside = position % 2 == 1
+        key = (g, r, position, self.gaps)
+        cached = None if inside else self.options_cache.get(key)
+        if cached is not None:
+            return cached
+        group = self.groups[g]
+        moves: list[Move | None] = []
+        if position < group.ends[r]:
+            moves.extend(group.rows[r].moves(position)[0])
+            if self.gaps and not inside and group.covering[r]:
+                moves.append(None)  # a gap (not inside a split letter; only under cover)
+        else:
+            moves.append(None)
+        options = [(m, None if m is None else self.known(g, r, m, node)) for m in moves]
+        known = [j for j, (_, length) in enumerate(options) if length is not None]
+        lengths = np.array([options[j][1] for j in known])
+        cached = (options, known, lengths)
+        if not inside:
+            self.options_cache[key] = cached
+        return cached
+
+    def fitting(self, lengths: np.ndarray, first: np.ndarray, system: _System) -> list[bool]:
+        """Which entries of known ``lengths`` may be as long as ``first`` within the
+        incumbent: first alone (their preferred lengths apart), then with the equalities
+        so far."""
+        if not len(lengths):
+            return []
+        differences = lengths - first
+        alone = np.zeros(len(lengths))
+        plain = ~differences[:, self.sized :].any(axis=1)
+        if plain.any():
+            d = differences[plain]
+            norms = np.einsum("ij,ij->i", d, d)
+            misses = d[:, : self.sized] @ self.target
+            alone[plain] = np.divide(
+                misses * misses, norms, out=np.zeros_like(norms), where=norms > 0
+            )
+        limit = self.incumbent + SAME
+        return [
+            bool(value <= limit and system.probe(difference, self.canvas) <= limit)
+            for value, difference in zip(alone, differences, strict=True)
+        ]
 
     # -- equalities -------------------------------------------------------------------------
     # A column's entries are as long as each other; the width of a column is the length of
@@ -530,7 +558,11 @@ class _Search:
             return
         children: list[tuple[tuple[float, int, float, int, int, int], _Node]] = []
         for entries in self.columns(g, node):
-            if path and self.merges(group, path[-1], entries, node.before):
+            stretch = _stretch(entries)
+            if stretch is not None:
+                if stretch.letters > 1:  # see _stretch
+                    continue
+            elif path and self.merges(group, path[-1], entries, node.before):
                 continue  # the one column they make is searched too, and is looser
             self.budget.spend()
             system, width, used = self.child(g, entries, node)
@@ -677,6 +709,28 @@ def _remember(
         else:
             updated.append(AFTER_ATTACHED if move.last_attached else FREE)
     return tuple(updated)
+
+
+def _stretch(entries: Column) -> Move | None:
+    """The entry of a *stretch*: a column where one row holds whole sized letters and every
+    other row is empty, inside a placeholder it does not finish, or starting one. A stretch
+    of several letters is the same layout as a stretch per letter (they add no equality;
+    each of its letters is opaque if the column is valid, so each column is covered), so
+    the search takes stretches one letter at a time and never merges them: under a long
+    placeholder, the row of letters is one column per letter, not every way of grouping
+    them."""
+    found = None
+    for move in entries:
+        if (
+            move is None
+            or move.middle
+            or (move.letters == 1 and move.piece_of is None and move.tail is not None)
+        ):
+            continue  # empty, inside a placeholder, or starting one with nothing before it
+        if found is not None or not move.plain:
+            return None
+        found = move
+    return found
 
 
 def _spread(entries: Sequence[Move | None]) -> float:
