@@ -510,18 +510,18 @@ def grammar(
     name = stem(layout)
     for warning in extraction.warnings:
         typer.echo(f"{layout}: warning: {warning}", err=True)
-    outputs = grammar_files(extraction, name, timings)
     try:  # every size is derived before anything is written
         derived = derive_sizes(extraction, name, sizes, variations, seed)
     except TooLarge as error:
         raise typer.BadParameter(str(error), param_hint="--derive") from None
+    outputs = grammar_files(extraction, name, timings, derived)
     for new in derived:
         at = f"{layout}: warning: {new.width:g}x{new.height:g}"
         for note in new.notes:
             typer.echo(f"{at}: {note}", err=True)
-        for k, result in enumerate(new.layouts):
+        for k, (result, keeps) in enumerate(zip(new.layouts, new.kept, strict=True)):
             which = f" v{k}" if variations > 1 else ""
-            for warning in result.warnings:
+            for warning in [*result.warnings, *keeps.warnings()]:
                 typer.echo(f"{at}{which}: {warning}", err=True)
     if variations > 1 and derived:
         outputs[f"{name}.variations.svg"] = variations_sheet(derived, name, seed)

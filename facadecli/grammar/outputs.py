@@ -6,12 +6,13 @@ from __future__ import annotations
 import itertools
 import json
 import re
+from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
 from xml.sax.saxutils import escape
 
 from facadecli.grammar.palette import label_colour
-from facadecli.grammar.run import Extraction
+from facadecli.grammar.run import DerivedSize, Extraction
 from facadecli.grammar.split import Grammar, derive_tree
 from facadecli.grammar.tiling import Tiling
 
@@ -122,7 +123,9 @@ def tiling_svg(tiling: Tiling, grammar: Grammar, title: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def grammar_report(extraction: Extraction, timings: bool = False) -> str:
+def grammar_report(
+    extraction: Extraction, timings: bool = False, derived: Sequence[DerivedSize] = ()
+) -> str:
     grammar, found, tiling = extraction.grammar, extraction.found, extraction.tiling
     options = extraction.options
     ops: dict[str, int] = {}
@@ -149,6 +152,16 @@ def grammar_report(extraction: Extraction, timings: bool = False) -> str:
         "snapping": extraction.snapping.summary(),
         "regularization": extraction.regularization.summary(),
         "warnings": extraction.warnings,
+        "style": [constraint.summary() for constraint in extraction.style],
+        "derived": [
+            {
+                "size": {"width": size.width, "height": size.height},
+                "variation": k,
+                "style_kept": keeps.summary(),
+            }
+            for size in derived
+            for k, keeps in enumerate(size.kept)
+        ],
         "time_ms": round(extraction.time_ms, 3) if timings else None,
     }
     return json.dumps(data, indent=2) + "\n"

@@ -8,10 +8,17 @@ edges keep their order, and
 - elements of one label whose sizes differ by less than ``tolerance`` x the façade's extent
   (and less than a tenth) get one size;
 - strips of the tiling between neighbouring edges that show the same labels across the
-  whole façade (the wall between two window columns, say) and differ as little get one size.
+  whole façade (the wall between two window columns, say) and differ as little get one size;
+- *periodic runs* (Bao et al. 2013's equal spacing): three or more elements of one label
+  and size side by side in a row (or stacked in a column) whose pitches differ by less than
+  ``PITCH`` x the tolerance x the extent (and less than a tenth of the pitch) get one pitch,
+  so hand-drawn bays become a run a grammar can repeat;
+- *line-ups* (Bao's alignment): elements whose centres are nearer than the tolerance x the
+  extent get one centre where they can (a door under a window column, a balcony under a
+  window): a soft constraint, weighted, as one element may line up with two that cannot.
 
-If the equalities cannot all hold, the strips' are dropped, then the elements'. What moved is
-returned for the report.
+If the equalities cannot all hold, the runs' are dropped, then the strips', then the
+elements'. What moved is returned for the report.
 """
 
 from __future__ import annotations
@@ -27,6 +34,9 @@ from facadecli.grammar.tiling import LabelledLayout, Rect, Tiling, snap, tile
 
 DEFAULT_TOLERANCE = 0.01  # of the façade's extent along the axis
 RELATIVE = 0.1  # and never sizes more than this fraction apart
+LINED = 1e-3  # of the extent: line-ups the soft QP brings this near are then made exact
+SOFT = 100.0  # weight of a line-up against moving edges (both squared)
+PITCH = 2.0  # pitches of a run may differ by this many tolerances (hand drawing jitters)
 
 
 @dataclass(frozen=True)
@@ -39,7 +49,7 @@ class Move:
 @dataclass(frozen=True)
 class SizeGroup:
     axis: str
-    kind: str  # "element" (one label) or "strip" (a band of the tiling)
+    kind: str  # "element" (one label), "strip" (a band of the tiling), "run" or "line-up"
     label: str
     count: int
     size: float
@@ -92,6 +102,11 @@ def _clusters(items: list[tuple[float, int]], tolerance: float) -> list[list[int
     return [[index for _, index in group] for group in groups if len(group) > 1]
 
 
+def _movable(group: list[Span], cuts: set[float]) -> bool:
+    """Whether every edge of a group is an edge of the tiling (a QP variable)."""
+    return all(a in cuts and b in cuts for a, b in group)
+
+
 def _pairs_of(
     rects: list[Rect], tiling: Tiling, axis: str, extent: float, tolerance: float
 ) -> tuple[dict[str, list[list[tuple[float, float]]]], dict[str, list[list[tuple[float, float]]]]]:
@@ -121,20 +136,72 @@ def _pairs_of(
     return elements, strips
 
 
-def _solve_axis(
-    edges: list[float],
-    extent: float,
-    groups: list[list[tuple[float, float]]],
-    elements: list[tuple[float, float]],
-) -> list[float] | None:
-    import cvxpy as cp  # imported here: it takes half a second
+Span = tuple[float, float]
 
-    index = {value: i for i, value in enumerate(edges)}
-    kept = sorted(set(elements))  # elements keep their sizes as well as they can
-    starts = np.array([index[a] for a, _ in kept], dtype=int)
-    stops = np.array([index[b] for _, b in kept], dtype=int)
-    drawn = np.array([b - a for a, b in kept])
-    equal = np.array(  # (a0, b0, a, b): b - a == b0 - a0
+
+def _runs(
+    rects: list[Rect], axis: str, extent: float, tolerance: float
+) -> dict[str, list[list[Span]]]:
+    """Equal pitches of periodic runs (see the module), as groups of spans from one
+    element's start to the next one's, by label."""
+    rows: dict[tuple[str, float, float], set[Span]] = defaultdict(set)
+    for rect in rects:
+        start, end = (rect.x0, rect.x1) if axis == "x" else (rect.y0, rect.y1)
+        across = (rect.y0, rect.y1) if axis == "x" else (rect.x0, rect.x1)
+        rows[(rect.label, *across)].add((start, end - start))
+    runs: dict[str, list[list[Span]]] = defaultdict(list)
+    for (label, *_), members in sorted(rows.items()):
+        ordered = sorted(members)
+        run: list[Span] = []
+        for (a, size_a), (b, size_b) in itertools.pairwise(ordered):
+            pitch = b - a
+            near = min(PITCH * tolerance * extent, RELATIVE * pitch)
+            if (
+                run
+                and abs(pitch - (run[0][1] - run[0][0])) <= near
+                and abs(size_b - size_a) <= min(tolerance * extent, RELATIVE * size_a)
+            ):
+                run.append((a, b))
+                continue
+            if len(run) >= 2:
+                runs[label].append(run)
+            run = (
+                [(a, b)]
+                if abs(size_b - size_a) <= min(tolerance * extent, RELATIVE * size_a)
+                else []
+            )
+        if len(run) >= 2:
+            runs[label].append(run)
+    return runs
+
+
+def _line_ups(rects: list[Rect], axis: str, extent: float, tolerance: float) -> list[list[Span]]:
+    """Line-ups (see the module), each as pairs that keep the sum of their edges: the
+    centre of ``(a, b)`` equals that of ``(a0, b0)`` when ``b - a0 == b0 - a``, so each
+    member after the first is the group ``[(b0, a), (a0, b)]`` read as equal spans."""
+    spans = sorted(
+        {((r.x0, r.x1) if axis == "x" else (r.y0, r.y1)) for r in rects},
+        key=lambda span: (span[0] + span[1], span),
+    )
+    centres = [((a + b) / 2, i) for i, (a, b) in enumerate(spans)]
+    groups = []
+    for members in _clusters(centres, tolerance * extent):
+        (a0, b0), rest = spans[members[0]], [spans[i] for i in members[1:]]
+        groups += [[(a, b0), (a0, b)] for a, b in rest if (a, b) != (a0, b0)]
+    return groups
+
+
+def _centre_gap(line_up: list[Span], at: dict[float, float]) -> float:
+    """How far apart the centres of a line-up's two elements are (twice, in fact), with
+    the edges where ``at`` puts them."""
+    (a0, b0), (a, b) = line_up
+    return abs(at[b] - at[a] - at[b0] + at[a0])
+
+
+def _pairs(groups: list[list[Span]], index: dict[float, int]) -> np.ndarray:
+    """Rows (a0, b0, a, b) of edge indices, one per member after a group's first: the
+    span (a, b) is to be as long as (a0, b0)."""
+    return np.array(
         [
             (index[group[0][0]], index[group[0][1]], index[a], index[b])
             for group in groups
@@ -142,6 +209,26 @@ def _solve_axis(
         ],
         dtype=int,
     ).reshape(-1, 4)
+
+
+def _solve_axis(
+    edges: list[float],
+    extent: float,
+    groups: list[list[tuple[float, float]]],
+    elements: list[tuple[float, float]],
+    soft: list[list[tuple[float, float]]],
+) -> list[float] | None:
+    """Edges as near as they can be to where they were, with the spans of each group
+    equal, and those of each ``soft`` group as near to equal as they can be (weighted by
+    ``SOFT``)."""
+    import cvxpy as cp  # imported here: it takes half a second
+
+    index = {value: i for i, value in enumerate(edges)}
+    kept = sorted(set(elements))  # elements keep their sizes as well as they can
+    starts = np.array([index[a] for a, _ in kept], dtype=int)
+    stops = np.array([index[b] for _, b in kept], dtype=int)
+    drawn = np.array([b - a for a, b in kept])
+    equal = _pairs(groups, index)
     v = cp.Variable(len(edges))
     # constraints as a few vector expressions: building one per pair is slow in cvxpy
     constraints = [v[0] == 0.0, v[len(edges) - 1] == extent, cp.diff(v) >= 0]
@@ -151,6 +238,11 @@ def _solve_axis(
         objective += cp.sum_squares(v[stops] - v[starts] - drawn)
     if len(equal):
         constraints.append(v[equal[:, 3]] - v[equal[:, 2]] == v[equal[:, 1]] - v[equal[:, 0]])
+    near = _pairs(soft, index)
+    if len(near):
+        objective += SOFT * cp.sum_squares(
+            v[near[:, 3]] - v[near[:, 2]] - v[near[:, 1]] + v[near[:, 0]]
+        )
     problem = cp.Problem(cp.Minimize(objective), constraints)
     try:
         problem.solve(solver=cp.CLARABEL)
@@ -182,24 +274,34 @@ def regularize(
         elements, strips = _pairs_of(rects, tiling, axis, extent, tolerance)
         element_groups = [g for groups in elements.values() for g in groups]
         strip_groups = [g for groups in strips.values() for g in groups]
+        runs = _runs(rects, axis, extent, tolerance)
+        run_groups = [g for groups in runs.values() for g in groups]
+        line_ups = _line_ups(rects, axis, extent, tolerance)
         spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
         cuts = set(edges)
         spans = [(a, b) for a, b in spans if a in cuts and b in cuts]
         solved = None
-        for kept, used in (
-            (element_groups + strip_groups, True),
-            (element_groups, False),
-        ):
+        attempts = (  # each one without what the one before could not hold
+            (element_groups + strip_groups + run_groups, "runs", "equal pitches of runs"),
+            (element_groups + strip_groups, "strips", "equal sizes of strips"),
+            (element_groups, "elements", "equal sizes of elements"),
+        )
+        used = ""
+        movable_line_ups = [g for g in line_ups if _movable(g, cuts)]
+        for kept, dropped, what in attempts:
             deadline.check("regularising")
-            solved = _solve_axis(edges, extent, kept, spans)
+            movable = [g for g in kept if _movable(g, cuts)]
+            solved = _solve_axis(edges, extent, movable, spans, movable_line_ups)
             if solved is not None:
+                used = dropped
+                # the line-ups the soft QP nearly met are made exact where they all can be
+                at = dict(zip(edges, solved, strict=True))
+                met = [g for g in movable_line_ups if _centre_gap(g, at) <= LINED * extent]
+                if met:
+                    exact = _solve_axis(edges, extent, movable + met, spans, [])
+                    solved = exact or solved
                 break
-            result.warnings.append(
-                f"{axis}: equal sizes of {'strips' if used else 'elements'} do not all fit; "
-                "left out"
-            )
-        else:
-            used = False
+            result.warnings.append(f"{axis}: {what} do not all fit; left out")
         if solved is None:
             mapping[axis] = {e: e for e in edges}
             continue
@@ -210,12 +312,28 @@ def regularize(
         for before, after in zip(edges, solved, strict=True):
             if abs(after - before) > 1e-6 * extent:
                 result.moves.append(Move(axis, before, after))
-        for kind, named in (("element", elements), ("strip", strips if used else {})):
+        strips_kept = used in ("strips", "runs")
+        runs_kept = used == "runs"
+        for kind, named in (
+            ("element", elements),
+            ("strip", strips if strips_kept else {}),
+            ("run", runs if runs_kept else {}),
+        ):
             for label, groups in named.items():
                 for group in groups:
                     a, b = group[0]
                     size = mapping[axis][b] - mapping[axis][a]
-                    result.groups.append(SizeGroup(axis, kind, label, len(group), size))
+                    count = len(group) + (kind == "run")  # a run of n pitches has n + 1
+                    result.groups.append(SizeGroup(axis, kind, label, count, size))
+        lined = sum(_centre_gap(g, mapping[axis]) <= 1e-6 * extent for g in movable_line_ups)
+        if movable_line_ups:
+            result.groups.append(SizeGroup(axis, "line-up", "*", lined, 0.0))
+            if lined < len(movable_line_ups):
+                result.warnings.append(
+                    f"{axis}: {len(movable_line_ups) - lined} of {len(movable_line_ups)} near "
+                    "line-ups of element centres left apart (lining them up would move "
+                    "other edges)"
+                )
     moved = tuple(
         replace(
             r,

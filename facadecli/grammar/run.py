@@ -11,6 +11,7 @@ from __future__ import annotations
 import bisect
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -23,6 +24,7 @@ from facadecli.grammar.json_layouts import read_plain, read_report
 from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
+from facadecli.grammar.style import Constraint, Kept, style_of
 from facadecli.grammar.tiling import NO_SNAPPING, Snapping, Tiling, snap_and_count, tile
 from facadecli.limits import LAYOUT_CELLS_MAX
 
@@ -65,6 +67,12 @@ class Extraction:
     time_ms: float = 0.0
     problems: list[str] = field(default_factory=list)
     snapping: Snapping = NO_SNAPPING  # what snapping changed
+
+    @property
+    def style(self) -> list[Constraint]:
+        """Bao's constraints the input holds (found on its tiling, as derivations are
+        checked on their terminals)."""
+        return style_of(self.tiling)
 
     @property
     def grammar(self) -> Grammar:
@@ -240,9 +248,14 @@ __all__ = [
 ]
 
 
-def grammar_files(extraction: Extraction, name: str, timings: bool = False) -> dict[str, str]:
+def grammar_files(
+    extraction: Extraction,
+    name: str,
+    timings: bool = False,
+    derived: Sequence[DerivedSize] = (),
+) -> dict[str, str]:
     """The grammar's own files by name: text, JSON, CityEngine CGA, the tiling as SVG and
-    the report."""
+    the report (with the style each derived layout keeps)."""
     from facadecli.grammar.cga import grammar_cga
     from facadecli.grammar.outputs import grammar_json, grammar_report, tiling_svg
 
@@ -253,7 +266,7 @@ def grammar_files(extraction: Extraction, name: str, timings: bool = False) -> d
         f"{name}.grammar.json": grammar_json(found),
         f"{name}.cga": grammar_cga(found, tiling.xs[-1], tiling.ys[-1], name),
         f"{name}.tiling.svg": tiling_svg(tiling, found, name),
-        f"{name}.grammar-report.json": grammar_report(extraction, timings),
+        f"{name}.grammar-report.json": grammar_report(extraction, timings, derived),
     }
 
 
@@ -266,6 +279,7 @@ class DerivedSize:
     height: float
     layouts: list[Layout]
     notes: list[str]
+    kept: list[Kept] = field(default_factory=list)  # the input's style each layout keeps
 
 
 def derive_sizes(
@@ -280,11 +294,14 @@ def derive_sizes(
     from facadecli.grammar.variation import derive_variations
 
     derived = []
+    style = extraction.style
     for width, height in sizes:
         drawn, notes = derive_variations(
-            extraction.grammar, extraction.tiling, width, height, name, variations, seed
+            extraction.grammar, extraction.tiling, width, height, name, variations, seed, style
         )
-        derived.append(DerivedSize(width, height, [v.layout for v in drawn], notes))
+        derived.append(
+            DerivedSize(width, height, [v.layout for v in drawn], notes, [v.kept for v in drawn])
+        )
     return derived
 
 

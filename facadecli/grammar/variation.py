@@ -21,10 +21,12 @@ import math
 import random
 import re
 from collections import defaultdict
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
+from facadecli.grammar.style import NOTHING_KEPT, Box, Constraint, Kept, check, facade_of, style_of
 from facadecli.grammar.tiling import BACKGROUND, CMP_Z_ORDER, Tiling, snap
 
 if TYPE_CHECKING:
@@ -36,6 +38,7 @@ SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exa
 MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
 STRETCH = 0.5  # a varied repeat's copies stay within 1/(1 + this) to 1 + this of their size
 CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fewer: 3^6)
+STYLE_MAX = 81  # ... and for one layout, when the best fit breaks some of the style (3^4)
 TEMPERATURE = 0.1  # of the score: how strongly variations near the source's sizes are preferred
 NAME_MAX = 150  # characters of the source's name in a derived layout's name
 
@@ -408,11 +411,11 @@ def _safe(name: str) -> str:
 def derive_layout(
     grammar: Grammar, tiling: Tiling, width: float, height: float, name: str
 ) -> Layout:
-    """The grammar at a new size, aligned, as a layout named ``<name>-<W>x<H>`` (the name
-    with every character a layout name cannot hold made ``_``)."""
-    source = (tiling.xs[-1], tiling.ys[-1])
-    pieces, warnings = align(derive_at(grammar, source, width, height), width, height)
-    return pieces_layout(pieces, width, height, f"{_safe(name)}-{width:g}x{height:g}", warnings)
+    """The grammar at a new size as a layout named ``<name>-<W>x<H>`` (the name with every
+    character a layout name cannot hold made ``_``): :func:`derive_variations`' first, with
+    the style of the tiling the grammar comes from."""
+    drawn, _ = derive_variations(grammar, tiling, width, height, name, 1, 0, style_of(tiling))
+    return drawn[0].layout
 
 
 # -- variations (Bao et al. 2013) ---------------------------------------------------------
@@ -427,6 +430,7 @@ class Variation:
     layout: Layout
     offsets: tuple[tuple[str, int], ...]
     score: float
+    kept: Kept = NOTHING_KEPT  # the source's style it keeps
 
 
 def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
@@ -457,75 +461,85 @@ def derive_variations(
     name: str,
     count: int,
     seed: int,
+    style: Sequence[Constraint] = (),
 ) -> tuple[list[Variation], list[str]]:
     """Up to ``count`` different layouts of the grammar at a size, and warnings (fewer than
-    asked). Variation 0 is ``derive_layout``'s; the others vary the best-fitting count of
-    each repeat rule by -1, 0 or +1 (one offset per rule, so a rule's copies stay equal and
-    the two halves of a mirrored split stay alike; one offset for all repeats of one period
-    along one axis, so columns of windows and of their sills stay lined up), where the
-    copies stretch by at most ``STRETCH`` (elsewhere the best fit stays). They are drawn at
-    random (``seed``), favouring low scores, and ordered by score. Named ``<name>-<W>x<H>``
-    when ``count`` is 1, else ``<name>-<W>x<H>-v<K>``."""
+    asked). Candidates vary the best-fitting count of each repeat rule by -1, 0 or +1 (one
+    offset per rule, so a rule's copies stay equal and the two halves of a mirrored split
+    stay alike; one offset for all repeats of one period along one axis, so columns of
+    windows and of their sills stay lined up), where the copies stretch by at most
+    ``STRETCH`` (elsewhere the best fit stays).
+
+    Variation 0 keeps the most of the source's ``style`` (Bao et al. 2013's constraints),
+    and among those it is the nearest the source's sizes (the best fit, when it keeps as
+    much as any). The others are drawn at random (``seed``) among the candidates that keep
+    as much, then among the rest, favouring low scores, and ordered by what they keep and
+    their score. Named ``<name>-<W>x<H>`` when ``count`` is 1, else ``<name>-<W>x<H>-v<K>``."""
     source = (tiling.xs[-1], tiling.ys[-1])
     stem = f"{_safe(name)}-{width:g}x{height:g}"
 
     def named(k: int) -> str:
         return stem if count == 1 else f"{stem}-v{k}"
 
+    def kept(pieces: list[Piece]) -> Kept:
+        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+        return check(style, facade_of(boxes, width, height, BACKGROUND))
+
     used: set[str] = set()
     best = derive_at(grammar, source, width, height, used=used)
-    aligned, warnings = align(best, width, height)
-    found = [Variation(pieces_layout(aligned, width, height, named(0), warnings), (), score(best))]
-    if count == 1:
-        return found, []
-    rng = random.Random(seed)
-    linked: dict[tuple[str, float], list[str]] = defaultdict(list)
-    for symbol in sorted(used):  # repeats of one period along one axis vary together
-        rule = grammar.rules[symbol]
-        linked[(rule.axis, round(sum(p.size for p in rule.parts), 6))].append(symbol)
-    groups = [linked[k] for k in sorted(linked)]
-    if 3 ** len(groups) <= CANDIDATES_MAX:
-        choices = list(itertools.product((-1, 0, 1), repeat=len(groups)))
-    else:
-        choices = sorted(
-            {tuple(rng.choice((-1, 0, 1)) for _ in groups) for _ in range(CANDIDATES_MAX)}
-        )
-    seen = {_key(best)}
-    candidates = []
-    for choice in choices:
-        offsets = {s: o for g, o in zip(groups, choice, strict=True) if o for s in g}
-        if not offsets:
-            continue
-        try:
-            pieces = derive_at(grammar, source, width, height, offsets)
-        except TooLarge:
-            continue
-        key = _key(pieces)
+    best_kept = kept(best)
+    candidates: list[tuple[float, tuple[tuple[str, int], ...], list[Piece], Kept]] = [
+        (score(best), (), best, best_kept)
+    ]
+    wanted = count > 1 or bool(best_kept.broken)
+    if wanted:
+        rng = random.Random(seed)
+        for offsets in _offsets(grammar, used, rng, CANDIDATES_MAX if count > 1 else STYLE_MAX):
+            try:
+                pieces = derive_at(grammar, source, width, height, offsets)
+            except TooLarge:
+                continue
+            changes = tuple(sorted(offsets.items()))
+            candidates.append((score(pieces), changes, pieces, kept(pieces)))
+    # most constraints kept, then nearest the source; the same pieces only once
+    seen: set[tuple[tuple[str, float, float, float, float], ...]] = set()
+    ranked = []
+    for candidate in sorted(candidates, key=lambda c: (-len(c[3].kept), bool(c[1]), c[0], c[1])):
+        key = _key(candidate[2])
         if key not in seen:
             seen.add(key)
-            candidates.append((score(pieces), tuple(sorted(offsets.items())), pieces))
-    # a weighted draw without replacement (Efraimidis and Spirakis): keys u^(1/w)
-    floor = found[0].score
+            ranked.append(candidate)
+    value, changes, pieces, keeps = ranked[0]
+    aligned, warnings, keeps = _tidied(pieces, keeps, kept, width, height)
+    layout = pieces_layout(aligned, width, height, named(0), warnings)
+    found = [Variation(layout, changes, value, keeps)]
+    if count == 1:
+        return found, []
+    # a weighted draw without replacement (Efraimidis and Spirakis): keys u^(1/w), drawn
+    # first among the candidates that keep as much of the style as variation 0
+    rng = random.Random(seed)
+    floor = value
     drawn = sorted(
-        candidates,
+        ranked[1:],
         key=lambda c: (
-            -math.log(rng.random() or 1e-300) * math.exp(min((c[0] - floor) / TEMPERATURE, 700.0))
+            -len(c[3].kept),
+            -math.log(rng.random() or 1e-300) * math.exp(min((c[0] - floor) / TEMPERATURE, 700.0)),
         ),
     )
-    kept: list[tuple[float, tuple[tuple[str, int], ...], list[Piece], list[str]]] = []
+    chosen: list[tuple[float, tuple[tuple[str, int], ...], list[Piece], list[str], Kept]] = []
     aligned_seen = {_key(aligned)}
-    for value, changes, pieces in drawn:  # aligned, two could still coincide: skip the second
-        if len(kept) == count - 1:
+    for value, changes, pieces, keeps in drawn:  # aligned, two could still coincide
+        if len(chosen) == count - 1:
             break
-        moved, moved_warnings = align(pieces, width, height)
+        moved, moved_warnings, keeps = _tidied(pieces, keeps, kept, width, height)
         key = _key(moved)
         if key not in aligned_seen:
             aligned_seen.add(key)
-            kept.append((value, changes, moved, moved_warnings))
-    kept.sort(key=lambda c: (c[0], c[1]))
-    for k, (value, changes, moved, moved_warnings) in enumerate(kept, start=1):
+            chosen.append((value, changes, moved, moved_warnings, keeps))
+    chosen.sort(key=lambda c: (-len(c[4].kept), c[0], c[1]))
+    for k, (value, changes, moved, moved_warnings, keeps) in enumerate(chosen, start=1):
         layout = pieces_layout(moved, width, height, named(k), moved_warnings)
-        found.append(Variation(layout, changes, value))
+        found.append(Variation(layout, changes, value, keeps))
     notes = []
     if len(found) < count:
         notes.append(
@@ -533,3 +547,41 @@ def derive_variations(
             f"best fit whose copies stretch by at most {STRETCH:.0%})"
         )
     return found, notes
+
+
+def _tidied(
+    pieces: list[Piece],
+    keeps: Kept,
+    kept: Callable[[list[Piece]], Kept],
+    width: float,
+    height: float,
+) -> tuple[list[Piece], list[str], Kept]:
+    """A derivation through the alignment QP (:func:`align`), unless that breaks some of
+    the style the derivation keeps: then as derived, with a warning."""
+    aligned, warnings = align(pieces, width, height)
+    after = kept(aligned)
+    if len(after.kept) >= len(keeps.kept):
+        return aligned, warnings, after
+    lost = len(keeps.kept) - len(after.kept)
+    return pieces, [f"not tidied: lining up equal terminals would break {lost} of its style"], keeps
+
+
+def _offsets(
+    grammar: Grammar, used: set[str], rng: random.Random, most: int
+) -> Iterator[dict[str, int]]:
+    """Changes to the best-fitting repeat counts (see :func:`derive_variations`): every
+    choice of -1, 0 or +1 per group of repeats when there are at most ``most``, else
+    ``most`` drawn at random."""
+    linked: dict[tuple[str, float], list[str]] = defaultdict(list)
+    for symbol in sorted(used):  # repeats of one period along one axis vary together
+        rule = grammar.rules[symbol]
+        linked[(rule.axis, round(sum(p.size for p in rule.parts), 6))].append(symbol)
+    groups = [linked[k] for k in sorted(linked)]
+    if 3 ** len(groups) <= most:
+        choices = list(itertools.product((-1, 0, 1), repeat=len(groups)))
+    else:
+        choices = sorted({tuple(rng.choice((-1, 0, 1)) for _ in groups) for _ in range(most)})
+    for choice in choices:
+        offsets = {s: o for g, o in zip(groups, choice, strict=True) if o for s in g}
+        if offsets:
+            yield offsets

@@ -18,8 +18,9 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from facadecli.grammar.run import Options, extract_grammar  # noqa: E402
-from facadecli.grammar.variation import derive_layout  # noqa: E402
+from facadecli.grammar.variation import derive_layout, derive_variations  # noqa: E402
 
+SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
 
 
@@ -31,8 +32,10 @@ def main() -> None:
     iterations = int(sys.argv[1]) if len(sys.argv) > 1 else 2000
     print(f"split grammars, ADP {iterations} iterations, seed 0")
     header = f"{'facade':10} {'cells':>6} {'moved':>6} {'greedy':>7} {'adp':>7} {'rules':>5}"
-    print(header + f" {'best@':>6} {'time':>7}")
+    print(header + f" {'repeat':>6} {'best@':>6} {'time':>7}   style kept at 0.7x 1.5x 2x width")
     greedy, adp, times = [], [], []
+    style_kept: dict[float, int] = {}
+    style_total = 0
     last = None
     for path in files:
         started = time.perf_counter()
@@ -46,15 +49,32 @@ def main() -> None:
         greedy.append(found.greedy_cost)
         adp.append(extraction.grammar.cost)
         times.append(elapsed)
+        repeats = sum(r.op in ("repeat", "repeatABA") for r in extraction.grammar.rules.values())
+        style = extraction.style
+        kept = []
+        for scale in SCALES:
+            drawn, _ = derive_variations(
+                extraction.grammar, tiling, 15.0 * scale, 15.0, "bench", 1, 0, style
+            )
+            kept.append(len(drawn[0].kept.kept))
+        for scale, count in zip(SCALES, kept, strict=True):
+            style_kept[scale] = style_kept.get(scale, 0) + count
+        style_total += len(style)
         print(
             f"{path.stem:10} {cells:6d} {moved:6d} {found.greedy_cost:7.1f} "
-            f"{extraction.grammar.cost:7.1f} {len(extraction.grammar.rules):5d} "
-            f"{found.best_iteration:6d} {elapsed:6.2f}s"
+            f"{extraction.grammar.cost:7.1f} {len(extraction.grammar.rules):5d} {repeats:6d} "
+            f"{found.best_iteration:6d} {elapsed:6.2f}s   "
+            + " ".join(f"{k}/{len(style)}" for k in kept)
         )
         last = extraction
     print(
         f"{'mean':10} {'':6} {'':6} {statistics.mean(greedy):7.1f} {statistics.mean(adp):7.1f}"
         f" {'':5} {'':6} {statistics.mean(times):6.2f}s (max {max(times):.2f}s)"
+    )
+    print(
+        "style kept by derived layouts: "
+        + ", ".join(f"{style_kept[s]} of {style_total} at {s}x" for s in SCALES)
+        + " width (the input's tiling keeps all)"
     )
     wins = sum(a < g for a, g in zip(adp, greedy, strict=True))
     print(f"ADP is cheaper than greedy on {wins} of {len(files)} façades")

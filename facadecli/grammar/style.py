@@ -1,0 +1,306 @@
+"""A façade's style as constraints (Bao et al. 2013, section 4), found in a labelled layout
+and checked on layouts derived from it.
+
+Found on the (regularised) input, over its elements (the background is not one):
+
+- ``symmetry``: the elements are mirror images of each other about the vertical centre line
+  (at least ``MIRRORED`` of them have a partner of their label);
+- ``columns``: rows of one label (elements at one height) whose centres are the same set of
+  columns, floor after floor;
+- ``axis``: every element of another label (narrower than half the façade) is centred on
+  one of those columns (a door under a window column: Bao's Figure 16);
+- ``spacing``: rows of three or more elements of one label at one pitch;
+- ``ends`` and ``centre``: a label at both ends of the façade, or on its centre line
+  (pilasters at the corners and in the middle: a frequency pattern).
+
+A derived layout keeps a constraint when it holds there too (for ``columns`` and
+``spacing``, in as large a share of the label's rows: a taller façade has more floors);
+distances are compared within ``TOLERANCE`` of the façade's extent.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+from facadecli.grammar.tiling import BACKGROUND, Tiling
+
+TOLERANCE = 0.01  # of the façade's extent along the axis compared
+MIRRORED = 0.9  # share of the elements with a mirror partner for a symmetric façade
+
+
+class Box(NamedTuple):
+    """A labelled rectangle."""
+
+    label: str
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+
+
+@dataclass(frozen=True)
+class Constraint:
+    kind: str  # symmetry, columns, axis, spacing, ends, centre
+    label: str  # the label it is about ("*": every element)
+    text: str  # what it says, for people
+    share: float = 1.0  # for ``columns`` and ``spacing``: the share of the label's rows
+    other: str = ""  # for ``axis``: the label whose columns it is centred on
+
+    def summary(self) -> dict[str, object]:
+        return {"kind": self.kind, "label": self.label, "text": self.text}
+
+
+@dataclass(frozen=True)
+class Facade:
+    """The elements of a layout, by label and row."""
+
+    boxes: tuple[Box, ...]
+    width: float
+    height: float
+
+    def rows(self, label: str) -> list[list[Box]]:
+        """The elements of a label in rows (one height, within the tolerance), bottom up,
+        each left to right."""
+        near = TOLERANCE * self.height
+        found: list[list[Box]] = []
+        for box in sorted((b for b in self.boxes if b.label == label), key=lambda b: (b.y0, b.y1)):
+            row = next(
+                (
+                    r
+                    for r in found
+                    if abs(r[0].y0 - box.y0) <= near and abs(r[0].y1 - box.y1) <= near
+                ),
+                None,
+            )
+            if row is None:
+                found.append([box])
+            else:
+                row.append(box)
+        return [sorted(row, key=lambda b: b.x0) for row in found]
+
+    def mirrored(self) -> float:
+        """The share of elements with a mirror partner of their label."""
+        near_x, near_y = TOLERANCE * self.width, TOLERANCE * self.height
+        partners = 0
+        for label, x0, y0, x1, y1 in self.boxes:
+            partners += any(
+                other.label == label
+                and abs(other.x0 - (self.width - x1)) <= near_x
+                and abs(other.x1 - (self.width - x0)) <= near_x
+                and abs(other.y0 - y0) <= near_y
+                and abs(other.y1 - y1) <= near_y
+                for other in self.boxes
+            )
+        return partners / len(self.boxes) if self.boxes else 0.0
+
+
+def facade_of(tiles: Sequence[Box], width: float, height: float, background: str) -> Facade:
+    """The elements of a layout from its visible tiles (a tiling's cells or a derivation's
+    terminals), the background left out. The tiles are cut at every edge of every tile
+    (so two ways of cutting one picture give the same cells); cells of one label side by
+    side in a row are joined, then such runs stacked in a column (so a window cut by the
+    edges of other elements is one window again)."""
+    near = 1e-6 * max(width, height)
+    boxes = [b for b in _cells(tiles, near) if b.label != background]
+    rows = _joined(sorted(boxes, key=lambda b: (b.label, b.y0, b.y1, b.x0)), True, near)
+    return Facade(
+        tuple(_joined(sorted(rows, key=lambda b: (b.label, b.x0, b.x1, b.y0)), False, near)),
+        width,
+        height,
+    )
+
+
+def _cells(tiles: Sequence[Box], near: float) -> list[Box]:
+    """The tiles cut at every edge of every tile."""
+    xs = _distinct([v for t in tiles for v in (t.x0, t.x1)], near)
+    ys = _distinct([v for t in tiles for v in (t.y0, t.y1)], near)
+    cells = []
+    for label, x0, y0, x1, y1 in tiles:
+        inner_x = [x for x in xs if x0 - near <= x <= x1 + near]
+        inner_y = [y for y in ys if y0 - near <= y <= y1 + near]
+        for a, b in itertools.pairwise(inner_x):
+            for c, d in itertools.pairwise(inner_y):
+                cells.append(Box(label, a, c, b, d))
+    return cells
+
+
+def _distinct(values: list[float], near: float) -> list[float]:
+    found: list[float] = []
+    for value in sorted(values):
+        if not found or value - found[-1] > near:
+            found.append(value)
+    return found
+
+
+def _joined(boxes: list[Box], along_x: bool, near: float) -> list[Box]:
+    """Sorted boxes with each one joined to the next where they touch along x (or y) and
+    match across it."""
+    joined: list[Box] = []
+    for box in boxes:
+        last = joined[-1] if joined else None
+        if last is not None and last.label == box.label:
+            if along_x:
+                touching = abs(last.x1 - box.x0) <= near
+                matching = abs(last.y0 - box.y0) <= near and abs(last.y1 - box.y1) <= near
+            else:
+                touching = abs(last.y1 - box.y0) <= near
+                matching = abs(last.x0 - box.x0) <= near and abs(last.x1 - box.x1) <= near
+            if touching and matching:
+                joined[-1] = last._replace(x1=box.x1) if along_x else last._replace(y1=box.y1)
+                continue
+        joined.append(box)
+    return joined
+
+
+def style_of(tiling: Tiling, background: str = BACKGROUND) -> list[Constraint]:
+    """The constraints a tiling holds (as derivations are checked on their terminals)."""
+    facade = facade_of(tiles_of(tiling), tiling.xs[-1], tiling.ys[-1], background)
+    return find_style(facade)
+
+
+def tiles_of(tiling: Tiling) -> list[Box]:
+    """A tiling's cells as tiles."""
+    return [
+        Box(label, tiling.xs[c], tiling.ys[r], tiling.xs[c + 1], tiling.ys[r + 1])
+        for r, row in enumerate(tiling.labels)
+        for c, label in enumerate(row)
+    ]
+
+
+def _cx(box: Box) -> float:
+    return (box.x0 + box.x1) / 2
+
+
+def _cy(box: Box) -> float:
+    return (box.y0 + box.y1) / 2
+
+
+def _centres(row: list[Box]) -> list[float]:
+    return [_cx(b) for b in row]
+
+
+def _same(a: list[float], b: list[float], near: float) -> bool:
+    return len(a) == len(b) and all(abs(p - q) <= near for p, q in zip(a, b, strict=True))
+
+
+def _even(row: list[Box], near: float) -> bool:
+    pitches = [b - a for a, b in itertools.pairwise(_centres(row))]
+    return len(pitches) >= 2 and max(pitches) - min(pitches) <= near
+
+
+def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
+    """The largest set of a label's rows on the same columns, and how many rows it has."""
+    near = TOLERANCE * facade.width
+    rows = facade.rows(label)
+    groups: list[list[list[Box]]] = []
+    for row in rows:
+        group = next((g for g in groups if _same(_centres(g[0]), _centres(row), near)), None)
+        if group is None:
+            groups.append([row])
+        else:
+            group.append(row)
+    return max(groups, key=len, default=[]), len(rows)
+
+
+def _evenly_spaced(facade: Facade, label: str) -> tuple[int, int]:
+    """How many of a label's rows of three or more are evenly spaced, of how many."""
+    near = TOLERANCE * facade.width
+    rows = [row for row in facade.rows(label) if len(row) >= 3]
+    return sum(_even(row, near) for row in rows), len(rows)
+
+
+def find_style(facade: Facade) -> list[Constraint]:
+    """The constraints a layout holds (see the module). ``columns`` and ``spacing`` hold
+    for a share of a label's rows (``Constraint.share``): a derived layout keeps them when
+    as large a share of its rows does, however many floors it has."""
+    found: list[Constraint] = []
+    near = TOLERANCE * facade.width
+    share = facade.mirrored()
+    if share >= MIRRORED and len(facade.boxes) >= 2:
+        text = f"mirror-symmetric about the centre line ({share:.0%} of elements)"
+        found.append(Constraint("symmetry", "*", text))
+    labels = sorted({b.label for b in facade.boxes})
+    columned = []
+    for label in labels:
+        best, rows = _shared_columns(facade, label)
+        if len(best) >= 2:
+            text = f"{len(best)} of {rows} rows of {label} on the same {len(best[0])} columns"
+            found.append(Constraint("columns", label, text, len(best) / rows))
+            columned.append(label)
+        even, rows = _evenly_spaced(facade, label)
+        if even:
+            text = f"{even} of {rows} rows of three or more {label} evenly spaced"
+            found.append(Constraint("spacing", label, text, even / rows))
+        boxes = [b for b in facade.boxes if b.label == label]
+        if any(b.x0 <= near for b in boxes) and any(b.x1 >= facade.width - near for b in boxes):
+            found.append(Constraint("ends", label, f"{label} at both ends"))
+        if any(abs(_cx(b) - facade.width / 2) <= near for b in boxes):
+            found.append(Constraint("centre", label, f"{label} on the centre line"))
+    for label in labels:
+        for other in columned:
+            axis = Constraint(
+                "axis", label, f"{label} centred on the columns of {other}", 1.0, other
+            )
+            if other != label and holds(axis, facade):
+                found.append(axis)
+                break
+    return found
+
+
+def holds(constraint: Constraint, facade: Facade) -> bool:
+    """Whether a (derived) layout keeps a constraint."""
+    near = TOLERANCE * facade.width
+    kind, label = constraint.kind, constraint.label
+    if kind == "symmetry":
+        return facade.mirrored() >= MIRRORED
+    boxes = [b for b in facade.boxes if b.label == label]
+    if kind == "columns":
+        best, rows = _shared_columns(facade, label)
+        return len(best) >= 2 and len(best) >= constraint.share * rows - 1e-9
+    if kind == "spacing":
+        even, rows = _evenly_spaced(facade, label)
+        return rows > 0 and even >= constraint.share * rows - 1e-9
+    if kind == "ends":
+        return any(b.x0 <= near for b in boxes) and any(b.x1 >= facade.width - near for b in boxes)
+    if kind == "centre":
+        return any(abs(_cx(b) - facade.width / 2) <= near for b in boxes)
+    if kind == "axis":
+        best, _ = _shared_columns(facade, constraint.other)
+        centres = _centres(best[0]) if best else []
+        narrow = [b for b in boxes if b.x1 - b.x0 < facade.width / 2]
+        return bool(narrow) and all(any(abs(_cx(b) - c) <= near for c in centres) for b in narrow)
+    raise ValueError(f"unknown constraint kind {kind!r}")
+
+
+@dataclass(frozen=True)
+class Kept:
+    """Which of a style's constraints a layout keeps."""
+
+    kept: tuple[Constraint, ...]
+    broken: tuple[Constraint, ...]
+
+    def summary(self) -> dict[str, object]:
+        return {"kept": len(self.kept), "broken": [c.text for c in self.broken]}
+
+    def warnings(self) -> list[str]:
+        if not self.broken:
+            return []
+        total = len(self.kept) + len(self.broken)
+        broken = "; ".join(c.text for c in self.broken)
+        return [
+            f"keeps {len(self.kept)} of {total} constraints of the source's style, not: {broken}"
+        ]
+
+
+def check(style: Sequence[Constraint], facade: Facade) -> Kept:
+    results: dict[bool, list[Constraint]] = defaultdict(list)
+    for constraint in style:
+        results[holds(constraint, facade)].append(constraint)
+    return Kept(tuple(results[True]), tuple(results[False]))
+
+
+NOTHING_KEPT = Kept((), ())  # of an empty style

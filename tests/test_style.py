@@ -1,0 +1,150 @@
+"""A façade's style (Bao et al. 2013, issue 14): constraints found in a labelled layout, kept
+or broken in layouts derived from it; periodic runs and line-ups in regularisation."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import random
+import subprocess
+import sys
+from pathlib import Path
+
+from facadecli.grammar.inputs import BACKGROUND
+from facadecli.grammar.regularize import regularize
+from facadecli.grammar.run import Options, extract_grammar
+from facadecli.grammar.style import Box, check, facade_of, find_style, holds
+from facadecli.grammar.tiling import LabelledLayout, Rect
+from facadecli.grammar.variation import derive_variations
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _palazzo(jitter: float = 0.0, seed: int = 0) -> list[Box]:
+    """Three floors of three windows 1.2 m wide, 3 m apart, over a centred door, on a
+    11.4 x 10 façade, each window moved by up to ``jitter`` metres."""
+    rng = random.Random(seed)
+    boxes = []
+    for floor in range(3):
+        y = 3.5 + 2.5 * floor
+        for bay in range(3):
+            x = 2.1 + 3.0 * bay + rng.uniform(-jitter, jitter)
+            boxes.append(Box("window", x, y, x + 1.2, y + 1.6))
+    boxes.append(Box("door", 5.1, 0.0, 6.3, 2.6))
+    return boxes
+
+
+def _kinds(constraints: list) -> set[tuple[str, str]]:  # type: ignore[type-arg]
+    return {(c.kind, c.label) for c in constraints}
+
+
+def test_the_style_of_a_symmetric_facade() -> None:
+    style = find_style(facade_of(_palazzo(), 11.4, 10.0, BACKGROUND))
+    assert _kinds(style) == {
+        ("symmetry", "*"),
+        ("columns", "window"),
+        ("spacing", "window"),
+        ("axis", "door"),
+        ("centre", "door"),
+        ("centre", "window"),
+    }
+    columns = next(c for c in style if c.kind == "columns")
+    assert columns.text == "3 of 3 rows of window on the same 3 columns"
+    spacing = next(c for c in style if c.kind == "spacing")
+    assert spacing.text == "3 of 3 rows of three or more window evenly spaced"
+
+
+def test_a_moved_window_breaks_columns_spacing_and_symmetry() -> None:
+    boxes = _palazzo()
+    style = find_style(facade_of(boxes, 11.4, 10.0, BACKGROUND))
+    moved = [b._replace(x0=b.x0 + 0.6, x1=b.x1 + 0.6) if b == boxes[5] else b for b in boxes]
+    kept = check(style, facade_of(moved, 11.4, 10.0, BACKGROUND))
+    broken = _kinds(list(kept.broken))
+    assert {("columns", "window"), ("spacing", "window"), ("symmetry", "*")} <= broken
+    assert ("axis", "door") not in broken and ("centre", "door") not in broken
+    assert kept.warnings() and "3 of 3 rows of window on the same 3 columns" in kept.warnings()[0]
+
+
+def test_tiles_of_one_element_are_joined_back() -> None:
+    window = [Box("window", 1.0, 1.0, 1.5, 2.0), Box("window", 1.5, 1.0, 2.0, 2.0)]
+    window += [Box("window", 1.0, 2.0, 2.0, 2.5)]
+    wall = [Box(BACKGROUND, 0.0, 0.0, 3.0, 1.0), Box(BACKGROUND, 0.0, 2.5, 3.0, 3.0)]
+    facade = facade_of([*window, *wall], 3.0, 3.0, BACKGROUND)
+    assert facade.boxes == (Box("window", 1.0, 1.0, 2.0, 2.5),)
+
+
+def test_a_wider_facade_keeps_what_it_can_and_the_report_says_which() -> None:
+    style = find_style(facade_of(_palazzo(), 11.4, 10.0, BACKGROUND))
+    wider = facade_of([b for b in _palazzo() if b.label != "door"], 17.1, 10.0, BACKGROUND)
+    assert not holds(next(c for c in style if c.kind == "axis"), wider)  # no door
+    assert holds(next(c for c in style if c.kind == "columns"), wider)
+
+
+def _layout(boxes: list[Box], width: float, height: float) -> LabelledLayout:
+    return LabelledLayout(
+        width, height, tuple(Rect(b.label, b.x0, b.y0, b.x1, b.y1, 2) for b in boxes)
+    )
+
+
+def test_regularisation_evens_out_hand_drawn_runs() -> None:
+    layout = _layout(_palazzo(jitter=0.05, seed=3), 11.4, 10.0)
+    regular, report = regularize(layout, tolerance=0.01)
+    for floor in range(3):
+        row = sorted(
+            r.x0
+            for r in regular.rects
+            if r.label == "window" and abs(r.y0 - 3.5 - 2.5 * floor) < 0.01
+        )
+        pitches = [b - a for a, b in itertools.pairwise(row)]
+        assert max(pitches) - min(pitches) < 1e-6, pitches
+    assert any(g.kind == "run" and g.label == "window" for g in report.groups)
+    drawn = sorted(b.x0 for b in _palazzo(jitter=0.05, seed=3) if b.y0 == 3.5)
+    assert abs((drawn[1] - drawn[0]) - (drawn[2] - drawn[1])) > 0.01  # the run was uneven
+
+
+def test_regularisation_lines_up_a_door_under_a_window_column() -> None:
+    boxes = [b for b in _palazzo() if b.label != "door"] + [Box("door", 5.15, 0.0, 6.35, 2.6)]
+    regular, report = regularize(_layout(boxes, 11.4, 10.0), tolerance=0.01)
+    door = next(r for r in regular.rects if r.label == "door")
+    middle = next(r for r in regular.rects if r.label == "window" and 4 < r.x0 < 6)
+    assert abs((door.x0 + door.x1) - (middle.x0 + middle.x1)) < 1e-6
+    assert any(g.kind == "line-up" and g.count >= 1 for g in report.groups)
+
+
+def _extracted(tmp_path: Path, boxes: list[Box], width: float, height: float):  # type: ignore[no-untyped-def]
+    path = tmp_path / "palazzo.json"
+    rects = [{"label": b.label, "x0": b.x0, "y0": b.y0, "x1": b.x1, "y1": b.y1} for b in boxes]
+    path.write_text(json.dumps({"canvas": {"width": width, "height": height}, "rects": rects}))
+    return extract_grammar(path, Options(iterations=200))
+
+
+def test_derived_layouts_keep_the_style_at_new_widths(tmp_path: Path) -> None:
+    extraction = _extracted(tmp_path, _palazzo(), 11.4, 10.0)
+    style = extraction.style
+    assert ("columns", "window") in _kinds(style) and ("axis", "door") in _kinds(style)
+    for width, height in ((7.98, 10.0), (17.1, 10.0), (22.8, 10.0), (11.4, 15.0)):
+        found, _ = derive_variations(
+            extraction.grammar, extraction.tiling, width, height, "p", 1, 0, style
+        )
+        assert not found[0].kept.broken, (width, [c.text for c in found[0].kept.broken])
+
+
+def test_the_grammar_report_lists_the_style_and_what_each_derived_layout_keeps(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "palazzo.json"
+    rects = [{"label": b.label, "x0": b.x0, "y0": b.y0, "x1": b.x1, "y1": b.y1} for b in _palazzo()]
+    path.write_text(json.dumps({"canvas": {"width": 11.4, "height": 10.0}, "rects": rects}))
+    out = tmp_path / "out"
+    args = [str(path), "-o", str(out), "-n", "100", "--derive", "17.1x10", "--variations", "2"]
+    done = subprocess.run(
+        [sys.executable, "-m", "facadecli", "grammar", *args], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    report = json.loads((out / "palazzo.grammar-report.json").read_text())
+    columns = "3 of 3 rows of window on the same 3 columns"
+    assert {"kind": "columns", "label": "window", "text": columns} in report["style"]
+    derived = report["derived"]
+    assert [d["variation"] for d in derived] == list(range(len(derived)))
+    assert derived[0]["size"] == {"width": 17.1, "height": 10.0}
+    assert derived[0]["style_kept"] == {"kept": len(report["style"]), "broken": []}
