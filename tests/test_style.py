@@ -15,7 +15,7 @@ from facadecli.grammar.regularize import regularize
 from facadecli.grammar.run import Options, extract_grammar
 from facadecli.grammar.style import Box, check, facade_of, find_style, holds
 from facadecli.grammar.tiling import LabelledLayout, Rect
-from facadecli.grammar.variation import derive_variations
+from facadecli.grammar.variation import Piece, align, derive_variations
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -148,3 +148,22 @@ def test_the_grammar_report_lists_the_style_and_what_each_derived_layout_keeps(
     assert [d["variation"] for d in derived] == list(range(len(derived)))
     assert derived[0]["size"] == {"width": 17.1, "height": 10.0}
     assert derived[0]["style_kept"] == {"kept": len(report["style"]), "broken": []}
+
+
+def test_the_alignment_qp_makes_near_misses_of_the_style_exact() -> None:
+    style = find_style(facade_of(_palazzo(), 11.4, 10.0, BACKGROUND))
+    off = [
+        b._replace(x0=b.x0 + 0.3, x1=b.x1 + 0.3) if b.label == "door" or b == _palazzo()[4] else b
+        for b in _palazzo()
+    ]
+    pieces = [Piece(b.label, b.x0, b.y0, b.x1, b.y1, b.x1 - b.x0, b.y1 - b.y0) for b in off]
+    before = check(style, facade_of(off, 11.4, 10.0, BACKGROUND))
+    assert {c.kind for c in before.broken} >= {"centre", "columns", "symmetry"}
+    plain, _ = align(pieces, 11.4, 10.0)
+    tidied, _ = align(pieces, 11.4, 10.0, style=style)
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in tidied]
+    assert not check(style, facade_of(boxes, 11.4, 10.0, BACKGROUND)).broken
+    door = next(p for p in tidied if p.label == "door")
+    assert abs(door.x0 + door.x1 - 11.4) < 1e-6  # on the centre line again
+    plain_door = next(p for p in plain if p.label == "door")
+    assert abs(plain_door.x0 + plain_door.x1 - 11.4) > 0.1  # without the style it stays off

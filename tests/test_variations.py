@@ -51,7 +51,7 @@ def _draw(
     extraction: Extraction, size: tuple[float, float], count: int, seed: int = 0
 ) -> list[Variation]:
     variations, _ = derive_variations(
-        extraction.grammar, extraction.tiling, *size, "facade", count, seed
+        extraction.grammar, extraction.tiling, *size, "facade", count, seed, extraction.style
     )
     return variations
 

@@ -276,6 +276,69 @@ def holds(constraint: Constraint, facade: Facade) -> bool:
     raise ValueError(f"unknown constraint kind {kind!r}")
 
 
+# -- equations that make a derived layout keep its style --------------------------------
+
+Equation = tuple[tuple[tuple[float, float], ...], float]  # sum(coefficient * x) == rhs
+
+
+def equations(style: Sequence[Constraint], facade: Facade, near: float) -> list[Equation]:
+    """Linear equations over x coordinates of element edges (each term is a coordinate and
+    its coefficient) that make a layout keep a constraint where it nearly does already
+    (every coordinate it moves moves less than ``near``): the alignment QP takes them."""
+    found: list[Equation] = []
+    width = facade.width
+    for constraint in style:
+        label = constraint.label
+        boxes = [b for b in facade.boxes if b.label == label]
+        if constraint.kind == "centre":
+            nearest = min(boxes, key=lambda b: abs(_cx(b) - width / 2), default=None)
+            if nearest is not None and abs(_cx(nearest) - width / 2) <= near:
+                found.append((((nearest.x0, 1.0), (nearest.x1, 1.0)), width))
+        elif constraint.kind == "axis":
+            best, _ = _shared_columns(facade, constraint.other)
+            columns = best[0] if best else []
+            for box in (b for b in boxes if b.x1 - b.x0 < width / 2):
+                column = min(columns, key=lambda c: abs(_cx(c) - _cx(box)), default=None)
+                if column is not None and 0 < abs(_cx(column) - _cx(box)) <= near:
+                    found.append((_same_centre(box, column), 0.0))
+        elif constraint.kind == "columns":
+            rows = facade.rows(label)
+            counts = [len(row) for row in rows]
+            common = max(set(counts), key=lambda n: (counts.count(n), n), default=0)
+            same = [row for row in rows if len(row) == common]
+            for row in same[1:]:
+                for box, model in zip(row, same[0], strict=True):
+                    if 0 < abs(_cx(box) - _cx(model)) <= near:
+                        found.append((_same_centre(box, model), 0.0))
+        elif constraint.kind == "spacing":
+            for row in facade.rows(label):
+                centres = _centres(row)
+                pitches = [b - a for a, b in itertools.pairwise(centres)]
+                if len(row) >= 3 and 0 < max(pitches) - min(pitches) <= near:
+                    for a, b, c in zip(row, row[1:], row[2:], strict=False):
+                        terms = ((a.x0, 1.0), (a.x1, 1.0), (b.x0, -2.0), (b.x1, -2.0))
+                        found.append(((*terms, (c.x0, 1.0), (c.x1, 1.0)), 0.0))
+        elif constraint.kind == "symmetry":
+            for box in facade.boxes:
+                partner = min(
+                    (o for o in facade.boxes if o.label == box.label and o.x0 >= box.x0),
+                    key=lambda o: abs(o.x1 - (width - box.x0)) + abs(o.y0 - box.y0),
+                    default=None,
+                )
+                if (
+                    partner is not None
+                    and 0 < abs(partner.x1 - (width - box.x0)) <= near
+                    and abs(partner.y0 - box.y0) <= near
+                ):
+                    found.append((((box.x0, 1.0), (partner.x1, 1.0)), width))
+                    found.append((((box.x1, 1.0), (partner.x0, 1.0)), width))
+    return found
+
+
+def _same_centre(box: Box, other: Box) -> tuple[tuple[float, float], ...]:
+    return ((box.x0, 1.0), (box.x1, 1.0), (other.x0, -1.0), (other.x1, -1.0))
+
+
 @dataclass(frozen=True)
 class Kept:
     """Which of a style's constraints a layout keeps."""

@@ -26,7 +26,17 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
-from facadecli.grammar.style import NOTHING_KEPT, Box, Constraint, Kept, check, facade_of, style_of
+from facadecli.grammar.style import (
+    NOTHING_KEPT,
+    Box,
+    Constraint,
+    Equation,
+    Kept,
+    check,
+    equations,
+    facade_of,
+    style_of,
+)
 from facadecli.grammar.tiling import BACKGROUND, CMP_Z_ORDER, Tiling, snap
 
 if TYPE_CHECKING:
@@ -34,6 +44,7 @@ if TYPE_CHECKING:
 
 THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute size
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
+STYLE_NEAR = 0.05  # of the new width: near misses of the style this close are made exact
 SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
 MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
 STRETCH = 0.5  # a varied repeat's copies stay within 1/(1 + this) to 1 + this of their size
@@ -204,14 +215,21 @@ def _grid(rule: Rule, box: tuple[float, float, float, float], expand: object) ->
 
 
 def align(
-    pieces: list[Piece], width: float, height: float, background: str = BACKGROUND
+    pieces: list[Piece],
+    width: float,
+    height: float,
+    background: str = BACKGROUND,
+    style: Sequence[Constraint] = (),
 ) -> tuple[list[Piece], list[str]]:
-    """Equal terminals one size and lined up (see the module)."""
+    """Equal terminals one size and lined up, and the style's near misses made exact (see
+    the module and :func:`~facadecli.grammar.style.equations`)."""
     warnings: list[str] = []
     mapping = {}
-    axes: tuple[tuple[Axis, float], ...] = (("x", width), ("y", height))
-    for axis, extent in axes:
-        mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background)
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    kept = equations(style, facade_of(boxes, width, height, background), STYLE_NEAR * width)
+    axes: tuple[tuple[Axis, float, list[Equation]], ...] = (("x", width, kept), ("y", height, []))
+    for axis, extent, extra in axes:
+        mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background, extra)
         warnings += axis_warnings
     moved = [
         Piece(
@@ -229,7 +247,7 @@ def align(
 
 
 def _align_axis(
-    pieces: list[Piece], axis: Axis, extent: float, background: str
+    pieces: list[Piece], axis: Axis, extent: float, background: str, extra: list[Equation]
 ) -> tuple[dict[float, float], list[str]]:
     import cvxpy as cp  # imported here: it takes half a second
 
@@ -262,12 +280,24 @@ def _align_axis(
     base += [v[b] - v[a] >= size / 2 for (a, b), size in set(spans)]
     size_gaps = [v[b1] - v[a1] - (v[b0] - v[a0]) for (a0, b0), (a1, b1) in equal]
     line_gaps = [v[a] - v[b] for a, b in lined]
+    style_gaps = [
+        sum(c * v[index[joined[value]]] for value, c in terms) - rhs
+        for terms, rhs in extra
+        if all(value in joined for value, _ in terms)
+    ]
     moves = cp.sum_squares(v - edges)
     hard_sizes = [g == 0 for g in size_gaps]
+    hard_style = [g == 0 for g in style_gaps]
+    soft_style = SOFT * _squares(cp, style_gaps)
     attempts = [  # hard where they fit, else as near as they can be (weighted), else neither
-        (moves, hard_sizes + [g == 0 for g in line_gaps], None),
-        (moves + SOFT * _squares(cp, line_gaps), hard_sizes, None),
-        (moves + SOFT * _squares(cp, size_gaps + line_gaps), [], "made as near as they can be"),
+        (moves, hard_sizes + hard_style + [g == 0 for g in line_gaps], None),
+        (moves + SOFT * _squares(cp, line_gaps), hard_sizes + hard_style, None),
+        (moves + SOFT * _squares(cp, line_gaps) + soft_style, hard_sizes, None),
+        (
+            moves + SOFT * _squares(cp, size_gaps + line_gaps) + soft_style,
+            [],
+            "made as near as they can be",
+        ),
         (moves, [], "left out"),
     ]
     warnings = []
@@ -510,7 +540,7 @@ def derive_variations(
             seen.add(key)
             ranked.append(candidate)
     value, changes, pieces, keeps = ranked[0]
-    aligned, warnings, keeps = _tidied(pieces, keeps, kept, width, height)
+    aligned, warnings, keeps = _tidied(pieces, keeps, kept, width, height, style)
     layout = pieces_layout(aligned, width, height, named(0), warnings)
     found = [Variation(layout, changes, value, keeps)]
     if count == 1:
@@ -531,7 +561,7 @@ def derive_variations(
     for value, changes, pieces, keeps in drawn:  # aligned, two could still coincide
         if len(chosen) == count - 1:
             break
-        moved, moved_warnings, keeps = _tidied(pieces, keeps, kept, width, height)
+        moved, moved_warnings, keeps = _tidied(pieces, keeps, kept, width, height, style)
         key = _key(moved)
         if key not in aligned_seen:
             aligned_seen.add(key)
@@ -555,10 +585,11 @@ def _tidied(
     kept: Callable[[list[Piece]], Kept],
     width: float,
     height: float,
+    style: Sequence[Constraint],
 ) -> tuple[list[Piece], list[str], Kept]:
     """A derivation through the alignment QP (:func:`align`), unless that breaks some of
     the style the derivation keeps: then as derived, with a warning."""
-    aligned, warnings = align(pieces, width, height)
+    aligned, warnings = align(pieces, width, height, style=style)
     after = kept(aligned)
     if len(after.kept) >= len(keeps.kept):
         return aligned, warnings, after
