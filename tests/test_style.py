@@ -167,3 +167,20 @@ def test_the_alignment_qp_makes_near_misses_of_the_style_exact() -> None:
     assert abs(door.x0 + door.x1 - 11.4) < 1e-6  # on the centre line again
     plain_door = next(p for p in plain if p.label == "door")
     assert abs(plain_door.x0 + plain_door.x1 - 11.4) > 0.1  # without the style it stays off
+
+
+def test_variations_shuffle_parts_of_one_size_and_the_first_keeps_the_style(
+    tmp_path: Path,
+) -> None:
+    shops = [Box("shop", 2.1, 0.0, 3.3, 2.6), Box("shop", 8.1, 0.0, 9.3, 2.6)]
+    extraction = _extracted(tmp_path, _palazzo() + shops, 11.4, 10.0)
+    found, _ = derive_variations(
+        extraction.grammar, extraction.tiling, 11.4, 10.0, "p", 6, 0, extraction.style
+    )
+    assert len(found) >= 2 and found[0].shuffle is None and not found[0].kept.broken
+    shuffled = [v for v in found if v.shuffle is not None]
+    assert shuffled
+    for variation in shuffled:  # the door moved to where a shop was, a shop to the middle
+        doors = [s for s in variation.layout.shapes if s.layer == "door" and s.visible]
+        assert doors and all(abs(s.x0 + s.x1 - 11.4) > 1.0 for s in doors)
+        assert len(variation.kept.broken) >= 1  # off the centre line

@@ -22,7 +22,7 @@ import random
 import re
 from collections import defaultdict
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
@@ -49,6 +49,7 @@ SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exa
 MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
 STRETCH = 0.5  # a varied repeat's copies stay within 1/(1 + this) to 1 + this of their size
 CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fewer: 3^6)
+SHUFFLES_MAX = 6  # new orders of one split rule's parts tried as variations
 STYLE_MAX = 81  # ... and for one layout, when the best fit breaks some of the style (3^4)
 TEMPERATURE = 0.1  # of the score: how strongly variations near the source's sizes are preferred
 NAME_MAX = 150  # characters of the source's name in a derived layout's name
@@ -454,13 +455,34 @@ def derive_layout(
 @dataclass(frozen=True)
 class Variation:
     """One derived layout of a size: ``offsets`` to the best-fitting repeat counts (rule,
-    offset; empty for the best fit), and its ``score``, the mean squared log-ratio of its
-    elements' sizes to their sizes in the source (lower is nearer the source)."""
+    offset; empty for the best fit), ``shuffle`` (a split rule and its parts' symbols in
+    their new order; None when none is shuffled), its ``score``, the mean squared
+    log-ratio of its elements' sizes to their sizes in the source (lower is nearer the
+    source), and the source's style it keeps."""
 
     layout: Layout
     offsets: tuple[tuple[str, int], ...]
     score: float
-    kept: Kept = NOTHING_KEPT  # the source's style it keeps
+    kept: Kept = NOTHING_KEPT
+    shuffle: Shuffle | None = None
+
+
+Shuffle = tuple[str, tuple[str, ...]]  # a split rule, its parts' symbols in a new order
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    score: float
+    offsets: tuple[tuple[str, int], ...]
+    shuffle: Shuffle | None
+    pieces: list[Piece]
+    kept: Kept
+
+    @property
+    def rank(self) -> tuple[int, bool, float, tuple[tuple[str, int], ...], Shuffle]:
+        """Most of the style kept, the best fit (unchanged) first, nearest the source."""
+        changed = bool(self.offsets) or self.shuffle is not None
+        return (-len(self.kept.kept), changed, self.score, self.offsets, self.shuffle or ("", ()))
 
 
 def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
@@ -515,68 +537,105 @@ def derive_variations(
         boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
         return check(style, facade_of(boxes, width, height, BACKGROUND))
 
+    def candidate(offsets: dict[str, int], shuffle: Shuffle | None = None) -> _Candidate | None:
+        rules = grammar
+        if shuffle is not None:
+            rule = grammar.rules[shuffle[0]]
+            parts = tuple(Part(p.size, s) for p, s in zip(rule.parts, shuffle[1], strict=True))
+            rules = replace(
+                grammar, rules={**grammar.rules, shuffle[0]: replace(rule, parts=parts)}
+            )
+        try:
+            pieces = derive_at(rules, source, width, height, offsets)
+        except TooLarge:
+            return None
+        changes = tuple(sorted(offsets.items()))
+        return _Candidate(score(pieces), changes, shuffle, pieces, kept(pieces))
+
     used: set[str] = set()
     best = derive_at(grammar, source, width, height, used=used)
-    best_kept = kept(best)
-    candidates: list[tuple[float, tuple[tuple[str, int], ...], list[Piece], Kept]] = [
-        (score(best), (), best, best_kept)
-    ]
-    wanted = count > 1 or bool(best_kept.broken)
-    if wanted:
+    candidates: list[_Candidate | None] = [_Candidate(score(best), (), None, best, kept(best))]
+    if count > 1 or kept(best).broken:
         rng = random.Random(seed)
-        for offsets in _offsets(grammar, used, rng, CANDIDATES_MAX if count > 1 else STYLE_MAX):
-            try:
-                pieces = derive_at(grammar, source, width, height, offsets)
-            except TooLarge:
-                continue
-            changes = tuple(sorted(offsets.items()))
-            candidates.append((score(pieces), changes, pieces, kept(pieces)))
-    # most constraints kept, then nearest the source; the same pieces only once
+        most = CANDIDATES_MAX if count > 1 else STYLE_MAX
+        candidates += [candidate(offsets) for offsets in _offsets(grammar, used, rng, most)]
+    if count > 1:
+        candidates += [candidate({}, shuffle) for shuffle in _shuffles(grammar)]
+    # most constraints kept, then the best fit, then nearest the source; the same pieces once
     seen: set[tuple[tuple[str, float, float, float, float], ...]] = set()
     ranked = []
-    for candidate in sorted(candidates, key=lambda c: (-len(c[3].kept), bool(c[1]), c[0], c[1])):
-        key = _key(candidate[2])
+    for found_one in sorted((c for c in candidates if c is not None), key=lambda c: c.rank):
+        key = _key(found_one.pieces)
         if key not in seen:
             seen.add(key)
-            ranked.append(candidate)
-    value, changes, pieces, keeps = ranked[0]
-    aligned, warnings, keeps = _tidied(pieces, keeps, kept, width, height, style)
+            ranked.append(found_one)
+    first = ranked[0]
+    aligned, warnings, keeps = _tidied(first.pieces, first.kept, kept, width, height, style)
     layout = pieces_layout(aligned, width, height, named(0), warnings)
-    found = [Variation(layout, changes, value, keeps)]
+    found = [Variation(layout, first.offsets, first.score, keeps, first.shuffle)]
     if count == 1:
         return found, []
     # a weighted draw without replacement (Efraimidis and Spirakis): keys u^(1/w), drawn
     # first among the candidates that keep as much of the style as variation 0
     rng = random.Random(seed)
-    floor = value
     drawn = sorted(
         ranked[1:],
         key=lambda c: (
-            -len(c[3].kept),
-            -math.log(rng.random() or 1e-300) * math.exp(min((c[0] - floor) / TEMPERATURE, 700.0)),
+            -len(c.kept.kept),
+            -math.log(rng.random() or 1e-300)
+            * math.exp(min((c.score - first.score) / TEMPERATURE, 700.0)),
         ),
     )
-    chosen: list[tuple[float, tuple[tuple[str, int], ...], list[Piece], list[str], Kept]] = []
+    chosen: list[tuple[_Candidate, list[Piece], list[str], Kept]] = []
     aligned_seen = {_key(aligned)}
-    for value, changes, pieces, keeps in drawn:  # aligned, two could still coincide
+    for other in drawn:  # aligned, two could still coincide
         if len(chosen) == count - 1:
             break
-        moved, moved_warnings, keeps = _tidied(pieces, keeps, kept, width, height, style)
+        moved, moved_warnings, keeps = _tidied(other.pieces, other.kept, kept, width, height, style)
         key = _key(moved)
         if key not in aligned_seen:
             aligned_seen.add(key)
-            chosen.append((value, changes, moved, moved_warnings, keeps))
-    chosen.sort(key=lambda c: (-len(c[4].kept), c[0], c[1]))
-    for k, (value, changes, moved, moved_warnings, keeps) in enumerate(chosen, start=1):
+            chosen.append((other, moved, moved_warnings, keeps))
+    chosen.sort(key=lambda c: (-len(c[3].kept), c[0].rank[2:]))
+    for k, (other, moved, moved_warnings, keeps) in enumerate(chosen, start=1):
         layout = pieces_layout(moved, width, height, named(k), moved_warnings)
-        found.append(Variation(layout, changes, value, keeps))
+        found.append(Variation(layout, other.offsets, other.score, keeps, other.shuffle))
     notes = []
     if len(found) < count:
         notes.append(
             f"only {len(found)} of {count} variations exist (repeat counts within 1 of the "
-            f"best fit whose copies stretch by at most {STRETCH:.0%})"
+            f"best fit whose copies stretch by at most {STRETCH:.0%}, and parts of a split "
+            "that are as long as each other in a new order)"
         )
     return found, notes
+
+
+def _shuffles(grammar: Grammar) -> list[Shuffle]:
+    """New orders of split rules' parts (Bao et al. 2013's shuffles, ABB -> BAB): parts as
+    long as each other (and not plain wall) change places; a mirrored split's centre stays,
+    and its halves stay mirrored (the rule lays them). At most ``SHUFFLES_MAX`` a rule."""
+    found: list[Shuffle] = []
+    for name in sorted(grammar.rules):
+        rule = grammar.rules[name]
+        if rule.op not in ("split", "symsplit"):
+            continue
+        movable = len(rule.parts) - (1 if rule.op == "symsplit" and rule.centre else 0)
+        by_size: dict[float, list[int]] = defaultdict(list)
+        for i, part in enumerate(rule.parts[:movable]):
+            if part.symbol != BACKGROUND:
+                by_size[round(part.size, 6)].append(i)
+        symbols = [p.symbol for p in rule.parts]
+        for places in by_size.values():
+            here = [symbols[i] for i in places]
+            if len(set(here)) < 2:
+                continue
+            orders = sorted(set(itertools.permutations(here)) - {tuple(here)})
+            for order in orders[:SHUFFLES_MAX]:
+                new = list(symbols)
+                for i, symbol in zip(places, order, strict=True):
+                    new[i] = symbol
+                found.append((name, tuple(new)))
+    return found
 
 
 def _tidied(
