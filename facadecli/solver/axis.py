@@ -324,7 +324,8 @@ def solve_axis_alternatives(
         failures.clear()  # each pass searches again every candidate it reaches: the last
         unproven = len(candidates) >= CANDIDATE_LIMIT  # one run says what is proven
         for bound, _, candidate in bounds:
-            target = min(threshold, best_objective() + TIE)  # ties too: SPEC 2.7 breaks them
+            # ties too (SPEC 2.7 breaks them); for variations, layouts near the best
+            target = min(threshold, best_objective() + (NEAR_EQUAL if alternatives > 1 else TIE))
             if timed_out or bound > target:
                 break
             if budget.left == 0:
