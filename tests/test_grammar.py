@@ -153,7 +153,7 @@ def test_adp_beats_greedy_and_is_reproducible() -> None:
     first = extract(tiling, iterations=400, seed=3)
     again = extract(tiling, iterations=400, seed=3)
     assert first.greedy_cost == pytest.approx(greedy.cost)
-    assert first.grammar.cost < 0.6 * greedy.cost
+    assert first.grammar.cost < 0.7 * greedy.cost  # both inlined: 37.6 against 55.9
     assert first.grammar.text() == again.grammar.text()
     assert first.iterations == 400 and 0 < first.best_iteration < 400
     assert rederivation_problems(first.grammar, tiling) == []
@@ -501,3 +501,27 @@ def test_grammar_reads_plain_lists(tmp_path: Path) -> None:
     source.write_text(json.dumps([{"label": "window", "x0": 1, "y0": 1, "x1": 2, "y1": 2}]))
     tiling = tile(read_plain(source), 0)
     assert extract(tiling, iterations=10).grammar.terminals == {"window", "facade"}
+
+
+def test_splits_used_once_inside_a_split_along_their_axis_are_written_into_it() -> None:
+    from facadecli.grammar.split import Grammar, inlined
+
+    rules = {
+        "S": Rule("split", "x", (Part(1.0, "facade"), Part(3.0, "A"), Part(1.0, "facade"))),
+        "A": Rule("split", "x", (Part(1.0, "window"), Part(1.0, "B"), Part(1.0, "window"))),
+        "B": Rule("split", "y", (Part(2.0, "door"), Part(1.0, "facade"))),  # across: kept
+        "R": Rule("repeat", "x", (Part(1.0, "window"), Part(1.0, "facade")), 2),
+        "T": Rule("split", "y", (Part(1.5, "R"), Part(1.5, "R"))),  # R used twice: kept
+    }
+    grammar = Grammar("S", rules, {"facade", "window", "door"})
+    merged = inlined(grammar)
+    assert sorted(merged.rules) == ["B", "R", "S", "T"]
+    assert [p.symbol for p in merged.rules["S"].parts] == [
+        "facade",
+        "window",
+        "B",
+        "window",
+        "facade",
+    ]
+    assert abs(merged.cost - (grammar.cost - (Costs().split + 3) + 2)) < 1e-9  # A: 3.1, S: +2
+    assert derive(merged, 5.0, 3.0) == derive(grammar, 5.0, 3.0)

@@ -43,7 +43,7 @@ import numpy as np
 
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.regions import Grid, Region
-from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Part, Rule
+from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Part, Rule, inlined
 from facadecli.grammar.symmetry import Repeats, find_repeats
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
@@ -737,18 +737,19 @@ def extract(
     the run's deadline (else one of ``time_limit`` seconds from now)."""
     deadline = deadline or Deadline(time_limit)
     search = Search(tiling, costs, extensions, background, deadline)
-    greedy = search.greedy()
-    greedy_cost = search.cost(greedy)
-    if method == "greedy" or iterations <= 1:
-        rules, best_at, done = greedy, 0, 1
-    else:
+    greedy = inlined(search.grammar(search.greedy()))
+    grammar, best_at, done = greedy, 0, 1
+    if method != "greedy" and iterations > 1:
         rules, best_at, done = search.adp(iterations, seed)
+        grammar = inlined(search.grammar(rules))
+        if greedy.cost < grammar.cost - 1e-9:  # inlining can favour the greedy grammar
+            grammar, best_at = greedy, 0
     return SearchResult(
-        search.grammar(rules),
+        grammar,
         method,
         done,
         best_at,
-        greedy_cost,
+        greedy.cost,
         search.regions_explored,
         search.repeats.kinds,
         search.repeats.complete,

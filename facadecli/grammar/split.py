@@ -18,7 +18,7 @@ sum over its rules (Eq. 1).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 Axis = Literal["x", "y"]
@@ -103,6 +103,38 @@ class Grammar:
             return f"{self.start}\n"
         names = [self.start, *(name for name in self.rules if name != self.start)]
         return "\n".join(self.rules[name].text(name) for name in names if name in self.rules) + "\n"
+
+
+def inlined(grammar: Grammar) -> Grammar:
+    """The grammar with every split rule that is used once, as a part of a split along the
+    same axis, written into that split: the same derivation for less (Eq. 1 charges a rule
+    its operation and its parts; the parent only gains the parts). Wu et al. 2014 leave
+    this to the search, which rarely finds it: most grammars it makes have such rules."""
+    rules = dict(grammar.rules)
+    while True:
+        uses: dict[str, int] = {grammar.start: 1}
+        for rule in rules.values():
+            for part in rule.parts:
+                uses[part.symbol] = uses.get(part.symbol, 0) + 1
+        found = next(
+            (
+                (name, i)
+                for name, rule in rules.items()
+                if rule.op == "split"
+                for i, part in enumerate(rule.parts)
+                if uses[part.symbol] == 1
+                and part.symbol in rules
+                and rules[part.symbol].op == "split"
+                and rules[part.symbol].axis == rule.axis
+            ),
+            None,
+        )
+        if found is None:
+            return replace(grammar, rules=rules)
+        name, i = found
+        parent = rules[name]
+        child = rules.pop(parent.parts[i].symbol)
+        rules[name] = replace(parent, parts=parent.parts[:i] + child.parts + parent.parts[i + 1 :])
 
 
 Box = tuple[str, float, float, float, float]
