@@ -338,3 +338,25 @@ def test_the_safety_time_limit_is_reported_as_such_never_as_no_layout() -> None:
     with pytest.raises(SearchLimitError, match="time limit") as raised:
         solve(parse_spec(text))
     assert raised.value.exit_code == 4
+
+
+def test_many_alignment_groups_of_long_words_do_not_exhaust_the_stack() -> None:
+    """The exact search recurses a column at a time through every group in turn: 40
+    groups of 31-letter words are a path of some 2,500 columns (an internal error before)."""
+    letters = " ".join(["A", "B"] * 15 + ["A"])
+    layers = "\n".join(f"  - {{name: L{k}, x: row, y: V, groups: {{x: g{k}}}}}" for k in range(40))
+    spec = parse_spec(
+        f"""
+version: 1
+name: many-groups
+canvas: {{width: 46.0, height: 3}}
+symbol_defaults: {{opaque: true}}
+symbols: {{A: 1.0, B: 2.0, V: 3}}
+patterns: {{row: "{letters}"}}
+layers:
+{layers}
+"""
+    )
+    layout = solve(spec)
+    assert layout.x.objective < 1e-9
+    assert len([s for s in layout.shapes if s.layer == "L39"]) == 31

@@ -23,6 +23,7 @@ the same input gives the same answer on any machine.
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -40,6 +41,7 @@ Option = tuple[Move | None, np.ndarray | None]  # an entry (None: a gap), its le
 Options = tuple[list[Option], list[int], np.ndarray]  # see _Search.options()
 LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
 COMBINATION_WORK = 64  # partial columns built per work unit
+RECURSION_MARGIN = 1000  # frames beyond the search's deepest path (the callers', numpy's)
 SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
 
 
@@ -798,6 +800,11 @@ def align_exactly(
     variables = {name: i for i, name in enumerate([*sized, *placeholders])}
     target = np.array([spec.size(name) for name in sized], dtype=float)
     search = _Search(spec, canvas, prepared, budget, incumbent, variables, target)
+    # the search recurses a column at a time through every group in turn: room for the
+    # longest path (a column per half-step of every row, at most), whatever the groups
+    depth = sum(max(group.ends, default=0) for group in prepared) + RECURSION_MARGIN
+    limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(limit, depth))
     # first without gaps (most layouts have none, and gaps multiply the columns out of
     # every state), then with them, looking only for better layouts than that one
     try:
@@ -810,6 +817,8 @@ def align_exactly(
         pass
     except BudgetExhausted:
         return Outcome(search.best, False, "the search budget ran out")
+    finally:
+        sys.setrecursionlimit(limit)
     reason = ""
     if search.best is None:
         # the rule that stopped the search furthest along, then the most often
