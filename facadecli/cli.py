@@ -7,6 +7,7 @@ limit) before it found a layout. No traceback reaches a user unless ``--debug``.
 
 from __future__ import annotations
 
+import json
 import math
 import sys
 import traceback
@@ -32,7 +33,7 @@ from facadecli.export import (
 from facadecli.limits import CANVAS_MAX
 from facadecli.preview import preview_words
 from facadecli.solve import retarget, solve, solve_variants
-from facadecli.spec import Spec, load_spec, spec_schema_text
+from facadecli.spec import Spec, load_spec, parse_spec, spec_schema_text
 
 app = typer.Typer(
     name="facade",
@@ -356,6 +357,100 @@ def _size(text: str, option: str = "--derive") -> tuple[float, float]:
             param_hint=option,
         )
     return width, height
+
+
+@app.command()
+def infer(
+    layout: Annotated[
+        Path,
+        typer.Argument(
+            help="A labelled layout: CMP .xml, a facadecli .layout.json, or a JSON list of "
+            "rectangles.",
+            metavar="LAYOUT",
+        ),
+    ],
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output",
+            "-o",
+            help="The spec to write [default: out/<name>.yaml]; the report goes beside it "
+            "as <name>.infer.json.",
+            show_default=False,
+        ),
+    ] = None,
+    size: Annotated[
+        str | None,
+        typer.Option(
+            "--size",
+            metavar="WxH",
+            help="The façade's real size WxH (CMP annotations are a unit square).",
+            show_default=False,
+        ),
+    ] = None,
+    snap: Annotated[
+        float | None,
+        typer.Option(
+            "--snap",
+            min=0,
+            max=0.1,
+            help="Join edges closer than this fraction of the façade [as facade grammar].",
+            show_default=False,
+        ),
+    ] = None,
+    tolerance: Annotated[
+        float | None,
+        typer.Option(
+            "--tolerance",
+            min=0,
+            max=0.1,
+            help="Give repeated elements one size within this fraction [as facade grammar].",
+            show_default=False,
+        ),
+    ] = None,
+    check: Annotated[
+        bool,
+        typer.Option(
+            "--check/--no-check",
+            help="Solve the spec at the input's size (intersection over union per label) "
+            "and at 0.7 and 1.5 times its width, and report it.",
+        ),
+    ] = True,
+) -> None:
+    """Infer a layered spec from a labelled façade: a wall and a layer per grid of each
+    label's elements, back to front, with the sizes measured."""
+    from facadecli.grammar.run import Options, stem
+    from facadecli.infer.run import check as check_spec
+    from facadecli.infer.run import infer as infer_spec
+
+    name = stem(layout)
+    target = output or Path("out") / f"{name}.yaml"
+    report_path = target.with_name(f"{target.name.removesuffix('.yaml')}.infer.json")
+    check_output_file(target)
+    check_output_file(report_path)
+    options = Options(snap=snap, tolerance=tolerance, size=_size(size, "--size") if size else None)
+    inferred = infer_spec(layout, name, options)
+    spec = parse_spec(inferred.text, str(target))  # a bug if it fails: never the user's input
+    if check:
+        inferred.checks = check_spec(inferred, spec)
+    report = inferred.report()
+    target.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(target, inferred.text)
+    write_atomic(report_path, json.dumps(report, indent=2) + "\n")
+    summary = (
+        f"{report['layers']} layers, {report['spec_lines']} lines for "
+        f"{report['rectangles']} rectangles"
+    )
+    if check and not report.get("solves"):
+        typer.echo(f"{layout}: warning: the spec does not solve: {report.get('error')}", err=True)
+    elif check:
+        summary += f", IoU at least {report['iou_min']:.3f}"
+        for entry in report["retargets"]:  # type: ignore[attr-defined]
+            if not entry["solves"]:
+                typer.echo(
+                    f"{layout}: warning: at {entry['width']:g} m wide: {entry['error']}", err=True
+                )
+    typer.echo(f"{layout}: {summary} -> {target}, {report_path}")
 
 
 @app.command()

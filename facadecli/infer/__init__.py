@@ -1,0 +1,1 @@
+"""From a labelled façade back to a layered spec (``facade infer``)."""

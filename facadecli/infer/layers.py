@@ -1,0 +1,93 @@
+"""The layers of a labelled layout: each label's elements as grids, back to front.
+
+The layered model draws a layer as the outer product of a horizontal and a vertical word
+(Ilčík et al. 2015), so a layer's elements are a *grid*: every row holds an element in
+every column. A label's elements are split into grids: rows (one height span) that hold the
+same columns (width spans) form one, bottom up; elements that overlap one of their label
+already taken in a row, and rows that overlap a row already in the grid, go to the next
+grid. Labels stack in the input's z-order (the CMP order: what is drawn over what), and the
+background becomes the wall behind them all, cut at every edge of every element so that
+each element's edges are edges of the wall's cells (an opaque letter cannot be split).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass
+
+from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
+
+Span = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Grid:
+    """One layer: a label's elements at every crossing of ``columns`` and ``rows``."""
+
+    label: str
+    columns: tuple[Span, ...]  # along x, left to right
+    rows: tuple[Span, ...]  # along y, bottom up
+
+    @property
+    def elements(self) -> int:
+        return len(self.columns) * len(self.rows)
+
+
+def _z(label: str, rects: list[Rect]) -> tuple[int, float, str]:
+    """Back to front: the CMP order, then the z the input gives, then the label."""
+    return (CMP_Z_ORDER.get(label, 99), min(r.z for r in rects), label)
+
+
+def grids(layout: LabelledLayout, background: str = BACKGROUND) -> list[Grid]:
+    """Every label's elements as grids, back to front (see the module)."""
+    by_label: dict[str, list[Rect]] = defaultdict(list)
+    for rect in layout.rects:
+        if rect.label != background:
+            by_label[rect.label].append(rect)
+    found: list[Grid] = []
+    for label in sorted(by_label, key=lambda name: _z(name, by_label[name])):
+        spans = sorted({((r.y0, r.y1), (r.x0, r.x1)) for r in by_label[label]})
+        while spans:
+            taken, spans = _grid_rows(spans)
+            found.extend(_by_columns(label, taken))
+    return found
+
+
+def _grid_rows(spans: list[tuple[Span, Span]]) -> tuple[dict[Span, tuple[Span, ...]], list]:  # type: ignore[type-arg]
+    """Rows of disjoint elements (the rest for later grids)."""
+    rows: dict[Span, list[Span]] = defaultdict(list)
+    rest = []
+    for row, column in spans:
+        held = rows[row]
+        if held and held[-1][1] > column[0]:  # overlaps the last one taken in its row
+            rest.append((row, column))
+        else:
+            held.append(column)
+    return {row: tuple(columns) for row, columns in rows.items()}, rest
+
+
+def _by_columns(label: str, rows: dict[Span, tuple[Span, ...]]) -> list[Grid]:
+    """Rows that hold the same columns, as grids whose rows do not overlap."""
+    same: dict[tuple[Span, ...], list[Span]] = defaultdict(list)
+    for row in sorted(rows):
+        same[rows[row]].append(row)
+    found: list[Grid] = []
+    for columns, members in same.items():
+        stacks: list[list[Span]] = []
+        for row in members:  # bottom up; a row overlapping the last of a stack starts another
+            stack = next((s for s in stacks if s[-1][1] <= row[0]), None)
+            if stack is None:
+                stacks.append([row])
+            else:
+                stack.append(row)
+        found.extend(Grid(label, columns, tuple(stack)) for stack in stacks)
+    return sorted(found, key=lambda g: (g.rows[0], g.columns[0]))
+
+
+def cuts(found: list[Grid], extent: float, axis: str) -> list[float]:
+    """Every edge of every element along an axis, with the façade's own."""
+    edges = {0.0, extent}
+    for grid in found:
+        for a, b in grid.columns if axis == "x" else grid.rows:
+            edges.update((a, b))
+    return sorted(edges)

@@ -1,0 +1,134 @@
+"""``facade infer`` (issue 15): a labelled layout back to a layered spec that solves to it."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from facadecli import parse_spec
+from facadecli.grammar.tiling import LabelledLayout, Rect
+from facadecli.infer.layers import grids
+from facadecli.infer.run import Inference, check, infer
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _palazzo() -> list[dict[str, object]]:
+    """Three floors of three windows over a door, on an 11.4 x 10 façade."""
+    rects: list[dict[str, object]] = []
+    for floor in range(3):
+        y = 3.5 + 2.0 * floor
+        for bay in range(3):
+            x = 2.1 + 3.0 * bay
+            rects.append({"label": "window", "x0": x, "y0": y, "x1": x + 1.2, "y1": y + 1.5})
+            rects.append({"label": "sill", "x0": x - 0.1, "y0": y - 0.15, "x1": x + 1.3, "y1": y})
+    rects.append({"label": "door", "x0": 5.1, "y0": 0.0, "x1": 6.3, "y1": 2.6})
+    rects.append({"label": "shop", "x0": 1.6, "y0": 0.4, "x1": 3.8, "y1": 2.6})
+    return rects
+
+
+def _write(path: Path, rects: list[dict[str, object]], width: float = 11.4) -> Path:
+    path.write_text(json.dumps({"canvas": {"width": width, "height": 10.0}, "rects": rects}))
+    return path
+
+
+def test_a_label_is_split_into_grids() -> None:
+    rects = [Rect("window", x, y, x + 1, y + 1, 1) for x in (1, 3, 5) for y in (1, 4)]
+    rects += [Rect("window", 1, 7, 2, 8, 1), Rect("window", 5, 7, 6, 8, 1)]  # a third row: 2
+    rects += [Rect("window", 1.5, 1, 2.5, 2, 1)]  # overlaps a window of its row
+    found = grids(LabelledLayout(7.0, 9.0, tuple(rects)))
+    assert [(len(g.columns), len(g.rows)) for g in found] == [(3, 2), (2, 1), (1, 1)]
+    assert found[2].columns == ((1.5, 2.5),)  # in a grid of its own, in front
+    assert found[0].columns == ((1, 2), (3, 4), (5, 6)) and found[0].rows == ((1, 2), (4, 5))
+
+
+def test_the_spec_solves_back_to_the_input(tmp_path: Path) -> None:
+    inferred = infer(_write(tmp_path / "palazzo.json", _palazzo()), "palazzo")
+    spec = parse_spec(inferred.text, "palazzo.yaml")
+    assert [layer.name for layer in spec.layers] == ["wall", "sill", "door", "shop", "window"]
+    checks = check(inferred, spec)
+    assert checks["solves"] and checks["iou"] == {
+        "door": 1.0,
+        "facade": 1.0,
+        "shop": 1.0,
+        "sill": 1.0,
+        "window": 1.0,
+    }
+    assert [r["solves"] for r in checks["retargets"]] == [True, True]  # type: ignore[index]
+    assert "window_w1" in inferred.text and "window_w2" not in inferred.text  # one size
+
+
+def test_the_check_sees_a_spec_that_does_not_match(tmp_path: Path) -> None:
+    inferred = infer(_write(tmp_path / "palazzo.json", _palazzo()), "palazzo")
+    wrong = Inference(
+        inferred.source,
+        inferred.layout,
+        inferred.tiling,
+        inferred.grids,
+        inferred.text.replace("door_w1: {size: 1.2", "door_w1: {size: 0.6"),
+    )
+    checks = check(wrong, parse_spec(wrong.text, "wrong.yaml"))
+    assert checks["solves"] and checks["iou"]["door"] < 0.9  # type: ignore[index]
+
+
+def _infer(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "facadecli", "infer", *args], capture_output=True, text=True
+    )
+
+
+def test_facade_infer_writes_a_valid_spec_and_its_report(tmp_path: Path) -> None:
+    source = _write(tmp_path / "palazzo.json", _palazzo())
+    spec = tmp_path / "out" / "palazzo.yaml"
+    done = _infer(str(source), "-o", str(spec))
+    assert done.returncode == 0, done.stderr
+    assert "IoU at least 1.000" in done.stdout
+    report = json.loads((tmp_path / "out" / "palazzo.infer.json").read_text())
+    assert report["rectangles"] == 20 and report["layers"] == 5 and report["iou_min"] == 1.0
+    assert report["spec_lines"] == len(
+        [line for line in spec.read_text().splitlines() if line and not line.startswith("#")]
+    )
+    validate = subprocess.run(
+        [sys.executable, "-m", "facadecli", "validate", str(spec)], capture_output=True, text=True
+    )
+    assert validate.returncode == 0, validate.stderr
+    quick = _infer(str(source), "-o", str(tmp_path / "quick.yaml"), "--no-check")
+    assert quick.returncode == 0 and "iou" not in json.loads(
+        (tmp_path / "quick.infer.json").read_text()
+    )
+
+
+def test_facade_infer_rejects_a_layout_without_elements(tmp_path: Path) -> None:
+    empty = _write(
+        tmp_path / "empty.json", [{"label": "facade", "x0": 0, "y0": 0, "x1": 1, "y1": 1}]
+    )
+    done = _infer(str(empty), "-o", str(tmp_path / "empty.yaml"))
+    assert done.returncode == 2 and "no elements" in done.stderr and "Traceback" not in done.stderr
+    assert not (tmp_path / "empty.yaml").exists()
+
+
+def test_a_solved_example_infers_back(tmp_path: Path) -> None:
+    solved = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "facadecli",
+            "solve",
+            str(ROOT / "specs" / "residential-house.yaml"),
+            "-o",
+            str(tmp_path),
+            "-f",
+            "json",
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert solved.returncode == 0, solved.stderr
+    (layout,) = tmp_path.glob("*.layout.json")
+    done = _infer(str(layout), "-o", str(tmp_path / "back.yaml"))
+    assert done.returncode == 0, done.stderr
+    report = json.loads((tmp_path / "back.infer.json").read_text())
+    assert report["solves"] and report["iou_min"] >= 0.9
+    assert all(r["solves"] for r in report["retargets"])
