@@ -44,10 +44,11 @@ format: $(STAMP) ## Reformat the code with ruff
 	$(BIN)/ruff check --fix facadecli tests
 	$(BIN)/ruff format facadecli tests
 
-bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extraction on CMP, and cities
+bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extraction on CMP, cities, and infer on CMP
 	$(BIN)/python tests/benchmarks/bench.py
 	$(BIN)/python tests/benchmarks/grammar_bench.py
 	$(BIN)/python tests/benchmarks/city_bench.py
+	$(BIN)/python tests/benchmarks/infer_bench.py
 
 schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json

@@ -132,3 +132,19 @@ def test_a_solved_example_infers_back(tmp_path: Path) -> None:
     report = json.loads((tmp_path / "back.infer.json").read_text())
     assert report["solves"] and report["iou_min"] >= 0.9
     assert all(r["solves"] for r in report["retargets"])
+
+
+def test_runs_become_counters_and_a_wider_facade_gains_bays(tmp_path: Path) -> None:
+    from facadecli import solve
+    from facadecli.solve import retarget
+
+    inferred = infer(_write(tmp_path / "palazzo.json", _palazzo()), "palazzo")
+    assert "(window_w1 window_gx" in inferred.text and "counters:" in inferred.text
+    spec = parse_spec(inferred.text, "palazzo.yaml")
+    windows = {}
+    for width in (11.4, 17.1):
+        layout = solve(retarget(spec, width, 10.0))
+        shown = [s for s in layout.shapes if s.layer == "window" and s.visible]
+        windows[width] = (len(shown), {round(s.x1 - s.x0, 1) for s in shown})
+    assert windows[11.4] == (9, {1.2})
+    assert windows[17.1][0] == 15 and windows[17.1][1] <= {1.1, 1.2, 1.3}  # 5 bays, not wider

@@ -1,17 +1,21 @@
 """A layered spec, as YAML text, from the grids of a labelled layout.
 
-- The wall: the background, one opaque letter per cell between two consecutive edges of
-  any element (so every element's edges are the wall's), along x and along y.
-- One layer per grid, back to front: along each axis its word is the elements' sizes with
-  the wall's cells between them; the layer's mask shows its elements only. Each layer is
-  an alignment group of its own (SPEC 2.6): its word alone covers the canvas, so nothing
-  is left to align, and the layers hold together through their shared symbols (the
-  wall's cells, the elements' sizes), which the sizing QP gives one size each. Cells of
-  one size share a symbol, and so do elements: equal gaps and mirrored margins stay equal
-  when the spec is retargeted.
-- Symbols have the sizes measured (in metres, to a tenth of a millimetre); elements are
-  opaque (their shapes cover their cells). No symbol is unoccludable: every layer's
-  cells between its elements stand in front of the layers behind it.
+- The wall: the background, one opaque cell over the whole canvas, behind everything.
+- One layer per grid, back to front. Along each axis its word is its elements with the
+  gaps between them (and the margins to the façade's edges); its mask (``visible``) shows
+  the elements only. Each layer is an alignment group of its own (SPEC 2.6): its word
+  alone covers the canvas, so nothing is left to align (which would cost the solver
+  dearly with dozens of layers), and the layers hold together through their shared
+  symbols, which the sizing QP gives one size each.
+- Symbols: a layer's gaps of one size share one (``window_gx1``, ``window_gy2``), and a
+  label's elements of one size share one across layers (``window_w1``, ``window_h2``),
+  with the sizes measured (in metres, to a tenth of a millimetre); all are opaque (a
+  layer's gaps are hidden by its mask). Gaps are a layer's own: shared between layers,
+  they would tie the layers' words so tightly that only the input's size could hold them.
+- Repeats: where a word repeats a gap and an element twice or more (three elements), or
+  an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
+  counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
+  pitch and one count along an axis share the counter, so windows and sills keep together.
 - Meshes and materials by label (frames for windows and shop fronts, doors, ledges for
   sills, cornices and mouldings, balconies, shutters for blinds, boxes for the rest),
   colours from the label palette; every layer says in a comment where it came from.
@@ -19,15 +23,15 @@
 
 from __future__ import annotations
 
-import itertools
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.layers import Grid, Span, cuts
+from facadecli.infer.layers import Grid, Span
 
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
+RUNS = {1: 3, 2: 2}  # copies of a unit of one letter, or of two, that make a repeat
 MESHES = {  # CMP labels; anything else is a box
     "window": ("frame", 0.1),
     "door": ("door", 0.12),
@@ -49,7 +53,7 @@ class _Symbols:
     """Symbol names by kind and size: one symbol per distinct size of a kind."""
 
     prefix: str
-    sizes: dict[float, str]
+    sizes: dict[float, str] = field(default_factory=dict)
 
     def of(self, size: float) -> str:
         key = round(size, 6)
@@ -59,60 +63,82 @@ class _Symbols:
         return name
 
 
+@dataclass
+class _Counters:
+    """Counters by (axis, pitch, count): runs alike share one."""
+
+    names: dict[tuple[str, float, int], str] = field(default_factory=dict)
+
+    def of(self, axis: str, pitch: float, count: int) -> str:
+        key = (axis, round(pitch, 4), count)
+        name = self.names.get(key)
+        if name is None:
+            name = self.names[key] = f"n{len(self.names) + 1}"
+        return name
+
+
 def ident(label: str) -> str:
     """A label as a name a spec accepts."""
     name = re.sub(r"[^A-Za-z0-9_]", "_", label) or "label"
     return name if name[0].isalpha() else "L" + name
 
 
-def _word(spans: tuple[Span, ...], edges: list[float], element: _Symbols, spacer: _Symbols) -> str:
-    """Elements and, between them, a spacer per cell of the wall (so no letter is ever
-    split: every row steps from one edge of the wall to the next with the others)."""
-    letters = []
-    starts = {a: (a, b) for a, b in spans}
-    inside = None
-    for a, b in itertools.pairwise(edges):
-        if inside is not None:
-            if b >= inside[1]:
-                inside = None
-            continue
-        if a in starts:
-            inside = starts[a]
-            letters.append(element.of(inside[1] - inside[0]))
-            if b >= inside[1]:
-                inside = None
-        else:
-            letters.append(spacer.of(b - a))
-    return " ".join(letters)
+def _tokens(spans: tuple[Span, ...], extent: float, element: _Symbols, gap: _Symbols) -> list:  # type: ignore[type-arg]
+    """(symbol, size) of the elements and the gaps between them, from 0 to ``extent``."""
+    tokens = []
+    cursor = 0.0
+    for a, b in spans:
+        if a - cursor > 1e-9 * extent:
+            tokens.append((gap.of(a - cursor), a - cursor))
+        tokens.append((element.of(b - a), b - a))
+        cursor = b
+    if extent - cursor > 1e-9 * extent:
+        tokens.append((gap.of(extent - cursor), extent - cursor))
+    return tokens
 
 
-def _cells(edges: list[float], cell: _Symbols) -> str:
-    return " ".join(cell.of(b - a) for a, b in itertools.pairwise(edges))
-
-
-def _overlaps(grid: Grid, other: Grid) -> bool:
-    return any(
-        a < d and c < b and e < h and g < f
-        for (a, b), (c, d) in itertools.product(grid.columns, other.columns)
-        for (e, f), (g, h) in itertools.product(grid.rows, other.rows)
-    )
+def _word(tokens: list, axis: str, counters: _Counters) -> str:  # type: ignore[type-arg]
+    """The tokens as a word, the longest run of a repeated unit (one or two letters, at
+    least ``RUNS`` copies) written with a counter."""
+    symbols = [symbol for symbol, _ in tokens]
+    best = None  # (letters covered, start, unit, copies)
+    for unit in (1, 2):
+        for start in range(len(tokens) - unit):
+            copies = 1
+            while (
+                symbols[start + copies * unit : start + (copies + 1) * unit]
+                == (symbols[start : start + unit])
+            ):
+                copies += 1
+            if copies >= RUNS[unit] and (best is None or copies * unit > best[0]):
+                best = (copies * unit, start, unit, copies)
+    if best is None:
+        return " ".join(symbols)
+    _, start, unit, copies = best
+    pitch = sum(size for _, size in tokens[start : start + unit])
+    counter = counters.of(axis, pitch, copies)
+    body = " ".join(symbols[start : start + unit])
+    run = f"({body})^{counter}" if unit > 1 else f"{body}^{counter}"
+    return " ".join([*symbols[:start], run, *symbols[start + copies * unit :]])
 
 
 def spec_text(name: str, width: float, height: float, found: list[Grid], source: str) -> str:
     """The spec (see the module)."""
-    xs, ys = cuts(found, width, "x"), cuts(found, height, "y")
-    wall_x, wall_y = _Symbols("wx", {}), _Symbols("wy", {})
+    gaps: list[_Symbols] = []
+    counters = _Counters()
     elements: dict[str, tuple[_Symbols, _Symbols]] = {}
-    patterns = {"wall_x": _cells(xs, wall_x), "wall_y": _cells(ys, wall_y)}
+    patterns = {"wall_x": "wall_w", "wall_y": "wall_h"}
     layers: list[tuple[str, Grid]] = []
     masks: dict[str, tuple[list[str], list[str]]] = {}
     for layer, grid in zip(layer_names(found), found, strict=True):
         base = ident(grid.label)
-        symbols = elements.setdefault(
-            grid.label, (_Symbols(f"{base}_w", {}), _Symbols(f"{base}_h", {}))
-        )
-        patterns[f"{layer}_x"] = _word(grid.columns, xs, symbols[0], wall_x)
-        patterns[f"{layer}_y"] = _word(grid.rows, ys, symbols[1], wall_y)
+        symbols = elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
+        gap_x, gap_y = _Symbols(f"{layer}_gx"), _Symbols(f"{layer}_gy")
+        gaps += [gap_x, gap_y]
+        x_tokens = _tokens(grid.columns, width, symbols[0], gap_x)
+        y_tokens = _tokens(grid.rows, height, symbols[1], gap_y)
+        patterns[f"{layer}_x"] = _word(x_tokens, "x", counters)
+        patterns[f"{layer}_y"] = _word(y_tokens, "y", counters)
         masks[layer] = (
             sorted({symbols[0].of(b - a) for a, b in grid.columns}),
             sorted({symbols[1].of(b - a) for a, b in grid.rows}),
@@ -120,26 +146,34 @@ def spec_text(name: str, width: float, height: float, found: list[Grid], source:
         layers.append((layer, grid))
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
-        "# a label's elements on a grid (its columns x its rows), back to front. Between",
-        "# its elements a layer holds the wall's cells (wx, wy), and shows its elements only.",
+        "# a label's elements on a grid (its columns x its rows), back to front, with the",
+        "# gaps between them (_gx, _gy; hidden). Runs repeat with counters (n1, ...).",
         "version: 1",
         f"name: {name}",
         f"canvas: {{width: {_number(width)}, height: {_number(height)}}}",
         "symbol_defaults: {opaque: true}",
         f"solver: {{tolerance: {TOLERANCE}}}",
         "symbols:",
+        f"  wall_w: {{size: {_number(width)}, label: wall}}",
+        f"  wall_h: {{size: {_number(height)}, label: wall}}",
     ]
-    for names, label in ((wall_x, "wall"), (wall_y, "wall")):
-        out += [f"  {n}: {{size: {_number(s)}, label: {label}}}" for s, n in names.sizes.items()]
+    for names in gaps:
+        out += [f"  {n}: {{size: {_number(s)}, label: gap}}" for s, n in names.sizes.items()]
     for label, pair in elements.items():
         for names in pair:
             for size, symbol in names.sizes.items():
                 out.append(f"  {symbol}: {{size: {_number(size)}, label: {label}}}")
+    if counters.names:
+        out.append("counters:")
+        out += [
+            f"  {n}: {{min: 1}}  # {count} along {axis} at a pitch of {_number(pitch)} m"
+            for (axis, pitch, count), n in counters.names.items()
+        ]
     out.append("patterns:")
     out += [f'  {pattern}: "{word}"' for pattern, word in patterns.items()]
     out.append("layers:")
     out += [
-        "  - name: wall  # the background, cut at every element's edges",
+        "  - name: wall  # the background",
         "    x: wall_x",
         "    y: wall_y",
         "    shapes: [{material: wall, mesh: box, thickness: 0.3}]",
