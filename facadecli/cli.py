@@ -359,16 +359,52 @@ def _size(text: str, option: str = "--derive") -> tuple[float, float]:
     return width, height
 
 
+# options of the commands that read a labelled layout (grammar, infer)
+LayoutArgument = Annotated[
+    Path,
+    typer.Argument(
+        help="A labelled layout: CMP .xml, a facadecli .layout.json, or a JSON list of rectangles.",
+        metavar="LAYOUT",
+    ),
+]
+SnapOption = Annotated[
+    float | None,
+    typer.Option(
+        "--snap",
+        min=0,
+        max=0.1,
+        help="Join edges closer than this fraction of the façade [default: 0.005 for CMP, "
+        "0.001 for JSON lists, 0 for .layout.json].",
+        show_default=False,
+    ),
+]
+ToleranceOption = Annotated[
+    float | None,
+    typer.Option(
+        "--tolerance",
+        min=0,
+        max=0.1,
+        help="Regularise: give repeated elements one size when they differ by less than "
+        "this fraction of the façade [default: 0.01 for CMP, 0.005 for JSON lists, 0 for "
+        ".layout.json].",
+        show_default=False,
+    ),
+]
+SizeOption = Annotated[
+    str | None,
+    typer.Option(
+        "--size",
+        metavar="WxH",
+        help="The façade's real size WxH (CMP annotations are a unit square): the "
+        "layout is stretched to it.",
+        show_default=False,
+    ),
+]
+
+
 @app.command()
 def infer(
-    layout: Annotated[
-        Path,
-        typer.Argument(
-            help="A labelled layout: CMP .xml, a facadecli .layout.json, or a JSON list of "
-            "rectangles.",
-            metavar="LAYOUT",
-        ),
-    ],
+    layout: LayoutArgument,
     output: Annotated[
         Path | None,
         typer.Option(
@@ -379,35 +415,9 @@ def infer(
             show_default=False,
         ),
     ] = None,
-    size: Annotated[
-        str | None,
-        typer.Option(
-            "--size",
-            metavar="WxH",
-            help="The façade's real size WxH (CMP annotations are a unit square).",
-            show_default=False,
-        ),
-    ] = None,
-    snap: Annotated[
-        float | None,
-        typer.Option(
-            "--snap",
-            min=0,
-            max=0.1,
-            help="Join edges closer than this fraction of the façade [as facade grammar].",
-            show_default=False,
-        ),
-    ] = None,
-    tolerance: Annotated[
-        float | None,
-        typer.Option(
-            "--tolerance",
-            min=0,
-            max=0.1,
-            help="Give repeated elements one size within this fraction [as facade grammar].",
-            show_default=False,
-        ),
-    ] = None,
+    size: SizeOption = None,
+    snap: SnapOption = None,
+    tolerance: ToleranceOption = None,
     check: Annotated[
         bool,
         typer.Option(
@@ -455,14 +465,7 @@ def infer(
 
 @app.command()
 def grammar(
-    layout: Annotated[
-        Path,
-        typer.Argument(
-            help="A labelled layout: CMP .xml, a facadecli "
-            ".layout.json, or a JSON list of rectangles.",
-            metavar="LAYOUT",
-        ),
-    ],
+    layout: LayoutArgument,
     outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
         "out/grammar"
     ),
@@ -487,39 +490,9 @@ def grammar(
     repeat_cost: Annotated[
         float, typer.Option("--repeat-cost", min=0, help="Cost of a repeat rule (Eq. 2).")
     ] = 0.5,
-    snap: Annotated[
-        float | None,
-        typer.Option(
-            "--snap",
-            min=0,
-            max=0.1,
-            help="Join edges closer than this fraction of the façade [default: 0.005 for CMP, "
-            "0.001 for JSON lists, 0 for .layout.json].",
-            show_default=False,
-        ),
-    ] = None,
-    tolerance: Annotated[
-        float | None,
-        typer.Option(
-            "--tolerance",
-            min=0,
-            max=0.1,
-            help="Regularise: give repeated elements one size when they differ by less than "
-            "this fraction of the façade [default: 0.01 for CMP, 0.005 for JSON lists, 0 for "
-            ".layout.json].",
-            show_default=False,
-        ),
-    ] = None,
-    size: Annotated[
-        str | None,
-        typer.Option(
-            "--size",
-            metavar="WxH",
-            help="The façade's real size WxH (CMP annotations are a unit square): the "
-            "layout is stretched to it.",
-            show_default=False,
-        ),
-    ] = None,
+    snap: SnapOption = None,
+    tolerance: ToleranceOption = None,
+    size: SizeOption = None,
     derive: Annotated[
         list[str] | None,
         typer.Option(
