@@ -6,7 +6,7 @@ import textwrap
 
 import pytest
 
-from facadecli import InfeasibleError, make_word, parse_spec, solve
+from facadecli import InfeasibleError, make_word, parse_spec, retarget, solve
 from facadecli.solver.alignment import align, score_alignment
 from facadecli.solver.candidates import (
     generate_candidates,
@@ -360,3 +360,25 @@ layers:
     layout = solve(spec)
     assert layout.x.objective < 1e-9
     assert len([s for s in layout.shapes if s.layer == "L39"]) == 31
+
+
+def test_a_far_larger_canvas_is_not_called_infeasible() -> None:
+    """Two groups sharing a symbol, stretched to three times their words: the closed-form
+    sizing misses its equalities by rounding there (sized symbols weigh 10^8 times the
+    columns), which once read as a conflict: 'no layout exists'."""
+    spec = parse_spec(
+        """
+version: 1
+name: stretched
+canvas: {width: 18, height: 3}
+symbol_defaults: {opaque: true}
+symbols: {a1: 1.0, a2: 2.0, b1: 1.0, b2: 2.0, S: 1.3, T: 1.0, V: 3}
+patterns: {p: "a1 S a2 T a1", q: "b1 T b2 T b1"}
+layers:
+  - {name: P, x: p, y: V, groups: {x: gp}}
+  - {name: Q, x: q, y: V, groups: {x: gq}}
+"""
+    )
+    for width in (6.3, 18.0, 40.0):
+        layout = solve(retarget(spec, width, 3.0))
+        assert abs(max(s.x1 for s in layout.shapes if s.layer == "P") - width) < 1e-6

@@ -163,9 +163,11 @@ def _result(program: Program, values: np.ndarray) -> Sizing:
     return Sizing(values, float(deviation @ deviation), float(values[unsized].sum()))
 
 
-def _equality_solution(program: Program) -> np.ndarray | None:
-    """The minimiser under the equalities alone (bounds ignored), in closed form; None when
-    the equalities conflict."""
+def _equality_solution(program: Program) -> tuple[np.ndarray, bool]:
+    """The minimiser under the equalities alone (bounds ignored), in closed form, and
+    whether it meets them: the normal equations weigh sized symbols against the TINY
+    weights of columns and placeholders, so a large layout can miss them by rounding
+    where they do not conflict at all (a QP solver then decides)."""
     h = 2.0 * program.weight
     e, d = program.equalities, program.rhs
     f = h * program.target
@@ -173,21 +175,16 @@ def _equality_solution(program: Program) -> np.ndarray | None:
     e_scaled = e / h
     normal = e_scaled @ e.T
     nu, *_ = np.linalg.lstsq(normal, e_scaled @ f - d, rcond=None)
-    z = (f - e.T @ nu) / h
-    if np.abs(e @ z - d).max(initial=0.0) > 1e-6:
-        return None
-    solution: np.ndarray = z
-    return solution
+    z: np.ndarray = (f - e.T @ nu) / h
+    return z, bool(np.abs(e @ z - d).max(initial=0.0) <= 1e-6)
 
 
-def _closed_form(program: Program) -> Sizing | np.ndarray | None:
-    """The optimum in closed form when it meets every bound (then no bound is active and
-    it is the QP's optimum); the equality solution when a bound is broken (a QP solver
-    must decide); None when the equalities conflict."""
-    z = _equality_solution(program)
-    if z is None:
-        return None
-    if (z >= program.lower - 1e-9).all() and (z <= program.upper + 1e-9).all():
+def _closed_form(program: Program) -> Sizing | np.ndarray:
+    """The optimum in closed form when it meets every equality and bound (then no bound is
+    active and it is the QP's optimum); else the equality solution (a QP solver must
+    decide, and says when nothing is feasible)."""
+    z, meets = _equality_solution(program)
+    if meets and (z >= program.lower - 1e-9).all() and (z <= program.upper + 1e-9).all():
         return _result(program, np.clip(z, program.lower, program.upper))
     return z
 
