@@ -34,7 +34,7 @@ class Inference:
     checks: dict[str, object] = field(default_factory=dict)
 
     def report(self) -> dict[str, object]:
-        lines = [line for line in self.text.splitlines() if line and not line.startswith("#")]
+        lines = [line for line in self.text.splitlines() if line.strip()[:1] not in ("", "#")]
         return {
             "source": self.source,
             "canvas": {"width": self.layout.width, "height": self.layout.height},

@@ -123,79 +123,66 @@ def _word(tokens: list, axis: str, counters: _Counters) -> str:  # type: ignore[
 
 
 def spec_text(name: str, width: float, height: float, found: list[Grid], source: str) -> str:
-    """The spec (see the module)."""
-    gaps: list[_Symbols] = []
+    """The spec (see the module): the sizes a line per label and a line per layer, and each
+    layer in two lines under the comment that says where it came from."""
     counters = _Counters()
     elements: dict[str, tuple[_Symbols, _Symbols]] = {}
-    patterns = {"wall_x": "wall_w", "wall_y": "wall_h"}
-    layers: list[tuple[str, Grid]] = []
-    masks: dict[str, tuple[list[str], list[str]]] = {}
+    layers: list[tuple[str, Grid, str, str, tuple[_Symbols, _Symbols]]] = []
     for layer, grid in zip(layer_names(found), found, strict=True):
         base = ident(grid.label)
         symbols = elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
-        gap_x, gap_y = _Symbols(f"{layer}_gx"), _Symbols(f"{layer}_gy")
-        gaps += [gap_x, gap_y]
-        x_tokens = _tokens(grid.columns, width, symbols[0], gap_x)
-        y_tokens = _tokens(grid.rows, height, symbols[1], gap_y)
-        patterns[f"{layer}_x"] = _word(x_tokens, "x", counters)
-        patterns[f"{layer}_y"] = _word(y_tokens, "y", counters)
-        masks[layer] = (
-            sorted({symbols[0].of(b - a) for a, b in grid.columns}),
-            sorted({symbols[1].of(b - a) for a, b in grid.rows}),
-        )
-        layers.append((layer, grid))
+        gaps = (_Symbols(f"{layer}_gx"), _Symbols(f"{layer}_gy"))
+        x = _word(_tokens(grid.columns, width, symbols[0], gaps[0]), "x", counters)
+        y = _word(_tokens(grid.rows, height, symbols[1], gaps[1]), "y", counters)
+        layers.append((layer, grid, x, y, gaps))
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
         "# a label's elements on a grid (its columns x its rows), back to front, with the",
-        "# gaps between them (_gx, _gy; hidden). Runs repeat with counters (n1, ...).",
+        "# gaps between them (<layer>_gx, _gy: hidden); runs repeat with counters (n1, ...).",
+        "# Sizes in metres: a line per label's elements, then per layer's gaps.",
         "version: 1",
         f"name: {name}",
         f"canvas: {{width: {_number(width)}, height: {_number(height)}}}",
         "symbol_defaults: {opaque: true}",
         f"solver: {{tolerance: {TOLERANCE}}}",
-        "symbols:",
-        f"  wall_w: {{size: {_number(width)}, label: wall}}",
-        f"  wall_h: {{size: {_number(height)}, label: wall}}",
+        "symbols: {",
+        f"  wall_w: {_number(width)}, wall_h: {_number(height)},",
     ]
-    for names in gaps:
-        out += [f"  {n}: {{size: {_number(s)}, label: gap}}" for s, n in names.sizes.items()]
-    for label, pair in elements.items():
-        for names in pair:
-            for size, symbol in names.sizes.items():
-                out.append(f"  {symbol}: {{size: {_number(size)}, label: {label}}}")
+    sizes = [[*pair[0].sizes.items(), *pair[1].sizes.items()] for pair in elements.values()]
+    sizes += [[*gaps[0].sizes.items(), *gaps[1].sizes.items()] for *_, gaps in layers]
+    out += [
+        "  " + ", ".join(f"{symbol}: {_number(size)}" for size, symbol in line) + ","
+        for line in sizes
+        if line
+    ]
+    out[-1] = out[-1].rstrip(",")
+    out.append("}")
     if counters.names:
         out.append("counters:")
         out += [
             f"  {n}: {{min: 1}}  # {count} along {axis} at a pitch of {_number(pitch)} m"
             for (axis, pitch, count), n in counters.names.items()
         ]
-    out.append("patterns:")
-    out += [f'  {pattern}: "{word}"' for pattern, word in patterns.items()]
+    out.append("patterns: {wall_x: wall_w, wall_y: wall_h}")
     out.append("layers:")
-    out += [
-        "  - name: wall  # the background",
-        "    x: wall_x",
-        "    y: wall_y",
-        "    shapes: [{material: wall, mesh: box, thickness: 0.3}]",
-    ]
-    for k, (layer, grid) in enumerate(layers, start=1):
+    out.append("  # the background")
+    out.append("  - {name: wall, x: wall_x, y: wall_y, shapes: [{material: wall, thickness: 0.3}]}")
+    for k, (layer, grid, x, y, _) in enumerate(layers, start=1):
         mesh, thickness = MESHES.get(grid.label, DEFAULT_MESH)
         rows = ", ".join(f"{_number(a)}-{_number(b)}" for a, b in grid.rows)
+        shown_x = sorted({elements[grid.label][0].of(b - a) for a, b in grid.columns})
+        shown_y = sorted({elements[grid.label][1].of(b - a) for a, b in grid.rows})
         out += [
-            f"  - name: {layer}  # {grid.elements} {grid.label} of the input: "
-            f"{len(grid.columns)} columns, rows at y = {rows}",
-            f"    x: {layer}_x",
-            f"    y: {layer}_y",
-            f"    visible: {{x: [{', '.join(masks[layer][0])}], "
-            f"y: [{', '.join(masks[layer][1])}]}}",
-            f"    groups: {{x: {layer}, y: {layer}}}",
-            f"    offset: {_number(STEP * k)}",
-            f"    shapes: [{{material: {ident(grid.label)}, mesh: {mesh}, "
-            f"thickness: {thickness}}}]",
+            f"  # {grid.elements} {grid.label} of the input: {len(grid.columns)} columns, "
+            f"rows at y = {rows}",
+            f'  - {{name: {layer}, x: "{x}", y: "{y}",',
+            f"     visible: {{x: [{', '.join(shown_x)}], y: [{', '.join(shown_y)}]}}, "
+            f"groups: {{x: {layer}, y: {layer}}}, offset: {_number(STEP * k)}, "
+            f"shapes: [{{material: {ident(grid.label)}, mesh: {mesh}, thickness: {thickness}}}]}}",
         ]
-    out.append("materials:")
-    out.append(f'  wall: {{color: "{label_colour("facade")}"}}')
-    out += [f'  {ident(label)}: {{color: "{label_colour(label)}"}}' for label in elements]
+    colours = [("wall", label_colour("facade"))]
+    colours += [(ident(label), label_colour(label)) for label in elements]
+    out.append("materials: {" + ", ".join(f'{n}: {{color: "{c}"}}' for n, c in colours) + "}")
     return "\n".join(out) + "\n"
 
 
