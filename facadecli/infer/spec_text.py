@@ -45,6 +45,8 @@ MESHES = {  # CMP labels; anything else is a box
     "deco": ("box", 0.08),
 }
 DEFAULT_MESH = ("box", 0.1)
+PANE = ", pane_material: pane"  # glass that reads as glass over the wall behind it
+PANE_COLOUR = "#2f4356"  # (the wall has no openings: a see-through pane would show it)
 STEP = 0.02  # m: each layer stands this much further out than the one behind it
 
 
@@ -178,9 +180,10 @@ def spec_text(name: str, width: float, height: float, found: list[Grid], source:
             f'  - {{name: {layer}, x: "{x}", y: "{y}",',
             f"     visible: {{x: [{', '.join(shown_x)}], y: [{', '.join(shown_y)}]}}, "
             f"groups: {{x: {layer}, y: {layer}}}, offset: {_number(STEP * k)}, "
-            f"shapes: [{{material: {ident(grid.label)}, mesh: {mesh}, thickness: {thickness}}}]}}",
+            f"shapes: [{{material: {ident(grid.label)}, mesh: {mesh}, thickness: {thickness}"
+            f"{PANE if mesh in ('frame', 'door') else ''}}}]}}",
         ]
-    colours = [("wall", label_colour("facade"))]
+    colours = [("wall", label_colour("facade")), ("pane", PANE_COLOUR)]
     colours += [(ident(label), label_colour(label)) for label in elements]
     out.append("materials: {" + ", ".join(f'{n}: {{color: "{c}"}}' for n, c in colours) + "}")
     return "\n".join(out) + "\n"
