@@ -5,9 +5,8 @@ The layered model draws a layer as the outer product of a horizontal and a verti
 every column. A label's elements are split into grids: rows (one height span) that hold the
 same columns (width spans) form one, bottom up; elements that overlap one of their label
 already taken in a row, and rows that overlap a row already in the grid, go to the next
-grid. Labels stack in the input's z-order (the CMP order: what is drawn over what), and the
-background becomes the wall behind them all, cut at every edge of every element so that
-each element's edges are edges of the wall's cells (an opaque letter cannot be split).
+grid. Labels stack in the input's z-order (the CMP order: what is drawn over what); the
+background becomes the wall behind them all.
 """
 
 from __future__ import annotations
@@ -53,10 +52,12 @@ def grids(layout: LabelledLayout, background: str = BACKGROUND) -> list[Grid]:
     return found
 
 
-def _grid_rows(spans: list[tuple[Span, Span]]) -> tuple[dict[Span, tuple[Span, ...]], list]:  # type: ignore[type-arg]
+def _grid_rows(
+    spans: list[tuple[Span, Span]],
+) -> tuple[dict[Span, tuple[Span, ...]], list[tuple[Span, Span]]]:
     """Rows of disjoint elements (the rest for later grids)."""
     rows: dict[Span, list[Span]] = defaultdict(list)
-    rest = []
+    rest: list[tuple[Span, Span]] = []
     for row, column in spans:
         held = rows[row]
         if held and held[-1][1] > column[0]:  # overlaps the last one taken in its row
@@ -82,12 +83,3 @@ def _by_columns(label: str, rows: dict[Span, tuple[Span, ...]]) -> list[Grid]:
                 stack.append(row)
         found.extend(Grid(label, columns, tuple(stack)) for stack in stacks)
     return sorted(found, key=lambda g: (g.rows[0], g.columns[0]))
-
-
-def cuts(found: list[Grid], extent: float, axis: str) -> list[float]:
-    """Every edge of every element along an axis, with the façade's own."""
-    edges = {0.0, extent}
-    for grid in found:
-        for a, b in grid.columns if axis == "x" else grid.rows:
-            edges.update((a, b))
-    return sorted(edges)

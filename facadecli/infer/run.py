@@ -18,6 +18,7 @@ from facadecli.grammar.run import TIDY, Options, check_cells, check_options, rea
 from facadecli.grammar.tiling import Tiling, snap_and_count, tile
 from facadecli.infer.layers import Grid, grids
 from facadecli.infer.spec_text import ident, layer_names, spec_text
+from facadecli.layout import Layout
 from facadecli.spec.model import Spec
 
 RASTER = 400  # samples along each axis of the IoU raster
@@ -116,7 +117,7 @@ def _raster_of_tiling(tiling: Tiling, labels: list[str]) -> np.ndarray:
 
 
 def _raster_of_layout(
-    layout: object, spec: Spec, inference: Inference, labels: list[str]
+    layout: Layout, spec: Spec, inference: Inference, labels: list[str]
 ) -> np.ndarray:
     """The label of the solved layout's front-most element at every sample: a layer is its
     grid's label; its spacers, and the wall, are the background."""
@@ -128,7 +129,7 @@ def _raster_of_layout(
         n: g.label for n, g in zip(names[1:], inference.grids, strict=True)
     }
     order = {n: k for k, n in enumerate(names)}
-    shapes = sorted(layout.shapes, key=lambda s: order.get(s.layer, 0))  # type: ignore[attr-defined]
+    shapes = sorted(layout.shapes, key=lambda s: order.get(s.layer, 0))
     for shape in shapes:
         if spec.qualifiers(shape.x).transparent or spec.qualifiers(shape.y).transparent:
             continue

@@ -85,9 +85,14 @@ def ident(label: str) -> str:
     return name if name[0].isalpha() else "L" + name
 
 
-def _tokens(spans: tuple[Span, ...], extent: float, element: _Symbols, gap: _Symbols) -> list:  # type: ignore[type-arg]
+Token = tuple[str, float]  # a letter of a word, and its size
+
+
+def _tokens(
+    spans: tuple[Span, ...], extent: float, element: _Symbols, gap: _Symbols
+) -> list[Token]:
     """(symbol, size) of the elements and the gaps between them, from 0 to ``extent``."""
-    tokens = []
+    tokens: list[Token] = []
     cursor = 0.0
     for a, b in spans:
         if a - cursor > 1e-9 * extent:
@@ -99,7 +104,7 @@ def _tokens(spans: tuple[Span, ...], extent: float, element: _Symbols, gap: _Sym
     return tokens
 
 
-def _word(tokens: list, axis: str, counters: _Counters) -> str:  # type: ignore[type-arg]
+def _word(tokens: list[Token], axis: str, counters: _Counters) -> str:
     """The tokens as a word, the longest run of a repeated unit (one or two letters, at
     least ``RUNS`` copies) written with a counter."""
     symbols = [symbol for symbol, _ in tokens]
