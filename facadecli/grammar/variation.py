@@ -10,8 +10,11 @@ bays rather than wider windows; without elastic parts, the weights share the cha
 
 The derivation is then tidied with a QP per axis (cvxpy), after Bao et al. 2013: edges stay
 near where the derivation put them, terminals that were one size in the source get one size,
-and their edges that nearly line up across the façade are lined up. Constraints that cannot
-all hold are dropped (alignment first, then equal sizes) with a warning.
+their edges that nearly line up across the façade are lined up, and the source's style
+(:mod:`facadecli.grammar.style`) is made exact where the derivation nearly keeps it.
+Constraints that cannot all hold are dropped (alignment first, then the style, then equal
+sizes) with a warning. Of the derivations the repeat counts allow, the one written keeps
+the most of the source's style; variations also vary counts and shuffle parts of one size.
 """
 
 from __future__ import annotations
