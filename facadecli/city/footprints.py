@@ -26,6 +26,7 @@ from shapely.geometry import MultiPolygon, Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
+from facadecli.city.geopackage import read_geopackage
 from facadecli.errors import Problem, SpecError
 from facadecli.limits import (
     BUILDING_HEIGHT_MAX,
@@ -101,7 +102,7 @@ Found = tuple[int, str, dict[str, Any], Any]  # index, id, properties, geometry
 
 def read_footprints(path: Path) -> FootprintSet:
     """Footprints of every usable feature; rejected features with a reason and place."""
-    document = read_geojson(path)
+    document = read_geopackage(path) if path.suffix.lower() == ".gpkg" else read_geojson(path)
     ids = [feature_id(feature, index) for index, feature in enumerate(document.features)]
     _check_unique(document, ids)
     rejected: list[Rejected] = []
