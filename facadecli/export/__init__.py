@@ -78,6 +78,12 @@ def _write_obj(layout: Layout, outdir: Path, options: OutputOptions) -> list[Pat
     return write_obj(_scene(layout, options), outdir / f"{layout.spec.name}.obj")
 
 
+def _write_usd(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
+    from facadecli.export.usd import write_usd
+
+    return write_usd(_scene(layout, options), outdir / f"{layout.spec.name}.usda")
+
+
 def _write_html(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.gltf import glb_bytes
     from facadecli.export.svg import svg_text
@@ -99,6 +105,7 @@ WRITERS: dict[str, Writer] = {
     "svg": _write_svg,
     "gltf": _write_gltf,
     "html": _write_html,
+    "usd": _write_usd,
 }
 DEFAULT_FORMATS = ("glb", "obj", "json", "svg")
 

@@ -14,7 +14,7 @@ def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, dict[str, bytes]]:
     """(OBJ text, {file name: bytes} of the MTL and its texture images): the scene's
     instances placed and merged by layer and material."""
     groups: dict[tuple[str, str], list[trimesh.Trimesh]] = {}
-    for node in _ordered(scene):
+    for node in ordered_nodes(scene):
         matrix, geometry = scene.graph[node]
         mesh = scene.geometry[geometry].copy()
         mesh.apply_transform(matrix)
@@ -37,7 +37,7 @@ def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, dict[str, bytes]]:
     return text, dict(sorted(textures.items()))
 
 
-def _ordered(scene: trimesh.Scene) -> list[str]:
+def ordered_nodes(scene: trimesh.Scene) -> list[str]:
     """Geometry nodes in a stable order: layer by layer, shapes in layout order."""
 
     def key(node: str) -> tuple[str, int]:

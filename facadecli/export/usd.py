@@ -1,0 +1,160 @@
+"""USD of a layout (``--format usd``): a ``.usda`` text stage for Houdini, Omniverse, Blender
+and the rest of the USD world, written without USD's own library.
+
+- The default prim is the façade (an Xform, kind ``component``, metres, Y up as the glTF),
+  with an Xform per layer, and under it an Xform per part of a shape, placed by its matrix.
+- Repeated parts are instanced: each distinct mesh is an Xform holding a Mesh under the
+  abstract class ``/<name>/Prototypes`` (points, triangles, face-varying normals, UVs
+  where it has them, its extent), and every part that uses it is an instanceable Xform
+  referencing it, with its own transform.
+- Materials are UsdPreviewSurface shaders under ``/<name>/Materials`` with the glTF's base
+  colour, metallic, roughness and opacity; every prototype is bound to its material.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from facadecli.export.atomic import write_atomic
+from facadecli.export.obj import ordered_nodes
+
+
+def usd_name(text: str) -> str:
+    """A name USD accepts for a prim: letters, digits and underscores, not starting with a
+    digit."""
+    name = re.sub(r"[^A-Za-z0-9_]", "_", text) or "_"
+    return name if not name[0].isdigit() else "_" + name
+
+
+def _floats(values: np.ndarray) -> str:
+    return ", ".join(f"{float(v):.9g}" for v in values)
+
+
+def _tuples(rows: np.ndarray) -> str:
+    return "[" + ", ".join(f"({_floats(row)})" for row in rows) + "]"
+
+
+def _material(name: str, material: object, root: str) -> list[str]:
+    colour = getattr(material, "baseColorFactor", None)
+    rgba = (
+        np.array(colour, dtype=float) / (255.0 if np.max(colour) > 1.0 else 1.0)
+        if colour is not None
+        else np.array([0.75, 0.75, 0.75, 1.0])
+    )
+    metallic = getattr(material, "metallicFactor", None)
+    roughness = getattr(material, "roughnessFactor", None)
+    path = f"{root}/Materials/{name}"
+    return [
+        f'        def Material "{name}"',
+        "        {",
+        f"            token outputs:surface.connect = <{path}/Surface.outputs:surface>",
+        '            def Shader "Surface"',
+        "            {",
+        '                uniform token info:id = "UsdPreviewSurface"',
+        f"                color3f inputs:diffuseColor = ({_floats(rgba[:3])})",
+        f"                float inputs:metallic = {0.0 if metallic is None else metallic:.6g}",
+        f"                float inputs:roughness = {1.0 if roughness is None else roughness:.6g}",
+        f"                float inputs:opacity = {rgba[3]:.6g}",
+        "                token outputs:surface",
+        "            }",
+        "        }",
+    ]
+
+
+def _mesh(name: str, mesh: trimesh.Trimesh, material: str, root: str) -> list[str]:
+    faces = mesh.faces
+    normals = np.repeat(mesh.face_normals, 3, axis=0)
+    indices = ", ".join(str(int(i)) for i in faces.ravel())
+    lines = [
+        f'        def Xform "{name}"',
+        "        {",
+        '            def Mesh "mesh" (',
+        '                prepend apiSchemas = ["MaterialBindingAPI"]',
+        "            )",
+        "            {",
+        f"                float3[] extent = {_tuples(mesh.bounds)}",
+        f"                int[] faceVertexCounts = [{', '.join(['3'] * len(faces))}]",
+        f"                int[] faceVertexIndices = [{indices}]",
+        f"                point3f[] points = {_tuples(mesh.vertices)}",
+        f"                normal3f[] normals = {_tuples(normals)} (",
+        '                    interpolation = "faceVarying"',
+        "                )",
+    ]
+    uv = getattr(mesh.visual, "uv", None)
+    if uv is not None and len(uv) == len(mesh.vertices):
+        lines += [
+            f"                texCoord2f[] primvars:st = {_tuples(uv)} (",
+            '                    interpolation = "vertex"',
+            "                )",
+        ]
+    lines += [
+        f"                rel material:binding = <{root}/Materials/{material}>",
+        '                uniform token subdivisionScheme = "none"',
+        "            }",
+        "        }",
+    ]
+    return lines
+
+
+def usda_text(scene: trimesh.Scene, name: str) -> str:
+    """The scene as a USD stage (see the module)."""
+    root = f"/{usd_name(name)}"
+    prototypes: dict[str, str] = {}  # geometry key -> prototype prim name
+    materials: dict[str, object] = {}
+    meshes: list[str] = []
+    for key in sorted(scene.geometry):
+        mesh = scene.geometry[key]
+        material = getattr(mesh.visual, "material", None)
+        material_name = usd_name(getattr(material, "name", None) or "default")
+        materials.setdefault(material_name, material)
+        prototypes[key] = usd_name(f"m_{key}")
+        meshes += _mesh(prototypes[key], mesh, material_name, root)
+    layers: dict[str, list[str]] = {}
+    for node in ordered_nodes(scene):
+        matrix, key = scene.graph[node]
+        layer = usd_name(node.split("/", 1)[0])
+        rows = np.asarray(matrix, dtype=float).T  # USD: row vectors, translation last
+        transform = ", ".join(f"({_floats(row)})" for row in rows)
+        layers.setdefault(layer, []).extend(
+            [
+                f'        def Xform "{usd_name(node)}" (',
+                "            instanceable = true",
+                f"            prepend references = <{root}/Prototypes/{prototypes[key]}>",
+                "        )",
+                "        {",
+                f"            matrix4d xformOp:transform = ({transform})",
+                '            uniform token[] xformOpOrder = ["xformOp:transform"]',
+                "        }",
+            ]
+        )
+    out = [
+        "#usda 1.0",
+        "(",
+        f'    defaultPrim = "{usd_name(name)}"',
+        "    metersPerUnit = 1",
+        '    upAxis = "Y"',
+        ")",
+        "",
+        f'def Xform "{usd_name(name)}" (',
+        '    kind = "component"',
+        ")",
+        "{",
+        '    def Scope "Materials"',
+        "    {",
+    ]
+    for material_name, material in materials.items():
+        out += _material(material_name, material, root)
+    out += ["    }", '    class Scope "Prototypes"', "    {", *meshes, "    }"]
+    for layer, prims in layers.items():
+        out += [f'    def Xform "{layer}"', "    {", *prims, "    }"]
+    out.append("}")
+    return "\n".join(out) + "\n"
+
+
+def write_usd(scene: trimesh.Scene, path: Path) -> list[Path]:
+    write_atomic(path, usda_text(scene, path.stem))
+    return [path]
