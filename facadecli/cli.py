@@ -625,6 +625,30 @@ def schema(
 
 
 @app.command()
+def watch(
+    spec: Annotated[Path, typer.Argument(help="The spec to preview.", metavar="SPEC")],
+    port: Annotated[
+        int,
+        typer.Option("--port", min=0, max=65535, help="Port on 127.0.0.1 (0: any free one)."),
+    ] = 8765,
+) -> None:
+    """Preview a spec live: solve it again on every save and serve its page (the 3D model
+    and the elevation) on 127.0.0.1, which reloads itself; errors show on the page."""
+    from facadecli.viewer.watch import serve
+
+    if not spec.is_file():
+        raise SpecError.at(str(spec), None, None, "no such file", "check the path")
+    try:
+        serve(spec, port, lambda line, error: typer.echo(line, err=error))
+    except OSError as error:
+        raise typer.BadParameter(
+            f"cannot serve on port {port}: {error.strerror}", param_hint="--port"
+        ) from None
+    except KeyboardInterrupt:
+        raise typer.Exit(0) from None
+
+
+@app.command()
 def view(
     folder: Annotated[
         Path,
