@@ -291,6 +291,16 @@ def city(
     ] = None,
     resume: Annotated[bool, typer.Option("--resume", help="Skip buildings already built.")] = False,
     limit: Annotated[int | None, typer.Option("--limit", min=1, help="Only the first N.")] = None,
+    bbox: Annotated[
+        str | None,
+        typer.Option(
+            "--bbox",
+            metavar="W,S,E,N",
+            help="Only footprints with a point in this box, in the footprints' CRS (lon/lat "
+            "for OSM extracts).",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Build every footprint of a city manifest into whole buildings (SPEC 5)."""
     import os
@@ -306,6 +316,7 @@ def city(
             f"'{scheduler}' is not a scheduler address",
             "write tcp://HOST:PORT",
         )
+    box = _bbox(bbox) if bbox is not None else None
     loaded = load_city(manifest)
     workers = jobs or os.cpu_count() or 1
     if sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
@@ -317,7 +328,7 @@ def city(
             def progress(done: int, total: int) -> None:
                 bar.update(task, completed=done, total=total)
 
-            report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler)
+            report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box)
     else:
         step = max(1, (limit or 1000) // 20)
 
@@ -325,7 +336,7 @@ def city(
             if done == total or done % step == 0:
                 typer.echo(f"{done}/{total} buildings", err=True)
 
-        report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler)
+        report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box)
     summary = report["summary"]
     for entry in report["rejected"]:  # rejected by design: reported, not a failure
         where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
@@ -343,6 +354,21 @@ def city(
     )
     if summary["failed"]:  # exit 1 only when a building that should build did not
         raise typer.Exit(1)
+
+
+def _bbox(text: str) -> tuple[float, float, float, float]:
+    try:
+        west, south, east, north = (float(v) for v in text.split(","))
+    except ValueError:
+        west = south = east = north = math.nan
+    box = (west, south, east, north)
+    if not all(math.isfinite(v) for v in box) or west >= east or south >= north:
+        raise typer.BadParameter(
+            f"{text!r} is not WEST,SOUTH,EAST,NORTH with west < east and south < north, "
+            "e.g. 24.93,60.16,24.96,60.18",
+            param_hint="--bbox",
+        )
+    return box
 
 
 def _size(text: str, option: str = "--derive") -> tuple[float, float]:

@@ -27,6 +27,7 @@ from shapely.geometry.polygon import orient
 
 from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
 from facadecli.city.geopackage import read_geopackage
+from facadecli.city.osm import is_osm, read_osm
 from facadecli.errors import Problem, SpecError
 from facadecli.limits import (
     BUILDING_HEIGHT_MAX,
@@ -82,6 +83,7 @@ class FootprintSet:
     rejected: tuple[Rejected, ...]
     crs: str  # what the input was in
     origin: tuple[float, float]  # where local (0, 0) is, in the projected CRS
+    outside: int = 0  # features left out by a bounding box
 
 
 def feature_id(feature: Any, index: int) -> str:
@@ -100,13 +102,30 @@ def feature_id(feature: Any, index: int) -> str:
 Found = tuple[int, str, dict[str, Any], Any]  # index, id, properties, geometry
 
 
-def read_footprints(path: Path) -> FootprintSet:
-    """Footprints of every usable feature; rejected features with a reason and place."""
-    document = read_geopackage(path) if path.suffix.lower() == ".gpkg" else read_geojson(path)
+def _document(path: Path) -> GeoJSON:
+    """The features of a footprints file, by its name: an OSM extract, a GeoPackage, else
+    GeoJSON."""
+    if is_osm(path):
+        return read_osm(path)
+    if path.suffix.lower() == ".gpkg":
+        return read_geopackage(path)
+    return read_geojson(path)
+
+
+BBox = tuple[float, float, float, float]  # west, south, east, north in the file's CRS
+
+
+def read_footprints(path: Path, bbox: BBox | None = None) -> FootprintSet:
+    """Footprints of every usable feature; rejected features with a reason and place.
+    With ``bbox``, only the features whose footprint has a point inside it (in the
+    file's CRS: lon/lat for OSM extracts) are read."""
+    document = _document(path)
     ids = [feature_id(feature, index) for index, feature in enumerate(document.features)]
     _check_unique(document, ids)
     rejected: list[Rejected] = []
-    found = _in_metres(document, _readable(document, ids, rejected), rejected)
+    readable = _readable(document, ids, rejected)
+    inside = readable if bbox is None else [f for f in readable if _within(f[3], bbox)]
+    found = _in_metres(document, inside, rejected)
     minx = min((geometry.bounds[0] for *_, geometry in found), default=0.0)
     miny = min((geometry.bounds[1] for *_, geometry in found), default=0.0)
     footprints = []
@@ -119,7 +138,14 @@ def read_footprints(path: Path) -> FootprintSet:
     rejected.sort(key=lambda r: r.index)
     if rejected and not footprints:
         raise _nothing_usable(document, rejected)
-    return FootprintSet(tuple(footprints), tuple(rejected), document.crs.to_string(), (minx, miny))
+    outside = len(readable) - len(inside)
+    crs = document.crs.to_string()
+    return FootprintSet(tuple(footprints), tuple(rejected), crs, (minx, miny), outside)
+
+
+def _within(geometry: Any, bbox: BBox) -> bool:
+    x, y = (float(v) for v in geometry.representative_point().coords[0])
+    return bbox[0] <= x <= bbox[2] and bbox[1] <= y <= bbox[3]
 
 
 def _readable(document: GeoJSON, ids: list[str], rejected: list[Rejected]) -> list[Found]:

@@ -38,7 +38,7 @@ from facadecli.city.cityjson import (
     building_object,
     write_cityjson,
 )
-from facadecli.city.footprints import Footprint, Rejected, Simplified, read_footprints
+from facadecli.city.footprints import BBox, Footprint, Rejected, Simplified, read_footprints
 from facadecli.city.manifest import City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
@@ -325,6 +325,7 @@ def run_city(
     resume: bool = False,
     progress: Callable[[int, int], None] | None = None,
     scheduler: str | None = None,
+    bbox: BBox | None = None,
 ) -> dict[str, Any]:
     """Build a city; returns the report (also written to ``<name>.report.json``).
 
@@ -334,7 +335,7 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    found = read_footprints(city.footprints)
+    found = read_footprints(city.footprints, bbox)
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
     footprints = [f for f in found.footprints if f.id not in replaced]
     footprints = footprints[: limit if limit is not None else None]
@@ -420,6 +421,7 @@ def run_city(
             "ok": len(results) - len(failed),
             "failed": len(failed),
             "rejected": len(found.rejected),
+            "outside_bbox": found.outside,
             "replaced": len(replaced),
             "party_walls": sum(r.get("party_walls", 0) for r in results),
             "seconds": round(time.perf_counter() - started, 2),
