@@ -27,6 +27,7 @@ from shapely.geometry.polygon import orient
 
 from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
 from facadecli.city.geopackage import read_geopackage
+from facadecli.city.ogr import is_ogr, read_ogr
 from facadecli.city.osm import is_osm, read_osm
 from facadecli.errors import Problem, SpecError
 from facadecli.limits import (
@@ -103,10 +104,12 @@ Found = tuple[int, str, dict[str, Any], Any]  # index, id, properties, geometry
 
 
 def _document(path: Path) -> GeoJSON:
-    """The features of a footprints file, by its name: an OSM extract, a GeoPackage, else
-    GeoJSON."""
+    """The features of a footprints file, by its name: an OSM extract, a Shapefile or a
+    FlatGeobuf, a GeoPackage, else GeoJSON."""
     if is_osm(path):
         return read_osm(path)
+    if is_ogr(path):
+        return read_ogr(path)
     if path.suffix.lower() == ".gpkg":
         return read_geopackage(path)
     return read_geojson(path)
