@@ -291,6 +291,12 @@ def city(
     ] = None,
     resume: Annotated[bool, typer.Option("--resume", help="Skip buildings already built.")] = False,
     limit: Annotated[int | None, typer.Option("--limit", min=1, help="Only the first N.")] = None,
+    usd: Annotated[
+        bool,
+        typer.Option(
+            "--usd", help="Also a USD stage: one per building, and the city's of their payloads."
+        ),
+    ] = False,
     bbox: Annotated[
         str | None,
         typer.Option(
@@ -328,7 +334,7 @@ def city(
             def progress(done: int, total: int) -> None:
                 bar.update(task, completed=done, total=total)
 
-            report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box)
+            report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box, usd)
     else:
         step = max(1, (limit or 1000) // 20)
 
@@ -336,7 +342,7 @@ def city(
             if done == total or done % step == 0:
                 typer.echo(f"{done}/{total} buildings", err=True)
 
-        report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box)
+        report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box, usd)
     summary = report["summary"]
     for entry in report["rejected"]:  # rejected by design: reported, not a failure
         where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"

@@ -56,3 +56,28 @@ def test_every_example_writes_a_stage_usd_opens(
         stage = Usd.Stage.Open(str(tmp_path / f"{spec.stem}.usda"))
         assert stage.GetDefaultPrim().IsValid(), spec.name
         assert any(p.IsInstance() for p in stage.Traverse()), spec.name
+
+
+def test_a_city_stage_holds_every_building_as_a_payload(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tests.test_city_inputs import square, town
+
+    manifest = town(tmp_path, [square("a", 0.0), square("b", 20.0, 10.0), square("c", 40.0)])
+    code, _, err = facade(capsys, "city", manifest, "-o", tmp_path / "out", "-j", "1", "--usd")
+    assert code == 0, err
+    stage = Usd.Stage.Open(str(tmp_path / "out" / "town.usda"))
+    root = stage.GetDefaultPrim()
+    buildings = root.GetChildren()
+    assert [p.GetName() for p in buildings] == ["a", "b", "c"]
+    assert all(p.HasPayload() for p in buildings)
+    meshes = [p for p in Usd.PrimRange(root, Usd.TraverseInstanceProxies()) if p.IsA(UsdGeom.Mesh)]
+    assert meshes and {p.GetPath().pathString.split("/")[2] for p in meshes} == {"a", "b", "c"}
+    closed = Usd.Stage.Open(str(tmp_path / "out" / "town.usda"), Usd.Stage.LoadNone)
+    assert not any(p.IsA(UsdGeom.Mesh) for p in closed.Traverse())  # payloads load on demand
+    bound = (
+        UsdGeom.BBoxCache(Usd.TimeCode.Default(), ["default"])
+        .ComputeWorldBound(root)
+        .ComputeAlignedRange()
+    )
+    assert bound.GetMax()[0] - bound.GetMin()[0] > 45  # the three side by side, 50 m

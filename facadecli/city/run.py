@@ -54,6 +54,7 @@ from facadecli.city.tiles import merge_city
 from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.gltf import glb_bytes
+from facadecli.export.usd import city_usda, usda_text
 from facadecli.geometry.facade import transmissions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
@@ -76,6 +77,7 @@ class Task:
     walls: tuple[tuple[WallRule, Facade], ...] = ()  # façades for some walls
     variants: int = 1  # layouts each axis may take
     pick: int = 0  # which of them this building takes (from the seed and its id)
+    usd: bool = False  # a USD stage beside the glb (``--usd``)
 
 
 PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
@@ -148,6 +150,10 @@ def build(task: Task) -> dict[str, Any]:
         solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
         write_cityjson(_feature_file(task.target), building_object(solids))
         write_atomic(task.target, glb_bytes(result.scene, transmissions(task.spec)))
+        if task.usd:
+            write_atomic(
+                task.target.with_suffix(".usda"), usda_text(result.scene, task.target.stem)
+            )
     except Exception as error:
         return {
             "id": task.footprint.id,
@@ -222,7 +228,7 @@ def _simplified(simplified: Simplified | None) -> dict[str, Any]:
     }
 
 
-def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
+def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = False) -> list[Task]:
     """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
@@ -286,6 +292,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path) -> list[Task]:
                 walls,
                 choice.variants,
                 pick,
+                usd,
             )
         )
     return tasks
@@ -326,6 +333,7 @@ def run_city(
     progress: Callable[[int, int], None] | None = None,
     scheduler: str | None = None,
     bbox: BBox | None = None,
+    usd: bool = False,
 ) -> dict[str, Any]:
     """Build a city; returns the report (also written to ``<name>.report.json``).
 
@@ -339,7 +347,7 @@ def run_city(
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
     footprints = [f for f in found.footprints if f.id not in replaced]
     footprints = footprints[: limit if limit is not None else None]
-    tasks = plan(city, footprints, outdir)
+    tasks = plan(city, footprints, outdir, usd)
     results: list[dict[str, Any]] = []
     todo = []
     for task in tasks:
@@ -395,6 +403,11 @@ def run_city(
             f"{outdir}: cannot write the merged model: {error.strerror or error}; the "
             "buildings built are kept: run again with --resume"
         ) from None
+    if usd:
+        stage = outdir / f"{city.manifest.name}.usda"
+        ok = [outdir / r["file"] for r in results if r["status"] == "ok"]
+        write_atomic(stage, city_usda(city.manifest.name, ok, outdir))
+        written = {**written, "usd": stage.name}
     cityjson = outdir / f"{city.manifest.name}.city.json"
     try:
         with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:

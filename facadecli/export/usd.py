@@ -158,3 +158,37 @@ def usda_text(scene: trimesh.Scene, name: str) -> str:
 def write_usd(scene: trimesh.Scene, path: Path) -> list[Path]:
     write_atomic(path, usda_text(scene, path.stem))
     return [path]
+
+
+def city_usda(name: str, buildings: list[Path], folder: Path) -> str:
+    """A city's stage: an Xform per building with its stage as a payload (loaded when a
+    tool asks for it, so a city of thousands opens at once), in the city's frame."""
+    out = [
+        "#usda 1.0",
+        "(",
+        f'    defaultPrim = "{usd_name(name)}"',
+        "    metersPerUnit = 1",
+        '    upAxis = "Y"',
+        ")",
+        "",
+        f'def Xform "{usd_name(name)}" (',
+        '    kind = "assembly"',
+        ")",
+        "{",
+    ]
+    taken: set[str] = set()
+    for glb in buildings:
+        prim = usd_name(glb.stem)
+        while prim in taken:  # two file names may read the same as prim names
+            prim += "_"
+        taken.add(prim)
+        stage = glb.with_suffix(".usda").relative_to(folder).as_posix()
+        out += [
+            f'    def Xform "{prim}" (',
+            f"        prepend payload = @./{stage}@",
+            "    )",
+            "    {",
+            "    }",
+        ]
+    out.append("}")
+    return "\n".join(out) + "\n"
