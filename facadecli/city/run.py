@@ -351,7 +351,8 @@ def run_city(
     results: list[dict[str, Any]] = []
     todo = []
     for task in tasks:
-        if resume and task.target.exists():
+        done = task.target.exists() and (not usd or task.target.with_suffix(".usda").exists())
+        if resume and done:
             results.append(
                 {
                     "id": task.footprint.id,
