@@ -351,8 +351,8 @@ def run_city(
     results: list[dict[str, Any]] = []
     todo = []
     for task in tasks:
-        done = task.target.exists() and (not usd or task.target.with_suffix(".usda").exists())
-        if resume and done:
+        built = task.target.exists() and (not usd or task.target.with_suffix(".usda").exists())
+        if resume and built:
             results.append(
                 {
                     "id": task.footprint.id,
