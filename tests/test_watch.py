@@ -62,12 +62,14 @@ def test_the_page_follows_the_file(watched: tuple[Path, str, subprocess.Popen[st
     spec, url, _ = watched
     _until(lambda: _state(url)["version"] == 1, "first layout")
     first = _get(url)
-    assert b"<svg" in first and b"/state" in first  # the model, the elevation, the reload
+    assert b"<svg" in first and b"/state" in first  # the model, the elevation, the swap
+    model, elevation = _get(url + "glb"), _get(url + "svg")
+    assert model and model in first and elevation.lstrip().startswith(b"<svg")  # as shown
     text = spec.read_text()
     spec.write_text(re.sub(r"canvas: \{width: [0-9.]+", "canvas: {width: 8.5", text))
     _until(lambda: _state(url)["version"] == 2, "second layout")
-    second = _get(url)
-    assert second != first and _state(url)["ok"] is True
+    assert _get(url) != first and _state(url)["ok"] is True
+    assert _get(url + "glb") != model and _get(url + "svg") != elevation  # swapped in place
 
 
 def test_an_error_shows_with_its_place_and_the_last_model_stays(

@@ -111,7 +111,7 @@ function frame(model) {  // the model's bounding sphere fills the view, seen fro
   controls.target.copy(centre); controls.update();
   moved = false;
 }
-function show(id) {
+function show(id, keep = false) {  // keep: the camera where the user turned it, if they did
   const mine = ++asked;
   status.textContent = 'loading the model';
   let bytes;
@@ -123,7 +123,7 @@ function show(id) {
     if (shown) { scene.remove(shown); dispose(shown); }
     shown = gltf.scene;
     scene.add(shown);
-    frame(shown);
+    if (!(keep && moved)) frame(shown);
     status.textContent = 'drag to orbit, scroll to zoom';
     document.title = document.title.replace('loading: ', '');
   }, error => {
@@ -132,6 +132,7 @@ function show(id) {
 }
 resize();
 renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); });
+window.facadeShow = show;  // for a page's own scripts (facade watch swaps the model)
 """
 
 STYLE = (

@@ -1,6 +1,7 @@
 """``facade watch SPEC``: a live preview. The spec is solved again whenever its file changes,
-and the viewer's page is served on 127.0.0.1; the page asks ``/state`` twice a second and
-reloads itself when a new layout is ready. A spec with an error keeps the last good model
+and the viewer's page is served on 127.0.0.1; the page asks ``/state`` twice a second and,
+when a new layout is ready, swaps in its model (``/glb``) and elevation (``/svg``) in
+place, the camera where the user left it. A spec with an error keeps the last good model
 on the page under a banner with the error (its file, line and column, and the hint).
 
 Only this machine can reach the server (127.0.0.1). The file is polled (its size, time and
@@ -10,6 +11,7 @@ one change at a time.
 
 from __future__ import annotations
 
+import base64
 import hashlib
 import json
 import threading
@@ -29,14 +31,25 @@ background:#7a1d1d;color:#fff;font:13px monospace;white-space:pre-wrap;z-index:9
 <script>
 (function () {{
   var seen = null;
+  function swap(version) {{  // the new model and elevation, in place: the camera stays
+    Promise.all([fetch('/glb', {{cache: 'no-store'}}).then(function (r) {{ return r.text(); }}),
+                 fetch('/svg', {{cache: 'no-store'}}).then(function (r) {{ return r.text(); }})])
+      .then(function (got) {{
+        document.getElementById('glb').textContent = got[0];
+        var old = document.querySelector('#side svg');
+        if (old) old.outerHTML = got[1];
+        window.facadeShow('glb', true);
+        seen = version;
+      }});
+  }}
   function ask() {{
     fetch('/state', {{cache: 'no-store'}}).then(function (r) {{ return r.json(); }})
       .then(function (state) {{
         var banner = document.getElementById('watch-error');
         banner.style.display = state.error ? 'block' : 'none';
         banner.textContent = state.error || '';
-        if (seen !== null && state.version !== seen) {{ location.reload(); return; }}
-        seen = state.version;
+        if (seen === null) seen = state.version;
+        else if (state.version !== seen) swap(state.version);
       }}).catch(function () {{}}).finally(function () {{ setTimeout(ask, {ASK}); }});
   }}
   ask();
@@ -52,10 +65,12 @@ class Preview:
     spec: Path
     version: int = 0  # a new page, each time one is made
     page: str = "<!doctype html><title>solving</title><p>solving...</p>" + RELOAD
+    glb: str = ""  # the model, base64 (what the page's element holds)
+    svg: str = ""  # the elevation, inline
     error: str = ""  # why the spec as saved has no layout (empty when it has one)
     solved_ms: float = 0.0
     seen: str = ""  # the file's fingerprint when it was last solved
-    lock: threading.Lock = field(default_factory=threading.Lock)
+    lock: threading.RLock = field(default_factory=threading.RLock)
 
     def state(self) -> dict[str, object]:
         with self.lock:
@@ -74,13 +89,13 @@ class Preview:
         self.seen = fingerprint
         started = time.perf_counter()
         try:
-            page = _page(self.spec)
+            page, glb, svg = _page(self.spec)
         except FacadeError as error:
             with self.lock:
                 self.error = str(error)
             return True
         with self.lock:
-            self.page = page
+            self.page, self.glb, self.svg = page, glb, svg
             self.error = ""
             self.version += 1
             self.solved_ms = (time.perf_counter() - started) * 1000
@@ -94,8 +109,9 @@ def _fingerprint(path: Path) -> str:
         return f"unreadable: {error}"
 
 
-def _page(path: Path) -> str:
-    """The viewer's page of the spec's layout, with the script that reloads it."""
+def _page(path: Path) -> tuple[str, str, str]:
+    """The viewer's page of the spec's layout, with the script that swaps in new ones; and
+    the model (base64) and the elevation (inline SVG) it swaps in."""
     from facadecli.export.gltf import glb_bytes
     from facadecli.export.svg import svg_text
     from facadecli.geometry.facade import facade_scene, transmissions
@@ -106,20 +122,25 @@ def _page(path: Path) -> str:
     spec = load_spec(path)
     layout = solve(spec)
     glb = glb_bytes(facade_scene(layout, path.parent), transmissions(spec))
-    html = page(spec.name, glb, svg_text(layout))
-    return html.replace("</body>", RELOAD + "</body>", 1)
+    svg = svg_text(layout)
+    html = page(spec.name, glb, svg).replace("</body>", RELOAD + "</body>", 1)
+    return html, base64.b64encode(glb).decode(), svg.split("?>", 1)[-1]
 
 
 def _handler(preview: Preview) -> type[BaseHTTPRequestHandler]:
     class Handler(BaseHTTPRequestHandler):
         def do_GET(self) -> None:
-            if self.path.split("?", 1)[0] == "/state":
-                body = json.dumps(preview.state()).encode()
-                kind = "application/json"
-            elif self.path.split("?", 1)[0] in ("/", "/index.html"):
-                with preview.lock:
-                    body = preview.page.encode()
-                kind = "text/html; charset=utf-8"
+            path = self.path.split("?", 1)[0]
+            with preview.lock:
+                served = {
+                    "/state": (json.dumps(preview.state()), "application/json"),
+                    "/": (preview.page, "text/html; charset=utf-8"),
+                    "/index.html": (preview.page, "text/html; charset=utf-8"),
+                    "/glb": (preview.glb, "text/plain"),
+                    "/svg": (preview.svg, "image/svg+xml"),
+                }.get(path)
+            if served is not None:
+                body, kind = served[0].encode(), served[1]
             else:
                 self.send_error(404)
                 return
