@@ -131,7 +131,19 @@ def usda_text(scene: trimesh.Scene, name: str) -> str:
                 "        }",
             ]
         )
-    out = [
+    out = [*_head(name, "component"), '    def Scope "Materials"', "    {"]
+    for material_name, material in materials.items():
+        out += _material(material_name, material, root)
+    out += ["    }", '    class Scope "Prototypes"', "    {", *meshes, "    }"]
+    for layer, prims in layers.items():
+        out += [f'    def Xform "{layer}"', "    {", *prims, "    }"]
+    out.append("}")
+    return "\n".join(out) + "\n"
+
+
+def _head(name: str, kind: str) -> list[str]:
+    """A stage's metadata (metres, Y up) and the opening of its default prim."""
+    return [
         "#usda 1.0",
         "(",
         f'    defaultPrim = "{usd_name(name)}"',
@@ -140,19 +152,10 @@ def usda_text(scene: trimesh.Scene, name: str) -> str:
         ")",
         "",
         f'def Xform "{usd_name(name)}" (',
-        '    kind = "component"',
+        f'    kind = "{kind}"',
         ")",
         "{",
-        '    def Scope "Materials"',
-        "    {",
     ]
-    for material_name, material in materials.items():
-        out += _material(material_name, material, root)
-    out += ["    }", '    class Scope "Prototypes"', "    {", *meshes, "    }"]
-    for layer, prims in layers.items():
-        out += [f'    def Xform "{layer}"', "    {", *prims, "    }"]
-    out.append("}")
-    return "\n".join(out) + "\n"
 
 
 def write_usd(scene: trimesh.Scene, path: Path) -> list[Path]:
@@ -163,19 +166,7 @@ def write_usd(scene: trimesh.Scene, path: Path) -> list[Path]:
 def city_usda(name: str, buildings: list[Path], folder: Path) -> str:
     """A city's stage: an Xform per building with its stage as a payload (loaded when a
     tool asks for it, so a city of thousands opens at once), in the city's frame."""
-    out = [
-        "#usda 1.0",
-        "(",
-        f'    defaultPrim = "{usd_name(name)}"',
-        "    metersPerUnit = 1",
-        '    upAxis = "Y"',
-        ")",
-        "",
-        f'def Xform "{usd_name(name)}" (',
-        '    kind = "assembly"',
-        ")",
-        "{",
-    ]
+    out = _head(name, "assembly")
     taken: set[str] = set()
     for glb in buildings:
         prim = usd_name(glb.stem)
