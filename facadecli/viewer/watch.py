@@ -25,7 +25,7 @@ from facadecli.errors import FacadeError
 
 POLL = 0.2  # seconds between looks at the file
 ASK = 500  # milliseconds between the page's questions to /state
-RELOAD = f"""
+LIVE = f"""
 <div id="watch-error" style="display:none;position:fixed;left:0;right:0;top:0;padding:8px 12px;
 background:#7a1d1d;color:#fff;font:13px monospace;white-space:pre-wrap;z-index:9"></div>
 <script>
@@ -64,7 +64,7 @@ class Preview:
 
     spec: Path
     version: int = 0  # a new page, each time one is made
-    page: str = "<!doctype html><title>solving</title><p>solving...</p>" + RELOAD
+    page: str = "<!doctype html><title>solving</title><p>solving...</p>" + LIVE
     glb: str = ""  # the model, base64 (what the page's element holds)
     svg: str = ""  # the elevation, inline
     error: str = ""  # why the spec as saved has no layout (empty when it has one)
@@ -93,6 +93,10 @@ class Preview:
         except FacadeError as error:
             with self.lock:
                 self.error = str(error)
+            return True
+        except Exception as error:  # a bug: shown, and the preview goes on with the next save
+            with self.lock:
+                self.error = f"{self.spec}: internal error: {type(error).__name__}: {error}"
             return True
         with self.lock:
             self.page, self.glb, self.svg = page, glb, svg
@@ -123,7 +127,7 @@ def _page(path: Path) -> tuple[str, str, str]:
     layout = solve(spec)
     glb = glb_bytes(facade_scene(layout, path.parent), transmissions(spec))
     svg = svg_text(layout)
-    html = page(spec.name, glb, svg).replace("</body>", RELOAD + "</body>", 1)
+    html = page(spec.name, glb, svg).replace("</body>", LIVE + "</body>", 1)
     return html, base64.b64encode(glb).decode(), svg.split("?>", 1)[-1]
 
 
