@@ -132,14 +132,30 @@ def _text(path: Path) -> str:
             "check the path in the manifest",
         ) from None
     if raw is None:
-        raise SpecError.at(
-            str(path),
-            None,
-            None,
-            f"the footprints file is longer than {GEOJSON_BYTES_MAX:,} bytes",
-            "split the district into several manifests, or cut the extract to a bounding box",
-        )
+        raise too_long(path)
     return decode_utf8(raw, str(path), "save the GeoJSON as UTF-8 (RFC 7946)")
+
+
+def too_long(path: Path) -> SpecError:
+    """The error of a footprints file past the limit of a file read whole."""
+    return SpecError.at(
+        str(path),
+        None,
+        None,
+        f"the footprints file is longer than {GEOJSON_BYTES_MAX:,} bytes",
+        "split the district into several manifests, or cut the extract to a bounding box",
+    )
+
+
+class NoPlaces(Places):
+    """A file without lines and columns (a GeoPackage, an OSM extract, a Shapefile): its
+    features are named by their id alone."""
+
+    def __init__(self) -> None:
+        super().__init__("")
+
+    def feature(self, index: int) -> tuple[int, int] | None:
+        return None
 
 
 class Features(Sequence[Any]):

@@ -22,7 +22,7 @@ import pyproj.exceptions
 import shapely
 import shapely.errors
 
-from facadecli.city.geojson import GeoJSON, Places
+from facadecli.city.geojson import GeoJSON, NoPlaces, too_long
 from facadecli.errors import SpecError
 from facadecli.limits import GEOJSON_BYTES_MAX
 
@@ -30,23 +30,11 @@ ENVELOPES = {0: 0, 1: 32, 2: 48, 3: 48, 4: 64}  # envelope code -> bytes (GeoPac
 HINT = "give a GeoPackage (.gpkg) with a feature table, or a GeoJSON file"
 
 
-class NoPlaces(Places):
-    """A GeoPackage has no lines and columns: features are named by their id alone."""
-
-    def __init__(self) -> None:
-        super().__init__("")
-
-    def feature(self, index: int) -> tuple[int, int] | None:
-        return None
-
-
 def read_geopackage(path: Path) -> GeoJSON:
     """The features and CRS of the first feature table (see the module)."""
     file = str(path)
     if path.stat().st_size > GEOJSON_BYTES_MAX:
-        raise SpecError.at(
-            file, None, None, f"larger than {GEOJSON_BYTES_MAX:,} bytes", "split the area"
-        )
+        raise too_long(path)
     try:
         with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as db:
             tables = db.execute(

@@ -20,8 +20,7 @@ import pyproj.exceptions
 import shapely
 import shapely.errors
 
-from facadecli.city.geojson import GeoJSON
-from facadecli.city.geopackage import NoPlaces
+from facadecli.city.geojson import GeoJSON, NoPlaces, too_long
 from facadecli.errors import SpecError
 from facadecli.limits import GEOJSON_BYTES_MAX
 
@@ -48,9 +47,7 @@ def read_ogr(path: Path) -> GeoJSON:
             "pip install 'facadecli[gdal]', or convert the file to GeoPackage or GeoJSON",
         ) from None
     if path.stat().st_size > GEOJSON_BYTES_MAX:
-        raise SpecError.at(
-            file, None, None, f"larger than {GEOJSON_BYTES_MAX:,} bytes", "split the area"
-        )
+        raise too_long(path)
     try:
         meta, ids, geometries, columns = pyogrio.raw.read(path, return_fids=True)
     except (pyogrio.errors.DataSourceError, pyogrio.errors.DataLayerError) as error:

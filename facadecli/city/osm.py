@@ -17,8 +17,7 @@ from typing import Any
 
 import pyproj
 
-from facadecli.city.geojson import GeoJSON
-from facadecli.city.geopackage import NoPlaces
+from facadecli.city.geojson import GeoJSON, NoPlaces
 from facadecli.errors import SpecError
 
 SUFFIXES = (".osm.pbf", ".pbf", ".osm", ".osm.bz2", ".osm.gz")

@@ -13,6 +13,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -68,7 +69,7 @@ class Extraction:
     problems: list[str] = field(default_factory=list)
     snapping: Snapping = NO_SNAPPING  # what snapping changed
 
-    @property
+    @cached_property
     def style(self) -> list[Constraint]:
         """Bao's constraints the input holds (found on its tiling, as derivations are
         checked on their terminals)."""
@@ -162,9 +163,19 @@ def stem(path: Path) -> str:
     return name.rsplit(".", 1)[0] if "." in name else name
 
 
-def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
+@dataclass(frozen=True)
+class Tidied:
+    """A labelled layout as read, resized, snapped and regularised, and what that changed."""
+
+    layout: LabelledLayout
+    snapping: Snapping
+    regularization: Regularization
+
+
+def tidy_layout(path: Path, options: Options, deadline: Deadline) -> Tidied:
+    """Read a labelled layout (``options`` checked first), stretch it to ``options.size``,
+    snap it and regularise it, with the defaults of its kind (``TIDY``)."""
     check_options(options)
-    deadline = Deadline(options.time_limit, str(path))
     layout, kind = read_layout(path)
     if not layout.rects:
         raise SpecError.at(str(path), None, None, "no rectangles", "label some elements")
@@ -175,6 +186,13 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
     snapped, snapping = snap_and_count(layout, snap, deadline)
     check_cells(path, snapped, snap)
     regular, regularization = regularize(snapped, tolerance, deadline=deadline)
+    return Tidied(regular, snapping, regularization)
+
+
+def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
+    deadline = Deadline(options.time_limit, str(path))
+    tidied = tidy_layout(path, options, deadline)
+    regular, regularization, snapping = tidied.layout, tidied.regularization, tidied.snapping
     tiling = tile(regular, tolerance=0.0, deadline=deadline)
     started = time.perf_counter()
     found = extract(

@@ -229,8 +229,10 @@ def align(
     the module and :func:`~facadecli.grammar.style.equations`)."""
     warnings: list[str] = []
     mapping = {}
-    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-    kept = equations(style, facade_of(boxes, width, height, background), STYLE_NEAR * width)
+    kept: list[Equation] = []
+    if style:
+        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+        kept = equations(style, facade_of(boxes, width, height, background), STYLE_NEAR * width)
     axes: tuple[tuple[Axis, float, list[Equation]], ...] = (("x", width, kept), ("y", height, []))
     for axis, extent, extra in axes:
         mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background, extra)
@@ -557,8 +559,9 @@ def derive_variations(
 
     used: set[str] = set()
     best = derive_at(grammar, source, width, height, used=used)
-    candidates: list[_Candidate | None] = [_Candidate(score(best), (), None, best, kept(best))]
-    if count > 1 or kept(best).broken:
+    best_kept = kept(best)
+    candidates: list[_Candidate | None] = [_Candidate(score(best), (), None, best, best_kept)]
+    if count > 1 or best_kept.broken:
         rng = random.Random(seed)
         most = CANDIDATES_MAX if count > 1 else STYLE_MAX
         candidates += [candidate(offsets) for offsets in _offsets(grammar, used, rng, most)]

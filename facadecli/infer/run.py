@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 
 from facadecli.errors import FacadeError, SpecError
+from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout
-from facadecli.grammar.regularize import regularize
-from facadecli.grammar.run import TIDY, Options, check_cells, check_options, read_layout, resize
-from facadecli.grammar.tiling import Tiling, snap_and_count, tile
+from facadecli.grammar.run import Options, tidy_layout
+from facadecli.grammar.tiling import Tiling, tile
 from facadecli.infer.layers import Grid, grids
 from facadecli.infer.spec_text import ident, layer_names, spec_text
 from facadecli.layout import Layout
@@ -49,17 +49,9 @@ class Inference:
 def infer(path: Path, name: str, options: Options | None = None) -> Inference:
     """The spec of a labelled layout (``options``: its size, snap and tolerance)."""
     options = options or Options()
-    check_options(options)
-    layout, kind = read_layout(path)
-    if not any(r.label != BACKGROUND for r in layout.rects):
+    regular = tidy_layout(path, options, Deadline(options.time_limit, str(path))).layout
+    if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
-    if options.size is not None:
-        layout = resize(layout, *options.size)
-    snap = options.snap if options.snap is not None else TIDY[kind][0]
-    tolerance = options.tolerance if options.tolerance is not None else TIDY[kind][1]
-    snapped, _ = snap_and_count(layout, snap)
-    check_cells(path, snapped, snap)
-    regular, _ = regularize(snapped, tolerance)
     found = grids(regular)
     text = spec_text(ident(name), regular.width, regular.height, found, path.name)
     return Inference(path.name, regular, tile(regular, tolerance=0.0), found, text)
