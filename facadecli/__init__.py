@@ -3,6 +3,7 @@
 The public API; everything else is internal and may change.
 """
 
+import facadecli._blas  # noqa: F401  (first: before anything loads numpy)
 from facadecli.errors import FacadeError, InfeasibleError, Problem, SpecError
 from facadecli.layout import Layout, Shape
 from facadecli.patterns import Choice, Letter, Word, compile_pattern, enumerate_words, make_word

@@ -250,3 +250,29 @@ def test_start_up_imports_neither_cvxpy_nor_trimesh_nor_scipy(args: list[str]) -
     )
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip().splitlines()[-1] == "[]"
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "1"), ("3", "3")])
+def test_numpy_runs_on_one_blas_thread_unless_the_user_says(
+    given: str | None, expected: str
+) -> None:
+    """BLAS threads spin against each other on a loaded machine (20-40x slower least
+    squares): facadecli asks for one before numpy loads, and keeps a value the user set."""
+    environment = {k: v for k, v in os.environ.items() if not k.endswith("_NUM_THREADS")}
+    if given is not None:
+        environment["OPENBLAS_NUM_THREADS"] = given
+    code = (
+        "import facadecli, numpy, os\n"
+        "from facadecli.cli import main\n"
+        "print(os.environ['OPENBLAS_NUM_THREADS'])\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        env=environment,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == expected

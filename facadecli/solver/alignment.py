@@ -191,27 +191,28 @@ class _Row:
         if k >= self.n:
             return
         if inside:  # within transparent letter k: a middle piece, or finish it and go on
-            yield self._move(position, position, [], piece_of=k)
+            yield self._move(position, position, _Whole(), piece_of=k)
             yield from self._extend(position, k + 1, True, piece_of=k)
             return
         transparent = self.row.traits[k].transparent
         if transparent:
-            yield self._move(position, position + 1, [], tail=k)
+            yield self._move(position, position + 1, _Whole(), tail=k)
         yield from self._extend(position, k, transparent, piece_of=None)
 
     def _extend(
         self, start: int, k: int, transparent: bool, piece_of: int | None
     ) -> Iterator[Move]:
-        """Entries from ``start`` holding letters k, k+1, ... whole (of one transparency)."""
+        """Entries from ``start`` holding letters k, k+1, ... whole (of one transparency),
+        their totals kept as they grow (a long row has an entry per letter after k)."""
         traits = self.row.traits
         if piece_of is not None:
-            yield self._move(start, 2 * k, [], piece_of=piece_of)
-        whole: list[int] = []
+            yield self._move(start, 2 * k, _Whole(), piece_of=piece_of)
         segment = traits[k].segment if k < self.n else 0
+        whole = _Whole()
         for index in range(k, self.n):
             if traits[index].transparent != transparent or traits[index].segment != segment:
                 return
-            whole.append(index)
+            whole.add(index, traits[index], self.row.word[index].symbol)
             yield self._move(start, 2 * (index + 1), whole, piece_of=piece_of)
             following = index + 1
             if transparent and following < self.n and traits[following].transparent:
@@ -221,33 +222,67 @@ class _Row:
         self,
         start: int,
         end: int,
-        whole: list[int],
+        held: _Whole,
         piece_of: int | None = None,
         tail: int | None = None,
     ) -> Move:
         word = self.row.word
-        traits = [self.row.traits[i] for i in whole]
         lead = piece_of is not None and end != start
         pieces = (1 if piece_of is not None else 0) + (1 if tail is not None else 0)
         return Move(
             start=start,
             end=end,
-            fixed=sum(t.size for t in traits if t.size is not None),
-            unsized=tuple(word[i].symbol for i in whole if self.row.traits[i].size is None),
-            letters=len(whole) + pieces,
+            fixed=held.fixed,
+            unsized=held.unsized,
+            letters=held.count + pieces,
             lead=lead,
             piece_of=None if piece_of is None else word[piece_of].symbol,
             tail=None if tail is None else self.size(tail),
             tail_symbol=None if tail is None else word[tail].symbol,
-            opaque=bool(traits) and not pieces and all(t.opaque for t in traits),
-            transparent=all(t.transparent for t in traits) if traits else True,
-            unoccludable=any(t.unoccludable for t in traits),
-            first_attached=piece_of is None and bool(traits) and traits[0].attached,
-            last_attached=tail is None and bool(traits) and traits[-1].attached,
-            fixed_only=piece_of is None
-            and tail is None
-            and all(t.size is not None for t in traits),
+            opaque=held.count > 0 and not pieces and held.opaque,
+            transparent=held.transparent,
+            unoccludable=held.unoccludable,
+            first_attached=piece_of is None and held.first_attached,
+            last_attached=tail is None and held.last_attached,
+            fixed_only=piece_of is None and tail is None and held.sized_only,
         )
+
+
+class _Whole:
+    """The letters an entry holds whole, summed as the entry grows a letter at a time."""
+
+    __slots__ = (
+        "count",
+        "first_attached",
+        "fixed",
+        "last_attached",
+        "opaque",
+        "sized_only",
+        "transparent",
+        "unoccludable",
+        "unsized",
+    )
+
+    def __init__(self) -> None:
+        self.count = 0
+        self.fixed = 0.0
+        self.unsized: tuple[str, ...] = ()
+        self.opaque = self.transparent = self.sized_only = True
+        self.unoccludable = self.first_attached = self.last_attached = False
+
+    def add(self, index: int, traits: LetterTraits, symbol: str) -> None:
+        if traits.size is None:
+            self.unsized = (*self.unsized, symbol)
+            self.sized_only = False
+        else:
+            self.fixed += traits.size
+        if self.count == 0:
+            self.first_attached = traits.attached
+        self.last_attached = traits.attached
+        self.opaque = self.opaque and traits.opaque
+        self.transparent = self.transparent and traits.transparent
+        self.unoccludable = self.unoccludable or traits.unoccludable
+        self.count += 1
 
 
 @dataclass(frozen=True)

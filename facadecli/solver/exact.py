@@ -269,6 +269,7 @@ class _Search:
         default_factory=dict
     )
     whole_cache: dict[tuple[int, int, int, int], np.ndarray] = field(default_factory=dict)
+    counts_cache: dict[tuple[int, int], np.ndarray] = field(default_factory=dict)
     options_cache: dict[tuple[int, int, int, bool], Options] = field(default_factory=dict)
     gaps: bool = True  # rows may make room for the opaque letters of rows in front
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
@@ -463,12 +464,22 @@ class _Search:
         key = (g, r, move.start, move.end)
         vector = self.whole_cache.get(key)
         if vector is None:
-            vector = np.zeros(len(self.variables))
-            word = self.groups[g].rows[r].row.word
-            for k in sizing.entry_parts(move)[0]:
-                vector[self.variables[word[k].symbol]] += 1.0
-            self.whole_cache[key] = vector
+            counts = self.counts(g, r)  # the letters (start + 1) // 2 ... end // 2 - 1
+            first, last = (move.start + 1) // 2, max(move.end // 2, (move.start + 1) // 2)
+            vector = self.whole_cache[key] = counts[last] - counts[first]
         return vector
+
+    def counts(self, g: int, r: int) -> np.ndarray:
+        """Row k: how many of each symbol the row's first k letters hold."""
+        found = self.counts_cache.get((g, r))
+        if found is None:
+            word = self.groups[g].rows[r].row.word
+            found = np.zeros((len(word) + 1, len(self.variables)))
+            for k, letter in enumerate(word):
+                found[k + 1] = found[k]
+                found[k + 1, self.variables[letter.symbol]] += 1.0
+            self.counts_cache[(g, r)] = found
+        return found
 
     def letter(self, g: int, r: int, k: int) -> int:
         return self.variables[self.groups[g].rows[r].row.word[k].symbol]
