@@ -33,7 +33,9 @@ CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
 EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
-TIE = 1e-3  # m^2: objectives this close are equally good (SPEC 2.7's tie-breaks decide)
+TIE = 1e-3  # m^2: objectives this close are equally good (SPEC 2.7's tie-breaks decide) on
+TIE_SCALE = 10.0  # a canvas of this length (m) or more; on a shorter one, less by the square
+# of its share of it, so a façade drawn at 1:10 solves as it does at full size
 NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
@@ -242,6 +244,7 @@ def solve_axis_alternatives(
     timed_out = False
     tried = 0
     step = max(tolerance, TIER * canvas)
+    tie = tie_window(canvas)
     effort = MAX_NODES  # once something aligned, a candidate that needs far more search
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     compare = max(FEASIBLE_TO_COMPARE, alternatives)
@@ -325,13 +328,13 @@ def solve_axis_alternatives(
         unproven = len(candidates) >= CANDIDATE_LIMIT  # one run says what is proven
         for bound, _, candidate in bounds:
             # ties too (SPEC 2.7 breaks them); for variations, layouts near the best
-            target = min(threshold, best_objective() + (NEAR_EQUAL if alternatives > 1 else TIE))
+            target = min(threshold, best_objective() + (NEAR_EQUAL if alternatives > 1 else tie))
             if timed_out or bound > target:
                 break
             if budget.left == 0:
                 unproven = True
                 break
-            search_exactly(candidate, target, bound > best_objective() - TIE)
+            search_exactly(candidate, target, bound > best_objective() - tie)
         if timed_out or budget.left == 0 or best_objective() <= threshold:
             break
         if not evaluated and not heuristic_done:
@@ -342,7 +345,7 @@ def solve_axis_alternatives(
     if not evaluated and unproven and not timed_out and not heuristic_done:
         heuristic_pass()  # the exact search ran out of work: the heuristic may still align
     aligned_at = time.perf_counter()
-    ranked = _by_rank(evaluated)
+    ranked = _by_rank(evaluated, tie)
     layouts: list[AxisLayout] = []
     first: float | None = None
     for choice in ranked:
@@ -377,8 +380,13 @@ def solve_axis_alternatives(
     return [replace(layout, timings=timings, candidates_tried=tried) for layout in layouts]
 
 
-def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
-    """Best first (SPEC 2.7): layouts within TIE of the least objective are equally good,
+def tie_window(canvas: float) -> float:
+    """How close two objectives (m^2) on an axis of this length are equally good."""
+    return TIE * min(1.0, (canvas / TIE_SCALE) ** 2)
+
+
+def _by_rank(evaluated: Sequence[_Evaluated], tie: float) -> list[_Evaluated]:
+    """Best first (SPEC 2.7): layouts within ``tie`` of the least objective are equally good,
     and among them the tie-breaks decide (placeholders covering least, more columns)."""
     if not evaluated:
         return []
@@ -390,10 +398,10 @@ def _by_rank(evaluated: Sequence[_Evaluated]) -> list[_Evaluated]:
     evaluated = list(best.values())
     least = min(e.estimate.objective for e in evaluated)
     good = sorted(
-        (e for e in evaluated if e.estimate.objective <= least + TIE), key=lambda e: e.rank[1:]
+        (e for e in evaluated if e.estimate.objective <= least + tie), key=lambda e: e.rank[1:]
     )
     rest = sorted(
-        (e for e in evaluated if e.estimate.objective > least + TIE), key=lambda e: e.rank
+        (e for e in evaluated if e.estimate.objective > least + tie), key=lambda e: e.rank
     )
     return [*good, *rest]
 
