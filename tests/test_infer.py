@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from facadecli import parse_spec
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.infer.layers import grids
@@ -148,3 +150,65 @@ def test_runs_become_counters_and_a_wider_facade_gains_bays(tmp_path: Path) -> N
         windows[width] = (len(shown), {round(s.x1 - s.x0, 1) for s in shown})
     assert windows[11.4] == (9, {1.2})
     assert windows[17.1][0] == 15 and windows[17.1][1] <= {1.1, 1.2, 1.3}  # 5 bays, not wider
+
+
+def test_layers_on_the_same_columns_stay_aligned_at_other_widths(tmp_path: Path) -> None:
+    """Blinds over the windows' columns, in rows of their own: the two layers share their
+    x gaps, so at other widths every blind is still over its window (with gaps of their
+    own, the sizing QP spread the change differently over each, as the windows' width is
+    held by a floor of windows on other columns too)."""
+    from facadecli import solve
+    from facadecli.solve import retarget
+
+    rects = []
+    for x in (0.9, 2.9, 5.5, 8.3):  # uneven bays: no run, every gap a symbol of its own
+        for y in (2.0, 5.0):
+            rects.append({"label": "window", "x0": x, "y0": y, "x1": x + 1.2, "y1": y + 1.5})
+            rects.append({"label": "blind", "x0": x, "y0": y + 1.6, "x1": x + 1.2, "y1": y + 2})
+    for x in (2.0, 7.0):  # windows of the same size on other columns, without blinds
+        rects.append({"label": "window", "x0": x, "y0": 8.0, "x1": x + 1.2, "y1": 9.5})
+    rects.append({"label": "door", "x0": 4.4, "y0": 0.0, "x1": 5.3, "y1": 1.8})
+    inferred = infer(_write(tmp_path / "blinds.json", rects), "blinds")
+    assert ("blind_gx" in inferred.text) != ("window_gx" in inferred.text)  # one set of gaps
+    spec = parse_spec(inferred.text, "blinds.yaml")
+    for width in (8.0, 17.1):
+        layout = solve(retarget(spec, width, 10.0))
+        spans = {
+            label: sorted(
+                {
+                    (round(s.x0, 6), round(s.x1, 6))
+                    for s in layout.shapes
+                    if s.layer == label and s.visible
+                }
+            )
+            for label in ("window", "blind")
+        }
+        assert len(spans["blind"]) == 4 and set(spans["blind"]) <= set(spans["window"])
+
+
+def test_a_runs_elements_keep_the_spread_of_their_sizes(tmp_path: Path) -> None:
+    """Hand annotation jitters: windows of 1.16-1.24 m in a run are regularised to one
+    size, with the range they span as min and max, so a retargeted façade gains bays of
+    windows sized within what the input shows; the door, which does not repeat, and the
+    ledge across the façade get no bounds (they stretch with it)."""
+    from facadecli import solve
+    from facadecli.solve import retarget
+
+    rects: list[dict[str, object]] = [
+        {"label": "window", "x0": 1.0 + 2.0 * k, "y0": 5.0, "x1": 1.0 + 2.0 * k + w, "y1": 6.5}
+        for k, w in enumerate((1.2, 1.16, 1.24, 1.19, 1.21))
+    ]
+    rects.append({"label": "door", "x0": 4.5, "y0": 0.0, "x1": 5.7, "y1": 2.4})
+    rects.append({"label": "cornice", "x0": 0.0, "y0": 8.0, "x1": 11.4, "y1": 8.4})
+    inferred = infer(_write(tmp_path / "jitter.json", rects), "jitter")
+    spec = parse_spec(inferred.text, "jitter.yaml")
+    window = spec.symbols["window_w1"]
+    assert window.min is not None and window.max is not None
+    assert window.min == pytest.approx(1.16, abs=2e-3) and window.max == pytest.approx(
+        1.24, abs=2e-3
+    )
+    assert spec.symbols["door_w1"].min is None and spec.symbols["cornice_w1"].min is None
+    for width in (8.0, 17.1):
+        layout = solve(retarget(spec, width, 10.0))
+        widths = {round(s.x1 - s.x0, 4) for s in layout.shapes if s.layer == "window" and s.visible}
+        assert widths and all(window.min - 1e-6 <= w <= window.max + 1e-6 for w in widths)

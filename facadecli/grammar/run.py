@@ -170,6 +170,7 @@ class Tidied:
     layout: LabelledLayout
     snapping: Snapping
     regularization: Regularization
+    snapped: LabelledLayout  # before regularising: its rectangles in the same order
 
 
 def tidy_layout(path: Path, options: Options, deadline: Deadline) -> Tidied:
@@ -186,7 +187,7 @@ def tidy_layout(path: Path, options: Options, deadline: Deadline) -> Tidied:
     snapped, snapping = snap_and_count(layout, snap, deadline)
     check_cells(path, snapped, snap)
     regular, regularization = regularize(snapped, tolerance, deadline=deadline)
-    return Tidied(regular, snapping, regularization)
+    return Tidied(regular, snapping, regularization, snapped)
 
 
 def extract_grammar(path: Path, options: Options = Options()) -> Extraction:

@@ -17,12 +17,13 @@ from facadecli.grammar.inputs import BACKGROUND, LabelledLayout
 from facadecli.grammar.run import Options, tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
 from facadecli.infer.layers import Grid, grids
-from facadecli.infer.spec_text import ident, layer_names, spec_text
+from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
 from facadecli.layout import Layout
 from facadecli.spec.model import Spec
 
 RASTER = 400  # samples along each axis of the IoU raster
 WIDTHS = (0.7, 1.5)  # other widths the spec must solve at, as shares of the input's
+ELEMENT_SHARE = 0.25  # elements up to this share of the façade keep their size's spread
 
 
 @dataclass
@@ -49,12 +50,35 @@ class Inference:
 def infer(path: Path, name: str, options: Options | None = None) -> Inference:
     """The spec of a labelled layout (``options``: its size, snap and tolerance)."""
     options = options or Options()
-    regular = tidy_layout(path, options, Deadline(options.time_limit, str(path))).layout
+    tidied = tidy_layout(path, options, Deadline(options.time_limit, str(path)))
+    regular = tidied.layout
     if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
     found = grids(regular)
-    text = spec_text(ident(name), regular.width, regular.height, found, path.name)
+    spread = size_spread(regular, tidied.snapped)
+    text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread)
     return Inference(path.name, regular, tile(regular, tolerance=0.0), found, text)
+
+
+def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:
+    """For each label's regularised element size along each axis, the least and greatest
+    size the elements made that size had before regularising (hand annotation's jitter:
+    the range a derived façade may size them in). Only for elements, not for bands across
+    a good share of the façade (``ELEMENT_SHARE``): those grow and shrink with it."""
+    spread: dict[tuple[str, str, float], tuple[float, float]] = {}
+    for tidy, raw in zip(regular.rects, snapped.rects, strict=True):
+        if tidy.label == BACKGROUND:
+            continue
+        for axis, size, before, extent in (
+            ("x", tidy.x1 - tidy.x0, raw.x1 - raw.x0, regular.width),
+            ("y", tidy.y1 - tidy.y0, raw.y1 - raw.y0, regular.height),
+        ):
+            if size > ELEMENT_SHARE * extent:
+                continue  # a band across the façade is as wide as the façade makes it
+            key = (axis, tidy.label, round(size, 6))
+            low, high = spread.get(key, (size, size))
+            spread[key] = (min(low, before), max(high, before))
+    return spread
 
 
 def check(inference: Inference, spec: Spec) -> dict[str, object]:

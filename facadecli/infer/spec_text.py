@@ -10,8 +10,10 @@
 - Symbols: a layer's gaps of one size share one (``window_gx1``, ``window_gy2``), and a
   label's elements of one size share one across layers (``window_w1``, ``window_h2``),
   with the sizes measured (in metres, to a tenth of a millimetre); all are opaque (a
-  layer's gaps are hidden by its mask). Gaps are a layer's own: shared between layers,
-  they would tie the layers' words so tightly that only the input's size could hold them.
+  layer's gaps are hidden by its mask). Gaps are a layer's own (shared between layers of
+  different columns, they would tie the words so tightly that only the input's size could
+  hold them), except that layers with the same columns (rows) share their x (y) gaps:
+  their words are then alike, so they stay aligned at any size.
 - Repeats: where a word repeats a gap and an element twice or more (three elements), or
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
@@ -86,6 +88,7 @@ def ident(label: str) -> str:
 
 
 Token = tuple[str, float]  # a letter of a word, and its size
+Spread = dict[tuple[str, str, float], tuple[float, float]]  # (axis, label, size) -> range
 
 
 def _tokens(
@@ -104,9 +107,9 @@ def _tokens(
     return tokens
 
 
-def _word(tokens: list[Token], axis: str, counters: _Counters) -> str:
+def _word(tokens: list[Token], axis: str, counters: _Counters, repeated: set[str]) -> str:
     """The tokens as a word, the longest run of a repeated unit (one or two letters, at
-    least ``RUNS`` copies) written with a counter."""
+    least ``RUNS`` copies) written with a counter; the run's symbols go into ``repeated``."""
     symbols = [symbol for symbol, _ in tokens]
     best = None  # (letters covered, start, unit, copies)
     for unit in (1, 2):
@@ -125,23 +128,47 @@ def _word(tokens: list[Token], axis: str, counters: _Counters) -> str:
     pitch = sum(size for _, size in tokens[start : start + unit])
     counter = counters.of(axis, pitch, copies)
     body = " ".join(symbols[start : start + unit])
+    repeated.update(symbols[start : start + unit])
     run = f"({body})^{counter}" if unit > 1 else f"{body}^{counter}"
     return " ".join([*symbols[:start], run, *symbols[start + copies * unit :]])
 
 
-def spec_text(name: str, width: float, height: float, found: list[Grid], source: str) -> str:
+def spec_text(
+    name: str,
+    width: float,
+    height: float,
+    found: list[Grid],
+    source: str,
+    spread: Spread | None = None,
+) -> str:
     """The spec (see the module): the sizes a line per label and a line per layer, and each
-    layer in two lines under the comment that says where it came from."""
+    layer in two lines under the comment that says where it came from. ``spread``: the
+    range the input's elements of a label's size span (see ``_size``)."""
     counters = _Counters()
     elements: dict[str, tuple[_Symbols, _Symbols]] = {}
-    layers: list[tuple[str, Grid, str, str, tuple[_Symbols, _Symbols]]] = []
+    # a layer's gaps are its own, but layers with the same columns (or rows) share them:
+    # their words are then alike and stay aligned at any size
+    gaps_x: dict[tuple[Span, ...], _Symbols] = {}
+    gaps_y: dict[tuple[Span, ...], _Symbols] = {}
+    owned: list[list[_Symbols]] = []  # the gap symbols each layer introduces
+    repeated: set[str] = set()  # symbols of runs (written with a counter)
+    layers: list[tuple[str, Grid, str, str]] = []
     for layer, grid in zip(layer_names(found), found, strict=True):
         base = ident(grid.label)
         symbols = elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
-        gaps = (_Symbols(f"{layer}_gx"), _Symbols(f"{layer}_gy"))
-        x = _word(_tokens(grid.columns, width, symbols[0], gaps[0]), "x", counters)
-        y = _word(_tokens(grid.rows, height, symbols[1], gaps[1]), "y", counters)
-        layers.append((layer, grid, x, y, gaps))
+        introduced = [
+            table.setdefault(spans, _Symbols(f"{layer}_g{axis}"))
+            for table, spans, axis in ((gaps_x, grid.columns, "x"), (gaps_y, grid.rows, "y"))
+            if spans not in table
+        ]
+        owned.append(introduced)
+        x = _word(
+            _tokens(grid.columns, width, symbols[0], gaps_x[grid.columns]), "x", counters, repeated
+        )
+        y = _word(
+            _tokens(grid.rows, height, symbols[1], gaps_y[grid.rows]), "y", counters, repeated
+        )
+        layers.append((layer, grid, x, y))
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
         "# a label's elements on a grid (its columns x its rows), back to front, with the",
@@ -155,10 +182,21 @@ def spec_text(name: str, width: float, height: float, found: list[Grid], source:
         "symbols: {",
         f"  wall_w: {_number(width)}, wall_h: {_number(height)},",
     ]
-    sizes = [[*pair[0].sizes.items(), *pair[1].sizes.items()] for pair in elements.values()]
-    sizes += [[*gaps[0].sizes.items(), *gaps[1].sizes.items()] for *_, gaps in layers]
+    spread = spread or {}
+    sizes = [
+        [
+            (symbol, _size(size, spread.get((axis, label, size)) if symbol in repeated else None))
+            for axis, table in zip("xy", pair, strict=True)
+            for size, symbol in table.sizes.items()
+        ]
+        for label, pair in elements.items()
+    ]
+    sizes += [
+        [(symbol, _number(size)) for gaps in mine for size, symbol in gaps.sizes.items()]
+        for mine in owned
+    ]
     out += [
-        "  " + ", ".join(f"{symbol}: {_number(size)}" for size, symbol in line) + ","
+        "  " + ", ".join(f"{symbol}: {size}" for symbol, size in line) + ","
         for line in sizes
         if line
     ]
@@ -174,7 +212,7 @@ def spec_text(name: str, width: float, height: float, found: list[Grid], source:
     out.append("layers:")
     out.append("  # the background")
     out.append("  - {name: wall, x: wall_x, y: wall_y, shapes: [{material: wall, thickness: 0.3}]}")
-    for k, (layer, grid, x, y, _) in enumerate(layers, start=1):
+    for k, (layer, grid, x, y) in enumerate(layers, start=1):
         mesh, thickness = MESHES.get(grid.label, DEFAULT_MESH)
         rows = ", ".join(f"{_number(a)}-{_number(b)}" for a, b in grid.rows)
         shown_x = sorted({elements[grid.label][0].of(b - a) for a, b in grid.columns})
@@ -192,6 +230,19 @@ def spec_text(name: str, width: float, height: float, found: list[Grid], source:
     colours += [(ident(label), label_colour(label)) for label in elements]
     out.append("materials: {" + ", ".join(f'{n}: {{color: "{c}"}}' for n, c in colours) + "}")
     return "\n".join(out) + "\n"
+
+
+def _size(size: float, spread: tuple[float, float] | None) -> str:
+    """A symbol's size, with ``min`` and ``max`` where the input's elements of it spread
+    wider than the sizes are written (a tenth of a millimetre). Only a run's elements get
+    them: a façade of another size gains or loses bays of them, and they keep their size
+    within what the input shows; an element that does not repeat stretches with the
+    façade."""
+    low, high = spread or (size, size)
+    low, high = min(low, size), max(high, size)
+    if high - low < 2 * 10.0**-DECIMALS:
+        return _number(size)
+    return f"{{size: {_number(size)}, min: {_number(low)}, max: {_number(high)}}}"
 
 
 def layer_names(found: list[Grid]) -> list[str]:
