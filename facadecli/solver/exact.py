@@ -381,8 +381,10 @@ class _Search:
                 ]
             return kept
 
+        last = len(order) - 1
+
         def extend(
-            i: int, first: tuple[int, Move, np.ndarray] | None
+            i: int, first: tuple[int, Move, np.ndarray] | None, solid: bool
         ) -> Iterator[tuple[Move | None, ...]]:
             self.combinations += 1
             if self.combinations % COMBINATION_WORK == 0:
@@ -393,14 +395,17 @@ class _Search:
                 return
             r = order[i]
             for move, length in choices(r, first):
+                if i == last and not solid and move is not None and move.plain and move.letters > 1:
+                    continue  # a stretch of several letters: searched a letter at a time
                 chosen[r] = move
+                held = solid or not _stands_aside(move)
                 if first is None and length is not None and move is not None:
-                    yield from extend(i + 1, (r, move, length))
+                    yield from extend(i + 1, (r, move, length), held)
                 else:
-                    yield from extend(i + 1, first)
+                    yield from extend(i + 1, first, held)
             chosen[r] = None
 
-        yield from extend(0, None)
+        yield from extend(0, None, False)
 
     def options(self, g: int, r: int, position: int, node: _Node) -> Options:
         """The entries of a row out of ``position`` (None: a gap) with their lengths when
@@ -724,6 +729,16 @@ def _remember(
     return tuple(updated)
 
 
+def _stands_aside(move: Move | None) -> bool:
+    """An entry that leaves a column to the others (see _stretch): empty, inside a
+    placeholder, or starting one with nothing before it."""
+    return (
+        move is None
+        or move.middle
+        or (move.letters == 1 and move.piece_of is None and move.tail is not None)
+    )
+
+
 def _stretch(entries: Column) -> Move | None:
     """The entry of a *stretch*: a column where one row holds whole sized letters and every
     other row is empty, inside a placeholder it does not finish, or starting one. A stretch
@@ -734,12 +749,8 @@ def _stretch(entries: Column) -> Move | None:
     them."""
     found = None
     for move in entries:
-        if (
-            move is None
-            or move.middle
-            or (move.letters == 1 and move.piece_of is None and move.tail is not None)
-        ):
-            continue  # empty, inside a placeholder, or starting one with nothing before it
+        if _stands_aside(move):
+            continue
         if found is not None or not move.plain:
             return None
         found = move
