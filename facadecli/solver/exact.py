@@ -749,7 +749,7 @@ def _stretch(entries: Column) -> Move | None:
     them."""
     found = None
     for move in entries:
-        if _stands_aside(move):
+        if move is None or _stands_aside(move):
             continue
         if found is not None or not move.plain:
             return None
