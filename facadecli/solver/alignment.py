@@ -212,7 +212,7 @@ class _Row:
         for index in range(k, self.n):
             if traits[index].transparent != transparent or traits[index].segment != segment:
                 return
-            whole.add(index, traits[index], self.row.word[index].symbol)
+            whole.add(traits[index], self.row.word[index].symbol)
             yield self._move(start, 2 * (index + 1), whole, piece_of=piece_of)
             following = index + 1
             if transparent and following < self.n and traits[following].transparent:
@@ -270,7 +270,7 @@ class _Whole:
         self.opaque = self.transparent = self.sized_only = True
         self.unoccludable = self.first_attached = self.last_attached = False
 
-    def add(self, index: int, traits: LetterTraits, symbol: str) -> None:
+    def add(self, traits: LetterTraits, symbol: str) -> None:
         if traits.size is None:
             self.unsized = (*self.unsized, symbol)
             self.sized_only = False
