@@ -247,8 +247,22 @@ def test_the_roof_is_lowered_to_leave_a_wall() -> None:
         Polygon(_box(0, 0, 40, 30)), Heights(9.0, None, 0.0, None, 9.0), Roof(type="gable")
     )  # its pitch would make the roof 8.7 m high: half the building at most
     assert (wide.eaves, wide.top) == pytest.approx((4.5, 9.0))
+    levels = volume(
+        Polygon(_box(0, 0, 40, 30)), Heights(None, 6.0, 0.0, None, 9.0), Roof(type="gable")
+    )  # under 2 levels of 3 m: the walls stay 6 m, the roof half the building, 6 m
+    assert (levels.eaves, levels.top) == pytest.approx((6.0, 12.0))
     flat = volume(part, Heights(None, None, 0.0, None, 9.0), Roof(type="flat"))
     assert (flat.eaves, flat.roof.type) == (9.0, "flat")
+
+
+def test_a_tagged_roof_lifts_the_default_top_of_a_lifted_part() -> None:
+    dome = volume(
+        Polygon(_box(0, 0, 4, 4)),
+        Heights(top=None, eaves=None, base=18.0, roof=5.0, default=12.0),
+        Roof(type="dome"),
+    )  # a dome drawn as a part of its own above a tower: min_height and roof:height
+    assert (dome.base, dome.eaves, dome.top) == pytest.approx((18.0, 18.5, 23.5))
+    assert dome.roof.type == "dome"
 
 
 def test_tags_read_as_osm_writes_them() -> None:

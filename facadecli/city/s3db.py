@@ -62,21 +62,28 @@ def volume(part: Polygon, heights: Heights, roof: Roof) -> Volume:
     """The part's walls and roof as the heights say. A roof whose height comes from its
     pitch alone (no ``roof:height``, ``roof:levels`` or roof ``height``) takes at most
     ROOF_SHARE of the building's height (a wide footprint gets a flatter roof, not walls
-    half a metre high); a roof too tall for the building is lowered to leave MIN_WALL of
-    wall; a roof of no height is flat."""
+    half a metre high; under levels, the walls keep the levels' height and the roof is
+    lowered); a roof too tall for the building is lowered to leave MIN_WALL of
+    wall; a roof of no height is flat. With no height and no levels the top is the
+    default, or, higher, a tagged roof on MIN_WALL of wall above the base (a dome drawn
+    as a part of its own, lifted above the default: the tag wins over the guess)."""
     own = 0.0 if roof.type == "flat" else roof_height(part, roof)
     rise = heights.roof if heights.roof is not None else own
     if roof.type == "flat":
         rise = 0.0
+    pitched = heights.roof is None and roof.height is None  # a roof from its pitch alone
     if heights.top is not None:
         top = heights.top
     elif heights.eaves is not None:
+        if pitched:  # ROOF_SHARE of the walls and the roof together, at most
+            walls = max(0.0, heights.eaves - heights.base)
+            rise = min(rise, ROOF_SHARE / (1 - ROOF_SHARE) * walls)
         top = heights.eaves + rise
     else:
-        top = heights.default
+        top = max(heights.default, heights.base + MIN_WALL + (heights.roof or 0.0))
     top = max(top, heights.base + MIN_WALL)
-    if heights.roof is None and roof.height is None:  # a roof from its pitch alone: at
-        rise = min(rise, ROOF_SHARE * (top - heights.base))  # most a share of the building
+    if pitched:  # at most a share of the building
+        rise = min(rise, ROOF_SHARE * (top - heights.base))
     eaves = max(top - rise, min(heights.base + MIN_WALL, top))
     rise = top - eaves
     if rise <= 1e-6:
