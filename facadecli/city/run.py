@@ -10,6 +10,7 @@ from the buildings: they do not fail the run; a building that fails to build doe
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -39,12 +40,14 @@ from facadecli.city.cityjson import (
     write_cityjson,
 )
 from facadecli.city.footprints import BBox, Footprint, Rejected, Simplified, read_footprints
-from facadecli.city.manifest import City, Roof, WallRule
+from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
+    outline_rest,
     replaced_outlines,
     roof_colour,
     shared_edges,
+    side_by_side,
     tagged_heights,
     tagged_roof,
     volume,
@@ -232,14 +235,15 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
     """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
-    names = city.manifest.properties.names()
     tolerance = defaults.party_wall_tolerance
-    shared = shared_edges(footprints, tolerance) if tolerance > 0 else {}
+    shapes = {footprint.id: _shape(city, footprint.properties) for footprint in footprints}
+    beside = _beside(footprints, shapes)
+    shared = shared_edges(footprints, tolerance, beside) if tolerance > 0 else {}
     tasks = []
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
     for footprint in footprints:
-        choice = city.choose(footprint.properties)
+        choice, heights, roof = shapes[footprint.id]
         name = safe_name(footprint.id)
         if owners.setdefault(name, footprint.id) != footprint.id:
             raise SpecError.at(
@@ -250,9 +254,6 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 "change one of the ids",
             )
         properties = footprint.properties
-        heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
-        if choice.height is not None:  # a rule's height wins over the tags'
-            heights = replace(heights, top=choice.height, eaves=None)
         for path in (choice.facade, *(rule.facade for rule in choice.walls)):
             if path not in identities:  # workers outlive a run: tell specs apart
                 content = city.specs[path].model_dump_json().encode("utf-8")
@@ -281,7 +282,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 choice.facade,
                 city.specs[choice.facade],
                 heights,
-                tagged_roof(properties, choice.roof),
+                roof,
                 defaults.min_facade_width,
                 outdir / "buildings" / f"{name}.glb",
                 (city.folder / choice.facade).parent.resolve(),
@@ -296,6 +297,71 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
             )
         )
     return tasks
+
+
+def _shape(city: City, properties: dict[str, Any]) -> tuple[Choice, Heights, Roof]:
+    """What the manifest and a feature's tags make of a building: the manifest's choice,
+    its heights (a rule's height wins over the tags') and its roof."""
+    defaults = city.manifest.defaults
+    choice = city.choose(properties)
+    names = city.manifest.properties.names()
+    heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
+    if choice.height is not None:
+        heights = replace(heights, top=choice.height, eaves=None)
+    return choice, heights, tagged_roof(properties, choice.roof)
+
+
+def _beside(
+    footprints: Sequence[Footprint], shapes: dict[str, tuple[Choice, Heights, Roof]]
+) -> Callable[[str, str], bool]:
+    """Whether two footprints' walls stand side by side (:func:`side_by_side`): always
+    when both stand on the ground; else from their volumes, found only then (a roof's
+    height from its pitch needs its skeleton)."""
+    by_id = {footprint.id: footprint for footprint in footprints}
+
+    @functools.cache
+    def span(key: str) -> tuple[float, float]:
+        _, heights, roof = shapes[key]
+        blocks = [volume(part, heights, roof) for part in by_id[key].parts]
+        return min(block.base for block in blocks), max(block.eaves for block in blocks)
+
+    def beside(one: str, other: str) -> bool:
+        if shapes[one][1].base <= 0 and shapes[other][1].base <= 0:
+            return True  # walls from the ground up meet for MIN_WALL at least
+        return side_by_side(span(one), span(other))
+
+    return beside
+
+
+def standing(
+    city: City, footprints: Sequence[Footprint], replaced: dict[str, list[str]]
+) -> tuple[list[Footprint], dict[str, float]]:
+    """The footprints to build: an outline with parts (``replaced``) as what its parts
+    leave of it (:func:`outline_rest`; dropped when they leave nothing), every other
+    footprint as it is; and the area (m²) still built of each outline with parts."""
+    by_id = {footprint.id: footprint for footprint in footprints}
+    built: list[Footprint] = []
+    kept: dict[str, float] = {}
+    for footprint in footprints:
+        ids = replaced.get(footprint.id)
+        if ids is None:
+            built.append(footprint)
+            continue
+        _, heights, roof = _shape(city, footprint.properties)
+        parts = [
+            (shape, _shape(city, by_id[i].properties)[1].base)
+            for i in ids
+            for shape in by_id[i].parts
+        ]
+        rest = [
+            piece
+            for shape in footprint.parts
+            for piece in outline_rest(shape, volume(shape, heights, roof).eaves, parts)
+        ]
+        kept[footprint.id] = round(sum(piece.area for piece in rest), 1)
+        if rest:
+            built.append(replace(footprint, parts=tuple(rest)))
+    return built, kept
 
 
 def check_output(outdir: Path, name: str) -> None:
@@ -345,7 +411,7 @@ def run_city(
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
     found = read_footprints(city.footprints, bbox)
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
-    footprints = [f for f in found.footprints if f.id not in replaced]
+    footprints, kept = standing(city, found.footprints, replaced)
     footprints = footprints[: limit if limit is not None else None]
     tasks = plan(city, footprints, outdir, usd)
     results: list[dict[str, Any]] = []
@@ -428,7 +494,9 @@ def run_city(
         "origin": list(found.origin),
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
-        "replaced": [{"id": key, "parts": ids} for key, ids in sorted(replaced.items())],
+        "replaced": [
+            {"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())
+        ],
         "models": written,
         "summary": {
             "buildings": len(tasks),
@@ -436,7 +504,8 @@ def run_city(
             "failed": len(failed),
             "rejected": len(found.rejected),
             "outside_bbox": found.outside,
-            "replaced": len(replaced),
+            "replaced": sum(1 for area in kept.values() if area == 0),
+            "trimmed": sum(1 for area in kept.values() if area > 0),
             "party_walls": sum(r.get("party_walls", 0) for r in results),
             "seconds": round(time.perf_counter() - started, 2),
         },
