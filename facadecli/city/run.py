@@ -18,7 +18,7 @@ import re
 import time
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TypeVar
@@ -101,6 +101,8 @@ def safe_name(building_id: str) -> str:
 
 IN_FLIGHT = 64  # chunks of tasks handed to the workers at once, at most
 _CACHE: dict[str, AxisCache] = {}  # per worker process: axes solved for earlier buildings
+_SEEDED: dict[str, str] = {}  # per Dask worker process: the run its cache was seeded for
+Axes = tuple[AxisLayout, ...]  # an axis's layouts at a rung: the best and its variants
 
 
 def _needs(task: Task) -> list[Slot]:
@@ -119,14 +121,31 @@ def _needs(task: Task) -> list[Slot]:
     return sorted(found)
 
 
-def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, tuple[AxisLayout, ...]]:
+def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, Axes]:
     spec, slot = job
     return slot, solve_rung(spec, slot[1], rung_length(slot[2]), slot[3])
 
 
-def _seed(axes: dict[Slot, tuple[AxisLayout, ...]]) -> None:
+def _seed(axes: dict[Slot, Axes]) -> None:
     """A worker's cache, filled with the axes solved ahead."""
     _CACHE["axes"] = AxisCache(axes=dict(axes))
+
+
+def _build_seeded(tasks: Sequence[Task], axes: dict[Slot, Axes], run: str) -> list[dict[str, Any]]:
+    """``build`` on a Dask worker handed a run's axes solved ahead: its cache is seeded
+    with them before its first building of the run (``run`` tells runs apart: workers
+    outlive them), as a local pool's processes are when they start."""
+    if _SEEDED.get("run") != run:
+        _seed(axes)
+        _SEEDED["run"] = run
+    return [build(task) for task in tasks]
+
+
+def axes_solved_while_building() -> int:
+    """How many axes this worker process solved while building, not ahead: 0 when the
+    run's presolve gave it every axis its buildings needed."""
+    cache = _CACHE.get("axes")
+    return 0 if cache is None else cache.solved
 
 
 def build(task: Task) -> dict[str, Any]:
@@ -404,8 +423,8 @@ def run_city(
     """Build a city; returns the report (also written to ``<name>.report.json``).
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
-    scheduler's address), on that Dask cluster: the same tasks and the same ``build``
-    function either way, so both give the same files."""
+    scheduler's address), on that Dask cluster: the same tasks, the same axes solved
+    ahead and the same ``build`` function either way, so both give the same files."""
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
@@ -431,7 +450,7 @@ def run_city(
             todo.append(task)
     done = len(results)
     local = scheduler is None
-    mapped = _map_local(todo, jobs) if local else _map_dask(build, todo, str(scheduler))
+    mapped = _map_local(todo, jobs) if local else _map_dask(todo, str(scheduler))
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
         outdir.mkdir(parents=True, exist_ok=True)
@@ -533,55 +552,71 @@ def _rejected(rejected: Rejected) -> dict[str, Any]:
     }
 
 
-def _map_dask(
-    function: Callable[[Task], dict[str, Any]], tasks: list[Task], scheduler: str
-) -> Iterator[dict[str, Any]]:
-    """The tasks on a Dask distributed cluster, results in task order."""
+Submit = Callable[..., Any]  # a pool's or a Dask client's submit: (function, *args) -> future
+
+
+def _chunk(tasks: int, workers: int) -> int:
+    """Tasks handed to a worker at once: a few chunks a worker, 16 tasks a chunk at most."""
+    return max(1, min(16, tasks // (max(1, workers) * 4)))
+
+
+def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, Axes]:
+    """The axes every building needs (:func:`_needs`), each solved once, spread over the
+    workers ``submit`` hands work to (a local pool's or a Dask cluster's). Each worker's
+    cache is then seeded with them: no two workers solve one axis, and the layouts are
+    those a worker would have solved itself, so the files are the same."""
+    specs = {task.cache_key: task.spec for task in tasks}
+    specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
+    needs = _bounded(lambda batch: submit(_each, _needs, batch), tasks, chunk)
+    slots = sorted({slot for need in needs for slot in need})
+    jobs = [(specs[slot[0]], slot) for slot in slots]
+    return dict(_bounded(lambda batch: submit(_each, _solve, batch), jobs, 1))
+
+
+def _map_dask(tasks: list[Task], scheduler: str) -> Iterator[dict[str, Any]]:
+    """The buildings on a Dask distributed cluster, results in task order: the axes are
+    solved ahead over the cluster (:func:`_presolve`), sent to every worker once, and
+    each worker's cache is seeded with them before its first building."""
     from distributed import Client
 
     with Client(scheduler, set_as_default=False) as client:
-        pending: deque[Any] = deque()
-        for task in tasks:  # a bounded stream: at most IN_FLIGHT tasks handed out at once
-            pending.append(client.submit(function, task, pure=False))
-            if len(pending) >= IN_FLIGHT:
-                yield pending.popleft().result()
-        while pending:
-            yield pending.popleft().result()
+        chunk = _chunk(len(tasks), sum(client.nthreads().values()))
+        solved = _presolve(functools.partial(client.submit, pure=False), tasks, chunk)
+        [axes] = client.scatter([solved], broadcast=True, hash=False)
+        yield from _bounded(
+            lambda batch: client.submit(_build_seeded, batch, axes, axes.key, pure=False),
+            tasks,
+            chunk,
+        )
 
 
 def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
     """The buildings in ``jobs`` local processes, results in task order. With several
-    processes, the axes every building needs are solved first, each once, spread over
-    the processes, and handed to each; one process solves them as it goes."""
+    processes, the axes every building needs are solved first (:func:`_presolve`) and
+    handed to each process as it starts; one process solves them as it goes."""
     if jobs <= 1 or len(tasks) < 2:
         for task in tasks:
             yield build(task)
         return
-    chunk = max(1, min(16, len(tasks) // (jobs * 4)))
-    specs = {task.cache_key: task.spec for task in tasks}
-    specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
+    chunk = _chunk(len(tasks), jobs)
     with ProcessPoolExecutor(max_workers=jobs) as pool:
-        needs = _bounded(pool, _needs, tasks, chunk)
-        slots = sorted({slot for need in needs for slot in need})
-        jobs_ahead = [(specs[slot[0]], slot) for slot in slots]
-        solved = dict(_bounded(pool, _solve, jobs_ahead, 1))
+        solved = _presolve(pool.submit, tasks, chunk)
     with ProcessPoolExecutor(max_workers=jobs, initializer=_seed, initargs=(solved,)) as pool:
-        yield from _bounded(pool, build, tasks, chunk)
+        yield from _bounded(lambda batch: pool.submit(_each, build, batch), tasks, chunk)
 
 
 T = TypeVar("T")
 R = TypeVar("R")
 
 
-def _bounded(
-    pool: ProcessPoolExecutor, function: Callable[[T], R], items: Sequence[T], chunk: int
-) -> Iterator[R]:
-    """``pool.map`` as a bounded stream: results in order, with at most IN_FLIGHT chunks
-    of ``chunk`` items handed to the workers at once (``Executor.map`` would queue every
-    item first, and a city of a million buildings with it)."""
-    pending: deque[Future[list[R]]] = deque()
+def _bounded(hand: Callable[[Sequence[T]], Any], items: Sequence[T], chunk: int) -> Iterator[Any]:
+    """A map as a bounded stream: ``hand`` gives a chunk of ``chunk`` items to the workers
+    (a future of their results); results come in order, with at most IN_FLIGHT chunks
+    handed out at once (``Executor.map`` would queue every item first, and a city of a
+    million buildings with it)."""
+    pending: deque[Any] = deque()
     for start in range(0, len(items), chunk):
-        pending.append(pool.submit(_each, function, items[start : start + chunk]))
+        pending.append(hand(items[start : start + chunk]))
         if len(pending) >= IN_FLIGHT:
             yield from pending.popleft().result()
     while pending:
