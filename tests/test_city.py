@@ -17,7 +17,7 @@ from facadecli.city.demo import district, write_demo
 from facadecli.city.footprints import read_footprints
 from facadecli.city.manifest import Roof, load_city
 from facadecli.city.roofs import roof_meshes
-from facadecli.city.run import run_city, safe_name
+from facadecli.city.run import axes_solved_while_building, run_city, safe_name
 from facadecli.city.s3db import tagged_heights, volume
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -151,7 +151,7 @@ def test_the_demo_district_is_deterministic() -> None:
 
 
 def test_a_dask_cluster_gives_the_same_files_as_local_processes(tmp_path: Path) -> None:
-    from distributed import LocalCluster
+    from distributed import Client, LocalCluster
 
     manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
     city = load_city(manifest)
@@ -164,7 +164,10 @@ def test_a_dask_cluster_gives_the_same_files_as_local_processes(tmp_path: Path) 
         dashboard_address=None,
     ) as cluster:
         report = run_city(city, tmp_path / "dask", scheduler=cluster.scheduler_address)
+        with Client(cluster) as client:  # the axes came solved ahead: none while building
+            assert list(client.run(axes_solved_while_building).values()) == [0, 0]
     assert report["summary"]["ok"] == 4
+    assert all(b["facades"] >= 4 for b in report["buildings"])  # they needed axes
     local = sorted(p.relative_to(tmp_path / "local") for p in (tmp_path / "local").rglob("*.glb"))
     assert local == sorted(
         p.relative_to(tmp_path / "dask") for p in (tmp_path / "dask").rglob("*.glb")

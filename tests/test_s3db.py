@@ -21,6 +21,7 @@ from facadecli.city.s3db import (
     blind,
     colour,
     compass,
+    outline_rest,
     replaced_outlines,
     shared_edges,
     tagged_heights,
@@ -111,6 +112,17 @@ FEATURES = [
     _feature("t3", _box(54, 40, 7, 10), building="terrace", height="9"),
     # a national dataset's property: decimetres
     _feature("dataset", _box(80, 40, 10, 10), HAUTEUR=180),
+    # an outline with one wing drawn as a part: the other wing is still built
+    _feature("station", _box(0, 15, 20, 10), building="train_station", height="9"),
+    _feature("hall", _box(0, 15, 10, 10), **{"building:part": "yes", "height": "15"}),
+    # a podium drawn as the outline, upper storeys as a part on it: nothing floats, and
+    # the storeys' walls are their own, not party walls (flush with the podium's south)
+    _feature("podium", _box(30, 15, 12, 10), building="yes", **{"building:levels": "2"}),
+    _feature(
+        "storeys",
+        _box(32, 15, 8, 6),
+        **{"building:part": "yes", "building:min_level": "2", "building:levels": "5"},
+    ),
 ]
 
 
@@ -170,10 +182,44 @@ def test_parts_replace_their_outline(district: tuple[Path, dict[str, Any]]) -> N
     folder, report = district
     built = {b["id"] for b in report["buildings"]}
     assert "outline" not in built and {"low", "tower"} <= built
-    assert report["replaced"] == [{"id": "outline", "parts": ["low", "tower"]}]
+    assert {"id": "outline", "parts": ["low", "tower"], "kept_m2": 0.0} in report["replaced"]
     assert report["summary"]["replaced"] == 1
     assert _model(folder, "tower").bounds[1][1] == pytest.approx(15.0, abs=1e-3)
     assert _model(folder, "low").bounds[1][1] == pytest.approx(6.0, abs=1e-3)
+
+
+def test_what_parts_leave_of_their_outline_is_built(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, report = district
+    wing = _model(folder, "station").bounds
+    assert wing[0][0] == pytest.approx(10.0, abs=0.3) and wing[1][0] == pytest.approx(20.0, abs=0.3)
+    assert wing[1][1] == pytest.approx(9.0, abs=1e-3)  # the outline's own height
+    assert _model(folder, "hall").bounds[1][1] == pytest.approx(15.0, abs=1e-3)
+    entries = {r["id"]: r for r in report["replaced"]}
+    assert entries["station"] == {"id": "station", "parts": ["hall"], "kept_m2": 100.0}
+    assert entries["podium"]["kept_m2"] == 120.0  # the storeys stand on it: all of it
+    assert report["summary"]["trimmed"] == 2
+    podium, storeys = _model(folder, "podium").bounds, _model(folder, "storeys").bounds
+    assert podium[1][1] == pytest.approx(6.0, abs=1e-3)  # 2 levels of 3 m, flat
+    assert storeys[0][1] == pytest.approx(6.0 - 0.01, abs=1e-3)  # on the podium's roof
+    assert _entry(report, "storeys")["party_walls"] == 0  # walls above the podium's
+    assert _entry(report, "storeys")["facades"] == 4
+    assert _entry(report, "podium")["party_walls"] == 0
+
+
+def test_outline_rest_keeps_what_no_part_stands_in() -> None:
+    outline = Polygon(_box(0, 0, 20, 10))
+    ground = Polygon(_box(0, 0, 10, 10))
+    assert outline_rest(outline, 9.0, [(ground, 0.0)])[0].area == pytest.approx(100.0)
+    both = [(ground, 0.0), (Polygon(_box(10.3, 0, 9.7, 10)), 0.0)]  # drawn 30 cm apart
+    assert outline_rest(outline, 9.0, both) == []  # the strip between them is a gap
+    on_top = Polygon(_box(5, 2, 10, 6))
+    assert outline_rest(outline, 9.0, [(on_top, 9.0)]) == [outline]  # upper storeys
+    arcade = [(on_top, 3.0)]  # lifted, but inside the outline's walls: an overhang
+    assert outline_rest(outline, 9.0, arcade)[0].area == pytest.approx(200.0 - 60.0)
+    rest = outline_rest(outline, 9.0, [(Polygon(_box(8, 3, 4, 4)), 0.0)])[0]
+    assert len(rest.interiors) == 1 and rest.exterior.is_ccw  # a courtyard where it stood
 
 
 def test_colour_tags_colour_walls_and_roof(district: tuple[Path, dict[str, Any]]) -> None:
@@ -199,7 +245,8 @@ def test_party_walls_of_a_terrace_are_blind(district: tuple[Path, dict[str, Any]
     assert _entry(report, "t2")["facades"] == 2  # street and garden only
     # the tower and the low part share a wall too: inside one building, blind
     assert _entry(report, "low")["party_walls"] == 1
-    assert report["summary"]["party_walls"] == 1 + 2 + 1 + 1 + 1
+    # and the hall and the rest of the station's outline
+    assert report["summary"]["party_walls"] == 1 + 2 + 1 + 1 + 1 + 1 + 1
 
 
 def test_heights_from_any_property_with_a_scale(district: tuple[Path, dict[str, Any]]) -> None:
@@ -247,8 +294,22 @@ def test_the_roof_is_lowered_to_leave_a_wall() -> None:
         Polygon(_box(0, 0, 40, 30)), Heights(9.0, None, 0.0, None, 9.0), Roof(type="gable")
     )  # its pitch would make the roof 8.7 m high: half the building at most
     assert (wide.eaves, wide.top) == pytest.approx((4.5, 9.0))
+    levels = volume(
+        Polygon(_box(0, 0, 40, 30)), Heights(None, 6.0, 0.0, None, 9.0), Roof(type="gable")
+    )  # under 2 levels of 3 m: the walls stay 6 m, the roof half the building, 6 m
+    assert (levels.eaves, levels.top) == pytest.approx((6.0, 12.0))
     flat = volume(part, Heights(None, None, 0.0, None, 9.0), Roof(type="flat"))
     assert (flat.eaves, flat.roof.type) == (9.0, "flat")
+
+
+def test_a_tagged_roof_lifts_the_default_top_of_a_lifted_part() -> None:
+    dome = volume(
+        Polygon(_box(0, 0, 4, 4)),
+        Heights(top=None, eaves=None, base=18.0, roof=5.0, default=12.0),
+        Roof(type="dome"),
+    )  # a dome drawn as a part of its own above a tower: min_height and roof:height
+    assert (dome.base, dome.eaves, dome.top) == pytest.approx((18.0, 18.5, 23.5))
+    assert dome.roof.type == "dome"
 
 
 def test_tags_read_as_osm_writes_them() -> None:

@@ -85,6 +85,7 @@ class AxisCache:
 
     axes: dict[Slot, tuple[AxisLayout, ...]] = field(default_factory=dict)
     facades: dict[tuple[str, int, int, int, int], FacadeMeshes] = field(default_factory=dict)
+    solved: int = 0  # axes this cache solved itself (not given it solved ahead)
 
     def get(
         self, key: str, spec: Spec, axis: str, length: float, variants: int = 1, pick: int = 0
@@ -100,6 +101,7 @@ class AxisCache:
         slot = (key, axis, rung(length), variants)
         if slot not in self.axes:
             self.axes[slot] = solve_rung(spec, axis, rung_length(slot[2]), variants)
+            self.solved += 1
         return self.axes[slot]
 
     def facade(

@@ -10,6 +10,7 @@ from the buildings: they do not fail the run; a building that fails to build doe
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -17,7 +18,7 @@ import re
 import time
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TypeVar
@@ -39,12 +40,14 @@ from facadecli.city.cityjson import (
     write_cityjson,
 )
 from facadecli.city.footprints import BBox, Footprint, Rejected, Simplified, read_footprints
-from facadecli.city.manifest import City, Roof, WallRule
+from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
+    outline_rest,
     replaced_outlines,
     roof_colour,
     shared_edges,
+    side_by_side,
     tagged_heights,
     tagged_roof,
     volume,
@@ -98,6 +101,8 @@ def safe_name(building_id: str) -> str:
 
 IN_FLIGHT = 64  # chunks of tasks handed to the workers at once, at most
 _CACHE: dict[str, AxisCache] = {}  # per worker process: axes solved for earlier buildings
+_SEEDED: dict[str, str] = {}  # per Dask worker process: the run its cache was seeded for
+Axes = tuple[AxisLayout, ...]  # an axis's layouts at a rung: the best and its variants
 
 
 def _needs(task: Task) -> list[Slot]:
@@ -116,14 +121,31 @@ def _needs(task: Task) -> list[Slot]:
     return sorted(found)
 
 
-def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, tuple[AxisLayout, ...]]:
+def _solve(job: tuple[Spec, Slot]) -> tuple[Slot, Axes]:
     spec, slot = job
     return slot, solve_rung(spec, slot[1], rung_length(slot[2]), slot[3])
 
 
-def _seed(axes: dict[Slot, tuple[AxisLayout, ...]]) -> None:
+def _seed(axes: dict[Slot, Axes]) -> None:
     """A worker's cache, filled with the axes solved ahead."""
     _CACHE["axes"] = AxisCache(axes=dict(axes))
+
+
+def _build_seeded(tasks: Sequence[Task], axes: dict[Slot, Axes], run: str) -> list[dict[str, Any]]:
+    """``build`` on a Dask worker handed a run's axes solved ahead: its cache is seeded
+    with them before its first building of the run (``run`` tells runs apart: workers
+    outlive them), as a local pool's processes are when they start."""
+    if _SEEDED.get("run") != run:
+        _seed(axes)
+        _SEEDED["run"] = run
+    return [build(task) for task in tasks]
+
+
+def axes_solved_while_building() -> int:
+    """How many axes this worker process solved while building, not ahead: 0 when the
+    run's presolve gave it every axis its buildings needed."""
+    cache = _CACHE.get("axes")
+    return 0 if cache is None else cache.solved
 
 
 def build(task: Task) -> dict[str, Any]:
@@ -232,14 +254,15 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
     """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
-    names = city.manifest.properties.names()
     tolerance = defaults.party_wall_tolerance
-    shared = shared_edges(footprints, tolerance) if tolerance > 0 else {}
+    shapes = {footprint.id: _shape(city, footprint.properties) for footprint in footprints}
+    beside = _beside(footprints, shapes)
+    shared = shared_edges(footprints, tolerance, beside) if tolerance > 0 else {}
     tasks = []
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
     for footprint in footprints:
-        choice = city.choose(footprint.properties)
+        choice, heights, roof = shapes[footprint.id]
         name = safe_name(footprint.id)
         if owners.setdefault(name, footprint.id) != footprint.id:
             raise SpecError.at(
@@ -250,9 +273,6 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 "change one of the ids",
             )
         properties = footprint.properties
-        heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
-        if choice.height is not None:  # a rule's height wins over the tags'
-            heights = replace(heights, top=choice.height, eaves=None)
         for path in (choice.facade, *(rule.facade for rule in choice.walls)):
             if path not in identities:  # workers outlive a run: tell specs apart
                 content = city.specs[path].model_dump_json().encode("utf-8")
@@ -281,7 +301,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 choice.facade,
                 city.specs[choice.facade],
                 heights,
-                tagged_roof(properties, choice.roof),
+                roof,
                 defaults.min_facade_width,
                 outdir / "buildings" / f"{name}.glb",
                 (city.folder / choice.facade).parent.resolve(),
@@ -296,6 +316,71 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
             )
         )
     return tasks
+
+
+def _shape(city: City, properties: dict[str, Any]) -> tuple[Choice, Heights, Roof]:
+    """What the manifest and a feature's tags make of a building: the manifest's choice,
+    its heights (a rule's height wins over the tags') and its roof."""
+    defaults = city.manifest.defaults
+    choice = city.choose(properties)
+    names = city.manifest.properties.names()
+    heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
+    if choice.height is not None:
+        heights = replace(heights, top=choice.height, eaves=None)
+    return choice, heights, tagged_roof(properties, choice.roof)
+
+
+def _beside(
+    footprints: Sequence[Footprint], shapes: dict[str, tuple[Choice, Heights, Roof]]
+) -> Callable[[str, str], bool]:
+    """Whether two footprints' walls stand side by side (:func:`side_by_side`): always
+    when both stand on the ground; else from their volumes, found only then (a roof's
+    height from its pitch needs its skeleton)."""
+    by_id = {footprint.id: footprint for footprint in footprints}
+
+    @functools.cache
+    def span(key: str) -> tuple[float, float]:
+        _, heights, roof = shapes[key]
+        blocks = [volume(part, heights, roof) for part in by_id[key].parts]
+        return min(block.base for block in blocks), max(block.eaves for block in blocks)
+
+    def beside(one: str, other: str) -> bool:
+        if shapes[one][1].base <= 0 and shapes[other][1].base <= 0:
+            return True  # walls from the ground up meet for MIN_WALL at least
+        return side_by_side(span(one), span(other))
+
+    return beside
+
+
+def standing(
+    city: City, footprints: Sequence[Footprint], replaced: dict[str, list[str]]
+) -> tuple[list[Footprint], dict[str, float]]:
+    """The footprints to build: an outline with parts (``replaced``) as what its parts
+    leave of it (:func:`outline_rest`; dropped when they leave nothing), every other
+    footprint as it is; and the area (m²) still built of each outline with parts."""
+    by_id = {footprint.id: footprint for footprint in footprints}
+    built: list[Footprint] = []
+    kept: dict[str, float] = {}
+    for footprint in footprints:
+        ids = replaced.get(footprint.id)
+        if ids is None:
+            built.append(footprint)
+            continue
+        _, heights, roof = _shape(city, footprint.properties)
+        parts = [
+            (shape, _shape(city, by_id[i].properties)[1].base)
+            for i in ids
+            for shape in by_id[i].parts
+        ]
+        rest = [
+            piece
+            for shape in footprint.parts
+            for piece in outline_rest(shape, volume(shape, heights, roof).eaves, parts)
+        ]
+        kept[footprint.id] = round(sum(piece.area for piece in rest), 1)
+        if rest:
+            built.append(replace(footprint, parts=tuple(rest)))
+    return built, kept
 
 
 def check_output(outdir: Path, name: str) -> None:
@@ -338,14 +423,14 @@ def run_city(
     """Build a city; returns the report (also written to ``<name>.report.json``).
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
-    scheduler's address), on that Dask cluster: the same tasks and the same ``build``
-    function either way, so both give the same files."""
+    scheduler's address), on that Dask cluster: the same tasks, the same axes solved
+    ahead and the same ``build`` function either way, so both give the same files."""
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
     found = read_footprints(city.footprints, bbox)
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
-    footprints = [f for f in found.footprints if f.id not in replaced]
+    footprints, kept = standing(city, found.footprints, replaced)
     footprints = footprints[: limit if limit is not None else None]
     tasks = plan(city, footprints, outdir, usd)
     results: list[dict[str, Any]] = []
@@ -365,7 +450,7 @@ def run_city(
             todo.append(task)
     done = len(results)
     local = scheduler is None
-    mapped = _map_local(todo, jobs) if local else _map_dask(build, todo, str(scheduler))
+    mapped = _map_local(todo, jobs) if local else _map_dask(todo, str(scheduler))
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
         outdir.mkdir(parents=True, exist_ok=True)
@@ -428,7 +513,9 @@ def run_city(
         "origin": list(found.origin),
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
-        "replaced": [{"id": key, "parts": ids} for key, ids in sorted(replaced.items())],
+        "replaced": [
+            {"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())
+        ],
         "models": written,
         "summary": {
             "buildings": len(tasks),
@@ -436,7 +523,8 @@ def run_city(
             "failed": len(failed),
             "rejected": len(found.rejected),
             "outside_bbox": found.outside,
-            "replaced": len(replaced),
+            "replaced": sum(1 for area in kept.values() if area == 0),
+            "trimmed": sum(1 for area in kept.values() if area > 0),
             "party_walls": sum(r.get("party_walls", 0) for r in results),
             "seconds": round(time.perf_counter() - started, 2),
         },
@@ -464,55 +552,71 @@ def _rejected(rejected: Rejected) -> dict[str, Any]:
     }
 
 
-def _map_dask(
-    function: Callable[[Task], dict[str, Any]], tasks: list[Task], scheduler: str
-) -> Iterator[dict[str, Any]]:
-    """The tasks on a Dask distributed cluster, results in task order."""
+Submit = Callable[..., Any]  # a pool's or a Dask client's submit: (function, *args) -> future
+
+
+def _chunk(tasks: int, workers: int) -> int:
+    """Tasks handed to a worker at once: a few chunks a worker, 16 tasks a chunk at most."""
+    return max(1, min(16, tasks // (max(1, workers) * 4)))
+
+
+def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, Axes]:
+    """The axes every building needs (:func:`_needs`), each solved once, spread over the
+    workers ``submit`` hands work to (a local pool's or a Dask cluster's). Each worker's
+    cache is then seeded with them: no two workers solve one axis, and the layouts are
+    those a worker would have solved itself, so the files are the same."""
+    specs = {task.cache_key: task.spec for task in tasks}
+    specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
+    needs = _bounded(lambda batch: submit(_each, _needs, batch), tasks, chunk)
+    slots = sorted({slot for need in needs for slot in need})
+    jobs = [(specs[slot[0]], slot) for slot in slots]
+    return dict(_bounded(lambda batch: submit(_each, _solve, batch), jobs, 1))
+
+
+def _map_dask(tasks: list[Task], scheduler: str) -> Iterator[dict[str, Any]]:
+    """The buildings on a Dask distributed cluster, results in task order: the axes are
+    solved ahead over the cluster (:func:`_presolve`), sent to every worker once, and
+    each worker's cache is seeded with them before its first building."""
     from distributed import Client
 
     with Client(scheduler, set_as_default=False) as client:
-        pending: deque[Any] = deque()
-        for task in tasks:  # a bounded stream: at most IN_FLIGHT tasks handed out at once
-            pending.append(client.submit(function, task, pure=False))
-            if len(pending) >= IN_FLIGHT:
-                yield pending.popleft().result()
-        while pending:
-            yield pending.popleft().result()
+        chunk = _chunk(len(tasks), sum(client.nthreads().values()))
+        solved = _presolve(functools.partial(client.submit, pure=False), tasks, chunk)
+        [axes] = client.scatter([solved], broadcast=True, hash=False)
+        yield from _bounded(
+            lambda batch: client.submit(_build_seeded, batch, axes, axes.key, pure=False),
+            tasks,
+            chunk,
+        )
 
 
 def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
     """The buildings in ``jobs`` local processes, results in task order. With several
-    processes, the axes every building needs are solved first, each once, spread over
-    the processes, and handed to each; one process solves them as it goes."""
+    processes, the axes every building needs are solved first (:func:`_presolve`) and
+    handed to each process as it starts; one process solves them as it goes."""
     if jobs <= 1 or len(tasks) < 2:
         for task in tasks:
             yield build(task)
         return
-    chunk = max(1, min(16, len(tasks) // (jobs * 4)))
-    specs = {task.cache_key: task.spec for task in tasks}
-    specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
+    chunk = _chunk(len(tasks), jobs)
     with ProcessPoolExecutor(max_workers=jobs) as pool:
-        needs = _bounded(pool, _needs, tasks, chunk)
-        slots = sorted({slot for need in needs for slot in need})
-        jobs_ahead = [(specs[slot[0]], slot) for slot in slots]
-        solved = dict(_bounded(pool, _solve, jobs_ahead, 1))
+        solved = _presolve(pool.submit, tasks, chunk)
     with ProcessPoolExecutor(max_workers=jobs, initializer=_seed, initargs=(solved,)) as pool:
-        yield from _bounded(pool, build, tasks, chunk)
+        yield from _bounded(lambda batch: pool.submit(_each, build, batch), tasks, chunk)
 
 
 T = TypeVar("T")
 R = TypeVar("R")
 
 
-def _bounded(
-    pool: ProcessPoolExecutor, function: Callable[[T], R], items: Sequence[T], chunk: int
-) -> Iterator[R]:
-    """``pool.map`` as a bounded stream: results in order, with at most IN_FLIGHT chunks
-    of ``chunk`` items handed to the workers at once (``Executor.map`` would queue every
-    item first, and a city of a million buildings with it)."""
-    pending: deque[Future[list[R]]] = deque()
+def _bounded(hand: Callable[[Sequence[T]], Any], items: Sequence[T], chunk: int) -> Iterator[Any]:
+    """A map as a bounded stream: ``hand`` gives a chunk of ``chunk`` items to the workers
+    (a future of their results); results come in order, with at most IN_FLIGHT chunks
+    handed out at once (``Executor.map`` would queue every item first, and a city of a
+    million buildings with it)."""
+    pending: deque[Any] = deque()
     for start in range(0, len(items), chunk):
-        pending.append(pool.submit(_each, function, items[start : start + chunk]))
+        pending.append(hand(items[start : start + chunk]))
         if len(pending) >= IN_FLIGHT:
             yield from pending.popleft().result()
     while pending:

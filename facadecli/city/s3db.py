@@ -6,7 +6,9 @@ volume, roof and colours, read into numbers the builder uses.
 - ``building:levels`` counts the levels below the roof: with no ``height`` the walls are
   levels x floor height and the roof sits on top.
 - ``min_height`` (or ``building:min_level`` x floor height) lifts the bottom of the walls.
-- Features tagged ``building:part`` replace the volume of the outline they lie in.
+- Features tagged ``building:part`` replace the volume of the outline they lie in; what
+  of the outline no part stands in (a wing left undrawn, a podium under upper storeys
+  drawn as parts) is still built.
 - ``building:colour`` / ``building:material`` colour the walls, ``roof:colour`` /
   ``roof:material`` the roof.
 
@@ -17,18 +19,21 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
+import shapely
 from shapely import STRtree
 from shapely.geometry import LineString, Polygon
+from shapely.geometry.polygon import orient
 
-from facadecli.city.footprints import Footprint, number
+from facadecli.city.footprints import MIN_AREA, Footprint, number
 from facadecli.city.manifest import Roof
 from facadecli.city.roofs import roof_height
 
 MIN_WALL = 0.5  # metres: a roof taller than its building leaves at least this much wall
+SLIVER = 1.0  # metres: what parts leave of an outline narrower than this is a gap in the drawing
 ROOF_SHARE = 0.5  # of a building's height, at most, for a roof no tag gives a height
 
 
@@ -62,21 +67,28 @@ def volume(part: Polygon, heights: Heights, roof: Roof) -> Volume:
     """The part's walls and roof as the heights say. A roof whose height comes from its
     pitch alone (no ``roof:height``, ``roof:levels`` or roof ``height``) takes at most
     ROOF_SHARE of the building's height (a wide footprint gets a flatter roof, not walls
-    half a metre high); a roof too tall for the building is lowered to leave MIN_WALL of
-    wall; a roof of no height is flat."""
+    half a metre high; under levels, the walls keep the levels' height and the roof is
+    lowered); a roof too tall for the building is lowered to leave MIN_WALL of
+    wall; a roof of no height is flat. With no height and no levels the top is the
+    default, or, higher, a tagged roof on MIN_WALL of wall above the base (a dome drawn
+    as a part of its own, lifted above the default: the tag wins over the guess)."""
     own = 0.0 if roof.type == "flat" else roof_height(part, roof)
     rise = heights.roof if heights.roof is not None else own
     if roof.type == "flat":
         rise = 0.0
+    pitched = heights.roof is None and roof.height is None  # a roof from its pitch alone
     if heights.top is not None:
         top = heights.top
     elif heights.eaves is not None:
+        if pitched:  # ROOF_SHARE of the walls and the roof together, at most
+            walls = max(0.0, heights.eaves - heights.base)
+            rise = min(rise, ROOF_SHARE / (1 - ROOF_SHARE) * walls)
         top = heights.eaves + rise
     else:
-        top = heights.default
+        top = max(heights.default, heights.base + MIN_WALL + (heights.roof or 0.0))
     top = max(top, heights.base + MIN_WALL)
-    if heights.roof is None and roof.height is None:  # a roof from its pitch alone: at
-        rise = min(rise, ROOF_SHARE * (top - heights.base))  # most a share of the building
+    if pitched:  # at most a share of the building
+        rise = min(rise, ROOF_SHARE * (top - heights.base))
     eaves = max(top - rise, min(heights.base + MIN_WALL, top))
     rise = top - eaves
     if rise <= 1e-6:
@@ -273,8 +285,9 @@ def is_part(properties: dict[str, Any]) -> bool:
 
 
 def replaced_outlines(footprints: Iterable[Footprint]) -> dict[str, list[str]]:
-    """Outlines whose volume their ``building:part`` features replace: outline id -> the
-    ids of the parts inside it (a part is inside when a point of it surely in it is)."""
+    """Outlines with ``building:part`` features inside, which replace their volume (see
+    :func:`outline_rest`): outline id -> the ids of its parts (a part is inside when a
+    point of it surely in it is)."""
     footprints = list(footprints)
     parts = [f for f in footprints if is_part(f.properties)]
     if not parts:
@@ -291,17 +304,54 @@ def replaced_outlines(footprints: Iterable[Footprint]) -> dict[str, list[str]]:
     return {key: sorted(set(ids)) for key, ids in replaced.items()}
 
 
-def shared_edges(footprints: list[Footprint], tolerance: float) -> dict[str, Any]:
+def outline_rest(
+    outline: Polygon, eaves: float, parts: Iterable[tuple[Polygon, float]]
+) -> list[Polygon]:
+    """What of an outline its parts leave to build: the outline less every part standing
+    in its volume (``parts`` gives each part's polygon and base: a base below the
+    outline's ``eaves``, less MIN_WALL, is a part from the ground or an overhang), without
+    strips narrower than SLIVER (gaps where parts were drawn a little apart) or pieces under
+    MIN_AREA. S3DB builds the parts instead of the outline, as mappers draw parts over
+    the whole outline; where they drew some (one wing of a station, the middle of a
+    church) the rest of the outline still stands, and parts standing on the outline
+    (their base at its eaves: upper storeys drawn over a podium the outline is) keep it
+    whole under them. Outer rings counter-clockwise, as footprints' are."""
+    inside = [part for part, base in parts if base < eaves - MIN_WALL]
+    if not inside:
+        return [outline]
+    rest = outline.difference(shapely.union_all(inside))
+    opened = rest.buffer(-SLIVER / 2, join_style="mitre").buffer(SLIVER / 2, join_style="mitre")
+    kept = opened.intersection(rest)
+    found = [kept] if isinstance(kept, Polygon) else list(getattr(kept, "geoms", []))
+    return [
+        orient(piece, sign=1.0)
+        for piece in found
+        if isinstance(piece, Polygon) and piece.area >= MIN_AREA
+    ]
+
+
+def shared_edges(
+    footprints: list[Footprint],
+    tolerance: float,
+    beside: Callable[[str, str], bool] | None = None,
+) -> dict[str, Any]:
     """For each footprint, the lines of its outline that lie along another footprint's
     (within ``tolerance`` metres): party walls of terraces and city blocks, and the walls
-    between the parts of one building. Footprint id -> a shapely geometry (absent: none)."""
+    between the parts of one building. ``beside(id, other)`` says whether two footprints'
+    walls stand side by side at all (see :func:`side_by_side`; None: all do): upper
+    storeys drawn as a part over a podium have walls of their own, not party walls.
+    Footprint id -> a shapely geometry (absent: none)."""
     shapes = [shape for f in footprints for shape in f.parts]
     owner = [f.id for f in footprints for _ in f.parts]
     tree = STRtree(shapes)
     shared: dict[str, Any] = {}
     for index, shape in enumerate(shapes):
-        near = tree.query(shape.buffer(tolerance))
-        others = [shapes[int(i)] for i in near if owner[int(i)] != owner[index]]
+        near = [int(i) for i in tree.query(shape.buffer(tolerance))]
+        others = [
+            shapes[i]
+            for i in near
+            if owner[i] != owner[index] and (beside is None or beside(owner[index], owner[i]))
+        ]
         if not others:
             continue
         for other in others:
@@ -311,6 +361,12 @@ def shared_edges(footprints: list[Footprint], tolerance: float) -> dict[str, Any
             before = shared.get(owner[index])
             shared[owner[index]] = touching if before is None else before.union(touching)
     return shared
+
+
+def side_by_side(one: tuple[float, float], other: tuple[float, float]) -> bool:
+    """Do walls from ``one``'s base to its eaves and from ``other``'s stand side by side,
+    for MIN_WALL at least (not one volume on top of the other)?"""
+    return min(one[1], other[1]) - max(one[0], other[0]) >= MIN_WALL
 
 
 def party_zone(shared: Any, tolerance: float) -> Any:

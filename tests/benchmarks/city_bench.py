@@ -1,8 +1,9 @@
 """Time `facade city` (make bench): the generated demo district, and OpenStreetMap's Kotka
 (2,171 buildings) when ../shared/data/footprints/kotka.geojson is beside the project.
 
-Prints buildings a second, wall clock, for -j 1 and -j 2. Figures depend on the machine
-and its load; they are for the README and notes, never asserted by the tests."""
+Prints buildings a second, wall clock, for -j 1 and -j 2, and on a Dask LocalCluster of
+two single-threaded worker processes (--scheduler). Figures depend on the machine and its
+load; they are for the README and notes, never asserted by the tests."""
 
 from __future__ import annotations
 
@@ -32,11 +33,12 @@ rules:
 """
 
 
-def run(manifest: Path, jobs: int, out: Path) -> tuple[int, float]:
+def run(manifest: Path, where: list[str], out: Path) -> tuple[int, float]:
+    """``facade city`` with ``where`` (-j N, or --scheduler ADDRESS): buildings, seconds."""
     facade = Path(sys.executable).parent / "facade"
     started = time.perf_counter()
     done = subprocess.run(
-        [str(facade), "city", str(manifest), "-o", str(out), "-j", str(jobs)],
+        [str(facade), "city", str(manifest), "-o", str(out), *where],
         capture_output=True,
         text=True,
         check=True,
@@ -60,11 +62,31 @@ def main() -> None:
             print(f"({KOTKA} not found: Kotka skipped)")
         for name, manifest in cities:
             for jobs in (1, 2) if os.cpu_count() != 1 else (1,):
-                built, seconds = run(manifest, jobs, folder / f"out-{jobs}")
+                built, seconds = run(manifest, ["-j", str(jobs)], folder / f"out-{jobs}")
                 print(
                     f"city {name}, -j {jobs}: {built} buildings in {seconds:.1f} s "
                     f"({built / seconds:.0f} buildings/s)"
                 )
+            built, seconds = on_dask(manifest, folder / "out-dask")
+            print(
+                f"city {name}, Dask (2 workers): {built} buildings in {seconds:.1f} s "
+                f"({built / seconds:.0f} buildings/s)"
+            )
+
+
+def on_dask(manifest: Path, out: Path) -> tuple[int, float]:
+    """The city on a fresh LocalCluster (two worker processes of one thread): its workers
+    start with empty caches, as a cluster's do for a new run."""
+    from distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        host="127.0.0.1",
+        processes=True,
+        dashboard_address=None,
+    ) as cluster:
+        return run(manifest, ["--scheduler", cluster.scheduler_address], out)
 
 
 if __name__ == "__main__":
