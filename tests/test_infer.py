@@ -212,3 +212,34 @@ def test_a_runs_elements_keep_the_spread_of_their_sizes(tmp_path: Path) -> None:
         layout = solve(retarget(spec, width, 10.0))
         widths = {round(s.x1 - s.x0, 4) for s in layout.shapes if s.layer == "window" and s.visible}
         assert widths and all(window.min - 1e-6 <= w <= window.max + 1e-6 for w in widths)
+
+
+def test_a_mirrored_floor_is_written_reflected_and_stays_mirrored(tmp_path: Path) -> None:
+    """Three windows either side of a centred door: the windows' word reads the same
+    backwards, so it is written as its left half and that half reflected, each half with
+    its run of windows under one counter; a wider façade gains as many windows on the
+    right as on the left (written whole, only one of the two runs could repeat)."""
+    from facadecli import solve
+    from facadecli.solve import retarget
+
+    lefts = [1.0, 2.8, 4.6]
+    rects: list[dict[str, object]] = []
+    for x in [*lefts, *(14.4 - a - 1.2 for a in reversed(lefts))]:
+        for y in (5.0, 8.0):
+            rects.append({"label": "window", "x0": x, "y0": y, "x1": x + 1.2, "y1": y + 1.5})
+    rects.append({"label": "door", "x0": 6.6, "y0": 0.0, "x1": 7.8, "y1": 2.6})
+    inferred = infer(_write(tmp_path / "mirrored.json", rects, width=14.4), "mirrored")
+    (window,) = [line for line in inferred.text.splitlines() if "name: window" in line]
+    assert ")^-1" in window and window.count("^n1") == 2
+    spec = parse_spec(inferred.text, "mirrored.yaml")
+    assert check(inferred, spec)["iou_min"] == 1.0
+    layout = solve(retarget(spec, 21.6, 10.0))
+    row = sorted(
+        (s.x0, s.x1)
+        for s in layout.shapes
+        if s.layer == "window"
+        and s.visible
+        and s.y0 == min(t.y0 for t in layout.shapes if t.layer == "window")
+    )
+    assert len(row) > 6 and len(row) % 2 == 0
+    assert all(abs(a[0] + b[1] - 21.6) < 1e-6 for a, b in zip(row, reversed(row), strict=True))

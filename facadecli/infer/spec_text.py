@@ -18,6 +18,9 @@
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
   pitch and one count along an axis share the counter, so windows and sills keep together.
+  A word that reads the same backwards is written as its left half, the middle, and the
+  half reflected (``^-1``), when each half keeps its run: a wider façade then gains bays on
+  both sides alike.
 - Meshes and materials by label (frames for windows and shop fronts, doors, ledges for
   sills, cornices and mouldings, balconies, shutters for blinds, boxes for the rest),
   colours from the label palette; every layer says in a comment where it came from.
@@ -34,6 +37,7 @@ from facadecli.infer.layers import Grid, Span
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
 RUNS = {1: 3, 2: 2}  # copies of a unit of one letter, or of two, that make a repeat
+MIRRORED = 5  # letters a word needs (two elements and more) to be written as mirrored
 MESHES = {  # CMP labels; anything else is a box
     "window": ("frame", 0.1),
     "door": ("door", 0.12),
@@ -108,10 +112,28 @@ def _tokens(
 
 
 def _word(tokens: list[Token], axis: str, counters: _Counters, repeated: set[str]) -> str:
-    """The tokens as a word, the longest run of a repeated unit (one or two letters, at
-    least ``RUNS`` copies) written with a counter; the run's symbols go into ``repeated``."""
+    """The tokens as a word (see ``_with_run``). A mirrored word (the same read backwards,
+    two elements or more) is written as its first half, the middle letter, and the first
+    half reflected, ``... (...)^-1`` (SPEC 2.2), when that loses no repeat: each half then
+    keeps its run with one counter, and the meshes of the right half are mirrored."""
     symbols = [symbol for symbol, _ in tokens]
-    best = None  # (letters covered, start, unit, copies)
+    half = len(tokens) // 2
+    if len(tokens) >= MIRRORED and symbols == symbols[::-1]:
+        left = tokens[:half]
+        if 2 * _covered(_longest_run(left)) >= _covered(_longest_run(tokens)):
+            text = _with_run(left, axis, counters, repeated)
+            middle = [symbols[half]] if len(tokens) % 2 else []
+            return " ".join([text, *middle, f"({text})^-1"])
+    return _with_run(tokens, axis, counters, repeated)
+
+
+Run = tuple[int, int, int, int]  # letters covered, start, unit, copies
+
+
+def _longest_run(tokens: list[Token]) -> Run | None:
+    """The longest run of a repeated unit (one or two letters, at least ``RUNS`` copies)."""
+    symbols = [symbol for symbol, _ in tokens]
+    best = None
     for unit in (1, 2):
         for start in range(len(tokens) - unit):
             copies = 1
@@ -122,6 +144,18 @@ def _word(tokens: list[Token], axis: str, counters: _Counters, repeated: set[str
                 copies += 1
             if copies >= RUNS[unit] and (best is None or copies * unit > best[0]):
                 best = (copies * unit, start, unit, copies)
+    return best
+
+
+def _covered(run: Run | None) -> int:
+    return 0 if run is None else run[0]
+
+
+def _with_run(tokens: list[Token], axis: str, counters: _Counters, repeated: set[str]) -> str:
+    """The tokens as a word, the longest run written with a counter; the run's symbols go
+    into ``repeated``."""
+    symbols = [symbol for symbol, _ in tokens]
+    best = _longest_run(tokens)
     if best is None:
         return " ".join(symbols)
     _, start, unit, copies = best
