@@ -69,7 +69,7 @@ def test_the_check_sees_a_spec_that_does_not_match(tmp_path: Path) -> None:
         inferred.layout,
         inferred.tiling,
         inferred.grids,
-        inferred.text.replace("door_w1: 1.2,", "door_w1: 0.6,"),
+        inferred.text.replace("door_w1: {size: 1.2,", "door_w1: {size: 0.6,"),
     )
     checks = check(wrong, parse_spec(wrong.text, "wrong.yaml"))
     assert checks["solves"] and checks["iou"]["door"] < 0.9  # type: ignore[index]
@@ -243,3 +243,15 @@ def test_a_mirrored_floor_is_written_reflected_and_stays_mirrored(tmp_path: Path
     )
     assert len(row) > 6 and len(row) % 2 == 0
     assert all(abs(a[0] + b[1] - 21.6) < 1e-6 for a, b in zip(row, reversed(row), strict=True))
+
+
+def test_openings_nothing_covers_are_unoccludable(tmp_path: Path) -> None:
+    """The door is clear in the input, so its symbols are unoccludable; a pillar in front
+    of a window (CMP draws pillars over windows) covers it, so the windows' are not."""
+    rects = [*_palazzo()]
+    rects.append({"label": "pillar", "x0": 2.5, "y0": 3.0, "x1": 2.9, "y1": 9.0})
+    inferred = infer(_write(tmp_path / "pillar.json", rects), "pillar")
+    spec = parse_spec(inferred.text, "pillar.yaml")
+    assert spec.qualifiers("door_w1").unoccludable and spec.qualifiers("door_h1").unoccludable
+    assert not spec.qualifiers("window_w1").unoccludable
+    assert check(inferred, spec)["iou_min"] == 1.0

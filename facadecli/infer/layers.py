@@ -83,3 +83,30 @@ def _by_columns(label: str, rows: dict[Span, tuple[Span, ...]]) -> list[Grid]:
                 stack.append(row)
         found.extend(Grid(label, columns, tuple(stack)) for stack in stacks)
     return sorted(found, key=lambda g: (g.rows[0], g.columns[0]))
+
+
+OPENINGS = ("window", "door", "shop")  # labels that may be unoccludable (SPEC 2.4)
+
+
+def uncovered(found: list[Grid]) -> set[str]:
+    """The opening labels none of whose elements an element of a grid in front of it
+    overlaps: what the input shows nothing over (``unoccludable`` in the spec)."""
+    covered: set[str] = set()
+    for k, grid in enumerate(found):
+        if grid.label not in OPENINGS or grid.label in covered:
+            continue
+        mine = [(c, r) for c in grid.columns for r in grid.rows]
+        for front in found[k + 1 :]:
+            if any(
+                _overlap(c, fc) and _overlap(r, fr)
+                for c, r in mine
+                for fc in front.columns
+                for fr in front.rows
+            ):
+                covered.add(grid.label)
+                break
+    return {grid.label for grid in found if grid.label in OPENINGS} - covered
+
+
+def _overlap(a: Span, b: Span) -> bool:
+    return min(a[1], b[1]) - max(a[0], b[0]) > 1e-9

@@ -32,7 +32,7 @@ import re
 from dataclasses import dataclass, field
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.layers import Grid, Span
+from facadecli.infer.layers import Grid, Span, uncovered
 
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
@@ -217,9 +217,17 @@ def spec_text(
         f"  wall_w: {_number(width)}, wall_h: {_number(height)},",
     ]
     spread = spread or {}
+    clear = uncovered(found)
     sizes = [
         [
-            (symbol, _size(size, spread.get((axis, label, size)) if symbol in repeated else None))
+            (
+                symbol,
+                _size(
+                    size,
+                    spread.get((axis, label, size)) if symbol in repeated else None,
+                    label in clear,
+                ),
+            )
             for axis, table in zip("xy", pair, strict=True)
             for size, symbol in table.sizes.items()
         ]
@@ -266,17 +274,24 @@ def spec_text(
     return "\n".join(out) + "\n"
 
 
-def _size(size: float, spread: tuple[float, float] | None) -> str:
+def _size(size: float, spread: tuple[float, float] | None, unoccludable: bool = False) -> str:
     """A symbol's size, with ``min`` and ``max`` where the input's elements of it spread
     wider than the sizes are written (a tenth of a millimetre). Only a run's elements get
     them: a façade of another size gains or loses bays of them, and they keep their size
     within what the input shows; an element that does not repeat stretches with the
-    façade."""
+    façade. ``unoccludable`` for openings nothing covers in the input: each layer is its
+    own alignment group, so it steers nothing until layers are grouped (SPEC 2.6), and
+    then keeps what was clear clear."""
     low, high = spread or (size, size)
     low, high = min(low, size), max(high, size)
-    if high - low < 2 * 10.0**-DECIMALS:
+    extra = []
+    if high - low >= 2 * 10.0**-DECIMALS:
+        extra += [f"min: {_number(low)}", f"max: {_number(high)}"]
+    if unoccludable:
+        extra.append("unoccludable: true")
+    if not extra:
         return _number(size)
-    return f"{{size: {_number(size)}, min: {_number(low)}, max: {_number(high)}}}"
+    return "{" + ", ".join([f"size: {_number(size)}", *extra]) + "}"
 
 
 def layer_names(found: list[Grid]) -> list[str]:
