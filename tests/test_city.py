@@ -151,18 +151,14 @@ def test_the_demo_district_is_deterministic() -> None:
 
 
 def test_a_dask_cluster_gives_the_same_files_as_local_processes(tmp_path: Path) -> None:
-    from distributed import Client, LocalCluster
+    from distributed import Client
+
+    from tests.dask_cluster import two_workers
 
     manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
     city = load_city(manifest)
     run_city(city, tmp_path / "local", jobs=2)
-    with LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        host="127.0.0.1",
-        processes=True,
-        dashboard_address=None,
-    ) as cluster:
+    with two_workers() as cluster:
         report = run_city(city, tmp_path / "dask", scheduler=cluster.scheduler_address)
         with Client(cluster) as client:  # the axes came solved ahead: none while building
             assert list(client.run(axes_solved_while_building).values()) == [0, 0]

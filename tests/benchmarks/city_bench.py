@@ -77,15 +77,10 @@ def main() -> None:
 def on_dask(manifest: Path, out: Path) -> tuple[int, float]:
     """The city on a fresh LocalCluster (two worker processes of one thread): its workers
     start with empty caches, as a cluster's do for a new run."""
-    from distributed import LocalCluster
+    sys.path.insert(0, str(ROOT))
+    from tests.dask_cluster import two_workers
 
-    with LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        host="127.0.0.1",
-        processes=True,
-        dashboard_address=None,
-    ) as cluster:
+    with two_workers() as cluster:
         return run(manifest, ["--scheduler", cluster.scheduler_address], out)
 
 
