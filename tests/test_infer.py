@@ -255,3 +255,21 @@ def test_openings_nothing_covers_are_unoccludable(tmp_path: Path) -> None:
     assert spec.qualifiers("door_w1").unoccludable and spec.qualifiers("door_h1").unoccludable
     assert not spec.qualifiers("window_w1").unoccludable
     assert check(inferred, spec)["iou_min"] == 1.0
+
+
+def test_a_band_a_sliver_short_of_the_edge_stretches_with_the_facade(tmp_path: Path) -> None:
+    """A cornice drawn 4 cm short of the façade's left edge: the sliver is not kept as a
+    gap, which the sizing would grow as much as the cornice (a wider façade left the
+    cornice metres short of its edge); the cornice spans every width."""
+    from facadecli import solve
+    from facadecli.solve import retarget
+
+    rects = [*_palazzo()]
+    rects.append({"label": "cornice", "x0": 0.04, "y0": 9.4, "x1": 11.4, "y1": 9.8})
+    inferred = infer(_write(tmp_path / "cornice.json", rects), "cornice")
+    spec = parse_spec(inferred.text, "cornice.yaml")
+    assert check(inferred, spec)["iou"]["cornice"] >= 0.99  # type: ignore[index]
+    for width in (8.0, 17.1):
+        layout = solve(retarget(spec, width, 10.0))
+        (cornice,) = [s for s in layout.shapes if s.layer == "cornice" and s.visible]
+        assert (cornice.x0, cornice.x1) == (0.0, pytest.approx(width))

@@ -16,14 +16,13 @@ from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout
 from facadecli.grammar.run import Options, tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
-from facadecli.infer.layers import Grid, grids
+from facadecli.infer.layers import BAND, Grid, grids, to_edges
 from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
 from facadecli.layout import Layout
 from facadecli.spec.model import Spec
 
 RASTER = 400  # samples along each axis of the IoU raster
 WIDTHS = (0.7, 1.5)  # other widths the spec must solve at, as shares of the input's
-ELEMENT_SHARE = 0.25  # elements up to this share of the façade keep their size's spread
 
 
 @dataclass
@@ -54,7 +53,7 @@ def infer(path: Path, name: str, options: Options | None = None) -> Inference:
     regular = tidied.layout
     if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
-    found = grids(regular)
+    found = [to_edges(grid, regular.width, regular.height) for grid in grids(regular)]
     spread = size_spread(regular, tidied.snapped)
     text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread)
     return Inference(path.name, regular, tile(regular, tolerance=0.0), found, text)
@@ -64,7 +63,7 @@ def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:
     """For each label's regularised element size along each axis, the least and greatest
     size the elements made that size had before regularising (hand annotation's jitter:
     the range a derived façade may size them in). Only for elements, not for bands across
-    a good share of the façade (``ELEMENT_SHARE``): those grow and shrink with it."""
+    a good share of the façade (``BAND``): those grow and shrink with it."""
     spread: dict[tuple[str, str, float], tuple[float, float]] = {}
     for tidy, raw in zip(regular.rects, snapped.rects, strict=True):
         if tidy.label == BACKGROUND:
@@ -73,7 +72,7 @@ def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:
             ("x", tidy.x1 - tidy.x0, raw.x1 - raw.x0, regular.width),
             ("y", tidy.y1 - tidy.y0, raw.y1 - raw.y0, regular.height),
         ):
-            if size > ELEMENT_SHARE * extent:
+            if size > BAND * extent:
                 continue  # a band across the façade is as wide as the façade makes it
             key = (axis, tidy.label, round(size, 6))
             low, high = spread.get(key, (size, size))
