@@ -251,12 +251,15 @@ def solve_axis_alternatives(
 
     def search_exactly(candidate: Candidate, target: float, tie: bool) -> None:
         """Search a candidate exactly for a layout with an objective at most ``target``;
-        ``tie``: it cannot beat the best found, only tie with it (a search for the
-        tie-breaks, with less work, which proves nothing when it stops short)."""
+        ``tie``: it cannot beat the best found, only tie with it: a search for the
+        tie-breaks, which ends at its first layout (the least bound first, so the
+        candidate's best as a rule) or after a little work, and proves nothing."""
         nonlocal unproven, timed_out
         rows = _candidate_rows(spec, uses, candidate, memory)
         share = exact.Budget(min(budget.left, TIE_SHARE if tie else EXACT_SHARE), deadline)
-        outcome = exact.align_exactly(spec, rows, canvas, share, target, memory.prepared)
+        outcome = exact.align_exactly(
+            spec, rows, canvas, share, target, memory.prepared, first_only=tie
+        )
         budget.used += share.used
         timed_out = timed_out or share.timed_out
         unproven = unproven or not (outcome.complete or tie)

@@ -274,6 +274,7 @@ class _Search:
     gaps: bool = True  # rows may make room for the opaque letters of rows in front
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
+    first_only: bool = False  # stop at the first layout found
 
     # -- the rules of SPEC 2.4 on one column ----------------------------------------------
     def reject(self, why: str) -> bool:
@@ -688,8 +689,9 @@ class _Search:
         if self.best is None or found.rank < self.best.rank:
             self.best = found
             self.incumbent = min(self.incumbent, solved.objective)
-        if solved.objective <= SAME:
-            raise _Perfect  # nothing deviates less: the search order broke the tie
+        if solved.objective <= SAME or self.first_only:
+            raise _Perfect  # nothing deviates less (the search order broke the tie), or
+            # only a layout was asked for
 
 
 def _prepared(row: Row, known: dict[Row, _Row]) -> _Row:
@@ -788,6 +790,7 @@ def align_exactly(
     budget: Budget,
     incumbent: float = INF,
     prepared_rows: dict[Row, _Row] | None = None,
+    first_only: bool = False,
 ) -> Outcome:
     """The best layout of a candidate's groups (one set of rows per group), searched
     exactly; only layouts with an objective at most ``incumbent`` are looked for."""
@@ -822,6 +825,7 @@ def align_exactly(
     variables = {name: i for i, name in enumerate([*sized, *placeholders])}
     target = np.array([spec.size(name) for name in sized], dtype=float)
     search = _Search(spec, canvas, prepared, budget, incumbent, variables, target)
+    search.first_only = first_only
     # the search recurses a column at a time through every group in turn: room for the
     # longest path (a column per half-step of every row, at most), whatever the groups
     depth = sum(max(group.ends, default=0) for group in prepared) + RECURSION_MARGIN
