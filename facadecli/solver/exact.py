@@ -274,7 +274,7 @@ class _Search:
     gaps: bool = True  # rows may make room for the opaque letters of rows in front
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
-    first_only: bool = False  # stop at the first layout found
+    first_only: bool = False  # stop at the first layout found (then nothing is proven)
 
     # -- the rules of SPEC 2.4 on one column ----------------------------------------------
     def reject(self, why: str) -> bool:
@@ -840,7 +840,9 @@ def align_exactly(
             search.gaps = True
         search.run()
     except _Perfect:
-        pass
+        best = search.best
+        if best is not None and best.sizing.objective > SAME:  # the first layout, asked for
+            return Outcome(best, False, "stopped at the first layout found")
     except BudgetExhausted:
         return Outcome(search.best, False, "the search budget ran out")
     finally:
