@@ -367,11 +367,8 @@ def standing(
             built.append(footprint)
             continue
         _, heights, roof = _shape(city, footprint.properties)
-        parts = [
-            (shape, _shape(city, by_id[i].properties)[1].base)
-            for i in ids
-            for shape in by_id[i].parts
-        ]
+        bases = {i: _shape(city, by_id[i].properties)[1].base for i in ids}  # once a part
+        parts = [(shape, bases[i]) for i in ids for shape in by_id[i].parts]
         rest = [
             piece
             for shape in footprint.parts

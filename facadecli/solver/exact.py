@@ -824,8 +824,9 @@ def align_exactly(
     )
     variables = {name: i for i, name in enumerate([*sized, *placeholders])}
     target = np.array([spec.size(name) for name in sized], dtype=float)
-    search = _Search(spec, canvas, prepared, budget, incumbent, variables, target)
-    search.first_only = first_only
+    search = _Search(
+        spec, canvas, prepared, budget, incumbent, variables, target, first_only=first_only
+    )
     # the search recurses a column at a time through every group in turn: room for the
     # longest path (a column per half-step of every row, at most), whatever the groups
     depth = sum(max(group.ends, default=0) for group in prepared) + RECURSION_MARGIN
