@@ -273,3 +273,45 @@ def test_a_band_a_sliver_short_of_the_edge_stretches_with_the_facade(tmp_path: P
         layout = solve(retarget(spec, width, 10.0))
         (cornice,) = [s for s in layout.shapes if s.layer == "cornice" and s.visible]
         assert (cornice.x0, cornice.x1) == (0.0, pytest.approx(width))
+
+
+def _widths(spec_text: str, name: str, width: float, layer: str) -> list[float]:
+    from facadecli import solve
+    from facadecli.solve import retarget
+
+    layout = solve(retarget(parse_spec(spec_text, f"{name}.yaml"), width, 10.0))
+    return [round(s.x1 - s.x0, 6) for s in layout.shapes if s.layer == layer and s.visible]
+
+
+def test_an_element_that_does_not_repeat_never_grows_beyond_what_the_input_shows(
+    tmp_path: Path,
+) -> None:
+    """The palazzo's door and shop front appear once: a wider façade widens the wall
+    around them, not them (without a bound, the sizing spread the extra width over every
+    letter of the word, and a 1.2 m door became 3.1 m at 1.5x); a narrower one may
+    shrink them to fit."""
+    inferred = infer(_write(tmp_path / "palazzo.json", _palazzo()), "palazzo")
+    spec = parse_spec(inferred.text, "palazzo.yaml")
+    assert spec.symbols["door_w1"].max == pytest.approx(1.2)
+    assert spec.symbols["door_w1"].min is None  # it may shrink
+    assert _widths(inferred.text, "palazzo", 17.1, "door") == [pytest.approx(1.2)]
+    assert _widths(inferred.text, "palazzo", 17.1, "shop") == [pytest.approx(2.2)]
+    assert all(w <= 1.2 + 1e-6 for w in _widths(inferred.text, "palazzo", 6.0, "door"))
+
+
+def test_elements_that_fill_their_word_without_gaps_stretch_with_the_facade(
+    tmp_path: Path,
+) -> None:
+    """Two shop fronts side by side across the whole width leave no gap to take a
+    wider façade's extra width: they get no bound and grow with it (with one, the façade
+    would have no layout at 1.5x)."""
+    rects: list[dict[str, object]] = [
+        {"label": "shop", "x0": a, "y0": 0.0, "x1": b, "y1": 2.6}
+        for a, b in ((0.0, 5.0), (5.0, 11.4))
+    ]
+    rects.append({"label": "window", "x0": 5.1, "y0": 5.0, "x1": 6.3, "y1": 6.5})
+    inferred = infer(_write(tmp_path / "shops.json", rects), "shops")
+    spec = parse_spec(inferred.text, "shops.yaml")
+    assert spec.symbols["shop_w1"].max is None and spec.symbols["window_w1"].max is not None
+    shops = _widths(inferred.text, "shops", 17.1, "shop")
+    assert len(shops) == 2 and sum(shops) == pytest.approx(17.1) and min(shops) > 5.0

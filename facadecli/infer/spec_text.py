@@ -218,13 +218,24 @@ def spec_text(
     ]
     spread = spread or {}
     clear = uncovered(found)
+    # elements of a word without gaps fill the façade with no room to spare: they stretch
+    gap_symbols = {
+        symbol for table in (*gaps_x.values(), *gaps_y.values()) for symbol in table.sizes.values()
+    }
+    stretched: set[str] = set()
+    for _, _, x, y in layers:
+        for word in (x, y):
+            letters = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", word))
+            if not letters & gap_symbols:
+                stretched |= letters
     sizes = [
         [
             (
                 symbol,
                 _size(
                     size,
-                    spread.get((axis, label, size)) if symbol in repeated else None,
+                    None if symbol in stretched else spread.get((axis, label, size)),
+                    symbol in repeated,
                     label in clear,
                 ),
             )
@@ -274,19 +285,27 @@ def spec_text(
     return "\n".join(out) + "\n"
 
 
-def _size(size: float, spread: tuple[float, float] | None, unoccludable: bool = False) -> str:
-    """A symbol's size, with ``min`` and ``max`` where the input's elements of it spread
-    wider than the sizes are written (a tenth of a millimetre). Only a run's elements get
-    them: a façade of another size gains or loses bays of them, and they keep their size
-    within what the input shows; an element that does not repeat stretches with the
-    façade. ``unoccludable`` for openings nothing covers in the input: each layer is its
-    own alignment group, so it steers nothing until layers are grouped (SPEC 2.6), and
-    then keeps what was clear clear."""
-    low, high = spread or (size, size)
-    low, high = min(low, size), max(high, size)
+def _size(
+    size: float,
+    spread: tuple[float, float] | None,
+    repeated: bool = False,
+    unoccludable: bool = False,
+) -> str:
+    """A symbol's size, with the bounds the input shows (``spread``: the least and
+    greatest size its elements had before regularising; None for bands, which stretch
+    with the façade). An element never grows beyond the greatest (``max``): a wider
+    façade widens the gaps around a door, not the door. A run's elements also keep the
+    least (``min``), where the spread is wider than the sizes are written (a tenth of a
+    millimetre): a narrower façade loses a bay of them before they shrink further; an
+    element that does not repeat may shrink to fit. ``unoccludable`` for openings
+    nothing covers in the input: each layer is its own alignment group, so it steers
+    nothing until layers are grouped (SPEC 2.6), and then keeps what was clear clear."""
     extra = []
-    if high - low >= 2 * 10.0**-DECIMALS:
-        extra += [f"min: {_number(low)}", f"max: {_number(high)}"]
+    if spread is not None:
+        low, high = min(spread[0], size), max(spread[1], size)
+        if repeated and high - low >= 2 * 10.0**-DECIMALS:
+            extra.append(f"min: {_number(low)}")
+        extra.append(f"max: {_number(high)}")
     if unoccludable:
         extra.append("unoccludable: true")
     if not extra:
