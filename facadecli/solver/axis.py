@@ -340,9 +340,11 @@ def solve_axis_alternatives(
             search_exactly(candidate, target, bound > best_objective() - tie)
         if timed_out or budget.left == 0 or best_objective() <= threshold:
             break
-        if not evaluated and not heuristic_done:
-            # nothing within the first threshold: the heuristic's layout, if it finds one,
-            # bounds the next passes (they then only look for better ones)
+        if not evaluated and not heuristic_done and unproven:
+            # nothing within the threshold, and the search ran out of work before it proved
+            # so: the heuristic's layout, if it finds one, bounds the next passes (they then
+            # only look for better ones). A proof needs no such help: the next pass's own
+            # threshold bounds it as well (the heuristic took a fifth of the 60-bay palace)
             heuristic_done = True
             heuristic_pass()
     if not evaluated and unproven and not timed_out and not heuristic_done:
