@@ -542,8 +542,9 @@ def grammar(
             min=1,
             max=64,
             help="Layouts per --derive size: the best fit and others with repeat counts "
-            "within 1 of it, drawn by --seed (Bao et al. 2013); writes <name>-<W>x<H>-v<K>.* "
-            "and <name>.variations.svg when above 1.",
+            "within 1 of it, shuffled parts or proportions drawn near the input's, by --seed "
+            "(Bao et al. 2013); writes <name>-<W>x<H>-v<K>.* and <name>.variations.svg when "
+            "above 1.",
         ),
     ] = 1,
     formats: Annotated[

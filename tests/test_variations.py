@@ -74,14 +74,35 @@ def test_n_variations_are_distinct_and_the_first_is_the_single_derivation(
 
 
 def test_fewer_variations_than_asked_come_with_a_warning(tmp_path: Path) -> None:
-    extraction = _extract(tmp_path, _floors(6, 4))
+    """A window 1 m square in the middle of a 3 x 3 m façade: every part is 1 m long, so
+    drawn proportions scale them all alike, which the façade's size takes back; nothing
+    repeats and nothing can change places: one layout exists."""
+    rects = (Rect("window", 1.0, 1.0, 2.0, 2.0, 1),)
+    extraction = _extract(tmp_path, LabelledLayout(3.0, 3.0, rects))
     variations, notes = derive_variations(
-        extraction.grammar, extraction.tiling, 16.0, 17.0, "facade", 64, 0
+        extraction.grammar, extraction.tiling, 4.5, 3.0, "facade", 4, 0
     )
-    assert 1 < len(variations) < 64
-    assert len({tuple(_boxes(v.layout)) for v in variations}) == len(variations)
-    assert notes and f"only {len(variations)} of 64 variations" in notes[0]
-    assert derive_variations(extraction.grammar, extraction.tiling, 16.0, 17.0, "f", 3, 0)[1] == []
+    assert len(variations) == 1
+    assert notes and "only 1 of 4 variations" in notes[0]
+    assert derive_variations(extraction.grammar, extraction.tiling, 4.5, 3.0, "f", 1, 0)[1] == []
+
+
+def test_drawn_proportions_give_as_many_variations_as_asked_and_keep_the_style(
+    tmp_path: Path,
+) -> None:
+    """Bao et al. 2013 draw each region's size near its size in the input: with repeat
+    counts and shuffles alone, six floors of four windows gave 9 of 64 layouts at
+    16 x 17 m; drawn proportions give all 64, distinct, and each keeps every constraint of
+    the input's style (one factor for parts of one size: the windows stay in columns)."""
+    extraction = _extract(tmp_path, _floors(6, 4))
+    assert extraction.style
+    variations, notes = derive_variations(
+        extraction.grammar, extraction.tiling, 16.0, 17.0, "facade", 64, 0, extraction.style
+    )
+    assert len(variations) == 64 and notes == []
+    assert len({tuple(_boxes(v.layout)) for v in variations}) == 64
+    assert any(v.proportions for v in variations) and not variations[0].proportions
+    assert all(not v.kept.broken for v in variations)
 
 
 def test_variations_are_deterministic_per_seed_and_seeds_differ(tmp_path: Path) -> None:

@@ -14,7 +14,8 @@ their edges that nearly line up across the façade are lined up, and the source'
 (:mod:`facadecli.grammar.style`) is made exact where the derivation nearly keeps it.
 Constraints that cannot all hold are dropped (alignment first, then the style, then equal
 sizes) with a warning. Of the derivations the repeat counts allow, the one written keeps
-the most of the source's style; variations also vary counts and shuffle parts of one size.
+the most of the source's style; variations also vary counts, shuffle parts of one size
+and draw new proportions.
 """
 
 from __future__ import annotations
@@ -55,6 +56,9 @@ CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fe
 SHUFFLES_MAX = 6  # new orders of one split rule's parts tried as variations
 STYLE_MAX = 81  # ... and for one layout, when the best fit breaks some of the style (3^4)
 TEMPERATURE = 0.1  # of the score: how strongly variations near the source's sizes are preferred
+PROPORTION_SPREAD = 0.05  # sd of a drawn proportion's log (Bao et al. 2013's region sizes)
+PROPORTION_MOST = 0.1  # ... truncated here: parts keep within 0.9 to 1.1 times their size
+PROPORTION_DRAWS = 3  # proportions drawn per variation asked for (the style picks among them)
 NAME_MAX = 150  # characters of the source's name in a derived layout's name
 
 
@@ -470,9 +474,11 @@ class Variation:
     score: float
     kept: Kept = NOTHING_KEPT
     shuffle: Shuffle | None = None
+    proportions: Proportions = ()
 
 
 Shuffle = tuple[str, tuple[str, ...]]  # a split rule, its parts' symbols in a new order
+Proportions = tuple[tuple[str, str, float], ...]  # (axis, part size, factor on that size)
 
 
 @dataclass(frozen=True)
@@ -482,12 +488,22 @@ class _Candidate:
     shuffle: Shuffle | None
     pieces: list[Piece]
     kept: Kept
+    proportions: Proportions = ()
 
     @property
-    def rank(self) -> tuple[int, bool, float, tuple[tuple[str, int], ...], Shuffle]:
+    def rank(
+        self,
+    ) -> tuple[int, bool, float, tuple[tuple[str, int], ...], Shuffle, Proportions]:
         """Most of the style kept, the best fit (unchanged) first, nearest the source."""
-        changed = bool(self.offsets) or self.shuffle is not None
-        return (-len(self.kept.kept), changed, self.score, self.offsets, self.shuffle or ("", ()))
+        changed = bool(self.offsets) or self.shuffle is not None or bool(self.proportions)
+        return (
+            -len(self.kept.kept),
+            changed,
+            self.score,
+            self.offsets,
+            self.shuffle or ("", ()),
+            self.proportions,
+        )
 
 
 def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
@@ -525,7 +541,9 @@ def derive_variations(
     offset per rule, so a rule's copies stay equal and the two halves of a mirrored split
     stay alike; one offset for all repeats of one period along one axis, so columns of
     windows and of their sills stay lined up), where the copies stretch by at most
-    ``STRETCH`` (elsewhere the best fit stays).
+    ``STRETCH`` (elsewhere the best fit stays); shuffle the parts of a split that are as
+    long as each other (``_shuffles``); or draw new proportions near the source's
+    (``_proportions``, ``PROPORTION_DRAWS`` per variation asked for; never variation 0).
 
     Variation 0 keeps the most of the source's ``style`` (Bao et al. 2013's constraints),
     and among those it is the nearest the source's sizes (the best fit, when it keeps as
@@ -542,7 +560,9 @@ def derive_variations(
         boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
         return check(style, facade_of(boxes, width, height, BACKGROUND))
 
-    def candidate(offsets: dict[str, int], shuffle: Shuffle | None = None) -> _Candidate | None:
+    def candidate(
+        offsets: dict[str, int], shuffle: Shuffle | None = None, proportions: Proportions = ()
+    ) -> _Candidate | None:
         rules = grammar
         if shuffle is not None:
             rule = grammar.rules[shuffle[0]]
@@ -550,12 +570,14 @@ def derive_variations(
             rules = replace(
                 grammar, rules={**grammar.rules, shuffle[0]: replace(rule, parts=parts)}
             )
+        if proportions:
+            rules = _proportioned(rules, proportions, source)
         try:
             pieces = derive_at(rules, source, width, height, offsets)
         except TooLarge:
             return None
         changes = tuple(sorted(offsets.items()))
-        return _Candidate(score(pieces), changes, shuffle, pieces, kept(pieces))
+        return _Candidate(score(pieces), changes, shuffle, pieces, kept(pieces), proportions)
 
     used: set[str] = set()
     best = derive_at(grammar, source, width, height, used=used)
@@ -567,6 +589,9 @@ def derive_variations(
         candidates += [candidate(offsets) for offsets in _offsets(grammar, used, rng, most)]
     if count > 1:
         candidates += [candidate({}, shuffle) for shuffle in _shuffles(grammar)]
+        rng = random.Random(seed)
+        draws = _proportions(grammar, source, rng, PROPORTION_DRAWS * count)
+        candidates += [candidate({}, None, drawn) for drawn in draws]
     # most constraints kept, then the best fit, then nearest the source; the same pieces once
     seen: set[tuple[tuple[str, float, float, float, float], ...]] = set()
     ranked = []
@@ -575,7 +600,8 @@ def derive_variations(
         if key not in seen:
             seen.add(key)
             ranked.append(found_one)
-    first = ranked[0]
+    # drawn proportions only vary a layout: the layout of a size is the grammar's own
+    first = next(c for c in ranked if not c.proportions)
     aligned, warnings, keeps = _tidied(first.pieces, first.kept, kept, width, height, style)
     layout = pieces_layout(aligned, width, height, named(0), warnings)
     found = [Variation(layout, first.offsets, first.score, keeps, first.shuffle)]
@@ -585,7 +611,7 @@ def derive_variations(
     # first among the candidates that keep as much of the style as variation 0
     rng = random.Random(seed)
     drawn = sorted(
-        ranked[1:],
+        (c for c in ranked if c is not first),
         key=lambda c: (
             -len(c.kept.kept),
             -math.log(rng.random() or 1e-300)
@@ -605,15 +631,87 @@ def derive_variations(
     chosen.sort(key=lambda c: (-len(c[3].kept), c[0].rank[2:]))
     for k, (other, moved, moved_warnings, keeps) in enumerate(chosen, start=1):
         layout = pieces_layout(moved, width, height, named(k), moved_warnings)
-        found.append(Variation(layout, other.offsets, other.score, keeps, other.shuffle))
+        found.append(
+            Variation(layout, other.offsets, other.score, keeps, other.shuffle, other.proportions)
+        )
     notes = []
     if len(found) < count:
         notes.append(
             f"only {len(found)} of {count} variations exist (repeat counts within 1 of the "
-            f"best fit whose copies stretch by at most {STRETCH:.0%}, and parts of a split "
-            "that are as long as each other in a new order)"
+            f"best fit whose copies stretch by at most {STRETCH:.0%}, parts of a split "
+            "that are as long as each other in a new order, and parts' proportions drawn "
+            "near the source's)"
         )
     return found, notes
+
+
+def _proportions(
+    grammar: Grammar, source: tuple[float, float], rng: random.Random, draws: int
+) -> list[Proportions]:
+    """``draws`` sets of new proportions (Bao et al. 2013 draw each region's size from a
+    truncated Gaussian around its size in the input): a factor per class of part sizes
+    along an axis (``_size_classes``), the log of each drawn from N(0,
+    ``PROPORTION_SPREAD``) cut at ``PROPORTION_MOST``. Parts of one size along an axis,
+    in whatever rule, get one factor, so what lined up still does (columns over columns,
+    a mirrored split's halves, every floor of one kind)."""
+    classes = _size_classes(grammar, source)
+    found = []
+    for _ in range(draws if classes else 0):
+        factors = {}
+        for key in sorted(set(classes.values())):
+            log = max(-PROPORTION_MOST, min(PROPORTION_MOST, rng.gauss(0.0, PROPORTION_SPREAD)))
+            factors[key] = round(math.exp(log), 6)
+        found.append(tuple((axis, size, factors[k]) for (axis, size), k in sorted(classes.items())))
+    return found
+
+
+def _size_classes(grammar: Grammar, source: tuple[float, float]) -> dict[tuple[str, str], int]:
+    """The parts' sizes along each axis (of every rule but grid splits), in classes of
+    sizes within ``ALIGN`` of the façade's extent from the class's least (hand annotation
+    draws equal parts a little apart; a factor each would pull them further apart)."""
+    classes: dict[tuple[str, str], int] = {}
+    for axis, extent in zip(("x", "y"), source, strict=True):
+        sizes = sorted(
+            {
+                part.size
+                for rule in grammar.rules.values()
+                if rule.op != "gridsplit" and rule.axis == axis
+                for part in rule.parts
+            }
+        )
+        least = None
+        for size in sizes:
+            if least is None or size - least > ALIGN * extent:
+                least = size
+                number = len(set(classes.values()))
+            classes[(axis, _size_key(size))] = number
+    return classes
+
+
+def _size_key(size: float) -> str:
+    return f"{size:.6g}"
+
+
+def _proportioned(
+    grammar: Grammar, proportions: Proportions, source: tuple[float, float]
+) -> Grammar:
+    """The grammar with its parts' sizes multiplied by their factors; parts thinner than
+    ``THIN`` keep their size (frames and sills keep their absolute size anyway)."""
+    factor = {(axis, symbol): f for axis, symbol, f in proportions}
+    thin = {"x": THIN * source[0], "y": THIN * source[1]}
+    rules = {}
+    for name, rule in grammar.rules.items():
+        if rule.op == "gridsplit":
+            rules[name] = rule
+            continue
+        parts = tuple(
+            p
+            if p.size < thin[rule.axis]
+            else Part(p.size * factor[(rule.axis, _size_key(p.size))], p.symbol)
+            for p in rule.parts
+        )
+        rules[name] = replace(rule, parts=parts)
+    return replace(grammar, rules=rules)
 
 
 def _shuffles(grammar: Grammar) -> list[Shuffle]:

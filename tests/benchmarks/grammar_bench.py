@@ -4,7 +4,8 @@ Reads the CMP sample annotations beside the project (``../shared/data/cmp-sample
 are never copied into it) and prints, per façade, the tiling's size, what regularisation
 moved, the greedy baseline's cost and ADP's (2,000 iterations, seed 0), ADP's rules, the
 iteration that found the best grammar, and the time of the whole pipeline. Then one
-derivation at a new size. Skips, saying so, when the data is not there.
+derivation at a new size, and six variations at each width. Skips, saying so, when the data
+is not there.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from facadecli.grammar.run import Options, extract_grammar  # noqa: E402
+from facadecli.grammar.run import Extraction, Options, extract_grammar  # noqa: E402
 from facadecli.grammar.variation import derive_layout, derive_variations  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
@@ -34,6 +35,7 @@ def main() -> None:
     header = f"{'facade':10} {'cells':>6} {'moved':>6} {'greedy':>7} {'adp':>7} {'rules':>5}"
     print(header + f" {'repeat':>6} {'best@':>6} {'time':>7}   style kept at 0.7x 1.5x 2x width")
     greedy, adp, times = [], [], []
+    extractions: list[Extraction] = []
     style_kept: dict[float, int] = {}
     style_total = 0
     last = None
@@ -67,6 +69,7 @@ def main() -> None:
             + " ".join(f"{k}/{len(style)}" for k in kept)
         )
         last = extraction
+        extractions.append(extraction)
     print(
         f"{'mean':10} {'':6} {'':6} {statistics.mean(greedy):7.1f} {statistics.mean(adp):7.1f}"
         f" {'':5} {'':6} {statistics.mean(times):6.2f}s (max {max(times):.2f}s)"
@@ -82,6 +85,37 @@ def main() -> None:
     started = time.perf_counter()
     derive_layout(last.grammar, last.tiling, 24.0, 15.0, "bench")
     print(f"derive {files[-1].stem} at 24x15 with alignment: {time.perf_counter() - started:.2f}s")
+    variations(extractions)
+
+
+def variations(extractions: list[Extraction]) -> None:
+    """``--variations 6`` at each width: how many distinct layouts, and how many of them
+    keep every constraint of the style that the size's first layout keeps."""
+    asked, made, full, seconds = 6, dict.fromkeys(SCALES, 0), dict.fromkeys(SCALES, 0), 0.0
+    for extraction in extractions:
+        for scale in SCALES:
+            started = time.perf_counter()
+            drawn, _ = derive_variations(
+                extraction.grammar,
+                extraction.tiling,
+                15.0 * scale,
+                15.0,
+                "bench",
+                asked,
+                0,
+                extraction.style,
+            )
+            seconds += time.perf_counter() - started
+            made[scale] += len(drawn)
+            full[scale] += sum(len(v.kept.kept) >= len(drawn[0].kept.kept) for v in drawn)
+    total = asked * len(extractions)
+    print(
+        f"--variations {asked}: "
+        + ", ".join(f"{made[s]} of {total} at {s}x" for s in SCALES)
+        + " width; keeping as much of the style as the first: "
+        + ", ".join(f"{full[s]}" for s in SCALES)
+        + f" ({seconds / (len(extractions) * len(SCALES)):.1f} s a size)"
+    )
 
 
 if __name__ == "__main__":
