@@ -7,6 +7,8 @@ import random
 import time
 from dataclasses import replace
 
+from facadecli import proportions
+from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.layout import Layout, build_shapes, uncovered_area
 from facadecli.solver.axis import AxisLayout, solve_axis_alternatives
 from facadecli.spec.model import Canvas, Solver, Spec
@@ -76,11 +78,14 @@ def solve(spec: Spec) -> Layout:
 def solve_variants(spec: Spec, count: int) -> list[Layout]:
     """Up to ``count`` different layouts of a spec: the best first, then others drawn with
     ``spec.solver.seed`` from the pairs of near-best horizontal and vertical layouts (where
-    the spec leaves choices open: alternations, free counters, placeholders)."""
+    the spec leaves choices open: alternations, free counters, placeholders), then, while
+    fewer than ``count``, the spec solved with its symbols' sizes drawn near their own
+    (:func:`proportioned`)."""
     x, y, started = _axes(spec, ALTERNATIVES_PER_AXIS)
     pairs = list(itertools.product(range(len(x)), range(len(y))))
     rest = pairs[1:]
-    random.Random(spec.solver.seed).shuffle(rest)
+    rng = random.Random(spec.solver.seed)
+    rng.shuffle(rest)
     layouts = [solve(spec)]
     for i, j in rest:
         if len(layouts) >= count:
@@ -88,4 +93,34 @@ def solve_variants(spec: Spec, count: int) -> list[Layout]:
         layout = _layout(spec, x[i], y[j], started)
         if uncovered_area(layout) <= HOLE and layout.shapes != layouts[0].shapes:
             layouts.append(layout)
+    for _ in range(proportions.DRAWS * (count - len(layouts))):
+        if len(layouts) >= count:
+            break
+        try:
+            layout = solve(proportioned(spec, rng))
+        except (InfeasibleError, SearchLimitError):
+            continue  # those sizes leave no layout: draw again
+        if uncovered_area(layout) <= HOLE and all(layout.shapes != o.shapes for o in layouts):
+            layouts.append(layout)
     return layouts
+
+
+def proportioned(spec: Spec, rng: random.Random) -> Spec:
+    """The spec with new preferred sizes near its own (:mod:`facadecli.proportions`, Bao et
+    al. 2013): a factor per class of sizes (within ``proportions.CLASS_SHARE`` of each
+    other), kept within the symbol's ``min`` and ``max``; the canvas, counters and every
+    other setting as they were."""
+    sizes = {name: s.size for name, s in spec.symbols.items() if s.size is not None}
+    largest = max(sizes.values(), default=0.0)
+    classes = proportions.size_classes(sizes.values(), proportions.CLASS_SHARE * largest)
+    factors = {number: proportions.factor(rng) for number in sorted(set(classes.values()))}
+    symbols = dict(spec.symbols)
+    for name, size in sorted(sizes.items()):
+        symbol = spec.symbols[name]
+        drawn = size * factors[classes[size]]
+        if symbol.min is not None:
+            drawn = max(drawn, symbol.min)
+        if symbol.max is not None:
+            drawn = min(drawn, symbol.max)
+        symbols[name] = symbol.model_copy(update={"size": round(drawn, 6)})
+    return spec.model_copy(update={"symbols": symbols})

@@ -75,8 +75,8 @@ def test_a_browser_shows_the_model(tmp_path: Path) -> None:
 
 @pytest.fixture(scope="module")
 def varied(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A folder written by ``facade vary``: 3 variants (glb + svg; one layout exists at
-    8 m) and a contact sheet."""
+    """A folder written by ``facade vary``: 4 variants (glb + svg; at 8 m, the second is
+    drawn proportions) and a contact sheet."""
     folder = tmp_path_factory.mktemp("vary") / "out"
     argv = sys.argv
     sys.argv = ["facade", "vary", str(ROOT / "specs" / "residential-house.yaml")]
@@ -88,7 +88,7 @@ def varied(tmp_path_factory: pytest.TempPathFactory) -> Path:
     finally:
         sys.argv = argv
     assert stop.value.code in (0, None)
-    assert len(list(folder.glob("*.glb"))) == 3 and (folder / "contact-sheet.svg").exists()
+    assert len(list(folder.glob("*.glb"))) == 4 and (folder / "contact-sheet.svg").exists()
     return folder
 
 
@@ -98,11 +98,12 @@ def test_view_lists_every_model_of_a_vary_folder(
     page = tmp_path / "page.html"
     code, out, err = facade(capsys, "view", varied, "-o", page)
     assert code == 0, err
-    assert out.strip() == f"3 models -> {page}"
+    assert out.strip() == f"4 models -> {page}"
     text = page.read_text()
     names = re.findall(r'data-name="([^"]+)"', text)
     assert names == [  # every model once, numbers in order (8 before 12)
         "residential-house-8x3-0",
+        "residential-house-8x3-1",
         "residential-house-12x3-0",
         "residential-house-12x3-1",
     ]
@@ -122,7 +123,7 @@ def test_view_writes_index_html_and_the_same_bytes_each_time(
     folder = tmp_path / "copy"
     shutil.copytree(varied, folder)
     code, out, _ = facade(capsys, "view", folder)
-    assert code == 0 and out.strip() == f"3 models -> {folder / 'index.html'}"
+    assert code == 0 and out.strip() == f"4 models -> {folder / 'index.html'}"
     first = (folder / "index.html").read_bytes()
     assert facade(capsys, "view", folder)[0] == 0
     assert (folder / "index.html").read_bytes() == first

@@ -29,6 +29,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
+from facadecli import proportions
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.style import (
     NOTHING_KEPT,
@@ -56,9 +57,6 @@ CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fe
 SHUFFLES_MAX = 6  # new orders of one split rule's parts tried as variations
 STYLE_MAX = 81  # ... and for one layout, when the best fit breaks some of the style (3^4)
 TEMPERATURE = 0.1  # of the score: how strongly variations near the source's sizes are preferred
-PROPORTION_SPREAD = 0.05  # sd of a drawn proportion's log (Bao et al. 2013's region sizes)
-PROPORTION_MOST = 0.1  # ... truncated here: parts keep within 0.9 to 1.1 times their size
-PROPORTION_DRAWS = 3  # proportions drawn per variation asked for (the style picks among them)
 NAME_MAX = 150  # characters of the source's name in a derived layout's name
 
 
@@ -543,7 +541,7 @@ def derive_variations(
     windows and of their sills stay lined up), where the copies stretch by at most
     ``STRETCH`` (elsewhere the best fit stays); shuffle the parts of a split that are as
     long as each other (``_shuffles``); or draw new proportions near the source's
-    (``_proportions``, ``PROPORTION_DRAWS`` per variation asked for; never variation 0).
+    (``_proportions``, ``proportions.DRAWS`` per variation asked for; never variation 0).
 
     Variation 0 keeps the most of the source's ``style`` (Bao et al. 2013's constraints),
     and among those it is the nearest the source's sizes (the best fit, when it keeps as
@@ -590,7 +588,7 @@ def derive_variations(
     if count > 1:
         candidates += [candidate({}, shuffle) for shuffle in _shuffles(grammar)]
         rng = random.Random(seed)
-        draws = _proportions(grammar, source, rng, PROPORTION_DRAWS * count)
+        draws = _proportions(grammar, source, rng, proportions.DRAWS * count)
         candidates += [candidate({}, None, drawn) for drawn in draws]
     # most constraints kept, then the best fit, then nearest the source; the same pieces once
     seen: set[tuple[tuple[str, float, float, float, float], ...]] = set()
@@ -648,44 +646,27 @@ def derive_variations(
 def _proportions(
     grammar: Grammar, source: tuple[float, float], rng: random.Random, draws: int
 ) -> list[Proportions]:
-    """``draws`` sets of new proportions (Bao et al. 2013 draw each region's size from a
-    truncated Gaussian around its size in the input): a factor per class of part sizes
-    along an axis (``_size_classes``), the log of each drawn from N(0,
-    ``PROPORTION_SPREAD``) cut at ``PROPORTION_MOST``. Parts of one size along an axis,
-    in whatever rule, get one factor, so what lined up still does (columns over columns,
-    a mirrored split's halves, every floor of one kind)."""
-    classes = _size_classes(grammar, source)
-    found = []
-    for _ in range(draws if classes else 0):
-        factors = {}
-        for key in sorted(set(classes.values())):
-            log = max(-PROPORTION_MOST, min(PROPORTION_MOST, rng.gauss(0.0, PROPORTION_SPREAD)))
-            factors[key] = round(math.exp(log), 6)
-        found.append(tuple((axis, size, factors[k]) for (axis, size), k in sorted(classes.items())))
-    return found
-
-
-def _size_classes(grammar: Grammar, source: tuple[float, float]) -> dict[tuple[str, str], int]:
-    """The parts' sizes along each axis (of every rule but grid splits), in classes of
-    sizes within ``ALIGN`` of the façade's extent from the class's least (hand annotation
-    draws equal parts a little apart; a factor each would pull them further apart)."""
-    classes: dict[tuple[str, str], int] = {}
+    """``draws`` sets of new proportions (:mod:`facadecli.proportions`): a factor per class
+    of part sizes along an axis (sizes within ``ALIGN`` of the façade's extent), so parts
+    of one size, in whatever rule, stay alike."""
+    keys: list[tuple[str, str, int]] = []  # axis, size, class
     for axis, extent in zip(("x", "y"), source, strict=True):
-        sizes = sorted(
-            {
-                part.size
-                for rule in grammar.rules.values()
-                if rule.op != "gridsplit" and rule.axis == axis
-                for part in rule.parts
-            }
-        )
-        least = None
-        for size in sizes:
-            if least is None or size - least > ALIGN * extent:
-                least = size
-                number = len(set(classes.values()))
-            classes[(axis, _size_key(size))] = number
-    return classes
+        sizes = {
+            part.size
+            for rule in grammar.rules.values()
+            if rule.op != "gridsplit" and rule.axis == axis
+            for part in rule.parts
+        }
+        classes = proportions.size_classes(sizes, ALIGN * extent)
+        keys += [(axis, _size_key(size), number) for size, number in sorted(classes.items())]
+    found = []
+    for _ in range(draws if keys else 0):
+        factors: dict[tuple[str, int], float] = {}
+        for axis, _, number in keys:
+            if (axis, number) not in factors:
+                factors[(axis, number)] = proportions.factor(rng)
+        found.append(tuple((axis, size, factors[(axis, number)]) for axis, size, number in keys))
+    return found
 
 
 def _size_key(size: float) -> str:
