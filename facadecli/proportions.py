@@ -3,10 +3,10 @@ a truncated Gaussian centred on its size in the input): one place for the draw, 
 ``facade vary`` (a spec's symbols) and ``facade grammar --variations`` (a grammar's parts).
 
 A factor's log is drawn from N(0, ``SPREAD``) and cut at ``MOST``, so sizes stay within
-0.9 to 1.1 times their own. Sizes within ``CLASS_WIDTH`` of each other form one *class*
-and get one factor: what was as long as something else still is (columns over columns,
-mirrored halves, floors of one kind), and hand-drawn sizes a little apart do not drift
-further apart.
+0.9 to 1.1 times their own. Sizes close to each other (``size_classes``; the caller says
+how close) form one *class* and get one factor: what was as long as something else still
+is (columns over columns, mirrored halves, floors of one kind), and hand-drawn sizes a
+little apart do not drift further apart.
 """
 
 from __future__ import annotations

@@ -559,7 +559,7 @@ def derive_variations(
         return check(style, facade_of(boxes, width, height, BACKGROUND))
 
     def candidate(
-        offsets: dict[str, int], shuffle: Shuffle | None = None, proportions: Proportions = ()
+        offsets: dict[str, int], shuffle: Shuffle | None = None, drawn: Proportions = ()
     ) -> _Candidate | None:
         rules = grammar
         if shuffle is not None:
@@ -568,14 +568,14 @@ def derive_variations(
             rules = replace(
                 grammar, rules={**grammar.rules, shuffle[0]: replace(rule, parts=parts)}
             )
-        if proportions:
-            rules = _proportioned(rules, proportions, source)
+        if drawn:
+            rules = _proportioned(rules, drawn, source)
         try:
             pieces = derive_at(rules, source, width, height, offsets)
         except TooLarge:
             return None
         changes = tuple(sorted(offsets.items()))
-        return _Candidate(score(pieces), changes, shuffle, pieces, kept(pieces), proportions)
+        return _Candidate(score(pieces), changes, shuffle, pieces, kept(pieces), drawn)
 
     used: set[str] = set()
     best = derive_at(grammar, source, width, height, used=used)
@@ -589,7 +589,7 @@ def derive_variations(
         candidates += [candidate({}, shuffle) for shuffle in _shuffles(grammar)]
         rng = random.Random(seed)
         draws = _proportions(grammar, source, rng, proportions.DRAWS * count)
-        candidates += [candidate({}, None, drawn) for drawn in draws]
+        candidates += [candidate({}, None, factors) for factors in draws]
     # most constraints kept, then the best fit, then nearest the source; the same pieces once
     seen: set[tuple[tuple[str, float, float, float, float], ...]] = set()
     ranked = []
@@ -673,12 +673,10 @@ def _size_key(size: float) -> str:
     return f"{size:.6g}"
 
 
-def _proportioned(
-    grammar: Grammar, proportions: Proportions, source: tuple[float, float]
-) -> Grammar:
+def _proportioned(grammar: Grammar, drawn: Proportions, source: tuple[float, float]) -> Grammar:
     """The grammar with its parts' sizes multiplied by their factors; parts thinner than
     ``THIN`` keep their size (frames and sills keep their absolute size anyway)."""
-    factor = {(axis, symbol): f for axis, symbol, f in proportions}
+    factor = {(axis, size): f for axis, size, f in drawn}
     thin = {"x": THIN * source[0], "y": THIN * source[1]}
     rules = {}
     for name, rule in grammar.rules.items():
