@@ -90,7 +90,7 @@ def main() -> None:
 
 def variations(extractions: list[Extraction]) -> None:
     """``--variations 6`` at each width: how many distinct layouts, and how many of them
-    keep every constraint of the style that the size's first layout keeps."""
+    keep as many constraints of the style as the size's first layout."""
     asked, made, full, seconds = 6, dict.fromkeys(SCALES, 0), dict.fromkeys(SCALES, 0), 0.0
     for extraction in extractions:
         for scale in SCALES:
