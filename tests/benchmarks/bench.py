@@ -2,7 +2,8 @@
 
 Prints, per example spec, the median time to load and check it and to solve it (warm: the
 first solve of a process also pays for importing cvxpy), then the solve time of the
-generated palace façade as layers and bays grow, with the stages of each axis.
+generated palace façade as layers and bays grow, with the stages of each axis, and the
+layouts ``facade vary`` draws for each example.
 """
 
 from __future__ import annotations
@@ -95,6 +96,24 @@ def main() -> None:
     words = enumerate_words(pattern, sizes=sizes, max_length=1e6)
     enumerate_ms = median_ms(lambda: list(itertools.islice(words, count)), runs=1)
     print(f"enumerate {count} words of a nested pattern: {enumerate_ms:.1f} ms")
+    print()
+    vary_counts()
+
+
+def vary_counts() -> None:
+    """``facade vary --count 4`` at 10, 14 and 20 m: the layouts each example gets, and how
+    many of them are near-best layouts (the rest are drawn proportions)."""
+    from facadecli.solve import retarget, solve_variants
+
+    print("vary, 4 asked at 10, 14 and 20 m      layouts  near-best")
+    for path in sorted((ROOT / "specs").glob("*.yaml")):
+        spec = load_spec(path)
+        made = near = 0
+        for width in (10.0, 14.0, 20.0):
+            layouts = solve_variants(retarget(spec, width), 4)
+            made += len(layouts)
+            near += sum(layout.spec.symbols == layouts[0].spec.symbols for layout in layouts)
+        print(f"{path.name:38} {made:7d} {near:10d}")
 
 
 if __name__ == "__main__":
