@@ -197,3 +197,24 @@ def test_the_command_writes_each_variation_and_a_contact_sheet(tmp_path: Path) -
     assert {p.name: p.read_bytes() for p in many.iterdir()} == first  # same seed, same bytes
     if "8x7-v1.svg" not in " ".join(names):
         assert "only" in result.stderr and "8x7" in result.stderr
+
+
+def test_a_wider_facade_without_repeats_widens_its_wall_not_its_windows(
+    tmp_path: Path,
+) -> None:
+    """Windows on three unevenly spaced columns and a door: nothing repeats along x, so
+    the derivation shares a wider façade among all parts (windows 1.2 m became 1.8 m at
+    1.5x and 2.4 m at 2x); the tidying QP pulls elements derived longer than their source
+    back towards it, the wall around them taking the rest, and keeps the style."""
+    rects = [Rect("window", x, y, x + 1.2, y + 1.5, 1) for x in (1.0, 4.1, 8.3) for y in (1.0, 4.0)]
+    rects.append(Rect("door", 5.9, 0.0, 7.0, 2.2, 1))
+    extraction = _extract(tmp_path, LabelledLayout(11.0, 7.0, tuple(rects)))
+    assert not any(rule.op == "repeat" for rule in extraction.grammar.rules.values())
+    for width in (16.5, 22.0):
+        (variation,) = _draw(extraction, (width, 7.0), 1)
+        boxes = _boxes(variation.layout)
+        windows = [b[3] - b[1] for b in boxes if b[0] == "window"]
+        doors = [b[3] - b[1] for b in boxes if b[0] == "door"]
+        assert len(windows) == 6 and all(w == pytest.approx(1.2, abs=0.02) for w in windows)
+        assert doors == [pytest.approx(1.1, abs=0.02)]
+        assert not variation.kept.broken

@@ -10,8 +10,11 @@ bays rather than wider windows; without elastic parts, the weights share the cha
 
 The derivation is then tidied with a QP per axis (cvxpy), after Bao et al. 2013: edges stay
 near where the derivation put them, terminals that were one size in the source get one size,
-their edges that nearly line up across the façade are lined up, and the source's style
-(:mod:`facadecli.grammar.style`) is made exact where the derivation nearly keeps it.
+their edges that nearly line up across the façade are lined up, elements the derivation
+made longer than in the source (a split without repeats shares a wider façade among all
+its parts) are pulled back towards their source size, the wall taking the rest, and the
+source's style (:mod:`facadecli.grammar.style`) is made exact where the derivation nearly
+keeps it.
 Constraints that cannot all hold are dropped (alignment first, then the style, then equal
 sizes) with a warning. Of the derivations the repeat counts allow, the one written keeps
 the most of the source's style; variations also vary counts, shuffle parts of one size
@@ -48,6 +51,9 @@ if TYPE_CHECKING:
     from facadecli.layout import Layout
 
 THIN = 0.03  # of the source façade's extent: thinner parts keep their absolute size
+STRETCHED = 1.05  # an element derived longer than this times its source size is pulled back
+WIDTHS = 100.0  # ... with this weight against moving edges (bands are not: they stretch)
+BAND = 0.25  # of the new extent: a longer element is a band across the façade
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
 STYLE_NEAR = 0.05  # of the new width: near misses of the style this close are made exact
 SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
@@ -264,6 +270,7 @@ def _align_axis(
     edges = sorted(set(joined.values()))
     index = {v: i for i, v in enumerate(edges)}
     spans = []
+    stretched: dict[tuple[int, int], float] = {}  # elements derived longer than their source
     groups: dict[tuple[str, int], list[tuple[int, int]]] = defaultdict(list)
     for p in pieces:
         a, b = (p.x0, p.x1) if axis == "x" else (p.y0, p.y1)
@@ -272,6 +279,8 @@ def _align_axis(
             spans.append((span, edges[span[1]] - edges[span[0]]))
             source = p.source_w if axis == "x" else p.source_h
             groups[(p.label, round(source / (1e-6 * extent)))].append(span)
+            if b - a > STRETCHED * source and b - a <= BAND * extent:
+                stretched[span] = source
     equal = []
     lined = []
     for members in groups.values():
@@ -294,6 +303,10 @@ def _align_axis(
         if all(value in joined for value, _ in terms)
     ]
     moves = cp.sum_squares(v - edges)
+    if stretched:  # back towards their source size, the wall around them taking the rest
+        moves = moves + WIDTHS * _squares(
+            cp, [v[b] - v[a] - size for (a, b), size in sorted(stretched.items())]
+        )
     hard_sizes = [g == 0 for g in size_gaps]
     hard_style = [g == 0 for g in style_gaps]
     soft_style = SOFT * _squares(cp, style_gaps)

@@ -20,8 +20,10 @@ sys.path.insert(0, str(ROOT))
 
 from facadecli.grammar.run import Extraction, Options, extract_grammar  # noqa: E402
 from facadecli.grammar.variation import derive_layout, derive_variations  # noqa: E402
+from facadecli.layout import Layout  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
+WIDER = 1.15  # a derived window wider than this times the input's widest is stretched
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
 
 
@@ -37,6 +39,8 @@ def main() -> None:
     greedy, adp, times = [], [], []
     extractions: list[Extraction] = []
     style_kept: dict[float, int] = {}
+    windows: dict[float, int] = {}  # derived windows, and those wider than the source's
+    wide: dict[float, int] = {}
     style_total = 0
     last = None
     for path in files:
@@ -54,11 +58,15 @@ def main() -> None:
         repeats = sum(r.op in ("repeat", "repeatABA") for r in extraction.grammar.rules.values())
         style = extraction.style
         kept = []
+        widest = max(_window_widths(derive_layout(extraction.grammar, tiling, 15, 15, "b")))
         for scale in SCALES:
             drawn, _ = derive_variations(
                 extraction.grammar, tiling, 15.0 * scale, 15.0, "bench", 1, 0, style
             )
             kept.append(len(drawn[0].kept.kept))
+            widths = _window_widths(drawn[0].layout)
+            windows[scale] = windows.get(scale, 0) + len(widths)
+            wide[scale] = wide.get(scale, 0) + sum(w > WIDER * widest for w in widths)
         for scale, count in zip(SCALES, kept, strict=True):
             style_kept[scale] = style_kept.get(scale, 0) + count
         style_total += len(style)
@@ -79,6 +87,11 @@ def main() -> None:
         + ", ".join(f"{style_kept[s]} of {style_total} at {s}x" for s in SCALES)
         + " width (the input's tiling keeps all)"
     )
+    print(
+        "windows more than 15% wider than the input's widest: "
+        + ", ".join(f"{wide[s]} of {windows[s]} at {s}x" for s in SCALES)
+        + " width"
+    )
     wins = sum(a < g for a, g in zip(adp, greedy, strict=True))
     print(f"ADP is cheaper than greedy on {wins} of {len(files)} façades")
     assert last is not None
@@ -86,6 +99,11 @@ def main() -> None:
     derive_layout(last.grammar, last.tiling, 24.0, 15.0, "bench")
     print(f"derive {files[-1].stem} at 24x15 with alignment: {time.perf_counter() - started:.2f}s")
     variations(extractions)
+
+
+def _window_widths(layout: Layout) -> list[float]:
+    labels = {name: symbol.label for name, symbol in layout.spec.symbols.items()}
+    return [s.x1 - s.x0 for s in layout.shapes if labels.get(s.x) == "window"]
 
 
 def variations(extractions: list[Extraction]) -> None:
