@@ -3,8 +3,9 @@
 Reads the CMP sample annotations beside the project (``../shared/data/cmp-sample/xml``; they
 are never copied into it) and prints, per façade, the tiling's size, what regularisation
 moved, the greedy baseline's cost and ADP's (2,000 iterations, seed 0), ADP's rules, the
-iteration that found the best grammar, and the time of the whole pipeline. Then one
-derivation at a new size, and six variations at each width. Skips, saying so, when the data
+iteration that found the best grammar, and the time of the whole pipeline; derived at 0.7, 1.5
+and 2 times the width, the style kept and the windows stretched. Then one derivation at a
+new size, and six variations at each width. Skips, saying so, when the data
 is not there.
 """
 
@@ -58,7 +59,9 @@ def main() -> None:
         repeats = sum(r.op in ("repeat", "repeatABA") for r in extraction.grammar.rules.values())
         style = extraction.style
         kept = []
-        widest = max(_window_widths(derive_layout(extraction.grammar, tiling, 15, 15, "b")))
+        widest = max(
+            _window_widths(derive_layout(extraction.grammar, tiling, 15, 15, "b")), default=0
+        )
         for scale in SCALES:
             drawn, _ = derive_variations(
                 extraction.grammar, tiling, 15.0 * scale, 15.0, "bench", 1, 0, style
