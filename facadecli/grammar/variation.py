@@ -232,9 +232,11 @@ def align(
     height: float,
     background: str = BACKGROUND,
     style: Sequence[Constraint] = (),
+    pull: bool = True,
 ) -> tuple[list[Piece], list[str]]:
     """Equal terminals one size and lined up, and the style's near misses made exact (see
-    the module and :func:`~facadecli.grammar.style.equations`)."""
+    the module and :func:`~facadecli.grammar.style.equations`); with ``pull``, elements
+    derived longer than in the source pulled back towards their source size."""
     warnings: list[str] = []
     mapping = {}
     kept: list[Equation] = []
@@ -243,7 +245,7 @@ def align(
         kept = equations(style, facade_of(boxes, width, height, background), STYLE_NEAR * width)
     axes: tuple[tuple[Axis, float, list[Equation]], ...] = (("x", width, kept), ("y", height, []))
     for axis, extent, extra in axes:
-        mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background, extra)
+        mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background, extra, pull)
         warnings += axis_warnings
     moved = [
         Piece(
@@ -261,7 +263,12 @@ def align(
 
 
 def _align_axis(
-    pieces: list[Piece], axis: Axis, extent: float, background: str, extra: list[Equation]
+    pieces: list[Piece],
+    axis: Axis,
+    extent: float,
+    background: str,
+    extra: list[Equation],
+    pull: bool = True,
 ) -> tuple[dict[float, float], list[str]]:
     import cvxpy as cp  # imported here: it takes half a second
 
@@ -279,7 +286,7 @@ def _align_axis(
             spans.append((span, edges[span[1]] - edges[span[0]]))
             source = p.source_w if axis == "x" else p.source_h
             groups[(p.label, round(source / (1e-6 * extent)))].append(span)
-            if b - a > STRETCHED * source and b - a <= BAND * extent:
+            if pull and _stretched(b - a, source, extent):
                 stretched[span] = source
     equal = []
     lined = []
@@ -743,13 +750,37 @@ def _tidied(
     style: Sequence[Constraint],
 ) -> tuple[list[Piece], list[str], Kept]:
     """A derivation through the alignment QP (:func:`align`), unless that breaks some of
-    the style the derivation keeps: then as derived, with a warning."""
+    the style the derivation keeps: then as derived, with a warning. Where pulling
+    stretched elements back breaks some of the style, the QP without the pull is tried
+    too, and the one that keeps more is taken (the pulled one on a tie)."""
     aligned, warnings = align(pieces, width, height, style=style)
     after = kept(aligned)
+    if after.broken and _any_stretched(pieces, width, height):
+        plain, plain_warnings = align(pieces, width, height, style=style, pull=False)
+        plain_after = kept(plain)
+        if len(plain_after.kept) > len(after.kept):
+            aligned, warnings, after = plain, plain_warnings, plain_after
     if len(after.kept) >= len(keeps.kept):
         return aligned, warnings, after
     lost = len(keeps.kept) - len(after.kept)
     return pieces, [f"not tidied: lining up equal terminals would break {lost} of its style"], keeps
+
+
+def _any_stretched(pieces: list[Piece], width: float, height: float) -> bool:
+    """Whether the alignment QP pulls some element back towards its source size."""
+    return any(
+        p.label != BACKGROUND
+        and (
+            _stretched(p.x1 - p.x0, p.source_w, width)
+            or _stretched(p.y1 - p.y0, p.source_h, height)
+        )
+        for p in pieces
+    )
+
+
+def _stretched(size: float, source: float, extent: float) -> bool:
+    """An element derived longer than its source, and not a band across the façade."""
+    return STRETCHED * source < size <= BAND * extent
 
 
 def _offsets(
