@@ -186,6 +186,7 @@ def spec_text(
     gaps_y: dict[tuple[Span, ...], _Symbols] = {}
     owned: list[list[_Symbols]] = []  # the gap symbols each layer introduces
     repeated: set[str] = set()  # symbols of runs (written with a counter)
+    stretched: set[str] = set()  # elements of words without gaps: they fill the façade
     layers: list[tuple[str, Grid, str, str]] = []
     for layer, grid in zip(layer_names(found), found, strict=True):
         base = ident(grid.label)
@@ -196,12 +197,13 @@ def spec_text(
             if spans not in table
         ]
         owned.append(introduced)
-        x = _word(
-            _tokens(grid.columns, width, symbols[0], gaps_x[grid.columns]), "x", counters, repeated
-        )
-        y = _word(
-            _tokens(grid.rows, height, symbols[1], gaps_y[grid.rows]), "y", counters, repeated
-        )
+        x_tokens = _tokens(grid.columns, width, symbols[0], gaps_x[grid.columns])
+        y_tokens = _tokens(grid.rows, height, symbols[1], gaps_y[grid.rows])
+        for tokens, spans in ((x_tokens, grid.columns), (y_tokens, grid.rows)):
+            if len(tokens) == len(spans):  # no gap: nothing else takes a longer façade
+                stretched.update(symbol for symbol, _ in tokens)
+        x = _word(x_tokens, "x", counters, repeated)
+        y = _word(y_tokens, "y", counters, repeated)
         layers.append((layer, grid, x, y))
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
@@ -218,16 +220,6 @@ def spec_text(
     ]
     spread = spread or {}
     clear = uncovered(found)
-    # elements of a word without gaps fill the façade with no room to spare: they stretch
-    gap_symbols = {
-        symbol for table in (*gaps_x.values(), *gaps_y.values()) for symbol in table.sizes.values()
-    }
-    stretched: set[str] = set()
-    for _, _, x, y in layers:
-        for word in (x, y):
-            letters = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", word))
-            if not letters & gap_symbols:
-                stretched |= letters
     sizes = [
         [
             (
