@@ -1,17 +1,20 @@
-"""The search's fast tables give what the plain definitions give, to the bit: the merged
-cost (``Search.canonical``), the value table's costs (bit counts per rule cost), the rank of
-a cut in two, and the size test that spares computing contents."""
+"""The search's fast tables give what the plain definitions give, to the bit: the compiled
+inner loop (``_adp``) what the plain Python loop gives (tests/adp_reference.py), the merged
+cost what ``Search.canonical`` gives, the rank of a cut in two, and the size test that spares
+computing contents."""
 
 from __future__ import annotations
 
 import itertools
+import math
 import random
 
 import pytest
 
-from facadecli.grammar.search import Action, Entry, Search, _bit_rows, _reached_costs
+from facadecli.grammar.search import Action, Entry, Search
 from facadecli.grammar.split import Axis
 from facadecli.grammar.tiling import LabelledLayout, Rect, tile
+from tests import adp_reference
 
 
 def _layout(seed: int) -> LabelledLayout:
@@ -34,46 +37,56 @@ def _grammars(search: Search, seed: int, count: int) -> list[dict[int, Action]]:
     def any_action(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
         return rng.choice(search.actions_at(entry))
 
-    return [search.greedy(), *(search.build(any_action) for _ in range(count))]
+    return [search.greedy(), *(adp_reference.build(search, any_action) for _ in range(count))]
 
 
 def _plain_cost(search: Search, rules: dict[int, Action]) -> float:
     same = search.canonical(rules)
-    return sum(rules[cid].cost for cid in rules if same[cid] == cid)
+    cost = 0.0
+    for cid in rules:
+        if same[cid] == cid:
+            cost += rules[cid].cost
+    return cost
 
 
-def _plain_totals(rules: dict[int, Action], reach: list[int]) -> list[float]:
-    """Per rule, the costs of the rules it reaches: bit counts per distinct cost."""
-    order = list(rules)
-    by_cost: dict[float, int] = {}
-    for i, cid in enumerate(order):
-        by_cost[rules[cid].cost] = by_cost.get(rules[cid].cost, 0) | 1 << i
-    return [
-        sum(cost * (bits & mask).bit_count() for cost, mask in by_cost.items()) for bits in reach
-    ]
+EXTENSIONS: list[tuple[str, ...]] = [(), ("repeatABA", "symsplit", "gridsplit")]
 
 
 @pytest.mark.parametrize("seed", range(8))
-@pytest.mark.parametrize("extensions", [(), ("repeatABA", "symsplit", "gridsplit")])
-def test_the_survey_gives_the_merged_cost_and_the_costs_below_each_rule(
+@pytest.mark.parametrize("extensions", EXTENSIONS)
+def test_the_survey_gives_the_merged_cost_and_what_each_rule_reaches(
     seed: int, extensions: tuple[str, ...]
 ) -> None:
     search = Search(tile(_layout(seed), 0), extensions=extensions)
     for rules in _grammars(search, seed, 20):
-        cost, reach = search._survey(rules)
+        cost, reach = search.survey(rules)
         assert cost == _plain_cost(search, rules)  # the same sum, in the same order
         assert search.cost(rules) == cost
-        if not rules:
-            continue
-        totals = _reached_costs(_bit_rows(reach, len(rules)), [a.cost for a in rules.values()])
-        assert totals.tolist() == _plain_totals(rules, reach)
+        plain_cost, plain_reach = adp_reference.survey(search, rules)
+        assert (cost, [set(r) for r in reach]) == (plain_cost, plain_reach)
 
 
-def test_bit_rows_are_the_sets_the_bits_hold() -> None:
-    bits = [0b1, 0b1011, 0, 1 << 9 | 1 << 2]
-    rows = _bit_rows(bits, 10)
-    assert rows.shape == (4, 10)
-    assert [set(row.nonzero()[0].tolist()) for row in rows] == [{0}, {0, 1, 3}, set(), {2, 9}]
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("extensions", EXTENSIONS)
+def test_the_compiled_loop_builds_the_grammars_the_plain_loop_builds(
+    seed: int, extensions: tuple[str, ...]
+) -> None:
+    layout = tile(_layout(seed), 0)
+    fast, plain = Search(layout, extensions=extensions), Search(layout, extensions=extensions)
+    assert fast.greedy() == adp_reference.greedy(plain)  # equal actions, equal regions
+    for iterations in (1, 2, 60):
+        rules, best_at, done = fast.adp(iterations, seed)
+        expected, expected_at, _ = adp_reference.adp(plain, iterations, seed)
+        assert (rules, best_at, done) == (expected, expected_at, iterations)
+        assert fast.cost(rules) == plain.cost(expected)
+
+
+def test_a_time_limit_of_nothing_stops_adp_after_the_greedy_grammar() -> None:
+    search = Search(tile(_layout(3), 0))
+    search.deadline.seconds = 0.0
+    rules, best_at, done = search.adp(50, 0)
+    assert (rules, best_at) == (search.greedy(), 0) and done == 1
+    assert math.isfinite(search.cost(rules))
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -24,6 +24,11 @@ the repeated regions that line cuts through over the cells of the region.
   is never worse than greedy's; the cheapest grammar of all iterations is returned. A seed
   makes it reproducible; a time limit stops early with the best grammar so far.
 
+Regions and their actions are made here, in Python, once each; building grammars from
+them, their merged cost and the value table run in a compiled loop (``_adp.c``), which
+computes what the plain loop in tests/adp_reference.py does, to the bit, several times
+faster.
+
 The run's ``Deadline`` bounds the work: the greedy grammar checks its hard limit at every
 region (exit 4 when it passes), ADP stops at the soft limit, even within an iteration.
 """
@@ -31,7 +36,6 @@ region (exit 4 when it passes), ADP stops at the soft limit, even within an iter
 from __future__ import annotations
 
 import bisect
-import heapq
 import itertools
 import math
 import random
@@ -41,13 +45,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from facadecli.grammar import _adp
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.regions import Grid, Region
 from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Part, Rule, inlined
 from facadecli.grammar.symmetry import Repeats, find_repeats
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
-EMPTY: frozenset[int] = frozenset()
 GRID_CELLS = 48  # a gridsplit of more cells than this costs more than it can save
 TOP_ACTIONS = 8  # actions per region the search chooses among (the heuristic's best)
 
@@ -105,13 +109,17 @@ class Search:
         self._repeat_first = rep.r0.tolist()
         self._actions: dict[Region, list[Action]] = {}
         self._greedy: dict[int, Action] | None = None
-        # rule kinds: (form number, symbols) -> a number, the symbols being terminal labels
-        # or kind numbers, so that two contents read the same iff their kinds are equal
-        self._kinds: dict[tuple[int, tuple[object, ...]], int] = {}
         self._forms: dict[tuple[object, ...], int] = {}
         self._actions_at: dict[Entry, list[Action]] = {}
         self._quanta: dict[tuple[str, int, int], int] = {}  # (axis, start, stop) -> size
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
+        # the inner loop's tables (``_adp``): entries and actions are numbered as met
+        self._table = _adp.Table(self._provide)
+        self._entry_ids: dict[Entry, int] = {}
+        self._entry_list: list[Entry] = []
+        self._action_list: list[Action] = []
+        self._action_number: dict[int, int] = {}  # by id() of the action
+        self._label = {name: i for i, name in enumerate(self.grid.names)}
 
     @property
     def regions_explored(self) -> int:
@@ -417,29 +425,55 @@ class Search:
 
     # -- building grammars ---------------------------------------------------------------
 
-    def build(
-        self, choose: Callable[[Entry, dict[int, Action], set[int]], Action]
-    ) -> dict[int, Action]:
-        """One grammar: regions bottom to top, left to right, each content split once."""
-        rules: dict[int, Action] = {}
+    def _entry_id(self, entry: Entry) -> int:
+        """The table's number for a region to split, given the first time it is met."""
+        found = self._entry_ids.get(entry)
+        if found is None:
+            found = self._entry_ids[entry] = self._table.add_entry(entry)
+            self._entry_list.append(entry)
+        return found
+
+    def _provide(self, entry_id: int) -> _adp.Provided:
+        """The actions of an entry, for the table (``_adp.Table``): their cost, heuristic,
+        form, parts (a content for a non-terminal, -1 - label for a terminal), needs and
+        non-terminal parts (as entries), numbered in the order given."""
+        actions = self.actions_at(self._entry_list[entry_id])
+        self._action_list.extend(actions)
+        terminal, label = self.grid.terminal, self._label
+        return [
+            (
+                a.cost,
+                a.heuristic,
+                a.form_number,
+                tuple(-1 - label[terminal[c]] if c in terminal else c for c in a.cids),
+                a.needs,
+                tuple(map(self._entry_id, a.entries)),
+            )
+            for a in actions
+        ]
+
+    def _rules(self, pairs: list[tuple[int, int]]) -> dict[int, Action]:
+        """A grammar from the table: each content's action, in the order chosen."""
+        actions = self._action_list
+        return {cid: actions[a] for cid, a in pairs}
+
+    def _action_ids(self, rules: dict[int, Action]) -> list[int]:
+        """The table's numbers of a grammar's actions (the grammar may have been built
+        outside the table: its regions' actions are given to the table then)."""
+        number = self._action_number
+        for cid, action in rules.items():
+            if id(action) not in number:
+                self._table.provide(self._entry_id(_entry(_region_of(action), cid)))
+        for i in range(len(number), len(self._action_list)):
+            number[id(self._action_list[i])] = i
+        return [number[id(a)] for a in rules.values()]
+
+    def _start(self) -> int | None:
+        """The whole façade's entry, None when it is one terminal."""
         start = self.grid.content(self.whole)
         if start in self.grid.terminal:
-            return rules
-        pending = {start}
-        heap = [_entry(self.whole, start)]
-        pop, push = heapq.heappop, heapq.heappush
-        while heap:
-            entry = pop(heap)
-            cid = entry[4]
-            pending.discard(cid)
-            action = rules[cid] = choose(entry, rules, pending)
-            for part in action.entries:
-                sub = part[4]
-                if sub in rules or sub in pending:
-                    continue
-                pending.add(sub)
-                push(heap, part)
-        return rules
+            return None
+        return self._entry_id(_entry(self.whole, start))
 
     def actions_at(self, entry: Entry) -> list[Action]:
         """The actions of a heap entry's region."""
@@ -474,152 +508,49 @@ class Search:
 
     def cost(self, rules: dict[int, Action]) -> float:
         """Eq. 1 over the merged rules."""
-        return self._survey(rules)[0]
+        return self.survey(rules)[0]
 
-    def _survey(self, rules: dict[int, Action]) -> tuple[float, list[int]]:
-        """Eq. 1 over the merged rules, and for each rule (in order) the rules it reaches,
-        itself included, as bits of the rules' positions.
-
-        Rules merge as in ``canonical``: each gets a kind, a number for its form and the
-        kinds or labels of its parts, so that rules that read the same have one kind; a
-        kind's cost counts once, for the rule met first with it (the same sum, to the bit,
-        as over ``canonical``'s map)."""
-        terminal = self.grid.terminal
-        kinds = self._kinds
-        position = {cid: i for i, cid in enumerate(rules)}
-        kind_of: dict[int, int] = {}
-        reach: dict[int, int] = {}
-        first: dict[int, int] = {}  # kind -> the content met first with it
-
-        def visit(cid: int) -> int:
-            kind = kind_of.get(cid)
-            if kind is None:
-                action = rules[cid]
-                bits = 1 << position[cid]
-                symbols: list[object] = []
-                for sub in action.cids:
-                    if sub in terminal:
-                        symbols.append(terminal[sub])
-                    else:
-                        symbols.append(visit(sub))
-                        bits |= reach[sub]
-                kind = kinds.setdefault((action.form_number, tuple(symbols)), len(kinds))
-                kind_of[cid] = kind
-                reach[cid] = bits
-                first.setdefault(kind, cid)
-            return kind
-
-        for cid in rules:
-            visit(cid)
-        cost = sum(rules[cid].cost for cid in rules if first[kind_of[cid]] == cid)
-        return cost, [reach[cid] for cid in rules]
+    def survey(self, rules: dict[int, Action]) -> tuple[float, list[list[int]]]:
+        """Eq. 1 over the merged rules, and for each rule (in order) the positions of the
+        rules it reaches, itself included. Rules merge as in ``canonical``; a merged rule's
+        cost counts once, for the rule met first with it (the same sum, to the bit, as over
+        ``canonical``'s map)."""
+        if not rules:
+            return 0.0, []
+        return self._table.survey(self._action_ids(rules))
 
     def greedy(self) -> dict[int, Action]:
-        """The greedy baseline's rules (built once: ADP starts from them too)."""
+        """The greedy baseline's rules: every region takes its first action (built once:
+        ADP starts from them too)."""
         if self._greedy is None:
-
-            def best(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
-                self.deadline.check("building the greedy grammar")
-                return self.actions_at(entry)[0]
-
-            self._greedy = self.build(best)
+            start = self._start()
+            if start is None:
+                self._greedy = {}
+            else:
+                deadline = self.deadline
+                pairs = self._table.greedy(start, _monotonic(deadline.start + deadline.hard))
+                if pairs is None:
+                    deadline.check("building the greedy grammar")
+                    raise AssertionError("the hard time limit passed")  # check() raised
+                self._greedy = self._rules(pairs)
         return self._greedy
 
     def adp(self, iterations: int, seed: int) -> tuple[dict[int, Action], int, int]:
         """The cheapest grammar of ``iterations`` (see the module), the iteration it was
         found in (0 is the greedy one), and the iterations done: fewer when the deadline's
-        soft limit passes first."""
-        rng = random.Random(seed)
-        # content -> the least cost found for it, and the contents its best rules split
-        learned: dict[int, tuple[float, frozenset[int]]] = {}
+        soft limit passes first. The loop runs in ``_adp`` (compiled); its draws are
+        ``random.Random(seed)``'s."""
+        greedy = self.greedy()
+        start = self._start()
+        if start is None or iterations < 2:
+            return greedy, 0, max(iterations, 1)
         optimistic = min(self.costs.split + 2, self.costs.repeat + 1)
-        best = self.greedy()
-        best_cost, reach = self._survey(best)
-        best_at = 0
-        self._learn(best, reach, learned)
-        epsilon = 1.0
-
-        # a region's cumulative exp(-H) over its actions, and their total
-        odds: dict[Entry, tuple[list[float], float]] = {}
-        get_learned, draw = learned.get, rng.random
-
-        start, seconds = self.deadline.start, self.deadline.seconds  # ``Deadline.passed()``
-        clock, by_entry = time.perf_counter, self._actions_at
-
-        def choose(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
-            if clock() - start > seconds:
-                raise _TimeUp
-            actions = by_entry.get(entry) or self.actions_at(entry)
-            if len(actions) == 1:
-                return actions[0]
-            if draw() < epsilon:  # exploration: the heuristic's odds
-                found = odds.get(entry)
-                if found is None:
-                    low = actions[0].heuristic
-                    weights = list(
-                        itertools.accumulate(math.exp(low - a.heuristic) for a in actions)
-                    )
-                    found = odds[entry] = (weights, weights[-1] + 0.0)
-                # ``rng.choices(actions, cum_weights=weights)[0]``, to the draw
-                weights, total = found
-                return actions[bisect.bisect(weights, draw() * total, 0, len(actions) - 1)]
-            chosen, least = actions[0], math.inf
-            for action in actions:  # exploitation: Eq. 4 with the value table
-                score, covered = action.cost, EMPTY
-                for need in action.needs:  # larger parts first: theirs hold the smaller
-                    if score >= least:
-                        break  # values only add up
-                    if need in rules or need in pending or need in covered:
-                        continue
-                    known = get_learned(need)
-                    if known is None:
-                        score += optimistic
-                    else:
-                        score += known[0]
-                        covered = covered | known[1] if covered else known[1]
-                if score < least:
-                    chosen, least = action, score
-            return chosen
-
-        seen: set[tuple[int, ...]] = set()  # grammars built already: nothing new
-        done = iterations
-        for t in range(1, iterations):
-            epsilon = 1.0 - t / iterations
-            try:
-                rules = self.build(choose)
-            except _TimeUp:
-                done = t
-                break
-            # each action is one region's, so the actions tell the contents too
-            signature = tuple(map(id, rules.values()))
-            if signature in seen:
-                continue
-            seen.add(signature)
-            cost, reach = self._survey(rules)
-            self._learn(rules, reach, learned)
-            if cost < best_cost - 1e-9:
-                best, best_cost, best_at = rules, cost, t
-        return best, best_at, done
-
-    def _learn(
-        self,
-        rules: dict[int, Action],
-        reach: list[int],
-        learned: dict[int, tuple[float, frozenset[int]]],
-    ) -> None:
-        """Each content's cost to describe, with the rules below it counted once each, kept
-        in the value table when it is the least yet, with the contents it took (``reach``:
-        per rule, the rules below it as bits, from ``_survey``)."""
-        order = list(rules)
-        if not order:
-            return
-        reached = _bit_rows(reach, len(order))
-        totals = _reached_costs(reached, [rules[cid].cost for cid in order])
-        unknown = (math.inf, EMPTY)
-        known = np.array([learned.get(cid, unknown)[0] for cid in order])
-        contents = np.array(order)
-        for i in np.flatnonzero(totals < known - 1e-12).tolist():
-            learned[order[i]] = (float(totals[i]), frozenset(contents[reached[i]].tolist()))
+        state = random.Random(seed).getstate()[1]
+        stop = _monotonic(self.deadline.start + self.deadline.seconds)
+        pairs, best_at, done = self._table.adp(
+            start, self._action_ids(greedy), iterations, state, optimistic, stop
+        )
+        return self._rules(pairs), best_at, done
 
     # -- the grammar ---------------------------------------------------------------------
 
@@ -673,36 +604,27 @@ class Search:
         return Rule(action.op, action.axis, tuple(parts), action.count, action.centre)
 
 
-class _TimeUp(Exception):
-    """The soft time limit passed during an ADP iteration: the iteration is dropped."""
-
-
-def _bit_rows(bits: list[int], n: int) -> np.ndarray:
-    """Sets of ``0 .. n - 1`` given as bits of integers, as the rows of a boolean matrix."""
-    width = (n + 7) // 8
-    packed = np.frombuffer(b"".join(b.to_bytes(width, "little") for b in bits), dtype=np.uint8)
-    rows = np.unpackbits(packed.reshape(len(bits), width), axis=1, count=n, bitorder="little")
-    return rows.view(bool)
-
-
-def _reached_costs(reached: np.ndarray, costs: list[float]) -> np.ndarray:
-    """Per row, the sum of the costs of the rules it reaches, added up the way
-    ``sum(cost * count for each distinct cost, in order met)`` does, to the bit."""
-    distinct = list(dict.fromkeys(costs))
-    index = {c: i for i, c in enumerate(distinct)}
-    group = np.array([index[c] for c in costs])
-    members = np.zeros((len(costs), len(distinct)))
-    members[np.arange(len(costs)), group] = 1.0
-    counts = reached.astype(float) @ members  # whole numbers: exact in floats
-    totals = np.zeros(len(costs))
-    for j, cost in enumerate(distinct):
-        totals += cost * counts[:, j]
-    return totals
+def _monotonic(at: float) -> float:
+    """A ``time.perf_counter()`` instant as the table's clock reads it (the same clock on
+    Linux; elsewhere the offset is measured)."""
+    if math.isinf(at):
+        return at
+    return at - time.perf_counter() + time.monotonic()
 
 
 def _heuristic(rule_cost: float, bounds: tuple[int, ...], cost_of_line: dict[int, float]) -> float:
     """Eq. 5: the rule's cost plus the cost of each line it cuts."""
     return rule_cost + sum(cost_of_line.get(line, 0.0) for line in bounds[1:-1])
+
+
+def _region_of(action: Action) -> Region:
+    """The region an action splits."""
+    first = action.written[0]
+    if action.op == "gridsplit":
+        return (action.bounds[0], action.bounds[-1], action.across[0], action.across[-1])
+    if action.axis == "x":
+        return (first[0], first[1], action.bounds[0], action.bounds[-1])
+    return (action.bounds[0], action.bounds[-1], first[2], first[3])
 
 
 def _entry(region: Region, cid: int) -> Entry:
