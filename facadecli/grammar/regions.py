@@ -89,6 +89,14 @@ class Grid:
         self._content_of[region] = cid
         return cid
 
+    def contents_of(self, regions: list[Region]) -> list[int]:
+        """``content`` of each region (most are known: looked up at once)."""
+        known = self._content_of
+        cids = [known.get(region, -1) for region in regions]
+        if -1 in cids:
+            cids = [self.content(region) for region in regions]
+        return cids
+
     def lines(self, region: Region, axis: str) -> tuple[list[int], list[int]]:
         """Lines inside the region along an axis (column indices for x, row indices for y)
         that separate labels somewhere, and how many element cells each crosses."""

@@ -60,7 +60,7 @@ Entry = tuple[int, int, int, int, int]  # a region to split and its content (``_
 Rank = tuple[float, float, Axis, tuple[int, ...]]  # heuristic, cost, axis, bounds: least first
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)  # not frozen, which makes them slower to make; never changed
 class Action:
     op: Op
     axis: Axis
@@ -246,20 +246,21 @@ class Search:
 
     def _runs(self, region: Region, axis: Axis, full: tuple[int, ...]) -> list[tuple[int, ...]]:
         """Bounds that keep each maximal periodic run of two or more parts as one part."""
-        cids = [
-            self.grid.content(self._part(region, axis, a, b)) for a, b in itertools.pairwise(full)
-        ]
+        cids = self.grid.contents_of(
+            [self._part(region, axis, a, b) for a, b in itertools.pairwise(full)]
+        )
         n = len(cids)
         out = []
         for period in range(1, n // 2 + 1):
+            # run[j]: how many parts from j on equal the part a period after them, so the
+            # parts from i on hold 1 + run[i] // period copies of the first period
+            run = [0] * (n - period + 1)
+            for j in range(n - period - 1, -1, -1):
+                if cids[j] == cids[j + period]:
+                    run[j] = run[j + 1] + 1
             i = 0
             while i + 2 * period <= n:
-                k = 1
-                while (
-                    i + (k + 1) * period <= n
-                    and cids[i + k * period : i + (k + 1) * period] == cids[i : i + period]
-                ):
-                    k += 1
+                k = 1 + run[i] // period
                 if k >= 2 and not (i == 0 and i + k * period == n):
                     end = i + k * period
                     out.append((*full[: i + 1], *full[end:]))
@@ -300,22 +301,20 @@ class Search:
     def _action(
         self, region: Region, axis: Axis, bounds: tuple[int, ...], cost_of_line: dict[int, float]
     ) -> Action | None:
-        parts = [self._part(region, axis, a, b) for a, b in itertools.pairwise(bounds)]
-        n = len(parts)
+        n = len(bounds) - 1
         if n < 2:
             return None
-        cids = [self.grid.content(p) for p in parts]
+        r0, r1, c0, c1 = region
+        if axis == "x":
+            parts = [(r0, r1, a, b) for a, b in itertools.pairwise(bounds)]
+        else:
+            parts = [(a, b, c0, c1) for a, b in itertools.pairwise(bounds)]
+        cids = self.grid.contents_of(parts)
         op: Op = "split"
         written, count, centre = parts, 1, False
-        period = next(
-            (
-                p
-                for p in range(1, n // 2 + 1)
-                if n % p == 0 and all(cids[i] == cids[i % p] for i in range(n))
-            ),
-            None,
-        )
-        if period is not None:
+        # the least period p of the contents: the parts are n / p copies of the first p
+        period = next((p for p in range(1, n // 2 + 1) if not n % p and cids[p:] == cids[:-p]), 0)
+        if period:
             op, written, count = "repeat", parts[:period], n // period
         elif (
             "repeatABA" in self.extensions
@@ -327,12 +326,12 @@ class Search:
             op, written, count = "repeatABA", parts[:2], n // 2
         elif "symsplit" in self.extensions and n >= 3 and cids == cids[::-1]:
             op, written, centre = "symsplit", parts[: (n + 1) // 2], n % 2 == 1
-        rule_cost = (
-            self.costs.repeat if op in ("repeat", "repeatABA") else self.costs.split
-        ) + len(written)
+        m = len(written)
+        rule_cost = (self.costs.repeat if op in ("repeat", "repeatABA") else self.costs.split) + m
         heuristic = _heuristic(rule_cost, bounds, cost_of_line)
-        sizes = tuple(self._quantum(axis, p) for p in written)
-        kept = cids[: len(written)]
+        quantum = self._quantum
+        sizes = tuple(quantum(axis, p) for p in written)
+        kept = cids[:m]
         form = (op, axis, count, centre, sizes)
         return Action(
             op,
@@ -370,17 +369,19 @@ class Search:
     def _needs(self, written: Sequence[Region], cids: Sequence[int]) -> tuple[int, ...]:
         """The non-terminal contents among the parts, once each, larger parts first."""
         terminal = self.grid.terminal
-        smaller = [-_cells(part) for part in written]
-        order = sorted(range(len(written)), key=smaller.__getitem__)  # stable: ties in order
-        return tuple(dict.fromkeys(cids[i] for i in order if cids[i] not in terminal))
+        inner = [(-_cells(part), i) for i, part in enumerate(written) if cids[i] not in terminal]
+        if len(inner) < 2:
+            return tuple(cids[i] for _, i in inner)
+        inner.sort()  # by size, ties in order
+        return tuple(dict.fromkeys(cids[i] for _, i in inner))
 
     def _entries(self, written: Sequence[Region], cids: Sequence[int]) -> tuple[Entry, ...]:
         """The written parts that are not terminals, in order, as heap entries
         (``_entry``)."""
         terminal = self.grid.terminal
         return tuple(
-            (r0, c0, -r1, -c1, cid)
-            for (r0, r1, c0, c1), cid in zip(written, cids, strict=True)
+            (part[0], part[2], -part[1], -part[3], cid)
+            for part, cid in zip(written, cids, strict=True)
             if cid not in terminal
         )
 
