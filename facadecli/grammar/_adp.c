@@ -1,16 +1,16 @@
-/* The inner loop of the grammar search (facadecli.grammar.search): building grammars region
- * by region (greedy, or ADP's explore-or-exploit choice), the merged cost of a grammar and
- * the value table it teaches. Regions and their actions are made in Python (``Search``) and
- * handed over once each, through the ``provide`` callback; everything here is integers and
- * floats.
+/* The grammar search (facadecli.grammar.search), compiled: the actions offered for each region
+ * of the tiling, building grammars region by region (greedy, or ADP's explore-or-exploit
+ * choice), the merged cost of a grammar and the value table it teaches.
  *
- * It computes exactly what the plain Python loop does (tests/adp_reference.py), to the bit:
- * the same Mersenne Twister draws as ``random.Random`` (its state is handed over), the same
- * sums in the same order, the same tie rules. Only the speed differs.
+ * It computes exactly what the Python reference does (``Search._make_actions`` for the
+ * actions, tests/adp_reference.py for the loop), to the bit: the same Mersenne Twister
+ * draws as ``random.Random`` (its state is handed over), the same sums in the same order, the
+ * same tie rules. Only the speed differs. The tests compare the two.
  *
  * Ids: an *entry* is a region to split (its heap key and content); an *action* is one rule
- * an entry may take; a *content* is what regions read (``Grid.content``). An action's parts
- * are written as symbols: a content for a non-terminal, -1 - label for a terminal.
+ * an entry may take; a *content* is what regions read (``Grid.content``: numbered here on
+ * their own). An action's parts are written as symbols: a content for a non-terminal,
+ * -1 - label for a terminal.
  */
 
 #define PY_SSIZE_T_CLEAN
@@ -161,6 +161,696 @@ static double mt_random(Twister *t)
     return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
 }
 
+/* -- the tiling's regions and the actions offered for them ---------------------------------
+ *
+ * What ``Search._make_actions`` (search.py) computes, to the bit: the lines that may cut a
+ * region, the heuristic's cost of each line (Eq. 5), the cuts that keep periodic runs and
+ * repeated regions whole, the cuts in two the heuristic likes best, a gridsplit with the
+ * extension, each written as the cheapest rule that fits its parts. Python's version stays
+ * the reference (the tests compare the two) and makes the chosen rules' ``Action``s.
+ * Contents are numbered here on their own; they equal Python's where Python's are equal. */
+
+enum { EXT_ABA = 1, EXT_SYMSPLIT = 2, EXT_GRIDSPLIT = 4 };
+enum { OP_SPLIT, OP_REPEAT, OP_ABA, OP_SYMSPLIT, OP_GRID };
+#define TOP_ACTIONS 8
+#define GRID_CELLS 48
+
+typedef struct {
+    int rows, cols;
+    int32_t *labels;   /* rows x cols, bottom row first */
+    double *xs, *ys;   /* the cuts: cols + 1, rows + 1 */
+    double qx, qy;     /* the size quantum along each axis */
+    int32_t *change_x, *cross_x; /* (rows + 1) x (cols - 1): counts up to each row */
+    int32_t *change_y, *cross_y; /* (rows - 1) x (cols + 1): counts up to each column */
+    int n_repeats;
+    int32_t *repeats;  /* r0, r1, c0, c1, cells per occurrence, by first row */
+    int ext;
+    double split_cost, repeat_cost;
+    SeqSet keys;       /* content keys -> content */
+    int *terminal;     /* per content: its label, or -1 */
+    Py_ssize_t terminal_cap;
+    SeqSet regions;    /* (r0, r1, c0, c1) -> index */
+    int *region_cid;
+    Py_ssize_t region_cap;
+    SeqSet forms;      /* (op, axis, count, centre, sizes...) -> form */
+    int *buffer;       /* scratch for keys */
+    Py_ssize_t buffer_cap;
+} Grid;
+
+static void grid_free(Grid *g)
+{
+    PyMem_Free(g->labels);
+    PyMem_Free(g->xs);
+    PyMem_Free(g->ys);
+    PyMem_Free(g->change_x);
+    PyMem_Free(g->cross_x);
+    PyMem_Free(g->change_y);
+    PyMem_Free(g->cross_y);
+    PyMem_Free(g->repeats);
+    PyMem_Free(g->terminal);
+    PyMem_Free(g->region_cid);
+    PyMem_Free(g->buffer);
+    seqset_free(&g->keys);
+    seqset_free(&g->regions);
+    seqset_free(&g->forms);
+    memset(g, 0, sizeof(*g));
+}
+
+/* The prefix counts of ``regions.Grid``: for x lines, per line between columns c - 1 and c,
+ * label changes (and element crossings) in the rows below each row; for y the same across. */
+static int grid_prefixes(Grid *g, int background)
+{
+    int R = g->rows, C = g->cols;
+    size_t nx = (size_t)(R + 1) * (size_t)(C > 1 ? C - 1 : 0);
+    size_t ny = (size_t)(R > 1 ? R - 1 : 0) * (size_t)(C + 1);
+    g->change_x = PyMem_Calloc(nx + 1, sizeof(int32_t));
+    g->cross_x = PyMem_Calloc(nx + 1, sizeof(int32_t));
+    g->change_y = PyMem_Calloc(ny + 1, sizeof(int32_t));
+    g->cross_y = PyMem_Calloc(ny + 1, sizeof(int32_t));
+    if (!g->change_x || !g->cross_x || !g->change_y || !g->cross_y) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    const int32_t *L = g->labels;
+    for (int r = 0; r < R; r++)
+        for (int c = 1; c < C; c++) {
+            int same = L[r * C + c] == L[r * C + c - 1];
+            size_t at = (size_t)(r + 1) * (C - 1) + (c - 1), below = (size_t)r * (C - 1) + (c - 1);
+            g->change_x[at] = g->change_x[below] + !same;
+            g->cross_x[at] = g->cross_x[below] + (same && L[r * C + c] != background);
+        }
+    for (int r = 1; r < R; r++)
+        for (int c = 0; c < C; c++) {
+            int same = L[r * C + c] == L[(r - 1) * C + c];
+            size_t at = (size_t)(r - 1) * (C + 1) + c + 1, left = (size_t)(r - 1) * (C + 1) + c;
+            g->change_y[at] = g->change_y[left] + !same;
+            g->cross_y[at] = g->cross_y[left] + (same && L[r * C + c] != background);
+        }
+    return 0;
+}
+
+#define CHX(g, r, i) ((g)->change_x[(size_t)(r) * ((g)->cols - 1) + (i)])
+#define CRX(g, r, i) ((g)->cross_x[(size_t)(r) * ((g)->cols - 1) + (i)])
+#define CHY(g, i, c) ((g)->change_y[(size_t)(i) * ((g)->cols + 1) + (c)])
+#define CRY(g, i, c) ((g)->cross_y[(size_t)(i) * ((g)->cols + 1) + (c)])
+
+static int buffer_room(Grid *g, Py_ssize_t n) { return GROW(g->buffer, g->buffer_cap, n); }
+
+/* ``Grid.content``: the region's content, numbered as met; -1 on error. */
+static int grid_content(Grid *g, int r0, int r1, int c0, int c1)
+{
+    int box[4] = {r0, r1, c0, c1}, added;
+    Py_ssize_t at = seqset_add(&g->regions, box, 4, &added);
+    if (at < 0)
+        return -1;
+    if (!added)
+        return g->region_cid[at];
+    int nr = 0, nc = 0, w = c1 - c0, h = r1 - r0;
+    if (buffer_room(g, 2 + (Py_ssize_t)w * h + 2 * (w + h) + 4) < 0)
+        return -1;
+    /* starts of merged columns and rows, kept at the end of the buffer */
+    int *starts_c = g->buffer + g->buffer_cap - (w + h + 2), *starts_r = starts_c + w + 1;
+    for (int j = 0; j < w; j++)
+        if (j == 0 || CHX(g, r1, c0 + j - 1) != CHX(g, r0, c0 + j - 1))
+            starts_c[nc++] = j;
+    for (int i = 0; i < h; i++)
+        if (i == 0 || CHY(g, r0 + i - 1, c1) != CHY(g, r0 + i - 1, c0))
+            starts_r[nr++] = i;
+    starts_c[nc] = w;
+    starts_r[nr] = h;
+    int *key = g->buffer, n = 0;
+    key[n++] = nr;
+    key[n++] = nc;
+    for (int i = 0; i < nr; i++)
+        for (int j = 0; j < nc; j++)
+            key[n++] = g->labels[(size_t)(r0 + starts_r[i]) * g->cols + c0 + starts_c[j]];
+    for (int j = 0; j < nc; j++)
+        key[n++] = (int)nearbyint((g->xs[c0 + starts_c[j + 1]] - g->xs[c0 + starts_c[j]]) / g->qx);
+    for (int i = 0; i < nr; i++)
+        key[n++] = (int)nearbyint((g->ys[r0 + starts_r[i + 1]] - g->ys[r0 + starts_r[i]]) / g->qy);
+    Py_ssize_t cid = seqset_add(&g->keys, key, n, &added);
+    if (cid < 0)
+        return -1;
+    if (added) {
+        if (GROW(g->terminal, g->terminal_cap, cid + 1) < 0)
+            return -1;
+        g->terminal[cid] = nr * nc == 1 ? key[2] : -1;
+    }
+    if (GROW(g->region_cid, g->region_cap, at + 1) < 0)
+        return -1;
+    g->region_cid[at] = (int)cid;
+    return (int)cid;
+}
+
+static long grid_quantum(const Grid *g, int axis, int a, int b)
+{
+    return axis == 0 ? (long)nearbyint((g->xs[b] - g->xs[a]) / g->qx)
+                     : (long)nearbyint((g->ys[b] - g->ys[a]) / g->qy);
+}
+
+/* An action before it is kept: its rank, and its parts as regions (offsets in the pool of
+ * its region's drafts, which may move as it grows). */
+typedef struct {
+    double heuristic, cost;
+    int axis; /* 0: x, 1: y (a gridsplit ranks as y) */
+    int op, count, centre;
+    Py_ssize_t bounds, across, written, cids; /* offsets in Drafts.pool */
+    int n_bounds, n_across, n_written;
+    int order; /* where it stood before the last sort: ties keep it */
+} Draft;
+
+typedef struct {
+    Draft *items;
+    Py_ssize_t n, cap;
+    int *pool;
+    Py_ssize_t pool_n, pool_cap;
+} Drafts;
+
+#define DP(d, off) ((d)->pool + (off))
+
+static Py_ssize_t drafts_alloc(Drafts *d, Py_ssize_t n)
+{
+    if (GROW(d->pool, d->pool_cap, d->pool_n + n + 1) < 0)
+        return -1;
+    d->pool_n += n;
+    return d->pool_n - n;
+}
+
+static int compare_bounds(const int *a, int na, const int *b, int nb)
+{
+    for (int i = 0; i < na && i < nb; i++)
+        if (a[i] != b[i])
+            return a[i] < b[i] ? -1 : 1;
+    return (na > nb) - (na < nb);
+}
+
+/* ``Rank`` (heuristic, cost, axis, bounds), then the order before the sort. */
+static int compare_drafts(const Drafts *d, const Draft *a, const Draft *b)
+{
+    if (a->heuristic != b->heuristic)
+        return a->heuristic < b->heuristic ? -1 : 1;
+    if (a->cost != b->cost)
+        return a->cost < b->cost ? -1 : 1;
+    if (a->axis != b->axis)
+        return a->axis < b->axis ? -1 : 1;
+    int c = compare_bounds(DP(d, a->bounds), a->n_bounds, DP(d, b->bounds), b->n_bounds);
+    if (c)
+        return c;
+    return (a->order > b->order) - (a->order < b->order);
+}
+
+/* A stable sort of drafts[lo:hi] by rank (insertion: a region has a few dozen at most). */
+static void sort_drafts(Drafts *d, Py_ssize_t lo, Py_ssize_t hi)
+{
+    for (Py_ssize_t i = lo; i < hi; i++)
+        d->items[i].order = (int)i;
+    for (Py_ssize_t i = lo + 1; i < hi; i++) {
+        Draft x = d->items[i];
+        Py_ssize_t j = i;
+        while (j > lo && compare_drafts(d, &x, &d->items[j - 1]) < 0) {
+            d->items[j] = d->items[j - 1];
+            j--;
+        }
+        d->items[j] = x;
+    }
+}
+
+typedef struct {
+    int r0, r1, c0, c1;
+    double *cost[2]; /* per axis, the heuristic's cost of each line, indexed from lo */
+    int lo[2];
+    int *inside;     /* the repeated regions' occurrences inside the region */
+    int n_inside;
+} Place;
+
+static double line_cost(const Place *p, int axis, int line)
+{
+    return p->cost[axis][line - p->lo[axis]];
+}
+
+static void part_of(const Place *p, int axis, int a, int b, int *out)
+{
+    if (axis == 0) {
+        out[0] = p->r0, out[1] = p->r1, out[2] = a, out[3] = b;
+    } else {
+        out[0] = a, out[1] = b, out[2] = p->c0, out[3] = p->c1;
+    }
+}
+
+/* Eq. 5's sum over the lines a rule cuts, as Python's sum() adds them. */
+static double lines_cost(const Place *p, int axis, const int *bounds, int n_bounds)
+{
+    double s = 0.0;
+    for (int i = 1; i < n_bounds - 1; i++)
+        s += line_cost(p, axis, bounds[i]);
+    return s;
+}
+
+/* ``Search._action``: the cheapest rule over the parts between the bounds, as a draft;
+ * 0 (none when fewer than two parts: d->n unchanged), or -1 on error. */
+static int draft_action(Grid *g, const Place *p, Drafts *d, int axis, const int *bounds_in,
+                        int n_bounds)
+{
+    int n = n_bounds - 1;
+    if (n < 2)
+        return 0;
+    Py_ssize_t bounds = drafts_alloc(d, n_bounds), parts = drafts_alloc(d, 4 * n),
+               cids = drafts_alloc(d, n);
+    if (bounds < 0 || parts < 0 || cids < 0)
+        return -1;
+    memcpy(DP(d, bounds), bounds_in, (size_t)n_bounds * sizeof(int));
+    for (int i = 0; i < n; i++) {
+        part_of(p, axis, bounds_in[i], bounds_in[i + 1], DP(d, parts) + 4 * i);
+        const int *q = DP(d, parts) + 4 * i;
+        int cid = grid_content(g, q[0], q[1], q[2], q[3]);
+        if (cid < 0)
+            return -1;
+        DP(d, cids)[i] = cid;
+    }
+    const int *c = DP(d, cids);
+    int op = OP_SPLIT, m = n, count = 1, centre = 0, period = 0;
+    for (int q = 1; q <= n / 2 && !period; q++) {
+        if (n % q)
+            continue;
+        int same = 1;
+        for (int i = q; i < n && same; i++)
+            same = c[i] == c[i - q];
+        if (same)
+            period = q;
+    }
+    if (period) {
+        op = OP_REPEAT, m = period, count = n / period;
+    } else if ((g->ext & EXT_ABA) && n >= 5 && n % 2 == 1) {
+        int same = 1;
+        for (int i = 2; i < n && same; i++)
+            same = c[i] == c[i - 2];
+        if (same)
+            op = OP_ABA, m = 2, count = n / 2;
+    }
+    if (op == OP_SPLIT && (g->ext & EXT_SYMSPLIT) && n >= 3) {
+        int same = 1;
+        for (int i = 0; i < n && same; i++)
+            same = c[i] == c[n - 1 - i];
+        if (same)
+            op = OP_SYMSPLIT, m = (n + 1) / 2, centre = n % 2 == 1;
+    }
+    if (GROW(d->items, d->cap, d->n + 1) < 0)
+        return -1;
+    Draft *a = &d->items[d->n++];
+    a->cost = ((op == OP_REPEAT || op == OP_ABA) ? g->repeat_cost : g->split_cost) + m;
+    a->heuristic = a->cost + lines_cost(p, axis, bounds_in, n_bounds);
+    a->axis = axis, a->op = op, a->count = count, a->centre = centre;
+    a->bounds = bounds, a->n_bounds = n_bounds;
+    a->across = 0, a->n_across = 0;
+    a->written = parts, a->n_written = m;
+    a->cids = cids;
+    return 0;
+}
+
+/* ``Search._gridsplit``: rows by the usable y lines, columns by the usable x lines. */
+static int draft_grid(Grid *g, const Place *p, Drafts *d, const int *ys, int ny, const int *xs,
+                      int nx)
+{
+    int rows = ny + 1, cols = nx + 1, n = rows * cols;
+    Py_ssize_t bounds = drafts_alloc(d, rows + 1), across = drafts_alloc(d, cols + 1),
+               parts = drafts_alloc(d, 4 * n), cids = drafts_alloc(d, n);
+    if (bounds < 0 || across < 0 || parts < 0 || cids < 0)
+        return -1;
+    int *b = DP(d, bounds), *x = DP(d, across);
+    b[0] = p->r0, b[rows] = p->r1, x[0] = p->c0, x[cols] = p->c1;
+    memcpy(b + 1, ys, (size_t)ny * sizeof(int));
+    memcpy(x + 1, xs, (size_t)nx * sizeof(int));
+    for (int i = 0; i < rows; i++)
+        for (int j = 0; j < cols; j++) {
+            int *q = DP(d, parts) + 4 * (i * cols + j);
+            q[0] = DP(d, bounds)[i], q[1] = DP(d, bounds)[i + 1];
+            q[2] = DP(d, across)[j], q[3] = DP(d, across)[j + 1];
+            int cid = grid_content(g, q[0], q[1], q[2], q[3]);
+            if (cid < 0)
+                return -1;
+            DP(d, cids)[i * cols + j] = cid;
+        }
+    if (GROW(d->items, d->cap, d->n + 1) < 0)
+        return -1;
+    Draft *a = &d->items[d->n++];
+    a->cost = g->split_cost + n;
+    a->heuristic = a->cost + lines_cost(p, 0, DP(d, across), cols + 1);
+    a->heuristic += lines_cost(p, 1, DP(d, bounds), rows + 1);
+    a->axis = 1, a->op = OP_GRID, a->count = 1, a->centre = 0;
+    a->bounds = bounds, a->n_bounds = rows + 1;
+    a->across = across, a->n_across = cols + 1;
+    a->written = parts, a->n_written = n;
+    a->cids = cids;
+    return 0;
+}
+
+static int has_draft(const Drafts *d, Py_ssize_t lo, int axis, const int *bounds, int n_bounds)
+{
+    for (Py_ssize_t i = lo; i < d->n; i++) {
+        const Draft *a = &d->items[i];
+        if (a->op != OP_GRID && a->axis == axis &&
+            !compare_bounds(DP(d, a->bounds), a->n_bounds, bounds, n_bounds))
+            return 1;
+    }
+    return 0;
+}
+
+/* ``Search._line_costs`` of one axis into p->cost[axis] (zero where not positive). */
+static int place_line_costs(const Grid *g, Place *p, int axis)
+{
+    int lo = axis == 0 ? p->c0 : p->r0, hi = axis == 0 ? p->c1 : p->r1, size = hi - lo + 1;
+    double *cost = PyMem_Calloc((size_t)size + 1, sizeof(double));
+    if (!cost) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    p->cost[axis] = cost, p->lo[axis] = lo;
+    if (p->n_inside == 0 || hi - lo < 2)
+        return 0;
+    double *pos = PyMem_Calloc((size_t)size, sizeof(double));
+    double *neg = PyMem_Calloc((size_t)size, sizeof(double));
+    if (!pos || !neg) {
+        PyMem_Free(pos);
+        PyMem_Free(neg);
+        PyErr_NoMemory();
+        return -1;
+    }
+    for (int k = 0; k < p->n_inside; k++) {
+        const int32_t *rep = g->repeats + 5 * p->inside[k];
+        int start = axis == 0 ? rep[2] : rep[0], stop = axis == 0 ? rep[3] : rep[1];
+        pos[start + 1 - lo] += (double)rep[4];
+        neg[stop - lo] += (double)rep[4];
+    }
+    double cells = (double)(p->r1 - p->r0) * (double)(p->c1 - p->c0), sum = 0.0;
+    for (int i = 0; i < size; i++) {
+        sum += pos[i] - neg[i];
+        if (i >= 1 && i < hi - lo) {
+            double c = sum / cells;
+            cost[i] = c > 0 ? c : 0.0; /* cost[line - lo] */
+        }
+    }
+    PyMem_Free(pos);
+    PyMem_Free(neg);
+    return 0;
+}
+
+/* ``Search._runs``: bounds keeping each maximal periodic run of parts as one part. */
+static int add_runs(Grid *g, const Place *p, Drafts *d, Py_ssize_t found, int axis,
+                    const int *full, int n_full, int *work)
+{
+    int n = n_full - 1;
+    int *cids = work, *run = work + n, *out = work + 2 * n + 1;
+    for (int i = 0; i < n; i++) {
+        int q[4];
+        part_of(p, axis, full[i], full[i + 1], q);
+        if ((cids[i] = grid_content(g, q[0], q[1], q[2], q[3])) < 0)
+            return -1;
+    }
+    for (int period = 1; period <= n / 2; period++) {
+        run[n - period] = 0;
+        for (int j = n - period - 1; j >= 0; j--)
+            run[j] = cids[j] == cids[j + period] ? run[j + 1] + 1 : 0;
+        int i = 0;
+        while (i + 2 * period <= n) {
+            int k = 1 + run[i] / period;
+            if (k >= 2 && !(i == 0 && i + k * period == n)) {
+                int end = i + k * period, m = 0;
+                for (int j = 0; j <= i; j++)
+                    out[m++] = full[j];
+                for (int j = end; j <= n; j++)
+                    out[m++] = full[j];
+                if (!has_draft(d, found, axis, out, m) && draft_action(g, p, d, axis, out, m) < 0)
+                    return -1;
+                i = end;
+            } else {
+                i++;
+            }
+        }
+    }
+    return 0;
+}
+
+static int compare_spans(const void *x, const void *y)
+{
+    const int *a = x, *b = y;
+    int la = a[0] - a[1], lb = b[0] - b[1];
+    if (la != lb)
+        return la < lb ? -1 : 1;
+    if (a[0] != b[0])
+        return a[0] < b[0] ? -1 : 1;
+    return (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+/* ``Search._repeated``: bounds keeping whole the repeated regions across the region. */
+static int add_repeated(Grid *g, const Place *p, Drafts *d, Py_ssize_t found, int axis,
+                        const int *full, int n_full, int *work)
+{
+    int *spans = work, n = 0;
+    for (int k = 0; k < p->n_inside; k++) {
+        const int32_t *rep = g->repeats + 5 * p->inside[k];
+        if (axis == 0 && rep[0] == p->r0 && rep[1] == p->r1)
+            spans[2 * n] = rep[2], spans[2 * n + 1] = rep[3], n++;
+        else if (axis == 1 && rep[2] == p->c0 && rep[3] == p->c1)
+            spans[2 * n] = rep[0], spans[2 * n + 1] = rep[1], n++;
+    }
+    if (!n)
+        return 0;
+    qsort(spans, (size_t)n, 2 * sizeof(int), compare_spans);
+    int lo = full[0], hi = full[n_full - 1];
+    int *blocks = spans + 2 * n, nb = 0;
+    for (int i = 0; i < n; i++) {
+        int a = spans[2 * i], b = spans[2 * i + 1], free_ = !(a == lo && b == hi);
+        for (int j = 0; j < nb && free_; j++)
+            free_ = b <= blocks[2 * j] || blocks[2 * j + 1] <= a;
+        if (free_)
+            blocks[2 * nb] = a, blocks[2 * nb + 1] = b, nb++;
+    }
+    if (!nb)
+        return 0;
+    /* lo, hi, the blocks' ends, and the lines inside no block: sorted, once each */
+    int *marks = blocks + 2 * nb, span = hi - lo + 1, m = 0;
+    int *out = marks + span;
+    memset(marks, 0, (size_t)span * sizeof(int));
+    marks[0] = marks[span - 1] = 1;
+    for (int j = 0; j < nb; j++)
+        marks[blocks[2 * j] - lo] = marks[blocks[2 * j + 1] - lo] = 1;
+    for (int i = 0; i < n_full; i++) {
+        int line = full[i], inside = 0;
+        for (int j = 0; j < nb && !inside; j++)
+            inside = blocks[2 * j] < line && line < blocks[2 * j + 1];
+        if (!inside)
+            marks[line - lo] = 1;
+    }
+    for (int v = 0; v < span; v++)
+        if (marks[v])
+            out[m++] = lo + v;
+    if (!has_draft(d, found, axis, out, m) && draft_action(g, p, d, axis, out, m) < 0)
+        return -1;
+    return 0;
+}
+
+typedef struct {
+    double heuristic, cost;
+    int axis, line, lo, hi;
+} Half;
+
+static int compare_halves(const void *x, const void *y)
+{
+    const Half *a = x, *b = y;
+    if (a->heuristic != b->heuristic)
+        return a->heuristic < b->heuristic ? -1 : 1;
+    if (a->cost != b->cost)
+        return a->cost < b->cost ? -1 : 1;
+    if (a->axis != b->axis)
+        return a->axis < b->axis ? -1 : 1;
+    int ba[3] = {a->lo, a->line, a->hi}, bb[3] = {b->lo, b->line, b->hi};
+    return compare_bounds(ba, 3, bb, 3);
+}
+
+typedef struct {
+    double cost;
+    int line;
+} Cheap;
+
+static int compare_cheap(const void *x, const void *y)
+{
+    const Cheap *a = x, *b = y;
+    if (a->cost != b->cost)
+        return a->cost < b->cost ? -1 : 1;
+    return (a->line > b->line) - (a->line < b->line);
+}
+
+/* ``Search._rank_in_two``. */
+static int rank_in_two(Grid *g, const Place *p, int axis, int lo, int line, int hi, Half *out)
+{
+    int first[4], second[4];
+    part_of(p, axis, lo, line, first);
+    part_of(p, axis, line, hi, second);
+    int same = labs(grid_quantum(g, axis, lo, line) - grid_quantum(g, axis, line, hi)) <=
+               (hi - lo) + 2;
+    if (same) {
+        int a = grid_content(g, first[0], first[1], first[2], first[3]);
+        int b = a < 0 ? -1 : grid_content(g, second[0], second[1], second[2], second[3]);
+        if (a < 0 || b < 0)
+            return -1;
+        same = a == b;
+    }
+    out->cost = same ? g->repeat_cost + 1 : g->split_cost + 2;
+    out->heuristic = out->cost + (0.0 + line_cost(p, axis, line));
+    out->axis = axis, out->line = line, out->lo = lo, out->hi = hi;
+    return 0;
+}
+
+/* The drafts of ``Search._make_actions(region)``, best first, in d (from 0). 0 or -1. */
+static int region_drafts(Grid *g, int r0, int r1, int c0, int c1, Drafts *d)
+{
+    Place p = {r0, r1, c0, c1, {NULL, NULL}, {0, 0}, NULL, 0};
+    int result = -1, span = (r1 - r0) + (c1 - c0) + 2;
+    int *lines[2] = {NULL, NULL}, n_lines[2] = {0, 0}, usable[2] = {0, 0};
+    int *work = NULL;
+    Half *halves = NULL;
+    Cheap *cheap = NULL;
+    int n_halves = 0;
+    d->n = 0;
+    d->pool_n = 0;
+    lines[0] = PyMem_Malloc((size_t)(2 * span + 2) * sizeof(int));
+    lines[1] = PyMem_Malloc((size_t)(2 * span + 2) * sizeof(int));
+    halves = PyMem_Malloc((size_t)(2 * TOP_ACTIONS + 1) * sizeof(Half));
+    cheap = PyMem_Malloc((size_t)(span + 1) * sizeof(Cheap));
+    if (!lines[0] || !lines[1] || !halves || !cheap) {
+        PyErr_NoMemory();
+        goto end;
+    }
+    /* the lines of each axis, and how many element cells each crosses */
+    int least[2] = {INT32_MAX, INT32_MAX}, n_fallback[2] = {0, 0};
+    for (int axis = 0; axis < 2; axis++) {
+        int *ln = lines[axis], *cr = lines[axis] + span + 1, n = 0, clean = 0;
+        if (axis == 0) {
+            for (int i = 0; i + 1 < c1 - c0; i++)
+                if (CHX(g, r1, c0 + i) - CHX(g, r0, c0 + i) > 0)
+                    ln[n] = c0 + 1 + i, cr[n++] = CRX(g, r1, c0 + i) - CRX(g, r0, c0 + i);
+        } else {
+            for (int i = 0; i + 1 < r1 - r0; i++)
+                if (CHY(g, r0 + i, c1) - CHY(g, r0 + i, c0) > 0)
+                    ln[n] = r0 + 1 + i, cr[n++] = CRY(g, r0 + i, c1) - CRY(g, r0 + i, c0);
+        }
+        for (int i = 0; i < n; i++)
+            clean += cr[i] == 0;
+        if (clean) {
+            int m = 0;
+            for (int i = 0; i < n; i++)
+                if (cr[i] == 0)
+                    ln[m++] = ln[i];
+            n_lines[axis] = m, usable[axis] = 1;
+        } else if (n) {
+            for (int i = 0; i < n; i++)
+                least[axis] = cr[i] < least[axis] ? cr[i] : least[axis];
+            for (int i = 0; i < n; i++)
+                if (cr[i] == least[axis])
+                    cr[n_fallback[axis]++] = ln[i];
+        }
+    }
+    if (!usable[0] && !usable[1]) { /* every line cuts an element: the fewest cells */
+        if (!n_fallback[0] && !n_fallback[1]) {
+            PyErr_Format(PyExc_ValueError, "region (%d, %d, %d, %d) has one label and no rule",
+                         r0, r1, c0, c1);
+            goto end;
+        }
+        int axis = !n_fallback[0] ? 1 : !n_fallback[1] ? 0 : least[1] < least[0] ? 1 : 0;
+        memcpy(lines[axis], lines[axis] + span + 1, (size_t)n_fallback[axis] * sizeof(int));
+        n_lines[axis] = n_fallback[axis], usable[axis] = 1;
+    }
+    /* the repeated regions' occurrences inside the region */
+    {
+        int a = 0, b = g->n_repeats;
+        while (a < b) { /* bisect_left on the first rows for r0 */
+            int mid = (a + b) / 2;
+            if (g->repeats[5 * mid] < r0)
+                a = mid + 1;
+            else
+                b = mid;
+        }
+        int from = a;
+        b = g->n_repeats;
+        while (a < b) {
+            int mid = (a + b) / 2;
+            if (g->repeats[5 * mid] < r1)
+                a = mid + 1;
+            else
+                b = mid;
+        }
+        p.inside = PyMem_Malloc((size_t)(a - from + 1) * sizeof(int));
+        if (!p.inside) {
+            PyErr_NoMemory();
+            goto end;
+        }
+        for (int k = from; k < a; k++) {
+            const int32_t *rep = g->repeats + 5 * k;
+            if (rep[1] <= r1 && rep[2] >= c0 && rep[3] <= c1)
+                p.inside[p.n_inside++] = k;
+        }
+    }
+    if (place_line_costs(g, &p, 0) < 0 || place_line_costs(g, &p, 1) < 0)
+        goto end;
+    work = PyMem_Malloc((size_t)(6 * span + 4 * p.n_inside + 8) * sizeof(int));
+    if (!work) {
+        PyErr_NoMemory();
+        goto end;
+    }
+    for (int axis = 0; axis < 2; axis++) {
+        if (!usable[axis])
+            continue;
+        int lo = axis == 0 ? c0 : r0, hi = axis == 0 ? c1 : r1, n = n_lines[axis];
+        int *full = lines[axis] + span + 1; /* lo, the lines, hi */
+        full[0] = lo;
+        memcpy(full + 1, lines[axis], (size_t)n * sizeof(int));
+        full[n + 1] = hi;
+        Py_ssize_t found = 0; /* every axis's drafts so far are found ones */
+        if (draft_action(g, &p, d, axis, full, n + 2) < 0 ||
+            add_runs(g, &p, d, found, axis, full, n + 2, work) < 0 ||
+            add_repeated(g, &p, d, found, axis, full, n + 2, work) < 0)
+            goto end;
+        if (n > 1) { /* cuts in two: the lines the heuristic likes best */
+            for (int i = 0; i < n; i++)
+                cheap[i].cost = line_cost(&p, axis, lines[axis][i]), cheap[i].line = lines[axis][i];
+            qsort(cheap, (size_t)n, sizeof(Cheap), compare_cheap);
+            for (int i = 0; i < n && i < TOP_ACTIONS; i++) {
+                int b[3] = {lo, cheap[i].line, hi};
+                if (!has_draft(d, 0, axis, b, 3) &&
+                    rank_in_two(g, &p, axis, lo, cheap[i].line, hi, &halves[n_halves++]) < 0)
+                    goto end;
+            }
+        }
+    }
+    if ((g->ext & EXT_GRIDSPLIT) && usable[0] && usable[1] &&
+        (n_lines[0] + 1) * (n_lines[1] + 1) <= GRID_CELLS &&
+        draft_grid(g, &p, d, lines[1], n_lines[1], lines[0], n_lines[0]) < 0)
+        goto end;
+    /* every structural cut, and the heuristic's best cuts in two to fill up the choice */
+    sort_drafts(d, 0, d->n);
+    if (d->n > TOP_ACTIONS)
+        d->n = TOP_ACTIONS;
+    qsort(halves, (size_t)n_halves, sizeof(Half), compare_halves);
+    int take = TOP_ACTIONS - (int)d->n > TOP_ACTIONS / 2 ? TOP_ACTIONS - (int)d->n : TOP_ACTIONS / 2;
+    for (int i = 0; i < n_halves && i < take; i++) {
+        int b[3] = {halves[i].lo, halves[i].line, halves[i].hi};
+        if (draft_action(g, &p, d, halves[i].axis, b, 3) < 0)
+            goto end;
+    }
+    sort_drafts(d, 0, d->n);
+    result = 0;
+end:
+    PyMem_Free(lines[0]);
+    PyMem_Free(lines[1]);
+    PyMem_Free(halves);
+    PyMem_Free(cheap);
+    PyMem_Free(work);
+    PyMem_Free(p.inside);
+    PyMem_Free(p.cost[0]);
+    PyMem_Free(p.cost[1]);
+    return result;
+}
+
 /* -- the table -------------------------------------------------------------------------- */
 
 typedef struct {
@@ -169,6 +859,9 @@ typedef struct {
     int owner;                       /* its entry */
     Py_ssize_t parts, needs, kids;   /* offsets in the pool */
     int n_parts, n_needs, n_kids;
+    int op, axis, count, centre;     /* what it is, for ``describe`` */
+    Py_ssize_t bounds, across;       /* offsets in the pool */
+    int n_bounds, n_across;
 } Action;
 
 typedef struct {
@@ -180,7 +873,9 @@ typedef struct {
 
 typedef struct {
     PyObject_HEAD
-    PyObject *provide;   /* entry id -> [(cost, heuristic, form, parts, needs, kids)] */
+    Grid grid;
+    SeqSet entry_map;    /* (r0, r1, c0, c1) -> entry */
+    Drafts drafts;
     Entry *entries;
     Py_ssize_t n_entries, entries_cap;
     Action *actions;
@@ -267,85 +962,137 @@ static int content_seen(Table *t, int cid)
     return ensure_contents(t, (Py_ssize_t)cid + 1);
 }
 
-/* Ints of a Python sequence appended to the pool; checks contents or entries. */
-static int pool_ints(Table *t, PyObject *seq, Py_ssize_t *at, int *n, int what)
+static int pool_room(Table *t, Py_ssize_t n) { return GROW(t->pool, t->pool_cap, t->pool_n + n); }
+
+/* The entry of a region, added the first time: -1 on error. */
+static int entry_of(Table *t, int r0, int r1, int c0, int c1)
 {
-    PyObject *fast = PySequence_Fast(seq, "expected a sequence of ints");
-    if (!fast)
+    int box[4] = {r0, r1, c0, c1}, added;
+    Py_ssize_t e = seqset_add(&t->entry_map, box, 4, &added);
+    if (e < 0 || !added)
+        return (int)e;
+    int cid = grid_content(&t->grid, r0, r1, c0, c1);
+    if (cid < 0 || content_seen(t, cid) < 0 || GROW(t->entries, t->entries_cap, e + 1) < 0)
         return -1;
-    Py_ssize_t len = PySequence_Fast_GET_SIZE(fast);
-    if (GROW(t->pool, t->pool_cap, t->pool_n + len) < 0) {
-        Py_DECREF(fast);
+    Entry *entry = &t->entries[e];
+    entry->key[0] = r0, entry->key[1] = c0, entry->key[2] = -r1, entry->key[3] = -c1;
+    entry->key[4] = cid;
+    entry->cid = cid;
+    entry->first = 0;
+    entry->count = -1;
+    entry->odds = -1;
+    t->n_entries = e + 1;
+    return (int)e;
+}
+
+/* A draft made an action of entry e: its parts as symbols, its needs (non-terminal
+ * contents, larger parts first, once each), its non-terminal parts as entries, its form. */
+static int keep_draft(Table *t, int e, const Drafts *d, const Draft *x)
+{
+    Grid *g = &t->grid;
+    int m = x->n_written;
+    const int *w = DP(d, x->written), *c = DP(d, x->cids);
+    if (pool_room(t, 3 * m + x->n_bounds + x->n_across) < 0 ||
+        GROW(t->actions, t->actions_cap, t->n_actions + 1) < 0 ||
+        buffer_room(g, 2 * m + x->n_bounds + x->n_across + 8) < 0)
         return -1;
+    Action a;
+    a.cost = x->cost, a.heuristic = x->heuristic, a.owner = e;
+    a.op = x->op, a.axis = x->axis, a.count = x->count, a.centre = x->centre;
+    a.bounds = t->pool_n, a.n_bounds = x->n_bounds;
+    memcpy(t->pool + t->pool_n, DP(d, x->bounds), (size_t)x->n_bounds * sizeof(int));
+    t->pool_n += x->n_bounds;
+    a.across = t->pool_n, a.n_across = x->n_across;
+    memcpy(t->pool + t->pool_n, DP(d, x->across), (size_t)x->n_across * sizeof(int));
+    t->pool_n += x->n_across;
+    a.parts = t->pool_n, a.n_parts = m;
+    for (int i = 0; i < m; i++) {
+        if (content_seen(t, c[i]) < 0)
+            return -1;
+        t->pool[t->pool_n++] = g->terminal[c[i]] >= 0 ? -1 - g->terminal[c[i]] : c[i];
     }
-    *at = t->pool_n;
-    *n = (int)len;
-    for (Py_ssize_t i = 0; i < len; i++) {
-        long v = PyLong_AsLong(PySequence_Fast_GET_ITEM(fast, i));
-        if (v == -1 && PyErr_Occurred()) {
-            Py_DECREF(fast);
-            return -1;
+    /* needs: non-terminal parts by size (cells), ties in order, each content once */
+    int *order = g->buffer, n = 0;
+    for (int i = 0; i < m; i++)
+        if (g->terminal[c[i]] < 0)
+            order[n++] = i;
+    for (int i = 1; i < n; i++) {
+        int v = order[i], j = i;
+        long cells = (long)(w[4 * v + 1] - w[4 * v]) * (w[4 * v + 3] - w[4 * v + 2]);
+        while (j > 0) {
+            int u = order[j - 1];
+            long other = (long)(w[4 * u + 1] - w[4 * u]) * (w[4 * u + 3] - w[4 * u + 2]);
+            if (other >= cells)
+                break;
+            order[j] = u;
+            j--;
         }
-        if (what == 1 && v >= 0 && content_seen(t, (int)v) < 0) { /* a part */
-            Py_DECREF(fast);
-            return -1;
-        }
-        if (what == 2 && content_seen(t, (int)v) < 0) { /* a need */
-            Py_DECREF(fast);
-            return -1;
-        }
-        if (what == 3 && (v < 0 || v >= t->n_entries)) { /* a kid */
-            Py_DECREF(fast);
-            PyErr_SetString(PyExc_ValueError, "unknown entry");
-            return -1;
-        }
-        t->pool[t->pool_n++] = (int)v;
+        order[j] = v;
     }
-    Py_DECREF(fast);
+    a.needs = t->pool_n, a.n_needs = 0;
+    for (int i = 0; i < n; i++) {
+        int cid = c[order[i]], seen = 0;
+        for (int k = 0; k < a.n_needs && !seen; k++)
+            seen = t->pool[a.needs + k] == cid;
+        if (!seen)
+            t->pool[t->pool_n++] = cid, a.n_needs++;
+    }
+    /* the form: the rule without its symbols */
+    int *form = g->buffer, f = 0;
+    if (x->op == OP_GRID) {
+        const int *rows = DP(d, x->bounds), *cols = DP(d, x->across);
+        form[f++] = OP_GRID;
+        form[f++] = x->n_bounds;
+        for (int i = 0; i + 1 < x->n_bounds; i++)
+            form[f++] = (int)grid_quantum(g, 1, rows[i], rows[i + 1]);
+        for (int j = 0; j + 1 < x->n_across; j++)
+            form[f++] = (int)grid_quantum(g, 0, cols[j], cols[j + 1]);
+    } else {
+        form[f++] = x->op, form[f++] = x->axis, form[f++] = x->count, form[f++] = x->centre;
+        for (int i = 0; i < m; i++) {
+            const int *q = w + 4 * i;
+            form[f++] = (int)(x->axis == 0 ? grid_quantum(g, 0, q[2], q[3])
+                                           : grid_quantum(g, 1, q[0], q[1]));
+        }
+    }
+    int added;
+    Py_ssize_t number = seqset_add(&g->forms, form, f, &added);
+    if (number < 0)
+        return -1;
+    a.form = (int)number;
+    /* the non-terminal parts as entries (which may add entries) */
+    a.kids = t->pool_n, a.n_kids = 0;
+    for (int i = 0; i < m; i++) {
+        if (g->terminal[c[i]] >= 0)
+            continue;
+        const int *q = w + 4 * i;
+        int kid = entry_of(t, q[0], q[1], q[2], q[3]);
+        if (kid < 0 || pool_room(t, 1) < 0)
+            return -1;
+        t->pool[t->pool_n++] = kid;
+        a.n_kids++;
+    }
+    t->actions[t->n_actions++] = a;
     return 0;
 }
 
-/* The entry's actions, asked of Python the first time. 0, or -1 on error. */
+/* The entry's actions, made the first time. 0, or -1 on error. */
 static int provide(Table *t, int e)
 {
     if (t->entries[e].count >= 0)
         return 0;
-    PyObject *list = PyObject_CallFunction(t->provide, "i", e);
-    if (!list)
+    const int *k = t->entries[e].key;
+    Drafts *d = &t->drafts;
+    if (region_drafts(&t->grid, k[0], -k[2], k[1], -k[3], d) < 0)
         return -1;
-    PyObject *fast = PySequence_Fast(list, "provide() must give a list of actions");
-    Py_DECREF(list);
-    if (!fast)
-        return -1;
-    Py_ssize_t n = PySequence_Fast_GET_SIZE(fast);
-    if (n < 1) {
-        Py_DECREF(fast);
-        PyErr_SetString(PyExc_ValueError, "a region without actions");
-        return -1;
-    }
-    if (GROW(t->actions, t->actions_cap, t->n_actions + n) < 0) {
-        Py_DECREF(fast);
-        return -1;
-    }
     int first = (int)t->n_actions;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        Action a;
-        PyObject *parts, *needs, *kids;
-        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(fast, i), "ddiOOO", &a.cost, &a.heuristic,
-                              &a.form, &parts, &needs, &kids) ||
-            pool_ints(t, parts, &a.parts, &a.n_parts, 1) < 0 ||
-            pool_ints(t, needs, &a.needs, &a.n_needs, 2) < 0 ||
-            pool_ints(t, kids, &a.kids, &a.n_kids, 3) < 0) {
-            Py_DECREF(fast);
+    for (Py_ssize_t i = 0; i < d->n; i++)
+        if (keep_draft(t, e, d, &d->items[i]) < 0) {
             t->n_actions = first;
             return -1;
         }
-        a.owner = e;
-        t->actions[t->n_actions++] = a;
-    }
-    Py_DECREF(fast);
     t->entries[e].first = first; /* the entries array may have grown meanwhile */
-    t->entries[e].count = (int)n;
+    t->entries[e].count = (int)d->n;
     return 0;
 }
 
@@ -724,20 +1471,18 @@ static PyObject *current_pairs(Table *t)
     return out;
 }
 
-static PyObject *Table_add_entry(Table *t, PyObject *args)
+/* entry(r0, r1, c0, c1) -> id: the region's entry, added the first time. */
+static PyObject *Table_entry(Table *t, PyObject *args)
 {
-    int key[5];
-    if (!PyArg_ParseTuple(args, "(iiiii)", &key[0], &key[1], &key[2], &key[3], &key[4]))
+    int r0, r1, c0, c1;
+    if (!PyArg_ParseTuple(args, "iiii", &r0, &r1, &c0, &c1))
         return NULL;
-    if (content_seen(t, key[4]) < 0 || GROW(t->entries, t->entries_cap, t->n_entries + 1) < 0)
+    if (r0 < 0 || c0 < 0 || r1 > t->grid.rows || c1 > t->grid.cols || r0 >= r1 || c0 >= c1) {
+        PyErr_SetString(PyExc_ValueError, "not a region of the tiling");
         return NULL;
-    Entry *e = &t->entries[t->n_entries];
-    memcpy(e->key, key, sizeof(key));
-    e->cid = key[4];
-    e->first = 0;
-    e->count = -1;
-    e->odds = -1;
-    return PyLong_FromSsize_t(t->n_entries++);
+    }
+    int e = entry_of(t, r0, r1, c0, c1);
+    return e < 0 ? NULL : PyLong_FromLong(e);
 }
 
 static int check_entry(Table *t, int e)
@@ -749,13 +1494,79 @@ static int check_entry(Table *t, int e)
     return 0;
 }
 
-/* provide(entry): ask for the entry's actions now, when not yet given. */
-static PyObject *Table_provide(Table *t, PyObject *args)
+/* action_id(entry, index) -> the id of the entry's index-th action (made if need be). */
+static PyObject *Table_action_id(Table *t, PyObject *args)
 {
+    int e, index;
+    if (!PyArg_ParseTuple(args, "ii", &e, &index) || check_entry(t, e) < 0 || provide(t, e) < 0)
+        return NULL;
+    if (index < 0 || index >= t->entries[e].count) {
+        PyErr_SetString(PyExc_IndexError, "no such action");
+        return NULL;
+    }
+    return PyLong_FromLong(t->entries[e].first + index);
+}
+
+/* explored() -> how many regions were offered actions. */
+static PyObject *Table_explored(Table *t, PyObject *unused)
+{
+    Py_ssize_t n = 0;
+    for (Py_ssize_t e = 0; e < t->n_entries; e++)
+        n += t->entries[e].count >= 0;
+    return PyLong_FromSsize_t(n);
+}
+
+/* action(id) -> (r0, r1, c0, c1, index): the region an action splits, and its place in the
+ * region's actions. */
+static PyObject *Table_action(Table *t, PyObject *args)
+{
+    int id;
+    if (!PyArg_ParseTuple(args, "i", &id))
+        return NULL;
+    if (id < 0 || id >= t->n_actions) {
+        PyErr_SetString(PyExc_IndexError, "no such action");
+        return NULL;
+    }
+    const Entry *e = &t->entries[t->actions[id].owner];
+    return Py_BuildValue("(iiiii)", e->key[0], -e->key[2], e->key[1], -e->key[3], id - e->first);
+}
+
+static PyObject *ints(const int *v, int n)
+{
+    PyObject *out = PyTuple_New(n);
+    for (int i = 0; out && i < n; i++) {
+        PyObject *x = PyLong_FromLong(v[i]);
+        if (!x) {
+            Py_CLEAR(out);
+            break;
+        }
+        PyTuple_SET_ITEM(out, i, x);
+    }
+    return out;
+}
+
+/* describe(entry) -> [(op, axis, bounds, across, count, centre, cost, heuristic)], best
+ * first: the entry's actions (op: "split", "repeat", "repeatABA", "symsplit", "gridsplit"). */
+static PyObject *Table_describe(Table *t, PyObject *args)
+{
+    static const char *ops[] = {"split", "repeat", "repeatABA", "symsplit", "gridsplit"};
     int e;
     if (!PyArg_ParseTuple(args, "i", &e) || check_entry(t, e) < 0 || provide(t, e) < 0)
         return NULL;
-    Py_RETURN_NONE;
+    const Entry *entry = &t->entries[e];
+    PyObject *list = PyList_New(entry->count);
+    for (int i = 0; list && i < entry->count; i++) {
+        const Action *a = &t->actions[entry->first + i];
+        PyObject *item = Py_BuildValue(
+            "(ssNNiidd)", ops[a->op], a->axis ? "y" : "x", ints(t->pool + a->bounds, a->n_bounds),
+            ints(t->pool + a->across, a->n_across), a->count, a->centre, a->cost, a->heuristic);
+        if (!item) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, item);
+    }
+    return list;
 }
 
 /* greedy(start, stop_at) -> [(content, action)] in the order chosen, or None when the
@@ -970,38 +1781,62 @@ end:
     return result;
 }
 
+/* Table(labels, rows, cols, xs, ys, qx, qy, background, repeats, extensions, split, repeat):
+ * the tiling's labels (int32, rows x cols, bottom row first), its cuts (float64), the size
+ * quanta, the background's label (or -1), the repeated regions' occurrences (int32, five a
+ * row: r0, r1, c0, c1, cells, by first row), the extensions as bits (1 repeatABA, 2
+ * symsplit, 4 gridsplit) and the rule costs. */
 static int Table_init(Table *t, PyObject *args, PyObject *kwds)
 {
-    PyObject *provide;
-    static char *names[] = {"provide", NULL};
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "O", names, &provide))
-        return -1;
-    if (!PyCallable_Check(provide)) {
-        PyErr_SetString(PyExc_TypeError, "provide must be callable");
+    Py_buffer labels, xs, ys, repeats;
+    int rows, cols, background, ext;
+    double qx, qy, split, repeat;
+    if (t->grid.labels) {
+        PyErr_SetString(PyExc_TypeError, "a Table is made once");
         return -1;
     }
-    Py_INCREF(provide);
-    Py_XDECREF(t->provide);
-    t->provide = provide;
-    return 0;
-}
-
-static int Table_traverse(Table *t, visitproc visit, void *arg)
-{
-    Py_VISIT(t->provide);
-    return 0;
-}
-
-static int Table_clear(Table *t)
-{
-    Py_CLEAR(t->provide);
+    if (!PyArg_ParseTuple(args, "y*iiy*y*ddiy*idd", &labels, &rows, &cols, &xs, &ys, &qx, &qy,
+                          &background, &repeats, &ext, &split, &repeat))
+        return -1;
+    int ok = rows > 0 && cols > 0 && labels.len == (Py_ssize_t)rows * cols * 4 &&
+             xs.len == (Py_ssize_t)(cols + 1) * 8 && ys.len == (Py_ssize_t)(rows + 1) * 8 &&
+             repeats.len % 20 == 0 && qx > 0 && qy > 0;
+    Grid *g = &t->grid;
+    if (ok) {
+        g->rows = rows, g->cols = cols, g->qx = qx, g->qy = qy, g->ext = ext;
+        g->split_cost = split, g->repeat_cost = repeat;
+        g->n_repeats = (int)(repeats.len / 20);
+        g->labels = PyMem_Malloc((size_t)labels.len);
+        g->xs = PyMem_Malloc((size_t)xs.len);
+        g->ys = PyMem_Malloc((size_t)ys.len);
+        g->repeats = PyMem_Malloc((size_t)repeats.len + 20);
+        if (g->labels && g->xs && g->ys && g->repeats) {
+            memcpy(g->labels, labels.buf, (size_t)labels.len);
+            memcpy(g->xs, xs.buf, (size_t)xs.len);
+            memcpy(g->ys, ys.buf, (size_t)ys.len);
+            memcpy(g->repeats, repeats.buf, (size_t)repeats.len);
+        } else {
+            PyErr_NoMemory();
+            ok = -1;
+        }
+    } else {
+        PyErr_SetString(PyExc_ValueError, "the tiling's arrays do not match its size");
+    }
+    PyBuffer_Release(&labels);
+    PyBuffer_Release(&xs);
+    PyBuffer_Release(&ys);
+    PyBuffer_Release(&repeats);
+    if (ok != 1 || grid_prefixes(g, background) < 0)
+        return -1;
     return 0;
 }
 
 static void Table_dealloc(Table *t)
 {
-    PyObject_GC_UnTrack(t);
-    Table_clear(t);
+    grid_free(&t->grid);
+    seqset_free(&t->entry_map);
+    PyMem_Free(t->drafts.items);
+    PyMem_Free(t->drafts.pool);
     for (Py_ssize_t i = 0; i < t->n_contents; i++)
         PyMem_Free(t->covered[i]);
     PyMem_Free(t->entries);
@@ -1024,10 +1859,16 @@ static void Table_dealloc(Table *t)
 }
 
 static PyMethodDef Table_methods[] = {
-    {"add_entry", (PyCFunction)Table_add_entry, METH_VARARGS,
-     "add_entry(key) -> id: a region to split, by its heap key (r0, c0, -r1, -c1, content)."},
-    {"provide", (PyCFunction)Table_provide, METH_VARARGS,
-     "provide(entry): ask for the entry's actions now, when not given yet."},
+    {"entry", (PyCFunction)Table_entry, METH_VARARGS,
+     "entry(r0, r1, c0, c1) -> id: the region's entry, added the first time."},
+    {"action_id", (PyCFunction)Table_action_id, METH_VARARGS,
+     "action_id(entry, index) -> the id of the entry's index-th action."},
+    {"action", (PyCFunction)Table_action, METH_VARARGS,
+     "action(id) -> (r0, r1, c0, c1, index): its region and its place among its actions."},
+    {"explored", (PyCFunction)Table_explored, METH_NOARGS,
+     "explored() -> how many regions were offered actions."},
+    {"describe", (PyCFunction)Table_describe, METH_VARARGS,
+     "describe(entry) -> [(op, axis, bounds, across, count, centre, cost, heuristic)]."},
     {"greedy", (PyCFunction)Table_greedy, METH_VARARGS,
      "greedy(start, stop_at) -> [(content, action)], or None past stop_at."},
     {"survey", (PyCFunction)Table_survey, METH_VARARGS,
@@ -1040,13 +1881,11 @@ static PyMethodDef Table_methods[] = {
 static PyTypeObject TableType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "facadecli.grammar._adp.Table",
     .tp_basicsize = sizeof(Table),
-    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
     .tp_doc = "Regions, their actions and the value table of one grammar search.",
     .tp_new = PyType_GenericNew,
     .tp_init = (initproc)Table_init,
     .tp_dealloc = (destructor)Table_dealloc,
-    .tp_traverse = (traverseproc)Table_traverse,
-    .tp_clear = (inquiry)Table_clear,
     .tp_methods = Table_methods,
 };
 

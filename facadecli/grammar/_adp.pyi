@@ -1,13 +1,30 @@
-"""Types of the grammar search's compiled inner loop (``_adp.c``)."""
+"""Types of the compiled grammar search (``_adp.c``)."""
 
-from collections.abc import Callable, Sequence
-
-Provided = list[tuple[float, float, int, tuple[int, ...], tuple[int, ...], tuple[int, ...]]]
+from collections.abc import Sequence
 
 class Table:
-    def __init__(self, provide: Callable[[int], Provided]) -> None: ...
-    def add_entry(self, key: tuple[int, int, int, int, int]) -> int: ...
-    def provide(self, entry: int) -> None: ...
+    def __init__(
+        self,
+        labels: bytes,
+        rows: int,
+        cols: int,
+        xs: bytes,
+        ys: bytes,
+        qx: float,
+        qy: float,
+        background: int,
+        repeats: bytes,
+        extensions: int,
+        split: float,
+        repeat: float,
+    ) -> None: ...
+    def entry(self, r0: int, r1: int, c0: int, c1: int) -> int: ...
+    def action_id(self, entry: int, index: int) -> int: ...
+    def action(self, id: int) -> tuple[int, int, int, int, int]: ...
+    def explored(self) -> int: ...
+    def describe(
+        self, entry: int
+    ) -> list[tuple[str, str, tuple[int, ...], tuple[int, ...], int, int, float, float]]: ...
     def greedy(self, start: int, stop_at: float) -> list[tuple[int, int]] | None: ...
     def survey(self, actions: Sequence[int]) -> tuple[float, list[list[int]]]: ...
     def adp(

@@ -34,11 +34,12 @@ class Grid:
         self.labels = np.array([[ids[label] for label in row] for row in tiling.labels], dtype=int)
         self._labels32 = self.labels.astype(np.int32)  # as content keys hold them
         self.rows, self.columns = self.labels.shape
+        self._xs, self._ys = np.array(tiling.xs, dtype=float), np.array(tiling.ys, dtype=float)
         self.widths = self._sizes(tiling.xs)
         self.heights = self._sizes(tiling.ys)
         self.quantum_x = SIZE_QUANTUM * (tiling.xs[-1] - tiling.xs[0])
         self.quantum_y = SIZE_QUANTUM * (tiling.ys[-1] - tiling.ys[0])
-        bg = ids.get(background, -1)
+        self.background_id = bg = ids.get(background, -1)
         lab = self.labels
         # x lines: between columns c-1 and c, per row; y lines: between rows r-1 and r
         same_x = lab[:, 1:] == lab[:, :-1]
@@ -71,8 +72,11 @@ class Grid:
         keep_r[1:] = self._change_y[r0 : r1 - 1, c1] != self._change_y[r0 : r1 - 1, c0]
         starts_c, starts_r = keep_c.nonzero()[0], keep_r.nonzero()[0]
         reduced = block[starts_r][:, starts_c]
-        widths = np.add.reduceat(self.widths[c0:c1], starts_c) / self.quantum_x
-        heights = np.add.reduceat(self.heights[r0:r1], starts_r) / self.quantum_y
+        # a merged column's width is the difference of its cuts (one rounding, as the
+        # compiled search computes it too)
+        ends_c, ends_r = np.append(starts_c[1:], c1 - c0), np.append(starts_r[1:], r1 - r0)
+        widths = (self._xs[c0 + ends_c] - self._xs[c0 + starts_c]) / self.quantum_x
+        heights = (self._ys[r0 + ends_r] - self._ys[r0 + starts_r]) / self.quantum_y
         key = b"".join(
             (
                 _SHAPE.pack(*reduced.shape),

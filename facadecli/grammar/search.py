@@ -24,10 +24,11 @@ the repeated regions that line cuts through over the cells of the region.
   is never worse than greedy's; the cheapest grammar of all iterations is returned. A seed
   makes it reproducible; a time limit stops early with the best grammar so far.
 
-Regions and their actions are made here, in Python, once each; building grammars from
-them, their merged cost and the value table run in a compiled loop (``_adp.c``), which
-computes what the plain loop in tests/adp_reference.py does, to the bit, several times
-faster.
+The search runs compiled (``_adp.c``): the actions of each region it visits, building
+grammars from them, their merged cost and the value table. It computes what the Python here
+(``_make_actions`` and what it calls) and the plain loop in tests/adp_reference.py compute,
+to the bit (the tests compare them), some 10 times faster. Python then makes again the
+``Action``s of the rules chosen, from their regions' action lists, for the grammar.
 
 The run's ``Deadline`` bounds the work: the greedy grammar checks its hard limit at every
 region (exit 4 when it passes), ADP stops at the soft limit, even within an iteration.
@@ -113,18 +114,12 @@ class Search:
         self._actions_at: dict[Entry, list[Action]] = {}
         self._quanta: dict[tuple[str, int, int], int] = {}  # (axis, start, stop) -> size
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
-        # the inner loop's tables (``_adp``): entries and actions are numbered as met
-        self._table = _adp.Table(self._provide)
-        self._entry_ids: dict[Entry, int] = {}
-        self._entry_list: list[Entry] = []
-        self._action_list: list[Action] = []
-        self._action_number: dict[int, int] = {}  # by id() of the action
-        self._label = {name: i for i, name in enumerate(self.grid.names)}
+        self._table = self._compiled()
 
     @property
     def regions_explored(self) -> int:
         """Regions that were offered actions."""
-        return len(self._actions)
+        return self._table.explored()
 
     # -- actions ------------------------------------------------------------------------
 
@@ -426,55 +421,49 @@ class Search:
 
     # -- building grammars ---------------------------------------------------------------
 
-    def _entry_id(self, entry: Entry) -> int:
-        """The table's number for a region to split, given the first time it is met."""
-        found = self._entry_ids.get(entry)
-        if found is None:
-            found = self._entry_ids[entry] = self._table.add_entry(entry)
-            self._entry_list.append(entry)
-        return found
-
-    def _provide(self, entry_id: int) -> _adp.Provided:
-        """The actions of an entry, for the table (``_adp.Table``): their cost, heuristic,
-        form, parts (a content for a non-terminal, -1 - label for a terminal), needs and
-        non-terminal parts (as entries), numbered in the order given."""
-        actions = self.actions_at(self._entry_list[entry_id])
-        self._action_list.extend(actions)
-        terminal, label = self.grid.terminal, self._label
-        return [
-            (
-                a.cost,
-                a.heuristic,
-                a.form_number,
-                tuple(-1 - label[terminal[c]] if c in terminal else c for c in a.cids),
-                a.needs,
-                tuple(map(self._entry_id, a.entries)),
-            )
-            for a in actions
-        ]
+    def _compiled(self) -> _adp.Table:
+        """The compiled search over this tiling (``_adp.c``)."""
+        grid, tiling = self.grid, self.grid.tiling
+        extensions = {"repeatABA": 1, "symsplit": 2, "gridsplit": 4}
+        return _adp.Table(
+            grid.labels.astype(np.int32).tobytes(),
+            grid.rows,
+            grid.columns,
+            np.asarray(tiling.xs, dtype=np.float64).tobytes(),
+            np.asarray(tiling.ys, dtype=np.float64).tobytes(),
+            grid.quantum_x,
+            grid.quantum_y,
+            grid.background_id,
+            self._repeat_rows.astype(np.int32).tobytes(),
+            sum(bit for name, bit in extensions.items() if name in self.extensions),
+            self.costs.split,
+            self.costs.repeat,
+        )
 
     def _rules(self, pairs: list[tuple[int, int]]) -> dict[int, Action]:
-        """A grammar from the table: each content's action, in the order chosen."""
-        actions = self._action_list
-        return {cid: actions[a] for cid, a in pairs}
+        """A grammar from the compiled search, its rules in the order chosen: each action
+        is made again here, from its region's actions (the same list, in the same order)."""
+        rules: dict[int, Action] = {}
+        for _, number in pairs:
+            r0, r1, c0, c1, index = self._table.action(number)
+            region = (r0, r1, c0, c1)
+            rules[self.grid.content(region)] = self.actions(region)[index]
+        return rules
 
     def _action_ids(self, rules: dict[int, Action]) -> list[int]:
-        """The table's numbers of a grammar's actions (the grammar may have been built
-        outside the table: its regions' actions are given to the table then)."""
-        number = self._action_number
-        for cid, action in rules.items():
-            if id(action) not in number:
-                self._table.provide(self._entry_id(_entry(_region_of(action), cid)))
-        for i in range(len(number), len(self._action_list)):
-            number[id(self._action_list[i])] = i
-        return [number[id(a)] for a in rules.values()]
+        """The compiled search's numbers of a grammar's actions."""
+        numbers = []
+        for action in rules.values():
+            region = _region_of(action)
+            index = next(i for i, a in enumerate(self.actions(region)) if a is action)
+            numbers.append(self._table.action_id(self._table.entry(*region), index))
+        return numbers
 
     def _start(self) -> int | None:
         """The whole façade's entry, None when it is one terminal."""
-        start = self.grid.content(self.whole)
-        if start in self.grid.terminal:
+        if self.grid.content(self.whole) in self.grid.terminal:
             return None
-        return self._entry_id(_entry(self.whole, start))
+        return self._table.entry(*self.whole)
 
     def actions_at(self, entry: Entry) -> list[Action]:
         """The actions of a heap entry's region."""
