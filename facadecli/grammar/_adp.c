@@ -1516,21 +1516,6 @@ static PyObject *Table_explored(Table *t, PyObject *unused)
     return PyLong_FromSsize_t(n);
 }
 
-/* action(id) -> (r0, r1, c0, c1, index): the region an action splits, and its place in the
- * region's actions. */
-static PyObject *Table_action(Table *t, PyObject *args)
-{
-    int id;
-    if (!PyArg_ParseTuple(args, "i", &id))
-        return NULL;
-    if (id < 0 || id >= t->n_actions) {
-        PyErr_SetString(PyExc_IndexError, "no such action");
-        return NULL;
-    }
-    const Entry *e = &t->entries[t->actions[id].owner];
-    return Py_BuildValue("(iiiii)", e->key[0], -e->key[2], e->key[1], -e->key[3], id - e->first);
-}
-
 static PyObject *ints(const int *v, int n)
 {
     PyObject *out = PyTuple_New(n);
@@ -1543,6 +1528,24 @@ static PyObject *ints(const int *v, int n)
         PyTuple_SET_ITEM(out, i, x);
     }
     return out;
+}
+
+/* action(id) -> ((r0, r1, c0, c1), axis, bounds, across): the region an action splits and
+ * its cuts (the rest follows from them: ``Search._action``). */
+static PyObject *Table_action(Table *t, PyObject *args)
+{
+    int id;
+    if (!PyArg_ParseTuple(args, "i", &id))
+        return NULL;
+    if (id < 0 || id >= t->n_actions) {
+        PyErr_SetString(PyExc_IndexError, "no such action");
+        return NULL;
+    }
+    const Action *a = &t->actions[id];
+    const Entry *e = &t->entries[a->owner];
+    return Py_BuildValue("((iiii)sNN)", e->key[0], -e->key[2], e->key[1], -e->key[3],
+                         a->axis ? "y" : "x", ints(t->pool + a->bounds, a->n_bounds),
+                         ints(t->pool + a->across, a->n_across));
 }
 
 /* describe(entry) -> [(op, axis, bounds, across, count, centre, cost, heuristic)], best

@@ -115,6 +115,8 @@ class Search:
         self._quanta: dict[tuple[str, int, int], int] = {}  # (axis, start, stop) -> size
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
         self._table = self._compiled()
+        # the actions _rules made, with their numbers, by id() (kept alive, so ids stay theirs)
+        self._numbers: dict[int, tuple[Action, int]] = {}
 
     @property
     def regions_explored(self) -> int:
@@ -179,9 +181,8 @@ class Search:
             and "y" in usable
             and (len(usable["x"]) + 1) * (len(usable["y"]) + 1) <= GRID_CELLS
         ):
-            grid = self._gridsplit(region, usable, line_costs)
-            if grid is not None:
-                found[("xy", grid.bounds, grid.across)] = grid
+            grid = self._gridsplit(region, usable["x"], usable["y"], line_costs)
+            found[("xy", grid.bounds, grid.across)] = grid
 
         def rank(a: Action) -> Rank:
             return (a.heuristic, a.cost, a.axis, a.bounds)
@@ -383,12 +384,13 @@ class Search:
     def _gridsplit(
         self,
         region: Region,
-        usable: dict[Axis, list[int]],
+        x_lines: Sequence[int],
+        y_lines: Sequence[int],
         line_costs: dict[Axis, dict[int, float]],
-    ) -> Action | None:
+    ) -> Action:
         r0, r1, c0, c1 = region
-        rows = (r0, *usable["y"], r1)
-        columns = (c0, *usable["x"], c1)
+        rows = (r0, *y_lines, r1)
+        columns = (c0, *x_lines, c1)
         cells = [
             (a, b, c, d)
             for a, b in itertools.pairwise(rows)
@@ -441,22 +443,36 @@ class Search:
         )
 
     def _rules(self, pairs: list[tuple[int, int]]) -> dict[int, Action]:
-        """A grammar from the compiled search, its rules in the order chosen: each action
-        is made again here, from its region's actions (the same list, in the same order)."""
+        """A grammar from the compiled search, its rules in the order chosen, each action
+        made again here from its region and cuts."""
         rules: dict[int, Action] = {}
         for _, number in pairs:
-            r0, r1, c0, c1, index = self._table.action(number)
-            region = (r0, r1, c0, c1)
-            rules[self.grid.content(region)] = self.actions(region)[index]
+            region, axis, bounds, across = self._table.action(number)
+            axes: tuple[Axis, ...] = ("x", "y") if across else (axis,)
+            costs = {a: self._line_costs(region, a) for a in axes}
+            if across:
+                action = self._gridsplit(region, across[1:-1], bounds[1:-1], costs)
+            else:
+                made = self._action(region, axis, bounds, costs[axis])
+                assert made is not None  # two parts or more
+                action = made
+            self._numbers[id(action)] = (action, number)
+            rules[self.grid.content(region)] = action
         return rules
 
     def _action_ids(self, rules: dict[int, Action]) -> list[int]:
-        """The compiled search's numbers of a grammar's actions."""
+        """The compiled search's numbers of a grammar's actions (found by their place in
+        their region's actions when the grammar was not made by it)."""
         numbers = []
         for action in rules.values():
-            region = _region_of(action)
-            index = next(i for i, a in enumerate(self.actions(region)) if a is action)
-            numbers.append(self._table.action_id(self._table.entry(*region), index))
+            known = self._numbers.get(id(action))
+            if known is not None:
+                number = known[1]
+            else:
+                region = _region_of(action)
+                index = next(i for i, a in enumerate(self.actions(region)) if a is action)
+                number = self._table.action_id(self._table.entry(*region), index)
+            numbers.append(number)
         return numbers
 
     def _start(self) -> int | None:

@@ -109,32 +109,56 @@ def inlined(grammar: Grammar) -> Grammar:
     """The grammar with every split rule that is used once, as a part of a split along the
     same axis, written into that split: the same derivation for less (Eq. 1 charges a rule
     its operation and its parts; the parent only gains the parts). Wu et al. 2014 leave
-    this to the search, which rarely finds it: most grammars it makes have such rules."""
-    rules = dict(grammar.rules)
-    while True:
-        uses: dict[str, int] = {grammar.start: 1}
-        for rule in rules.values():
-            for part in rule.parts:
-                uses[part.symbol] = uses.get(part.symbol, 0) + 1
-        found = next(
-            (
-                (name, i)
-                for name, rule in rules.items()
-                if rule.op == "split"
-                for i, part in enumerate(rule.parts)
-                if uses[part.symbol] == 1
-                and part.symbol in rules
-                and rules[part.symbol].op == "split"
-                and rules[part.symbol].axis == rule.axis
-            ),
-            None,
+    this to the search, which rarely finds it: most grammars it makes have such rules.
+
+    A rule used once has one parent, so these rules hang from their parents as trees: each
+    rule's parts are found once, its children's first (linear in the rules)."""
+    rules = grammar.rules
+    uses: dict[str, int] = {grammar.start: 1}
+    for rule in rules.values():
+        for part in rule.parts:
+            uses[part.symbol] = uses.get(part.symbol, 0) + 1
+
+    def inlinable(parent: Rule, symbol: str) -> bool:
+        child = rules.get(symbol)
+        return (
+            parent.op == "split"
+            and uses[symbol] == 1
+            and child is not None
+            and child.op == "split"
+            and child.axis == parent.axis
         )
-        if found is None:
-            return replace(grammar, rules=rules)
-        name, i = found
-        parent = rules[name]
-        child = rules.pop(parent.parts[i].symbol)
-        rules[name] = replace(parent, parts=parent.parts[:i] + child.parts + parent.parts[i + 1 :])
+
+    parts: dict[str, tuple[Part, ...]] = {}  # each rule's parts, its inlined children's in
+    inside: set[str] = set()  # rules written into their parent
+    for name in rules:
+        stack = [name]
+        while stack:
+            top = stack[-1]
+            rule = rules[top]
+            if top in parts:
+                stack.pop()
+                continue
+            waiting = [p.symbol for p in rule.parts if inlinable(rule, p.symbol)]
+            waiting = [symbol for symbol in waiting if symbol not in parts]
+            if waiting:
+                stack.extend(waiting)
+                continue
+            written: list[Part] = []
+            for part in rule.parts:
+                if inlinable(rule, part.symbol):
+                    inside.add(part.symbol)
+                    written.extend(parts[part.symbol])
+                else:
+                    written.append(part)
+            parts[top] = tuple(written)
+            stack.pop()
+    merged = {
+        name: rule if parts[name] == rule.parts else replace(rule, parts=parts[name])
+        for name, rule in rules.items()
+        if name not in inside
+    }
+    return replace(grammar, rules=merged)
 
 
 Box = tuple[str, float, float, float, float]
