@@ -9,7 +9,7 @@ OUT    ?= out
 VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 
 .DEFAULT_GOAL := help
-.PHONY: help install demo test lint format bench schema golden grammar city pictures clean
+.PHONY: help install demo test lint format bench bench-large schema golden grammar city pictures clean
 
 help: ## Show the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-8s %s\n", $$1, $$2}'
@@ -49,6 +49,9 @@ bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extrac
 	$(BIN)/python tests/benchmarks/grammar_bench.py
 	$(BIN)/python tests/benchmarks/city_bench.py
 	$(BIN)/python tests/benchmarks/infer_bench.py
+
+bench-large: $(STAMP) ## Time facade grammar on three large generated layouts (minutes)
+	$(BIN)/python tests/benchmarks/grammar_large_bench.py
 
 schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json
