@@ -1530,8 +1530,8 @@ static PyObject *ints(const int *v, int n)
     return out;
 }
 
-/* action(id) -> ((r0, r1, c0, c1), axis, bounds, across): the region an action splits and
- * its cuts (the rest follows from them: ``Search._action``). */
+/* action(id) -> ((r0, r1, c0, c1), axis, bounds, across, heuristic): the region an action
+ * splits, its cuts and its heuristic value (the rest follows from them: ``Search._action``). */
 static PyObject *Table_action(Table *t, PyObject *args)
 {
     int id;
@@ -1543,9 +1543,9 @@ static PyObject *Table_action(Table *t, PyObject *args)
     }
     const Action *a = &t->actions[id];
     const Entry *e = &t->entries[a->owner];
-    return Py_BuildValue("((iiii)sNN)", e->key[0], -e->key[2], e->key[1], -e->key[3],
+    return Py_BuildValue("((iiii)sNNd)", e->key[0], -e->key[2], e->key[1], -e->key[3],
                          a->axis ? "y" : "x", ints(t->pool + a->bounds, a->n_bounds),
-                         ints(t->pool + a->across, a->n_across));
+                         ints(t->pool + a->across, a->n_across), a->heuristic);
 }
 
 /* describe(entry) -> [(op, axis, bounds, across, count, centre, cost, heuristic)], best

@@ -447,15 +447,14 @@ class Search:
         made again here from its region and cuts."""
         rules: dict[int, Action] = {}
         for _, number in pairs:
-            region, axis, bounds, across = self._table.action(number)
-            axes: tuple[Axis, ...] = ("x", "y") if across else (axis,)
-            costs = {a: self._line_costs(region, a) for a in axes}
+            region, axis, bounds, across, heuristic = self._table.action(number)
             if across:
-                action = self._gridsplit(region, across[1:-1], bounds[1:-1], costs)
+                action = self._gridsplit(region, across[1:-1], bounds[1:-1], {"x": {}, "y": {}})
             else:
-                made = self._action(region, axis, bounds, costs[axis])
+                made = self._action(region, axis, bounds, {})
                 assert made is not None  # two parts or more
                 action = made
+            action.heuristic = heuristic  # the line costs it needs are the compiled search's
             self._numbers[id(action)] = (action, number)
             rules[self.grid.content(region)] = action
         return rules

@@ -20,6 +20,7 @@ distances are compared within ``TOLERANCE`` of the façade's extent.
 
 from __future__ import annotations
 
+import bisect
 import itertools
 from collections import defaultdict
 from collections.abc import Sequence
@@ -119,9 +120,9 @@ def _cells(tiles: Sequence[Box], near: float) -> list[Box]:
     xs = _distinct([v for t in tiles for v in (t.x0, t.x1)], near)
     ys = _distinct([v for t in tiles for v in (t.y0, t.y1)], near)
     cells = []
-    for label, x0, y0, x1, y1 in tiles:
-        inner_x = [x for x in xs if x0 - near <= x <= x1 + near]
-        inner_y = [y for y in ys if y0 - near <= y <= y1 + near]
+    for label, x0, y0, x1, y1 in tiles:  # the edges within reach, found in the sorted edges
+        inner_x = xs[bisect.bisect_left(xs, x0 - near) : bisect.bisect_right(xs, x1 + near)]
+        inner_y = ys[bisect.bisect_left(ys, y0 - near) : bisect.bisect_right(ys, y1 + near)]
         for a, b in itertools.pairwise(inner_x):
             for c, d in itertools.pairwise(inner_y):
                 cells.append(Box(label, a, c, b, d))

@@ -10,7 +10,8 @@ Only the largest repeats are kept for the splitting heuristic: a repeated region
 occurrence lies inside an occurrence of a larger one, as often repeated, says nothing more.
 
 Growing stops after ``MAX_REPEATS`` repeated regions, or when the run's deadline says the
-share of the time limit for it has passed (``Repeats.complete`` is then False).
+share of the time limit for it has passed; then the smaller repeats not yet checked against
+the larger ones are kept unchecked (``Repeats.complete`` is then False).
 """
 
 from __future__ import annotations
@@ -128,19 +129,44 @@ def _disjoint(regions: list[Region], taken: np.ndarray) -> list[Region]:
     return kept
 
 
-def _held(regions: list[Region], kept: list[list[Region]]) -> bool:
-    """Whether every region lies in an occurrence of one kept kind that is at least as
-    often repeated (checked for the first region against all kept kinds at once, then in
-    full for the kinds that hold it)."""
-    if not kept:
+class _Kept:
+    """The kinds of repeated regions kept so far, their occurrences in one growing array
+    (a kind's occurrences side by side), so that a new kind is checked against all at once."""
+
+    def __init__(self) -> None:
+        self.kinds: list[list[Region]] = []
+        self.starts: list[int] = []  # where each kind's occurrences start in ``boxes``
+        self.boxes = np.empty((64, 4), dtype=int)
+        self.owner = np.empty(64, dtype=int)
+        self.size = 0
+
+    def add(self, regions: list[Region]) -> None:
+        end = self.size + len(regions)
+        if end > len(self.boxes):
+            room = max(end, 2 * len(self.boxes))
+            self.boxes = np.resize(self.boxes, (room, 4))
+            self.owner = np.resize(self.owner, room)
+        self.boxes[self.size : end] = regions
+        self.owner[self.size : end] = len(self.kinds)
+        self.starts.append(self.size)
+        self.kinds.append(regions)
+        self.size = end
+
+    def hold(self, regions: list[Region]) -> bool:
+        """Whether every region lies in an occurrence of one kept kind that is at least as
+        often repeated (checked for the first region against all kept kinds at once, then
+        in full for the kinds that hold it)."""
+        if not self.kinds:
+            return False
+        boxes, owner = self.boxes[: self.size], self.owner[: self.size]
+        inner = np.array(regions, dtype=int)
+        for index in np.unique(owner[_within(inner[:1], boxes)[0]]).tolist():
+            start, kind = self.starts[index], self.kinds[index]
+            if len(kind) < len(regions):
+                continue
+            if _within(inner, boxes[start : start + len(kind)]).any(1).all():
+                return True
         return False
-    boxes = np.array([r for kind in kept for r in kind], dtype=int)
-    owner = np.repeat(np.arange(len(kept)), [len(kind) for kind in kept])
-    inner = np.array(regions, dtype=int)
-    for index in np.unique(owner[_within(inner[:1], boxes)[0]]).tolist():
-        if len(kept[index]) >= len(regions) and _within(inner, boxes[owner == index]).any(1).all():
-            return True
-    return False
 
 
 def _within(inner: np.ndarray, outer: np.ndarray) -> np.ndarray:
@@ -187,11 +213,15 @@ def find_repeats(grid: Grid, limit: int = MAX_REPEATS, deadline: Deadline | None
                     table[cid] = kept
                     queue.append(cid)
     # the largest repeats: drop one whose occurrences all sit in those of a larger one
+    # (once the time share has passed, the smaller ones are kept unchecked)
     kinds = sorted(table.items(), key=lambda item: -_cells(item[1][0]))
-    kept_kinds: list[list[Region]] = []
+    kept = _Kept()
     for _, regions in kinds:
-        if not _held(regions, kept_kinds):
-            kept_kinds.append(regions)
+        if complete and deadline is not None and deadline.passed(TIME_SHARE):
+            complete = False
+        if not complete or not kept.hold(regions):
+            kept.add(regions)
+    kept_kinds = kept.kinds
     flat = [r for regions in kept_kinds for r in regions]
     array = np.array(flat, dtype=int).reshape(-1, 4)
     array = array[np.argsort(array[:, 0], kind="stable")]  # by first row (``starting_in``)
