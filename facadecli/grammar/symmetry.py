@@ -215,13 +215,13 @@ def find_repeats(grid: Grid, limit: int = MAX_REPEATS, deadline: Deadline | None
     # the largest repeats: drop one whose occurrences all sit in those of a larger one
     # (once the time share has passed, the smaller ones are kept unchecked)
     kinds = sorted(table.items(), key=lambda item: -_cells(item[1][0]))
-    kept = _Kept()
+    larger = _Kept()
     for _, regions in kinds:
         if complete and deadline is not None and deadline.passed(TIME_SHARE):
             complete = False
-        if not complete or not kept.hold(regions):
-            kept.add(regions)
-    kept_kinds = kept.kinds
+        if not complete or not larger.hold(regions):
+            larger.add(regions)
+    kept_kinds = larger.kinds
     flat = [r for regions in kept_kinds for r in regions]
     array = np.array(flat, dtype=int).reshape(-1, 4)
     array = array[np.argsort(array[:, 0], kind="stable")]  # by first row (``starting_in``)
