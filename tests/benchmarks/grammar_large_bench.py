@@ -49,9 +49,8 @@ def lattice() -> dict[str, object]:
     rects = []
     for _ in range(10_000):
         i, j = rng.randrange(999), rng.randrange(999)
-        x0, y0 = i / 1000, j / 1000
-        label = rng.choice("ab")
-        rects.append({"label": label, "x0": x0, "y0": y0, "x1": x0 + 0.001, "y1": y0 + 0.001})
+        x0, y0, x1, y1 = i / 1000, j / 1000, (i + 1) / 1000, (j + 1) / 1000  # on the lattice
+        rects.append({"label": rng.choice("ab"), "x0": x0, "y0": y0, "x1": x1, "y1": y1})
     return {"canvas": {"width": 1, "height": 1}, "rects": rects}
 
 
