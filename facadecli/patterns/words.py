@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from facadecli.patterns.ast import Alt, Anonymous, Fixed, Named, Node, Repeat, Seq, Sym, walk
 from facadecli.patterns.parse import PatternSyntaxError, parse_pattern
@@ -23,9 +24,9 @@ from facadecli.patterns.parse import PatternSyntaxError, parse_pattern
 EPS = 1e-9
 
 
-@dataclass(frozen=True)
-class Letter:
-    """One letter of a word: a symbol occurrence with its flags."""
+class Letter(NamedTuple):
+    """One letter of a word: a symbol occurrence with its flags. A named tuple, so that a
+    word (a tuple of letters) hashes at C speed: the solver keys its tables by words."""
 
     symbol: str
     reflected: bool = False
