@@ -35,8 +35,6 @@ class Grid:
         self._labels32 = self.labels.astype(np.int32)  # as content keys hold them
         self.rows, self.columns = self.labels.shape
         self._xs, self._ys = np.array(tiling.xs, dtype=float), np.array(tiling.ys, dtype=float)
-        self.widths = self._sizes(tiling.xs)
-        self.heights = self._sizes(tiling.ys)
         self.quantum_x = SIZE_QUANTUM * (tiling.xs[-1] - tiling.xs[0])
         self.quantum_y = SIZE_QUANTUM * (tiling.ys[-1] - tiling.ys[0])
         self.background_id = bg = ids.get(background, -1)
@@ -51,10 +49,6 @@ class Grid:
         self.contents: dict[bytes, int] = {}
         self._content_of: dict[Region, int] = {}
         self.terminal: dict[int, str] = {}  # content -> its label, for one-label regions
-
-    @staticmethod
-    def _sizes(cuts: tuple[float, ...]) -> np.ndarray:
-        return np.diff(np.array(cuts, dtype=float))
 
     def content(self, region: Region) -> int:
         """The region's content number: equal for regions with the same labels at the same
