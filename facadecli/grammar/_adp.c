@@ -1081,6 +1081,10 @@ static int provide(Table *t, int e)
 {
     if (t->entries[e].count >= 0)
         return 0;
+    if (!t->grid.repeats) {
+        PyErr_SetString(PyExc_TypeError, "prepare the Table before the search");
+        return -1;
+    }
     const int *k = t->entries[e].key;
     Drafts *d = &t->drafts;
     if (region_drafts(&t->grid, k[0], -k[2], k[1], -k[3], d) < 0)
@@ -1471,16 +1475,21 @@ static PyObject *current_pairs(Table *t)
     return out;
 }
 
+static int check_region(const Table *t, int r0, int r1, int c0, int c1)
+{
+    if (r0 < 0 || c0 < 0 || r1 > t->grid.rows || c1 > t->grid.cols || r0 >= r1 || c0 >= c1) {
+        PyErr_SetString(PyExc_ValueError, "not a region of the tiling");
+        return -1;
+    }
+    return 0;
+}
+
 /* entry(r0, r1, c0, c1) -> id: the region's entry, added the first time. */
 static PyObject *Table_entry(Table *t, PyObject *args)
 {
     int r0, r1, c0, c1;
-    if (!PyArg_ParseTuple(args, "iiii", &r0, &r1, &c0, &c1))
+    if (!PyArg_ParseTuple(args, "iiii", &r0, &r1, &c0, &c1) || check_region(t, r0, r1, c0, c1) < 0)
         return NULL;
-    if (r0 < 0 || c0 < 0 || r1 > t->grid.rows || c1 > t->grid.cols || r0 >= r1 || c0 >= c1) {
-        PyErr_SetString(PyExc_ValueError, "not a region of the tiling");
-        return NULL;
-    }
     int e = entry_of(t, r0, r1, c0, c1);
     return e < 0 ? NULL : PyLong_FromLong(e);
 }
@@ -1784,40 +1793,34 @@ end:
     return result;
 }
 
-/* Table(labels, rows, cols, xs, ys, qx, qy, background, repeats, extensions, split, repeat):
- * the tiling's labels (int32, rows x cols, bottom row first), its cuts (float64), the size
- * quanta, the background's label (or -1), the repeated regions' occurrences (int32, five a
- * row: r0, r1, c0, c1, cells, by first row), the extensions as bits (1 repeatABA, 2
- * symsplit, 4 gridsplit) and the rule costs. */
+/* Table(labels, rows, cols, xs, ys, qx, qy, background): a tiling, its labels (int32, rows
+ * x cols, bottom row first), its cuts (float64), the size quanta and the background's label
+ * (or -1). Its contents can be asked for at once; ``prepare`` readies it for the search. */
 static int Table_init(Table *t, PyObject *args, PyObject *kwds)
 {
-    Py_buffer labels, xs, ys, repeats;
-    int rows, cols, background, ext;
-    double qx, qy, split, repeat;
+    Py_buffer labels, xs, ys;
+    int rows, cols, background;
+    double qx, qy;
     if (t->grid.labels) {
         PyErr_SetString(PyExc_TypeError, "a Table is made once");
         return -1;
     }
-    if (!PyArg_ParseTuple(args, "y*iiy*y*ddiy*idd", &labels, &rows, &cols, &xs, &ys, &qx, &qy,
-                          &background, &repeats, &ext, &split, &repeat))
+    if (!PyArg_ParseTuple(args, "y*iiy*y*ddi", &labels, &rows, &cols, &xs, &ys, &qx, &qy,
+                          &background))
         return -1;
     int ok = rows > 0 && cols > 0 && labels.len == (Py_ssize_t)rows * cols * 4 &&
              xs.len == (Py_ssize_t)(cols + 1) * 8 && ys.len == (Py_ssize_t)(rows + 1) * 8 &&
-             repeats.len % 20 == 0 && qx > 0 && qy > 0;
+             qx > 0 && qy > 0;
     Grid *g = &t->grid;
     if (ok) {
-        g->rows = rows, g->cols = cols, g->qx = qx, g->qy = qy, g->ext = ext;
-        g->split_cost = split, g->repeat_cost = repeat;
-        g->n_repeats = (int)(repeats.len / 20);
+        g->rows = rows, g->cols = cols, g->qx = qx, g->qy = qy;
         g->labels = PyMem_Malloc((size_t)labels.len);
         g->xs = PyMem_Malloc((size_t)xs.len);
         g->ys = PyMem_Malloc((size_t)ys.len);
-        g->repeats = PyMem_Malloc((size_t)repeats.len + 20);
-        if (g->labels && g->xs && g->ys && g->repeats) {
+        if (g->labels && g->xs && g->ys) {
             memcpy(g->labels, labels.buf, (size_t)labels.len);
             memcpy(g->xs, xs.buf, (size_t)xs.len);
             memcpy(g->ys, ys.buf, (size_t)ys.len);
-            memcpy(g->repeats, repeats.buf, (size_t)repeats.len);
         } else {
             PyErr_NoMemory();
             ok = -1;
@@ -1828,10 +1831,54 @@ static int Table_init(Table *t, PyObject *args, PyObject *kwds)
     PyBuffer_Release(&labels);
     PyBuffer_Release(&xs);
     PyBuffer_Release(&ys);
-    PyBuffer_Release(&repeats);
     if (ok != 1 || grid_prefixes(g, background) < 0)
         return -1;
     return 0;
+}
+
+/* prepare(repeats, extensions, split, repeat): the repeated regions' occurrences (int32,
+ * five a row: r0, r1, c0, c1, cells, by first row), the extensions as bits (1 repeatABA, 2
+ * symsplit, 4 gridsplit) and the rule costs; once, before the search. */
+static PyObject *Table_prepare(Table *t, PyObject *args)
+{
+    Py_buffer repeats;
+    int ext;
+    double split, repeat;
+    Grid *g = &t->grid;
+    if (!g->labels || g->repeats) {
+        PyErr_SetString(PyExc_TypeError, "prepare a made Table, once");
+        return NULL;
+    }
+    if (!PyArg_ParseTuple(args, "y*idd", &repeats, &ext, &split, &repeat))
+        return NULL;
+    if (repeats.len % 20) {
+        PyBuffer_Release(&repeats);
+        PyErr_SetString(PyExc_ValueError, "repeats come five int32 a row");
+        return NULL;
+    }
+    g->repeats = PyMem_Malloc((size_t)repeats.len + 20);
+    if (!g->repeats) {
+        PyBuffer_Release(&repeats);
+        return PyErr_NoMemory();
+    }
+    memcpy(g->repeats, repeats.buf, (size_t)repeats.len);
+    g->n_repeats = (int)(repeats.len / 20);
+    g->ext = ext, g->split_cost = split, g->repeat_cost = repeat;
+    PyBuffer_Release(&repeats);
+    Py_RETURN_NONE;
+}
+
+/* content(r0, r1, c0, c1) -> (content, label): the region's content (``Grid.content``) and
+ * its label when it is one terminal, else -1. */
+static PyObject *Table_content(Table *t, PyObject *args)
+{
+    int r0, r1, c0, c1;
+    if (!PyArg_ParseTuple(args, "iiii", &r0, &r1, &c0, &c1) || check_region(t, r0, r1, c0, c1) < 0)
+        return NULL;
+    int cid = grid_content(&t->grid, r0, r1, c0, c1);
+    if (cid < 0)
+        return NULL;
+    return Py_BuildValue("(ii)", cid, t->grid.terminal[cid]);
 }
 
 static void Table_dealloc(Table *t)
@@ -1862,6 +1909,10 @@ static void Table_dealloc(Table *t)
 }
 
 static PyMethodDef Table_methods[] = {
+    {"prepare", (PyCFunction)Table_prepare, METH_VARARGS,
+     "prepare(repeats, extensions, split, repeat): ready the Table for the search."},
+    {"content", (PyCFunction)Table_content, METH_VARARGS,
+     "content(r0, r1, c0, c1) -> (content, label or -1)."},
     {"entry", (PyCFunction)Table_entry, METH_VARARGS,
      "entry(r0, r1, c0, c1) -> id: the region's entry, added the first time."},
     {"action_id", (PyCFunction)Table_action_id, METH_VARARGS,

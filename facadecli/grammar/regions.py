@@ -11,15 +11,13 @@ sides of it; such lines are not cut while a clean one exists.
 
 from __future__ import annotations
 
-import struct
-
 import numpy as np
 
+from facadecli.grammar import _adp
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
 Region = tuple[int, int, int, int]
 SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's extent)
-_SHAPE = struct.Struct("=ii")  # a content key's shape: two native int32, as numpy writes them
 
 
 class Grid:
@@ -32,12 +30,10 @@ class Grid:
         self.names = names
         ids = {name: i for i, name in enumerate(names)}
         self.labels = np.array([[ids[label] for label in row] for row in tiling.labels], dtype=int)
-        self._labels32 = self.labels.astype(np.int32)  # as content keys hold them
         self.rows, self.columns = self.labels.shape
-        self._xs, self._ys = np.array(tiling.xs, dtype=float), np.array(tiling.ys, dtype=float)
         self.quantum_x = SIZE_QUANTUM * (tiling.xs[-1] - tiling.xs[0])
         self.quantum_y = SIZE_QUANTUM * (tiling.ys[-1] - tiling.ys[0])
-        self.background_id = bg = ids.get(background, -1)
+        bg = ids.get(background, -1)
         lab = self.labels
         # x lines: between columns c-1 and c, per row; y lines: between rows r-1 and r
         same_x = lab[:, 1:] == lab[:, :-1]
@@ -46,49 +42,35 @@ class Grid:
         self._cross_x = _prefix(same_x & (lab[:, 1:] != bg), axis=0)
         self._change_y = _prefix(~same_y, axis=1)
         self._cross_y = _prefix(same_y & (lab[1:, :] != bg), axis=1)
-        self.contents: dict[bytes, int] = {}
         self._content_of: dict[Region, int] = {}
         self.terminal: dict[int, str] = {}  # content -> its label, for one-label regions
+        self.table = _adp.Table(  # the contents, and the search over this tiling
+            self.labels.astype(np.int32).tobytes(),
+            self.rows,
+            self.columns,
+            np.asarray(tiling.xs, dtype=np.float64).tobytes(),
+            np.asarray(tiling.ys, dtype=np.float64).tobytes(),
+            self.quantum_x,
+            self.quantum_y,
+            bg,
+        )
 
     def content(self, region: Region) -> int:
         """The region's content number: equal for regions with the same labels at the same
         places, whatever cuts other elements make through them (neighbouring rows and
-        columns with the same labels are merged first)."""
+        columns with the same labels are merged first, and a merged row or column's size is
+        the difference of its cuts, in steps of the size quantum). The compiled table
+        (``_adp.c``) keeps them, for the search too."""
         cid = self._content_of.get(region)
-        if cid is not None:
-            return cid
-        r0, r1, c0, c1 = region
-        block = self._labels32[r0:r1, c0:c1]
-        # a column (row) starts a new one where the labels change across the line before it
-        keep_c = np.ones(c1 - c0, dtype=bool)
-        keep_c[1:] = self._change_x[r1, c0 : c1 - 1] != self._change_x[r0, c0 : c1 - 1]
-        keep_r = np.ones(r1 - r0, dtype=bool)
-        keep_r[1:] = self._change_y[r0 : r1 - 1, c1] != self._change_y[r0 : r1 - 1, c0]
-        starts_c, starts_r = keep_c.nonzero()[0], keep_r.nonzero()[0]
-        reduced = block[starts_r][:, starts_c]
-        # a merged column's width is the difference of its cuts (one rounding, as the
-        # compiled search computes it too)
-        ends_c, ends_r = np.append(starts_c[1:], c1 - c0), np.append(starts_r[1:], r1 - r0)
-        widths = (self._xs[c0 + ends_c] - self._xs[c0 + starts_c]) / self.quantum_x
-        heights = (self._ys[r0 + ends_r] - self._ys[r0 + starts_r]) / self.quantum_y
-        key = b"".join(
-            (
-                _SHAPE.pack(*reduced.shape),
-                reduced.tobytes(),
-                np.rint(widths).astype(np.int64).tobytes(),
-                np.rint(heights).astype(np.int64).tobytes(),
-            )
-        )
-        cid = self.contents.get(key)
         if cid is None:
-            cid = self.contents[key] = len(self.contents)
-            if reduced.size == 1:
-                self.terminal[cid] = self.names[int(reduced[0, 0])]
-        self._content_of[region] = cid
+            cid, label = self.table.content(*region)
+            self._content_of[region] = cid
+            if label >= 0:
+                self.terminal[cid] = self.names[label]
         return cid
 
     def contents_of(self, regions: list[Region]) -> list[int]:
-        """``content`` of each region (most are known: looked up at once)."""
+        """``content`` of each region."""
         known = self._content_of
         cids = [known.get(region, -1) for region in regions]
         if -1 in cids:

@@ -424,23 +424,17 @@ class Search:
     # -- building grammars ---------------------------------------------------------------
 
     def _compiled(self) -> _adp.Table:
-        """The compiled search over this tiling (``_adp.c``)."""
-        grid, tiling = self.grid, self.grid.tiling
+        """The compiled search over this tiling (``_adp.c``): the grid's table, readied with
+        the repeated regions, the extensions and the costs."""
         extensions = {"repeatABA": 1, "symsplit": 2, "gridsplit": 4}
-        return _adp.Table(
-            grid.labels.astype(np.int32).tobytes(),
-            grid.rows,
-            grid.columns,
-            np.asarray(tiling.xs, dtype=np.float64).tobytes(),
-            np.asarray(tiling.ys, dtype=np.float64).tobytes(),
-            grid.quantum_x,
-            grid.quantum_y,
-            grid.background_id,
+        table = self.grid.table
+        table.prepare(
             self._repeat_rows.astype(np.int32).tobytes(),
             sum(bit for name, bit in extensions.items() if name in self.extensions),
             self.costs.split,
             self.costs.repeat,
         )
+        return table
 
     def _rules(self, pairs: list[tuple[int, int]]) -> dict[int, Action]:
         """A grammar from the compiled search, its rules in the order chosen, each action

@@ -84,17 +84,26 @@ class Facade:
         return [sorted(row, key=lambda b: b.x0) for row in found]
 
     def mirrored(self) -> float:
-        """The share of elements with a mirror partner of their label."""
+        """The share of elements with a mirror partner of their label (looked for among
+        the elements of that label starting near the same height)."""
         near_x, near_y = TOLERANCE * self.width, TOLERANCE * self.height
+        by_label: dict[str, list[Box]] = defaultdict(list)
+        for box in sorted(self.boxes, key=lambda b: b.y0):
+            by_label[box.label].append(box)
+        starts = {label: [b.y0 for b in boxes] for label, boxes in by_label.items()}
         partners = 0
         for label, x0, y0, x1, y1 in self.boxes:
+            boxes, at = by_label[label], starts[label]
+            # a window wider than the test, which then decides as it would over all
+            near = boxes[
+                bisect.bisect_left(at, y0 - 2 * near_y) : bisect.bisect_right(at, y0 + 2 * near_y)
+            ]
             partners += any(
-                other.label == label
-                and abs(other.x0 - (self.width - x1)) <= near_x
+                abs(other.x0 - (self.width - x1)) <= near_x
                 and abs(other.x1 - (self.width - x0)) <= near_x
                 and abs(other.y0 - y0) <= near_y
                 and abs(other.y1 - y1) <= near_y
-                for other in self.boxes
+                for other in near
             )
         return partners / len(self.boxes) if self.boxes else 0.0
 
