@@ -27,7 +27,7 @@ the repeated regions that line cuts through over the cells of the region.
 The search runs compiled (``_adp.c``): the actions of each region it visits, building
 grammars from them, their merged cost and the value table. It computes what the Python here
 (``_make_actions`` and what it calls) and the plain loop in tests/adp_reference.py compute,
-to the bit (the tests compare them), some 10 times faster. Python then makes again the
+to the bit (the tests compare them), some 20 times faster. Python then makes again the
 ``Action``s of the rules chosen, from their regions and cuts, for the grammar.
 
 The run's ``Deadline`` bounds the work: the greedy grammar checks its hard limit at every
