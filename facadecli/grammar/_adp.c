@@ -344,8 +344,15 @@ static int compare_bounds(const int *a, int na, const int *b, int nb)
     return (na > nb) - (na < nb);
 }
 
-/* ``Rank`` (heuristic, cost, axis, bounds), then the order before the sort. */
-static int compare_drafts(const Drafts *d, const Draft *a, const Draft *b)
+/* ``Rank``: heuristic, cost, axis, bounds, least first. */
+typedef struct {
+    double heuristic, cost;
+    int axis;
+    const int *bounds;
+    int n_bounds;
+} Rank;
+
+static int compare_ranks(const Rank *a, const Rank *b)
 {
     if (a->heuristic != b->heuristic)
         return a->heuristic < b->heuristic ? -1 : 1;
@@ -353,7 +360,15 @@ static int compare_drafts(const Drafts *d, const Draft *a, const Draft *b)
         return a->cost < b->cost ? -1 : 1;
     if (a->axis != b->axis)
         return a->axis < b->axis ? -1 : 1;
-    int c = compare_bounds(DP(d, a->bounds), a->n_bounds, DP(d, b->bounds), b->n_bounds);
+    return compare_bounds(a->bounds, a->n_bounds, b->bounds, b->n_bounds);
+}
+
+/* ``Rank``, then the order before the sort. */
+static int compare_drafts(const Drafts *d, const Draft *a, const Draft *b)
+{
+    Rank x = {a->heuristic, a->cost, a->axis, DP(d, a->bounds), a->n_bounds};
+    Rank y = {b->heuristic, b->cost, b->axis, DP(d, b->bounds), b->n_bounds};
+    int c = compare_ranks(&x, &y);
     if (c)
         return c;
     return (a->order > b->order) - (a->order < b->order);
@@ -657,14 +672,9 @@ typedef struct {
 static int compare_halves(const void *x, const void *y)
 {
     const Half *a = x, *b = y;
-    if (a->heuristic != b->heuristic)
-        return a->heuristic < b->heuristic ? -1 : 1;
-    if (a->cost != b->cost)
-        return a->cost < b->cost ? -1 : 1;
-    if (a->axis != b->axis)
-        return a->axis < b->axis ? -1 : 1;
     int ba[3] = {a->lo, a->line, a->hi}, bb[3] = {b->lo, b->line, b->hi};
-    return compare_bounds(ba, 3, bb, 3);
+    Rank ra = {a->heuristic, a->cost, a->axis, ba, 3}, rb = {b->heuristic, b->cost, b->axis, bb, 3};
+    return compare_ranks(&ra, &rb);
 }
 
 typedef struct {
@@ -699,6 +709,21 @@ static int rank_in_two(Grid *g, const Place *p, int axis, int lo, int line, int 
     out->heuristic = out->cost + (0.0 + line_cost(p, axis, line));
     out->axis = axis, out->line = line, out->lo = lo, out->hi = hi;
     return 0;
+}
+
+/* The first repeated region's occurrence whose first row is ``row`` or above (the
+ * occurrences are sorted by first row: ``bisect_left``). */
+static int first_repeat_from(const Grid *g, int row)
+{
+    int a = 0, b = g->n_repeats;
+    while (a < b) {
+        int mid = (a + b) / 2;
+        if (g->repeats[5 * mid] < row)
+            a = mid + 1;
+        else
+            b = mid;
+    }
+    return a;
 }
 
 /* The drafts of ``Search._make_actions(region)``, best first, in d (from 0). 0 or -1. */
@@ -760,31 +785,15 @@ static int region_drafts(Grid *g, int r0, int r1, int c0, int c1, Drafts *d)
         memcpy(lines[axis], lines[axis] + span + 1, (size_t)n_fallback[axis] * sizeof(int));
         n_lines[axis] = n_fallback[axis], usable[axis] = 1;
     }
-    /* the repeated regions' occurrences inside the region */
+    /* the repeated regions' occurrences inside the region: those starting in its rows */
     {
-        int a = 0, b = g->n_repeats;
-        while (a < b) { /* bisect_left on the first rows for r0 */
-            int mid = (a + b) / 2;
-            if (g->repeats[5 * mid] < r0)
-                a = mid + 1;
-            else
-                b = mid;
-        }
-        int from = a;
-        b = g->n_repeats;
-        while (a < b) {
-            int mid = (a + b) / 2;
-            if (g->repeats[5 * mid] < r1)
-                a = mid + 1;
-            else
-                b = mid;
-        }
-        p.inside = PyMem_Malloc((size_t)(a - from + 1) * sizeof(int));
+        int from = first_repeat_from(g, r0), to = first_repeat_from(g, r1);
+        p.inside = PyMem_Malloc((size_t)(to - from + 1) * sizeof(int));
         if (!p.inside) {
             PyErr_NoMemory();
             goto end;
         }
-        for (int k = from; k < a; k++) {
+        for (int k = from; k < to; k++) {
             const int32_t *rep = g->repeats + 5 * k;
             if (rep[1] <= r1 && rep[2] >= c0 && rep[3] <= c1)
                 p.inside[p.n_inside++] = k;

@@ -115,8 +115,7 @@ class Search:
         self._quanta: dict[tuple[str, int, int], int] = {}  # (axis, start, stop) -> size
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
         self._table = self._compiled()
-        # the actions _rules made, with their numbers, by id() (kept alive, so ids stay theirs)
-        self._numbers: dict[int, tuple[Action, int]] = {}
+        self._greedy_numbers: list[int] = []  # the greedy rules' actions in the table
 
     @property
     def regions_explored(self) -> int:
@@ -449,23 +448,17 @@ class Search:
                 assert made is not None  # two parts or more
                 action = made
             action.heuristic = heuristic  # the line costs it needs are the compiled search's
-            self._numbers[id(action)] = (action, number)
             rules[self.grid.content(region)] = action
         return rules
 
     def _action_ids(self, rules: dict[int, Action]) -> list[int]:
-        """The compiled search's numbers of a grammar's actions (found by their place in
-        their region's actions when the grammar was not made by it)."""
+        """The table's numbers of a grammar's actions, by their places in their regions'
+        actions (equal lists, in one order)."""
         numbers = []
         for action in rules.values():
-            known = self._numbers.get(id(action))
-            if known is not None:
-                number = known[1]
-            else:
-                region = _region_of(action)
-                index = next(i for i, a in enumerate(self.actions(region)) if a is action)
-                number = self._table.action_id(self._table.entry(*region), index)
-            numbers.append(number)
+            region = _region_of(action)
+            index = self.actions(region).index(action)
+            numbers.append(self._table.action_id(self._table.entry(*region), index))
         return numbers
 
     def _start(self) -> int | None:
@@ -532,6 +525,7 @@ class Search:
                     deadline.check("building the greedy grammar")
                     raise AssertionError("the hard time limit passed")  # check() raised
                 self._greedy = self._rules(pairs)
+                self._greedy_numbers = [number for _, number in pairs]
         return self._greedy
 
     def adp(self, iterations: int, seed: int) -> tuple[dict[int, Action], int, int]:
@@ -547,7 +541,7 @@ class Search:
         state = random.Random(seed).getstate()[1]
         stop = _monotonic(self.deadline.start + self.deadline.seconds)
         pairs, best_at, done = self._table.adp(
-            start, self._action_ids(greedy), iterations, state, optimistic, stop
+            start, self._greedy_numbers, iterations, state, optimistic, stop
         )
         return self._rules(pairs), best_at, done
 
