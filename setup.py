@@ -1,4 +1,5 @@
-"""The grammar search's compiled inner loop; everything else is in pyproject.toml."""
+"""The compiled inner loops (the grammar search, the exact alignment search); everything
+else is in pyproject.toml."""
 
 from setuptools import Extension, setup
 
@@ -8,6 +9,11 @@ setup(
             "facadecli.grammar._adp",
             ["facadecli/grammar/_adp.c"],
             extra_compile_args=["-O2", "-Wall", "-Wextra", "-Wno-unused-parameter"],
-        )
+        ),
+        Extension(
+            "facadecli.solver._exact",
+            ["facadecli/solver/_exact.c"],
+            extra_compile_args=["-O2", "-Wall", "-Wextra", "-Wno-unused-parameter"],
+        ),
     ]
 )

@@ -5,18 +5,23 @@ from __future__ import annotations
 
 import itertools
 import textwrap
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from facadecli import InfeasibleError, make_word, parse_spec, retarget, solve
-from facadecli.solver import sizing
+from facadecli import InfeasibleError, load_spec, make_word, parse_spec, retarget, solve
+from facadecli.export.svg import svg_text
+from facadecli.solver import exact, sizing
 from facadecli.solver.alignment import Alignment, Move, _Row
 from facadecli.solver.exact import Budget, align_exactly
 from facadecli.solver.rows import Row, full_layers, make_rows
 from facadecli.spec.resolve import layer_pattern
+from tests.benchmarks.generated import generated_spec
 from tests.solving import letters, solve_text
+
+ROOT = Path(__file__).resolve().parent.parent
 
 SETTINGS = settings(
     derandomize=True,
@@ -482,3 +487,80 @@ def test_planted_layouts_the_generator_once_missed(text: str, bays: int) -> None
     layout = solve(parse_spec(text, "planted.yaml"))
     assert layout.counters["k"] == bays
     assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
+
+
+# -- the compiled search (_exact.c) against the Python reference ---------------------------
+def _both_engines(spec: object, rows: list[Row], canvas: float, incumbent: float) -> list[object]:
+    seen = []
+    for compiled in (True, False):
+        budget = Budget(10**7)
+        outcome = align_exactly(  # type: ignore[arg-type]
+            spec, {"default": rows}, canvas, budget, incumbent, compiled=compiled
+        )
+        found = outcome.found
+        seen.append(
+            (
+                outcome.complete,
+                outcome.reason,
+                budget.used,
+                None if found is None else (found.rank, found.groups),
+            )
+        )
+    return seen
+
+
+@SETTINGS
+@given(tiny_specs(), st.sampled_from([float("inf"), 0.05, 0.0]))
+def test_the_compiled_search_takes_the_references_every_step(text: str, incumbent: float) -> None:
+    """The same layout, the same work units spent (every column bounded, every layout
+    sized), the same reason when there is none."""
+    spec, rows = _rows(text)
+    compiled, reference = _both_engines(spec, rows, spec.canvas.width, incumbent)  # type: ignore[attr-defined]
+    assert compiled == reference
+
+
+@settings(derandomize=True, max_examples=15, deadline=None, suppress_health_check=list(HealthCheck))
+@given(planted_specs())
+def test_the_compiled_search_solves_planted_layouts_as_the_reference(text: str) -> None:
+    """Whole solves, every candidate of both axes: the same drawing to the byte."""
+    spec = parse_spec(text, "planted.yaml")
+    drawings = []
+    try:
+        for compiled in (True, False):
+            exact.COMPILED = compiled
+            drawings.append(svg_text(solve(spec), labels=True))
+    finally:
+        exact.COMPILED = True
+    assert drawings[0] == drawings[1]
+
+
+@pytest.mark.parametrize("source", ["terraced-house", "centred-bay", "palace"])
+def test_the_compiled_search_spends_the_references_work_on_every_candidate(
+    source: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every exact search of a whole solve (both axes, every candidate and pass): the same
+    outcome after the same work units, so budgets end at the same place in both."""
+    if source == "palace":
+        spec = parse_spec(generated_spec(8, 5))
+    else:
+        spec = load_spec(ROOT / "specs" / f"{source}.yaml")
+    searched = exact.align_exactly
+    calls: list[tuple[object, ...]] = []
+
+    def recorded(*args: object, **kwargs: object) -> exact.Outcome:
+        outcome = searched(*args, **kwargs)  # type: ignore[arg-type]
+        found = outcome.found
+        calls.append(
+            (outcome.complete, outcome.reason, args[3].used, found and found.rank)  # type: ignore[attr-defined]
+        )
+        return outcome
+
+    monkeypatch.setattr(exact, "align_exactly", recorded)
+    runs = []
+    for compiled in (True, False):
+        monkeypatch.setattr(exact, "COMPILED", compiled)
+        calls.clear()
+        solve(spec)
+        runs.append(list(calls))
+    assert len(runs[0]) > 3
+    assert runs[0] == runs[1]

@@ -30,12 +30,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from facadecli.solver import columns, sizing
+from facadecli.solver import _exact, columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row
 from facadecli.solver.rows import Row
 from facadecli.spec.model import Spec
 
 FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2
+# the rules a column may break (numbered as in _exact.c)
+NO_OPAQUE, ATTACHED_GAP, NO_COVER, GAP_BEFORE_ATTACHED, COVERED = 1, 2, 3, 4, 5
 Column = tuple[Move | None, ...]
 Option = tuple[Move | None, np.ndarray | None]  # an entry (None: a gap), its length if known
 Options = tuple[list[Option], list[int], np.ndarray]  # see _Search.options()
@@ -43,6 +45,8 @@ LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
 COMBINATION_WORK = 64  # partial columns built per work unit
 RECURSION_MARGIN = 1000  # frames beyond the search's deepest path (the callers', numpy's)
 SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
+COMPILED = True  # search with _exact.c (False: the Python reference, for the tests)
+_EXHAUSTED, _STOPPED = 2, 3  # what _exact.Search.run() returns besides 0 (done)
 
 
 class BudgetExhausted(Exception):
@@ -287,39 +291,53 @@ class _Search:
             return False
         if not any(_opaque(m) for m in entries):
             r = next(r for r, m in enumerate(entries) if m is not None)
-            return self.reject(
-                f"nothing opaque would stand behind or in front of "
-                f"{self.text(group, r, entries[r])} of {self.layer(group, r)} (every column "
-                "needs an opaque layer: mark a symbol opaque, or let the layers fit)"
-            )
+            return self.reject(self.why(NO_OPAQUE, group, r, entries[r]))
         for r, move in enumerate(entries):
             if move is None:
                 if memory[r] == AFTER_ATTACHED:
-                    return self.reject(
-                        f"an attached letter of {self.layer(group, r)} would be separated from "
-                        "its neighbour by a gap"
-                    )
+                    return self.reject(self.why(ATTACHED_GAP, group, r))
                 if not any(_opaque(entries[a]) for a in group.covering[r]):
-                    return self.reject(
-                        f"{self.layer(group, r)} would need a gap where no layer in front of it "
-                        "has an opaque letter (only opaque letters of layers in front may make "
-                        "a layer give way)"
-                    )
+                    return self.reject(self.why(NO_COVER, group, r))
                 continue
             if move.first_attached and memory[r] == AFTER_EMPTY:
-                return self.reject(
-                    f"{self.text(group, r, move)} of {self.layer(group, r)} is attached, but a "
-                    "gap would open before it"
-                )
+                return self.reject(self.why(GAP_BEFORE_ATTACHED, group, r, move))
             if move.unoccludable:
                 for above in group.above[r]:
                     other = entries[above]
                     if other is not None and not other.transparent:
-                        return self.reject(
-                            f"{self.layer(group, above)} would cover unoccludable "
-                            f"{self.text(group, r, move)} of {self.layer(group, r)}"
-                        )
+                        return self.reject(self.why(COVERED, group, r, move, above))
         return True
+
+    def why(
+        self, rule: int, group: _Group, r: int, move: Move | None = None, above: int = -1
+    ) -> str:
+        """Why a column breaks a rule of SPEC 2.4, in the user's words (row r, its entry
+        ``move``, and the row ``above`` that would cover it)."""
+        if rule == NO_OPAQUE:
+            return (
+                f"nothing opaque would stand behind or in front of {self.text(group, r, move)} "
+                f"of {self.layer(group, r)} (every column needs an opaque layer: mark a symbol "
+                "opaque, or let the layers fit)"
+            )
+        if rule == ATTACHED_GAP:
+            return (
+                f"an attached letter of {self.layer(group, r)} would be separated from its "
+                "neighbour by a gap"
+            )
+        if rule == NO_COVER:
+            return (
+                f"{self.layer(group, r)} would need a gap where no layer in front of it has an "
+                "opaque letter (only opaque letters of layers in front may make a layer give way)"
+            )
+        if rule == GAP_BEFORE_ATTACHED:
+            return (
+                f"{self.text(group, r, move)} of {self.layer(group, r)} is attached, but a gap "
+                "would open before it"
+            )
+        return (
+            f"{self.layer(group, above)} would cover unoccludable {self.text(group, r, move)} "
+            f"of {self.layer(group, r)}"
+        )
 
     def merges(self, group: _Group, last: Column, entries: Column, before: tuple[int, ...]) -> bool:
         """Whether two columns in a row make one valid column. Then a path through both is
@@ -674,8 +692,12 @@ class _Search:
             cached = self.remaining_cache[key] = (vector, sorted(counts.items()))
         return cached
 
-    def leaf(self, paths: list[list[tuple[Move | None, ...]]]) -> None:
+    def leaf(self, paths: list[list[Column]]) -> None:
         self.budget.spend(LEAF_WORK)
+        self.settle(paths)
+
+    def settle(self, paths: list[list[Column]]) -> None:
+        """Size a complete alignment (a path per group); keep it if it ranks best."""
         groups = {
             group.name: _alignment(group, path)
             for group, path in zip(self.groups, paths, strict=True)
@@ -692,6 +714,90 @@ class _Search:
         if solved.objective <= SAME or self.first_only:
             raise _Perfect  # nothing deviates less (the search order broke the tie), or
             # only a layout was asked for
+
+
+class _Compiled:
+    """The search of ``_exact.c`` over a :class:`_Search`'s groups: it walks the network
+    as :meth:`_Search.run` does, and hands every complete alignment to
+    :meth:`_Search.settle` by its cuts; the budget, the incumbent and the rejections end
+    up where the Python search keeps them."""
+
+    def __init__(self, search: _Search):
+        self.search = search
+        variables = search.variables
+        groups = [
+            [
+                (
+                    [
+                        (
+                            variables[letter.symbol],
+                            traits.size,
+                            traits.transparent,
+                            traits.opaque,
+                            traits.attached,
+                            traits.unoccludable,
+                            traits.segment,
+                        )
+                        for letter, traits in zip(row.row.word, row.row.traits, strict=True)
+                    ],
+                    group.above[r],
+                    group.covering[r],
+                )
+                for r, row in enumerate(group.rows)
+            ]
+            for group in search.groups
+        ]
+        budget = search.budget
+        self.table = _exact.Search(
+            groups,
+            len(variables),
+            search.target.tolist(),
+            search.canvas,
+            search.incumbent,
+            budget.limit,
+            budget.used,
+            budget.deadline,
+            search.first_only,
+            self.leaf,
+        )
+
+    def run(self) -> None:
+        search = self.search
+        status = self.table.run(search.gaps)
+        search.budget.used = self.table.used
+        search.budget.timed_out = self.table.timed_out
+        search.incumbent = self.table.incumbent
+        search.rejections.clear()
+        for rule, g, r, above, start, end, progress, count in self.table.rejections():
+            group = search.groups[g]
+            move = None if start < 0 else group.rows[r].spanning(start, end)
+            why = search.why(rule, group, r, move, above)
+            before, times = search.rejections.get(why, (0, 0))
+            search.rejections[why] = (max(before, progress), times + count)
+        if status == _EXHAUSTED:
+            raise BudgetExhausted
+        if status == _STOPPED:
+            raise _Perfect
+
+    def leaf(self, cuts: list[list[tuple[tuple[int, int] | None, ...]]]) -> tuple[float, bool]:
+        """Size a complete alignment given by its cuts: the incumbent after it, and whether
+        the search should stop."""
+        search = self.search
+        paths = [
+            [
+                tuple(
+                    None if cut is None else group.rows[r].spanning(*cut)
+                    for r, cut in enumerate(column)
+                )
+                for column in columns
+            ]
+            for group, columns in zip(search.groups, cuts, strict=True)
+        ]
+        try:
+            search.settle(paths)
+        except _Perfect:
+            return search.incumbent, True
+        return search.incumbent, False
 
 
 def _prepared(row: Row, known: dict[Row, _Row]) -> _Row:
@@ -791,9 +897,12 @@ def align_exactly(
     incumbent: float = INF,
     prepared_rows: dict[Row, _Row] | None = None,
     first_only: bool = False,
+    compiled: bool | None = None,
 ) -> Outcome:
     """The best layout of a candidate's groups (one set of rows per group), searched
-    exactly; only layouts with an objective at most ``incumbent`` are looked for."""
+    exactly; only layouts with an objective at most ``incumbent`` are looked for.
+    ``compiled``: run the search of ``_exact.c`` (the default, :data:`COMPILED`) or the
+    Python reference, :class:`_Search`."""
     known = {} if prepared_rows is None else prepared_rows
     prepared = []
     for name, rows in sorted(groups.items()):
@@ -832,14 +941,15 @@ def align_exactly(
     depth = sum(max(group.ends, default=0) for group in prepared) + RECURSION_MARGIN
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(max(limit, depth))
+    run = _Compiled(search).run if (COMPILED if compiled is None else compiled) else search.run
     # first without gaps (most layouts have none, and gaps multiply the columns out of
     # every state), then with them, looking only for better layouts than that one
     try:
         if any(any(group.covering) for group in prepared):
             search.gaps = False
-            search.run()
+            run()
             search.gaps = True
-        search.run()
+        run()
     except _Perfect:
         best = search.best
         if best is not None and best.sizing.objective > SAME:  # the first layout, asked for
