@@ -79,17 +79,27 @@ def make_rows(
     known = {} if known is None else known
     by_word: dict[tuple[Word, int], list[int]] = {}
     for layer, word in sorted(words, key=lambda item: item[0]):
-        if word not in known:
-            known[word] = tuple(letter_traits(spec, letter) for letter in word)
+        traits = known.get(word)
+        if traits is None:
+            traits = known[word] = tuple(_traits(spec, letter, known) for letter in word)
         # a word with an unoccludable letter keeps a row of its own in every layer: the same
         # word in front would cover it, so the front layer must be free to make room
-        alone = layer if any(t.unoccludable for t in known[word]) else -1
+        alone = layer if any(t.unoccludable for t in traits) else -1
         by_word.setdefault((word, alone), []).append(layer)
     rows = [
         Row(tuple(layers), word, known[word], full_height=all(layer in full for layer in layers))
         for (word, _), layers in by_word.items()
     ]
     return sorted(rows, key=lambda row: row.lowest)
+
+
+def _traits(spec: Spec, letter: Letter, known: dict[Word, tuple[LetterTraits, ...]]) -> LetterTraits:
+    """A letter's traits, kept in the words' cache as those of the one-letter word."""
+    single = (letter,)
+    found = known.get(single)
+    if found is None:
+        found = known[single] = (letter_traits(spec, letter),)
+    return found[0]
 
 
 def full_layers(spec: Spec, axis: Axis) -> frozenset[int]:

@@ -102,12 +102,14 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
         return symbols[name]
 
     rows: list[tuple[dict[int, float], float]] = []  # sparse equality rows
+    seen: set[tuple[tuple[int, float], ...]] = set()
     for group, alignment in sorted(groups.items()):
         for j in range(alignment.columns):
             columns[(group, j)] = variable(f"column {j} of group {group}", 0.0, TINY, 0.0, np.inf)
         rows.append(({columns[(group, j)]: 1.0 for j in range(alignment.columns)}, canvas))
         split: dict[tuple[int, int], list[int]] = {}
         for j, entries in enumerate(alignment.entries):
+            first: dict[int, float] | None = None
             for r, move in enumerate(entries):
                 if move is None:
                     continue
@@ -122,7 +124,17 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
                     pieces[piece] = variable(f"piece of {word[k].symbol}", 0.0, TINY, 0.0, np.inf)
                     coefficients[pieces[piece]] = 1.0
                     split.setdefault((r, k), []).append(pieces[piece])
-                rows.append((coefficients, 0.0))
+                if first is None:
+                    first = coefficients
+                    rows.append((coefficients, 0.0))
+                    continue
+                # the entry as long as the column's first, written without the column: a
+                # long façade's many equal columns then give one row ("W == Sp"), not
+                # one a column and row (the same equalities: the solution is the same)
+                same = _difference(coefficients, first)
+                if same and same not in seen:
+                    seen.add(same)
+                    rows.append((dict(same), 0.0))
         for (r, k), parts in split.items():
             coefficients = {p: 1.0 for p in parts}
             index = symbol(alignment.rows[r].word[k].symbol)
@@ -145,6 +157,14 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
         pieces=pieces,
         sized=sized,
     )
+
+
+def _difference(a: Mapping[int, float], b: Mapping[int, float]) -> tuple[tuple[int, float], ...]:
+    """The row ``a - b``: its nonzero coefficients, by variable."""
+    merged = dict(a)
+    for j, value in b.items():
+        merged[j] = merged.get(j, 0.0) - value
+    return tuple(sorted((j, value) for j, value in merged.items() if value != 0.0))
 
 
 @dataclass(frozen=True)
