@@ -93,7 +93,9 @@ def make_rows(
     return sorted(rows, key=lambda row: row.lowest)
 
 
-def _traits(spec: Spec, letter: Letter, known: dict[Word, tuple[LetterTraits, ...]]) -> LetterTraits:
+def _traits(
+    spec: Spec, letter: Letter, known: dict[Word, tuple[LetterTraits, ...]]
+) -> LetterTraits:
     """A letter's traits, kept in the words' cache as those of the one-letter word."""
     single = (letter,)
     found = known.get(single)
