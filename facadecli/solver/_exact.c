@@ -100,7 +100,16 @@ typedef struct {
     double *brhs;
     double *point; /* sized */
     double value;
+    struct Probes *probes; /* probe() of rows already asked about (lazily) */
 } System;
+
+/* probe() results of one system, by the row's bits */
+typedef struct Probes {
+    double *keys; /* n x nv */
+    double *values;
+    Py_ssize_t n, cap;
+    Py_ssize_t *slots, n_slots;
+} Probes;
 
 /* -- the path: columns linked back to the first ----------------------------------------- */
 
@@ -403,8 +412,74 @@ static System *system_new(Search *s, int npiv, int nb)
 
 static void system_drop(System *y)
 {
-    if (y && --y->refs == 0)
+    if (y && --y->refs == 0) {
+        if (y->probes) {
+            PyMem_Free(y->probes->keys);
+            PyMem_Free(y->probes->values);
+            PyMem_Free(y->probes->slots);
+            PyMem_Free(y->probes);
+        }
         PyMem_Free(y);
+    }
+}
+
+static uint64_t bits_hash(const double *v, int n)
+{
+    uint64_t h = 1469598103934665603ULL;
+    for (int i = 0; i < n; i++) {
+        uint64_t b;
+        memcpy(&b, &v[i], sizeof(b));
+        h ^= b;
+        h *= 1099511628211ULL;
+        h ^= h >> 32;
+    }
+    return h;
+}
+
+/* where the row's probe is kept (*found: it is there); -1 when out of memory */
+static Py_ssize_t probes_slot(Probes *p, const double *row, int nv, int *found)
+{
+    Py_ssize_t mask = p->n_slots - 1;
+    Py_ssize_t j = (Py_ssize_t)(bits_hash(row, nv) & (uint64_t)mask);
+    while (p->slots[j]) {
+        if (!memcmp(p->keys + (size_t)(p->slots[j] - 1) * nv, row, sizeof(double) * (size_t)nv)) {
+            *found = 1;
+            return j;
+        }
+        j = (j + 1) & mask;
+    }
+    *found = 0;
+    return j;
+}
+
+static int probes_grow(Probes *p, int nv)
+{
+    if (p->n == p->cap) {
+        Py_ssize_t cap = p->cap ? 2 * p->cap : 64;
+        double *keys = PyMem_Realloc(p->keys, sizeof(double) * (size_t)cap * nv);
+        if (!keys)
+            return -1;
+        p->keys = keys;
+        double *values = PyMem_Realloc(p->values, sizeof(double) * (size_t)cap);
+        if (!values)
+            return -1;
+        p->values = values;
+        p->cap = cap;
+    }
+    if (2 * (p->n + 1) > p->n_slots) {
+        Py_ssize_t n = p->n_slots ? 2 * p->n_slots : 128;
+        Py_ssize_t *slots = PyMem_Calloc((size_t)n, sizeof(Py_ssize_t));
+        if (!slots)
+            return -1;
+        PyMem_Free(p->slots);
+        p->slots = slots;
+        p->n_slots = n;
+        for (Py_ssize_t i = 0; i < p->n; i++) {
+            int found;
+            slots[probes_slot(p, p->keys + (size_t)i * nv, nv, &found)] = i + 1;
+        }
+    }
+    return 0;
 }
 
 /* the row with the pivot placeholders solved out (in place) */
@@ -529,8 +604,29 @@ static System *system_add(Search *s, System *y, const double *given, double rhs,
     return z;
 }
 
-/* the bound with ``row @ symbols == 0`` added (INF when it conflicts) */
-static double probe(Search *s, const System *y, const double *given)
+static double probe_of(Search *s, const System *y, const double *given);
+
+/* the bound with ``row @ symbols == 0`` added (INF when it conflicts), kept with the system
+ * (a child that adds no equality shares its parent's); NAN when out of memory */
+static double probe(Search *s, System *y, const double *given)
+{
+    int nv = s->nv, found;
+    if (!y->probes && !(y->probes = PyMem_Calloc(1, sizeof(Probes))))
+        return NAN;
+    Probes *p = y->probes;
+    if (probes_grow(p, nv) < 0)
+        return NAN;
+    Py_ssize_t j = probes_slot(p, given, nv, &found);
+    if (found)
+        return p->values[p->slots[j] - 1];
+    double value = probe_of(s, y, given);
+    memcpy(p->keys + (size_t)p->n * nv, given, sizeof(double) * (size_t)nv);
+    p->values[p->n] = value;
+    p->slots[j] = ++p->n;
+    return value;
+}
+
+static double probe_of(Search *s, const System *y, const double *given)
 {
     int nv = s->nv, sz = s->sized;
     double row[nv];
@@ -861,7 +957,17 @@ static char *fitting(Builder *b, int fr, int j, int r)
             double miss = dot(d, s->target, sz);
             alone = norm > 0 ? miss * miss / norm : 0.0;
         }
-        mask[i] = alone <= limit && probe(s, b->node->system, d) <= limit;
+        if (alone > limit) {
+            mask[i] = 0;
+            continue;
+        }
+        double value = probe(s, b->node->system, d);
+        if (isnan(value)) {
+            PyMem_Free(mask);
+            PyErr_NoMemory();
+            return NULL;
+        }
+        mask[i] = value <= limit;
     }
     *slot = mask;
     return mask;
@@ -1482,9 +1588,9 @@ static int int_list(PyObject *seq, int **out, int *n, int bound)
     return 0;
 }
 
-/* a row from (letters, above, covering); letters: (var, size or None, transparent, opaque,
- * attached, unoccludable, segment) */
-static int read_row(Search *s, Row *row, PyObject *spec, int R)
+/* a row from (letters, above, covering); letters: (symbol, size or None, transparent, opaque,
+ * attached, unoccludable, segment), the symbol numbered by ``variables`` */
+static int read_row(Search *s, Row *row, PyObject *spec, int R, PyObject *variables)
 {
     PyObject *letters, *above, *covering;
     if (!PyArg_ParseTuple(spec, "OOO", &letters, &above, &covering))
@@ -1508,17 +1614,20 @@ static int read_row(Search *s, Row *row, PyObject *spec, int R)
         return -1;
     }
     for (int k = 0; k < n; k++) {
-        PyObject *size;
+        PyObject *symbol, *size, *var;
         Letter *l = &row->letters[k];
         int t, o, a, u;
-        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(fast, k), "iOppppi", &l->var, &size, &t,
+        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(fast, k), "OOppppi", &symbol, &size, &t,
                               &o, &a, &u, &l->segment)) {
             Py_DECREF(fast);
             return -1;
         }
+        var = PyDict_GetItemWithError(variables, symbol);
+        l->var = var ? (int)PyLong_AsLong(var) : -1;
         if (l->var < 0 || l->var >= nv) {
             Py_DECREF(fast);
-            PyErr_SetString(PyExc_ValueError, "a letter's variable out of range");
+            if (!PyErr_Occurred())
+                PyErr_SetString(PyExc_ValueError, "a letter's symbol is not a variable");
             return -1;
         }
         l->size = size == Py_None ? NAN : PyFloat_AsDouble(size);
@@ -1542,20 +1651,19 @@ static int read_row(Search *s, Row *row, PyObject *spec, int R)
         int *ph = row->rem_ph[p] = alloc(sizeof(int) * (size_t)(2 * (nv - s->sized) + 1));
         if (!rem || !ph)
             return -1;
+        const double *all = row->counts + (size_t)n * nv;
+        const double *before = row->counts + (size_t)((p + 1) / 2) * nv;
         int m = 0;
         for (int v = s->sized; v < nv; v++) {
-            int count = 0;
-            for (int k = (p + 1) / 2; k < n; k++)
-                count += row->letters[k].var == v;
+            int count = (int)(all[v] - before[v]);
             if (count) {
                 ph[m++] = v;
                 ph[m++] = count;
             }
         }
         ph[m] = -1;
-        for (int k = (p + 1) / 2; k < n; k++)
-            if (row->letters[k].var < s->sized)
-                rem[row->letters[k].var] += 1.0;
+        for (int v = 0; v < s->sized; v++)
+            rem[v] = all[v] - before[v];
     }
     if (int_list(above, &row->above, &row->n_above, R) < 0 ||
         int_list(covering, &row->covering, &row->n_covering, R) < 0)
@@ -1567,14 +1675,15 @@ static int Search_init(Search *s, PyObject *args, PyObject *kwds)
 {
     static char *names[] = {"groups", "variables", "target", "canvas", "incumbent", "limit",
                             "used", "deadline", "first_only", "leaf", NULL};
-    PyObject *groups, *target, *leaf;
-    int nv, first_only;
+    PyObject *groups, *variables, *target, *leaf;
+    int first_only;
     double canvas, incumbent, deadline;
     long long limit, used;
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OiOddLLdpO", names, &groups, &nv, &target,
-                                     &canvas, &incumbent, &limit, &used, &deadline, &first_only,
-                                     &leaf))
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OO!OddLLdpO", names, &groups, &PyDict_Type,
+                                     &variables, &target, &canvas, &incumbent, &limit, &used,
+                                     &deadline, &first_only, &leaf))
         return -1;
+    int nv = (int)PyDict_GET_SIZE(variables);
     if (!PyCallable_Check(leaf)) {
         PyErr_SetString(PyExc_TypeError, "leaf must be callable");
         return -1;
@@ -1640,7 +1749,7 @@ static int Search_init(Search *s, PyObject *args, PyObject *kwds)
         }
         group->n = R;
         for (int r = 0; r < R; r++) {
-            if (read_row(s, &group->rows[r], PySequence_Fast_GET_ITEM(rows, r), R) < 0) {
+            if (read_row(s, &group->rows[r], PySequence_Fast_GET_ITEM(rows, r), R, variables) < 0) {
                 group->n = r + 1;
                 Py_DECREF(rows);
                 Py_DECREF(gfast);

@@ -2,7 +2,7 @@
 
 from collections.abc import Callable, Sequence
 
-Letter = tuple[int, float | None, bool, bool, bool, bool, int]
+Letter = tuple[str, float | None, bool, bool, bool, bool, int]
 RowSpec = tuple[Sequence[Letter], Sequence[int], Sequence[int]]
 Cuts = list[list[tuple[tuple[int, int] | None, ...]]]
 
@@ -13,7 +13,7 @@ class Search:
     def __init__(
         self,
         groups: Sequence[Sequence[RowSpec]],
-        variables: int,
+        variables: dict[str, int],
         target: Sequence[float],
         canvas: float,
         incumbent: float,

@@ -22,6 +22,7 @@ costs more columns win (the paper's tie-break).
 from __future__ import annotations
 
 import bisect
+import functools
 import math
 import time
 from collections import Counter
@@ -150,6 +151,23 @@ class _Row:
                 counts[row.word[k].symbol] = counts.get(row.word[k].symbol, 0) + 1
             self.unsized_after[k] = counts
 
+    @functools.cached_property
+    def letters(self) -> list[tuple[str, float | None, bool, bool, bool, bool, int]]:
+        """Its letters as the compiled search reads them: symbol, preferred size (None for
+        a placeholder), transparent, opaque, attached, unoccludable, segment."""
+        return [
+            (
+                letter.symbol,
+                traits.size,
+                traits.transparent,
+                traits.opaque,
+                traits.attached,
+                traits.unoccludable,
+                traits.segment,
+            )
+            for letter, traits in zip(self.row.word, self.row.traits, strict=True)
+        ]
+
     def remaining(self, position: int, left: float, sizes: Sizes) -> float:
         """Least length the row still has to lay out from ``position`` on."""
         k, inside = divmod(position, 2)
@@ -175,9 +193,9 @@ class _Row:
         """The entry from ``start`` to ``end`` (a middle piece when they are equal), if any."""
         key = (start, end)
         found = self.spans.get(key, self)
-        if found is self:
+        if found is self:  # made alone: the entries out of ``start`` grow toward ``end``
             found = self.spans[key] = next(
-                (m for m in self.moves(start)[0] if m.end == end and m.middle == (start == end)),
+                (m for m in self._moves(start) if m.end == end and m.middle == (start == end)),
                 None,
             )
         return found  # type: ignore[return-value]

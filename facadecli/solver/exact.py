@@ -724,33 +724,14 @@ class _Compiled:
 
     def __init__(self, search: _Search):
         self.search = search
-        variables = search.variables
         groups = [
-            [
-                (
-                    [
-                        (
-                            variables[letter.symbol],
-                            traits.size,
-                            traits.transparent,
-                            traits.opaque,
-                            traits.attached,
-                            traits.unoccludable,
-                            traits.segment,
-                        )
-                        for letter, traits in zip(row.row.word, row.row.traits, strict=True)
-                    ],
-                    group.above[r],
-                    group.covering[r],
-                )
-                for r, row in enumerate(group.rows)
-            ]
+            [(row.letters, group.above[r], group.covering[r]) for r, row in enumerate(group.rows)]
             for group in search.groups
         ]
         budget = search.budget
         self.table = _exact.Search(
             groups,
-            len(variables),
+            search.variables,
             search.target.tolist(),
             search.canvas,
             search.incumbent,
