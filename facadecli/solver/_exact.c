@@ -1311,6 +1311,11 @@ static int leaf(Search *s, const Node *node)
 {
     if (spend(s, LEAF_WORK) < 0)
         return -1;
+    if (!s->leaf) {
+        PyErr_SetString(PyExc_RuntimeError, "the search has no leaf() any more");
+        s->stop = STOP_ERROR;
+        return -1;
+    }
     PyObject *paths = PyList_New(s->G);
     if (!paths)
         goto error;
@@ -1549,14 +1554,27 @@ static void free_groups(Search *s)
     s->groups = NULL;
 }
 
+static int Search_traverse(Search *s, visitproc visit, void *arg)
+{
+    Py_VISIT(s->leaf);
+    return 0;
+}
+
+static int Search_clear(Search *s)
+{
+    Py_CLEAR(s->leaf);
+    return 0;
+}
+
 static void Search_dealloc(Search *s)
 {
+    PyObject_GC_UnTrack(s);
     free_groups(s);
     PyMem_Free(s->target);
     PyMem_Free(s->done);
     PyMem_Free(s->rej);
     PyMem_Free(s->rej_slots);
-    Py_XDECREF(s->leaf);
+    Py_CLEAR(s->leaf);
     Py_TYPE(s)->tp_free((PyObject *)s);
 }
 
@@ -1854,7 +1872,9 @@ static PyMethodDef Search_methods[] = {
 static PyTypeObject SearchType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "facadecli.solver._exact.Search",
     .tp_basicsize = sizeof(Search),
-    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC, /* leaf() may hold the search */
+    .tp_traverse = (traverseproc)Search_traverse,
+    .tp_clear = (inquiry)Search_clear,
     .tp_doc = "The exact search of one candidate's groups (see facadecli.solver.exact).",
     .tp_new = PyType_GenericNew,
     .tp_init = (initproc)Search_init,
