@@ -18,6 +18,10 @@ is optimal and "none" is a proof.
 
 All work is counted in *work units* (columns bounded, layouts sized), never in seconds, so
 the same input gives the same answer on any machine.
+
+The search runs compiled (``_exact.c``, driven by :class:`_Compiled`; complete layouts are
+still sized here). :class:`_Search` is the same search in Python: the reference the tests
+compare it with, column for column (the same layouts, reasons and work units).
 """
 
 from __future__ import annotations
