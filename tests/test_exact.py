@@ -7,6 +7,7 @@ import itertools
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -564,3 +565,41 @@ def test_the_compiled_search_spends_the_references_work_on_every_candidate(
         runs.append(list(calls))
     assert len(runs[0]) > 3
     assert runs[0] == runs[1]
+
+
+def test_a_finished_compiled_search_is_collected() -> None:
+    """The compiled search holds its leaf(), which holds the search: the cycle must be
+    collectable, or every search keeps its moves (a city leaked megabytes a façade)."""
+    import gc
+    import weakref
+
+    spec, rows = _rows(
+        """
+        version: 1
+        name: cycle
+        canvas: {width: 3.0, height: 1}
+        symbols: {A: {size: 1.0, opaque: true}, F: 1}
+        patterns: {f: F}
+        layers:
+          - {name: wall, x: 'A A A', y: f}
+        """
+    )
+    search = exact._Search(  # type: ignore[call-arg]
+        spec,
+        3.0,
+        [exact._Group("default", [_Row(r) for r in rows], [[]], [[]], (6,))],
+        Budget(10**6),
+        exact.INF,
+        {"A": 0},
+        np.array([1.0]),
+    )
+    compiled = exact._Compiled(search)
+    try:
+        compiled.run()
+    except exact._Perfect:  # a layout at preferred sizes: the search stops there
+        pass
+    assert search.best is not None and search.best.sizing.objective == pytest.approx(0.0)
+    alive = weakref.ref(compiled)
+    del compiled
+    gc.collect()
+    assert alive() is None
