@@ -570,6 +570,7 @@ def test_the_compiled_search_spends_the_references_work_on_every_candidate(
 def test_a_finished_compiled_search_is_collected() -> None:
     """The compiled search holds its leaf(), which holds the search: the cycle must be
     collectable, or every search keeps its moves (a city leaked megabytes a façade)."""
+    import contextlib
     import gc
     import weakref
 
@@ -594,10 +595,8 @@ def test_a_finished_compiled_search_is_collected() -> None:
         np.array([1.0]),
     )
     compiled = exact._Compiled(search)
-    try:
+    with contextlib.suppress(exact._Perfect):  # a layout at preferred sizes: it stops there
         compiled.run()
-    except exact._Perfect:  # a layout at preferred sizes: the search stops there
-        pass
     assert search.best is not None and search.best.sizing.objective == pytest.approx(0.0)
     alive = weakref.ref(compiled)
     del compiled
