@@ -1808,6 +1808,10 @@ static PyObject *Search_run(Search *s, PyObject *args)
     s->gaps = gaps;
     s->stop = GO;
     s->recording = 1;
+    if (s->G == 0) {
+        PyErr_SetString(PyExc_ValueError, "a search needs a group of rows");
+        return NULL;
+    }
     System *empty = system_new(s, 0, 0);
     if (!empty)
         return NULL;
