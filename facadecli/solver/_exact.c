@@ -423,12 +423,14 @@ static void system_drop(System *y)
     }
 }
 
-static uint64_t bits_hash(const double *v, int n)
+/* FNV-1a over 64-bit words, folded: the key of the probe and rejection tables */
+static uint64_t words_hash(const void *key, size_t bytes)
 {
+    const unsigned char *p = key;
     uint64_t h = 1469598103934665603ULL;
-    for (int i = 0; i < n; i++) {
+    for (size_t i = 0; i + 8 <= bytes; i += 8) {
         uint64_t b;
-        memcpy(&b, &v[i], sizeof(b));
+        memcpy(&b, p + i, sizeof(b));
         h ^= b;
         h *= 1099511628211ULL;
         h ^= h >> 32;
@@ -440,7 +442,7 @@ static uint64_t bits_hash(const double *v, int n)
 static Py_ssize_t probes_slot(Probes *p, const double *row, int nv, int *found)
 {
     Py_ssize_t mask = p->n_slots - 1;
-    Py_ssize_t j = (Py_ssize_t)(bits_hash(row, nv) & (uint64_t)mask);
+    Py_ssize_t j = (Py_ssize_t)(words_hash(row, sizeof(double) * (size_t)nv) & (uint64_t)mask);
     while (p->slots[j]) {
         if (!memcmp(p->keys + (size_t)(p->slots[j] - 1) * nv, row, sizeof(double) * (size_t)nv)) {
             *found = 1;
@@ -645,16 +647,6 @@ static double probe_of(Search *s, const System *y, const double *given)
 
 /* -- rejections ----------------------------------------------------------------------------- */
 
-static uint64_t rej_hash(const int *k)
-{
-    uint64_t h = 1469598103934665603ULL;
-    for (int i = 0; i < 6; i++) {
-        h ^= (uint32_t)k[i];
-        h *= 1099511628211ULL;
-    }
-    return h ^ (h >> 31);
-}
-
 static int reject(Search *s, int code, int g, int r, int a, const Move *m)
 {
     if (!s->recording)
@@ -669,7 +661,7 @@ static int reject(Search *s, int code, int g, int r, int a, const Move *m)
             return 0;
         }
         for (Py_ssize_t i = 0; i < s->n_rej; i++) {
-            Py_ssize_t j = (Py_ssize_t)(rej_hash(&s->rej[i].code) & (uint64_t)(n - 1));
+            Py_ssize_t j = (Py_ssize_t)(words_hash(&s->rej[i].code, 6 * sizeof(int)) & (uint64_t)(n - 1));
             while (slots[j])
                 j = (j + 1) & (n - 1);
             slots[j] = i + 1;
@@ -678,7 +670,7 @@ static int reject(Search *s, int code, int g, int r, int a, const Move *m)
         s->rej_slots = slots;
         s->n_rej_slots = n;
     }
-    Py_ssize_t j = (Py_ssize_t)(rej_hash(key) & (uint64_t)(s->n_rej_slots - 1));
+    Py_ssize_t j = (Py_ssize_t)(words_hash(key, sizeof(key)) & (uint64_t)(s->n_rej_slots - 1));
     while (s->rej_slots[j]) {
         Rejection *e = &s->rej[s->rej_slots[j] - 1];
         if (!memcmp(&e->code, key, sizeof(key))) {

@@ -752,6 +752,16 @@ class _Compiled:
         search.budget.used = self.table.used
         search.budget.timed_out = self.table.timed_out
         search.incumbent = self.table.incumbent
+        if search.best is None:  # the reasons are read only when nothing was found
+            self.reasons()
+        if status == _EXHAUSTED:
+            raise BudgetExhausted
+        if status == _STOPPED:
+            raise _Perfect
+
+    def reasons(self) -> None:
+        """The compiled search's rejections, worded, into the search's (as it counts them)."""
+        search = self.search
         search.rejections.clear()
         for rule, g, r, above, start, end, progress, count in self.table.rejections():
             group = search.groups[g]
@@ -759,10 +769,6 @@ class _Compiled:
             why = search.why(rule, group, r, move, above)
             before, times = search.rejections.get(why, (0, 0))
             search.rejections[why] = (max(before, progress), times + count)
-        if status == _EXHAUSTED:
-            raise BudgetExhausted
-        if status == _STOPPED:
-            raise _Perfect
 
     def leaf(self, cuts: list[list[tuple[tuple[int, int] | None, ...]]]) -> tuple[float, bool]:
         """Size a complete alignment given by its cuts: the incumbent after it, and whether

@@ -14,6 +14,7 @@ bound, and ``search_solve`` calls Clarabel directly for the searches' many small
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -195,23 +196,25 @@ def _equality_solution(program: Program) -> tuple[np.ndarray, bool]:
     # z = H^-1 (f - E^T nu),  (E H^-1 E^T) nu = E H^-1 f - d
     e_scaled = e / h
     b = e_scaled @ f - d
-    if len(d) >= FACTOR_ROWS:  # a long façade: an LU is faster, and as exact when it holds
-        import scipy.sparse as sparse  # its rows hold a few symbols each
-
-        rows = sparse.csr_matrix(e)
-        normal = (rows.multiply(1.0 / h).tocsr() @ rows.T).toarray()
-        try:
+    long = len(d) >= FACTOR_ROWS
+    normal = _sparse_normal(e, h) if long else e_scaled @ e.T
+    if long:  # an LU is faster than least squares, and as exact when it meets the equalities
+        with contextlib.suppress(np.linalg.LinAlgError):  # exactly singular: dependent rows
             z: np.ndarray = (f - e.T @ np.linalg.solve(normal, b)) / h
-        except np.linalg.LinAlgError:  # exactly singular: dependent equalities
-            pass
-        else:
             if np.abs(e @ z - d).max(initial=0.0) <= 1e-9 * max(1.0, float(np.abs(d).max())):
                 return z, True
-    else:
-        normal = e_scaled @ e.T
     nu, *_ = np.linalg.lstsq(normal, b, rcond=None)
     z = (f - e.T @ nu) / h
     return z, bool(np.abs(e @ z - d).max(initial=0.0) <= 1e-6)
+
+
+def _sparse_normal(e: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """``E H^-1 E^T`` for a long façade's equalities, multiplied sparse (each row holds a
+    few symbols)."""
+    import scipy.sparse as sparse
+
+    rows = sparse.csr_matrix(e)
+    return np.asarray((rows.multiply(1.0 / h).tocsr() @ rows.T).toarray())
 
 
 def _closed_form(program: Program) -> Sizing | np.ndarray:
