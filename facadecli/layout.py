@@ -157,30 +157,73 @@ def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
     solid shapes of later layers that stand flush on them (no gap between, so no oblique
     view sees behind them). A shape behind one that stands proud stays."""
     order = {name: i for i, name in enumerate(dict.fromkeys(s.layer for s in shapes))}
-    opaque = [s for s in shapes if s.opaque and s.mesh in SOLID_BACK]
-    if not opaque:
+    solids = [
+        (s.x0, s.x1, s.y0, s.y1, s.z1, order[s.layer], getattr(s, SOLID_BACK[s.mesh]), s)
+        for s in shapes
+        if s.opaque and s.mesh in SOLID_BACK
+    ]
+    if not solids:
         return tuple(shapes)
-    boxes = np.array(
-        [
-            (s.x0, s.x1, s.y0, s.y1, s.z1, order[s.layer], getattr(s, SOLID_BACK[s.mesh]))
-            for s in opaque
-        ]
-    )
+    grid = _Grid(solids)
     result = []
     for shape in shapes:
-        near = (
-            (boxes[:, 5] > order[shape.layer])
-            & (boxes[:, 4] >= shape.z1)
-            & (boxes[:, 6] <= shape.z1 + 1e-9)
-            & (boxes[:, 0] < shape.x1)
-            & (boxes[:, 1] > shape.x0)
-            & (boxes[:, 2] < shape.y1)
-            & (boxes[:, 3] > shape.y0)
+        layer, z, left, right, low, high = (
+            order[shape.layer],
+            shape.z1,
+            shape.x0,
+            shape.x1,
+            shape.y0,
+            shape.y1,
         )
-        occluders = [opaque[i] for i in np.flatnonzero(near)]
+        occluders = [
+            o
+            for x0, x1, y0, y1, front, o_layer, back, o in grid.near(left, right, low, high)
+            if o_layer > layer
+            and front >= z
+            and back <= z + 1e-9
+            and x0 < right
+            and x1 > left
+            and y0 < high
+            and y1 > low
+        ]
         hidden = bool(occluders) and _covered(shape, occluders)
         result.append(replace(shape, visible=False) if hidden else shape)
     return tuple(result)
+
+
+# a solid shape: x0, x1, y0, y1, front, its layer's place (back to front), the depth its
+# mesh fills from, and the shape
+_Solid = tuple[float, float, float, float, float, int, float, Shape]
+
+
+class _Grid:
+    """Solid shapes filed by the cells of a grid over the façade that they overlap, to find
+    those near a rectangle without looking at all of them."""
+
+    def __init__(self, solids: list[_Solid]):
+        self.x0, self.y0 = min(s[0] for s in solids), min(s[2] for s in solids)
+        # cells about as large as a typical shape, so that a shape overlaps a few
+        count = 2 * len(solids)
+        width, height = max(s[1] for s in solids) - self.x0, max(s[3] for s in solids) - self.y0
+        self.dx = max(float(np.median([s[1] - s[0] for s in solids])), width / count, 1e-6)
+        self.dy = max(float(np.median([s[3] - s[2] for s in solids])), height / count, 1e-6)
+        self.cells: dict[tuple[int, int], list[_Solid]] = {}
+        for solid in solids:
+            for cell in self._cells(*solid[:4]):
+                self.cells.setdefault(cell, []).append(solid)
+
+    def _cells(self, x0: float, x1: float, y0: float, y1: float) -> list[tuple[int, int]]:
+        xs = range(max(0, int((x0 - self.x0) / self.dx)), int((x1 - self.x0) / self.dx) + 1)
+        ys = range(max(0, int((y0 - self.y0) / self.dy)), int((y1 - self.y0) / self.dy) + 1)
+        return [(i, j) for i in xs for j in ys]
+
+    def near(self, x0: float, x1: float, y0: float, y1: float) -> list[_Solid]:
+        """The solids filed in the cells the rectangle overlaps (one filed in several of
+        them comes once for each)."""
+        cells = self._cells(x0, x1, y0, y1)
+        if len(cells) == 1:
+            return self.cells.get(cells[0], [])
+        return [solid for cell in cells for solid in self.cells.get(cell, ())]
 
 
 def _covered(shape: Shape, occluders: list[Shape]) -> bool:

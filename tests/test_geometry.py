@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import random
 import shutil
 import subprocess
 from pathlib import Path
@@ -17,6 +18,7 @@ from facadecli.export.obj import obj_files
 from facadecli.geometry.facade import facade_scene
 from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
 from facadecli.geometry.runs import built
+from facadecli.layout import SOLID_BACK, Shape, _covered, _cull
 from tests.rays import directions, missing, nearest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -338,3 +340,61 @@ def test_labels_never_print_over_each_other(path: Path) -> None:
                 and a[2] < b[3] - 1e-9
                 and b[2] < a[3] - 1e-9
             )
+
+
+def _culled_by_brute_force(shapes: list[Shape]) -> list[bool]:
+    """Which shapes are hidden, looking at every pair (what the cull's grid must find)."""
+    order = {name: i for i, name in enumerate(dict.fromkeys(s.layer for s in shapes))}
+    solid = [s for s in shapes if s.opaque and s.mesh in SOLID_BACK]
+    hidden = []
+    for shape in shapes:
+        occluders = [
+            o
+            for o in solid
+            if order[o.layer] > order[shape.layer]
+            and o.z1 >= shape.z1
+            and getattr(o, SOLID_BACK[o.mesh]) <= shape.z1 + 1e-9
+            and o.x0 < shape.x1
+            and o.x1 > shape.x0
+            and o.y0 < shape.y1
+            and o.y1 > shape.y0
+        ]
+        hidden.append(bool(occluders) and _covered(shape, occluders))
+    return hidden
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_cull_hides_what_looking_at_every_pair_hides(seed: int) -> None:
+    """Random stacks of layers on a long façade: cells of a common grid (flush, proud or
+    behind), some shapes many cells wide or tall, some not opaque or not solid."""
+    rng = random.Random(seed)
+    shapes = []
+    for layer in range(6):
+        z = rng.choice([0.0, 0.1, 0.2]) + 0.1 * layer
+        for _ in range(rng.randint(20, 120)):
+            x0, y0 = rng.randint(0, 60) * 0.5, rng.randint(0, 12) * 0.5
+            wide = rng.random() < 0.1
+            x1 = x0 + 0.5 * (rng.randint(10, 60) if wide else rng.randint(1, 3))
+            y1 = y0 + 0.5 * (rng.randint(4, 12) if rng.random() < 0.1 else rng.randint(1, 2))
+            shapes.append(
+                Shape(
+                    layer=f"layer{layer}",
+                    x="A",
+                    y="B",
+                    x0=x0,
+                    x1=x1,
+                    y0=y0,
+                    y1=y1,
+                    z0=round(z - 0.1, 6),
+                    z1=round(z, 6),
+                    material="m",
+                    mesh=rng.choice(["box", "box", "box", "frame", "panel"]),
+                    reflected_x=False,
+                    reflected_y=False,
+                    opaque=rng.random() < 0.8,
+                )
+            )
+    culled = _cull(shapes)
+    expected = _culled_by_brute_force(shapes)
+    assert [not s.visible for s in culled] == expected
+    assert sum(expected) > 10  # the case hides something

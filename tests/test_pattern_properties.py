@@ -7,7 +7,14 @@ import itertools
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from facadecli.patterns import compile_pattern, enumerate_words, make_word, mirror, parse_pattern
+from facadecli.patterns import (
+    Letter,
+    compile_pattern,
+    enumerate_words,
+    make_word,
+    mirror,
+    parse_pattern,
+)
 from facadecli.patterns.ast import to_text
 from tests.acceptor import accepts
 
@@ -105,3 +112,27 @@ def test_substitution_puts_one_content_word_everywhere(content: str, control: li
         assert all(run in (first, mirror(first)) for run in runs)
         assert all(not lt.transparent for run in runs for lt in run)
         assert all(lt.transparent for lt in item.word if lt.placeholder is None)
+
+
+@settings(max_examples=40, deadline=None)
+@given(patterns(SYMBOLS))
+def test_every_word_the_pattern_accepts_is_enumerated(text: str) -> None:
+    """Completeness: every word of up to three letters (each symbol plain or reflected) that
+    the independent acceptor takes, the enumerator yields (and nothing else)."""
+    pattern = compile_pattern(text)
+    found = enumerate_words(
+        pattern,
+        sizes=SIZES,
+        max_length=100.0,
+        counters={"k": (0, None), "m": (0, None)},  # the acceptor's: from 0, unbounded
+        max_letters=3,
+    )
+    enumerated = {item.word for item in itertools.islice(found, 5000)}
+    letters = [Letter(symbol, reflected) for symbol in SYMBOLS for reflected in (False, True)]
+    accepted = {
+        word
+        for size in range(4)
+        for word in itertools.product(letters, repeat=size)
+        if accepts(pattern.root, word)
+    }
+    assert enumerated == accepted

@@ -9,7 +9,9 @@ import pytest
 import yaml
 
 from facadecli import InfeasibleError, load_spec, make_word, parse_spec, retarget, solve
+from facadecli.solver import candidates
 from facadecli.solver.alignment import align, score_alignment
+from facadecli.solver.axis import axis_words
 from facadecli.solver.candidates import (
     generate_candidates,
     pattern_uses,
@@ -432,3 +434,43 @@ def test_the_better_layout_wins_at_any_scale(scale: float) -> None:
         )
     )
     assert solve(spec).x.counters == {"n": 10}
+
+
+SHARED_COUNTER = """
+version: 1
+name: shared
+canvas: {{width: 12, height: 1}}
+symbols: {{A: 1, B: 1.5, C: 2, H: 1}}
+counters: {{n: {{min: 1}}}}
+patterns: {{first: "{first}", second: "{second}"}}
+layers:
+  - {{name: a, x: first, y: H}}
+  - {{name: b, x: second, y: H}}
+"""
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("A (B A)^n", "C^n A"),  # every word of the first sets n: the second's range narrows
+        ("(B^n | C C C)", "A^n"),  # a branch without n agrees with any n: nothing narrows
+        ("A^n B^n", "(A | B)^n C"),
+    ],
+)
+def test_candidates_are_those_of_patterns_enumerated_on_their_own(
+    first: str, second: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Enumerating a pattern within the range of a counter that the patterns before it have
+    fixed leaves the candidates as they were."""
+    spec = parse_spec(SHARED_COUNTER.format(first=first, second=second))
+    uses = pattern_uses(spec, axis_words(spec, "x"))
+
+    def described() -> list[tuple[object, ...]]:
+        return [
+            (c.key, c.counters, tuple(e.word for e in c.words.values()))
+            for c in generate_candidates(spec, uses, 12.0, 500)
+        ]
+
+    narrowed = described()
+    monkeypatch.setattr(candidates, "_seen_counters", lambda pattern, found: {})
+    assert narrowed and narrowed == described()

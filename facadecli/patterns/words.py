@@ -153,6 +153,8 @@ class _Expander:
         self.max_letters = max_letters
         self.keys = pattern.keys()
         self.letters: dict[tuple[int, str, bool], Letter] = {}
+        self.frames: dict[tuple[int, str, bool], tuple[Frame, ...]] = {}
+        self.settled: dict[tuple[int, str, bool], tuple[Word, tuple[float, ...]] | None] = {}
 
     # -- lower bounds over what is still to expand -------------------------------------
     def minimum(self, node: Node, scope: str, env: Mapping[str, int]) -> tuple[float, int]:
@@ -232,9 +234,8 @@ class _Expander:
                     if length > self.max_length + EPS or len(out) > self.max_letters:
                         return
                 elif isinstance(node, Seq):
-                    items = reversed(node.items) if frame.reflect else node.items
-                    for item in reversed(tuple(items)):
-                        stack = (Frame(item, frame.scope, frame.reflect), stack)
+                    for child in self.children(node, frame):
+                        stack = (child, stack)
                 elif isinstance(node, Alt):
                     key = self.keys[id(node)]
                     if key in env:
@@ -249,18 +250,27 @@ class _Expander:
                 else:
                     reflect = frame.reflect != _reflects(node)
                     body = Frame(node.body, frame.scope, reflect)
-                    if isinstance(node.count, Fixed):
-                        stack = _push(stack, body, abs(node.count.value))
-                        continue
-                    key = self.count_key(node, frame.scope)
-                    if key in env:
-                        stack = _push(stack, body, env[key])
+                    fixed = isinstance(node.count, Fixed)
+                    key = "" if fixed else self.count_key(node, frame.scope)
+                    if fixed or key in env:
+                        times = abs(node.count.value) if fixed else env[key]  # type: ignore[union-attr]
+                        settled = self.settle(body)
+                        if settled is None:
+                            stack = _push(stack, body, times)
+                            continue
+                        letters, sizes = settled  # no decision inside: its letters at once
+                        for _ in range(times):
+                            out.extend(letters)
+                            for size in sizes:
+                                length += size
+                        if length > self.max_length + EPS or len(out) > self.max_letters:
+                            return
                         continue
                     low, high = self.count_range(node)
                     value = low
                     while high is None or value <= high:
                         count_env = {**env, key: value}
-                        count_stack = _push(stack, body, value)
+                        count_stack = (frame, stack)  # expanded with the count now set
                         if not self.fits(count_stack, count_env, length, len(out)):
                             break  # lengths never shrink as a count grows
                         yield from self.expand(count_stack, count_env, out, length)
@@ -269,6 +279,47 @@ class _Expander:
             yield env, tuple(out), length
         finally:
             del out[mark:]
+
+    def settle(self, frame: Frame) -> tuple[Word, tuple[float, ...]] | None:
+        """The letters a piece of pattern with no decision in it makes, with their sizes
+        (0 unsized); None if it has a decision (an alternation or a free count)."""
+        key = (id(frame.node), frame.scope, frame.reflect)
+        if key in self.settled:
+            return self.settled[key]
+        node = frame.node
+        found: tuple[Word, tuple[float, ...]] | None = None
+        if isinstance(node, Sym):
+            if not frame.scope and node.name in self.pattern.contents:
+                content = self.pattern.contents[node.name]
+                found = self.settle(Frame(content, node.name, frame.reflect))
+            else:
+                found = (self.letter(node, frame),), (self.sizes.get(node.name) or 0.0,)
+        elif isinstance(node, Seq):
+            parts = [self.settle(child) for child in reversed(self.children(node, frame))]
+            if all(part is not None for part in parts):
+                found = (
+                    tuple(letter for part in parts if part for letter in part[0]),
+                    tuple(size for part in parts if part for size in part[1]),
+                )
+        elif isinstance(node, Repeat) and isinstance(node.count, Fixed):
+            reflect = frame.reflect != _reflects(node)
+            body = self.settle(Frame(node.body, frame.scope, reflect))
+            if body is not None:
+                times = abs(node.count.value)
+                found = body[0] * times, body[1] * times
+        self.settled[key] = found
+        return found
+
+    def children(self, node: Seq, frame: Frame) -> tuple[Frame, ...]:
+        """The frames of a sequence's items, last first (the order they are pushed in)."""
+        key = (id(node), frame.scope, frame.reflect)
+        children = self.frames.get(key)
+        if children is None:
+            items = reversed(node.items) if frame.reflect else node.items
+            children = self.frames[key] = tuple(
+                Frame(item, frame.scope, frame.reflect) for item in reversed(tuple(items))
+            )
+        return children
 
     def count_range(self, node: Repeat) -> tuple[int, int | None]:
         count = node.count

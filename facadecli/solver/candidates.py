@@ -56,17 +56,6 @@ class Candidate:
         return (round(self.need, 9), round(self.misfit, 9), round(self.shortfall, 6), self.order)
 
 
-def opaque_length(spec: Spec, item: Enumerated) -> float:
-    """Preferred length of the opaque letters of a word (what lower layers may make room for)."""
-    total = 0.0
-    for letter in item.word:
-        qualifiers = spec.qualifiers(letter.symbol)
-        size = spec.size(letter.symbol)
-        if size and qualifiers.opaque and not (letter.transparent or qualifiers.transparent):
-            total += size
-    return total
-
-
 def word_need(length: float, elastic: bool, canvas: float, made_room: float) -> float:
     """Least mu with ``canvas - mu - made_room <= length <= canvas + mu`` (Eq. 7)."""
     over = length - canvas
@@ -121,7 +110,15 @@ def generate_candidates(
         words[use.key] = list(itertools.islice(enumerated, WORDS_PER_PATTERN))
         if not words[use.key]:
             return []
-    opaque = {id(item): opaque_length(spec, item) for found in words.values() for item in found}
+        bounds.update(_seen_counters(use.pattern, words[use.key]))
+    opaque_of = _opaque_sizes(spec)
+    opaque = {
+        id(item): sum(
+            opaque_of.get(letter.symbol, 0.0) for letter in item.word if not letter.transparent
+        )
+        for found in words.values()
+        for item in found
+    }
     clusters = _clusters(uses)
     options = [_cluster_options(cluster, words) for cluster in clusters]
     if any(not cluster_options for cluster_options in options):
@@ -137,13 +134,40 @@ def generate_candidates(
         scored.sort(key=lambda item: (item[0], item[1]))
         ranked.append([option for _, _, option in scored])
     candidates = []
+    above = _layers_above(uses)
     for order, combination in enumerate(_best_combinations(ranked, limit)):
         merged: dict[str, Enumerated] = {}
         for option in combination:
             merged.update(option)
-        candidates.append(_candidate(uses, merged, canvas, order, opaque))
+        candidates.append(_candidate(above, merged, canvas, order, opaque))
     candidates.sort(key=lambda candidate: candidate.key)
     return candidates
+
+
+def _seen_counters(
+    pattern: CompiledPattern, found: Sequence[Enumerated]
+) -> dict[str, tuple[int, int]]:
+    """The range of each named counter over a pattern's words, for a counter that every
+    word sets: words of the patterns after it that share the counter agree with one of
+    them only within it (a pattern whose words leave a counter unset agrees with any)."""
+    seen = {}
+    for name in pattern.counter_names():
+        values = [item.choice.counters.get(name) for item in found]
+        known = [value for value in values if value is not None]
+        if len(known) == len(values):
+            seen[name] = (min(known), max(known))
+    return seen
+
+
+def _opaque_sizes(spec: Spec) -> dict[str, float]:
+    """Preferred size of every sized, opaque, non-transparent symbol."""
+    sizes = {}
+    for name in spec.symbols:
+        qualifiers = spec.qualifiers(name)
+        size = spec.size(name)
+        if size and qualifiers.opaque and not qualifiers.transparent:
+            sizes[name] = size
+    return sizes
 
 
 def _clusters(uses: Sequence[PatternUse]) -> list[list[PatternUse]]:
@@ -241,8 +265,25 @@ def _best_combinations(
                     heapq.heappush(heap, (sum(successor), successor))
 
 
+def _layers_above(uses: Sequence[PatternUse]) -> list[tuple[str, tuple[str, ...]]]:
+    """Per layer using a pattern: (its pattern, the patterns of the layers above it in its
+    group, one per layer)."""
+    return [
+        (
+            use.key,
+            tuple(
+                other.key
+                for other in uses
+                if any(g == group and i > layer for i, g in other.layers)
+            ),
+        )
+        for use in uses
+        for layer, group in use.layers
+    ]
+
+
 def _candidate(
-    uses: Sequence[PatternUse],
+    above: Sequence[tuple[str, tuple[str, ...]]],
     words: Mapping[str, Enumerated],
     canvas: float,
     order: int,
@@ -251,21 +292,16 @@ def _candidate(
     """A candidate with its exact Eq. 7 need (opaque room from the chosen words above)."""
     opaque = {key: opaque_of[id(item)] for key, item in words.items()}
     need = misfit = shortfall = slack = 0.0
-    for use in uses:
-        item = words[use.key]
-        for layer, group in use.layers:
-            room = sum(
-                opaque[other.key]
-                for other in uses
-                if any(g == group and i > layer for i, g in other.layers)
-            )
-            row_need = word_need(item.length, item.elastic, canvas, room)
-            need = max(need, row_need)
-            misfit += row_need * row_need
-            if item.elastic:
-                slack += max(0.0, canvas - item.length)
-            else:
-                shortfall += max(0.0, canvas - item.length - row_need)
+    for key, keys_above in above:
+        item = words[key]
+        room = sum(opaque[other] for other in keys_above)
+        row_need = word_need(item.length, item.elastic, canvas, room)
+        need = max(need, row_need)
+        misfit += row_need * row_need
+        if item.elastic:
+            slack += max(0.0, canvas - item.length)
+        else:
+            shortfall += max(0.0, canvas - item.length - row_need)
     counters: dict[str, int] = {}
     for item in words.values():
         counters.update(item.choice.counters)

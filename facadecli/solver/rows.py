@@ -77,18 +77,27 @@ def make_rows(
     ``full``: the layers that show all along the other axis; ``known``: the traits of
     words met before (a cache the caller keeps)."""
     known = {} if known is None else known
-    by_word: dict[tuple[Word, int], list[int]] = {}
+    # a long word is hashed once a call: equal words are found by value, then by identity
+    equal: dict[Word, tuple[Word, bool]] = {}
+    seen: dict[int, tuple[Word, bool]] = {}
+    by_word: dict[tuple[int, int], list[int]] = {}
     for layer, word in sorted(words, key=lambda item: item[0]):
-        traits = known.get(word)
-        if traits is None:
-            traits = known[word] = tuple(_traits(spec, letter, known) for letter in word)
+        found = seen.get(id(word))
+        if found is None:
+            found = equal.get(word)
+            if found is None:
+                traits = known.get(word)
+                if traits is None:
+                    traits = known[word] = tuple(_traits(spec, letter, known) for letter in word)
+                found = equal[word] = (word, any(t.unoccludable for t in traits))
+            seen[id(word)] = found
         # a word with an unoccludable letter keeps a row of its own in every layer: the same
         # word in front would cover it, so the front layer must be free to make room
-        alone = layer if any(t.unoccludable for t in traits) else -1
-        by_word.setdefault((word, alone), []).append(layer)
+        alone = layer if found[1] else -1
+        by_word.setdefault((id(found[0]), alone), []).append(layer)
     rows = [
         Row(tuple(layers), word, known[word], full_height=all(layer in full for layer in layers))
-        for (word, _), layers in by_word.items()
+        for word, layers in ((seen[key][0], layers) for (key, _), layers in by_word.items())
     ]
     return sorted(rows, key=lambda row: row.lowest)
 

@@ -8,13 +8,14 @@ symbols of (size - preferred)^2, plus a tiny weight on everything else so that t
 solution is unique (a placeholder covers as little as it can).
 
 When no bound is active the optimum is the equality-constrained problem's, solved in
-closed form (a few hundred microseconds); otherwise ``solve`` is the cvxpy QP with every
+closed form: the equalities are eliminated one variable at a time (sparse: an entry's row
+holds a few letters), which leaves the few free lengths the layout really has, and the
+objective over those is a small linear system. Otherwise ``solve`` is the cvxpy QP with every
 bound, and ``search_solve`` calls Clarabel directly for the searches' many small QPs.
 """
 
 from __future__ import annotations
 
-import contextlib
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -26,7 +27,7 @@ from facadecli.spec.model import Spec
 
 TINY = 1e-8  # weight of unsized variables: breaks ties, never trades against a deviation
 MIN_SIZE = 1e-3  # every sized letter is at least a millimetre long
-FACTOR_ROWS = 200  # equalities from which the closed form tries an LU before least squares
+ZERO = 1e-12  # coefficients smaller than this are rounding left by an elimination
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,7 @@ class Program:
     upper: np.ndarray
     equalities: np.ndarray
     rhs: np.ndarray
+    rows: list[tuple[dict[int, float], float]]  # the equalities, sparse: coefficients, rhs
     symbols: dict[str, int]
     columns: dict[tuple[str, int], int]
     pieces: dict[Piece, int]
@@ -154,6 +156,7 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
         upper=np.array(upper),
         equalities=matrix,
         rhs=np.array([value for _, value in rows]),
+        rows=rows,
         symbols=symbols,
         columns=columns,
         pieces=pieces,
@@ -187,34 +190,86 @@ def _result(program: Program, values: np.ndarray) -> Sizing:
 
 def _equality_solution(program: Program) -> tuple[np.ndarray, bool]:
     """The minimiser under the equalities alone (bounds ignored), in closed form, and
-    whether it meets them: the normal equations weigh sized symbols against the TINY
-    weights of columns and placeholders, so a large layout can miss them by rounding
-    where they do not conflict at all (a QP solver then decides)."""
-    h = 2.0 * program.weight
+    whether the equalities hold: they are eliminated (:func:`_parametrized`), leaving
+    ``z = z0 + N y`` over the free lengths ``y``, and the objective over ``y`` is the
+    small positive definite system ``(N^T W N) y = N^T W (t - z0)``."""
+    n = len(program.names)
+    parametrized = _parametrized(program.rows, n)
+    if parametrized is None:  # the equalities contradict each other
+        return program.target.copy(), False
+    z0, free = parametrized
+    w = program.weight
+    if free.shape[1]:
+        weighted = free.T * w
+        y = np.linalg.solve(weighted @ free, weighted @ (program.target - z0))
+        z = z0 + free @ y
+    else:
+        z = z0
     e, d = program.equalities, program.rhs
-    f = h * program.target
-    # z = H^-1 (f - E^T nu),  (E H^-1 E^T) nu = E H^-1 f - d
-    e_scaled = e / h
-    b = e_scaled @ f - d
-    long = len(d) >= FACTOR_ROWS
-    normal = _sparse_normal(e, h) if long else e_scaled @ e.T
-    if long:  # an LU is faster than least squares, and as exact when it meets the equalities
-        with contextlib.suppress(np.linalg.LinAlgError):  # exactly singular: dependent rows
-            z: np.ndarray = (f - e.T @ np.linalg.solve(normal, b)) / h
-            if np.abs(e @ z - d).max(initial=0.0) <= 1e-9 * max(1.0, float(np.abs(d).max())):
-                return z, True
-    nu, *_ = np.linalg.lstsq(normal, b, rcond=None)
-    z = (f - e.T @ nu) / h
-    return z, bool(np.abs(e @ z - d).max(initial=0.0) <= 1e-6)
+    scale = max(1.0, float(np.abs(d).max(initial=0.0)))
+    return z, bool(np.abs(e @ z - d).max(initial=0.0) <= 1e-9 * scale)
 
 
-def _sparse_normal(e: np.ndarray, h: np.ndarray) -> np.ndarray:
-    """``E H^-1 E^T`` for a long façade's equalities, multiplied sparse (each row holds a
-    few symbols)."""
-    import scipy.sparse as sparse
+def _parametrized(
+    rows: Sequence[tuple[Mapping[int, float], float]], n: int
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Every solution of the sparse equalities ``rows`` over ``n`` variables as
+    ``z0 + N y`` (``y`` the free variables), or None when they contradict each other.
 
-    rows = sparse.csr_matrix(e)
-    return np.asarray((rows.multiply(1.0 / h).tocsr() @ rows.T).toarray())
+    Gaussian elimination, a row at a time, shortest rows first: the row is written over
+    the variables still free, and one of them (the largest coefficient; the latest
+    variable on a tie) becomes its expression in the others, which replaces it in every
+    expression that named it (``users`` says which)."""
+    solved: dict[int, tuple[dict[int, float], float]] = {}  # variable -> (expression, constant)
+    users: dict[int, set[int]] = {}  # free variable -> solved variables naming it
+    scale = max((abs(rhs) for _, rhs in rows), default=0.0)
+    for coefficients, rhs in sorted(rows, key=lambda row: len(row[0])):
+        terms: dict[int, float] = {}
+        left = rhs
+        for v, c in coefficients.items():
+            if v in solved:
+                expression, k = solved[v]
+                left -= c * k
+                for u, a in expression.items():
+                    terms[u] = terms.get(u, 0.0) + c * a
+            else:
+                terms[v] = terms.get(v, 0.0) + c
+        terms = {u: c for u, c in terms.items() if abs(c) > ZERO}
+        if not terms:
+            if abs(left) > 1e-9 * max(1.0, scale):
+                return None
+            continue
+        pivot = max(terms, key=lambda u: (abs(terms[u]), u))
+        a = terms.pop(pivot)
+        expression = {u: -c / a for u, c in terms.items()}
+        constant = left / a
+        for v in users.pop(pivot, ()):
+            named, k = solved[v]
+            c = named.pop(pivot)
+            for u, b in expression.items():
+                value = named.get(u, 0.0) + c * b
+                if abs(value) > ZERO:
+                    named[u] = value
+                    users.setdefault(u, set()).add(v)
+                elif u in named:
+                    del named[u]
+                    users[u].discard(v)
+            solved[v] = named, k + c * constant
+        solved[pivot] = expression, constant
+        for u in expression:
+            users.setdefault(u, set()).add(pivot)
+    free = [v for v in range(n) if v not in solved]
+    column = {v: j for j, v in enumerate(free)}
+    z0 = np.zeros(n)
+    basis = np.zeros((n, len(free)))
+    for v in range(n):
+        if v in column:
+            basis[v, column[v]] = 1.0
+            continue
+        expression, z0[v] = solved[v]
+        for u, c in expression.items():
+            basis[v, column[u]] = c
+    return z0, basis
 
 
 def _closed_form(program: Program) -> Sizing | np.ndarray:

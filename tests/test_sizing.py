@@ -1,0 +1,85 @@
+"""The sizing's closed form: the equalities eliminated into the free lengths, checked
+against dense linear algebra on random systems."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from facadecli.solver import sizing
+
+
+def random_system(seed: int, rows: int, variables: int) -> tuple[np.ndarray, np.ndarray]:
+    """Sparse integer equalities with a solution, some rows repeated or summed (dependent),
+    as a façade's are (an entry as long as its column, the same letters in many columns)."""
+    rng = np.random.default_rng(seed)
+    e = np.zeros((rows, variables))
+    for row in e:
+        picked = rng.choice(variables, size=rng.integers(1, 5), replace=False)
+        row[picked] = rng.choice([-1.0, 1.0, 2.0], size=len(picked))
+    dependent = rng.choice(rows, size=(rows // 4, 2))
+    e = np.vstack([e, *(e[a] + e[b] for a, b in dependent)])
+    z = rng.uniform(0.5, 3.0, variables)
+    return e, e @ z
+
+
+def sparse(e: np.ndarray, d: np.ndarray) -> list[tuple[dict[int, float], float]]:
+    return [
+        ({int(j): float(row[j]) for j in np.flatnonzero(row)}, float(rhs))
+        for row, rhs in zip(e, d, strict=True)
+    ]
+
+
+def program(e: np.ndarray, d: np.ndarray, weight: np.ndarray, target: np.ndarray) -> sizing.Program:
+    n = e.shape[1]
+    return sizing.Program(
+        names=[f"z{i}" for i in range(n)],
+        target=target,
+        weight=weight,
+        lower=np.full(n, -np.inf),
+        upper=np.full(n, np.inf),
+        equalities=e,
+        rhs=d,
+        rows=sparse(e, d),
+        symbols={},
+        columns={},
+        pieces={},
+        sized=[i for i in range(n) if weight[i] == 1.0],
+    )
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_every_solution_of_the_equalities_is_parametrized(seed: int) -> None:
+    e, d = random_system(seed, rows=20 + seed, variables=30)
+    found = sizing._parametrized(sparse(e, d), e.shape[1])
+    assert found is not None
+    z0, basis = found
+    assert basis.shape[1] == e.shape[1] - np.linalg.matrix_rank(e)  # as free as it is
+    for y in np.random.default_rng(seed).normal(size=(5, basis.shape[1])):
+        assert e @ (z0 + basis @ y) == pytest.approx(d, abs=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_equalities_that_contradict_each_other_have_no_parametrization(seed: int) -> None:
+    e, d = random_system(seed, rows=20, variables=30)
+    e = np.vstack([e, e[3] + e[7]])
+    d = np.append(d, d[3] + d[7] + 0.5)  # the sum of two rows, off by half a metre
+    assert sizing._parametrized(sparse(e, d), e.shape[1]) is None
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_closed_form_is_the_weighted_least_squares_optimum(seed: int) -> None:
+    """The minimiser of sum w (z - t)^2 under E z = d, with the solver's two weights (a
+    sized symbol 1, a column or placeholder TINY), equals the dense KKT system's."""
+    e, d = random_system(seed, rows=15, variables=30)
+    rng = np.random.default_rng(seed + 100)
+    weight = np.where(rng.random(30) < 0.5, 1.0, sizing.TINY)
+    target = np.where(weight == 1.0, rng.uniform(0.5, 3.0, 30), 0.0)
+    z, meets = sizing._equality_solution(program(e, d, weight, target))
+    assert meets
+    particular = np.linalg.lstsq(e, d, rcond=None)[0]
+    free = scipy.linalg.null_space(e)  # an SVD: no elimination
+    weighted = free.T * weight
+    y = np.linalg.solve(weighted @ free, weighted @ (target - particular))
+    assert z == pytest.approx(particular + free @ y, abs=1e-6)
