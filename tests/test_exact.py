@@ -602,3 +602,31 @@ def test_a_finished_compiled_search_is_collected() -> None:
     del compiled
     gc.collect()
     assert alive() is None
+
+
+@pytest.mark.parametrize(("layers", "bays"), [(24, 4), (12, 6)])
+def test_a_path_with_an_empty_piece_is_left_for_the_one_without(
+    layers: int, bays: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An entry that ends with the first piece of a split letter which the equalities make
+    empty is the same layout as the letter starting a column later: the search leaves it,
+    and finds the same best layout (the same drawing) with fewer layouts sized."""
+    spec = parse_spec(generated_spec(layers, bays))
+    monkeypatch.setattr(exact, "COMPILED", False)  # the reference, where the rule can be lifted
+    settled = exact._Search.settle
+    sized: list[int] = []
+
+    def counted(search: exact._Search, paths: list[list[exact.Column]]) -> None:
+        sized.append(1)
+        settled(search, paths)
+
+    monkeypatch.setattr(exact._Search, "settle", counted)
+    drawings, counts = [], []
+    for lifted in (False, True):
+        if lifted:
+            monkeypatch.setattr(exact._Search, "empty_piece", lambda *args: False)
+        sized.clear()
+        drawings.append(svg_text(solve(spec), labels=True))
+        counts.append(len(sized))
+    assert drawings[0] == drawings[1]
+    assert counts[0] < counts[1]

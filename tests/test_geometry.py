@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import random
 import shutil
@@ -398,3 +399,9 @@ def test_the_cull_hides_what_looking_at_every_pair_hides(seed: int) -> None:
     expected = _culled_by_brute_force(shapes)
     assert [not s.visible for s in culled] == expected
     assert sum(expected) > 10  # the case hides something
+
+
+def test_a_hidden_shape_keeps_every_other_field() -> None:
+    layout = solve(parse_spec(HIDDEN.format(offset=0.3, mesh="")))
+    for shape in layout.shapes:
+        assert shape.hidden() == dataclasses.replace(shape, visible=False)

@@ -426,15 +426,20 @@ static void system_drop(System *y)
 /* FNV-1a over 64-bit words, folded: the key of the probe and rejection tables */
 static uint64_t words_hash(const void *key, size_t bytes)
 {
+    /* each word multiplied on its own (the products pipeline), then mixed */
     const unsigned char *p = key;
-    uint64_t h = 1469598103934665603ULL;
+    uint64_t h = 1469598103934665603ULL, k = 0x9E3779B97F4A7C15ULL;
     for (size_t i = 0; i + 8 <= bytes; i += 8) {
         uint64_t b;
         memcpy(&b, p + i, sizeof(b));
-        h ^= b;
-        h *= 1099511628211ULL;
-        h ^= h >> 32;
+        h += (b ^ (b >> 31)) * k;
+        k += 0xD6E8FEB86659FD93ULL;
     }
+    h ^= h >> 33;
+    h *= 0xFF51AFD7ED558CCDULL;
+    h ^= h >> 33;
+    h *= 0xC4CEB9FE1A85EC53ULL;
+    h ^= h >> 33;
     return h;
 }
 
@@ -1205,6 +1210,35 @@ static double bound_within(Search *s, int g, const System *y, const double *x,
     return best;
 }
 
+/* whether the equalities make ``row @ symbols`` zero */
+static int implies_zero(const Search *s, const System *y, const double *given)
+{
+    int nv = s->nv, sz = s->sized;
+    double row[nv];
+    memcpy(row, given, sizeof(double) * (size_t)nv);
+    double rhs = reduce(s, y, row, 0.0);
+    for (int j = sz; j < nv; j++)
+        if (fabs(row[j]) > 1e-9)
+            return 0;
+    rhs = orthogonal(s, y, row, rhs);
+    return dot(row, row, sz) <= 1e-18 && fabs(rhs) <= 1e-7 * s->canvas;
+}
+
+/* whether an entry ends with the first piece of a split letter that the equalities make
+ * empty, after whole letters: the same layout has the letter start in the next column,
+ * and that path is searched instead (not when the letter and the next are of two
+ * segments: the next column's entries then differ) */
+static int empty_piece(const Search *s, const Row *row, const Move *m, const double *used,
+                       const System *y)
+{
+    if (!m || m->tail < 0 || m->start == m->end - 1)
+        return 0;
+    int k = m->end / 2;
+    if (k + 1 < row->n && row->letters[k].segment != row->letters[k + 1].segment)
+        return 0;
+    return implies_zero(s, y, used);
+}
+
 /* the child of a node through a column: NULL when its equalities conflict (no error) */
 static Node *child_of(Search *s, int g, const Node *node, Move **entries, int *failed)
 {
@@ -1266,6 +1300,11 @@ static Node *child_of(Search *s, int g, const Node *node, Move **entries, int *f
                 *failed = 1;
         }
     }
+    for (int r = 0; r < R && y && !*failed; r++)
+        if (empty_piece(s, &group->rows[r], entries[r], c->used + (size_t)r * nv, y)) {
+            system_drop(y);
+            y = NULL;
+        }
     if (!y || *failed) {
         system_drop(y);
         node_free(c);

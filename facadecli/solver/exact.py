@@ -200,6 +200,15 @@ class _System:
         residual = rhs - float(a @ self.point)
         return self.value + residual * residual / norm2
 
+    def implies_zero(self, row: np.ndarray, scale: float) -> bool:
+        """Whether the equalities make ``row @ symbols`` zero."""
+        row, rhs = self._reduce(row, 0.0)
+        free = np.abs(row[self.sized :])
+        if free.size and free.max() > 1e-9:
+            return False
+        a, rhs = self._orthogonal(row[: self.sized], rhs)
+        return float(a @ a) <= 1e-18 and abs(rhs) <= 1e-7 * scale
+
     def _reduce(self, row: np.ndarray, rhs: float) -> tuple[np.ndarray, float]:
         """The row with the pivot placeholders solved out."""
         for v, pivot, pivot_rhs in self.pivots:
@@ -552,7 +561,27 @@ class _Search:
                 used[r] = width - known
             elif known is not width and system is not None:
                 system = system.add(known - width, 0.0, self.canvas)
+        if system is not None and any(
+            self.empty_piece(g, r, move, used[r], system) for r, move in enumerate(entries)
+        ):
+            system = None
         return system, width, tuple(used)
+
+    def empty_piece(
+        self, g: int, r: int, move: Move | None, used: np.ndarray | None, system: _System
+    ) -> bool:
+        """Whether an entry ends with the first piece of a split letter that the equalities
+        make empty, after whole letters. Then the same layout has the letter start in the
+        next column (this entry without the piece: the same equalities, one split fewer),
+        and that path is searched instead. Not when the letter and the next are of two
+        segments: the next column's entries then differ."""
+        if move is None or move.tail is None or used is None or move.start == move.end - 1:
+            return False
+        traits = self.groups[g].rows[r].row.traits
+        k = move.end // 2
+        if k + 1 < len(traits) and traits[k].segment != traits[k + 1].segment:
+            return False
+        return system.implies_zero(used, self.canvas)
 
     def filling(self, system: _System | None) -> _System | None:
         """A row without gaps (no row in front may make room for it, or the run allows
