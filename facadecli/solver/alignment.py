@@ -152,6 +152,12 @@ class _Row:
             self.unsized_after[k] = counts
 
     @functools.cached_property
+    def symbols(self) -> dict[str, float | None]:
+        """Its symbols with their preferred sizes (None for a placeholder)."""
+        pairs = zip(self.row.word, self.row.traits, strict=True)
+        return {letter.symbol: traits.size for letter, traits in pairs}
+
+    @functools.cached_property
     def letters(self) -> list[tuple[str, float | None, bool, bool, bool, bool, int]]:
         """Its letters as the compiled search reads them: symbol, preferred size (None for
         a placeholder), transparent, opaque, attached, unoccludable, segment."""

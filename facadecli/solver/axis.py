@@ -180,6 +180,7 @@ class _SearchMemory:
     prefixes: Prefixes = field(default_factory=dict)
     rows: dict[int, dict[str, list[Row]]] = field(default_factory=dict)  # by candidate order
     prepared: dict[Row, _Row] = field(default_factory=dict)  # rows with their moves cached
+    counted: dict[tuple[int, bool], tuple[Word, exact.Counts]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -322,7 +323,11 @@ def solve_axis_alternatives(
     # once the best layout found is within it: nothing better can exist. Low thresholds cut
     # hopeless columns at once, so the first passes are cheap.
     bounds = sorted(
-        (exact.candidate_bound(_candidate_rows(spec, uses, c, memory), canvas), c.key, c)
+        (
+            exact.candidate_bound(_candidate_rows(spec, uses, c, memory), canvas, memory.counted),
+            c.key,
+            c,
+        )
         for c in candidates
     )
     heuristic_done = alternatives > 1

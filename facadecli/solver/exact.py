@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from facadecli.patterns import Word
 from facadecli.solver import _exact, columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row
 from facadecli.solver.rows import Row
@@ -740,8 +741,17 @@ class _Search:
         if solved is None:
             self.sizing_failure = sizing.explain_infeasible(program)
             return
-        found = Found(*columns.finest(self.spec, self.canvas, groups, program, solved))
-        if self.best is None or found.rank < self.best.rank:
+        # cut into its finest columns, a layout keeps its sizes and has no fewer split
+        # letters or holes: one already behind the best before the cut stays behind
+        behind = self.best is not None and (
+            Found(groups, program, solved).rank[:4] > self.best.rank[:4]
+        )
+        found = (
+            None
+            if behind
+            else Found(*columns.finest(self.spec, self.canvas, groups, program, solved))
+        )
+        if found is not None and (self.best is None or found.rank < self.best.rank):
             self.best = found
             self.incumbent = min(self.incumbent, solved.objective)
         if solved.objective <= SAME or self.first_only:
@@ -938,19 +948,11 @@ def align_exactly(
                 tuple(2 * len(row.word) for row in rows),
             )
         )
-    sized = sorted(
-        {
-            letter.symbol
-            for group in prepared
-            for row in group.rows
-            for letter in row.row.word
-            if spec.size(letter.symbol) is not None
-        }
-    )
-    placeholders = sorted(
-        {letter.symbol for group in prepared for row in group.rows for letter in row.row.word}
-        - set(sized)
-    )
+    symbols = {
+        name: size for group in prepared for row in group.rows for name, size in row.symbols.items()
+    }
+    sized = sorted(name for name, size in symbols.items() if size is not None)
+    placeholders = sorted(name for name, size in symbols.items() if size is None)
     variables = {name: i for i, name in enumerate([*sized, *placeholders])}
     target = np.array([spec.size(name) for name in sized], dtype=float)
     search = _Search(
@@ -990,16 +992,33 @@ def align_exactly(
     return Outcome(search.best, True, reason)
 
 
-def candidate_bound(groups: Mapping[str, Sequence[Row]], canvas: float) -> float:
+Counts = dict[str, tuple[int, float]]  # symbol -> (letters, preferred size)
+
+
+def candidate_bound(
+    groups: Mapping[str, Sequence[Row]],
+    canvas: float,
+    counted: dict[tuple[int, bool], tuple[Word, Counts]] | None = None,
+) -> float:
     """A lower bound on the objective of any layout of a candidate's rows, from one row at
     a time (the paper's Eq. 7 with sizes free): a row longer than the canvas at preferred
     sizes must shrink (placeholders only grow); a row without placeholders that is
     shorter must grow, unless opaque letters of the rows in front may cover its gaps: then
     its letters and theirs together must reach the canvas."""
+    known = {} if counted is None else counted
+
+    def counts(row: Row, opaque_only: bool) -> Counts:
+        """The row's sized letters (a candidate's words are shared with the others: their
+        counts are kept by the word's identity, with the word, so it stays the same)."""
+        found = known.get((id(row.word), opaque_only))
+        if found is None:
+            found = known[id(row.word), opaque_only] = (row.word, _sized_counts(row, opaque_only))
+        return found[1]
+
     best = 0.0
     for rows in groups.values():
         for row in rows:
-            own = _sized_counts(row, opaque_only=False)
+            own = counts(row, opaque_only=False)
             if not own:
                 continue
             longer = _excess(own, canvas)
@@ -1009,14 +1028,14 @@ def candidate_bound(groups: Mapping[str, Sequence[Row]], canvas: float) -> float
             reach = dict(own)
             for other in rows:
                 if other.covers(row):
-                    for name, (count, size) in _sized_counts(other, opaque_only=True).items():
+                    for name, (count, size) in counts(other, opaque_only=True).items():
                         reach[name] = (reach.get(name, (0, size))[0] + count, size)
             best = max(best, _excess(reach, canvas, shorter=True))
     return best
 
 
-def _sized_counts(row: Row, opaque_only: bool) -> dict[str, tuple[int, float]]:
-    counts: dict[str, tuple[int, float]] = {}
+def _sized_counts(row: Row, opaque_only: bool) -> Counts:
+    counts: Counts = {}
     for letter, traits in zip(row.word, row.traits, strict=True):
         if traits.size is not None and (traits.opaque or not opaque_only):
             counts[letter.symbol] = (counts.get(letter.symbol, (0, 0.0))[0] + 1, traits.size)

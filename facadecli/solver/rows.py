@@ -47,6 +47,10 @@ class Row:
     traits: tuple[LetterTraits, ...]
     full_height: bool = True  # its layers cover the whole other axis (see covers())
 
+    def __hash__(self) -> int:
+        # the traits follow from the word (hashing them calls Python for every letter)
+        return hash((self.layers, self.word, self.full_height))
+
     @property
     def lowest(self) -> int:
         return self.layers[0]
