@@ -295,16 +295,17 @@ def uncovered_area(layout: Layout) -> float:
     Each axis is aligned on its own, so a lower layer may make room on one axis for a
     layer that does not cover that room on the other axis (SPEC 2.4's per-axis rule);
     this finds such holes in the plane."""
-    xs = np.unique(
-        [0.0, layout.width, *(s.x0 for s in layout.shapes), *(s.x1 for s in layout.shapes)]
-    )
-    ys = np.unique(
-        [0.0, layout.height, *(s.y0 for s in layout.shapes), *(s.y1 for s in layout.shapes)]
-    )
-    covered = np.zeros((len(xs) - 1, len(ys) - 1), dtype=bool)
-    for shape in layout.shapes:
-        i0, i1 = np.searchsorted(xs, [shape.x0, shape.x1])
-        j0, j1 = np.searchsorted(ys, [shape.y0, shape.y1])
-        covered[i0:i1, j0:j1] = True
+    boxes = np.array([(s.x0, s.x1, s.y0, s.y1) for s in layout.shapes]).reshape(-1, 4)
+    xs = np.unique(np.concatenate([[0.0, layout.width], boxes[:, 0], boxes[:, 1]]))
+    ys = np.unique(np.concatenate([[0.0, layout.height], boxes[:, 2], boxes[:, 3]]))
+    i0, i1 = np.searchsorted(xs, boxes[:, 0]), np.searchsorted(xs, boxes[:, 1])
+    j0, j1 = np.searchsorted(ys, boxes[:, 2]), np.searchsorted(ys, boxes[:, 3])
+    # every shape adds one to the cells it covers: corners of a difference table, summed
+    counts = np.zeros((len(xs), len(ys)), dtype=np.int64)
+    np.add.at(counts, (i0, j0), 1)
+    np.add.at(counts, (i1, j0), -1)
+    np.add.at(counts, (i0, j1), -1)
+    np.add.at(counts, (i1, j1), 1)
+    covered = counts.cumsum(axis=0).cumsum(axis=1)[:-1, :-1] > 0
     areas = np.outer(np.diff(xs), np.diff(ys))
     return float(areas[~covered].sum())

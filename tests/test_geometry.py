@@ -7,10 +7,12 @@ import json
 import random
 import shutil
 import subprocess
+import types
 from pathlib import Path
 
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 from facadecli import load_spec, parse_spec, solve
@@ -19,7 +21,7 @@ from facadecli.export.obj import obj_files
 from facadecli.geometry.facade import facade_scene
 from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
 from facadecli.geometry.runs import built
-from facadecli.layout import SOLID_BACK, Shape, _covered, _cull
+from facadecli.layout import SOLID_BACK, Shape, _covered, _cull, uncovered_area
 from tests.rays import directions, missing, nearest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -405,3 +407,21 @@ def test_a_hidden_shape_keeps_every_other_field() -> None:
     layout = solve(parse_spec(HIDDEN.format(offset=0.3, mesh="")))
     for shape in layout.shapes:
         assert shape.hidden() == dataclasses.replace(shape, visible=False)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_uncovered_area_is_the_canvas_less_the_union_of_the_shapes(seed: int) -> None:
+    rng = random.Random(seed)
+    rectangles = []
+    for _ in range(rng.randint(5, 60)):
+        x0, y0 = rng.uniform(0, 9), rng.uniform(0, 5)
+        rectangles.append(
+            (x0, min(10.0, x0 + rng.uniform(0.1, 4)), y0, min(6.0, y0 + rng.uniform(0.1, 3)))
+        )
+    shapes = [
+        Shape("l", "A", "B", x0, x1, y0, y1, 0.0, 0.1, "m", "box", False, False, True)
+        for x0, x1, y0, y1 in rectangles
+    ]
+    layout = types.SimpleNamespace(width=10.0, height=6.0, shapes=shapes)
+    union = shapely.unary_union([shapely.box(x0, y0, x1, y1) for x0, x1, y0, y1 in rectangles])
+    assert uncovered_area(layout) == pytest.approx(60.0 - union.area, abs=1e-9)  # type: ignore[arg-type]

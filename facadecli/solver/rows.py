@@ -85,6 +85,9 @@ def make_rows(
     equal: dict[Word, tuple[Word, bool]] = {}
     seen: dict[int, tuple[Word, bool]] = {}
     by_word: dict[tuple[int, int], list[int]] = {}
+    unoccludable = spec.symbol_defaults.unoccludable or any(
+        spec.qualifiers(name).unoccludable for name in spec.symbols
+    )
     for layer, word in sorted(words, key=lambda item: item[0]):
         found = seen.get(id(word))
         if found is None:
@@ -93,7 +96,10 @@ def make_rows(
                 traits = known.get(word)
                 if traits is None:
                     traits = known[word] = tuple(_traits(spec, letter, known) for letter in word)
-                found = equal[word] = (word, any(t.unoccludable for t in traits))
+                found = equal[word] = (
+                    word,
+                    unoccludable and any(t.unoccludable for t in traits),
+                )
             seen[id(word)] = found
         # a word with an unoccludable letter keeps a row of its own in every layer: the same
         # word in front would cover it, so the front layer must be free to make room
