@@ -180,6 +180,7 @@ class _SearchMemory:
     prefixes: Prefixes = field(default_factory=dict)
     rows: dict[int, dict[str, list[Row]]] = field(default_factory=dict)  # by candidate order
     prepared: dict[Row, _Row] = field(default_factory=dict)  # rows with their moves cached
+    made: dict[tuple[int, tuple[int, ...]], Row] = field(default_factory=dict)  # make_rows()
     counted: dict[tuple[int, bool], tuple[Word, exact.Counts]] = field(default_factory=dict)
 
 
@@ -205,7 +206,7 @@ def _align_candidate(
     aligned: dict[str, Alignment] = {}
     nodes = 0
     for group, members in sorted(_group_rows(spec, uses, candidate.words).items()):
-        rows = make_rows(spec, members, memory.full, memory.traits)
+        rows = make_rows(spec, members, memory.full, memory.traits, memory.made)
         key = (group, tuple(row.word for row in rows))
         if key not in memory.groups:
             memory.groups[key] = align(rows, canvas, mu, deadline, effort, memory.prefixes)
@@ -422,7 +423,7 @@ def _candidate_rows(
     rows = memory.rows.get(candidate.order)
     if rows is None:
         rows = memory.rows[candidate.order] = {
-            group: make_rows(spec, members, memory.full, memory.traits)
+            group: make_rows(spec, members, memory.full, memory.traits, memory.made)
             for group, members in _group_rows(spec, uses, candidate.words).items()
         }
     return rows

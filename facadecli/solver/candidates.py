@@ -198,21 +198,37 @@ def _cluster_options(
 ) -> list[dict[str, Enumerated]]:
     """Joint word choices of a cluster whose shared counters agree."""
     options: list[dict[str, Enumerated]] = []
+    # each pattern's words with their counters, and filed by the values of the counters
+    # that every one of them sets and a pattern before it names (the join's usual keys)
+    filed = []
+    named: set[str] = set()
+    for use in cluster:
+        items = [(item, item.choice.counters) for item in words[use.key]]
+        keys = tuple(
+            sorted(n for n in use.pattern.counter_names() & named if all(n in c for _, c in items))
+        )
+        index: dict[tuple[int, ...], list[tuple[Enumerated, dict[str, int]]]] = {}
+        for item, values in items:
+            index.setdefault(tuple(values[n] for n in keys), []).append((item, values))
+        filed.append((items, keys, index))
+        named |= use.pattern.counter_names()
 
-    def extend(index: int, chosen: dict[str, Enumerated], counters: dict[str, int]) -> None:
+    def extend(i: int, chosen: dict[str, Enumerated], counters: dict[str, int]) -> None:
         if len(options) >= OPTIONS_PER_CLUSTER:
             return
-        if index == len(cluster):
+        if i == len(cluster):
             options.append(dict(chosen))
             return
-        use = cluster[index]
-        for item in words[use.key]:
-            values = item.choice.counters
+        items, keys, index = filed[i]
+        if all(n in counters for n in keys):
+            items = index.get(tuple(counters[n] for n in keys), [])
+        key = cluster[i].key
+        for item, values in items:
             if any(counters.get(name, value) != value for name, value in values.items()):
                 continue
-            chosen[use.key] = item
-            extend(index + 1, chosen, {**counters, **values})
-            del chosen[use.key]
+            chosen[key] = item
+            extend(i + 1, chosen, {**counters, **values})
+            del chosen[key]
 
     extend(0, {}, {})
     return options

@@ -76,11 +76,14 @@ def make_rows(
     words: list[tuple[int, Word]],
     full: frozenset[int] = frozenset(),
     known: dict[Word, tuple[LetterTraits, ...]] | None = None,
+    made: dict[tuple[int, tuple[int, ...]], Row] | None = None,
 ) -> list[Row]:
     """Rows of one group from (layer index, word) pairs; identical words share a row.
     ``full``: the layers that show all along the other axis; ``known``: the traits of
-    words met before (a cache the caller keeps)."""
+    words met before, ``made``: rows made before (by their word's identity and layers;
+    the row holds the word, so it stays the same): caches the caller keeps."""
     known = {} if known is None else known
+    made = {} if made is None else made
     # a long word is hashed once a call: equal words are found by value, then by identity
     equal: dict[Word, tuple[Word, bool]] = {}
     seen: dict[int, tuple[Word, bool]] = {}
@@ -105,10 +108,14 @@ def make_rows(
         # word in front would cover it, so the front layer must be free to make room
         alone = layer if found[1] else -1
         by_word.setdefault((id(found[0]), alone), []).append(layer)
-    rows = [
-        Row(tuple(layers), word, known[word], full_height=all(layer in full for layer in layers))
-        for word, layers in ((seen[key][0], layers) for (key, _), layers in by_word.items())
-    ]
+    rows = []
+    for (key, _), layers in by_word.items():
+        row = made.get((key, tuple(layers)))
+        if row is None:
+            word = seen[key][0]
+            full_height = all(layer in full for layer in layers)
+            row = made[key, tuple(layers)] = Row(tuple(layers), word, known[word], full_height)
+        rows.append(row)
     return sorted(rows, key=lambda row: row.lowest)
 
 
