@@ -1918,11 +1918,314 @@ static PyTypeObject SearchType = {
     .tp_getset = Search_getset,
 };
 
+/* -- the sizing's elimination (sizing._parametrized, compiled) -------------------------- */
+
+typedef struct {
+    int *v;
+    double *c;
+    int n, cap;
+} Sparse; /* (variable, coefficient) pairs, in the order they came */
+
+static int sparse_push(Sparse *e, int v, double c)
+{
+    if (e->n == e->cap) {
+        int cap = e->cap ? 2 * e->cap : 4;
+        int *vs = PyMem_Realloc(e->v, sizeof(int) * (size_t)cap);
+        if (!vs)
+            return -1;
+        e->v = vs;
+        double *cs = PyMem_Realloc(e->c, sizeof(double) * (size_t)cap);
+        if (!cs)
+            return -1;
+        e->c = cs;
+        e->cap = cap;
+    }
+    e->v[e->n] = v;
+    e->c[e->n] = c;
+    e->n++;
+    return 0;
+}
+
+typedef struct {
+    int n;
+    Sparse *expr;  /* per solved variable: its expression in the free ones */
+    double *konst; /* ... and its constant */
+    char *solved;
+    Sparse *users; /* per variable: solved variables whose expression named it (maybe no more) */
+    double *acc;   /* scratch, one per variable */
+    int *at;       /* scratch: where a variable is in the expression being changed, or -1 */
+} Elimination;
+
+static void elimination_free(Elimination *el)
+{
+    for (int v = 0; v < el->n; v++) {
+        if (el->expr) {
+            PyMem_Free(el->expr[v].v);
+            PyMem_Free(el->expr[v].c);
+        }
+        if (el->users) {
+            PyMem_Free(el->users[v].v);
+            PyMem_Free(el->users[v].c);
+        }
+    }
+    PyMem_Free(el->expr);
+    PyMem_Free(el->users);
+    PyMem_Free(el->konst);
+    PyMem_Free(el->solved);
+    PyMem_Free(el->acc);
+    PyMem_Free(el->at);
+}
+
+typedef struct {
+    Py_ssize_t index, length;
+} RowOrder;
+
+static int row_order(const void *a, const void *b)
+{
+    const RowOrder *x = a, *y = b;
+    if (x->length != y->length)
+        return x->length < y->length ? -1 : 1;
+    return x->index < y->index ? -1 : x->index > y->index;
+}
+
+/* substitute pivot p = expr + konst into the expression of solved variable v */
+static int substitute(Elimination *el, int v, int p, double zero)
+{
+    Sparse *e = &el->expr[v];
+    const Sparse *x = &el->expr[p];
+    int k = -1;
+    for (int i = 0; i < e->n; i++)
+        if (e->v[i] == p) {
+            k = i;
+            break;
+        }
+    if (k < 0)
+        return 0; /* named it once, not any more */
+    double c = e->c[k];
+    e->n--; /* p out, the last in its place */
+    e->v[k] = e->v[e->n];
+    e->c[k] = e->c[e->n];
+    for (int i = 0; i < e->n; i++)
+        el->at[e->v[i]] = i;
+    for (int i = 0; i < x->n; i++) {
+        int u = x->v[i];
+        double value = c * x->c[i];
+        int j = el->at[u];
+        if (j >= 0) {
+            value += e->c[j];
+            e->c[j] = value;
+        } else {
+            if (sparse_push(e, u, value) < 0)
+                return -1;
+            el->at[u] = e->n - 1;
+            if (sparse_push(&el->users[u], v, 0.0) < 0)
+                return -1;
+        }
+    }
+    int kept = 0; /* drop what cancelled */
+    for (int i = 0; i < e->n; i++) {
+        el->at[e->v[i]] = -1;
+        if (fabs(e->c[i]) > zero) {
+            e->v[kept] = e->v[i];
+            e->c[kept] = e->c[i];
+            kept++;
+        }
+    }
+    e->n = kept;
+    el->konst[v] += c * el->konst[p];
+    return 0;
+}
+
+static PyObject *eliminate(PyObject *self, PyObject *args)
+{
+    PyObject *rows;
+    int n;
+    double zero, tolerance;
+    if (!PyArg_ParseTuple(args, "Oidd", &rows, &n, &zero, &tolerance))
+        return NULL;
+    PyObject *seq = PySequence_Fast(rows, "rows must be a sequence");
+    if (!seq)
+        return NULL;
+    Py_ssize_t m = PySequence_Fast_GET_SIZE(seq);
+    Elimination el = {n};
+    RowOrder *order = PyMem_Calloc((size_t)m + 1, sizeof(RowOrder));
+    int *touched = PyMem_Calloc((size_t)n + 1, sizeof(int));
+    PyObject *result = NULL;
+    el.expr = PyMem_Calloc((size_t)n + 1, sizeof(Sparse));
+    el.users = PyMem_Calloc((size_t)n + 1, sizeof(Sparse));
+    el.konst = PyMem_Calloc((size_t)n + 1, sizeof(double));
+    el.solved = PyMem_Calloc((size_t)n + 1, 1);
+    el.acc = PyMem_Calloc((size_t)n + 1, sizeof(double));
+    el.at = PyMem_Malloc(sizeof(int) * ((size_t)n + 1));
+    if (!order || !touched || !el.expr || !el.users || !el.konst || !el.solved || !el.acc ||
+        !el.at) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (int v = 0; v < n; v++)
+        el.at[v] = -1;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        PyObject *row = PySequence_Fast_GET_ITEM(seq, i);
+        PyObject *coefficients;
+        double rhs;
+        if (!PyArg_ParseTuple(row, "Od", &coefficients, &rhs))
+            goto done;
+        if (!PyDict_Check(coefficients)) {
+            PyErr_SetString(PyExc_TypeError, "a row's coefficients must be a dict");
+            goto done;
+        }
+        order[i].index = i;
+        order[i].length = PyDict_Size(coefficients);
+    }
+    qsort(order, (size_t)m, sizeof(RowOrder), row_order); /* shortest first, stable */
+    for (Py_ssize_t i = 0; i < m; i++) {
+        PyObject *row = PySequence_Fast_GET_ITEM(seq, order[i].index);
+        PyObject *coefficients = PyTuple_GET_ITEM(row, 0);
+        double left = PyFloat_AsDouble(PyTuple_GET_ITEM(row, 1));
+        if (left == -1.0 && PyErr_Occurred())
+            goto done;
+        int count = 0;
+        Py_ssize_t pos = 0;
+        PyObject *key, *value;
+        while (PyDict_Next(coefficients, &pos, &key, &value)) {
+            long v = PyLong_AsLong(key);
+            double c = PyFloat_AsDouble(value);
+            if (PyErr_Occurred())
+                goto done;
+            if (v < 0 || v >= n) {
+                PyErr_SetString(PyExc_IndexError, "a row names a variable out of range");
+                goto done;
+            }
+            if (el.solved[v]) {
+                left -= c * el.konst[v];
+                const Sparse *e = &el.expr[v];
+                for (int j = 0; j < e->n; j++) {
+                    int u = e->v[j];
+                    if (el.at[u] < 0) {
+                        el.at[u] = count;
+                        touched[count++] = u;
+                        el.acc[u] = 0.0;
+                    }
+                    el.acc[u] += c * e->c[j];
+                }
+            } else {
+                if (el.at[v] < 0) {
+                    el.at[v] = count;
+                    touched[count++] = (int)v;
+                    el.acc[v] = 0.0;
+                }
+                el.acc[v] += c;
+            }
+        }
+        int pivot = -1, terms = 0;
+        double best = 0.0;
+        for (int j = 0; j < count; j++) {
+            int u = touched[j];
+            el.at[u] = -1;
+            if (fabs(el.acc[u]) <= zero)
+                continue;
+            touched[terms++] = u;
+            double size = fabs(el.acc[u]);
+            if (pivot < 0 || size > best || (size == best && u > pivot)) {
+                pivot = u;
+                best = size;
+            }
+        }
+        if (pivot < 0) {
+            if (fabs(left) > tolerance) {
+                Py_INCREF(Py_None);
+                result = Py_None; /* the equalities contradict each other */
+                goto done;
+            }
+            continue;
+        }
+        double a = el.acc[pivot];
+        Sparse *x = &el.expr[pivot];
+        for (int j = 0; j < terms; j++) {
+            int u = touched[j];
+            if (u != pivot && sparse_push(x, u, -el.acc[u] / a) < 0) {
+                PyErr_NoMemory();
+                goto done;
+            }
+        }
+        el.konst[pivot] = left / a;
+        Sparse *named = &el.users[pivot];
+        for (int j = 0; j < named->n; j++)
+            if (substitute(&el, named->v[j], pivot, zero) < 0) {
+                PyErr_NoMemory();
+                goto done;
+            }
+        named->n = 0;
+        el.solved[pivot] = 1;
+        for (int j = 0; j < x->n; j++)
+            if (sparse_push(&el.users[x->v[j]], pivot, 0.0) < 0) {
+                PyErr_NoMemory();
+                goto done;
+            }
+    }
+    {
+        /* (constants, free variables, (variable, free index, coefficient) of the rest) */
+        PyObject *constants = PyList_New(n), *free = PyList_New(0), *entries = PyList_New(0);
+        result = PyTuple_Pack(3, constants, free, entries);
+        Py_XDECREF(constants);
+        Py_XDECREF(free);
+        Py_XDECREF(entries);
+        if (!result)
+            goto done;
+        int columns = 0;
+        for (int v = 0; v < n; v++) {
+            el.at[v] = el.solved[v] ? -1 : columns++;
+            PyObject *k = PyFloat_FromDouble(el.solved[v] ? el.konst[v] : 0.0);
+            if (!k)
+                goto fail;
+            PyList_SET_ITEM(constants, v, k);
+            if (!el.solved[v]) {
+                PyObject *index = PyLong_FromLong(v);
+                if (!index || PyList_Append(free, index) < 0) {
+                    Py_XDECREF(index);
+                    goto fail;
+                }
+                Py_DECREF(index);
+            }
+        }
+        for (int v = 0; v < n; v++) {
+            const Sparse *e = &el.expr[v];
+            for (int j = 0; el.solved[v] && j < e->n; j++) {
+                PyObject *t = Py_BuildValue("(iid)", v, el.at[e->v[j]], e->c[j]);
+                if (!t || PyList_Append(entries, t) < 0) {
+                    Py_XDECREF(t);
+                    goto fail;
+                }
+                Py_DECREF(t);
+            }
+        }
+        goto done;
+    fail:
+        Py_CLEAR(result);
+    }
+done:
+    PyMem_Free(order);
+    PyMem_Free(touched);
+    elimination_free(&el);
+    Py_DECREF(seq);
+    return result;
+}
+
+static PyMethodDef module_methods[] = {
+    {"eliminate", eliminate, METH_VARARGS,
+     "eliminate(rows, n, zero, tolerance): every solution of the sparse equalities rows "
+     "((coefficients by variable, rhs) pairs) over n variables, as (constants, free "
+     "variables, (variable, free index, coefficient) triples); None when they contradict "
+     "each other"},
+    {NULL},
+};
+
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT,
     .m_name = "_exact",
-    .m_doc = "The exact alignment search, compiled.",
+    .m_doc = "The exact alignment search, compiled; and the sizing's elimination.",
     .m_size = -1,
+    .m_methods = module_methods,
 };
 
 PyMODINIT_FUNC PyInit__exact(void)

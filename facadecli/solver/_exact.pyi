@@ -1,6 +1,6 @@
 """Types of the compiled exact alignment search (``_exact.c``)."""
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 Letter = tuple[str, float | None, bool, bool, bool, bool, int]
 RowSpec = tuple[Sequence[Letter], Sequence[int], Sequence[int]]
@@ -25,3 +25,7 @@ class Search:
     ) -> None: ...
     def run(self, gaps: bool) -> int: ...
     def rejections(self) -> list[tuple[int, int, int, int, int, int, int, int]]: ...
+
+def eliminate(
+    rows: Sequence[tuple[Mapping[int, float], float]], n: int, zero: float, tolerance: float
+) -> tuple[list[float], list[int], list[tuple[int, int, float]]] | None: ...

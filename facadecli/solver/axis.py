@@ -19,7 +19,7 @@ from facadecli.solver.alignment import (
     align,
 )
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
-from facadecli.solver.rows import LetterTraits, Row, full_layers, make_rows
+from facadecli.solver.rows import Row, WordTraits, full_layers, make_rows
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
@@ -175,7 +175,7 @@ class _SearchMemory:
     """Alignments already searched in one axis solve, shared by its candidates."""
 
     full: frozenset[int]  # layers that show all along the other axis
-    traits: dict[Word, tuple[LetterTraits, ...]] = field(default_factory=dict)
+    traits: WordTraits = field(default_factory=dict)
     groups: dict[tuple[str, tuple[Word, ...]], AlignmentResult] = field(default_factory=dict)
     prefixes: Prefixes = field(default_factory=dict)
     rows: dict[int, dict[str, list[Row]]] = field(default_factory=dict)  # by candidate order

@@ -71,11 +71,14 @@ class Row:
         return self is not other and self.full_height and self.lowest > other.highest
 
 
+WordTraits = dict[Word, tuple[tuple[LetterTraits, ...], bool]]  # and: has it unoccludable ones
+
+
 def make_rows(
     spec: Spec,
     words: list[tuple[int, Word]],
     full: frozenset[int] = frozenset(),
-    known: dict[Word, tuple[LetterTraits, ...]] | None = None,
+    known: WordTraits | None = None,
     made: dict[tuple[int, tuple[int, ...]], Row] | None = None,
 ) -> list[Row]:
     """Rows of one group from (layer index, word) pairs; identical words share a row.
@@ -88,21 +91,12 @@ def make_rows(
     equal: dict[Word, tuple[Word, bool]] = {}
     seen: dict[int, tuple[Word, bool]] = {}
     by_word: dict[tuple[int, int], list[int]] = {}
-    unoccludable = spec.symbol_defaults.unoccludable or any(
-        spec.qualifiers(name).unoccludable for name in spec.symbols
-    )
     for layer, word in sorted(words, key=lambda item: item[0]):
         found = seen.get(id(word))
         if found is None:
             found = equal.get(word)
             if found is None:
-                traits = known.get(word)
-                if traits is None:
-                    traits = known[word] = tuple(_traits(spec, letter, known) for letter in word)
-                found = equal[word] = (
-                    word,
-                    unoccludable and any(t.unoccludable for t in traits),
-                )
+                found = equal[word] = (word, _word_traits(spec, word, known)[1])
             seen[id(word)] = found
         # a word with an unoccludable letter keeps a row of its own in every layer: the same
         # word in front would cover it, so the front layer must be free to make room
@@ -114,20 +108,25 @@ def make_rows(
         if row is None:
             word = seen[key][0]
             full_height = all(layer in full for layer in layers)
-            row = made[key, tuple(layers)] = Row(tuple(layers), word, known[word], full_height)
+            traits = known[word][0]
+            row = made[key, tuple(layers)] = Row(tuple(layers), word, traits, full_height)
         rows.append(row)
     return sorted(rows, key=lambda row: row.lowest)
 
 
-def _traits(
-    spec: Spec, letter: Letter, known: dict[Word, tuple[LetterTraits, ...]]
-) -> LetterTraits:
-    """A letter's traits, kept in the words' cache as those of the one-letter word."""
-    single = (letter,)
-    found = known.get(single)
+def _word_traits(
+    spec: Spec, word: Word, known: WordTraits
+) -> tuple[tuple[LetterTraits, ...], bool]:
+    """A word's letters' traits, and whether one is unoccludable (kept in ``known``, as
+    are those of each letter, as one-letter words)."""
+    found = known.get(word)
     if found is None:
-        found = known[single] = (letter_traits(spec, letter),)
-    return found[0]
+        if len(word) == 1:
+            traits: tuple[LetterTraits, ...] = (letter_traits(spec, word[0]),)
+        else:
+            traits = tuple(_word_traits(spec, (letter,), known)[0][0] for letter in word)
+        found = known[word] = (traits, any(t.unoccludable for t in traits))
+    return found
 
 
 def full_layers(spec: Spec, axis: Axis) -> frozenset[int]:

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from facadecli.solver import _exact
 from facadecli.solver.alignment import Alignment, Move
 from facadecli.spec.model import Spec
 
@@ -214,7 +215,25 @@ def _parametrized(
     rows: Sequence[tuple[Mapping[int, float], float]], n: int
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """Every solution of the sparse equalities ``rows`` over ``n`` variables as
-    ``z0 + N y`` (``y`` the free variables), or None when they contradict each other.
+    ``z0 + N y`` (``y`` the free variables), or None when they contradict each other:
+    :func:`_parametrized_in_python`, compiled (``_exact.eliminate``)."""
+    scale = max((abs(rhs) for _, rhs in rows), default=0.0)
+    found = _exact.eliminate(rows, n, ZERO, 1e-9 * max(1.0, scale))
+    if found is None:
+        return None
+    constants, free, entries = found
+    basis = np.zeros((n, len(free)))
+    basis[free, np.arange(len(free))] = 1.0
+    if entries:
+        v, j, c = zip(*entries, strict=True)
+        basis[list(v), list(j)] = c
+    return np.array(constants), basis
+
+
+def _parametrized_in_python(
+    rows: Sequence[tuple[Mapping[int, float], float]], n: int
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`_parametrized` in Python, the reference the tests compare it with.
 
     Gaussian elimination, a row at a time, shortest rows first: the row is written over
     the variables still free, and one of them (the largest coefficient; the latest
