@@ -4,6 +4,7 @@ transparency, appearance rules) and occlusion flags (SPEC 2.5, 2.8)."""
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import MISSING, dataclass, fields
 
 import numpy as np
@@ -235,16 +236,24 @@ class _Grid:
     """Solid shapes filed by the cells of a grid over the façade that they overlap, to find
     those near a rectangle without looking at all of them."""
 
+    LARGE = 16  # a shape over more cells than this is looked at for every rectangle
+
     def __init__(self, solids: list[_Solid]):
         self.x0, self.y0 = min(s[0] for s in solids), min(s[2] for s in solids)
-        # cells about as large as a typical shape, so that a shape overlaps a few
-        count = 2 * len(solids)
+        # cells about as large as a typical shape, so that a shape overlaps a few (and at
+        # most 2 sqrt(n) cells a side)
+        count = 2 * math.sqrt(len(solids))
         width, height = max(s[1] for s in solids) - self.x0, max(s[3] for s in solids) - self.y0
         self.dx = max(float(np.median([s[1] - s[0] for s in solids])), width / count, 1e-6)
         self.dy = max(float(np.median([s[3] - s[2] for s in solids])), height / count, 1e-6)
         self.cells: dict[tuple[int, int], list[_Solid]] = {}
+        self.large: list[_Solid] = []
         for solid in solids:
-            for cell in self._cells(*solid[:4]):
+            cells = self._cells(*solid[:4])
+            if len(cells) > self.LARGE:
+                self.large.append(solid)
+                continue
+            for cell in cells:
                 self.cells.setdefault(cell, []).append(solid)
 
     def _cells(self, x0: float, x1: float, y0: float, y1: float) -> list[tuple[int, int]]:
@@ -254,11 +263,11 @@ class _Grid:
 
     def near(self, x0: float, x1: float, y0: float, y1: float) -> list[_Solid]:
         """The solids filed in the cells the rectangle overlaps (one filed in several of
-        them comes once for each)."""
+        them comes once for each), and the large ones."""
         cells = self._cells(x0, x1, y0, y1)
-        if len(cells) == 1:
+        if len(cells) == 1 and not self.large:
             return self.cells.get(cells[0], [])
-        return [solid for cell in cells for solid in self.cells.get(cell, ())]
+        return [*(solid for cell in cells for solid in self.cells.get(cell, ())), *self.large]
 
 
 def _covered(shape: Shape, occluders: list[Shape]) -> bool:
