@@ -19,12 +19,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from facadecli.grammar.run import Extraction, Options, extract_grammar  # noqa: E402
+from facadecli.grammar.cmp_xml import read_cmp  # noqa: E402
+from facadecli.grammar.run import Extraction, Options, extract_grammar, resize  # noqa: E402
 from facadecli.grammar.variation import derive_layout, derive_variations  # noqa: E402
 from facadecli.layout import Layout  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
-WIDER = 1.15  # a derived window wider than this times the input's widest is stretched
+WIDER = 1.15  # a derived window wider than this times the annotation's widest is stretched
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
 
 
@@ -64,9 +65,7 @@ def main() -> None:
         repeats = sum(r.op in ("repeat", "repeatABA") for r in extraction.grammar.rules.values())
         style = extraction.style
         kept = []
-        widest = max(
-            _window_widths(derive_layout(extraction.grammar, tiling, 15, 15, "b")), default=0
-        )
+        widest = _input_widest(path)
         for scale in SCALES:
             drawn, _ = derive_variations(
                 extraction.grammar, tiling, 15.0 * scale, 15.0, "bench", 1, 0, style
@@ -109,6 +108,13 @@ def main() -> None:
     derive_layout(last.grammar, last.tiling, 24.0, 15.0, "bench")
     print(f"derive {files[-1].stem} at 24x15 with alignment: {time.perf_counter() - started:.2f}s")
     variations(extractions)
+
+
+def _input_widest(path: Path) -> float:
+    """The widest window of the annotation itself, at 15 x 15 m (the layout derived at the
+    input's size is no reference: tidying may have changed it)."""
+    annotation = resize(read_cmp(path), 15.0, 15.0)
+    return max((r.x1 - r.x0 for r in annotation.rects if r.label == "window"), default=0.0)
 
 
 def _window_widths(layout: Layout) -> list[float]:
