@@ -30,7 +30,7 @@ import math
 import sys
 import time
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -732,8 +732,8 @@ class _Search:
 
     def settle(self, paths: list[list[Column]]) -> None:
         """Size a complete alignment (a path per group); keep it if it ranks best."""
-        groups = {
-            group.name: _alignment(group, path)
+        groups = {  # their error (Eq. 9) is taken for the best only, once it is
+            group.name: _alignment(group, path, 0.0)
             for group, path in zip(self.groups, paths, strict=True)
         }
         program = sizing.build_program(self.spec, groups, self.canvas)
@@ -752,7 +752,15 @@ class _Search:
             else Found(*columns.finest(self.spec, self.canvas, groups, program, solved))
         )
         if found is not None and (self.best is None or found.rank < self.best.rank):
-            self.best = found
+            errors = {
+                group.name: sum(_spread(entries) for entries in path)
+                for group, path in zip(self.groups, paths, strict=True)
+            }
+            self.best = Found(
+                {name: replace(a, error=errors[name]) for name, a in found.groups.items()},
+                found.program,
+                found.sizing,
+            )
             self.incumbent = min(self.incumbent, solved.objective)
         if solved.objective <= SAME or self.first_only:
             raise _Perfect  # nothing deviates less (the search order broke the tie), or
@@ -907,9 +915,8 @@ def _spread(entries: Sequence[Move | None]) -> float:
     return round(max(0.0, max(lows) - min(highs)), 9)
 
 
-def _alignment(group: _Group, path: Sequence[tuple[Move | None, ...]]) -> Alignment:
-    """The path as an :class:`Alignment`, its error (Eq. 9) taken at preferred sizes."""
-    error = sum(_spread(entries) for entries in path)
+def _alignment(group: _Group, path: Sequence[tuple[Move | None, ...]], error: float) -> Alignment:
+    """The path as an :class:`Alignment` with its error (Eq. 9, at preferred sizes)."""
     return Alignment(
         tuple(row.row for row in group.rows),
         tuple(path),
