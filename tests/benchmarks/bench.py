@@ -84,6 +84,7 @@ def main() -> None:
             print(f"{label:28} no layout: exit {error.exit_code} ({str(error)[:60]}...)")
             continue
         solved = median_ms(lambda spec=spec: solve(spec), runs=3)
+        layout = solve(spec)  # the stages of a warm solve (the first may load the QP solver)
         stages = " ".join(
             f"{axis.axis}:{'/'.join(f'{ms:.0f}' for ms in axis.timings.values())}"
             for axis in (layout.x, layout.y)
