@@ -71,6 +71,7 @@ typedef struct {
 typedef struct {
     int n; /* letters */
     Letter *letters;
+    double least; /* the least preferred size of its sized letters (0: none, or one of 0) */
     int has_attached;
     int *above, n_above;
     int *covering, n_covering;
@@ -936,25 +937,65 @@ static char *fitting(Builder *b, int fr, int j, int r)
     double limit = s->incumbent + SAME;
     int nv = s->nv, sz = s->sized;
     double d[nv];
+    /* a first entry holding placeholders: with the equalities' pivots solved out of it
+     * (when they fix every placeholder it holds), an entry of sized letters must meet
+     * (len + reduced) @ sizes == rest; as the least deviation under that equality alone
+     * is beyond the limit, so is the probe (it adds the other equalities): no probe then */
+    double reduced[nv], rest = 0.0;
+    int pinned = 0;
+    for (int k = sz; k < nv; k++)
+        if (first[k] != 0.0)
+            pinned = 1;
+    if (pinned) {
+        for (int k = 0; k < nv; k++)
+            reduced[k] = -first[k];
+        rest = reduce(s, b->node->system, reduced, 0.0);
+        for (int k = sz; k < nv; k++)
+            if (fabs(reduced[k]) > 1e-9)
+                pinned = 0;
+    }
+    /* entries of whole sized letters out of one position are each the one before and more
+     * letters: each adds at least ``least`` to the miss and at most 1 to the norm, so past
+     * one too long (the miss >= 0) with ``least``^2 beyond the limit, all are (``beyond``) */
+    double least = s->groups[b->g].rows[r].least, margin = limit + 1e-9 * (1.0 + limit);
+    int beyond = INT_MAX, grows = least * least > margin;
     for (int i = 0; i < o->n; i++) {
         const double *len = o->items[i].len;
         if (!len) {
             mask[i] = 1;
             continue;
         }
-        int placeholders = 0;
+        int placeholders = 0, own = 0;
+        for (int k = sz; k < nv; k++)
+            if (len[k] != 0.0)
+                own = 1;
+        const Move *m = o->items[i].m;
+        int whole = grows && plain(m) && !own;
+        if (whole && m->end > beyond) {
+            mask[i] = 0;
+            continue;
+        }
         for (int k = 0; k < nv; k++)
             d[k] = len[k] - first[k];
         for (int k = sz; k < nv; k++)
             if (d[k] != 0.0)
                 placeholders = 1;
-        double alone = 0.0;
+        double alone = 0.0, miss = -1.0, norm = 0.0;
         if (!placeholders) {
-            double norm = dot(d, d, sz);
-            double miss = dot(d, s->target, sz);
+            norm = dot(d, d, sz);
+            miss = dot(d, s->target, sz);
             alone = norm > 0 ? miss * miss / norm : 0.0;
+        } else if (pinned && !own) {
+            double e[sz];
+            for (int k = 0; k < sz; k++)
+                e[k] = len[k] + reduced[k];
+            norm = dot(e, e, sz);
+            miss = dot(e, s->target, sz) - rest;
+            alone = norm > 0 && miss * miss / norm > margin ? miss * miss / norm : 0.0;
         }
         if (alone > limit) {
+            if (whole && miss >= 0 && norm > 0 && alone > margin && m->end < beyond)
+                beyond = m->end;
             mask[i] = 0;
             continue;
         }
@@ -1662,6 +1703,7 @@ static int read_row(Search *s, Row *row, PyObject *spec, int R, PyObject *variab
         Py_DECREF(fast);
         return -1;
     }
+    int sized = 0; /* sized letters met */
     for (int k = 0; k < n; k++) {
         PyObject *symbol, *size, *var;
         Letter *l = &row->letters[k];
@@ -1683,6 +1725,11 @@ static int read_row(Search *s, Row *row, PyObject *spec, int R, PyObject *variab
         if (l->size == -1.0 && PyErr_Occurred()) {
             Py_DECREF(fast);
             return -1;
+        }
+        if (!isnan(l->size)) {
+            double size = l->size > 0 ? l->size : 0.0;
+            if (!sized++ || size < row->least)
+                row->least = size;
         }
         l->transparent = (char)t;
         l->opaque = (char)o;
