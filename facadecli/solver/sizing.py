@@ -19,6 +19,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -31,9 +32,9 @@ MIN_SIZE = 1e-3  # every sized letter is at least a millimetre long
 ZERO = 1e-12  # coefficients smaller than this are rounding left by an elimination
 
 
-@dataclass(frozen=True)
-class Piece:
-    """Where a piece of a split letter sits: group, row, letter index, column."""
+class Piece(NamedTuple):
+    """Where a piece of a split letter sits: group, row, letter index, column (a named
+    tuple: a long façade's programs key thousands of them)."""
 
     group: str
     row: int
