@@ -19,7 +19,7 @@ from facadecli.solver.alignment import (
     align,
 )
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
-from facadecli.solver.rows import Row, WordTraits, full_layers, make_rows
+from facadecli.solver.rows import Row, RowCache, WordTraits, full_layers, make_rows
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
@@ -180,7 +180,7 @@ class _SearchMemory:
     prefixes: Prefixes = field(default_factory=dict)
     rows: dict[int, dict[str, list[Row]]] = field(default_factory=dict)  # by candidate order
     prepared: dict[Row, _Row] = field(default_factory=dict)  # rows with their moves cached
-    made: dict[tuple[int, tuple[int, ...]], Row] = field(default_factory=dict)  # make_rows()
+    made: RowCache = field(default_factory=RowCache)  # make_rows()'s
     counted: dict[tuple[int, bool], tuple[Word, exact.Counts]] = field(default_factory=dict)
 
 

@@ -6,7 +6,7 @@ share a row (they move together: the same pattern makes the same word, SPEC 2.6)
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from facadecli.patterns import Letter, Word
 from facadecli.patterns.ast import symbols
@@ -74,42 +74,55 @@ class Row:
 WordTraits = dict[Word, tuple[tuple[LetterTraits, ...], bool]]  # and: has it unoccludable ones
 
 
+@dataclass
+class RowCache:
+    """What :func:`make_rows` keeps between calls (the caller keeps it): each word object's
+    canonical equal (by identity, the object kept too, so its identity stays its own), the
+    canonical words by value, and the rows made (by canonical word and layers)."""
+
+    ids: dict[int, tuple[Word, Word, bool]] = field(default_factory=dict)  # id -> (word,
+    # its canonical equal, has it an unoccludable letter)
+    canonical: dict[Word, tuple[Word, bool]] = field(default_factory=dict)
+    rows: dict[tuple[int, tuple[int, ...]], Row] = field(default_factory=dict)
+
+
 def make_rows(
     spec: Spec,
     words: list[tuple[int, Word]],
     full: frozenset[int] = frozenset(),
     known: WordTraits | None = None,
-    made: dict[tuple[int, tuple[int, ...]], Row] | None = None,
+    cache: RowCache | None = None,
 ) -> list[Row]:
     """Rows of one group from (layer index, word) pairs; identical words share a row.
     ``full``: the layers that show all along the other axis; ``known``: the traits of
-    words met before, ``made``: rows made before (by their word's identity and layers;
-    the row holds the word, so it stays the same): caches the caller keeps."""
+    words met before, ``cache``: words and rows met before (caches the caller keeps, for
+    one spec and axis)."""
     known = {} if known is None else known
-    made = {} if made is None else made
-    # a long word is hashed once a call: equal words are found by value, then by identity
-    equal: dict[Word, tuple[Word, bool]] = {}
-    seen: dict[int, tuple[Word, bool]] = {}
+    cache = RowCache() if cache is None else cache
+    # a long word is hashed once: equal words are found by value, then by identity
     by_word: dict[tuple[int, int], list[int]] = {}
+    canonical: dict[int, Word] = {}
     for layer, word in sorted(words, key=lambda item: item[0]):
-        found = seen.get(id(word))
+        found = cache.ids.get(id(word))
         if found is None:
-            found = equal.get(word)
-            if found is None:
-                found = equal[word] = (word, _word_traits(spec, word, known)[1])
-            seen[id(word)] = found
+            same = cache.canonical.get(word)
+            if same is None:
+                same = cache.canonical[word] = (word, _word_traits(spec, word, known)[1])
+            found = cache.ids[id(word)] = (word, *same)
+        _, first, unoccludable = found
+        canonical[id(first)] = first
         # a word with an unoccludable letter keeps a row of its own in every layer: the same
         # word in front would cover it, so the front layer must be free to make room
-        alone = layer if found[1] else -1
-        by_word.setdefault((id(found[0]), alone), []).append(layer)
+        alone = layer if unoccludable else -1
+        by_word.setdefault((id(first), alone), []).append(layer)
     rows = []
     for (key, _), layers in by_word.items():
-        row = made.get((key, tuple(layers)))
+        row = cache.rows.get((key, tuple(layers)))
         if row is None:
-            word = seen[key][0]
+            word = canonical[key]
             full_height = all(layer in full for layer in layers)
             traits = known[word][0]
-            row = made[key, tuple(layers)] = Row(tuple(layers), word, traits, full_height)
+            row = cache.rows[key, tuple(layers)] = Row(tuple(layers), word, traits, full_height)
         rows.append(row)
     return sorted(rows, key=lambda row: row.lowest)
 
