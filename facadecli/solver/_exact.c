@@ -424,10 +424,10 @@ static void system_drop(System *y)
     }
 }
 
-/* FNV-1a over 64-bit words, folded: the key of the probe and rejection tables */
+/* a hash of 64-bit words (the key of the probe and rejection tables) */
 static uint64_t words_hash(const void *key, size_t bytes)
 {
-    /* each word multiplied on its own (the products pipeline), then mixed */
+    /* each word multiplied on its own (the products pipeline), then mixed (murmur3 fmix) */
     const unsigned char *p = key;
     uint64_t h = 1469598103934665603ULL, k = 0x9E3779B97F4A7C15ULL;
     for (size_t i = 0; i + 8 <= bytes; i += 8) {
