@@ -980,15 +980,18 @@ static char *fitting(Builder *b, int fr, int j, int r)
         for (int k = sz; k < nv; k++)
             if (d[k] != 0.0)
                 placeholders = 1;
-        double alone = 0.0, miss = -1.0, norm = 0.0;
+        double alone = 0.0, miss = -1.0, norm = 0.0, off = 0.0;
+        const double *e = d;
+        double shifted[sz];
         if (!placeholders) {
             norm = dot(d, d, sz);
             miss = dot(d, s->target, sz);
             alone = norm > 0 ? miss * miss / norm : 0.0;
         } else if (pinned && !own) {
-            double e[sz];
             for (int k = 0; k < sz; k++)
-                e[k] = len[k] + reduced[k];
+                shifted[k] = len[k] + reduced[k];
+            e = shifted;
+            off = rest;
             norm = dot(e, e, sz);
             miss = dot(e, s->target, sz) - rest;
             alone = norm > 0 && miss * miss / norm > margin ? miss * miss / norm : 0.0;
@@ -998,6 +1001,16 @@ static char *fitting(Builder *b, int fr, int j, int r)
                 beyond = m->end;
             mask[i] = 0;
             continue;
+        }
+        if (norm > 0 && (!placeholders || (pinned && !own))) {
+            /* the bound with the equality: its residual at the system's point is the
+             * probe's, over a row no longer than this one (the probe is at least this) */
+            const System *y = b->node->system;
+            double residual = off - dot(e, y->point, sz);
+            if (y->value + residual * residual / norm > margin) {
+                mask[i] = 0;
+                continue;
+            }
         }
         double value = probe(s, b->node->system, d);
         if (isnan(value)) {
