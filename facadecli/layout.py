@@ -211,17 +211,14 @@ def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
         ):
             result.append(shape.hidden())
             continue
-        occluders = [
-            o
-            for x0, x1, y0, y1, front, o_layer, back, o in grid.near(left, right, low, high)
-            if o_layer > layer
-            and front >= z
-            and back <= z + 1e-9
-            and x0 < right
-            and x1 > left
-            and y0 < high
-            and y1 > low
-        ]
+        occluders = []
+        for near in grid.near(left, right, low, high):
+            for x0, x1, y0, y1, front, o_layer, back, o in near:
+                if o_layer <= layer:
+                    break  # the rest are behind it (filed front to back)
+                flush = front >= z and back <= z + 1e-9
+                if flush and x0 < right and x1 > left and y0 < high and y1 > low:
+                    occluders.append(o)
         hidden = bool(occluders) and _covered(shape, occluders)
         result.append(shape.hidden() if hidden else shape)
     return tuple(result)
@@ -248,7 +245,7 @@ class _Grid:
         self.dy = max(float(np.median([s[3] - s[2] for s in solids])), height / count, 1e-6)
         self.cells: dict[tuple[int, int], list[_Solid]] = {}
         self.large: list[_Solid] = []
-        for solid in solids:
+        for solid in sorted(solids, key=lambda solid: -solid[5]):  # front to back
             cells = self._cells(*solid[:4])
             if len(cells) > self.LARGE:
                 self.large.append(solid)
@@ -261,13 +258,11 @@ class _Grid:
         ys = range(max(0, int((y0 - self.y0) / self.dy)), int((y1 - self.y0) / self.dy) + 1)
         return [(i, j) for i in xs for j in ys]
 
-    def near(self, x0: float, x1: float, y0: float, y1: float) -> list[_Solid]:
-        """The solids filed in the cells the rectangle overlaps (one filed in several of
-        them comes once for each), and the large ones."""
-        cells = self._cells(x0, x1, y0, y1)
-        if len(cells) == 1 and not self.large:
-            return self.cells.get(cells[0], [])
-        return [*(solid for cell in cells for solid in self.cells.get(cell, ())), *self.large]
+    def near(self, x0: float, x1: float, y0: float, y1: float) -> list[list[_Solid]]:
+        """The lists of solids, each front to back, filed in the cells the rectangle
+        overlaps (one filed in several of them comes once for each), and the large ones."""
+        lists = [self.cells[cell] for cell in self._cells(x0, x1, y0, y1) if cell in self.cells]
+        return [*lists, self.large] if self.large else lists
 
 
 def _covered(shape: Shape, occluders: list[Shape]) -> bool:
