@@ -918,8 +918,81 @@ static int emit(Builder *b)
     return 0;
 }
 
+/* what fitting() knows of one first entry while it checks a row's options against it */
+typedef struct {
+    Search *s;
+    System *y;
+    const double *first;
+    double limit, margin;
+    int pinned;       /* the first holds placeholders that the equalities fix ... */
+    double *reduced;  /* ... solved out: an entry of sized letters meets (len + reduced) @ sizes */
+    double rest;      /* == rest */
+} Fit;
+
+/* whether an option of known length ``len`` may be as long as the first: 1 it may, 0 it
+ * may not, NOT_NEAR it may not by its own least deviation (the equality alone: see
+ * fitting()), with *miss its miss at preferred sizes; -1 out of memory */
+#define NOT_NEAR 2
+static int fits(const Fit *f, const double *len, double *miss)
+{
+    Search *s = f->s;
+    int nv = s->nv, sz = s->sized, placeholders = 0, own = 0;
+    double d[nv], shifted[sz + 1];
+    for (int k = 0; k < nv; k++)
+        d[k] = len[k] - f->first[k];
+    for (int k = sz; k < nv; k++) {
+        if (d[k] != 0.0)
+            placeholders = 1;
+        if (len[k] != 0.0)
+            own = 1;
+    }
+    const double *e = d;
+    double alone = 0.0, norm = 0.0, off = 0.0;
+    *miss = -1.0;
+    if (!placeholders) {
+        norm = dot(d, d, sz);
+        *miss = dot(d, s->target, sz);
+        alone = norm > 0 ? *miss * *miss / norm : 0.0;
+    } else if (f->pinned && !own) {
+        for (int k = 0; k < sz; k++)
+            shifted[k] = len[k] + f->reduced[k];
+        e = shifted;
+        off = f->rest;
+        norm = dot(e, e, sz);
+        *miss = dot(e, s->target, sz) - f->rest;
+        alone = norm > 0 && *miss * *miss / norm > f->margin ? *miss * *miss / norm : 0.0;
+    }
+    if (alone > f->limit)
+        return norm > 0 && alone > f->margin ? NOT_NEAR : 0;
+    if (norm > 0 && (!placeholders || (f->pinned && !own))) {
+        /* the bound with the equality: its residual at the system's point is the probe's,
+         * over a row no longer than this one (the probe is at least this) */
+        double residual = off - dot(e, f->y->point, sz);
+        if (f->y->value + residual * residual / norm > f->margin)
+            return 0;
+    }
+    double value = probe(s, f->y, d);
+    if (isnan(value)) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    return value <= f->limit;
+}
+
 /* which options of row r may be as long as the first entry (row fr, option j) within the
- * incumbent: first alone (their preferred lengths apart), then with the equalities */
+ * incumbent: first alone (their preferred lengths apart), then with the equalities.
+ *
+ * A first entry holding placeholders: with the equalities' pivots solved out of it (when
+ * they fix every placeholder it holds), an entry of sized letters must meet
+ * (len + reduced) @ sizes == rest; when the least deviation under that equality alone is
+ * beyond the limit, so is the probe (it adds the other equalities): no probe then.
+ *
+ * The entries of whole sized letters out of one position are each the one before and
+ * more letters: each letter adds at least the row's least size ``least`` to the miss and
+ * at most 1 to the norm. So once one longer than the first is not near, nor are the
+ * longer ones; once one shorter is not, nor are the shorter ones (when ``least``^2 is
+ * beyond the limit): they are checked outward from the first's length, until both
+ * sides stop. */
 static char *fitting(Builder *b, int fr, int j, int r)
 {
     Search *s = b->s;
@@ -933,92 +1006,73 @@ static char *fitting(Builder *b, int fr, int j, int r)
     char *mask = alloc((size_t)o->n + 1);
     if (!mask)
         return NULL;
-    const double *first = b->opts[fr].items[j].len;
-    double limit = s->incumbent + SAME;
     int nv = s->nv, sz = s->sized;
-    double d[nv];
-    /* a first entry holding placeholders: with the equalities' pivots solved out of it
-     * (when they fix every placeholder it holds), an entry of sized letters must meet
-     * (len + reduced) @ sizes == rest; as the least deviation under that equality alone
-     * is beyond the limit, so is the probe (it adds the other equalities): no probe then */
-    double reduced[nv], rest = 0.0;
-    int pinned = 0;
+    double reduced[nv];
+    double limit = s->incumbent + SAME;
+    Fit f = {s, b->node->system, b->opts[fr].items[j].len, limit,
+             limit + 1e-9 * (1.0 + limit), 0, reduced, 0.0};
     for (int k = sz; k < nv; k++)
-        if (first[k] != 0.0)
-            pinned = 1;
-    if (pinned) {
+        if (f.first[k] != 0.0)
+            f.pinned = 1;
+    if (f.pinned) {
         for (int k = 0; k < nv; k++)
-            reduced[k] = -first[k];
-        rest = reduce(s, b->node->system, reduced, 0.0);
+            reduced[k] = -f.first[k];
+        f.rest = reduce(s, f.y, reduced, 0.0);
         for (int k = sz; k < nv; k++)
             if (fabs(reduced[k]) > 1e-9)
-                pinned = 0;
+                f.pinned = 0;
     }
-    /* entries of whole sized letters out of one position are each the one before and more
-     * letters: each adds at least ``least`` to the miss and at most 1 to the norm, so past
-     * one too long (the miss >= 0) with ``least``^2 beyond the limit, all are (``beyond``) */
-    double least = s->groups[b->g].rows[r].least, margin = limit + 1e-9 * (1.0 + limit);
-    int beyond = INT_MAX, grows = least * least > margin;
+    double least = s->groups[b->g].rows[r].least;
+    int ordered = least * least > f.margin;
+    int whole[o->n + 1], nw = 0;
+    double miss;
     for (int i = 0; i < o->n; i++) {
         const double *len = o->items[i].len;
-        if (!len) {
-            mask[i] = 1;
+        mask[i] = 1;
+        if (!len)
             continue;
-        }
-        int placeholders = 0, own = 0;
+        int own = 0;
         for (int k = sz; k < nv; k++)
             if (len[k] != 0.0)
                 own = 1;
-        const Move *m = o->items[i].m;
-        int whole = grows && plain(m) && !own;
-        if (whole && m->end > beyond) {
+        if (ordered && plain(o->items[i].m) && !own) {
+            whole[nw++] = i; /* checked below, outward */
             mask[i] = 0;
             continue;
         }
-        for (int k = 0; k < nv; k++)
-            d[k] = len[k] - first[k];
-        for (int k = sz; k < nv; k++)
-            if (d[k] != 0.0)
-                placeholders = 1;
-        double alone = 0.0, miss = -1.0, norm = 0.0, off = 0.0;
-        const double *e = d;
-        double shifted[sz];
-        if (!placeholders) {
-            norm = dot(d, d, sz);
-            miss = dot(d, s->target, sz);
-            alone = norm > 0 ? miss * miss / norm : 0.0;
-        } else if (pinned && !own) {
-            for (int k = 0; k < sz; k++)
-                shifted[k] = len[k] + reduced[k];
-            e = shifted;
-            off = rest;
-            norm = dot(e, e, sz);
-            miss = dot(e, s->target, sz) - rest;
-            alone = norm > 0 && miss * miss / norm > margin ? miss * miss / norm : 0.0;
-        }
-        if (alone > limit) {
-            if (whole && miss >= 0 && norm > 0 && alone > margin && m->end < beyond)
-                beyond = m->end;
-            mask[i] = 0;
-            continue;
-        }
-        if (norm > 0 && (!placeholders || (pinned && !own))) {
-            /* the bound with the equality: its residual at the system's point is the
-             * probe's, over a row no longer than this one (the probe is at least this) */
-            const System *y = b->node->system;
-            double residual = off - dot(e, y->point, sz);
-            if (y->value + residual * residual / norm > margin) {
-                mask[i] = 0;
-                continue;
-            }
-        }
-        double value = probe(s, b->node->system, d);
-        if (isnan(value)) {
+        int fit = fits(&f, len, &miss);
+        if (fit < 0) {
             PyMem_Free(mask);
-            PyErr_NoMemory();
             return NULL;
         }
-        mask[i] = value <= limit;
+        mask[i] = fit == 1;
+    }
+    /* the first whole entry at least as long as the first, at preferred sizes */
+    double length = f.pinned ? f.rest : 0.0;
+    for (int k = 0; k < sz; k++)
+        length += (f.pinned ? -reduced[k] : f.first[k]) * s->target[k];
+    int start = 0;
+    while (start < nw && o->items[whole[start]].m->fixed < length)
+        start++;
+    for (int w = start; w < nw; w++) { /* longer, outward */
+        int fit = fits(&f, o->items[whole[w]].len, &miss);
+        if (fit < 0) {
+            PyMem_Free(mask);
+            return NULL;
+        }
+        mask[whole[w]] = fit == 1;
+        if (fit == NOT_NEAR && miss >= 0)
+            break;
+    }
+    for (int w = start - 1; w >= 0; w--) { /* shorter, outward */
+        int fit = fits(&f, o->items[whole[w]].len, &miss);
+        if (fit < 0) {
+            PyMem_Free(mask);
+            return NULL;
+        }
+        mask[whole[w]] = fit == 1;
+        if (fit == NOT_NEAR && miss < 0)
+            break;
     }
     *slot = mask;
     return mask;
@@ -2107,7 +2161,7 @@ static PyObject *eliminate(PyObject *self, PyObject *args)
     if (!seq)
         return NULL;
     Py_ssize_t m = PySequence_Fast_GET_SIZE(seq);
-    Elimination el = {n};
+    Elimination el = {.n = n};
     RowOrder *order = PyMem_Calloc((size_t)m + 1, sizeof(RowOrder));
     int *touched = PyMem_Calloc((size_t)n + 1, sizeof(int));
     PyObject *result = NULL;
