@@ -248,12 +248,12 @@ class _Expander:
                             yield from self.expand(branch_stack, branch_env, out, length)
                     return
                 else:
-                    reflect = frame.reflect != _reflects(node)
-                    body = Frame(node.body, frame.scope, reflect)
                     fixed = isinstance(node.count, Fixed)
                     key = "" if fixed else self.count_key(node, frame.scope)
                     if fixed or key in env:
                         times = abs(node.count.value) if fixed else env[key]  # type: ignore[union-attr]
+                        reflect = frame.reflect != _reflects(node)
+                        body = Frame(node.body, frame.scope, reflect)
                         settled = self.settle(body)
                         if settled is None:
                             stack = _push(stack, body, times)

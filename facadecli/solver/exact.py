@@ -732,8 +732,8 @@ class _Search:
 
     def settle(self, paths: list[list[Column]]) -> None:
         """Size a complete alignment (a path per group); keep it if it ranks best."""
-        groups = {  # their error (Eq. 9) is taken for the best only, once it is
-            group.name: _alignment(group, path, 0.0)
+        groups = {
+            group.name: _alignment(group, path)
             for group, path in zip(self.groups, paths, strict=True)
         }
         program = sizing.build_program(self.spec, groups, self.canvas)
@@ -753,8 +753,7 @@ class _Search:
         )
         if found is not None and (self.best is None or found.rank < self.best.rank):
             errors = {
-                group.name: sum(_spread(entries) for entries in path)
-                for group, path in zip(self.groups, paths, strict=True)
+                group.name: _error(path) for group, path in zip(self.groups, paths, strict=True)
             }
             self.best = Found(
                 {name: replace(a, error=errors[name]) for name, a in found.groups.items()},
@@ -903,6 +902,11 @@ def _stretch(entries: Column) -> Move | None:
     return found
 
 
+def _error(path: Sequence[tuple[Move | None, ...]]) -> float:
+    """Eq. 9 summed over a path's columns."""
+    return sum(_spread(entries) for entries in path)
+
+
 def _spread(entries: Sequence[Move | None]) -> float:
     """Eq. 9: how far apart the entries' lengths are at preferred sizes (elastic entries
     are intervals)."""
@@ -915,12 +919,13 @@ def _spread(entries: Sequence[Move | None]) -> float:
     return round(max(0.0, max(lows) - min(highs)), 9)
 
 
-def _alignment(group: _Group, path: Sequence[tuple[Move | None, ...]], error: float) -> Alignment:
-    """The path as an :class:`Alignment` with its error (Eq. 9, at preferred sizes)."""
+def _alignment(group: _Group, path: Sequence[tuple[Move | None, ...]]) -> Alignment:
+    """The path as an :class:`Alignment`; its error is left 0 until it is the best (then
+    :func:`_error`: most complete layouts a search meets are not)."""
     return Alignment(
         tuple(row.row for row in group.rows),
         tuple(path),
-        error,
+        0.0,
         tuple(0.0 for _ in path),
         tuple(False for _ in path),
     )
