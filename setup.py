@@ -13,7 +13,7 @@ setup(
         Extension(
             "facadecli.solver._exact",
             ["facadecli/solver/_exact.c"],
-            extra_compile_args=["-O2", "-Wall", "-Wextra", "-Wno-unused-parameter"],
+            extra_compile_args=["-O3", "-Wall", "-Wextra", "-Wno-unused-parameter"],
         ),
     ]
 )

@@ -109,3 +109,41 @@ def test_the_compiled_elimination_refuses_rows_it_cannot_read() -> None:
         sizing._parametrized([({5: 1.0}, 0.0)], 3)
     with pytest.raises(TypeError):
         sizing._parametrized([([1.0], 0.0)], 3)  # type: ignore[list-item]
+
+
+@pytest.mark.parametrize("seed", range(16))
+def test_a_layout_with_one_free_length_is_sized_as_the_qp_solver_sizes_it(seed: int) -> None:
+    """With one free length the bounds cut the solutions to an interval and the searches
+    size the layout without a solver: the same optimum as Clarabel's, and the same
+    verdict when the bounds leave nothing (about half of these)."""
+    rng = np.random.default_rng(seed)
+    n = 8
+    while True:
+        e, d = random_system(seed, rows=n, variables=n)
+        e, d = e[: n - 1], d[: n - 1]
+        if np.linalg.matrix_rank(e) == n - 1:
+            break
+        seed += 1000
+    weight = np.where(rng.random(n) < 0.6, 1.0, sizing.TINY)
+    target = np.where(weight == 1.0, rng.uniform(0.5, 3.0, n), 0.0)
+    p = program(e, d, weight, target)
+    p.lower = np.where(rng.random(n) < 0.7, rng.uniform(-1.0, 1.5, n), -np.inf)
+    base = np.where(np.isfinite(p.lower), p.lower, 0.0)
+    p.upper = np.where(rng.random(n) < 0.3, base + rng.uniform(0.5, 4.0, n), np.inf)
+    p.sized = [i for i in range(n) if weight[i] == 1.0]
+    line = sizing._on_a_line(p)
+    solver = sizing._clarabel(p)
+    if solver is None:
+        assert line is None
+        return
+    assert isinstance(line, sizing.Sizing)
+    assert line.objective == pytest.approx(solver.objective, abs=1e-6)
+    assert line.values == pytest.approx(solver.values, abs=1e-5)
+
+
+def test_a_layout_with_two_free_lengths_is_left_to_the_qp_solver() -> None:
+    e, d = random_system(3, rows=4, variables=6)
+    e, d = e[:4], d[:4]
+    assert np.linalg.matrix_rank(e) == 4
+    weight = np.ones(6)
+    assert sizing._on_a_line(program(e, d, weight, np.ones(6))) is sizing._MANY_FREE

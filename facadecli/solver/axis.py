@@ -181,7 +181,7 @@ class _SearchMemory:
     rows: dict[int, dict[str, list[Row]]] = field(default_factory=dict)  # by candidate order
     prepared: dict[Row, _Row] = field(default_factory=dict)  # rows with their moves cached
     made: RowCache = field(default_factory=RowCache)  # make_rows()'s
-    counted: dict[tuple[int, bool], tuple[Word, exact.Counts]] = field(default_factory=dict)
+    counted: dict[tuple[int, bool], exact.Counted] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -29,8 +29,10 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections import Counter
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -1007,50 +1009,70 @@ def align_exactly(
 Counts = dict[str, tuple[int, float]]  # symbol -> (letters, preferred size)
 
 
+class Counted(NamedTuple):
+    """What :func:`candidate_bound` needs of a word (kept by the word's identity, with the
+    word, so that the identity stays its own)."""
+
+    word: Word
+    counts: Counts  # its sized letters (only the opaque ones, when asked for those)
+    longer: float  # the bound of the word alone, too long for the canvas
+    placeholder: bool  # it holds a placeholder (which takes up any shortfall)
+
+
 def candidate_bound(
     groups: Mapping[str, Sequence[Row]],
     canvas: float,
-    counted: dict[tuple[int, bool], tuple[Word, Counts]] | None = None,
+    counted: dict[tuple[int, bool], Counted] | None = None,
 ) -> float:
     """A lower bound on the objective of any layout of a candidate's rows, from one row at
     a time (the paper's Eq. 7 with sizes free): a row longer than the canvas at preferred
     sizes must shrink (placeholders only grow); a row without placeholders that is
     shorter must grow, unless opaque letters of the rows in front may cover its gaps: then
-    its letters and theirs together must reach the canvas."""
+    its letters and theirs together must reach the canvas. ``counted``: words counted
+    before, on this canvas (the caller keeps it)."""
     known = {} if counted is None else counted
 
-    def counts(row: Row, opaque_only: bool) -> Counts:
-        """The row's sized letters (a candidate's words are shared with the others: their
-        counts are kept by the word's identity, with the word, so it stays the same)."""
+    def counts(row: Row, opaque_only: bool) -> Counted:
+        """The row's word, counted (a candidate's words are shared with the others)."""
         found = known.get((id(row.word), opaque_only))
         if found is None:
-            found = known[id(row.word), opaque_only] = (row.word, _sized_counts(row, opaque_only))
-        return found[1]
+            sized = _sized_counts(row, opaque_only)
+            found = known[id(row.word), opaque_only] = Counted(
+                row.word,
+                sized,
+                _excess(sized, canvas),
+                any(traits.size is None for traits in row.traits),
+            )
+        return found
 
     best = 0.0
     for rows in groups.values():
         for row in rows:
             own = counts(row, opaque_only=False)
-            if not own:
+            if not own.counts:
                 continue
-            longer = _excess(own, canvas)
-            best = max(best, longer)
-            if any(traits.size is None for traits in row.traits):
+            best = max(best, own.longer)
+            if own.placeholder:
                 continue  # a placeholder takes up any shortfall
-            reach = dict(own)
+            reach = dict(own.counts)
             for other in rows:
                 if other.covers(row):
-                    for name, (count, size) in counts(other, opaque_only=True).items():
+                    for name, (count, size) in counts(other, opaque_only=True).counts.items():
                         reach[name] = (reach.get(name, (0, size))[0] + count, size)
             best = max(best, _excess(reach, canvas, shorter=True))
     return best
 
 
 def _sized_counts(row: Row, opaque_only: bool) -> Counts:
+    """The row's sized letters (opaque ones only, if asked) by symbol, in the order they
+    first come (letters are counted at C speed: a word has few distinct ones)."""
+    traits_of = dict(zip(row.word, row.traits, strict=True))
     counts: Counts = {}
-    for letter, traits in zip(row.word, row.traits, strict=True):
+    for letter, count in Counter(row.word).items():
+        traits = traits_of[letter]
         if traits.size is not None and (traits.opaque or not opaque_only):
-            counts[letter.symbol] = (counts.get(letter.symbol, (0, 0.0))[0] + 1, traits.size)
+            before = counts.get(letter.symbol, (0, 0.0))[0]
+            counts[letter.symbol] = (before + count, traits.size)
     return counts
 
 

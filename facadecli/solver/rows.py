@@ -84,6 +84,7 @@ class RowCache:
     # its canonical equal, has it an unoccludable letter)
     canonical: dict[Word, tuple[Word, bool]] = field(default_factory=dict)
     rows: dict[tuple[int, tuple[int, ...]], Row] = field(default_factory=dict)
+    letters: dict[Letter, LetterTraits] = field(default_factory=dict)  # letter_traits()
 
 
 def make_rows(
@@ -107,7 +108,10 @@ def make_rows(
         if found is None:
             same = cache.canonical.get(word)
             if same is None:
-                same = cache.canonical[word] = (word, _word_traits(spec, word, known)[1])
+                same = cache.canonical[word] = (
+                    word,
+                    _word_traits(spec, word, known, cache.letters)[1],
+                )
             found = cache.ids[id(word)] = (word, *same)
         _, first, unoccludable = found
         canonical[id(first)] = first
@@ -128,17 +132,17 @@ def make_rows(
 
 
 def _word_traits(
-    spec: Spec, word: Word, known: WordTraits
+    spec: Spec, word: Word, known: WordTraits, letters: dict[Letter, LetterTraits]
 ) -> tuple[tuple[LetterTraits, ...], bool]:
-    """A word's letters' traits, and whether one is unoccludable (kept in ``known``, as
-    are those of each letter, as one-letter words)."""
+    """A word's letters' traits, and whether one is unoccludable (kept in ``known``; each
+    letter's in ``letters``: a long word has few distinct letters)."""
     found = known.get(word)
     if found is None:
-        if len(word) == 1:
-            traits: tuple[LetterTraits, ...] = (letter_traits(spec, word[0]),)
-        else:
-            traits = tuple(_word_traits(spec, (letter,), known)[0][0] for letter in word)
-        found = known[word] = (traits, any(t.unoccludable for t in traits))
+        distinct = set(word)
+        for letter in distinct.difference(letters):
+            letters[letter] = letter_traits(spec, letter)
+        traits = tuple(map(letters.__getitem__, word))
+        found = known[word] = (traits, any(letters[letter].unoccludable for letter in distinct))
     return found
 
 

@@ -114,36 +114,50 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
             columns[(group, j)] = variable(f"column {j} of group {group}", 0.0, TINY, 0.0, np.inf)
         rows.append(({columns[(group, j)]: 1.0 for j in range(alignment.columns)}, canvas))
         split: dict[tuple[int, int], list[int]] = {}
+        words = [row.word for row in alignment.rows]
+        letter_symbol: list[list[int | None]] = [[None] * len(word) for word in words]
         for j, entries in enumerate(alignment.entries):
+            column = columns[(group, j)]
             first: dict[int, float] | None = None
+            first_letters: dict[int, float] | None = None  # its symbols, if it holds no piece
             for r, move in enumerate(entries):
                 if move is None:
                     continue
                 whole, parts = entry_parts(move)
-                coefficients: dict[int, float] = {columns[(group, j)]: -1.0}
-                word = alignment.rows[r].word
+                coefficients: dict[int, float] = {column: -1.0}
+                letters: dict[int, float] = {}
+                known = letter_symbol[r]
                 for k in whole:
-                    index = symbol(word[k].symbol)
-                    coefficients[index] = coefficients.get(index, 0.0) + 1.0
+                    index = known[k]
+                    if index is None:
+                        index = known[k] = symbol(words[r][k].symbol)
+                    letters[index] = letters.get(index, 0.0) + 1.0
+                coefficients.update(letters)
                 for k in parts:
-                    piece = Piece(group, r, k, j)
-                    pieces[piece] = variable(f"piece of {word[k].symbol}", 0.0, TINY, 0.0, np.inf)
-                    coefficients[pieces[piece]] = 1.0
-                    split.setdefault((r, k), []).append(pieces[piece])
+                    index = pieces[Piece(group, r, k, j)] = variable(
+                        f"piece of {words[r][k].symbol}", 0.0, TINY, 0.0, np.inf
+                    )
+                    coefficients[index] = 1.0
+                    split.setdefault((r, k), []).append(index)
                 if first is None:
                     first = coefficients
+                    first_letters = None if parts else letters
                     rows.append((coefficients, 0.0))
                     continue
+                if not parts and letters == first_letters:
+                    continue  # the same letters as the first: nothing new
                 # the entry as long as the column's first, written without the column: a
                 # long façade's many equal columns then give one row ("W == Sp"), not
                 # one a column and row (the same equalities: the solution is the same)
                 same = _difference(coefficients, first)
-                if same and same not in seen:
+                if parts:
+                    rows.append((dict(same), 0.0))  # a new piece: a new row
+                elif same and same not in seen:
                     seen.add(same)
                     rows.append((dict(same), 0.0))
         for (r, k), parts in split.items():
             coefficients = {p: 1.0 for p in parts}
-            index = symbol(alignment.rows[r].word[k].symbol)
+            index = symbol(words[r][k].symbol)
             coefficients[index] = coefficients.get(index, 0.0) - 1.0
             rows.append((coefficients, 0.0))
     matrix = np.zeros((len(rows), len(names)))
@@ -309,13 +323,60 @@ def exact(program: Program) -> Sizing | None:
     return solve(program) if isinstance(found, np.ndarray) else found
 
 
+_MANY_FREE = object()  # _on_a_line(): more than one free length, a QP solver must decide
+
+
+def _on_a_line(program: Program) -> Sizing | object | None:
+    """The QP's optimum when the equalities leave at most one free length ``y``, without a
+    solver: the solutions are the line ``z0 + a y``, every bound cuts it to an interval of
+    ``y``, and the objective is a parabola in ``y``, least at its vertex clamped to the
+    intervals' intersection; None when that is empty (infeasible), :data:`_MANY_FREE` when
+    the layout has more free lengths."""
+    n = len(program.names)
+    parametrized = _parametrized(program.rows, n)
+    if parametrized is None:
+        return None  # the equalities contradict each other
+    z0, free = parametrized
+    if free.shape[1] > 1:
+        return _MANY_FREE
+    low, high = -np.inf, np.inf
+    if free.shape[1]:
+        a = free[:, 0]
+        moving = np.abs(a) > ZERO
+        ends = np.stack(
+            [(program.lower - z0)[moving] / a[moving], (program.upper - z0)[moving] / a[moving]]
+        )
+        low = float(ends.min(axis=0).max(initial=-np.inf))
+        high = float(ends.max(axis=0).min(initial=np.inf))
+        weighted = a * program.weight
+        y = float(weighted @ (program.target - z0)) / float(weighted @ a)
+        z = z0 + a * min(max(y, low), high)
+    else:
+        z = z0
+    if (z < program.lower - 1e-9).any() or (z > program.upper + 1e-9).any():
+        return None  # the interval is empty, or a fixed length breaks a bound
+    scale = max(1.0, float(np.abs(program.rhs).max(initial=0.0)))
+    if np.abs(program.equalities @ z - program.rhs).max(initial=0.0) > 1e-9 * scale:
+        return None
+    return _result(program, np.clip(z, program.lower, program.upper))
+
+
 def search_solve(program: Program) -> Sizing | None:
     """The QP with all bounds, for the searches' many small layouts: the closed form when
-    no bound is active, else Clarabel called directly (the solver cvxpy calls, without
-    cvxpy's compile step of ~10 ms); None if infeasible."""
+    no bound is active; exactly on a line when the equalities leave at most one free
+    length; else Clarabel called directly (the solver cvxpy calls, without cvxpy's compile
+    step of ~10 ms); None if infeasible."""
     found = _closed_form(program)
     if not isinstance(found, np.ndarray):
         return found
+    on_line = _on_a_line(program)
+    if on_line is not _MANY_FREE:
+        return on_line  # type: ignore[return-value]
+    return _clarabel(program)
+
+
+def _clarabel(program: Program) -> Sizing | None:
+    """The QP with all bounds, by Clarabel; None if infeasible."""
     import clarabel
     import scipy.sparse as sparse
 
