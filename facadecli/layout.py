@@ -133,100 +133,134 @@ def _shown(layer: Layer, x: PlacedLetter, y: PlacedLetter) -> bool:
 
 
 def build_shapes(spec: Spec, x: AxisLayout, y: AxisLayout) -> tuple[Shape, ...]:
-    shapes: list[Shape] = []
+    # each shape's fields first, as a tuple in Shape's order (without visible and look)
+    # and its look: the cull reads them, then each Shape is made once, hidden or not
+    made: list[tuple[_Fields, Appearance]] = []
     for index, layer in enumerate(spec.layers):
         if not layer.enabled:
             continue
-        looks: dict[tuple[str, str], Appearance] = {}  # a layer repeats a few symbols
+        # what a pair of symbols looks like: a layer repeats a few
+        looks: dict[tuple[str, str], tuple[Appearance, float, float, bool]] = {}
         for row in y.letters.get(index, ()):
             for column in x.letters.get(index, ()):
                 if not _shown(layer, column, row):
                     continue
-                look = looks.get((column.symbol, row.symbol))
-                if look is None:
-                    look = looks[column.symbol, row.symbol] = appearance(
+                found = looks.get((column.symbol, row.symbol))
+                if found is None:
+                    found = looks[column.symbol, row.symbol] = _look(
                         spec, layer, column.symbol, row.symbol
                     )
-                front = layer.offset + look.depth
-                material = spec.materials.get(look.material)
-                see_through = material is not None and material.opacity < 1.0
-                shapes.append(
-                    Shape(
-                        layer=layer.name,
-                        x=column.symbol,
-                        y=row.symbol,
-                        x0=column.start,
-                        x1=column.end,
-                        y0=row.start,
-                        y1=row.end,
-                        z0=round(front - look.thickness, 6),
-                        z1=round(front, 6),
-                        material=look.material,
-                        mesh=look.mesh,
-                        reflected_x=column.reflected,
-                        reflected_y=row.reflected,
-                        opaque=spec.qualifiers(column.symbol).opaque
-                        and spec.qualifiers(row.symbol).opaque
-                        and not see_through,
-                        look=look,
-                    )
+                look, z0, z1, opaque = found
+                fields: _Fields = (
+                    layer.name,
+                    column.symbol,
+                    row.symbol,
+                    column.start,
+                    column.end,
+                    row.start,
+                    row.end,
+                    z0,
+                    z1,
+                    look.material,
+                    look.mesh,
+                    column.reflected,
+                    row.reflected,
+                    opaque,
                 )
-    return _cull(shapes)
+                made.append((fields, look))
+    hidden = _hidden([fields for fields, _ in made])
+    return tuple(
+        Shape(*fields, not hide, look) for (fields, look), hide in zip(made, hidden, strict=True)
+    )
+
+
+def _look(spec: Spec, layer: Layer, x: str, y: str) -> tuple[Appearance, float, float, bool]:
+    """A pair of symbols' appearance in a layer, its depths (back, front) and whether it
+    covers its whole cell (both symbols opaque, the material not see-through)."""
+    look = appearance(spec, layer, x, y)
+    front = layer.offset + look.depth
+    material = spec.materials.get(look.material)
+    see_through = material is not None and material.opacity < 1.0
+    opaque = spec.qualifiers(x).opaque and spec.qualifiers(y).opaque and not see_through
+    return look, round(front - look.thickness, 6), round(front, 6), opaque
 
 
 # meshes that fill their whole cell, from the depth given here up to their front: only
 # they can hide what is behind them (a frame, an arch or a column leaves gaps to see through)
 SOLID_BACK = {"box": "z0", "ledge": "z0", "panel": "z1"}
+_BACK_FIELD = {"z0": 7, "z1": 8}  # where those depths are in a shape's fields
+
+# a shape's fields in Shape's order, up to opaque (the cull reads them before the shape is
+# made): layer, x, y, x0, x1, y0, y1, z0, z1, material, mesh, reflected x and y, opaque
+_Fields = tuple[str, str, str, float, float, float, float, float, float, str, str, bool, bool, bool]
 
 
 def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
-    """Mark shapes hidden from every viewpoint in front: their cell is covered by opaque,
-    solid shapes of later layers that stand flush on them (no gap between, so no oblique
-    view sees behind them). A shape behind one that stands proud stays."""
-    order = {name: i for i, name in enumerate(dict.fromkeys(s.layer for s in shapes))}
-    solids = [
-        (s.x0, s.x1, s.y0, s.y1, s.z1, order[s.layer], getattr(s, SOLID_BACK[s.mesh]), s)
+    """The shapes, those hidden from every viewpoint in front marked so (see _hidden)."""
+    fields: list[_Fields] = [
+        (
+            s.layer,
+            s.x,
+            s.y,
+            s.x0,
+            s.x1,
+            s.y0,
+            s.y1,
+            s.z0,
+            s.z1,
+            s.material,
+            s.mesh,
+            s.reflected_x,
+            s.reflected_y,
+            s.opaque,
+        )
         for s in shapes
-        if s.opaque and s.mesh in SOLID_BACK
+    ]
+    hidden = _hidden(fields)
+    return tuple(s.hidden() if h else s for s, h in zip(shapes, hidden, strict=True))
+
+
+def _hidden(shapes: list[_Fields]) -> list[bool]:
+    """Which shapes (their fields, in Shape's order) are hidden from every viewpoint in
+    front: their cell is covered by opaque, solid shapes of later layers that stand flush
+    on them (no gap between, so no oblique view sees behind them). A shape behind one
+    that stands proud stays."""
+    order = {name: i for i, name in enumerate(dict.fromkeys(s[0] for s in shapes))}
+    solids: list[_Solid] = [
+        (s[3], s[4], s[5], s[6], s[8], order[s[0]], float(s[_BACK_FIELD[SOLID_BACK[s[10]]]]))
+        for s in shapes
+        if s[13] and s[10] in SOLID_BACK
     ]
     if not solids:
-        return tuple(shapes)
+        return [False] * len(shapes)
     grid = _Grid(solids)
     alike: dict[tuple[float, float, float, float], list[_Solid]] = {}  # by rectangle
     for solid in solids:
         alike.setdefault(solid[:4], []).append(solid)
     result = []
     for shape in shapes:
-        layer, z, left, right, low, high = (
-            order[shape.layer],
-            shape.z1,
-            shape.x0,
-            shape.x1,
-            shape.y0,
-            shape.y1,
-        )
+        layer, z = order[shape[0]], shape[8]
+        rectangle = left, right, low, high = shape[3], shape[4], shape[5], shape[6]
         if any(  # most often a shape is hidden by one as large as itself
-            o[5] > layer and o[4] >= z and o[6] <= z + 1e-9
-            for o in alike.get((left, right, low, high), ())
+            o[5] > layer and o[4] >= z and o[6] <= z + 1e-9 for o in alike.get(rectangle, ())
         ):
-            result.append(shape.hidden())
+            result.append(True)
             continue
         occluders = []
         for near in grid.near(left, right, low, high):
-            for x0, x1, y0, y1, front, o_layer, back, o in near:
+            for x0, x1, y0, y1, front, o_layer, back in near:
                 if o_layer <= layer:
                     break  # the rest are behind it (filed front to back)
                 flush = front >= z and back <= z + 1e-9
                 if flush and x0 < right and x1 > left and y0 < high and y1 > low:
-                    occluders.append(o)
-        hidden = bool(occluders) and _covered(shape, occluders)
-        result.append(shape.hidden() if hidden else shape)
-    return tuple(result)
+                    occluders.append((x0, x1, y0, y1))
+        result.append(bool(occluders) and _covered(rectangle, occluders))
+    return result
 
 
-# a solid shape: x0, x1, y0, y1, front, its layer's place (back to front), the depth its
-# mesh fills from, and the shape
-_Solid = tuple[float, float, float, float, float, int, float, Shape]
+# a solid shape: x0, x1, y0, y1, front, its layer's place (back to front), and the depth
+# its mesh fills from
+_Solid = tuple[float, float, float, float, float, int, float]
 
 
 class _Grid:
@@ -245,13 +279,25 @@ class _Grid:
         self.dy = max(float(np.median([s[3] - s[2] for s in solids])), height / count, 1e-6)
         self.cells: dict[tuple[int, int], list[_Solid]] = {}
         self.large: list[_Solid] = []
-        for solid in sorted(solids, key=lambda solid: -solid[5]):  # front to back
-            cells = self._cells(*solid[:4])
-            if len(cells) > self.LARGE:
+        ordered = sorted(solids, key=lambda solid: -solid[5])  # front to back
+        # the cells of every solid at once (as _cells finds them, at numpy's speed)
+        box = np.array([solid[:4] for solid in ordered])
+        i0 = np.maximum(0, ((box[:, 0] - self.x0) / self.dx).astype(int)).tolist()
+        i1 = ((box[:, 1] - self.x0) / self.dx).astype(int).tolist()
+        j0 = np.maximum(0, ((box[:, 2] - self.y0) / self.dy).astype(int)).tolist()
+        j1 = ((box[:, 3] - self.y0) / self.dy).astype(int).tolist()
+        cells = self.cells
+        for solid, a, b, c, d in zip(ordered, i0, i1, j0, j1, strict=True):
+            if (b - a + 1) * (d - c + 1) > self.LARGE:
                 self.large.append(solid)
                 continue
-            for cell in cells:
-                self.cells.setdefault(cell, []).append(solid)
+            for i in range(a, b + 1):
+                for j in range(c, d + 1):
+                    found = cells.get((i, j))
+                    if found is None:
+                        cells[i, j] = [solid]
+                    else:
+                        found.append(solid)
 
     def _cells(self, x0: float, x1: float, y0: float, y1: float) -> list[tuple[int, int]]:
         xs = range(max(0, int((x0 - self.x0) / self.dx)), int((x1 - self.x0) / self.dx) + 1)
@@ -265,22 +311,26 @@ class _Grid:
         return [*lists, self.large] if self.large else lists
 
 
-def _covered(shape: Shape, occluders: list[Shape]) -> bool:
-    """Is the shape's rectangle inside the union of the occluders' rectangles?"""
+def _covered(
+    rectangle: tuple[float, float, float, float],
+    occluders: list[tuple[float, float, float, float]],
+) -> bool:
+    """Is the rectangle (x0, x1, y0, y1) inside the union of the occluders' rectangles?"""
+    x0, x1, y0, y1 = rectangle
     xs = sorted(
         {
-            shape.x0,
-            shape.x1,
-            *(min(max(o.x0, shape.x0), shape.x1) for o in occluders),
-            *(min(max(o.x1, shape.x0), shape.x1) for o in occluders),
+            x0,
+            x1,
+            *(min(max(o[0], x0), x1) for o in occluders),
+            *(min(max(o[1], x0), x1) for o in occluders),
         }
     )
     ys = sorted(
         {
-            shape.y0,
-            shape.y1,
-            *(min(max(o.y0, shape.y0), shape.y1) for o in occluders),
-            *(min(max(o.y1, shape.y0), shape.y1) for o in occluders),
+            y0,
+            y1,
+            *(min(max(o[2], y0), y1) for o in occluders),
+            *(min(max(o[3], y0), y1) for o in occluders),
         }
     )
     for xa, xb in itertools.pairwise(xs):
@@ -288,7 +338,7 @@ def _covered(shape: Shape, occluders: list[Shape]) -> bool:
             if xb - xa < 1e-9 or yb - ya < 1e-9:
                 continue
             cx, cy = (xa + xb) / 2, (ya + yb) / 2
-            if not any(o.x0 <= cx <= o.x1 and o.y0 <= cy <= o.y1 for o in occluders):
+            if not any(o[0] <= cx <= o[1] and o[2] <= cy <= o[3] for o in occluders):
                 return False
     return True
 

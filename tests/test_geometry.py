@@ -362,7 +362,10 @@ def _culled_by_brute_force(shapes: list[Shape]) -> list[bool]:
             and o.y0 < shape.y1
             and o.y1 > shape.y0
         ]
-        hidden.append(bool(occluders) and _covered(shape, occluders))
+        rectangles = [(o.x0, o.x1, o.y0, o.y1) for o in occluders]
+        hidden.append(
+            bool(occluders) and _covered((shape.x0, shape.x1, shape.y0, shape.y1), rectangles)
+        )
     return hidden
 
 

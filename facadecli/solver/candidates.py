@@ -307,10 +307,13 @@ def _candidate(
 ) -> Candidate:
     """A candidate with its exact Eq. 7 need (opaque room from the chosen words above)."""
     opaque = {key: opaque_of[id(item)] for key, item in words.items()}
+    rooms: dict[tuple[str, ...], float] = {}  # layers of one pattern often share what is above
     need = misfit = shortfall = slack = 0.0
     for key, keys_above in above:
         item = words[key]
-        room = sum(opaque[other] for other in keys_above)
+        room = rooms.get(keys_above)
+        if room is None:
+            room = rooms[keys_above] = sum(opaque[other] for other in keys_above)
         row_need = word_need(item.length, item.elastic, canvas, room)
         need = max(need, row_need)
         misfit += row_need * row_need

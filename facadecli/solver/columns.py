@@ -46,6 +46,9 @@ def _refine(
     starts = sizing.column_starts(solved, program, group, alignment.columns)
     columns: list[tuple[Move | None, ...]] = []
     for j, column in enumerate(alignment.entries):
+        if any(_uncut(move) for move in column):
+            columns.append(column)  # a visible letter spans it whole: no cut inside
+            continue
         points = {
             r: _points(group, r, j, move, alignment, program, solved, starts[j])
             for r, move in enumerate(column)
@@ -67,6 +70,17 @@ def _refine(
         alignment.error,
         tuple(0.0 for _ in columns),
         tuple(False for _ in columns),
+    )
+
+
+def _uncut(move: Move | None) -> bool:
+    """A visible entry of one whole letter: no boundary inside it, so its column has none
+    that every visible entry shares."""
+    return (
+        move is not None
+        and not move.transparent
+        and move.start % 2 == 0
+        and move.end == move.start + 2
     )
 
 
