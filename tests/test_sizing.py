@@ -39,7 +39,6 @@ def program(e: np.ndarray, d: np.ndarray, weight: np.ndarray, target: np.ndarray
         weight=weight,
         lower=np.full(n, -np.inf),
         upper=np.full(n, np.inf),
-        equalities=e,
         rhs=d,
         rows=sparse(e, d),
         symbols={},

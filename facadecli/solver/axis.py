@@ -182,6 +182,24 @@ class _SearchMemory:
     prepared: dict[Row, _Row] = field(default_factory=dict)  # rows with their moves cached
     made: RowCache = field(default_factory=RowCache)  # make_rows()'s
     counted: dict[tuple[int, bool], exact.Counted] = field(default_factory=dict)
+    cores: dict[_CoreKey, _Core] = field(default_factory=dict)  # candidates' relaxations
+
+
+# a candidate without one pattern's layers: that pattern, and the other patterns' words
+_CoreKey = tuple[str, tuple[tuple[str, int], ...]]
+
+
+@dataclass
+class _Core:
+    """What the searches learnt of a relaxation that candidates share: the candidate
+    without the layers of one pattern that covers no other layer (it makes no room for
+    another, so without it every other rule holds as before, and the sizing has fewer
+    equalities): a layout of a candidate is a layout of its relaxation, no better."""
+
+    failed: int = 0  # candidates with it that had no layout within their search's target
+    reason: str = ""  # why the first of them had none
+    none_within: float = -INF  # its search proved no layout within this objective
+    reached: float = INF  # it has a complete alignment within this objective
 
 
 @dataclass(frozen=True)
@@ -239,6 +257,7 @@ def solve_axis_alternatives(
         raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
     tolerance = spec.solver.tolerance
     memory = _SearchMemory(full_layers(spec, axis))
+    shared = _relaxations(uses, candidates, memory.full)
     budget = exact.Budget(EXACT_WORK, deadline)
     evaluated: list[_Evaluated] = []
     failures: list[str] = []
@@ -251,12 +270,42 @@ def solve_axis_alternatives(
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     compare = max(FEASIBLE_TO_COMPARE, alternatives)
 
+    def relaxation(candidate: Candidate) -> _CoreKey | None:
+        return shared.get(candidate.order)
+
+    def ruled_out(candidate: Candidate, target: float) -> str | None:
+        """Why the candidate has no layout within ``target``, when a relaxation of it has
+        none: known, or searched for (once a candidate sharing it had none) when it may
+        have none; None when that is not known."""
+        nonlocal timed_out
+        key = relaxation(candidate)
+        core = None if key is None else memory.cores.get(key)
+        if key is None or core is None:
+            return None
+        if target <= core.none_within:
+            return core.reason
+        if core.failed and target < core.reached:
+            share = exact.Budget(min(budget.left, EXACT_SHARE), deadline)
+            rows = _relaxed_rows(spec, uses, candidate, key[0], memory)
+            found = not rows or exact.reaches(spec, rows, canvas, share, target, memory.prepared)
+            budget.used += share.used
+            timed_out = timed_out or share.timed_out
+            if not found:
+                core.none_within = target
+                return core.reason
+            core.reached = target
+        return None
+
     def search_exactly(candidate: Candidate, target: float, tie: bool) -> None:
         """Search a candidate exactly for a layout with an objective at most ``target``;
         ``tie``: it cannot beat the best found, only tie with it: a search for the
         tie-breaks, which ends at its first layout (the least bound first, so the
         candidate's best as a rule) or after a little work, and proves nothing."""
         nonlocal unproven, timed_out
+        why = ruled_out(candidate, target)
+        if why is not None:
+            failures.append(why)
+            return
         rows = _candidate_rows(spec, uses, candidate, memory)
         share = exact.Budget(min(budget.left, TIE_SHARE if tie else EXACT_SHARE), deadline)
         outcome = exact.align_exactly(
@@ -267,8 +316,15 @@ def solve_axis_alternatives(
         unproven = unproven or not (outcome.complete or tie)
         if outcome.found is None:
             failures.append(outcome.reason)
+            key = relaxation(candidate)
+            if outcome.complete and key is not None:  # proven: its relaxation may have none
+                memory.cores.setdefault(key, _Core(reason=outcome.reason)).failed += 1
             return
         found = outcome.found
+        key = relaxation(candidate)
+        if key is not None:
+            core = memory.cores.setdefault(key, _Core())
+            core.reached = min(core.reached, found.sizing.objective)
         evaluated.append(_Evaluated(candidate, found.groups, found.program, found.sizing))
 
     def align_heuristically(candidate: Candidate, most: int = MAX_NODES) -> float | None:
@@ -427,6 +483,45 @@ def _candidate_rows(
             for group, members in _group_rows(spec, uses, candidate.words).items()
         }
     return rows
+
+
+def _relaxations(
+    uses: Sequence[PatternUse], candidates: Sequence[Candidate], full: frozenset[int]
+) -> dict[int, _CoreKey]:
+    """Per candidate (by its order), the relaxation it shares with the most others, if
+    any: without a pattern whose layers cover no other layer (see :class:`_Core`)."""
+    droppable = [use.key for use in uses if not any(i in full for i, _ in use.layers)]
+    keys: dict[int, list[_CoreKey]] = {}
+    sharing: dict[_CoreKey, int] = {}
+    for candidate in candidates:
+        words = [(use.key, id(candidate.words[use.key].word)) for use in uses]
+        keys[candidate.order] = [
+            (left_out, tuple(pair for pair in words if pair[0] != left_out))
+            for left_out in droppable
+        ]
+        for key in keys[candidate.order]:
+            sharing[key] = sharing.get(key, 0) + 1
+    best = {}
+    for order, found in keys.items():
+        most = max(found, key=lambda key: sharing[key], default=None)  # the first on a tie
+        if most is not None and sharing[most] > 1:
+            best[order] = most
+    return best
+
+
+def _relaxed_rows(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    candidate: Candidate,
+    left_out: str,
+    memory: _SearchMemory,
+) -> dict[str, list[Row]]:
+    """A candidate's rows without the layers of one pattern (groups left empty dropped)."""
+    kept = [use for use in uses if use.key != left_out]
+    return {
+        group: make_rows(spec, members, memory.full, memory.traits, memory.made)
+        for group, members in _group_rows(spec, kept, candidate.words).items()
+    }
 
 
 def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:

@@ -295,6 +295,7 @@ class _Search:
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
     first_only: bool = False  # stop at the first layout found (then nothing is proven)
+    existence: bool = False  # stop at the first complete alignment, unsized (see reaches())
 
     # -- the rules of SPEC 2.4 on one column ----------------------------------------------
     def reject(self, why: str) -> bool:
@@ -730,6 +731,8 @@ class _Search:
 
     def leaf(self, paths: list[list[Column]]) -> None:
         self.budget.spend(LEAF_WORK)
+        if self.existence:
+            raise _Perfect
         self.settle(paths)
 
     def settle(self, paths: list[list[Column]]) -> None:
@@ -822,6 +825,8 @@ class _Compiled:
         """Size a complete alignment given by its cuts: the incumbent after it, and whether
         the search should stop."""
         search = self.search
+        if search.existence:
+            return search.incumbent, True
         paths = [
             [
                 tuple(
@@ -947,6 +952,58 @@ def align_exactly(
     exactly; only layouts with an objective at most ``incumbent`` are looked for.
     ``compiled``: run the search of ``_exact.c`` (the default, :data:`COMPILED`) or the
     Python reference, :class:`_Search`."""
+    search = _search_of(spec, groups, canvas, budget, incumbent, prepared_rows, first_only)
+    try:
+        _run(search, compiled)
+    except _Perfect:
+        best = search.best
+        if best is not None and best.sizing.objective > SAME:  # the first layout, asked for
+            return Outcome(best, False, "stopped at the first layout found")
+    except BudgetExhausted:
+        return Outcome(search.best, False, "the search budget ran out")
+    reason = ""
+    if search.best is None:
+        # the rule that stopped the search furthest along, then the most often
+        counts = sorted(
+            search.rejections.items(), key=lambda item: (-item[1][0], -item[1][1], item[0])
+        )
+        reason = search.sizing_failure or (
+            counts[0][0] if counts else "the words cannot be cut into matching columns"
+        )
+    return Outcome(search.best, True, reason)
+
+
+def reaches(
+    spec: Spec,
+    groups: Mapping[str, Sequence[Row]],
+    canvas: float,
+    budget: Budget,
+    incumbent: float,
+    prepared_rows: dict[Row, _Row] | None = None,
+    compiled: bool | None = None,
+) -> bool:
+    """Whether the search reaches a complete alignment of the groups within ``incumbent``,
+    unsized: its equalities allow that objective, the sizing's bounds unchecked. A quick,
+    one-sided answer: False proves that no layout is within ``incumbent``; the budget
+    running out answers True."""
+    search = _search_of(spec, groups, canvas, budget, incumbent, prepared_rows, True)
+    search.existence = True
+    try:
+        _run(search, compiled)
+    except (_Perfect, BudgetExhausted):
+        return True
+    return False
+
+
+def _search_of(
+    spec: Spec,
+    groups: Mapping[str, Sequence[Row]],
+    canvas: float,
+    budget: Budget,
+    incumbent: float,
+    prepared_rows: dict[Row, _Row] | None,
+    first_only: bool,
+) -> _Search:
     known = {} if prepared_rows is None else prepared_rows
     prepared = []
     for name, rows in sorted(groups.items()):
@@ -969,41 +1026,29 @@ def align_exactly(
     placeholders = sorted(name for name, size in symbols.items() if size is None)
     variables = {name: i for i, name in enumerate([*sized, *placeholders])}
     target = np.array([spec.size(name) for name in sized], dtype=float)
-    search = _Search(
+    return _Search(
         spec, canvas, prepared, budget, incumbent, variables, target, first_only=first_only
     )
+
+
+def _run(search: _Search, compiled: bool | None) -> None:
+    """Run a search, compiled (the default, :data:`COMPILED`) or in Python: first without
+    gaps (most layouts have none, and gaps multiply the columns out of every state), then
+    with them, looking only for better layouts than that one."""
     # the search recurses a column at a time through every group in turn: room for the
     # longest path (a column per half-step of every row, at most), whatever the groups
-    depth = sum(max(group.ends, default=0) for group in prepared) + RECURSION_MARGIN
+    depth = sum(max(group.ends, default=0) for group in search.groups) + RECURSION_MARGIN
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(max(limit, depth))
     run = _Compiled(search).run if (COMPILED if compiled is None else compiled) else search.run
-    # first without gaps (most layouts have none, and gaps multiply the columns out of
-    # every state), then with them, looking only for better layouts than that one
     try:
-        if any(any(group.covering) for group in prepared):
+        if any(any(group.covering) for group in search.groups):
             search.gaps = False
             run()
             search.gaps = True
         run()
-    except _Perfect:
-        best = search.best
-        if best is not None and best.sizing.objective > SAME:  # the first layout, asked for
-            return Outcome(best, False, "stopped at the first layout found")
-    except BudgetExhausted:
-        return Outcome(search.best, False, "the search budget ran out")
     finally:
         sys.setrecursionlimit(limit)
-    reason = ""
-    if search.best is None:
-        # the rule that stopped the search furthest along, then the most often
-        counts = sorted(
-            search.rejections.items(), key=lambda item: (-item[1][0], -item[1][1], item[0])
-        )
-        reason = search.sizing_failure or (
-            counts[0][0] if counts else "the words cannot be cut into matching columns"
-        )
-    return Outcome(search.best, True, reason)
 
 
 Counts = dict[str, tuple[int, float]]  # symbol -> (letters, preferred size)

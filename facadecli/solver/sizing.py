@@ -16,6 +16,7 @@ bound, and ``search_solve`` calls Clarabel directly for the searches' many small
 
 from __future__ import annotations
 
+import functools
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -66,13 +67,33 @@ class Program:
     weight: np.ndarray
     lower: np.ndarray
     upper: np.ndarray
-    equalities: np.ndarray
     rhs: np.ndarray
     rows: list[tuple[dict[int, float], float]]  # the equalities, sparse: coefficients, rhs
     symbols: dict[str, int]
     columns: dict[tuple[str, int], int]
     pieces: dict[Piece, int]
     sized: list[int]  # variables whose deviation is the objective
+
+    @functools.cached_property
+    def equalities(self) -> np.ndarray:
+        """The equalities as a dense matrix E (E z = rhs), for the QP solvers."""
+        matrix = np.zeros((len(self.rows), len(self.names)))
+        row, column, value = self._triplets
+        matrix[row, column] = value
+        return matrix
+
+    @functools.cached_property
+    def _triplets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The equalities' nonzero coefficients: (row, variable, coefficient) arrays."""
+        at = [(i, j, c) for i, (terms, _) in enumerate(self.rows) for j, c in terms.items()]
+        row, column, value = zip(*at, strict=True) if at else ((), (), ())
+        return np.array(row, dtype=int), np.array(column, dtype=int), np.array(value, dtype=float)
+
+    def residual(self, z: np.ndarray) -> float:
+        """The largest amount by which ``z`` misses an equality."""
+        row, column, value = self._triplets
+        made = np.bincount(row, weights=value * z[column], minlength=len(self.rows))
+        return float(np.abs(made - self.rhs).max(initial=0.0))
 
 
 def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) -> Program:
@@ -160,17 +181,12 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
             index = symbol(words[r][k].symbol)
             coefficients[index] = coefficients.get(index, 0.0) - 1.0
             rows.append((coefficients, 0.0))
-    matrix = np.zeros((len(rows), len(names)))
-    for i, (coefficients, _) in enumerate(rows):
-        for j, value in coefficients.items():
-            matrix[i, j] = value
     return Program(
         names=names,
         target=np.array(target),
         weight=np.array(weight),
         lower=np.array(lower),
         upper=np.array(upper),
-        equalities=matrix,
         rhs=np.array([value for _, value in rows]),
         rows=rows,
         symbols=symbols,
@@ -221,9 +237,8 @@ def _equality_solution(program: Program) -> tuple[np.ndarray, bool]:
         z = z0 + free @ y
     else:
         z = z0
-    e, d = program.equalities, program.rhs
-    scale = max(1.0, float(np.abs(d).max(initial=0.0)))
-    return z, bool(np.abs(e @ z - d).max(initial=0.0) <= 1e-9 * scale)
+    scale = max(1.0, float(np.abs(program.rhs).max(initial=0.0)))
+    return z, program.residual(z) <= 1e-9 * scale
 
 
 def _parametrized(
@@ -356,7 +371,7 @@ def _on_a_line(program: Program) -> Sizing | object | None:
     if (z < program.lower - 1e-9).any() or (z > program.upper + 1e-9).any():
         return None  # the interval is empty, or a fixed length breaks a bound
     scale = max(1.0, float(np.abs(program.rhs).max(initial=0.0)))
-    if np.abs(program.equalities @ z - program.rhs).max(initial=0.0) > 1e-9 * scale:
+    if program.residual(z) > 1e-9 * scale:
         return None
     return _result(program, np.clip(z, program.lower, program.upper))
 
@@ -404,7 +419,7 @@ def _clarabel(program: Program) -> Sizing | None:
     if solution.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
         return None
     values = np.clip(np.asarray(solution.x, dtype=float), program.lower, program.upper)
-    if np.abs(program.equalities @ values - program.rhs).max(initial=0.0) > 1e-6:
+    if program.residual(values) > 1e-6:
         return None
     return _result(program, values)
 
