@@ -66,6 +66,11 @@ typedef struct {
     Option *items;
     int n;
     int fresh; /* lengths computed for one node (inside a split letter): freed with it */
+    /* the options by how fitting() checks them: first the entries of whole sized letters
+     * (in the options' order, so by least length), then the other ones of known length,
+     * then those of unknown length (always allowed) */
+    int *order;
+    int n_whole, n_known;
 } Options;
 
 typedef struct {
@@ -838,7 +843,43 @@ static void options_free(Options *o)
         for (int i = 0; i < o->n; i++)
             PyMem_Free(o->items[i].len);
     PyMem_Free(o->items);
+    PyMem_Free(o->order);
     o->items = NULL;
+    o->order = NULL;
+}
+
+/* whether a length holds a placeholder */
+static int holds_placeholder(const Search *s, const double *len)
+{
+    for (int k = s->sized; k < s->nv; k++)
+        if (len[k] != 0.0)
+            return 1;
+    return 0;
+}
+
+/* o->order: the options sorted into the three kinds fitting() checks apart */
+static int options_sort(const Search *s, Options *o)
+{
+    o->order = alloc(sizeof(int) * (size_t)(o->n + 1));
+    if (!o->order)
+        return -1;
+    int at = 0;
+    for (int i = 0; i < o->n; i++) {
+        Option *x = &o->items[i];
+        if (x->len && plain(x->m) && !holds_placeholder(s, x->len))
+            o->order[at++] = i;
+    }
+    o->n_whole = at;
+    for (int i = 0; i < o->n; i++) {
+        Option *x = &o->items[i];
+        if (x->len && !(plain(x->m) && !holds_placeholder(s, x->len)))
+            o->order[at++] = i;
+    }
+    o->n_known = at - o->n_whole;
+    for (int i = 0; i < o->n; i++)
+        if (!o->items[i].len)
+            o->order[at++] = i;
+    return 0;
 }
 
 static int options_of(Search *s, int g, int r, const Node *node, Options *out)
@@ -861,7 +902,7 @@ static int options_of(Search *s, int g, int r, const Node *node, Options *out)
         gap = s->gaps && !inside && row->n_covering;
     } else
         gap = 1;
-    Options o = {alloc(sizeof(Option) * (size_t)(n + 1)), 0, 0};
+    Options o = {alloc(sizeof(Option) * (size_t)(n + 1)), 0, 0, NULL, 0, 0};
     if (!o.items)
         return -1;
     for (int i = 0; i < n; i++) {
@@ -876,6 +917,10 @@ static int options_of(Search *s, int g, int r, const Node *node, Options *out)
     }
     if (gap)
         o.items[o.n++] = (Option){NULL, NULL};
+    if (options_sort(s, &o) < 0) {
+        options_free(&o);
+        return -1;
+    }
     if (!inside) {
         row->cached[s->gaps][position] = o;
         o.fresh = 0;
@@ -896,7 +941,7 @@ typedef struct {
     Options *opts;
     int *order;
     Move **chosen;
-    char **fits; /* per (first row, option): per row, a fitting mask (lazily) */
+    char ***fits; /* per (first row, option): per row, a fitting mask (both lazily) */
     Columns *out;
 } Builder;
 
@@ -999,7 +1044,10 @@ static char *fitting(Builder *b, int fr, int j, int r)
     int base = 0;
     for (int q = 0; q < fr; q++)
         base += b->opts[q].n;
-    char **slot = &b->fits[(size_t)(base + j) * b->R + r];
+    char ***masks = &b->fits[base + j];
+    if (!*masks && !(*masks = alloc(sizeof(char *) * (size_t)b->R)))
+        return NULL;
+    char **slot = &(*masks)[r];
     if (*slot)
         return *slot;
     Options *o = &b->opts[r];
@@ -1024,36 +1072,43 @@ static char *fitting(Builder *b, int fr, int j, int r)
     }
     double least = s->groups[b->g].rows[r].least;
     int ordered = least * least > f.margin;
-    int whole[o->n + 1], nw = 0;
+    const int *whole = o->order, *known = o->order + o->n_whole;
+    const int *unknown = known + o->n_known;
+    int nw = o->n_whole, nk = o->n_known, nu = o->n - nw - nk;
     double miss;
-    for (int i = 0; i < o->n; i++) {
-        const double *len = o->items[i].len;
-        mask[i] = 1;
-        if (!len)
-            continue;
-        int own = 0;
-        for (int k = sz; k < nv; k++)
-            if (len[k] != 0.0)
-                own = 1;
-        if (ordered && plain(o->items[i].m) && !own) {
-            whole[nw++] = i; /* checked below, outward */
-            mask[i] = 0;
-            continue;
+    memset(mask, 0, (size_t)o->n + 1);
+    for (int u = 0; u < nu; u++)
+        mask[unknown[u]] = 1;
+    /* with the whole entries first when they are not checked outward */
+    for (int pass = ordered; pass < 2; pass++) {
+        const int *items = pass ? known : whole;
+        int count = pass ? nk : nw;
+        for (int w = 0; w < count; w++) {
+            int fit = fits(&f, o->items[items[w]].len, &miss);
+            if (fit < 0) {
+                PyMem_Free(mask);
+                return NULL;
+            }
+            mask[items[w]] = fit == 1;
         }
-        int fit = fits(&f, len, &miss);
-        if (fit < 0) {
-            PyMem_Free(mask);
-            return NULL;
-        }
-        mask[i] = fit == 1;
+    }
+    if (!ordered) {
+        *slot = mask;
+        return mask;
     }
     /* the first whole entry at least as long as the first, at preferred sizes */
     double length = f.pinned ? f.rest : 0.0;
     for (int k = 0; k < sz; k++)
         length += (f.pinned ? -reduced[k] : f.first[k]) * s->target[k];
-    int start = 0;
-    while (start < nw && o->items[whole[start]].m->fixed < length)
-        start++;
+    int low = 0, high = nw; /* binary search: the whole entries are sorted by least length */
+    while (low < high) {
+        int mid = (low + high) / 2;
+        if (o->items[whole[mid]].m->fixed < length)
+            low = mid + 1;
+        else
+            high = mid;
+    }
+    int start = low;
     for (int w = start; w < nw; w++) { /* longer, outward */
         int fit = fits(&f, o->items[whole[w]].len, &miss);
         if (fit < 0) {
@@ -1135,13 +1190,18 @@ static int columns_of(Search *s, int g, const Node *node, Options *opts, Columns
         }
         order[k] = v;
     }
-    char **fits = alloc(sizeof(char *) * (size_t)total * R);
+    char ***fits = alloc(sizeof(char **) * (size_t)total);
     if (!fits)
         return -1;
     Builder b = {s, g, R, R - 1, node, opts, order, chosen, fits, out};
     int rc = extend(&b, 0, -1, -1, 0);
-    for (size_t k = 0; k < (size_t)total * R; k++)
+    for (int k = 0; k < total; k++) {
+        if (!fits[k])
+            continue;
+        for (int r = 0; r < R; r++)
+            PyMem_Free(fits[k][r]);
         PyMem_Free(fits[k]);
+    }
     PyMem_Free(fits);
     return rc;
 }
@@ -1668,8 +1728,10 @@ static void free_groups(Search *s)
             }
             for (int gaps = 0; gaps < 2; gaps++)
                 if (row->cached[gaps])
-                    for (int p = 0; p < positions; p++)
+                    for (int p = 0; p < positions; p++) {
                         PyMem_Free(row->cached[gaps][p].items);
+                        PyMem_Free(row->cached[gaps][p].order);
+                    }
             if (row->rem)
                 for (int p = 0; p < positions; p++) {
                     PyMem_Free(row->rem[p]);
