@@ -123,13 +123,16 @@ def _matches(rule: ShapeRule, x: str, y: str) -> bool:
     return rule.match.x in ("*", x) and rule.match.y in ("*", y)
 
 
-def _shown(layer: Layer, x: PlacedLetter, y: PlacedLetter) -> bool:
-    if x.transparent or y.transparent:
-        return False
+def _shown(layer: Layer, letters: tuple[PlacedLetter, ...], axis: str) -> list[PlacedLetter]:
+    """A layer's letters on one axis that may make shapes: not transparent, and in the
+    layer's mask on that axis if it has one (a shape is shown iff both its letters are)."""
     mask = layer.visible
-    if mask is None:
-        return True
-    return (mask.x is None or x.symbol in mask.x) and (mask.y is None or y.symbol in mask.y)
+    allowed = None if mask is None else getattr(mask, axis)
+    return [
+        letter
+        for letter in letters
+        if not letter.transparent and (allowed is None or letter.symbol in allowed)
+    ]
 
 
 def build_shapes(spec: Spec, x: AxisLayout, y: AxisLayout) -> tuple[Shape, ...]:
@@ -141,10 +144,9 @@ def build_shapes(spec: Spec, x: AxisLayout, y: AxisLayout) -> tuple[Shape, ...]:
             continue
         # what a pair of symbols looks like: a layer repeats a few
         looks: dict[tuple[str, str], tuple[Appearance, float, float, bool]] = {}
-        for row in y.letters.get(index, ()):
-            for column in x.letters.get(index, ()):
-                if not _shown(layer, column, row):
-                    continue
+        columns = _shown(layer, x.letters.get(index, ()), "x")
+        for row in _shown(layer, y.letters.get(index, ()), "y"):
+            for column in columns:
                 found = looks.get((column.symbol, row.symbol))
                 if found is None:
                     found = looks[column.symbol, row.symbol] = _look(

@@ -1733,10 +1733,9 @@ static void free_groups(Search *s)
                         PyMem_Free(row->cached[gaps][p].order);
                     }
             if (row->rem)
-                for (int p = 0; p < positions; p++) {
-                    PyMem_Free(row->rem[p]);
-                    PyMem_Free(row->rem_ph ? row->rem_ph[p] : NULL);
-                }
+                PyMem_Free(row->rem[0]); /* the block of every position's */
+            if (row->rem_ph)
+                PyMem_Free(row->rem_ph[0]);
             PyMem_Free(row->rem);
             PyMem_Free(row->rem_ph);
             PyMem_Free(row->cached[0]);
@@ -1837,8 +1836,20 @@ static int read_row(Search *s, Row *row, PyObject *spec, int R, PyObject *variab
         PyObject *symbol, *size, *var;
         Letter *l = &row->letters[k];
         int t, o, a, u;
-        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(fast, k), "OOppppi", &symbol, &size, &t,
-                              &o, &a, &u, &l->segment)) {
+        PyObject *item = PySequence_Fast_GET_ITEM(fast, k);
+        if (!PyTuple_Check(item) || PyTuple_GET_SIZE(item) != 7) {
+            Py_DECREF(fast);
+            PyErr_SetString(PyExc_TypeError, "a letter is a tuple of 7 items");
+            return -1;
+        }
+        symbol = PyTuple_GET_ITEM(item, 0);
+        size = PyTuple_GET_ITEM(item, 1);
+        t = PyObject_IsTrue(PyTuple_GET_ITEM(item, 2));
+        o = PyObject_IsTrue(PyTuple_GET_ITEM(item, 3));
+        a = PyObject_IsTrue(PyTuple_GET_ITEM(item, 4));
+        u = PyObject_IsTrue(PyTuple_GET_ITEM(item, 5));
+        l->segment = (int)PyLong_AsLong(PyTuple_GET_ITEM(item, 6));
+        if (t < 0 || o < 0 || a < 0 || u < 0 || (l->segment == -1 && PyErr_Occurred())) {
             Py_DECREF(fast);
             return -1;
         }
@@ -1870,12 +1881,18 @@ static int read_row(Search *s, Row *row, PyObject *spec, int R, PyObject *variab
         row->counts[(size_t)(k + 1) * nv + l->var] += 1.0;
     }
     Py_DECREF(fast);
-    /* what is left to lay out whole from each position */
+    /* what is left to lay out whole from each position (one block each for all of them) */
+    size_t rem_size = (size_t)(s->sized + 1), ph_size = (size_t)(2 * (nv - s->sized) + 1);
+    double *rem_block = alloc(sizeof(double) * rem_size * (size_t)positions);
+    int *ph_block = alloc(sizeof(int) * ph_size * (size_t)positions);
+    if (!rem_block || !ph_block) {
+        PyMem_Free(rem_block);
+        PyMem_Free(ph_block);
+        return -1;
+    }
     for (int p = 0; p < positions; p++) {
-        double *rem = row->rem[p] = alloc(sizeof(double) * (size_t)(s->sized + 1));
-        int *ph = row->rem_ph[p] = alloc(sizeof(int) * (size_t)(2 * (nv - s->sized) + 1));
-        if (!rem || !ph)
-            return -1;
+        double *rem = row->rem[p] = rem_block + rem_size * (size_t)p;
+        int *ph = row->rem_ph[p] = ph_block + ph_size * (size_t)p;
         const double *all = row->counts + (size_t)n * nv;
         const double *before = row->counts + (size_t)((p + 1) / 2) * nv;
         int m = 0;
