@@ -18,6 +18,9 @@ from facadecli.solver.alignment import Alignment, Move, _entry, _NoEntry, _Row
 from facadecli.spec.model import Spec
 
 NEAR = 1e-7  # metres: boundaries this close are one
+# m^2: the cut layout has the same sizes, but its program more lengths with the tiny weight
+# (sizing.TINY) that makes the optimum unique: its objective may move by about this much
+REGULARIZATION = 1e-7
 
 
 def finest(
@@ -34,7 +37,7 @@ def finest(
         return dict(groups), program, solved
     finer = sizing.build_program(spec, refined, canvas)
     resized = sizing.search_solve(finer)
-    if resized is None or resized.objective > solved.objective + 1e-9:
+    if resized is None or resized.objective > solved.objective + REGULARIZATION:
         return dict(groups), program, solved
     return refined, finer, resized
 

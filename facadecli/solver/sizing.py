@@ -1,7 +1,8 @@
 """Sizing (Ilčík et al. 2015, section 5.3; SPEC 2.7): one quadratic program per axis.
 
 Variables: one size per symbol on the axis (shared by every group), the width of every
-column of every group, and one length per piece of a split transparent letter. Equalities:
+column of every group, and one length per piece of a split transparent letter that shares
+its entry with other letters (a piece alone in its entry is its column's width). Equalities:
 the columns of a group fill the canvas; every non-empty entry is as wide as its column;
 the pieces of a split letter add up to its symbol's size. Objective: the sum over sized
 symbols of (size - preferred)^2, plus a tiny weight on everything else so that the
@@ -145,6 +146,13 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
                 if move is None:
                     continue
                 whole, parts = entry_parts(move)
+                if not whole and len(parts) == 1:
+                    # a piece alone is as long as its column: the column stands for it
+                    # (with the piece's tiny weight added, so the objective is the same)
+                    pieces[Piece(group, r, parts[0], j)] = column
+                    weight[column] += TINY
+                    split.setdefault((r, parts[0]), []).append(column)
+                    continue
                 coefficients: dict[int, float] = {column: -1.0}
                 letters: dict[int, float] = {}
                 known = letter_symbol[r]
@@ -177,7 +185,7 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
                     seen.add(same)
                     rows.append((dict(same), 0.0))
         for (r, k), parts in split.items():
-            coefficients = {p: 1.0 for p in parts}
+            coefficients = dict.fromkeys(parts, 1.0)
             index = symbol(words[r][k].symbol)
             coefficients[index] = coefficients.get(index, 0.0) - 1.0
             rows.append((coefficients, 0.0))
