@@ -675,3 +675,46 @@ def test_a_relaxation_is_shared_only_by_candidates_that_differ_in_one_covering_f
             (use.key, id(mine.words[use.key].word)) for use in uses if use.key != left_out
         )
         assert sum(1 for key in shared.values() if key == (left_out, kept)) > 1
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_candidates_come_in_the_order_of_their_bounds_found_lazily(seed: int) -> None:
+    """The exact search reads candidates by their bound (ties by key); the bounds are
+    found only as it gets near them, in the order of a cheaper bound that is never above
+    them. The order is the full sort's, and a pass that stops early found few."""
+    spec = parse_spec(generated_spec(8, 5))
+    uses = candidates.pattern_uses(spec, axis.axis_words(spec, "x"))
+    found = candidates.generate_candidates(spec, uses, spec.canvas.width)
+    rng = np.random.default_rng(seed)
+    extra = {c.order: float(rng.choice([0.0, 0.0, rng.uniform(0.0, 0.3)])) for c in found}
+    least = {c.order: float(rng.uniform(0.0, 0.2)) for c in found}
+    bound = {order: least[order] + extra[order] for order in least}
+    asked: list[int] = []
+
+    def exact_bound(c: candidates.Candidate) -> float:
+        asked.append(c.order)
+        return bound[c.order]
+
+    ordered = axis._InBoundOrder(found, exact_bound, lambda c: least[c.order])
+    expected = sorted((bound[c.order], c.key, c) for c in found)
+    for _ in range(2):  # a second pass reads the same order again, finding nothing anew
+        assert [item[2].order for item in ordered] == [item[2].order for item in expected]
+    assert sorted(asked) == sorted(c.order for c in found)  # each bound found once
+    asked.clear()
+    early = axis._InBoundOrder(found, exact_bound, lambda c: least[c.order])
+    for item in early:
+        if item[0] > 0.05:
+            break
+    assert len(asked) < len(found)
+
+
+def test_the_least_bound_of_a_candidate_is_never_above_its_bound() -> None:
+    for layers, bays in [(8, 3), (24, 7), (12, 20)]:
+        spec = parse_spec(generated_spec(layers, bays))
+        for name, canvas in (("x", spec.canvas.width), ("y", spec.canvas.height)):
+            uses = candidates.pattern_uses(spec, axis.axis_words(spec, name))  # type: ignore[arg-type]
+            memory = axis._SearchMemory(full_layers(spec, name))  # type: ignore[arg-type]
+            least = axis._least_bounds(uses, canvas, memory.full)
+            for c in candidates.generate_candidates(spec, uses, canvas):
+                rows = axis._candidate_rows(spec, uses, c, memory)
+                assert least(c) <= exact.candidate_bound(rows, canvas) + 1e-12

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import heapq
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from facadecli.errors import InfeasibleError, SearchLimitError
@@ -379,13 +380,12 @@ def solve_axis_alternatives(
     # threshold for a layout within it, in the order of those bounds, and ends the solve
     # once the best layout found is within it: nothing better can exist. Low thresholds cut
     # hopeless columns at once, so the first passes are cheap.
-    bounds = sorted(
-        (
-            exact.candidate_bound(_candidate_rows(spec, uses, c, memory), canvas, memory.counted),
-            c.key,
-            c,
-        )
-        for c in candidates
+    bounds = _InBoundOrder(
+        candidates,
+        lambda c: exact.candidate_bound(
+            _candidate_rows(spec, uses, c, memory), canvas, memory.counted
+        ),
+        _least_bounds(uses, canvas, memory.full),
     )
     heuristic_done = alternatives > 1
     for threshold in DEEPENING:
@@ -483,6 +483,74 @@ def _candidate_rows(
             for group, members in _group_rows(spec, uses, candidate.words).items()
         }
     return rows
+
+
+class _InBoundOrder:
+    """Candidates with their lower bounds (``bound``), least first (on a tie by key), as
+    the passes of the exact search read them: a candidate's rows are made and its bound
+    found only once the passes get near it. ``least`` is a bound on ``bound`` that needs no
+    rows: candidates are taken in its order, and one is handed on once no candidate left
+    can come before it (``least`` is beyond its bound)."""
+
+    def __init__(
+        self,
+        candidates: Sequence[Candidate],
+        bound: Callable[[Candidate], float],
+        least: Callable[[Candidate], float],
+    ):
+        self.bound = bound
+        self.waiting = sorted((least(c), c.key, c) for c in candidates)
+        self.next = 0  # the first waiting candidate whose bound is not found yet
+        self.found: list[tuple[float, tuple[float, float, float, int], Candidate]] = []  # a heap
+        self.ordered: list[tuple[float, tuple[float, float, float, int], Candidate]] = []
+
+    def __iter__(self) -> Iterator[tuple[float, tuple[float, float, float, int], Candidate]]:
+        at = 0
+        while True:
+            if at == len(self.ordered):
+                while self.next < len(self.waiting) and (
+                    not self.found or self.waiting[self.next][0] <= self.found[0][0]
+                ):
+                    _, key, candidate = self.waiting[self.next]
+                    self.next += 1
+                    heapq.heappush(self.found, (self.bound(candidate), key, candidate))
+                if not self.found:
+                    return
+                self.ordered.append(heapq.heappop(self.found))
+            yield self.ordered[at]
+            at += 1
+
+
+def _least_bounds(
+    uses: Sequence[PatternUse], canvas: float, full: frozenset[int]
+) -> Callable[[Candidate], float]:
+    """A bound on a candidate's bound from its words' lengths alone (no rows, no letters
+    looked at): what :func:`exact.candidate_bound` finds of a row, a word too long for the
+    canvas, or too short when nothing in front can make room in it and it has no
+    placeholder, is the miss squared over the sum of its symbols' counts squared, and
+    that sum is at most the word's letters squared."""
+    uncovered = {
+        use.key: not any(
+            other > layer and other in full and other_group == group
+            for layer, group in use.layers
+            for other_use in uses
+            for other, other_group in other_use.layers
+        )
+        for use in uses
+    }
+
+    def least(candidate: Candidate) -> float:
+        best = 0.0
+        for use in uses:
+            item = candidate.words[use.key]
+            miss = item.length - canvas
+            if miss < 0.0 and uncovered[use.key] and not item.elastic:
+                miss = -miss
+            if miss > 0.0 and item.word:
+                best = max(best, miss * miss / (len(item.word) * len(item.word)))
+        return best
+
+    return least
 
 
 def _relaxations(

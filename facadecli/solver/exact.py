@@ -39,7 +39,7 @@ import numpy as np
 from facadecli.patterns import Word
 from facadecli.solver import _exact, columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row
-from facadecli.solver.rows import Row
+from facadecli.solver.rows import LetterTraits, Row
 from facadecli.spec.model import Spec
 
 FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2
@@ -1078,17 +1078,7 @@ def candidate_bound(
     known = {} if counted is None else counted
 
     def counts(row: Row, opaque_only: bool) -> Counted:
-        """The row's word, counted (a candidate's words are shared with the others)."""
-        found = known.get((id(row.word), opaque_only))
-        if found is None:
-            sized = _sized_counts(row, opaque_only)
-            found = known[id(row.word), opaque_only] = Counted(
-                row.word,
-                sized,
-                _excess(sized, canvas),
-                any(traits.size is None for traits in row.traits),
-            )
-        return found
+        return counted_word(row.word, row.traits, canvas, opaque_only, known)
 
     best = 0.0
     for rows in groups.values():
@@ -1108,16 +1098,34 @@ def candidate_bound(
     return best
 
 
-def _sized_counts(row: Row, opaque_only: bool) -> Counts:
-    """The row's sized letters (opaque ones only, if asked) by symbol, in the order they
+def counted_word(
+    word: Word,
+    traits: Sequence[LetterTraits],
+    canvas: float,
+    opaque_only: bool,
+    counted: dict[tuple[int, bool], Counted],
+) -> Counted:
+    """A word counted for :func:`candidate_bound` (kept in ``counted`` by its identity: a
+    candidate's words are shared with the others)."""
+    found = counted.get((id(word), opaque_only))
+    if found is None:
+        sized = _sized_counts(word, traits, opaque_only)
+        found = counted[id(word), opaque_only] = Counted(
+            word, sized, _excess(sized, canvas), any(t.size is None for t in traits)
+        )
+    return found
+
+
+def _sized_counts(word: Word, traits: Sequence[LetterTraits], opaque_only: bool) -> Counts:
+    """A word's sized letters (opaque ones only, if asked) by symbol, in the order they
     first come (letters are counted at C speed: a word has few distinct ones)."""
-    traits_of = dict(zip(row.word, row.traits, strict=True))
+    traits_of = dict(zip(word, traits, strict=True))
     counts: Counts = {}
-    for letter, count in Counter(row.word).items():
-        traits = traits_of[letter]
-        if traits.size is not None and (traits.opaque or not opaque_only):
+    for letter, count in Counter(word).items():
+        its = traits_of[letter]
+        if its.size is not None and (its.opaque or not opaque_only):
             before = counts.get(letter.symbol, (0, 0.0))[0]
-            counts[letter.symbol] = (before + count, traits.size)
+            counts[letter.symbol] = (before + count, its.size)
     return counts
 
 
