@@ -718,3 +718,28 @@ def test_the_least_bound_of_a_candidate_is_never_above_its_bound() -> None:
             for c in candidates.generate_candidates(spec, uses, canvas):
                 rows = axis._candidate_rows(spec, uses, c, memory)
                 assert least(c) <= exact.candidate_bound(rows, canvas) + 1e-12
+
+
+def test_a_finished_search_is_let_go_without_the_garbage_collector() -> None:
+    """Each candidate's compiled search holds its moves and options (megabytes for a long
+    row): once it ends, nothing holds it, so it is freed at once, even with the garbage
+    collector off."""
+    import gc
+    import weakref
+
+    made: list[weakref.ref[exact._Compiled]] = []
+    init = exact._Compiled.__init__
+
+    def kept(self: exact._Compiled, search: exact._Search) -> None:
+        init(self, search)
+        made.append(weakref.ref(self))
+
+    spec = parse_spec(generated_spec(8, 3))
+    gc.disable()
+    try:
+        exact._Compiled.__init__ = kept  # type: ignore[method-assign]
+        solve(spec)
+        assert made and all(ref() is None for ref in made)
+    finally:
+        exact._Compiled.__init__ = init  # type: ignore[method-assign]
+        gc.enable()

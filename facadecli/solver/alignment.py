@@ -807,6 +807,10 @@ def composite_row(alignment: Alignment, rows: Sequence[_Row]) -> tuple[Row, list
         if j and _must_stay_apart(entries[j - 1], column):
             segment += 1
         present = [m for m in column if m is not None]
+        # a row inside a split letter at the column's start or end: the letter goes on in
+        # the column before or after, so no empty column may come between (as if attached)
+        split_before = any(m.start % 2 for m in present)
+        split_after = any(m.end % 2 for m in present)
         cutter = _subdivision(column, rows)
         if cutter is None:
             parts.append(_Part(j, 0, 1))
@@ -815,7 +819,9 @@ def composite_row(alignment: Alignment, rows: Sequence[_Row]) -> tuple[Row, list
                     size=None if alignment.elastic[j] else alignment.widths[j],
                     transparent=False,
                     opaque=True,
-                    attached=any(m.first_attached or m.last_attached for m in present),
+                    attached=split_before
+                    or split_after
+                    or any(m.first_attached or m.last_attached for m in present),
                     unoccludable=any(m.unoccludable for m in present),
                     segment=segment,
                 )
@@ -824,6 +830,10 @@ def composite_row(alignment: Alignment, rows: Sequence[_Row]) -> tuple[Row, list
         entry = column[cutter]
         assert entry is not None
         letters = range(entry.start // 2, entry.end // 2)
+        # the other rows' entries span the whole column: an empty column between two of
+        # its parts would cut them (as if its parts were attached; before the first and
+        # after the last too, the one flag there is)
+        spanned = any(m is not None for q, m in enumerate(column) if q != cutter)
         for index, k in enumerate(letters):
             own = rows[cutter].row.traits[k]
             parts.append(_Part(j, index, len(letters)))
@@ -832,7 +842,10 @@ def composite_row(alignment: Alignment, rows: Sequence[_Row]) -> tuple[Row, list
                     size=own.size,
                     transparent=False,
                     opaque=own.opaque,
-                    attached=own.attached,
+                    attached=own.attached
+                    or (spanned and len(letters) > 1)
+                    or (index == 0 and split_before)
+                    or (index == len(letters) - 1 and split_after),
                     unoccludable=own.unoccludable,
                     segment=segment,
                 )

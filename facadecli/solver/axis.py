@@ -640,10 +640,8 @@ def _place(
     letters: dict[int, tuple[PlacedLetter, ...]] = {}
     groups: dict[str, GroupColumns] = {}
     for group, alignment in sorted(choice.groups.items()):
-        bounds = [
-            round(b, PRECISION)
-            for b in sizing.column_starts(final, program, group, alignment.columns)
-        ]
+        starts = sizing.column_starts(final, program, group, alignment.columns)
+        bounds = [round(b, PRECISION) for b in starts]
         bounds[-1] = round(canvas, PRECISION)
         for r, row in enumerate(alignment.rows):
             spans: dict[int, list[float]] = {}
@@ -653,17 +651,16 @@ def _place(
                     continue
                 whole, parts = sizing.entry_parts(move)
                 order = sorted([(k, False) for k in whole] + [(k, True) for k in parts])
-                cursor = bounds[j]
+                cursor, exact = bounds[j], starts[j]  # rounded, and as solved: the letters
+                # are laid out by the solved sizes (rounding each end alone, so that no
+                # rounding adds up along an entry of many letters)
                 for position, (k, is_piece) in enumerate(order):
                     if is_piece:
                         length = final.of(program.pieces[sizing.Piece(group, r, k, j)])
                     else:
                         length = final.of(program.symbols[row.word[k].symbol])
-                    end = (
-                        bounds[j + 1]
-                        if position == len(order) - 1
-                        else round(cursor + length, PRECISION)
-                    )
+                    exact += length
+                    end = bounds[j + 1] if position == len(order) - 1 else round(exact, PRECISION)
                     span = spans.setdefault(k, [cursor, end])
                     span[1] = end
                     cursor = end

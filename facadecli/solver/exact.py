@@ -784,7 +784,7 @@ class _Compiled:
             for group in search.groups
         ]
         budget = search.budget
-        self.table = _exact.Search(
+        self.table: _exact.Search | None = _exact.Search(
             groups,
             search.variables,
             search.target.tolist(),
@@ -797,8 +797,14 @@ class _Compiled:
             self.leaf,
         )
 
+    def close(self) -> None:
+        """Let the compiled search go: it holds leaf(), which holds it (a cycle that only
+        the garbage collector would find), and its moves and options."""
+        self.table = None
+
     def run(self) -> None:
         search = self.search
+        assert self.table is not None, "a closed search"
         status = self.table.run(search.gaps)
         search.budget.used = self.table.used
         search.budget.timed_out = self.table.timed_out
@@ -814,6 +820,7 @@ class _Compiled:
         """The compiled search's rejections, worded, into the search's (as it counts them)."""
         search = self.search
         search.rejections.clear()
+        assert self.table is not None, "a closed search"
         for rule, g, r, above, start, end, progress, count in self.table.rejections():
             group = search.groups[g]
             move = None if start < 0 else group.rows[r].spanning(start, end)
@@ -1040,7 +1047,8 @@ def _run(search: _Search, compiled: bool | None) -> None:
     depth = sum(max(group.ends, default=0) for group in search.groups) + RECURSION_MARGIN
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(max(limit, depth))
-    run = _Compiled(search).run if (COMPILED if compiled is None else compiled) else search.run
+    table = _Compiled(search) if (COMPILED if compiled is None else compiled) else None
+    run = search.run if table is None else table.run
     try:
         if any(any(group.covering) for group in search.groups):
             search.gaps = False
@@ -1049,6 +1057,8 @@ def _run(search: _Search, compiled: bool | None) -> None:
         run()
     finally:
         sys.setrecursionlimit(limit)
+        if table is not None:
+            table.close()
 
 
 Counts = dict[str, tuple[int, float]]  # symbol -> (letters, preferred size)
