@@ -665,11 +665,15 @@ def test_a_relaxation_is_shared_only_by_candidates_that_differ_in_one_covering_f
     uses = candidates.pattern_uses(spec, axis.axis_words(spec, "x"))
     found = candidates.generate_candidates(spec, uses, spec.canvas.width)
     full = full_layers(spec, "x")
-    shared = axis._relaxations(uses, found, full)
+    shared = axis._relaxations(spec, uses, found, full)
     assert shared  # the pilasters' counter k varies with the bays fixed
     by_order = {c.order: c for c in found}
     for order, (left_out, kept) in shared.items():
         assert not any(i in full for use in uses if use.key == left_out for i, _ in use.layers)
+        left = by_order[order].words[left_out].word
+        assert not any(
+            spec.qualifiers(letter.symbol).opaque for letter in left if not letter.transparent
+        )
         mine = by_order[order]
         assert kept == tuple(
             (use.key, id(mine.words[use.key].word)) for use in uses if use.key != left_out
@@ -743,3 +747,29 @@ def test_a_finished_search_is_let_go_without_the_garbage_collector() -> None:
     finally:
         exact._Compiled.__init__ = init  # type: ignore[method-assign]
         gc.enable()
+
+
+def test_a_layer_that_backs_a_column_is_never_left_out_of_a_relaxation() -> None:
+    """The front layer covers nothing (masked), but its opaque B are the only backing the
+    base's non-opaque W have. Its words differ from candidate to candidate (B^n C^j); a
+    relaxation without it would have no backed layout at all, and once B B C C failed it
+    would rule out B B B C too, the one that backs every W."""
+    layout = solve_text(
+        """
+        version: 1
+        name: backing
+        canvas: {width: 4.0, height: 1.0}
+        counters: {n: {min: 1, max: 3}, j: {min: 1, max: 3}}
+        symbols:
+          W: {size: 1.0, opaque: false}
+          A: {size: 1.0, opaque: true}
+          B: {size: 1.0, opaque: true}
+          C: {size: 1.0, opaque: false}
+          F: {size: 1.0, opaque: true}
+        patterns: {floor: F}
+        layers:
+          - {name: base, x: "W A W A", y: floor}
+          - {name: front, x: "B^n C^j", y: floor, visible: {y: [F]}, offset: 0.1}
+        """
+    )
+    assert (layout.counters["n"], layout.counters["j"]) == (3, 1)

@@ -8,7 +8,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from facadecli.errors import InfeasibleError, SearchLimitError
-from facadecli.patterns import CompiledPattern, Enumerated, Word, format_word
+from facadecli.patterns import CompiledPattern, Enumerated, Letter, Word, format_word
 from facadecli.solver import columns, exact, sizing
 from facadecli.solver.alignment import (
     INF,
@@ -20,7 +20,14 @@ from facadecli.solver.alignment import (
     align,
 )
 from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
-from facadecli.solver.rows import Row, RowCache, WordTraits, full_layers, make_rows
+from facadecli.solver.rows import (
+    Row,
+    RowCache,
+    WordTraits,
+    full_layers,
+    letter_traits,
+    make_rows,
+)
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
@@ -258,7 +265,7 @@ def solve_axis_alternatives(
         raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
     tolerance = spec.solver.tolerance
     memory = _SearchMemory(full_layers(spec, axis))
-    shared = _relaxations(uses, candidates, memory.full)
+    shared = _relaxations(spec, uses, candidates, memory.full)
     budget = exact.Budget(EXACT_WORK, deadline)
     evaluated: list[_Evaluated] = []
     failures: list[str] = []
@@ -554,15 +561,24 @@ def _least_bounds(
 
 
 def _relaxations(
-    uses: Sequence[PatternUse], candidates: Sequence[Candidate], full: frozenset[int]
+    spec: Spec, uses: Sequence[PatternUse], candidates: Sequence[Candidate], full: frozenset[int]
 ) -> dict[int, _CoreKey]:
     """Per candidate (by its order), the relaxation it shares with the most others, if
-    any: without a pattern whose layers cover no other layer (see :class:`_Core`)."""
-    droppable = [use.key for use in uses if not any(i in full for i, _ in use.layers)]
+    any: without a pattern whose layers cover no other layer and whose word has no opaque
+    letter (so that no column loses its opaque backing; see :class:`_Core`)."""
+    covering_none = [use.key for use in uses if not any(i in full for i, _ in use.layers)]
+    opaque: dict[Letter, bool] = {}
     keys: dict[int, list[_CoreKey]] = {}
     sharing: dict[_CoreKey, int] = {}
     for candidate in candidates:
         words = [(use.key, id(candidate.words[use.key].word)) for use in uses]
+        droppable = []
+        for pattern in covering_none:
+            letters = set(candidate.words[pattern].word)
+            for letter in letters.difference(opaque):
+                opaque[letter] = letter_traits(spec, letter).opaque
+            if not any(opaque[letter] for letter in letters):
+                droppable.append(pattern)
         keys[candidate.order] = [
             (left_out, tuple(pair for pair in words if pair[0] != left_out))
             for left_out in droppable
