@@ -1088,7 +1088,7 @@ def candidate_bound(
     known = {} if counted is None else counted
 
     def counts(row: Row, opaque_only: bool) -> Counted:
-        return counted_word(row.word, row.traits, canvas, opaque_only, known)
+        return _counted_word(row.word, row.traits, canvas, opaque_only, known)
 
     best = 0.0
     for rows in groups.values():
@@ -1108,7 +1108,7 @@ def candidate_bound(
     return best
 
 
-def counted_word(
+def _counted_word(
     word: Word,
     traits: Sequence[LetterTraits],
     canvas: float,
