@@ -218,3 +218,25 @@ def test_a_wider_facade_without_repeats_widens_its_wall_not_its_windows(
         assert len(windows) == 6 and all(w == pytest.approx(1.2, abs=0.02) for w in windows)
         assert doors == [pytest.approx(1.1, abs=0.02)]
         assert not variation.kept.broken
+
+
+def test_each_variation_carries_its_terminals_with_their_sizes_in_the_source(
+    tmp_path: Path,
+) -> None:
+    """The pieces of a variation are its layout's rectangles (the background aside), each
+    with the size its part has in the source grammar: at the source's own size a window
+    is as wide as its source piece; a façade twice as wide has windows no wider than that
+    where the grammar repeats them (the bench counts those that grew)."""
+    extraction = _extract(tmp_path, _floors(6, 4))
+    source = (extraction.tiling.xs[-1], extraction.tiling.ys[-1])
+    for width in (source[0], 2 * source[0]):
+        for variation in _draw(extraction, (width, source[1]), 2):
+            drawn = sorted(
+                (p.label, *(round(v, 6) for v in (p.x0, p.y0, p.x1, p.y1)))
+                for p in variation.pieces
+                if p.label != "facade"
+            )
+            assert drawn == [b for b in _boxes(variation.layout) if b[0] != "facade"]
+            windows = [p for p in variation.pieces if p.label == "window"]
+            assert windows
+            assert all(p.x1 - p.x0 <= 1.15 * p.source_w for p in windows)

@@ -485,7 +485,8 @@ class Variation:
     offset; empty for the best fit), ``shuffle`` (a split rule and its parts' symbols in
     their new order; None when none is shuffled), its ``score``, the mean squared
     log-ratio of its elements' sizes to their sizes in the source (lower is nearer the
-    source), and the source's style it keeps."""
+    source), the source's style it keeps, and its terminals (tidied) with their sizes in
+    the source."""
 
     layout: Layout
     offsets: tuple[tuple[str, int], ...]
@@ -493,6 +494,7 @@ class Variation:
     kept: Kept = NOTHING_KEPT
     shuffle: Shuffle | None = None
     proportions: Proportions = ()
+    pieces: tuple[Piece, ...] = ()
 
 
 Shuffle = tuple[str, tuple[str, ...]]  # a split rule, its parts' symbols in a new order
@@ -622,7 +624,9 @@ def derive_variations(
     first = next(c for c in ranked if not c.proportions)
     aligned, warnings, keeps = _tidied(first.pieces, first.kept, kept, width, height, style)
     layout = pieces_layout(aligned, width, height, named(0), warnings)
-    found = [Variation(layout, first.offsets, first.score, keeps, first.shuffle)]
+    found = [
+        Variation(layout, first.offsets, first.score, keeps, first.shuffle, (), tuple(aligned))
+    ]
     if count == 1:
         return found, []
     # a weighted draw without replacement (Efraimidis and Spirakis): keys u^(1/w), drawn
@@ -650,7 +654,15 @@ def derive_variations(
     for k, (other, moved, moved_warnings, keeps) in enumerate(chosen, start=1):
         layout = pieces_layout(moved, width, height, named(k), moved_warnings)
         found.append(
-            Variation(layout, other.offsets, other.score, keeps, other.shuffle, other.proportions)
+            Variation(
+                layout,
+                other.offsets,
+                other.score,
+                keeps,
+                other.shuffle,
+                other.proportions,
+                tuple(moved),
+            )
         )
     notes = []
     if len(found) < count:

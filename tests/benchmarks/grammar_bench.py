@@ -47,6 +47,7 @@ def main() -> None:
     style_kept: dict[float, int] = {}
     windows: dict[float, int] = {}  # derived windows, and those wider than the source's
     wide: dict[float, int] = {}
+    grown: dict[float, int] = {}  # windows wider than their own piece in the source
     style_total = 0
     last = None
     for path in files:
@@ -74,6 +75,9 @@ def main() -> None:
             widths = _window_widths(drawn[0].layout)
             windows[scale] = windows.get(scale, 0) + len(widths)
             wide[scale] = wide.get(scale, 0) + sum(w > WIDER * widest for w in widths)
+            grown[scale] = grown.get(scale, 0) + sum(
+                p.x1 - p.x0 > WIDER * p.source_w for p in drawn[0].pieces if p.label == "window"
+            )
         for scale, count in zip(SCALES, kept, strict=True):
             style_kept[scale] = style_kept.get(scale, 0) + count
         style_total += len(style)
@@ -99,6 +103,11 @@ def main() -> None:
     print(
         "windows more than 15% wider than the input's widest: "
         + ", ".join(f"{wide[s]} of {windows[s]} at {s}x" for s in SCALES)
+        + " width"
+    )
+    print(
+        "windows more than 15% wider than their own piece of the source grammar: "
+        + ", ".join(f"{grown[s]} of {windows[s]} at {s}x" for s in SCALES)
         + " width"
     )
     wins = sum(a < g for a, g in zip(adp, greedy, strict=True))
