@@ -9,8 +9,15 @@ from pathlib import Path
 import pytest
 
 from facadecli.grammar.run import Extraction, Options, extract_grammar
+from facadecli.grammar.split import Part
 from facadecli.grammar.tiling import LabelledLayout, Rect
-from facadecli.grammar.variation import Variation, derive_layout, derive_variations
+from facadecli.grammar.variation import (
+    Piece,
+    Variation,
+    _run_of,
+    derive_layout,
+    derive_variations,
+)
 from facadecli.layout import Layout
 from tests.test_grammar import _facade, _floors, _write_plain
 
@@ -240,3 +247,45 @@ def test_each_variation_carries_its_terminals_with_their_sizes_in_the_source(
             windows = [p for p in variation.pieces if p.label == "window"]
             assert windows
             assert all(p.x1 - p.x0 <= 1.15 * p.source_w for p in windows)
+
+
+def _bays_drawn_apart() -> LabelledLayout:
+    """Three floors of three window bays, the middle bay's window with a sill the others
+    lack (drawn a little differently, as a hand annotation is): no rule repeats the bays."""
+    rects = []
+    for j in range(3):
+        y = 0.5 + 3 * j
+        for i in range(3):
+            x = 1.0 + 2 * i
+            rects.append(Rect("window", x, y + 0.2, x + 1, y + 1.7, 1))
+            if i == 1:
+                rects.append(Rect("sill", x, y, x + 1, y + 0.2, 1))
+    return LabelledLayout(7.0, 9.5, tuple(rects))
+
+
+def test_bays_alike_but_not_identical_are_laid_more_often_on_a_wider_facade(
+    tmp_path: Path,
+) -> None:
+    """Bays of one size holding the same kinds of element, between equal gaps, make a run:
+    twice as wide, the façade gets more of them, not wider windows; its own size and a
+    narrower one keep the source's bays."""
+    extraction = _extract(tmp_path, _bays_drawn_apart())
+    rules = extraction.grammar.rules.values()
+    assert not any(r.op in ("repeat", "repeatABA") for r in rules if r.axis == "x")
+
+    def windows(width: float) -> list[Piece]:
+        (variation,) = _draw(extraction, (width, 9.5), 1)
+        return [p for p in variation.pieces if p.label == "window"]
+
+    assert len(windows(7.0)) == len(windows(5.0)) == 9
+    wide = windows(14.0)
+    assert len(wide) > 9 and len(wide) % 3 == 0  # each floor alike
+    assert all(p.x1 - p.x0 <= 1.15 * p.source_w for p in wide)
+
+
+def test_a_run_gains_copies_of_its_middle_bay_and_never_loses_one() -> None:
+    a, b, c, gap = (Part(1.0, s) for s in ("A", "B", "C", "g"))
+    run = (a, gap, b, gap, c)
+    assert _run_of(run, 3) == run
+    assert [p.symbol for p in _run_of(run, 5)] == ["A", "g", "B", "g", "B", "g", "B", "g", "C"]
+    assert _run_of(run, 5)[::2] == (a, b, b, b, c)

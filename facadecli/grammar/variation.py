@@ -58,6 +58,9 @@ ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are
 STYLE_NEAR = 0.05  # of the new width: near misses of the style this close are made exact
 SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
 MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
+REPEATS = ("repeat", "repeatABA", "run")  # rules whose count the derivation chooses
+RUN_BAYS = 3  # bays of one size and kind side by side that a derivation may add to
+RUN_LEAST = 0.05  # of the source's extent: a narrower part is no bay (a slat, a frame)
 STRETCH = 0.5  # a varied repeat's copies stay within 1/(1 + this) to 1 + this of their size
 CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fewer: 3^6)
 SHUFFLES_MAX = 6  # new orders of one split rule's parts tried as variations
@@ -94,10 +97,7 @@ def _elastic(grammar: Grammar) -> dict[tuple[str, str], bool]:
                 rule is not None
                 and rule.axis == axis
                 and rule.op != "gridsplit"
-                and (
-                    rule.op in ("repeat", "repeatABA")
-                    or any(elastic(p.symbol, axis) for p in rule.parts)
-                )
+                and (rule.op in REPEATS or any(elastic(p.symbol, axis) for p in rule.parts))
             )
         return memo[key]
 
@@ -161,7 +161,7 @@ def derive_at(
             return
         axis = rule.axis
         extent = (x1 - x0) if axis == "x" else (y1 - y0)
-        if used is not None and rule.op in ("repeat", "repeatABA"):
+        if used is not None and rule.op in REPEATS:
             used.add(symbol)
         sequence = _fit(rule, extent, (offsets or {}).get(symbol, 0))
         sizes = distribute(
@@ -193,7 +193,93 @@ def _fit(rule: Rule, extent: float, offset: int = 0) -> tuple[Part, ...]:
         a, b = rule.parts
         count = _count(extent - a.size, period, offset)
         return (a, *((b, a) * count))
+    if rule.op == "run":
+        a, b = rule.parts[:2]
+        count = _count(extent - a.size, a.size + b.size, offset) + 1
+        return _run_of(rule.parts, max(count, (len(rule.parts) + 1) // 2))
     return rule.sequence()
+
+
+def _run_of(parts: tuple[Part, ...], count: int) -> tuple[Part, ...]:
+    """A run's bays A B A B A made ``count`` bays long (never fewer than the source's):
+    the source's bays as they are, and copies of the middle bay beside it (a symmetric run
+    stays symmetric)."""
+    bays, gap = list(parts[::2]), parts[1]
+    middle = (len(bays) - 1) // 2
+    bays = [*bays[: middle + 1], *[bays[middle]] * (count - len(bays)), *bays[middle + 1 :]]
+    sequence: list[Part] = []
+    for bay in bays:
+        sequence += [gap, bay] if sequence else [bay]
+    return tuple(sequence)
+
+
+def _with_runs(grammar: Grammar, source: tuple[float, float]) -> Grammar:
+    """The grammar with every run of bays in a split (see :func:`_run_end`) made a rule of
+    its own, a ``run``, that the derivation lays as many bays of as fit: windows of one size
+    and kind drawn a little differently from bay to bay (a sill missing, a pillar thinner)
+    are not one rule a repeat could copy, yet a wider façade should get more of them."""
+    kinds: dict[str, frozenset[str]] = {}
+
+    def kind(symbol: str) -> frozenset[str]:
+        """The labels a symbol's region holds."""
+        if symbol not in kinds:
+            rule = grammar.rules.get(symbol)
+            kinds[symbol] = (
+                frozenset([symbol])
+                if rule is None
+                else frozenset().union(*(kind(p.symbol) for p in rule.parts))
+            )
+        return kinds[symbol]
+
+    rules = dict(grammar.rules)
+    for name, rule in grammar.rules.items():
+        if rule.op != "split":
+            continue
+        least = RUN_LEAST * (source[0] if rule.axis == "x" else source[1])
+        parts: list[Part] = []
+        at = 0
+        while at < len(rule.parts):
+            end = _run_end(rule.parts, at, kind) if rule.parts[at].size >= least else at + 1
+            if end - at < RUN_BAYS * 2 - 1:
+                parts.append(rule.parts[at])
+                at += 1
+                continue
+            symbol = f"{name}~run{at}"
+            run = rule.parts[at:end]
+            rules[symbol] = Rule("run", rule.axis, run)
+            parts.append(Part(sum(p.size for p in run), symbol))
+            at = end
+        if len(parts) < len(rule.parts):
+            rules[name] = replace(rule, parts=tuple(parts))
+    return replace(grammar, rules=rules)
+
+
+def _run_end(parts: Sequence[Part], at: int, kind: Callable[[str], frozenset[str]]) -> int:
+    """Where a run of bays that starts at ``at`` ends (``at`` + 1 when none): bays of one
+    size and the same kinds of element, not plain wall, between gaps of one symbol and size,
+    A B A B A."""
+    first = parts[at]
+    if kind(first.symbol) <= {BACKGROUND}:
+        return at + 1
+    end = at + 1
+    while end + 1 < len(parts):
+        gap, bay = parts[end], parts[end + 1]
+        same_gap = end == at + 1 or (
+            gap.symbol == parts[at + 1].symbol and _alike(gap.size, parts[at + 1].size)
+        )
+        if not (
+            same_gap
+            and gap.symbol != first.symbol
+            and _alike(bay.size, first.size)
+            and kind(bay.symbol) == kind(first.symbol)
+        ):
+            break
+        end += 2
+    return end
+
+
+def _alike(a: float, b: float) -> bool:
+    return abs(a - b) <= 1e-6 * max(abs(a), abs(b), 1e-12)
 
 
 def _count(length: float, period: float, offset: int) -> int:
@@ -572,6 +658,7 @@ def derive_variations(
     their score. Named ``<name>-<W>x<H>`` when ``count`` is 1, else ``<name>-<W>x<H>-v<K>``."""
     source = (tiling.xs[-1], tiling.ys[-1])
     stem = f"{_safe(name)}-{width:g}x{height:g}"
+    grammar = _with_runs(grammar, source)
 
     def named(k: int) -> str:
         return stem if count == 1 else f"{stem}-v{k}"
@@ -804,7 +891,8 @@ def _offsets(
     linked: dict[tuple[str, float], list[str]] = defaultdict(list)
     for symbol in sorted(used):  # repeats of one period along one axis vary together
         rule = grammar.rules[symbol]
-        linked[(rule.axis, round(sum(p.size for p in rule.parts), 6))].append(symbol)
+        period = rule.parts[:2] if rule.op == "run" else rule.parts
+        linked[(rule.axis, round(sum(p.size for p in period), 6))].append(symbol)
     groups = [linked[k] for k in sorted(linked)]
     if 3 ** len(groups) <= most:
         choices = list(itertools.product((-1, 0, 1), repeat=len(groups)))
