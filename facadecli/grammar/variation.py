@@ -32,6 +32,8 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from facadecli import proportions
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.style import (
@@ -385,30 +387,55 @@ def _align_axis(
                 (a, b) for a, b in itertools.pairwise(ends) if edges[b] - edges[a] < ALIGN * extent
             ]
     v = cp.Variable(len(edges))
-    base = [v[0] == 0.0, v[len(edges) - 1] == extent]
-    base += [v[i + 1] >= v[i] for i in range(len(edges) - 1)]
-    base += [v[b] - v[a] >= size / 2 for (a, b), size in set(spans)]
-    size_gaps = [v[b1] - v[a1] - (v[b0] - v[a0]) for (a0, b0), (a1, b1) in equal]
-    line_gaps = [v[a] - v[b] for a, b in lined]
-    style_gaps = [
-        sum(c * v[index[joined[value]]] for value, c in terms) - rhs
-        for terms, rhs in extra
-        if all(value in joined for value, _ in terms)
-    ]
+    n = len(edges)
+    base = [v[0] == 0.0, v[n - 1] == extent]
+    if n > 1:
+        base.append(v[1:] >= v[:-1])
+    floors = sorted(set(spans))  # elements keep at least half their size
+    if floors:
+        lengths = _combination(cp, v, n, [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in floors])
+        base.append(lengths >= np.array([size / 2 for _, size in floors]))
+    # every gap below one vector (a matrix times the edges): one expression each, however
+    # many terminals a large derivation makes
+    size_gaps = _combination(
+        cp,
+        v,
+        n,
+        [_terms((b1, 1.0), (a1, -1.0), (b0, -1.0), (a0, 1.0)) for (a0, b0), (a1, b1) in equal],
+    )
+    line_gaps = _combination(cp, v, n, [_terms((a, 1.0), (b, -1.0)) for a, b in lined])
+    styled = [(terms, rhs) for terms, rhs in extra if all(value in joined for value, _ in terms)]
+    style_gaps = _combination(
+        cp,
+        v,
+        n,
+        [_terms(*((index[joined[value]], c) for value, c in terms)) for terms, _ in styled],
+        [rhs for _, rhs in styled],
+    )
     moves = cp.sum_squares(v - edges)
     if stretched:  # back towards their source size, the wall around them taking the rest
-        moves = moves + WIDTHS * _squares(
-            cp, [v[b] - v[a] - size for (a, b), size in sorted(stretched.items())]
+        pulled = sorted(stretched.items())
+        moves = moves + WIDTHS * cp.sum_squares(
+            _combination(
+                cp,
+                v,
+                n,
+                [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in pulled],
+                [s for _, s in pulled],
+            )
         )
-    hard_sizes = [g == 0 for g in size_gaps]
-    hard_style = [g == 0 for g in style_gaps]
-    soft_style = SOFT * _squares(cp, style_gaps)
+    hard_sizes = [] if size_gaps is None else [size_gaps == 0]
+    hard_style = [] if style_gaps is None else [style_gaps == 0]
+    hard_lines = [] if line_gaps is None else [line_gaps == 0]
+    soft_sizes = 0.0 if size_gaps is None else cp.sum_squares(size_gaps)
+    soft_lines = 0.0 if line_gaps is None else cp.sum_squares(line_gaps)
+    soft_style = 0.0 if style_gaps is None else SOFT * cp.sum_squares(style_gaps)
     attempts = [  # hard where they fit, else as near as they can be (weighted), else neither
-        (moves, hard_sizes + hard_style + [g == 0 for g in line_gaps], None),
-        (moves + SOFT * _squares(cp, line_gaps), hard_sizes + hard_style, None),
-        (moves + SOFT * _squares(cp, line_gaps) + soft_style, hard_sizes, None),
+        (moves, hard_sizes + hard_style + hard_lines, None),
+        (moves + SOFT * soft_lines, hard_sizes + hard_style, None),
+        (moves + SOFT * soft_lines + soft_style, hard_sizes, None),
         (
-            moves + SOFT * _squares(cp, size_gaps + line_gaps) + soft_style,
+            moves + SOFT * (soft_sizes + soft_lines) + soft_style,
             [],
             "made as near as they can be",
         ),
@@ -437,8 +464,30 @@ def _align_axis(
     return {value: joined[value] for value in joined}, warnings
 
 
-def _squares(cp: Any, terms: list[Any]) -> Any:
-    return cp.sum_squares(cp.hstack(terms)) if terms else 0.0
+def _terms(*pairs: tuple[int, float]) -> dict[int, float]:
+    """Coefficients by edge, those of one edge added up."""
+    found: dict[int, float] = {}
+    for i, c in pairs:
+        found[i] = found.get(i, 0.0) + c
+    return found
+
+
+def _combination(
+    cp: Any, v: Any, n: int, rows: list[dict[int, float]], rhs: list[float] | None = None
+) -> Any:
+    """The vector of ``row @ v - rhs`` over the rows (None when there are none), as one
+    sparse matrix times the edges."""
+    if not rows:
+        return None
+    import scipy.sparse as sparse
+
+    entries = [(r, i, c) for r, row in enumerate(rows) for i, c in row.items()]
+    matrix = sparse.csr_matrix(
+        ([c for _, _, c in entries], ([r for r, _, _ in entries], [i for _, i, _ in entries])),
+        shape=(len(rows), n),
+    )
+    made = matrix @ v
+    return made if rhs is None else made - np.array(rhs)
 
 
 # -- the result as a layout ---------------------------------------------------------------
