@@ -18,7 +18,7 @@ from facadecli import load_spec, solve
 from facadecli.export.report import report_text
 from facadecli.grammar.regions import Grid
 from facadecli.grammar.regularize import regularize
-from facadecli.grammar.run import Options, extract_grammar, rederivation_problems
+from facadecli.grammar.run import Options, derive_sizes, extract_grammar, rederivation_problems
 from facadecli.grammar.search import Search, extract, greedy_grammar
 from facadecli.grammar.split import Costs, Part, Rule, derive
 from facadecli.grammar.symmetry import find_repeats
@@ -525,3 +525,16 @@ def test_splits_used_once_inside_a_split_along_their_axis_are_written_into_it() 
     ]
     assert abs(merged.cost - (grammar.cost - (Costs().split + 3) + 2)) < 1e-9  # A: 3.1, S: +2
     assert derive(merged, 5.0, 3.0) == derive(grammar, 5.0, 3.0)
+
+
+def test_a_size_far_from_the_inputs_is_noted(tmp_path: Path) -> None:
+    """A CMP annotation is a unit square: `--derive 30x15` without `--size` makes every
+    element 30 times larger (a façade of slivers and hundreds of copies). The derivation
+    says so, with the fix; a size near the input's says nothing."""
+    source = tmp_path / "house.json"
+    _write_plain(source, _house())
+    extraction = extract_grammar(source, Options(iterations=50))
+    far, near = derive_sizes(extraction, "house", [(120.0, 13.0), (17.0, 13.0)])
+    assert any("give --size WxH in metres" in note for note in far.notes)
+    assert "10 times it" in far.notes[0]
+    assert not any("times it" in note for note in near.notes)

@@ -37,6 +37,7 @@ if TYPE_CHECKING:
 # size. CMP annotations are drawn by hand on photographs (a few pixels off); plain lists may
 # be measured or detected; facadecli layouts are exact.
 TIDY = {"cmp": (0.005, 0.01), "plain": (0.001, 0.005), "report": (0.0, 0.0)}
+SCALE_NOTED = 8.0  # a derived size this many times the input's (or less) is noted
 REDERIVE_TOLERANCE = 1e-4  # x the façade's size: a derived edge this near a tiling edge is on it
 CELLS_MAX = LAYOUT_CELLS_MAX  # cells of the snapped tiling (a plain list at its snap)
 TIDY_MAX = 0.1  # the largest snap and tolerance
@@ -314,10 +315,19 @@ def derive_sizes(
 
     derived = []
     style = extraction.style
+    source = (extraction.tiling.xs[-1], extraction.tiling.ys[-1])
     for width, height in sizes:
         drawn, notes = derive_variations(
             extraction.grammar, extraction.tiling, width, height, name, variations, seed, style
         )
+        scale = max(width / source[0], height / source[1], source[0] / width, source[1] / height)
+        if scale > SCALE_NOTED:
+            notes = [
+                f"the input is {source[0]:g} x {source[1]:g} and this size {scale:.0f} times it "
+                "along an axis: its elements are that many times larger or smaller (a CMP "
+                "annotation is a unit square: give --size WxH in metres)",
+                *notes,
+            ]
         derived.append(
             DerivedSize(width, height, [v.layout for v in drawn], notes, [v.kept for v in drawn])
         )
