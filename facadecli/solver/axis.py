@@ -485,11 +485,18 @@ def _candidate_rows(
 ) -> dict[str, list[Row]]:
     rows = memory.rows.get(candidate.order)
     if rows is None:
-        rows = memory.rows[candidate.order] = {
-            group: make_rows(spec, members, memory.full, memory.traits, memory.made)
-            for group, members in _group_rows(spec, uses, candidate.words).items()
-        }
+        rows = memory.rows[candidate.order] = _rows_of(spec, uses, candidate, memory)
     return rows
+
+
+def _rows_of(
+    spec: Spec, uses: Sequence[PatternUse], candidate: Candidate, memory: _SearchMemory
+) -> dict[str, list[Row]]:
+    """The rows of each group that the layers of ``uses`` make with the candidate's words."""
+    return {
+        group: make_rows(spec, members, memory.full, memory.traits, memory.made)
+        for group, members in _group_rows(spec, uses, candidate.words).items()
+    }
 
 
 class _InBoundOrder:
@@ -601,11 +608,7 @@ def _relaxed_rows(
     memory: _SearchMemory,
 ) -> dict[str, list[Row]]:
     """A candidate's rows without the layers of one pattern (groups left empty dropped)."""
-    kept = [use for use in uses if use.key != left_out]
-    return {
-        group: make_rows(spec, members, memory.full, memory.traits, memory.made)
-        for group, members in _group_rows(spec, kept, candidate.words).items()
-    }
+    return _rows_of(spec, [use for use in uses if use.key != left_out], candidate, memory)
 
 
 def solve_axis(spec: Spec, axis: Axis, canvas: float, deadline: float) -> AxisLayout:

@@ -90,6 +90,12 @@ class Program:
         row, column, value = zip(*at, strict=True) if at else ((), (), ())
         return np.array(row, dtype=int), np.array(column, dtype=int), np.array(value, dtype=float)
 
+    @functools.cached_property
+    def parametrized(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Every solution of the equalities as ``z0 + N y`` (:func:`_parametrized`), found
+        once for the closed form and the solve on a line."""
+        return _parametrized(self.rows, len(self.names))
+
     def residual(self, z: np.ndarray) -> float:
         """The largest amount by which ``z`` misses an equality."""
         row, column, value = self._triplets
@@ -233,8 +239,7 @@ def _equality_solution(program: Program) -> tuple[np.ndarray, bool]:
     whether the equalities hold: they are eliminated (:func:`_parametrized`), leaving
     ``z = z0 + N y`` over the free lengths ``y``, and the objective over ``y`` is the
     small positive definite system ``(N^T W N) y = N^T W (t - z0)``."""
-    n = len(program.names)
-    parametrized = _parametrized(program.rows, n)
+    parametrized = program.parametrized
     if parametrized is None:  # the equalities contradict each other
         return program.target.copy(), False
     z0, free = parametrized
@@ -355,8 +360,7 @@ def _on_a_line(program: Program) -> Sizing | object | None:
     ``y``, and the objective is a parabola in ``y``, least at its vertex clamped to the
     intervals' intersection; None when that is empty (infeasible), :data:`_MANY_FREE` when
     the layout has more free lengths."""
-    n = len(program.names)
-    parametrized = _parametrized(program.rows, n)
+    parametrized = program.parametrized
     if parametrized is None:
         return None  # the equalities contradict each other
     z0, free = parametrized
