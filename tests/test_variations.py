@@ -289,3 +289,19 @@ def test_a_run_gains_copies_of_its_middle_bay_and_never_loses_one() -> None:
     assert _run_of(run, 3) == run
     assert [p.symbol for p in _run_of(run, 5)] == ["A", "g", "B", "g", "B", "g", "B", "g", "C"]
     assert _run_of(run, 5)[::2] == (a, b, b, b, c)
+
+
+def test_a_much_wider_facade_gains_whole_bays_on_every_floor_and_keeps_its_style(
+    tmp_path: Path,
+) -> None:
+    """Twice as wide, the symmetric façade's window bays are copied (a bay and its mirror
+    image together) through every floor: each floor has the same, larger, number of
+    windows, none wider than in the source, and every constraint of the style holds."""
+    extraction = _extract(tmp_path, _symmetric())
+    (variation,) = _draw(extraction, (40.0, 10.0), 1)
+    windows = [p for p in variation.pieces if p.label == "window"]
+    per_floor = {y: sum(round(p.y0, 6) == y for p in windows) for y in (1.0, 4.0, 7.0)}
+    assert len(set(per_floor.values())) == 1 and per_floor[1.0] > 8
+    assert all(p.x1 - p.x0 <= 1.0001 * p.source_w for p in windows)
+    assert not variation.kept.broken and len(variation.kept.kept) == len(extraction.style)
+    assert variation.retarget.startswith("x copied")

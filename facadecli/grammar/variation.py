@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from facadecli import proportions
+from facadecli.grammar import retarget
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.style import (
     NOTHING_KEPT,
@@ -630,6 +631,7 @@ class Variation:
     shuffle: Shuffle | None = None
     proportions: Proportions = ()
     pieces: tuple[Piece, ...] = ()
+    retarget: str = ""
 
 
 Shuffle = tuple[str, tuple[str, ...]]  # a split rule, its parts' symbols in a new order
@@ -644,12 +646,14 @@ class _Candidate:
     pieces: list[Piece]
     kept: Kept
     proportions: Proportions = ()
+    retarget: str = ""
 
     @property
     def rank(
         self,
-    ) -> tuple[int, bool, float, tuple[tuple[str, int], ...], Shuffle, Proportions]:
-        """Most of the style kept, the best fit (unchanged) first, nearest the source."""
+    ) -> tuple[int, bool, float, tuple[tuple[str, int], ...], Shuffle, Proportions, str]:
+        """Most of the style kept, the best fit (unchanged: the grammar's, or whole bays
+        copied) first, nearest the source."""
         changed = bool(self.offsets) or self.shuffle is not None or bool(self.proportions)
         return (
             -len(self.kept.kept),
@@ -658,6 +662,7 @@ class _Candidate:
             self.offsets,
             self.shuffle or ("", ()),
             self.proportions,
+            self.retarget,
         )
 
 
@@ -739,6 +744,12 @@ def derive_variations(
     best = derive_at(grammar, source, width, height, used=used)
     best_kept = kept(best)
     candidates: list[_Candidate | None] = [_Candidate(score(best), (), None, best, best_kept)]
+    mirrored = any(c.kind == "symmetry" for c in style)
+    at_source = derive_at(grammar, source, *source)
+    for pieces, stretch, text in _retargeted(at_source, source, width, height, mirrored):
+        candidates.append(
+            _Candidate(score(pieces) + stretch, (), None, pieces, kept(pieces), (), text)
+        )
     if count > 1 or best_kept.broken:
         rng = random.Random(seed)
         most = CANDIDATES_MAX if count > 1 else STYLE_MAX
@@ -757,11 +768,32 @@ def derive_variations(
             seen.add(key)
             ranked.append(found_one)
     # drawn proportions only vary a layout: the layout of a size is the grammar's own
-    first = next(c for c in ranked if not c.proportions)
-    aligned, warnings, keeps = _tidied(first.pieces, first.kept, kept, width, height, style)
+    # the best of the grammar's and the best of whole bays copied, as each is written:
+    # tidying makes a near miss of the style exact, so either may keep more in the end
+    finalists = [
+        next((c for c in ranked if not c.proportions and bool(c.retarget) is copied), None)
+        for copied in (False, True)
+    ]
+    tidied = [
+        (c, *_tidied(c.pieces, c.kept, kept, width, height, style, bool(c.retarget)))
+        for c in finalists
+        if c is not None
+    ]
+    first, aligned, warnings, keeps = min(
+        tidied, key=lambda t: (-len(t[3].kept), score(t[1]) + t[0].score - score(t[0].pieces))
+    )
     layout = pieces_layout(aligned, width, height, named(0), warnings)
     found = [
-        Variation(layout, first.offsets, first.score, keeps, first.shuffle, (), tuple(aligned))
+        Variation(
+            layout,
+            first.offsets,
+            first.score,
+            keeps,
+            first.shuffle,
+            (),
+            tuple(aligned),
+            first.retarget,
+        )
     ]
     if count == 1:
         return found, []
@@ -781,7 +813,9 @@ def derive_variations(
     for other in drawn:  # aligned, two could still coincide
         if len(chosen) == count - 1:
             break
-        moved, moved_warnings, keeps = _tidied(other.pieces, other.kept, kept, width, height, style)
+        moved, moved_warnings, keeps = _tidied(
+            other.pieces, other.kept, kept, width, height, style, bool(other.retarget)
+        )
         key = _key(moved)
         if key not in aligned_seen:
             aligned_seen.add(key)
@@ -798,6 +832,7 @@ def derive_variations(
                 other.shuffle,
                 other.proportions,
                 tuple(moved),
+                other.retarget,
             )
         )
     notes = []
@@ -809,6 +844,131 @@ def derive_variations(
             "near the source's)"
         )
     return found, notes
+
+
+RETARGETS_MAX = 5  # plans per axis whose combinations are tried (the least stretched)
+
+Span = tuple[float, float]
+
+
+def _retargeted(
+    pieces: list[Piece], source: tuple[float, float], width: float, height: float, mirrored: bool
+) -> list[tuple[list[Piece], float, str]]:
+    """The source's pieces laid out at a new size by :mod:`~facadecli.grammar.retarget`:
+    each layout, how far its wall stretched (the squares of the log-ratios, a term of its
+    score) and what was done; none at the source's size.
+
+    Floors are copied across the whole width. Bays are copied floor by floor (a floor, or
+    the wall between floors, is a stratum): one unit, where a stratum lets it be cut out
+    (a ground floor of shops may not), else that stratum's own least stretched plan, so
+    the floors above keep their columns whatever the ground floor does."""
+    if (width, height) == source:
+        return []
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    joined = facade_of(boxes, *source, BACKGROUND).boxes
+    # no cut may cross an element, nor a piece of one (an L-shaped molding), but for
+    # labels that make bands along the axis (a cornice, pilasters): a copy lengthens them
+    elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
+    in_bays = _unbanded(elements, joined, "x", source[0])
+    in_floors = _unbanded(elements, joined, "y", source[1])
+    floors = retarget.plans([(b.y0, b.y1) for b in in_floors], source[1], height, False)
+    bays = _bays(in_bays, source, width, mirrored)
+    laid = []
+    for (text_x, strata, across), along_y in itertools.product(
+        bays, sorted(floors, key=lambda p: (p.stretch, p.text))[:RETARGETS_MAX]
+    ):
+        parts: dict[int, list[tuple[float, float, float, float]]] = defaultdict(list)
+        for k, p in enumerate(pieces):
+            for (lo, hi), plan in zip(strata, across, strict=True):
+                if p.y0 < hi and p.y1 > lo:
+                    for x0, x1 in retarget.place(plan, p.x0, p.x1):
+                        for y0, y1 in retarget.place(along_y, max(p.y0, lo), min(p.y1, hi)):
+                            parts[k].append((x0, x1, y0, y1))
+        moved = [
+            Piece(pieces[k].label, x0, y0, x1, y1, pieces[k].source_w, pieces[k].source_h)
+            for k in sorted(parts)
+            for x0, x1, y0, y1 in _stacked(parts[k])
+        ]
+        stretch = max(plan.stretch for plan in across) ** 2 + along_y.stretch**2
+        texts = [t for t in (text_x, f"y {along_y.text}" if along_y.text else "") if t]
+        laid.append((moved, stretch, "; ".join(texts) or "stretched"))
+    return laid
+
+
+def _unbanded(elements: list[Box], joined: Sequence[Box], axis: str, extent: float) -> list[Box]:
+    """The elements but those of labels that make a band along the axis somewhere."""
+    bands = {
+        b.label
+        for b in joined
+        if ((b.x1 - b.x0) if axis == "x" else (b.y1 - b.y0)) >= retarget.BAND * extent
+    }
+    return [b for b in elements if b.label not in bands]
+
+
+def _bays(
+    elements: Sequence[Box], source: tuple[float, float], width: float, mirrored: bool
+) -> list[tuple[str, list[Span], list[retarget.Plan]]]:
+    """Ways to lay the façade's strata across (see :func:`_retargeted`): what was done,
+    the strata and a plan for each; the source stretched first."""
+    extent = source[0]
+    strata = retarget.strata([(b.y0, b.y1) for b in elements], source[1])
+    spans = [[(b.x0, b.x1) for b in elements if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
+    # a unit's worth: the height of the strata it can be cut out of, less their height
+    # times how far it is from a period there
+    listed = [
+        dict((u, irregular) for irregular, u in retarget.laid_units(here, extent, mirrored))
+        for here in spans
+    ]
+    worth: dict[tuple[Span, ...], float] = {}
+    for unit in (u for here in listed for u in here):
+        worth[unit] = sum(
+            (hi - lo) * (1 - min(1.0, here.get(unit, 0.5)))
+            for (lo, hi), cut, here in zip(strata, spans, listed, strict=True)
+            if _cuts(cut, extent, unit)
+        )
+    ranked = sorted(worth, key=lambda u: (-worth[u], u))[: retarget.UNITS_TRIED]
+    found = []
+    for unit, copies in [((), 0)] + [
+        (u, c)
+        for u in ranked
+        for c in retarget.copies_near(sum(b - a for a, b in u), extent, width)
+        if c
+    ]:
+        across = []
+        for here in spans:
+            plan = (
+                retarget.copied(here, extent, width, unit, copies)
+                if _cuts(here, extent, unit)
+                else None
+            )
+            if plan is None:  # the stratum's own least stretched plan
+                own = retarget.plans(here, extent, width, mirrored)
+                plan = min(own, key=lambda p: (p.stretch, p.text), default=None)
+            if plan is None:
+                break
+            across.append(plan)
+        else:
+            text = f"x {across[0].text}" if unit else ""
+            text = next((f"x {p.text}" for p in across if p.text and unit), text)
+            found.append((text, strata, across))
+    return found
+
+
+def _cuts(spans: Sequence[Span], extent: float, unit: Sequence[Span]) -> bool:
+    """Whether a stratum can be cut at both ends of a unit (and its mirror image)."""
+    return all(retarget.free(spans, extent, v) for lo, hi in unit for v in (lo, hi))
+
+
+def _stacked(parts: list[tuple[float, float, float, float]]) -> list[tuple[float, ...]]:
+    """A piece's parts, those one above the other across the same span joined."""
+    joined: list[tuple[float, ...]] = []
+    for x0, x1, y0, y1 in sorted(parts):
+        last = joined[-1] if joined else None
+        if last is not None and (last[0], last[1]) == (x0, x1) and abs(last[3] - y0) < 1e-12:
+            joined[-1] = (x0, x1, last[2], y1)
+        else:
+            joined.append((x0, x1, y0, y1))
+    return joined
 
 
 def _proportions(
@@ -896,11 +1056,14 @@ def _tidied(
     width: float,
     height: float,
     style: Sequence[Constraint],
+    copies: bool = False,
 ) -> tuple[list[Piece], list[str], Kept]:
     """A derivation through the alignment QP (:func:`align`), unless that breaks some of
     the style the derivation keeps: then as derived, with a warning. Where pulling
     stretched elements back breaks some of the style, the QP without the pull is tried
-    too, and the one that keeps more is taken (the pulled one on a tie)."""
+    too, and the one that keeps more is taken (the pulled one on a tie). Of ``copies``
+    (whole bays copied: already aligned) the QP's is taken only where it keeps more of
+    the style, or as much and its sizes are no further from the source's."""
     aligned, warnings = align(pieces, width, height, style=style)
     after = kept(aligned)
     if after.broken and _any_stretched(pieces, width, height):
@@ -908,6 +1071,8 @@ def _tidied(
         plain_after = kept(plain)
         if len(plain_after.kept) > len(after.kept):
             aligned, warnings, after = plain, plain_warnings, plain_after
+    if copies and len(after.kept) == len(keeps.kept) and score(aligned) > score(pieces) + 1e-9:
+        return pieces, [], keeps
     if len(after.kept) >= len(keeps.kept):
         return aligned, warnings, after
     lost = len(keeps.kept) - len(after.kept)

@@ -1,0 +1,264 @@
+"""A layout made wider or taller by copying (or removing) whole bays, the rest taken up by
+the wall: retargeting by slabs, after Lin et al. 2011 (the simple form of relayouting that
+Bao et al. 2013 compare themselves with).
+
+Along one axis the elements (the background and bands, elements at least ``BAND`` of the
+extent long, left out) stand in *blocks*, the stretches that some element covers; the
+*gaps* between blocks, and the margins, are wall only. A *unit* runs from the middle of
+one gap to the middle of a later one, at most ``UNIT_BLOCKS`` blocks: a bay, everything
+above and below it included (a window column from the plinth to the cornice). A *plan*
+lays the source along the axis with some units copied beside themselves (a unit and its
+mirror image together, so a symmetric façade stays symmetric) or one left out, and
+stretches the gaps to fill the new extent (everything, when the gaps would go below
+``GAPS_LEAST`` of their size). Whole bays copied keep every column, alignment and
+spacing of the source, and no element stretches: the copies, not wider windows, fill a
+wider façade.
+
+The module is one-dimensional: :func:`plans` makes plans from the elements' spans, and
+:func:`place` lays a source interval by a plan.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+BAND = 0.5  # of the extent: a longer element is a band, which a copy lengthens
+UNIT_BLOCKS = 3  # blocks a unit holds at most
+UNITS_TRIED = 6  # units made into plans, the most regular first
+GAPS_LEAST = 0.5  # of their source size: gaps squeezed further squeeze everything instead
+GAPS_MOST = 1.5  # ... and stretched further, the plan is no good (copies should fill it)
+SQUEEZE_MOST = 1.5  # elements squeezed further (1 / this), the plan is no good
+WIDEN_MOST = 1.1  # ... or stretched further: copies, not wider windows, fill a façade
+NEAR = 1e-9  # of the extent: spans closer than this touch
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A stretch of the source, ``lo`` to ``hi``, laid ``scale`` times its length."""
+
+    lo: float
+    hi: float
+    scale: float
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The source laid along one axis: ``segments`` in their new order (a unit copied is
+    there twice), and what was done, for people (empty: the source stretched)."""
+
+    segments: tuple[Segment, ...]
+    text: str = ""
+
+    @property
+    def stretch(self) -> float:
+        """How far the gaps are from their source size (0: not at all)."""
+        return max((abs(math.log(s.scale)) for s in self.segments), default=0.0)
+
+
+def blocks_of(spans: Sequence[tuple[float, float]], extent: float) -> list[tuple[float, float]]:
+    """The stretches that some element's span covers, in order (bands left out)."""
+    near = NEAR * extent
+    found: list[list[float]] = []
+    for lo, hi in sorted(s for s in spans if s[1] - s[0] < BAND * extent):
+        if found and lo < found[-1][1] - near:
+            found[-1][1] = max(found[-1][1], hi)
+        else:
+            found.append([lo, hi])
+    return [(lo, hi) for lo, hi in found]
+
+
+def units(spans: Sequence[tuple[float, float]], extent: float) -> list[tuple[float, float, float]]:
+    """The units of a stretch of façade whose elements span ``spans``, with how far each
+    is from a period of the source (0: a copy looks like the next bay along), the most
+    regular first; at most ``UNIT_BLOCKS`` blocks and half the extent long, never all of
+    it."""
+    blocks = blocks_of(spans, extent)
+    gaps = _gaps(blocks, extent)
+    middles = [(lo + hi) / 2 for lo, hi in gaps]
+    found = sorted(
+        (_irregularity(blocks, gaps, i, j, extent), j - i, middles[i], middles[j])
+        for i in range(len(gaps))
+        for j in range(i + 1, min(i + UNIT_BLOCKS, len(gaps) - 1) + 1)
+        if j - i < len(blocks) and middles[j] - middles[i] <= extent / 2
+    )
+    return [(irregular, lo, hi) for irregular, _, lo, hi in found]
+
+
+def free(spans: Sequence[tuple[float, float]], extent: float, at: float) -> bool:
+    """Whether a cut at ``at`` crosses no element (bands aside)."""
+    near = 1e-3 * extent
+    return not any(lo + near < at < hi - near for lo, hi in blocks_of(spans, extent))
+
+
+def mirror(
+    spans: Sequence[tuple[float, float]], extent: float, unit: tuple[float, float]
+) -> tuple[float, float] | None:
+    """The unit's mirror image about the centre, when that is a unit too and apart from it."""
+    lo, hi = unit
+    mirrored = (extent - hi, extent - lo)
+    if mirrored[0] < hi - NEAR * extent and mirrored[1] > lo + NEAR * extent:
+        return None
+    return mirrored if all(free(spans, extent, v) for v in mirrored) else None
+
+
+def copied(
+    spans: Sequence[tuple[float, float]],
+    extent: float,
+    new_extent: float,
+    laid: Sequence[tuple[float, float]],
+    copies: int,
+) -> Plan | None:
+    """The plan that copies the units ``laid`` ``copies`` times each (-1: leaves them out;
+    0: stretches the source) and stretches the gaps to fill ``new_extent`` (None when that
+    is no good: see :func:`_laid`)."""
+    blocks = blocks_of(spans, extent)
+    stretches = _stretches(sorted(laid), extent, copies)
+    if sum(b - a for a, b, times in stretches if times) < extent / 2:
+        return None  # not the source any more
+    where = " and ".join(f"{a:.3g}-{b:.3g}" for a, b in sorted(laid))
+    text = "" if copies == 0 else f"{'left out' if copies < 0 else f'copied {copies}x'}: {where}"
+    return _laid(blocks, extent, new_extent, stretches, text)
+
+
+def copies_near(length: float, extent: float, new_extent: float) -> list[int]:
+    """Copies of units ``length`` long to try: as many as fit best, one more and one fewer
+    (-1 leaves them out, 0 is the source stretched)."""
+    if new_extent == extent:
+        return [0]
+    best = round((new_extent - extent) / length)
+    return [c for c in sorted({best - 1, best, best + 1}) if c >= -1]
+
+
+def plans(
+    spans: Sequence[tuple[float, float]], extent: float, new_extent: float, mirrored: bool
+) -> list[Plan]:
+    """Plans that lay a stretch of façade ``extent`` long (elements spanning ``spans``)
+    along ``new_extent``: the source stretched, and the first ``UNITS_TRIED`` units copied
+    as often as fit best, one more and one fewer (or left out), in mirrored pairs when
+    ``mirrored`` (a unit without a mirror image must then be centred)."""
+    found = [copied(spans, extent, new_extent, [], 0)]
+    for _, unit in laid_units(spans, extent, mirrored)[:UNITS_TRIED]:
+        length = sum(hi - lo for lo, hi in unit)
+        for copies in copies_near(length, extent, new_extent):
+            if copies:
+                found.append(copied(spans, extent, new_extent, unit, copies))
+    return [plan for plan in found if plan is not None]
+
+
+def laid_units(
+    spans: Sequence[tuple[float, float]], extent: float, mirrored: bool
+) -> list[tuple[float, tuple[tuple[float, float], ...]]]:
+    """The units (see :func:`units`) as they are copied, with how irregular they are:
+    alone, or when ``mirrored`` with their mirror image (alone only when centred)."""
+    found = []
+    for irregular, lo, hi in units(spans, extent):
+        pair = mirror(spans, extent, (lo, hi)) if mirrored else None
+        if mirrored and pair is None and abs(lo + hi - extent) > 1e-3 * extent:
+            continue  # an unmirrored unit off the centre would break the symmetry
+        found.append((irregular, ((lo, hi),) if pair is None else tuple(sorted([(lo, hi), pair]))))
+    return found
+
+
+def strata(spans: Sequence[tuple[float, float]], extent: float) -> list[tuple[float, float]]:
+    """The façade across the axis cut where no element crosses (bands aside): each block
+    of elements and each gap between them (a floor and the wall between floors)."""
+    blocks = blocks_of(spans, extent)
+    ends = sorted({0.0, extent, *(v for b in blocks for v in b)})
+    return [(a, b) for a, b in itertools.pairwise(ends) if b > a]
+
+
+def _gaps(blocks: list[tuple[float, float]], extent: float) -> list[tuple[float, float]]:
+    """The wall between blocks, the margins included (as long as there are blocks, + 1)."""
+    ends = [0.0, *(v for b in blocks for v in b), extent]
+    return [(ends[k], ends[k + 1]) for k in range(0, len(ends), 2)]
+
+
+def _irregularity(
+    blocks: list[tuple[float, float]],
+    gaps: list[tuple[float, float]],
+    i: int,
+    j: int,
+    extent: float,
+) -> float:
+    """How far copying the unit from gap ``i`` to gap ``j`` is from repeating a period:
+    the gap it starts in against the one it ends in, and its first block against the block
+    after it (0: a copy looks like the next bay along)."""
+    length = [hi - lo for lo, hi in gaps]
+    width = [hi - lo for lo, hi in blocks]
+    after = width[j] if j < len(blocks) else 0.0
+    margin = i == 0 or j == len(gaps) - 1
+    return (abs(length[i] - length[j]) + abs(width[i] - after)) / extent + margin
+
+
+def _stretches(
+    units: list[tuple[float, float]], extent: float, copies: int
+) -> list[tuple[float, float, int]]:
+    """The source as stretches laid once, ``1 + copies`` times (a unit) or not at all."""
+    found: list[tuple[float, float, int]] = []
+    at = 0.0
+    for lo, hi in units:
+        found.append((at, lo, 1))
+        found.append((lo, hi, 1 + copies))
+        at = hi
+    found.append((at, extent, 1))
+    return [s for s in found if s[1] > s[0]]
+
+
+def _laid(
+    blocks: list[tuple[float, float]],
+    extent: float,
+    new_extent: float,
+    stretches: list[tuple[float, float, int]],
+    text: str,
+) -> Plan | None:
+    """The stretches cut where blocks meet gaps, the gaps scaled to fill ``new_extent``
+    (everything, where they would shrink below ``GAPS_LEAST``); None where the gaps would
+    stretch beyond ``GAPS_MOST`` or the elements beyond ``SQUEEZE_MOST`` or ``WIDEN_MOST``."""
+    cuts = sorted({v for b in blocks for v in b})
+    pieces: list[tuple[float, float, bool]] = []  # lo, hi, wall
+    for lo, hi, times in stretches:
+        edges = [lo, *(c for c in cuts if lo < c < hi), hi]
+        laid = [
+            (a, b, not any(p < (a + b) / 2 < q for p, q in blocks))
+            for a, b in itertools.pairwise(edges)
+        ]
+        pieces += laid * times
+    wall = sum(b - a for a, b, is_wall in pieces if is_wall)
+    rest = sum(b - a for a, b, is_wall in pieces if not is_wall)
+    if wall > 0 and new_extent - rest >= GAPS_LEAST * wall:
+        gap_scale, block_scale = (new_extent - rest) / wall, 1.0
+    else:
+        gap_scale = block_scale = new_extent / (wall + rest)
+    if gap_scale > GAPS_MOST or not 1 / SQUEEZE_MOST <= block_scale <= WIDEN_MOST:
+        return None
+    return Plan(
+        tuple(Segment(a, b, gap_scale if w else block_scale) for a, b, w in pieces),
+        text,
+    )
+
+
+def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[float, float]]:
+    """Where the source interval ``lo``-``hi`` lies after a plan: once, or once per copy
+    of a unit it lies in (the parts of one stretch laid end to end joined). Overlaps of
+    ``near`` or less are none (rounding in the source's coordinates)."""
+    found: list[tuple[float, float]] = []
+    at = 0.0
+    joined = False  # the last part ended where this segment starts
+    for segment in plan.segments:
+        length = (segment.hi - segment.lo) * segment.scale
+        a, b = max(lo, segment.lo), min(hi, segment.hi)
+        if b - a > near:
+            start = at + (a - segment.lo) * segment.scale
+            end = at + (b - segment.lo) * segment.scale
+            if joined and found and a - segment.lo <= near:
+                found[-1] = (found[-1][0], end)
+            else:
+                found.append((start, end))
+            joined = segment.hi - b <= near
+        else:
+            joined = False
+        at += length
+    return found

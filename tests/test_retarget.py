@@ -1,0 +1,71 @@
+"""Retargeting by slabs (:mod:`facadecli.grammar.retarget`): whole bays copied or left out
+along one axis, the wall taking up the rest."""
+
+from __future__ import annotations
+
+import pytest
+
+from facadecli.grammar import retarget
+
+ROW = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]  # three windows 1 m wide, 1 m apart, in 7 m
+
+
+def _length(plan: retarget.Plan) -> float:
+    return sum((s.hi - s.lo) * s.scale for s in plan.segments)
+
+
+def test_a_copied_unit_lays_its_elements_twice_and_lengthens_a_band_across_it() -> None:
+    plan = retarget.copied(ROW, 7.0, 9.0, [(2.5, 4.5)], 1)
+    assert plan is not None
+    assert plan.stretch == pytest.approx(0.0)  # the copy fills the new length exactly
+    assert retarget.place(plan, 3.0, 4.0) == [(3.0, 4.0), (5.0, 6.0)]
+    assert retarget.place(plan, 5.0, 6.0) == [(7.0, 8.0)]
+    assert retarget.place(plan, 0.0, 7.0) == [(0.0, 9.0)]  # a band: one, longer
+
+
+def test_a_unit_left_out_takes_its_elements_with_it() -> None:
+    plan = retarget.copied(ROW, 7.0, 5.0, [(2.5, 4.5)], -1)
+    assert plan is not None
+    assert retarget.place(plan, 3.0, 4.0) == []
+    assert retarget.place(plan, 5.0, 6.0) == [(3.0, 4.0)]
+
+
+def test_the_gaps_take_up_the_rest_and_elements_keep_their_size() -> None:
+    plan = retarget.copied(ROW, 7.0, 10.0, [(2.5, 4.5)], 1)
+    assert plan is not None and _length(plan) == pytest.approx(10.0)
+    laid = [retarget.place(plan, lo, hi) for lo, hi in ROW]
+    assert all(b - a == pytest.approx(1.0) for spans in laid for a, b in spans)
+
+
+def test_gaps_stretched_too_far_or_elements_widened_make_no_plan() -> None:
+    assert retarget.copied(ROW, 7.0, 14.0, [], 0) is None  # the wall alone: 4 m -> 11 m
+    assert retarget.copied(ROW, 7.0, 7.5, [], 0) is not None
+
+
+def test_the_units_nearest_a_period_come_first() -> None:
+    irregular, lo, hi = retarget.units(ROW, 7.0)[0]
+    assert irregular == pytest.approx(0.0)
+    assert hi - lo == pytest.approx(2.0)  # a window and a gap: the row's period
+
+
+def test_a_mirrored_facade_copies_a_unit_and_its_mirror_image_together() -> None:
+    row = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0), (7.0, 8.0), (9.0, 10.0)]  # 11 m, symmetric
+    for _, unit in retarget.laid_units(row, 11.0, mirrored=True):
+        centred = len(unit) == 1 and unit[0][0] + unit[0][1] == pytest.approx(11.0)
+        mirrored = len(unit) == 2 and unit[0][0] + unit[1][1] == pytest.approx(11.0)
+        assert centred or mirrored
+    for plan in retarget.plans(row, 11.0, 15.0, mirrored=True):
+        assert _length(plan) == pytest.approx(15.0)
+        centres = sorted((a + b) / 2 for lo, hi in row for a, b in retarget.place(plan, lo, hi))
+        assert centres == pytest.approx([15.0 - c for c in reversed(centres)])
+
+
+def test_strata_are_the_floors_and_the_wall_between_them() -> None:
+    floors = [(1.0, 2.5), (3.5, 5.0), (1.2, 2.0)]
+    assert retarget.strata(floors, 6.0) == [
+        (0.0, 1.0),
+        (1.0, 2.5),
+        (2.5, 3.5),
+        (3.5, 5.0),
+        (5.0, 6.0),
+    ]
