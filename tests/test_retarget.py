@@ -69,3 +69,17 @@ def test_strata_are_the_floors_and_the_wall_between_them() -> None:
         (3.5, 5.0),
         (5.0, 6.0),
     ]
+
+
+def test_a_unit_that_a_stratum_cannot_be_cut_at_moves_by_the_least_distance() -> None:
+    with_ornament = [*ROW, (4.3, 4.7)]  # an ornament where the unit 2.5-4.5 ends
+    assert retarget.shifted(ROW, 7.0, [(2.5, 4.5)]) == ((2.5, 4.5),)
+    assert retarget.shifted(with_ornament, 7.0, [(2.5, 4.5)]) == ((2.3, 4.3),)
+    chained = [(0.5, 3.0), (2.9, 5.5)]  # one block 5 m wide: no cut near the unit
+    assert retarget.shifted(chained, 7.0, [(2.5, 4.5)]) is None
+
+
+def test_what_a_plan_does_is_said_for_people() -> None:
+    assert retarget.describe([(2.5, 4.5)], 2) == "copied 2x: 2.5-4.5"
+    assert retarget.describe([(9.0, 11.0), (1.0, 3.0)], -1) == "left out: 1-3 and 9-11"
+    assert retarget.describe([(2.5, 4.5)], 0) == ""

@@ -150,6 +150,8 @@ def test_the_grammar_report_lists_the_style_and_what_each_derived_layout_keeps(
     assert [d["variation"] for d in derived] == list(range(len(derived)))
     assert derived[0]["size"] == {"width": 17.1, "height": 10.0}
     assert derived[0]["style_kept"] == {"kept": len(report["style"]), "broken": []}
+    made = [d["made"] for d in derived]  # the grammar's derivation, or bays copied
+    assert all(m in ("grammar", "stretched") or m.startswith(("x ", "y ")) for m in made)
 
 
 def test_the_alignment_qp_makes_near_misses_of_the_style_exact() -> None:

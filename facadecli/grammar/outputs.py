@@ -157,10 +157,11 @@ def grammar_report(
             {
                 "size": {"width": size.width, "height": size.height},
                 "variation": k,
+                "made": made,
                 "style_kept": keeps.summary(),
             }
             for size in derived
-            for k, keeps in enumerate(size.kept)
+            for k, (keeps, made) in enumerate(zip(size.kept, size.made, strict=True))
         ],
         "time_ms": round(extraction.time_ms, 3) if timings else None,
     }

@@ -9,13 +9,16 @@ one gap to the middle of a later one, at most ``UNIT_BLOCKS`` blocks: a bay, eve
 above and below it included (a window column from the plinth to the cornice). A *plan*
 lays the source along the axis with some units copied beside themselves (a unit and its
 mirror image together, so a symmetric façade stays symmetric) or one left out, and
-stretches the gaps to fill the new extent (everything, when the gaps would go below
-``GAPS_LEAST`` of their size). Whole bays copied keep every column, alignment and
-spacing of the source, and no element stretches: the copies, not wider windows, fill a
-wider façade.
+scales what is left over: everything alike when that changes it by ``WIDEN_MOST`` at
+most (spacing and symmetry stay exact), else the gaps alone (within ``GAPS_LEAST`` to
+``GAPS_MOST`` of their size), else everything squeezed (to 1 / ``SQUEEZE_MOST`` at
+most); otherwise there is no plan. Whole bays copied keep every column, alignment and
+spacing of the source, and no element grows by more than ``WIDEN_MOST``: the copies,
+not wider windows, fill a wider façade.
 
-The module is one-dimensional: :func:`plans` makes plans from the elements' spans, and
-:func:`place` lays a source interval by a plan.
+The module is one-dimensional: :func:`units` and :func:`shifted` find where a stretch of
+façade can be cut, :func:`copied` and :func:`plans` make plans from the elements' spans,
+and :func:`place` lays a source interval by a plan.
 """
 
 from __future__ import annotations
@@ -118,9 +121,44 @@ def copied(
     stretches = _stretches(sorted(laid), extent, copies)
     if sum(b - a for a, b, times in stretches if times) < extent / 2:
         return None  # not the source any more
+    return _laid(blocks, extent, new_extent, stretches, describe(laid, copies))
+
+
+def describe(laid: Sequence[tuple[float, float]], copies: int) -> str:
+    """What copying the units ``laid`` does, for people (empty: nothing)."""
     where = " and ".join(f"{a:.3g}-{b:.3g}" for a, b in sorted(laid))
-    text = "" if copies == 0 else f"{'left out' if copies < 0 else f'copied {copies}x'}: {where}"
-    return _laid(blocks, extent, new_extent, stretches, text)
+    return "" if copies == 0 else f"{'left out' if copies < 0 else f'copied {copies}x'}: {where}"
+
+
+def shifted(
+    spans: Sequence[tuple[float, float]], extent: float, laid: Sequence[tuple[float, float]]
+) -> tuple[tuple[float, float], ...] | None:
+    """The units ``laid`` (a unit, or a unit and its mirror image) moved by the least
+    distance, at most half the unit's length, that lets a stretch of façade be cut at
+    their ends (a unit and its mirror image by mirrored moves where they can be, else
+    each by its own); themselves when it can be already; None when no move does. On a
+    periodic façade a bay cut a little to one side copies the same bay."""
+    edges = sorted({v for b in blocks_of(spans, extent) for v in b})
+
+    def moves(lo: float, hi: float) -> list[float]:
+        found = {0.0, *(e - v for e in edges for v in (lo, hi))}
+        return sorted((d for d in found if abs(d) <= (hi - lo) / 2), key=lambda d: (abs(d), d))
+
+    def cuts(lo: float, hi: float) -> bool:
+        return lo >= 0.0 and hi <= extent and free(spans, extent, lo) and free(spans, extent, hi)
+
+    (lo, hi), *rest = laid
+    for move in moves(lo, hi):  # mirrored moves keep a mirrored pair mirrored
+        unit = ((lo + move, hi + move), *((a - move, b - move) for a, b in rest))
+        if all(cuts(a, b) for a, b in unit):
+            return unit
+    found = []
+    for a, b in laid:
+        own = next((d for d in moves(a, b) if cuts(a + d, b + d)), None)
+        if own is None:
+            return None
+        found.append((a + own, b + own))
+    return tuple(found)
 
 
 def copies_near(length: float, extent: float, new_extent: float) -> list[int]:
@@ -214,9 +252,10 @@ def _laid(
     stretches: list[tuple[float, float, int]],
     text: str,
 ) -> Plan | None:
-    """The stretches cut where blocks meet gaps, the gaps scaled to fill ``new_extent``
-    (everything, where they would shrink below ``GAPS_LEAST``); None where the gaps would
-    stretch beyond ``GAPS_MOST`` or the elements beyond ``SQUEEZE_MOST`` or ``WIDEN_MOST``."""
+    """The stretches cut where blocks meet gaps and scaled to fill ``new_extent``: all
+    alike where that changes them by ``WIDEN_MOST`` at most (every spacing and symmetry
+    kept), else the gaps alone where they stay within ``GAPS_LEAST`` to ``GAPS_MOST`` of
+    their size, else all alike squeezed down to 1 / ``SQUEEZE_MOST``; None otherwise."""
     cuts = sorted({v for b in blocks for v in b})
     pieces: list[tuple[float, float, bool]] = []  # lo, hi, wall
     for lo, hi, times in stretches:
@@ -228,11 +267,15 @@ def _laid(
         pieces += laid * times
     wall = sum(b - a for a, b, is_wall in pieces if is_wall)
     rest = sum(b - a for a, b, is_wall in pieces if not is_wall)
-    if wall > 0 and new_extent - rest >= GAPS_LEAST * wall:
-        gap_scale, block_scale = (new_extent - rest) / wall, 1.0
+    alike = new_extent / (wall + rest)
+    gaps = (new_extent - rest) / wall if wall > 0 else 0.0
+    if 1 / WIDEN_MOST <= alike <= WIDEN_MOST:
+        gap_scale = block_scale = alike
+    elif GAPS_LEAST <= gaps <= GAPS_MOST:
+        gap_scale, block_scale = gaps, 1.0
+    elif 1 / SQUEEZE_MOST <= alike <= 1.0:
+        gap_scale = block_scale = alike
     else:
-        gap_scale = block_scale = new_extent / (wall + rest)
-    if gap_scale > GAPS_MOST or not 1 / SQUEEZE_MOST <= block_scale <= WIDEN_MOST:
         return None
     return Plan(
         tuple(Segment(a, b, gap_scale if w else block_scale) for a, b, w in pieces),

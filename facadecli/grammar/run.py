@@ -300,6 +300,7 @@ class DerivedSize:
     layouts: list[Layout]
     notes: list[str]
     kept: list[Kept] = field(default_factory=list)  # the input's style each layout keeps
+    made: list[str] = field(default_factory=list)  # how: "grammar", or bays copied
 
 
 def derive_sizes(
@@ -329,7 +330,14 @@ def derive_sizes(
                 *notes,
             ]
         derived.append(
-            DerivedSize(width, height, [v.layout for v in drawn], notes, [v.kept for v in drawn])
+            DerivedSize(
+                width,
+                height,
+                [v.layout for v in drawn],
+                notes,
+                [v.kept for v in drawn],
+                [v.retarget or "grammar" for v in drawn],
+            )
         )
     return derived
 

@@ -216,6 +216,13 @@ def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
     return max(groups, key=len, default=[]), len(rows)
 
 
+def column_centres(facade: Facade, label: str) -> list[float]:
+    """The centres of the columns that rows of a label share, floor after floor (none
+    when no two rows share them)."""
+    best, _ = _shared_columns(facade, label)
+    return _centres(best[0]) if len(best) >= 2 else []
+
+
 def _evenly_spaced(facade: Facade, label: str) -> tuple[int, int]:
     """How many of a label's rows of three or more are evenly spaced, of how many."""
     near = TOLERANCE * facade.width

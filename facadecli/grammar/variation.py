@@ -27,6 +27,7 @@ import itertools
 import math
 import random
 import re
+import warnings as warnings_module
 from collections import defaultdict
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
@@ -44,6 +45,7 @@ from facadecli.grammar.style import (
     Equation,
     Kept,
     check,
+    column_centres,
     equations,
     facade_of,
     style_of,
@@ -322,10 +324,13 @@ def align(
     background: str = BACKGROUND,
     style: Sequence[Constraint] = (),
     pull: bool = True,
+    hold: bool = False,
 ) -> tuple[list[Piece], list[str]]:
     """Equal terminals one size and lined up, and the style's near misses made exact (see
     the module and :func:`~facadecli.grammar.style.equations`); with ``pull``, elements
-    derived longer than in the source pulled back towards their source size."""
+    derived longer than in the source pulled back towards their source size; with
+    ``hold``, every element (bands aside) keeps its size as derived instead, only moved
+    (bays copied: their elements have the source's sizes already)."""
     warnings: list[str] = []
     mapping = {}
     kept: list[Equation] = []
@@ -334,7 +339,9 @@ def align(
         kept = equations(style, facade_of(boxes, width, height, background), STYLE_NEAR * width)
     axes: tuple[tuple[Axis, float, list[Equation]], ...] = (("x", width, kept), ("y", height, []))
     for axis, extent, extra in axes:
-        mapping[axis], axis_warnings = _align_axis(pieces, axis, extent, background, extra, pull)
+        mapping[axis], axis_warnings = _align_axis(
+            pieces, axis, extent, background, extra, pull, hold
+        )
         warnings += axis_warnings
     moved = [
         Piece(
@@ -358,6 +365,7 @@ def _align_axis(
     background: str,
     extra: list[Equation],
     pull: bool = True,
+    hold: bool = False,
 ) -> tuple[dict[float, float], list[str]]:
     import cvxpy as cp  # imported here: it takes half a second
 
@@ -367,6 +375,7 @@ def _align_axis(
     index = {v: i for i, v in enumerate(edges)}
     spans = []
     stretched: dict[tuple[int, int], float] = {}  # elements derived longer than their source
+    held: dict[tuple[int, int], float] = {}  # elements that keep their size as derived
     groups: dict[tuple[str, int], list[tuple[int, int]]] = defaultdict(list)
     for p in pieces:
         a, b = (p.x0, p.x1) if axis == "x" else (p.y0, p.y1)
@@ -375,7 +384,9 @@ def _align_axis(
             spans.append((span, edges[span[1]] - edges[span[0]]))
             source = p.source_w if axis == "x" else p.source_h
             groups[(p.label, round(source / (1e-6 * extent)))].append(span)
-            if pull and _stretched(b - a, source, extent):
+            if hold and b - a <= BAND * extent:
+                held[span] = b - a
+            elif pull and _stretched(b - a, source, extent):
                 stretched[span] = source
     equal = []
     lined = []
@@ -396,6 +407,18 @@ def _align_axis(
     if floors:
         lengths = _combination(cp, v, n, [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in floors])
         base.append(lengths >= np.array([size / 2 for _, size in floors]))
+    if held:
+        kept_sizes = sorted(held.items())
+        base.append(
+            _combination(
+                cp,
+                v,
+                n,
+                [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in kept_sizes],
+                [size for _, size in kept_sizes],
+            )
+            == 0
+        )
     # every gap below one vector (a matrix times the edges): one expression each, however
     # many terminals a large derivation makes
     size_gaps = _combination(
@@ -448,7 +471,9 @@ def _align_axis(
             warnings.append(f"{axis}: equal sizes of equal terminals {fallback}")
         problem = cp.Problem(cp.Minimize(objective), base + constraints)
         try:
-            problem.solve(solver=cp.CLARABEL)
+            with warnings_module.catch_warnings():  # "may be inaccurate": the style is checked
+                warnings_module.simplefilter("ignore", UserWarning)
+                problem.solve(solver=cp.CLARABEL)
         except cp.error.SolverError:
             continue
         if problem.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) and v.value is not None:
@@ -676,6 +701,21 @@ def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
     return sum(terms) / len(terms) if terms else 0.0
 
 
+def likeness(pieces: list[Piece]) -> float:
+    """How far the pieces' sizes are from the source's, the wall included, each weighted by
+    its area (0: the same): a derivation that widens its wall into blank margins is as far
+    from the source as one that widens its windows."""
+    total = 0.0
+    area = 0.0
+    for p in pieces:
+        w, h = p.x1 - p.x0, p.y1 - p.y0
+        if w > 0 and h > 0:
+            terms = math.log(w / p.source_w) ** 2 + math.log(h / p.source_h) ** 2
+            total += w * h * terms
+            area += w * h
+    return total / area if area else 0.0
+
+
 def _key(pieces: list[Piece]) -> tuple[tuple[str, float, float, float, float], ...]:
     """The pieces as they would be written (to tell two derivations apart)."""
     return tuple(
@@ -744,9 +784,8 @@ def derive_variations(
     best = derive_at(grammar, source, width, height, used=used)
     best_kept = kept(best)
     candidates: list[_Candidate | None] = [_Candidate(score(best), (), None, best, best_kept)]
-    mirrored = any(c.kind == "symmetry" for c in style)
     at_source = derive_at(grammar, source, *source)
-    for pieces, stretch, text in _retargeted(at_source, source, width, height, mirrored):
+    for pieces, stretch, text in _retargeted(at_source, source, width, height, style):
         candidates.append(
             _Candidate(score(pieces) + stretch, (), None, pieces, kept(pieces), (), text)
         )
@@ -779,9 +818,7 @@ def derive_variations(
         for c in finalists
         if c is not None
     ]
-    first, aligned, warnings, keeps = min(
-        tidied, key=lambda t: (-len(t[3].kept), score(t[1]) + t[0].score - score(t[0].pieces))
-    )
+    first, aligned, warnings, keeps = min(tidied, key=lambda t: (-len(t[3].kept), likeness(t[1])))
     layout = pieces_layout(aligned, width, height, named(0), warnings)
     found = [
         Variation(
@@ -852,7 +889,11 @@ Span = tuple[float, float]
 
 
 def _retargeted(
-    pieces: list[Piece], source: tuple[float, float], width: float, height: float, mirrored: bool
+    pieces: list[Piece],
+    source: tuple[float, float],
+    width: float,
+    height: float,
+    style: Sequence[Constraint],
 ) -> list[tuple[list[Piece], float, str]]:
     """The source's pieces laid out at a new size by :mod:`~facadecli.grammar.retarget`:
     each layout, how far its wall stretched (the squares of the log-ratios, a term of its
@@ -860,19 +901,28 @@ def _retargeted(
 
     Floors are copied across the whole width. Bays are copied floor by floor (a floor, or
     the wall between floors, is a stratum): one unit, where a stratum lets it be cut out
-    (a ground floor of shops may not), else that stratum's own least stretched plan, so
-    the floors above keep their columns whatever the ground floor does."""
+    there or a little to one side (:func:`~facadecli.grammar.retarget.shifted`); a
+    stratum that cannot be cut near it (a ground floor of shops) is stretched instead, so
+    the floors above keep their columns whatever the ground floor does. The units tried
+    first hold a column of the style's (one pitch of it, centred on a column, is a period
+    by construction), then those that most strata can be cut at. Every stratum stretches
+    the wall that is wall in all of them, so strata cut alike stay lined up. ``style``
+    gives the columns and whether the façade is mirrored (units are then copied with
+    their mirror images)."""
     if (width, height) == source:
         return []
     boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-    joined = facade_of(boxes, *source, BACKGROUND).boxes
+    facade = facade_of(boxes, *source, BACKGROUND)
+    joined = facade.boxes
+    mirrored = any(c.kind == "symmetry" for c in style)
+    columns = [column_centres(facade, c.label) for c in style if c.kind == "columns"]
     # no cut may cross an element, nor a piece of one (an L-shaped molding), but for
     # labels that make bands along the axis (a cornice, pilasters): a copy lengthens them
     elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
     in_bays = _unbanded(elements, joined, "x", source[0])
     in_floors = _unbanded(elements, joined, "y", source[1])
     floors = retarget.plans([(b.y0, b.y1) for b in in_floors], source[1], height, False)
-    bays = _bays(in_bays, source, width, mirrored)
+    bays = _bays(in_bays, in_floors, source, width, mirrored, columns)
     laid = []
     for (text_x, strata, across), along_y in itertools.product(
         bays, sorted(floors, key=lambda p: (p.stretch, p.text))[:RETARGETS_MAX]
@@ -906,12 +956,19 @@ def _unbanded(elements: list[Box], joined: Sequence[Box], axis: str, extent: flo
 
 
 def _bays(
-    elements: Sequence[Box], source: tuple[float, float], width: float, mirrored: bool
+    elements: Sequence[Box],
+    floors: Sequence[Box],
+    source: tuple[float, float],
+    width: float,
+    mirrored: bool,
+    columns: Sequence[Sequence[float]] = (),
 ) -> list[tuple[str, list[Span], list[retarget.Plan]]]:
     """Ways to lay the façade's strata across (see :func:`_retargeted`): what was done,
-    the strata and a plan for each; the source stretched first."""
+    the strata and a plan for each; the source stretched first. The strata are cut where
+    none of ``floors`` crosses (a balcony across the façade is in one stratum), a stratum
+    where none of ``elements`` crosses."""
     extent = source[0]
-    strata = retarget.strata([(b.y0, b.y1) for b in elements], source[1])
+    strata = retarget.strata([(b.y0, b.y1) for b in floors], source[1])
     spans = [[(b.x0, b.x1) for b in elements if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
     # a unit's worth: the height of the strata it can be cut out of, less their height
     # times how far it is from a period there
@@ -919,14 +976,20 @@ def _bays(
         dict((u, irregular) for irregular, u in retarget.laid_units(here, extent, mirrored))
         for here in spans
     ]
+    every = [span for here in spans for span in here]
+    pitched = _pitched(columns, extent, mirrored)  # periods by construction
     worth: dict[tuple[Span, ...], float] = {}
-    for unit in (u for here in listed for u in here):
+    for unit in [*pitched, *(u for here in listed for u in here)]:
         worth[unit] = sum(
-            (hi - lo) * (1 - min(1.0, here.get(unit, 0.5)))
+            (hi - lo) * (1 - min(1.0, 0.0 if unit in pitched else here.get(unit, 0.5)))
             for (lo, hi), cut, here in zip(strata, spans, listed, strict=True)
-            if _cuts(cut, extent, unit)
+            if retarget.shifted(cut, extent, unit) is not None
         )
-    ranked = sorted(worth, key=lambda u: (-worth[u], u))[: retarget.UNITS_TRIED]
+    # units that hold one of the style's columns (of windows, say) first: a bay, not a
+    # slab of wall with an ornament in it
+    ranked = sorted(worth, key=lambda u: (not _holds_column(u, columns), -worth[u], u))[
+        : retarget.UNITS_TRIED
+    ]
     found = []
     for unit, copies in [((), 0)] + [
         (u, c)
@@ -936,27 +999,47 @@ def _bays(
     ]:
         across = []
         for here in spans:
-            plan = (
-                retarget.copied(here, extent, width, unit, copies)
-                if _cuts(here, extent, unit)
-                else None
-            )
-            if plan is None:  # the stratum's own least stretched plan
-                own = retarget.plans(here, extent, width, mirrored)
-                plan = min(own, key=lambda p: (p.stretch, p.text), default=None)
+            cut = retarget.shifted(here, extent, unit) if unit else ()
+            # the wall that stretches is the wall of every stratum, so that the strata
+            # cut alike stay lined up
+            plan = None if cut is None else retarget.copied(every, extent, width, cut, copies)
+            if plan is None:  # the stratum stretched (its own bays copied would not line up)
+                plan = retarget.copied(every, extent, width, (), 0)
             if plan is None:
                 break
             across.append(plan)
         else:
-            text = f"x {across[0].text}" if unit else ""
-            text = next((f"x {p.text}" for p in across if p.text and unit), text)
-            found.append((text, strata, across))
+            text = retarget.describe(unit, copies)
+            found.append((f"x {text}" if text else "", strata, across))
     return found
 
 
-def _cuts(spans: Sequence[Span], extent: float, unit: Sequence[Span]) -> bool:
-    """Whether a stratum can be cut at both ends of a unit (and its mirror image)."""
-    return all(retarget.free(spans, extent, v) for lo, hi in unit for v in (lo, hi))
+def _pitched(
+    columns: Sequence[Sequence[float]], extent: float, mirrored: bool
+) -> list[tuple[Span, ...]]:
+    """Units one pitch of a label's columns long (of the style's ``columns``), centred on
+    one of them (a window column and half the wall each side: its copy is the next bay
+    along), with their mirror images when ``mirrored``."""
+    near = 1e-3 * extent
+    centred = 0.01 * extent  # the style's tolerance
+    found: list[tuple[Span, ...]] = []
+    pairs = [pair for centres in columns for pair in itertools.pairwise(centres)]
+    for a, b in pairs:
+        half = (b - a) / 2
+        for centre in (a, b):
+            lo, hi = max(0.0, centre - half), min(extent, centre + half)
+            unit: tuple[Span, ...] = ((lo, hi),)
+            if mirrored and abs(lo + hi - extent) > centred:
+                if extent - hi < hi - near:
+                    continue  # the unit and its mirror image overlap
+                unit = ((lo, hi), (extent - hi, extent - lo))
+            if unit not in found:
+                found.append(unit)
+    return found
+
+
+def _holds_column(unit: Sequence[Span], columns: Sequence[Sequence[float]]) -> bool:
+    return any(lo < c < hi for lo, hi in unit for centres in columns for c in centres)
 
 
 def _stacked(parts: list[tuple[float, float, float, float]]) -> list[tuple[float, ...]]:
@@ -1064,9 +1147,9 @@ def _tidied(
     too, and the one that keeps more is taken (the pulled one on a tie). Of ``copies``
     (whole bays copied: already aligned) the QP's is taken only where it keeps more of
     the style, or as much and its sizes are no further from the source's."""
-    aligned, warnings = align(pieces, width, height, style=style)
+    aligned, warnings = align(pieces, width, height, style=style, hold=copies)
     after = kept(aligned)
-    if after.broken and _any_stretched(pieces, width, height):
+    if after.broken and not copies and _any_stretched(pieces, width, height):
         plain, plain_warnings = align(pieces, width, height, style=style, pull=False)
         plain_after = kept(plain)
         if len(plain_after.kept) > len(after.kept):

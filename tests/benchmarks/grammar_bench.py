@@ -4,7 +4,8 @@ Reads the CMP sample annotations beside the project (``../shared/data/cmp-sample
 are never copied into it) and prints, per façade, the tiling's size, what regularisation
 moved, the greedy baseline's cost and ADP's (2,000 iterations, seed 0), ADP's rules, the
 iteration that found the best grammar, the search's time and the whole pipeline's; derived
-at 0.7, 1.5 and 2 times the width, the style kept and the windows stretched. Then one
+at 0.7, 1.5 and 2 times the width, the style kept, the windows stretched and the façades
+with blank wall instead of bays (fewer windows a metre than the input). Then one
 derivation at a new size, and six variations at each width. Skips, saying so, when the data
 is not there.
 """
@@ -21,11 +22,14 @@ sys.path.insert(0, str(ROOT))
 
 from facadecli.grammar.cmp_xml import read_cmp  # noqa: E402
 from facadecli.grammar.run import Extraction, Options, extract_grammar, resize  # noqa: E402
-from facadecli.grammar.variation import derive_layout, derive_variations  # noqa: E402
+from facadecli.grammar.style import Box, facade_of, tiles_of  # noqa: E402
+from facadecli.grammar.tiling import BACKGROUND, Tiling  # noqa: E402
+from facadecli.grammar.variation import Piece, derive_layout, derive_variations  # noqa: E402
 from facadecli.layout import Layout  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
 WIDER = 1.15  # a derived window wider than this times the annotation's widest is stretched
+SPARSE = 0.8  # a derived layout with fewer windows a metre than this times the input's
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
 
 
@@ -48,6 +52,7 @@ def main() -> None:
     windows: dict[float, int] = {}  # derived windows, and those wider than the source's
     wide: dict[float, int] = {}
     grown: dict[float, int] = {}  # windows wider than their own piece in the source
+    sparse: dict[float, int] = {}  # façades with fewer windows a metre than the input's
     style_total = 0
     last = None
     for path in files:
@@ -67,6 +72,7 @@ def main() -> None:
         style = extraction.style
         kept = []
         widest = _input_widest(path)
+        source_density = len(_source_windows(tiling)) / tiling.xs[-1]
         for scale in SCALES:
             drawn, _ = derive_variations(
                 extraction.grammar, tiling, 15.0 * scale, 15.0, "bench", 1, 0, style
@@ -78,6 +84,8 @@ def main() -> None:
             grown[scale] = grown.get(scale, 0) + sum(
                 p.x1 - p.x0 > WIDER * p.source_w for p in drawn[0].pieces if p.label == "window"
             )
+            density = _windows(drawn[0].pieces, 15.0 * scale) / (15.0 * scale)
+            sparse[scale] = sparse.get(scale, 0) + (density < SPARSE * source_density)
         for scale, count in zip(SCALES, kept, strict=True):
             style_kept[scale] = style_kept.get(scale, 0) + count
         style_total += len(style)
@@ -110,6 +118,10 @@ def main() -> None:
         + ", ".join(f"{grown[s]} of {windows[s]} at {s}x" for s in SCALES)
         + " width"
     )
+    print(
+        f"façades with under {SPARSE:.0%} of the input's windows a metre of width (blank wall "
+        "instead of bays): " + ", ".join(f"{sparse[s]} of {len(files)} at {s}x" for s in SCALES)
+    )
     wins = sum(a < g for a, g in zip(adp, greedy, strict=True))
     print(f"ADP is cheaper than greedy on {wins} of {len(files)} façades")
     assert last is not None
@@ -124,6 +136,18 @@ def _input_widest(path: Path) -> float:
     input's size is no reference: tidying may have changed it)."""
     annotation = resize(read_cmp(path), 15.0, 15.0)
     return max((r.x1 - r.x0 for r in annotation.rects if r.label == "window"), default=0.0)
+
+
+def _source_windows(tiling: Tiling) -> list[Box]:
+    facade = facade_of(tiles_of(tiling), tiling.xs[-1], tiling.ys[-1], BACKGROUND)
+    return [b for b in facade.boxes if b.label == "window"]
+
+
+def _windows(pieces: tuple[Piece, ...], width: float) -> int:
+    """The windows of a derived layout, each counted once however many pieces make it."""
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    height = max((p.y1 for p in pieces), default=1.0)
+    return sum(b.label == "window" for b in facade_of(boxes, width, height, BACKGROUND).boxes)
 
 
 def _window_widths(layout: Layout) -> list[float]:
