@@ -351,3 +351,30 @@ def test_likeness_counts_the_wall_a_derivation_widens() -> None:
     blank = [window, Piece("facade", 0.0, 0.0, 9.0, 3.0, 3.0, 3.0)]
     assert likeness(same) == 0.0
     assert likeness(blank) > 0.5
+
+
+def _floors_drawn_apart() -> LabelledLayout:
+    """Three floors of three windows, the middle floor's with sills: the floors are not
+    one rule a repeat could copy."""
+    rects = []
+    for j, y in enumerate((1.0, 4.0, 7.0)):
+        for x in (1.0, 4.0, 7.0):
+            rects.append(Rect("window", x, y + 0.2, x + 1.0, y + 1.7, 1))
+            if j == 1:
+                rects.append(Rect("sill", x, y, x + 1.0, y + 0.2, 1))
+    return LabelledLayout(9.0, 9.5, tuple(rects))
+
+
+def test_a_taller_facade_gains_floors_copied_whole(tmp_path: Path) -> None:
+    """The grammar has no repeat up the façade; twice as tall, whole floors are copied
+    (one pitch of the rows of windows): more floors of three windows, none taller than
+    in the source, every constraint of the style kept."""
+    extraction = _extract(tmp_path, _floors_drawn_apart())
+    assert not any(r.op in ("repeat", "repeatABA") for r in extraction.grammar.rules.values())
+    (variation,) = _draw(extraction, (9.0, 19.0), 1)
+    windows = [p for p in variation.pieces if p.label == "window"]
+    floors = {round(p.y0, 6) for p in windows}
+    assert len(floors) > 3 and len(windows) == 3 * len(floors)
+    assert all(p.y1 - p.y0 <= 1.1 * p.source_h for p in windows)
+    assert not variation.kept.broken
+    assert variation.retarget.startswith("y copied")

@@ -223,6 +223,13 @@ def column_centres(facade: Facade, label: str) -> list[float]:
     return _centres(best[0]) if len(best) >= 2 else []
 
 
+def row_centres(facade: Facade, label: str) -> list[float]:
+    """The heights of the centres of the rows of a label that share columns, bottom up
+    (none when no two rows share them)."""
+    best, _ = _shared_columns(facade, label)
+    return sorted(_cy(row[0]) for row in best) if len(best) >= 2 else []
+
+
 def _evenly_spaced(facade: Facade, label: str) -> tuple[int, int]:
     """How many of a label's rows of three or more are evenly spaced, of how many."""
     near = TOLERANCE * facade.width

@@ -48,6 +48,7 @@ from facadecli.grammar.style import (
     column_centres,
     equations,
     facade_of,
+    row_centres,
     style_of,
 )
 from facadecli.grammar.tiling import BACKGROUND, CMP_Z_ORDER, Tiling, snap
@@ -914,19 +915,22 @@ def _retargeted(
     boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
     facade = facade_of(boxes, *source, BACKGROUND)
     joined = facade.boxes
-    mirrored = any(c.kind == "symmetry" for c in style)
+    # a mirrored façade copies a unit with its mirror image; one with an element on the
+    # centre line may (so it stays there) or may not (the centred unit itself copied)
+    symmetric = any(c.kind == "symmetry" for c in style)
+    centred = any(c.kind == "centre" for c in style)
+    pairs = (True,) if symmetric else (False, True) if centred else (False,)
     columns = [column_centres(facade, c.label) for c in style if c.kind == "columns"]
     # no cut may cross an element, nor a piece of one (an L-shaped molding), but for
     # labels that make bands along the axis (a cornice, pilasters): a copy lengthens them
     elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
     in_bays = _unbanded(elements, joined, "x", source[0])
     in_floors = _unbanded(elements, joined, "y", source[1])
-    floors = retarget.plans([(b.y0, b.y1) for b in in_floors], source[1], height, False)
-    bays = _bays(in_bays, in_floors, source, width, mirrored, columns)
+    rows = [row_centres(facade, c.label) for c in style if c.kind == "columns"]
+    floors = _floors(in_floors, source[1], height, rows)
+    bays = _bays(in_bays, in_floors, source, width, pairs, columns)
     laid = []
-    for (text_x, strata, across), along_y in itertools.product(
-        bays, sorted(floors, key=lambda p: (p.stretch, p.text))[:RETARGETS_MAX]
-    ):
+    for (text_x, strata, across), along_y in itertools.product(bays, floors[:RETARGETS_MAX]):
         parts: dict[int, list[tuple[float, float, float, float]]] = defaultdict(list)
         for k, p in enumerate(pieces):
             for (lo, hi), plan in zip(strata, across, strict=True):
@@ -945,6 +949,33 @@ def _retargeted(
     return laid
 
 
+def _floors(
+    elements: Sequence[Box], extent: float, height: float, rows: Sequence[Sequence[float]]
+) -> list[retarget.Plan]:
+    """Ways to lay the façade up its height: the façade stretched, then floors copied
+    across the whole width: a unit one pitch of the style's rows (of windows, say),
+    centred on a row that is neither the lowest nor the highest, so that a copy is the
+    next floor up (a strip of a ground floor, an attic or a frieze copied would stack shop
+    fronts, doors or bands)."""
+    spans = [(b.y0, b.y1) for b in elements]
+    found: list[retarget.Plan | None] = [retarget.copied(spans, extent, height, (), 0)]
+    inner = [centres[1:-1] for centres in rows]
+    units = [
+        unit
+        for unit in _pitched(rows, extent, False)
+        if any(unit[0][0] < c < unit[0][1] for centres in inner for c in centres)
+    ]
+    for unit in units:
+        cut = retarget.shifted(spans, extent, unit)
+        if cut is None:
+            continue
+        length = sum(b - a for a, b in cut)
+        for copies in retarget.copies_near(length, extent, height):
+            if copies:
+                found.append(retarget.copied(spans, extent, height, cut, copies))
+    return [plan for plan in found if plan is not None]
+
+
 def _unbanded(elements: list[Box], joined: Sequence[Box], axis: str, extent: float) -> list[Box]:
     """The elements but those of labels that make a band along the axis somewhere."""
     bands = {
@@ -960,7 +991,7 @@ def _bays(
     floors: Sequence[Box],
     source: tuple[float, float],
     width: float,
-    mirrored: bool,
+    pairs: Sequence[bool] = (False,),
     columns: Sequence[Sequence[float]] = (),
 ) -> list[tuple[str, list[Span], list[retarget.Plan]]]:
     """Ways to lay the façade's strata across (see :func:`_retargeted`): what was done,
@@ -973,11 +1004,15 @@ def _bays(
     # a unit's worth: the height of the strata it can be cut out of, less their height
     # times how far it is from a period there
     listed = [
-        dict((u, irregular) for irregular, u in retarget.laid_units(here, extent, mirrored))
+        {
+            u: irregular
+            for mirrored in pairs
+            for irregular, u in retarget.laid_units(here, extent, mirrored)
+        }
         for here in spans
     ]
     every = [span for here in spans for span in here]
-    pitched = _pitched(columns, extent, mirrored)  # periods by construction
+    pitched = [u for mirrored in pairs for u in _pitched(columns, extent, mirrored)]
     worth: dict[tuple[Span, ...], float] = {}
     for unit in [*pitched, *(u for here in listed for u in here)]:
         worth[unit] = sum(
