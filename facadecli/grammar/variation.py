@@ -925,10 +925,11 @@ def _retargeted(
     # labels that make bands along the axis (a cornice, pilasters): a copy lengthens them
     elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
     in_bays = _unbanded(elements, joined, "x", source[0])
+    clean = _unbanded(elements, joined, "x", source[0], whole_labels=False)
     in_floors = _unbanded(elements, joined, "y", source[1])
     rows = [row_centres(facade, c.label) for c in style if c.kind == "columns"]
     floors = _floors(in_floors, source[1], height, rows)
-    bays = _bays(in_bays, in_floors, source, width, pairs, columns)
+    bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
     laid = []
     for (text_x, strata, across), along_y in itertools.product(bays, floors[:RETARGETS_MAX]):
         parts: dict[int, list[tuple[float, float, float, float]]] = defaultdict(list)
@@ -976,14 +977,38 @@ def _floors(
     return [plan for plan in found if plan is not None]
 
 
-def _unbanded(elements: list[Box], joined: Sequence[Box], axis: str, extent: float) -> list[Box]:
-    """The elements but those of labels that make a band along the axis somewhere."""
-    bands = {
-        b.label
-        for b in joined
-        if ((b.x1 - b.x0) if axis == "x" else (b.y1 - b.y0)) >= retarget.BAND * extent
-    }
-    return [b for b in elements if b.label not in bands]
+def _unbanded(
+    elements: list[Box],
+    joined: Sequence[Box],
+    axis: str,
+    extent: float,
+    whole_labels: bool = True,
+) -> list[Box]:
+    """The elements but bands along the axis (a cornice, a balcony across the façade) and
+    the pieces they are made of; with ``whole_labels``, but every element of a label that
+    makes a band somewhere (the molding around a floor's windows, beside the molding
+    across the façade)."""
+
+    def length(b: Box) -> float:
+        return (b.x1 - b.x0) if axis == "x" else (b.y1 - b.y0)
+
+    bands = [b for b in joined if length(b) >= retarget.BAND * extent]
+    if whole_labels:
+        labels = {b.label for b in bands}
+        return [e for e in elements if e.label not in labels]
+    near = 1e-9 * extent
+    return [
+        e
+        for e in elements
+        if not any(
+            e.label == b.label
+            and b.x0 - near <= e.x0
+            and e.x1 <= b.x1 + near
+            and b.y0 - near <= e.y0
+            and e.y1 <= b.y1 + near
+            for b in bands
+        )
+    ]
 
 
 def _bays(
@@ -993,6 +1018,7 @@ def _bays(
     width: float,
     pairs: Sequence[bool] = (False,),
     columns: Sequence[Sequence[float]] = (),
+    clean: Sequence[Box] = (),
 ) -> list[tuple[str, list[Span], list[retarget.Plan]]]:
     """Ways to lay the façade's strata across (see :func:`_retargeted`): what was done,
     the strata and a plan for each; the source stretched first. The strata are cut where
@@ -1001,6 +1027,7 @@ def _bays(
     extent = source[0]
     strata = retarget.strata([(b.y0, b.y1) for b in floors], source[1])
     spans = [[(b.x0, b.x1) for b in elements if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
+    cleanly = [[(b.x0, b.x1) for b in clean if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
     # a unit's worth: the height of the strata it can be cut out of, less their height
     # times how far it is from a period there
     listed = [
@@ -1033,8 +1060,14 @@ def _bays(
         if c
     ]:
         across = []
-        for here in spans:
-            cut = retarget.shifted(here, extent, unit) if unit else ()
+        for here, whole in zip(spans, cleanly, strict=True):
+            # a cut that crosses no piece of an element if there is one near, else one
+            # that crosses only pieces of labels that make bands
+            cut = (
+                (retarget.shifted(whole, extent, unit) or retarget.shifted(here, extent, unit))
+                if unit
+                else ()
+            )
             # the wall that stretches is the wall of every stratum, so that the strata
             # cut alike stay lined up
             plan = None if cut is None else retarget.copied(every, extent, width, cut, copies)
