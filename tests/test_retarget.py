@@ -3,7 +3,11 @@ along one axis, the wall taking up the rest."""
 
 from __future__ import annotations
 
+import itertools
+
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from facadecli.grammar import retarget
 
@@ -83,3 +87,38 @@ def test_what_a_plan_does_is_said_for_people() -> None:
     assert retarget.describe([(2.5, 4.5)], 2) == "copied 2x: 2.5-4.5"
     assert retarget.describe([(9.0, 11.0), (1.0, 3.0)], -1) == "left out: 1-3 and 9-11"
     assert retarget.describe([(2.5, 4.5)], 0) == ""
+
+
+@st.composite
+def _rows(draw: st.DrawFn) -> tuple[list[tuple[float, float]], float]:
+    """Elements along one axis: widths and gaps drawn, in whole centimetres."""
+    at, spans = draw(st.integers(0, 300)) / 100, []
+    for _ in range(draw(st.integers(1, 8))):
+        width = draw(st.integers(20, 300)) / 100
+        spans.append((at, at + width))
+        at += width + draw(st.integers(0, 300)) / 100
+    return spans, at + draw(st.integers(0, 300)) / 100
+
+
+@settings(max_examples=150, deadline=None)
+@given(_rows(), st.floats(0.5, 3.0), st.booleans())
+def test_every_plan_fills_the_new_extent_and_keeps_elements_whole(
+    row: tuple[list[tuple[float, float]], float], factor: float, mirrored: bool
+) -> None:
+    """Whatever the elements and the new extent: a plan lays the source end to end over
+    exactly the new extent, every element but a band is laid whole (not cut) and at most
+    ``WIDEN_MOST`` longer or ``SQUEEZE_MOST`` shorter, and a copied element never overlaps
+    another."""
+    spans, extent = row
+    new = extent * factor
+    for plan in retarget.plans(spans, extent, new, mirrored):
+        assert _length(plan) == pytest.approx(new)
+        laid = sorted(part for lo, hi in spans for part in retarget.place(plan, lo, hi))
+        for lo, hi in spans:
+            for a, b in retarget.place(plan, lo, hi):
+                assert 0.0 <= a < b <= new + 1e-9
+                if hi - lo < retarget.BAND * extent:  # a band may be lengthened
+                    ratio = (b - a) / (hi - lo)
+                    assert 1 / retarget.SQUEEZE_MOST - 1e-9 <= ratio <= retarget.WIDEN_MOST + 1e-9
+        for (_, end), (start, _) in itertools.pairwise(laid):
+            assert start >= end - 1e-9

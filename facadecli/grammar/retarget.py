@@ -36,6 +36,7 @@ GAPS_MOST = 1.5  # ... and stretched further, the plan is no good (copies should
 SQUEEZE_MOST = 1.5  # elements squeezed further (1 / this), the plan is no good
 WIDEN_MOST = 1.1  # ... or stretched further: copies, not wider windows, fill a façade
 NEAR = 1e-9  # of the extent: spans closer than this touch
+SNAP = 1e-3  # of the extent: a cut this near an element's edge is moved onto it
 
 
 @dataclass(frozen=True)
@@ -92,19 +93,35 @@ def units(spans: Sequence[tuple[float, float]], extent: float) -> list[tuple[flo
 
 def free(spans: Sequence[tuple[float, float]], extent: float, at: float) -> bool:
     """Whether a cut at ``at`` crosses no element (bands aside)."""
-    near = 1e-3 * extent
-    return not any(lo + near < at < hi - near for lo, hi in blocks_of(spans, extent))
+    return _free(blocks_of(spans, extent), extent, at)
+
+
+def _free(blocks: Sequence[tuple[float, float]], extent: float, at: float) -> bool:
+    near = NEAR * extent
+    return not any(lo + near < at < hi - near for lo, hi in blocks)
 
 
 def mirror(
     spans: Sequence[tuple[float, float]], extent: float, unit: tuple[float, float]
 ) -> tuple[float, float] | None:
-    """The unit's mirror image about the centre, when that is a unit too and apart from it."""
+    """The unit's mirror image about the centre, when that is a unit too and apart from it
+    (its ends moved onto an element's edge within ``SNAP`` of the extent: see
+    :func:`snapped`)."""
     lo, hi = unit
-    mirrored = (extent - hi, extent - lo)
+    blocks = blocks_of(spans, extent)
+    edges = sorted({v for b in blocks for v in b})
+    mirrored = (snapped(edges, extent - hi, extent), snapped(edges, extent - lo, extent))
     if mirrored[0] < hi - NEAR * extent and mirrored[1] > lo + NEAR * extent:
         return None
-    return mirrored if all(free(spans, extent, v) for v in mirrored) else None
+    return mirrored if all(_free(blocks, extent, v) for v in mirrored) else None
+
+
+def snapped(edges: Sequence[float], at: float, extent: float) -> float:
+    """A cut moved onto the nearest element's edge within ``SNAP`` of the extent (so that
+    a hand-drawn façade's bays and mirror images are found, and no element is cut a
+    sliver off); else where it is."""
+    near = min(edges, key=lambda e: abs(e - at), default=None)
+    return near if near is not None and abs(near - at) <= SNAP * extent else at
 
 
 def copied(
@@ -138,26 +155,31 @@ def shifted(
     their ends (a unit and its mirror image by mirrored moves where they can be, else
     each by its own); themselves when it can be already; None when no move does. On a
     periodic façade a bay cut a little to one side copies the same bay."""
-    edges = sorted({v for b in blocks_of(spans, extent) for v in b})
+    blocks = blocks_of(spans, extent)
+    edges = sorted({v for b in blocks for v in b})
 
     def moves(lo: float, hi: float) -> list[float]:
         found = {0.0, *(e - v for e in edges for v in (lo, hi))}
         return sorted((d for d in found if abs(d) <= (hi - lo) / 2), key=lambda d: (abs(d), d))
 
-    def cuts(lo: float, hi: float) -> bool:
-        return lo >= 0.0 and hi <= extent and free(spans, extent, lo) and free(spans, extent, hi)
+    def cut(lo: float, hi: float) -> tuple[float, float] | None:
+        lo, hi = snapped(edges, lo, extent), snapped(edges, hi, extent)
+        inside = lo >= 0.0 and hi <= extent
+        return (
+            (lo, hi) if inside and _free(blocks, extent, lo) and _free(blocks, extent, hi) else None
+        )
 
     (lo, hi), *rest = laid
     for move in moves(lo, hi):  # mirrored moves keep a mirrored pair mirrored
-        unit = ((lo + move, hi + move), *((a - move, b - move) for a, b in rest))
-        if all(cuts(a, b) for a, b in unit):
-            return unit
+        units = [cut(lo + move, hi + move), *(cut(a - move, b - move) for a, b in rest)]
+        if all(units):
+            return tuple(u for u in units if u is not None)
     found = []
     for a, b in laid:
-        own = next((d for d in moves(a, b) if cuts(a + d, b + d)), None)
+        own = next((u for d in moves(a, b) if (u := cut(a + d, b + d)) is not None), None)
         if own is None:
             return None
-        found.append((a + own, b + own))
+        found.append(own)
     return tuple(found)
 
 
@@ -285,23 +307,26 @@ def _laid(
 
 def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[float, float]]:
     """Where the source interval ``lo``-``hi`` lies after a plan: once, or once per copy
-    of a unit it lies in (the parts of one stretch laid end to end joined). Overlaps of
-    ``near`` or less are none (rounding in the source's coordinates)."""
+    of a unit it lies in. Where the interval goes on across the end of a segment and the
+    next segment starts inside it (a band across a copied unit), the two parts are one;
+    an interval exactly as long as a unit is laid once per copy. Overlaps of ``near`` or
+    less are none (rounding in the source's coordinates)."""
     found: list[tuple[float, float]] = []
     at = 0.0
-    joined = False  # the last part ended where this segment starts
+    going_on = False  # the last part was cut where its segment ends, the interval going on
     for segment in plan.segments:
         length = (segment.hi - segment.lo) * segment.scale
         a, b = max(lo, segment.lo), min(hi, segment.hi)
         if b - a > near:
             start = at + (a - segment.lo) * segment.scale
             end = at + (b - segment.lo) * segment.scale
-            if joined and found and a - segment.lo <= near:
+            cut_here = a - segment.lo <= near and lo < segment.lo - near
+            if going_on and cut_here and found:
                 found[-1] = (found[-1][0], end)
             else:
                 found.append((start, end))
-            joined = segment.hi - b <= near
+            going_on = segment.hi - b <= near and hi > segment.hi + near
         else:
-            joined = False
+            going_on = False
         at += length
     return found

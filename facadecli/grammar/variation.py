@@ -954,17 +954,17 @@ def _floors(
     elements: Sequence[Box], extent: float, height: float, rows: Sequence[Sequence[float]]
 ) -> list[retarget.Plan]:
     """Ways to lay the façade up its height: the façade stretched, then floors copied
-    across the whole width: a unit one pitch of the style's rows (of windows, say),
-    centred on a row that is neither the lowest nor the highest, so that a copy is the
-    next floor up (a strip of a ground floor, an attic or a frieze copied would stack shop
-    fronts, doors or bands)."""
+    across the whole width: a unit one pitch of ``rows`` (the style's rows, of windows
+    say), centred on one of them, holding no label's lowest or highest row, so that a copy
+    is the next floor up (a strip of a ground floor, an attic or a frieze copied would
+    stack shop fronts, doors or bands)."""
     spans = [(b.y0, b.y1) for b in elements]
     found: list[retarget.Plan | None] = [retarget.copied(spans, extent, height, (), 0)]
-    inner = [centres[1:-1] for centres in rows]
-    units = [
+    ends = [c for centres in rows if centres for c in (centres[0], centres[-1])]
+    units = [  # holding no label's lowest or highest row
         unit
         for unit in _pitched(rows, extent, False)
-        if any(unit[0][0] < c < unit[0][1] for centres in inner for c in centres)
+        if not any(unit[0][0] < c < unit[0][1] for c in ends)
     ]
     for unit in units:
         cut = retarget.shifted(spans, extent, unit)
