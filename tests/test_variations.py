@@ -9,12 +9,12 @@ from pathlib import Path
 import pytest
 
 from facadecli.grammar.run import Extraction, Options, extract_grammar
+from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Part
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.grammar.variation import (
     Piece,
     Variation,
-    _retargeted,
     _run_of,
     align,
     derive_at,
@@ -318,7 +318,7 @@ def test_bays_copied_on_a_symmetric_facade_keep_it_symmetric(tmp_path: Path) -> 
     extraction = _extract(tmp_path, _symmetric())
     source = (20.0, 10.0)
     pieces = derive_at(extraction.grammar, source, *source)
-    laid = _retargeted(pieces, source, 33.0, 10.0, extraction.style)
+    laid = retargeted(pieces, source, 33.0, 10.0, extraction.style)
     copied = [(moved, text) for moved, _, text in laid if text.startswith("x copied")]
     assert copied
     for moved, text in copied:

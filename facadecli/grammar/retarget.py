@@ -58,7 +58,7 @@ class Plan:
 
     @property
     def stretch(self) -> float:
-        """How far the gaps are from their source size (0: not at all)."""
+        """How far its most scaled segment is from its source size (0: none scaled)."""
         return max((abs(math.log(s.scale)) for s in self.segments), default=0.0)
 
 
@@ -91,12 +91,8 @@ def units(spans: Sequence[tuple[float, float]], extent: float) -> list[tuple[flo
     return [(irregular, lo, hi) for irregular, _, lo, hi in found]
 
 
-def free(spans: Sequence[tuple[float, float]], extent: float, at: float) -> bool:
-    """Whether a cut at ``at`` crosses no element (bands aside)."""
-    return _free(blocks_of(spans, extent), extent, at)
-
-
 def _free(blocks: Sequence[tuple[float, float]], extent: float, at: float) -> bool:
+    """Whether a cut at ``at`` crosses none of the blocks."""
     near = NEAR * extent
     return not any(lo + near < at < hi - near for lo, hi in blocks)
 
@@ -132,8 +128,8 @@ def copied(
     copies: int,
 ) -> Plan | None:
     """The plan that copies the units ``laid`` ``copies`` times each (-1: leaves them out;
-    0: stretches the source) and stretches the gaps to fill ``new_extent`` (None when that
-    is no good: see :func:`_laid`)."""
+    0: stretches the source) and scales what is left over to fill ``new_extent`` (None
+    when that is no good: see :func:`_laid`)."""
     blocks = blocks_of(spans, extent)
     stretches = _stretches(sorted(laid), extent, copies)
     if sum(b - a for a, b, times in stretches if times) < extent / 2:

@@ -1,0 +1,253 @@
+"""A façade at a new size made of the input's own terminals, whole bays and floors copied
+(retargeting by slabs, after Lin et al. 2011): the two-dimensional use of the
+one-dimensional plans of :mod:`facadecli.grammar.retarget`, beside the grammar's
+derivations in :mod:`facadecli.grammar.variation`, which compares them.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections import defaultdict
+from collections.abc import Sequence
+
+from facadecli.grammar import retarget
+from facadecli.grammar.pieces import Piece
+from facadecli.grammar.style import Box, Constraint, column_centres, facade_of, row_centres
+from facadecli.grammar.tiling import BACKGROUND
+
+RETARGETS_MAX = 5  # plans per axis whose combinations are tried (the least stretched)
+
+Span = tuple[float, float]
+
+
+def retargeted(
+    pieces: list[Piece],
+    source: tuple[float, float],
+    width: float,
+    height: float,
+    style: Sequence[Constraint],
+) -> list[tuple[list[Piece], float, str]]:
+    """The source's pieces laid out at a new size by :mod:`~facadecli.grammar.retarget`:
+    each layout, how far its wall stretched (the squares of the log-ratios, a term of its
+    score) and what was done; none at the source's size.
+
+    Floors are copied across the whole width. Bays are copied floor by floor (a floor, or
+    the wall between floors, is a stratum): one unit, where a stratum lets it be cut out
+    there or a little to one side (:func:`~facadecli.grammar.retarget.shifted`); a
+    stratum that cannot be cut near it (a ground floor of shops) is stretched instead, so
+    the floors above keep their columns whatever the ground floor does. The units tried
+    first hold a column of the style's (one pitch of it, centred on a column, is a period
+    by construction), then those that most strata can be cut at. Every stratum stretches
+    the wall that is wall in all of them, so strata cut alike stay lined up. ``style``
+    gives the columns and whether the façade is mirrored (units are then copied with
+    their mirror images)."""
+    if (width, height) == source:
+        return []
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    facade = facade_of(boxes, *source, BACKGROUND)
+    joined = facade.boxes
+    # a mirrored façade copies a unit with its mirror image; one with an element on the
+    # centre line may (so it stays there) or may not (the centred unit itself copied)
+    symmetric = any(c.kind == "symmetry" for c in style)
+    centred = any(c.kind == "centre" for c in style)
+    pairs = (True,) if symmetric else (False, True) if centred else (False,)
+    columns = [column_centres(facade, c.label) for c in style if c.kind == "columns"]
+    # no cut may cross an element, nor a piece of one (an L-shaped molding), but for
+    # labels that make bands along the axis (a cornice, pilasters): a copy lengthens them
+    elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
+    in_bays = _unbanded(elements, joined, "x", source[0])
+    clean = _unbanded(elements, joined, "x", source[0], whole_labels=False)
+    in_floors = _unbanded(elements, joined, "y", source[1])
+    rows = [row_centres(facade, c.label) for c in style if c.kind == "columns"]
+    floors = _floors(in_floors, source[1], height, rows)
+    bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
+    laid = []
+    for (text_x, strata, across), along_y in itertools.product(bays, floors[:RETARGETS_MAX]):
+        parts: dict[int, list[tuple[float, float, float, float]]] = defaultdict(list)
+        for k, p in enumerate(pieces):
+            for (lo, hi), plan in zip(strata, across, strict=True):
+                if p.y0 < hi and p.y1 > lo:
+                    for x0, x1 in retarget.place(plan, p.x0, p.x1):
+                        for y0, y1 in retarget.place(along_y, max(p.y0, lo), min(p.y1, hi)):
+                            parts[k].append((x0, x1, y0, y1))
+        moved = [
+            Piece(pieces[k].label, x0, y0, x1, y1, pieces[k].source_w, pieces[k].source_h)
+            for k in sorted(parts)
+            for x0, x1, y0, y1 in _stacked(parts[k])
+        ]
+        stretch = max(plan.stretch for plan in across) ** 2 + along_y.stretch**2
+        texts = [t for t in (text_x, f"y {along_y.text}" if along_y.text else "") if t]
+        laid.append((moved, stretch, "; ".join(texts) or "stretched"))
+    return laid
+
+
+def _floors(
+    elements: Sequence[Box], extent: float, height: float, rows: Sequence[Sequence[float]]
+) -> list[retarget.Plan]:
+    """Ways to lay the façade up its height: the façade stretched, then floors copied
+    across the whole width: a unit one pitch of ``rows`` (the style's rows, of windows
+    say), centred on one of them, holding no label's lowest or highest row, so that a copy
+    is the next floor up (a strip of a ground floor, an attic or a frieze copied would
+    stack shop fronts, doors or bands)."""
+    spans = [(b.y0, b.y1) for b in elements]
+    found: list[retarget.Plan | None] = [retarget.copied(spans, extent, height, (), 0)]
+    ends = [c for centres in rows if centres for c in (centres[0], centres[-1])]
+    units = [  # holding no label's lowest or highest row
+        unit
+        for unit in _pitched(rows, extent, False)
+        if not any(unit[0][0] < c < unit[0][1] for c in ends)
+    ]
+    for unit in units:
+        cut = retarget.shifted(spans, extent, unit)
+        if cut is None:
+            continue
+        length = sum(b - a for a, b in cut)
+        for copies in retarget.copies_near(length, extent, height):
+            if copies:
+                found.append(retarget.copied(spans, extent, height, cut, copies))
+    return [plan for plan in found if plan is not None]
+
+
+def _unbanded(
+    elements: list[Box],
+    joined: Sequence[Box],
+    axis: str,
+    extent: float,
+    whole_labels: bool = True,
+) -> list[Box]:
+    """The elements but bands along the axis (a cornice, a balcony across the façade) and
+    the pieces they are made of; with ``whole_labels``, but every element of a label that
+    makes a band somewhere (the molding around a floor's windows, beside the molding
+    across the façade)."""
+
+    def length(b: Box) -> float:
+        return (b.x1 - b.x0) if axis == "x" else (b.y1 - b.y0)
+
+    bands = [b for b in joined if length(b) >= retarget.BAND * extent]
+    if whole_labels:
+        labels = {b.label for b in bands}
+        return [e for e in elements if e.label not in labels]
+    near = 1e-9 * extent
+    return [
+        e
+        for e in elements
+        if not any(
+            e.label == b.label
+            and b.x0 - near <= e.x0
+            and e.x1 <= b.x1 + near
+            and b.y0 - near <= e.y0
+            and e.y1 <= b.y1 + near
+            for b in bands
+        )
+    ]
+
+
+def _bays(
+    elements: Sequence[Box],
+    floors: Sequence[Box],
+    source: tuple[float, float],
+    width: float,
+    pairs: Sequence[bool] = (False,),
+    columns: Sequence[Sequence[float]] = (),
+    clean: Sequence[Box] = (),
+) -> list[tuple[str, list[Span], list[retarget.Plan]]]:
+    """Ways to lay the façade's strata across (see :func:`retargeted`): what was done,
+    the strata and a plan for each; the source stretched first. The strata are cut where
+    none of ``floors`` crosses (a balcony across the façade is in one stratum), a stratum
+    where none of ``elements`` crosses."""
+    extent = source[0]
+    strata = retarget.strata([(b.y0, b.y1) for b in floors], source[1])
+    spans = [[(b.x0, b.x1) for b in elements if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
+    cleanly = [[(b.x0, b.x1) for b in clean if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
+    # a unit's worth: the height of the strata it can be cut out of, less their height
+    # times how far it is from a period there
+    listed = [
+        {
+            u: irregular
+            for mirrored in pairs
+            for irregular, u in retarget.laid_units(here, extent, mirrored)
+        }
+        for here in spans
+    ]
+    every = [span for here in spans for span in here]
+    pitched = [u for mirrored in pairs for u in _pitched(columns, extent, mirrored)]
+    worth: dict[tuple[Span, ...], float] = {}
+    for unit in [*pitched, *(u for here in listed for u in here)]:
+        worth[unit] = sum(
+            (hi - lo) * (1 - min(1.0, 0.0 if unit in pitched else here.get(unit, 0.5)))
+            for (lo, hi), cut, here in zip(strata, spans, listed, strict=True)
+            if retarget.shifted(cut, extent, unit) is not None
+        )
+    # units that hold one of the style's columns (of windows, say) first: a bay, not a
+    # slab of wall with an ornament in it
+    ranked = sorted(worth, key=lambda u: (not _holds_column(u, columns), -worth[u], u))[
+        : retarget.UNITS_TRIED
+    ]
+    found = []
+    for unit, copies in [((), 0)] + [
+        (u, c)
+        for u in ranked
+        for c in retarget.copies_near(sum(b - a for a, b in u), extent, width)
+        if c
+    ]:
+        across = []
+        for here, whole in zip(spans, cleanly, strict=True):
+            # a cut that crosses no piece of an element if there is one near, else one
+            # that crosses only pieces of labels that make bands
+            cut = (
+                (retarget.shifted(whole, extent, unit) or retarget.shifted(here, extent, unit))
+                if unit
+                else ()
+            )
+            # the wall that stretches is the wall of every stratum, so that the strata
+            # cut alike stay lined up
+            plan = None if cut is None else retarget.copied(every, extent, width, cut, copies)
+            if plan is None:  # the stratum stretched (its own bays copied would not line up)
+                plan = retarget.copied(every, extent, width, (), 0)
+            if plan is None:
+                break
+            across.append(plan)
+        else:
+            text = retarget.describe(unit, copies)
+            found.append((f"x {text}" if text else "", strata, across))
+    return found
+
+
+def _pitched(
+    columns: Sequence[Sequence[float]], extent: float, mirrored: bool
+) -> list[tuple[Span, ...]]:
+    """Units one pitch of a label's columns long (of the style's ``columns``), centred on
+    one of them (a window column and half the wall each side: its copy is the next bay
+    along), with their mirror images when ``mirrored``."""
+    near = 1e-3 * extent
+    centred = 0.01 * extent  # the style's tolerance
+    found: list[tuple[Span, ...]] = []
+    pairs = [pair for centres in columns for pair in itertools.pairwise(centres)]
+    for a, b in pairs:
+        half = (b - a) / 2
+        for centre in (a, b):
+            lo, hi = max(0.0, centre - half), min(extent, centre + half)
+            unit: tuple[Span, ...] = ((lo, hi),)
+            if mirrored and abs(lo + hi - extent) > centred:
+                if extent - hi < hi - near:
+                    continue  # the unit and its mirror image overlap
+                unit = ((lo, hi), (extent - hi, extent - lo))
+            if unit not in found:
+                found.append(unit)
+    return found
+
+
+def _holds_column(unit: Sequence[Span], columns: Sequence[Sequence[float]]) -> bool:
+    return any(lo < c < hi for lo, hi in unit for centres in columns for c in centres)
+
+
+def _stacked(parts: list[tuple[float, float, float, float]]) -> list[tuple[float, ...]]:
+    """A piece's parts, those one above the other across the same span joined."""
+    joined: list[tuple[float, ...]] = []
+    for x0, x1, y0, y1 in sorted(parts):
+        last = joined[-1] if joined else None
+        if last is not None and (last[0], last[1]) == (x0, x1) and abs(last[3] - y0) < 1e-12:
+            joined[-1] = (x0, x1, last[2], y1)
+        else:
+            joined.append((x0, x1, y0, y1))
+    return joined
