@@ -15,7 +15,7 @@ from facadecli.grammar.pieces import Piece
 from facadecli.grammar.style import Box, Constraint, column_centres, facade_of, row_centres
 from facadecli.grammar.tiling import BACKGROUND
 
-RETARGETS_MAX = 5  # plans per axis whose combinations are tried (the least stretched)
+RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
 
 Span = tuple[float, float]
 
