@@ -197,11 +197,24 @@ def plans(
     ``mirrored`` (a unit without a mirror image must then be centred)."""
     found = [copied(spans, extent, new_extent, [], 0)]
     for _, unit in laid_units(spans, extent, mirrored)[:UNITS_TRIED]:
-        length = sum(hi - lo for lo, hi in unit)
-        for copies in copies_near(length, extent, new_extent):
-            if copies:
-                found.append(copied(spans, extent, new_extent, unit, copies))
+        found += copying(spans, extent, new_extent, unit)
     return [plan for plan in found if plan is not None]
+
+
+def copying(
+    spans: Sequence[tuple[float, float]],
+    extent: float,
+    new_extent: float,
+    laid: Sequence[tuple[float, float]],
+) -> list[Plan | None]:
+    """The plans that copy the units ``laid`` as many times as fit best, one more and one
+    fewer, or leave them out (see :func:`copies_near`; None where :func:`copied` is)."""
+    length = sum(hi - lo for lo, hi in laid)
+    return [
+        copied(spans, extent, new_extent, laid, copies)
+        for copies in copies_near(length, extent, new_extent)
+        if copies
+    ]
 
 
 def laid_units(

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 from facadecli.grammar import retarget
 from facadecli.grammar.pieces import Piece
-from facadecli.grammar.style import Box, Constraint, column_centres, facade_of, row_centres
+from facadecli.grammar.style import Box, Constraint, facade_of, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
@@ -51,14 +51,15 @@ def retargeted(
     symmetric = any(c.kind == "symmetry" for c in style)
     centred = any(c.kind == "centre" for c in style)
     pairs = (True,) if symmetric else (False, True) if centred else (False,)
-    columns = [column_centres(facade, c.label) for c in style if c.kind == "columns"]
+    shared = [shared_rows(facade, c.label) for c in style if c.kind == "columns"]
+    columns = [[(b.x0 + b.x1) / 2 for b in group[0]] for group in shared if group]
     # no cut may cross an element, nor a piece of one (an L-shaped molding), but for
     # labels that make bands along the axis (a cornice, pilasters): a copy lengthens them
     elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
     in_bays = _unbanded(elements, joined, "x", source[0])
     clean = _unbanded(elements, joined, "x", source[0], whole_labels=False)
     in_floors = _unbanded(elements, joined, "y", source[1])
-    rows = [row_centres(facade, c.label) for c in style if c.kind == "columns"]
+    rows = [sorted((r[0].y0 + r[0].y1) / 2 for r in group) for group in shared if group]
     floors = _floors(in_floors, source[1], height, rows)
     bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
     laid = []
@@ -99,12 +100,8 @@ def _floors(
     ]
     for unit in units:
         cut = retarget.shifted(spans, extent, unit)
-        if cut is None:
-            continue
-        length = sum(b - a for a, b in cut)
-        for copies in retarget.copies_near(length, extent, height):
-            if copies:
-                found.append(retarget.copied(spans, extent, height, cut, copies))
+        if cut is not None:
+            found += retarget.copying(spans, extent, height, cut)
     return [plan for plan in found if plan is not None]
 
 
@@ -171,18 +168,42 @@ def _bays(
     ]
     every = [span for here in spans for span in here]
     pitched = [u for mirrored in pairs for u in _pitched(columns, extent, mirrored)]
-    worth: dict[tuple[Span, ...], float] = {}
-    for unit in [*pitched, *(u for here in listed for u in here)]:
-        worth[unit] = sum(
+    # where each unit is cut in each stratum (None: nowhere near)
+    cuts = {
+        unit: [retarget.shifted(here, extent, unit) for here in spans]
+        for unit in [*pitched, *(u for here in listed for u in here)]
+    }
+    worth = {
+        unit: sum(
             (hi - lo) * (1 - min(1.0, 0.0 if unit in pitched else here.get(unit, 0.5)))
-            for (lo, hi), cut, here in zip(strata, spans, listed, strict=True)
-            if retarget.shifted(cut, extent, unit) is not None
+            for (lo, hi), cut, here in zip(strata, cuts[unit], listed, strict=True)
+            if cut is not None
         )
+        for unit in cuts
+    }
     # units that hold one of the style's columns (of windows, say) first: a bay, not a
     # slab of wall with an ornament in it
     ranked = sorted(worth, key=lambda u: (not _holds_column(u, columns), -worth[u], u))[
         : retarget.UNITS_TRIED
     ]
+    # a cut that crosses no piece of an element if there is one near, else one that
+    # crosses only pieces of labels that make bands
+    best_cuts = {
+        unit: [
+            retarget.shifted(whole, extent, unit) or cut
+            for whole, cut in zip(cleanly, cuts[unit], strict=True)
+        ]
+        for unit in ranked
+    }
+    # the wall that stretches is the wall of every stratum, so that the strata cut alike
+    # stay lined up; strata cut alike share their plan
+    plans: dict[tuple[tuple[Span, ...], int], retarget.Plan | None] = {}
+
+    def plan_of(cut: tuple[Span, ...], copies: int) -> retarget.Plan | None:
+        if (cut, copies) not in plans:
+            plans[(cut, copies)] = retarget.copied(every, extent, width, cut, copies)
+        return plans[(cut, copies)]
+
     found = []
     for unit, copies in [((), 0)] + [
         (u, c)
@@ -191,19 +212,11 @@ def _bays(
         if c
     ]:
         across = []
-        for here, whole in zip(spans, cleanly, strict=True):
-            # a cut that crosses no piece of an element if there is one near, else one
-            # that crosses only pieces of labels that make bands
-            cut = (
-                (retarget.shifted(whole, extent, unit) or retarget.shifted(here, extent, unit))
-                if unit
-                else ()
-            )
-            # the wall that stretches is the wall of every stratum, so that the strata
-            # cut alike stay lined up
-            plan = None if cut is None else retarget.copied(every, extent, width, cut, copies)
+        for k in range(len(strata)):
+            cut = best_cuts[unit][k] if unit else ()
+            plan = None if cut is None else plan_of(cut, copies)
             if plan is None:  # the stratum stretched (its own bays copied would not line up)
-                plan = retarget.copied(every, extent, width, (), 0)
+                plan = plan_of((), 0)
             if plan is None:
                 break
             across.append(plan)

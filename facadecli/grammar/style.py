@@ -216,18 +216,11 @@ def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
     return max(groups, key=len, default=[]), len(rows)
 
 
-def column_centres(facade: Facade, label: str) -> list[float]:
-    """The centres of the columns that rows of a label share, floor after floor (none
-    when no two rows share them)."""
+def shared_rows(facade: Facade, label: str) -> list[list[Box]]:
+    """The largest set of a label's rows on the same columns, floor after floor, bottom
+    up (none when no two rows share them)."""
     best, _ = _shared_columns(facade, label)
-    return _centres(best[0]) if len(best) >= 2 else []
-
-
-def row_centres(facade: Facade, label: str) -> list[float]:
-    """The heights of the centres of the rows of a label that share columns, bottom up
-    (none when no two rows share them)."""
-    best, _ = _shared_columns(facade, label)
-    return sorted(_cy(row[0]) for row in best) if len(best) >= 2 else []
+    return best if len(best) >= 2 else []
 
 
 def _evenly_spaced(facade: Facade, label: str) -> tuple[int, int]:

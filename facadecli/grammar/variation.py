@@ -394,20 +394,9 @@ def _align_axis(
         base.append(v[1:] >= v[:-1])
     floors = sorted(set(spans))  # elements keep at least half their size
     if floors:
-        lengths = _combination(cp, v, n, [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in floors])
-        base.append(lengths >= np.array([size / 2 for _, size in floors]))
+        base.append(_lengths(cp, v, n, [(span, size / 2) for span, size in floors]) >= 0)
     if held:
-        kept_sizes = sorted(held.items())
-        base.append(
-            _combination(
-                cp,
-                v,
-                n,
-                [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in kept_sizes],
-                [size for _, size in kept_sizes],
-            )
-            == 0
-        )
+        base.append(_lengths(cp, v, n, sorted(held.items())) == 0)
     # every gap below one vector (a matrix times the edges): one expression each, however
     # many terminals a large derivation makes
     size_gaps = _combination(
@@ -427,16 +416,7 @@ def _align_axis(
     )
     moves = cp.sum_squares(v - edges)
     if stretched:  # back towards their source size, the wall around them taking the rest
-        pulled = sorted(stretched.items())
-        moves = moves + WIDTHS * cp.sum_squares(
-            _combination(
-                cp,
-                v,
-                n,
-                [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in pulled],
-                [s for _, s in pulled],
-            )
-        )
+        moves = moves + WIDTHS * cp.sum_squares(_lengths(cp, v, n, sorted(stretched.items())))
     hard_sizes = [] if size_gaps is None else [size_gaps == 0]
     hard_style = [] if style_gaps is None else [style_gaps == 0]
     hard_lines = [] if line_gaps is None else [line_gaps == 0]
@@ -477,6 +457,13 @@ def _align_axis(
             merged = snap(solved, 1e-7 * extent, (0.0, extent))
             return {value: merged[solved[index[joined[value]]]] for value in joined}, warnings
     return {value: joined[value] for value in joined}, warnings
+
+
+def _lengths(cp: Any, v: Any, n: int, spans: list[tuple[tuple[int, int], float]]) -> Any:
+    """The vector of each span's length (its end edge less its start edge) less a size."""
+    return _combination(
+        cp, v, n, [_terms((b, 1.0), (a, -1.0)) for (a, b), _ in spans], [s for _, s in spans]
+    )
 
 
 def _terms(*pairs: tuple[int, float]) -> dict[int, float]:
@@ -773,11 +760,12 @@ def derive_variations(
     best = derive_at(grammar, source, width, height, used=used)
     best_kept = kept(best)
     candidates: list[_Candidate | None] = [_Candidate(score(best), (), None, best, best_kept)]
-    at_source = derive_at(grammar, source, *source)
-    for pieces, stretch, text in retargeted(at_source, source, width, height, style):
-        candidates.append(
-            _Candidate(score(pieces) + stretch, (), None, pieces, kept(pieces), (), text)
-        )
+    if (width, height) != source:  # whole bays copied from the source's own terminals
+        at_source = derive_at(grammar, source, *source)
+        for pieces, stretch, text in retargeted(at_source, source, width, height, style):
+            candidates.append(
+                _Candidate(score(pieces) + stretch, (), None, pieces, kept(pieces), (), text)
+            )
     if count > 1 or best_kept.broken:
         rng = random.Random(seed)
         most = CANDIDATES_MAX if count > 1 else STYLE_MAX
