@@ -41,6 +41,23 @@ def test_the_gaps_take_up_the_rest_and_elements_keep_their_size() -> None:
     assert all(b - a == pytest.approx(1.0) for spans in laid for a, b in spans)
 
 
+def test_a_little_too_long_everything_shrinks_alike_and_keeps_its_pitch() -> None:
+    plan = retarget.copied(ROW, 7.0, 8.0, [(2.5, 4.5)], 1)  # 9 m of source in 8 m
+    assert plan is not None and _length(plan) == pytest.approx(8.0)
+    centres = [sum(retarget.place(plan, lo, hi)[0]) / 2 for lo, hi in ROW]
+    assert centres[1] - centres[0] == pytest.approx(2.0 * 8.0 / 9.0)
+    assert retarget.place(plan, 3.0, 4.0)[1][0] - retarget.place(plan, 3.0, 4.0)[0][0] == (
+        pytest.approx(2.0 * 8.0 / 9.0)
+    )
+
+
+def test_a_band_stays_one_where_its_end_is_in_a_copied_unit() -> None:
+    plan = retarget.copied(ROW, 7.0, 9.5, [(0.0, 2.5)], 1)  # the end bay copied
+    assert plan is not None
+    assert retarget.place(plan, 0.2, 6.8) == [(pytest.approx(0.2), pytest.approx(9.3))]
+    assert retarget.place(plan, 1.0, 2.0) == [(1.0, 2.0), (3.5, 4.5)]  # a window: twice
+
+
 def test_gaps_stretched_too_far_or_elements_widened_make_no_plan() -> None:
     assert retarget.copied(ROW, 7.0, 14.0, [], 0) is None  # the wall alone: 4 m -> 11 m
     assert retarget.copied(ROW, 7.0, 7.5, [], 0) is not None

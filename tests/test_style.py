@@ -67,6 +67,21 @@ def test_a_moved_window_breaks_columns_spacing_and_symmetry() -> None:
     assert kept.warnings() and "3 of 3 rows of window on the same 3 columns" in kept.warnings()[0]
 
 
+def test_a_row_on_one_pitch_with_an_empty_place_is_evenly_spaced() -> None:
+    def row(*xs: float) -> list[Box]:
+        return [Box("window", x - 0.5, 3.0, x + 0.5, 4.0) for x in xs]
+
+    def even(boxes: list[Box]) -> bool:
+        spacing = find_style(facade_of(boxes, 20.0, 10.0, BACKGROUND))
+        return any(c.kind == "spacing" for c in spacing)
+
+    assert even(row(2.0, 6.0, 10.0))
+    assert even(row(2.0, 6.0, 14.0, 18.0))  # the middle place empty: still one pitch
+    assert not even(row(2.0, 6.0, 14.0))  # one pitch and a double: no pitch twice
+    assert not even(row(2.0, 6.0, 11.0, 15.0))  # 4, 5, 4: off the pitch
+    assert not even(row(2.0, 3.0, 15.0, 16.0))  # 1, 12, 1: more than one place empty
+
+
 def test_tiles_of_one_element_are_joined_back() -> None:
     window = [Box("window", 1.0, 1.0, 1.5, 2.0), Box("window", 1.5, 1.0, 2.0, 2.0)]
     window += [Box("window", 1.0, 2.0, 2.0, 2.5)]

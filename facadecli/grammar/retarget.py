@@ -9,8 +9,9 @@ one gap to the middle of a later one, at most ``UNIT_BLOCKS`` blocks: a bay, eve
 above and below it included (a window column from the plinth to the cornice). A *plan*
 lays the source along the axis with some units copied beside themselves (a unit and its
 mirror image together, so a symmetric façade stays symmetric) or one left out, and
-scales what is left over: everything alike when that changes it by ``WIDEN_MOST`` at
-most (spacing and symmetry stay exact), else the gaps alone (within ``GAPS_LEAST`` to
+scales what is left over: everything alike when that widens it by ``WIDEN_MOST`` or
+shrinks it by ``SHRINK_MOST`` at most (spacing and symmetry stay exact), else the gaps
+alone (within ``GAPS_LEAST`` to
 ``GAPS_MOST`` of their size), else everything squeezed (to 1 / ``SQUEEZE_MOST`` at
 most); otherwise there is no plan. Whole bays copied keep every column, alignment and
 spacing of the source, and no element grows by more than ``WIDEN_MOST``: the copies,
@@ -35,6 +36,7 @@ GAPS_LEAST = 0.5  # of their source size: gaps squeezed further squeeze everythi
 GAPS_MOST = 1.5  # ... and stretched further, the plan is no good (copies should fill it)
 SQUEEZE_MOST = 1.5  # elements squeezed further (1 / this), the plan is no good
 WIDEN_MOST = 1.1  # ... or stretched further: copies, not wider windows, fill a façade
+SHRINK_MOST = 1.25  # shrunk alike by this at most, else the gaps alone are squeezed
 NEAR = 1e-9  # of the extent: spans closer than this touch
 SNAP = 1e-3  # of the extent: a cut this near an element's edge is moved onto it
 
@@ -284,9 +286,10 @@ def _laid(
     text: str,
 ) -> Plan | None:
     """The stretches cut where blocks meet gaps and scaled to fill ``new_extent``: all
-    alike where that changes them by ``WIDEN_MOST`` at most (every spacing and symmetry
-    kept), else the gaps alone where they stay within ``GAPS_LEAST`` to ``GAPS_MOST`` of
-    their size, else all alike squeezed down to 1 / ``SQUEEZE_MOST``; None otherwise."""
+    alike where that widens them by ``WIDEN_MOST`` or shrinks them by ``SHRINK_MOST`` at
+    most (every spacing and symmetry kept), else the gaps alone where they stay within
+    ``GAPS_LEAST`` to ``GAPS_MOST`` of their size, else all alike squeezed down to
+    1 / ``SQUEEZE_MOST``; None otherwise."""
     cuts = sorted({v for b in blocks for v in b})
     pieces: list[tuple[float, float, bool]] = []  # lo, hi, wall
     for lo, hi, times in stretches:
@@ -300,7 +303,7 @@ def _laid(
     rest = sum(b - a for a, b, is_wall in pieces if not is_wall)
     alike = new_extent / (wall + rest)
     gaps = (new_extent - rest) / wall if wall > 0 else 0.0
-    if 1 / WIDEN_MOST <= alike <= WIDEN_MOST:
+    if 1 / SHRINK_MOST <= alike <= WIDEN_MOST:
         gap_scale = block_scale = alike
     elif GAPS_LEAST <= gaps <= GAPS_MOST:
         gap_scale, block_scale = gaps, 1.0
@@ -318,10 +321,13 @@ def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[fl
     """Where the source interval ``lo``-``hi`` lies after a plan: once, or once per copy
     of a unit it lies in. Where the interval goes on across the end of a segment and the
     next segment starts inside it (a band across a copied unit), the two parts are one;
-    an interval exactly as long as a unit is laid once per copy. Overlaps of ``near`` or
+    an interval exactly as long as a unit is laid once per copy. A band (an interval at
+    least ``BAND`` of the source long) is one, also where it starts or ends inside a copied
+    unit (a cornice across a copied end bay). Overlaps of ``near`` or
     less are none (rounding in the source's coordinates)."""
     found: list[tuple[float, float]] = []
     at = 0.0
+    band = hi - lo >= BAND * max((s.hi for s in plan.segments), default=0.0)
     going_on = False  # the last part was cut where its segment ends, the interval going on
     for segment in plan.segments:
         length = (segment.hi - segment.lo) * segment.scale
@@ -330,7 +336,8 @@ def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[fl
             start = at + (a - segment.lo) * segment.scale
             end = at + (b - segment.lo) * segment.scale
             cut_here = a - segment.lo <= near and lo < segment.lo - near
-            if going_on and cut_here and found:
+            joined = (going_on or cut_here) if band else (going_on and cut_here)
+            if found and joined:
                 found[-1] = (found[-1][0], end)
             else:
                 found.append((start, end))

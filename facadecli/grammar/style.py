@@ -9,7 +9,9 @@ Found on the (regularised) input, over its elements (the background is not one):
   columns, floor after floor;
 - ``axis``: every element of another label (narrower than half the façade) is centred on
   one of those columns (a door under a window column: Bao's Figure 16);
-- ``spacing``: rows of three or more elements of one label at one pitch;
+- ``spacing``: rows of three or more elements of one label at one pitch (at least two
+  pitches apart; up to ``SKIPPED`` places of the pitch may be empty between two: the
+  windows each side of a staircase's, which sit half a floor lower);
 - ``ends`` and ``centre``: a label at both ends of the façade, or on its centre line
   (pilasters at the corners and in the middle: a frequency pattern).
 
@@ -29,6 +31,7 @@ from typing import NamedTuple
 
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
+SKIPPED = 1  # places of a row's pitch that may be empty between two elements
 TOLERANCE = 0.01  # of the façade's extent along the axis compared
 MIRRORED = 0.9  # share of the elements with a mirror partner for a symmetric façade
 
@@ -198,8 +201,14 @@ def _same(a: list[float], b: list[float], near: float) -> bool:
 
 
 def _even(row: list[Box], near: float) -> bool:
+    """Whether a row's centres are on one pitch: at least two of its gaps are the
+    pitch, the others the pitch or up to ``SKIPPED`` more of it."""
     pitches = [b - a for a, b in itertools.pairwise(_centres(row))]
-    return len(pitches) >= 2 and max(pitches) - min(pitches) <= near
+    if len(pitches) < 2:
+        return False
+    pitch = min(pitches)
+    on_pitch = [min(abs(p - k * pitch) for k in range(1, SKIPPED + 2)) <= near for p in pitches]
+    return all(on_pitch) and sum(abs(p - pitch) <= near for p in pitches) >= 2
 
 
 def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
