@@ -41,21 +41,20 @@ def test_the_gaps_take_up_the_rest_and_elements_keep_their_size() -> None:
     assert all(b - a == pytest.approx(1.0) for spans in laid for a, b in spans)
 
 
-def test_a_little_too_long_everything_shrinks_alike_and_keeps_its_pitch() -> None:
-    plan = retarget.copied(ROW, 7.0, 8.0, [(2.5, 4.5)], 1)  # 9 m of source in 8 m
-    assert plan is not None and _length(plan) == pytest.approx(8.0)
-    centres = [sum(retarget.place(plan, lo, hi)[0]) / 2 for lo, hi in ROW]
-    assert centres[1] - centres[0] == pytest.approx(2.0 * 8.0 / 9.0)
-    assert retarget.place(plan, 3.0, 4.0)[1][0] - retarget.place(plan, 3.0, 4.0)[0][0] == (
-        pytest.approx(2.0 * 8.0 / 9.0)
-    )
-
-
-def test_a_band_stays_one_where_its_end_is_in_a_copied_unit() -> None:
-    plan = retarget.copied(ROW, 7.0, 9.5, [(0.0, 2.5)], 1)  # the end bay copied
+def test_a_unit_is_cut_through_pilasters_that_a_copy_puts_together_again() -> None:
+    # pilasters 1 m wide every 3 m, windows between them, no wall between: 9 m
+    row = [(0.0, 1.0), (1.0, 2.0), (2.0, 4.0), (4.0, 5.0), (5.0, 7.0), (7.0, 8.0), (8.0, 9.0)]
+    row = [(lo, hi) for lo, hi in row if (lo, hi) not in ((2.0, 4.0), (5.0, 7.0))]
+    row += [(1.8, 4.2), (4.8, 7.2)]  # windows overlapping the pilasters: no cut between
+    assert retarget.cuttable(row, 9.0, 1.5, 4.5)  # each end halves a pilaster
+    assert not retarget.cuttable(row, 9.0, 1.5, 4.6)  # not one unit along
+    assert not retarget.cuttable(row, 9.0, 1.9, 4.5)  # a window at one end only
+    assert retarget.shifted(row, 9.0, [(1.4, 4.4)]) == ((1.4, 4.4),)  # a period: as it is
+    assert retarget.shifted(row, 9.0, [(1.4, 4.4)], through=False) is None  # no wall
+    plan = retarget.copied(row, 9.0, 12.0, [(1.5, 4.5)], 1)
     assert plan is not None
-    assert retarget.place(plan, 0.2, 6.8) == [(pytest.approx(0.2), pytest.approx(9.3))]
-    assert retarget.place(plan, 1.0, 2.0) == [(1.0, 2.0), (3.5, 4.5)]  # a window: twice
+    halves = retarget.place(plan, 4.0, 5.0)[:1] + retarget.place(plan, 1.0, 2.0)[1:]
+    assert halves == [(4.0, 4.5), (4.5, 5.0)]  # one pilaster between the bay and its copy
 
 
 def test_gaps_stretched_too_far_or_elements_widened_make_no_plan() -> None:
@@ -123,19 +122,33 @@ def test_every_plan_fills_the_new_extent_and_keeps_elements_whole(
     row: tuple[list[tuple[float, float]], float], factor: float, mirrored: bool
 ) -> None:
     """Whatever the elements and the new extent: a plan lays the source end to end over
-    exactly the new extent, every element but a band is laid whole (not cut) and at most
-    ``WIDEN_MOST`` longer or ``SQUEEZE_MOST`` shorter, and a copied element never overlaps
-    another."""
+    exactly the new extent, every element but a band is laid whole (or cut in two at the
+    ends of a copied unit and put together again there) and at most ``WIDEN_MOST`` longer
+    or ``SQUEEZE_MOST`` shorter, and a copied element never overlaps another."""
     spans, extent = row
     new = extent * factor
+    least, most = 1 / retarget.SQUEEZE_MOST, retarget.WIDEN_MOST
     for plan in retarget.plans(spans, extent, new, mirrored):
         assert _length(plan) == pytest.approx(new)
         laid = sorted(part for lo, hi in spans for part in retarget.place(plan, lo, hi))
-        for lo, hi in spans:
-            for a, b in retarget.place(plan, lo, hi):
-                assert 0.0 <= a < b <= new + 1e-9
-                if hi - lo < retarget.BAND * extent:  # a band may be lengthened
-                    ratio = (b - a) / (hi - lo)
-                    assert 1 / retarget.SQUEEZE_MOST - 1e-9 <= ratio <= retarget.WIDEN_MOST + 1e-9
+        assert all(0.0 <= a < b <= new + 1e-9 for a, b in laid)
         for (_, end), (start, _) in itertools.pairwise(laid):
             assert start >= end - 1e-9
+        parts = sorted(  # a band may be lengthened
+            (a, b, hi - lo)
+            for lo, hi in spans
+            if hi - lo < retarget.BAND * extent
+            for a, b in retarget.place(plan, lo, hi)
+        )
+        off = retarget.ALIKE_PART  # two parts of cut elements, one unit along, nearly
+
+        def fits(a: float, b: float, length: float, slack: float = 0.0) -> bool:
+            ratio = (b - a) / length
+            return least * (1 - slack) - 1e-9 <= ratio <= most * (1 + slack) + 1e-9
+
+        for a, b, length in parts:  # whole, or cut and put together with another part
+            assert fits(a, b, length) or any(
+                fits(min(a, c), max(b, d), length, off)
+                for c, d, _ in parts
+                if abs(c - b) < 1e-9 or abs(d - a) < 1e-9
+            )

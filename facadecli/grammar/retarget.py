@@ -6,12 +6,14 @@ Along one axis the elements (the background and bands, elements at least ``BAND`
 extent long, left out) stand in *blocks*, the stretches that some element covers; the
 *gaps* between blocks, and the margins, are wall only. A *unit* runs from the middle of
 one gap to the middle of a later one, at most ``UNIT_BLOCKS`` blocks: a bay, everything
-above and below it included (a window column from the plinth to the cornice). A *plan*
+above and below it included (a window column from the plinth to the cornice). A unit
+may also be cut through elements where its other end cuts the same elements one unit
+along (:func:`cuttable`): the pilasters between the bays of a façade that has no wall
+between them, which a copy puts together again. A *plan*
 lays the source along the axis with some units copied beside themselves (a unit and its
 mirror image together, so a symmetric façade stays symmetric) or one left out, and
-scales what is left over: everything alike when that widens it by ``WIDEN_MOST`` or
-shrinks it by ``SHRINK_MOST`` at most (spacing and symmetry stay exact), else the gaps
-alone (within ``GAPS_LEAST`` to
+scales what is left over: everything alike when that changes it by ``WIDEN_MOST`` at
+most (spacing and symmetry stay exact), else the gaps alone (within ``GAPS_LEAST`` to
 ``GAPS_MOST`` of their size), else everything squeezed (to 1 / ``SQUEEZE_MOST`` at
 most); otherwise there is no plan. Whole bays copied keep every column, alignment and
 spacing of the source, and no element grows by more than ``WIDEN_MOST``: the copies,
@@ -36,9 +38,10 @@ GAPS_LEAST = 0.5  # of their source size: gaps squeezed further squeeze everythi
 GAPS_MOST = 1.5  # ... and stretched further, the plan is no good (copies should fill it)
 SQUEEZE_MOST = 1.5  # elements squeezed further (1 / this), the plan is no good
 WIDEN_MOST = 1.1  # ... or stretched further: copies, not wider windows, fill a façade
-SHRINK_MOST = 1.25  # shrunk alike by this at most, else the gaps alone are squeezed
 NEAR = 1e-9  # of the extent: spans closer than this touch
 SNAP = 1e-3  # of the extent: a cut this near an element's edge is moved onto it
+ALIKE = 0.02  # of the extent: elements cut at both ends of a unit this near one unit apart
+ALIKE_PART = 0.05  # ... and this near, of their length
 
 
 @dataclass(frozen=True)
@@ -93,32 +96,53 @@ def units(spans: Sequence[tuple[float, float]], extent: float) -> list[tuple[flo
     return [(irregular, lo, hi) for irregular, _, lo, hi in found]
 
 
-def _free(blocks: Sequence[tuple[float, float]], extent: float, at: float) -> bool:
-    """Whether a cut at ``at`` crosses none of the blocks."""
+def _crossed(
+    spans: Sequence[tuple[float, float]], extent: float, at: float
+) -> list[tuple[float, float]]:
+    """The elements a cut at ``at`` crosses (bands aside: a copy lengthens them)."""
     near = NEAR * extent
-    return not any(lo + near < at < hi - near for lo, hi in blocks)
+    return [(lo, hi) for lo, hi in spans if lo + near < at < hi - near and hi - lo < BAND * extent]
+
+
+def cuttable(spans: Sequence[tuple[float, float]], extent: float, lo: float, hi: float) -> bool:
+    """Whether a unit can be cut out from ``lo`` to ``hi``: both cuts cross no element, or
+    what one crosses the other crosses too, one unit along (within ``ALIKE`` of the
+    extent): a pilaster cut at each end of a bay, which a copy puts together again."""
+    a, b = sorted(set(_crossed(spans, extent, lo))), sorted(set(_crossed(spans, extent, hi)))
+    along = hi - lo
+
+    def alike(x0: float, x1: float, y0: float, y1: float) -> bool:
+        near = min(ALIKE * extent, ALIKE_PART * (x1 - x0))
+        return abs(x0 + along - y0) <= near and abs(x1 + along - y1) <= near
+
+    return len(a) == len(b) and all(alike(*x, *y) for x, y in zip(a, b, strict=True))
+
+
+def _cut_points(spans: Sequence[tuple[float, float]], extent: float) -> list[float]:
+    """Where a cut may go: the elements' edges and middles (bands aside)."""
+    kept = [(lo, hi) for lo, hi in spans if hi - lo < BAND * extent]
+    return sorted({v for lo, hi in kept for v in (lo, hi, (lo + hi) / 2)})
 
 
 def mirror(
     spans: Sequence[tuple[float, float]], extent: float, unit: tuple[float, float]
 ) -> tuple[float, float] | None:
     """The unit's mirror image about the centre, when that is a unit too and apart from it
-    (its ends moved onto an element's edge within ``SNAP`` of the extent: see
-    :func:`snapped`)."""
+    (its ends moved onto an element's edge or middle within ``SNAP`` of the extent: see
+    :func:`snapped`), cut where :func:`cuttable` lets it be."""
     lo, hi = unit
-    blocks = blocks_of(spans, extent)
-    edges = sorted({v for b in blocks for v in b})
-    mirrored = (snapped(edges, extent - hi, extent), snapped(edges, extent - lo, extent))
+    points = _cut_points(spans, extent)
+    mirrored = (snapped(points, extent - hi, extent), snapped(points, extent - lo, extent))
     if mirrored[0] < hi - NEAR * extent and mirrored[1] > lo + NEAR * extent:
         return None
-    return mirrored if all(_free(blocks, extent, v) for v in mirrored) else None
+    return mirrored if cuttable(spans, extent, *mirrored) else None
 
 
-def snapped(edges: Sequence[float], at: float, extent: float) -> float:
-    """A cut moved onto the nearest element's edge within ``SNAP`` of the extent (so that
-    a hand-drawn façade's bays and mirror images are found, and no element is cut a
-    sliver off); else where it is."""
-    near = min(edges, key=lambda e: abs(e - at), default=None)
+def snapped(points: Sequence[float], at: float, extent: float) -> float:
+    """A cut moved onto the nearest of ``points`` (elements' edges and middles) within
+    ``SNAP`` of the extent (so that a hand-drawn façade's bays and mirror images are
+    found, and no element is cut a sliver off); else where it is."""
+    near = min(points, key=lambda e: abs(e - at), default=None)
     return near if near is not None and abs(near - at) <= SNAP * extent else at
 
 
@@ -146,26 +170,30 @@ def describe(laid: Sequence[tuple[float, float]], copies: int) -> str:
 
 
 def shifted(
-    spans: Sequence[tuple[float, float]], extent: float, laid: Sequence[tuple[float, float]]
+    spans: Sequence[tuple[float, float]],
+    extent: float,
+    laid: Sequence[tuple[float, float]],
+    through: bool = True,
 ) -> tuple[tuple[float, float], ...] | None:
     """The units ``laid`` (a unit, or a unit and its mirror image) moved by the least
     distance, at most half the unit's length, that lets a stretch of façade be cut at
     their ends (a unit and its mirror image by mirrored moves where they can be, else
     each by its own); themselves when it can be already; None when no move does. On a
-    periodic façade a bay cut a little to one side copies the same bay."""
-    blocks = blocks_of(spans, extent)
-    edges = sorted({v for b in blocks for v in b})
+    periodic façade a bay cut a little to one side copies the same bay. Without
+    ``through``, the cuts cross no element (see :func:`cuttable`)."""
+    points = _cut_points(spans, extent)
 
     def moves(lo: float, hi: float) -> list[float]:
-        found = {0.0, *(e - v for e in edges for v in (lo, hi))}
+        found = {0.0, *(e - v for e in points for v in (lo, hi))}
         return sorted((d for d in found if abs(d) <= (hi - lo) / 2), key=lambda d: (abs(d), d))
 
     def cut(lo: float, hi: float) -> tuple[float, float] | None:
-        lo, hi = snapped(edges, lo, extent), snapped(edges, hi, extent)
+        lo, hi = snapped(points, lo, extent), snapped(points, hi, extent)
         inside = lo >= 0.0 and hi <= extent
-        return (
-            (lo, hi) if inside and _free(blocks, extent, lo) and _free(blocks, extent, hi) else None
-        )
+        if through:
+            return (lo, hi) if inside and cuttable(spans, extent, lo, hi) else None
+        free = not _crossed(spans, extent, lo) and not _crossed(spans, extent, hi)
+        return (lo, hi) if inside and free else None
 
     (lo, hi), *rest = laid
     for move in moves(lo, hi):  # mirrored moves keep a mirrored pair mirrored
@@ -286,10 +314,9 @@ def _laid(
     text: str,
 ) -> Plan | None:
     """The stretches cut where blocks meet gaps and scaled to fill ``new_extent``: all
-    alike where that widens them by ``WIDEN_MOST`` or shrinks them by ``SHRINK_MOST`` at
-    most (every spacing and symmetry kept), else the gaps alone where they stay within
-    ``GAPS_LEAST`` to ``GAPS_MOST`` of their size, else all alike squeezed down to
-    1 / ``SQUEEZE_MOST``; None otherwise."""
+    alike where that changes them by ``WIDEN_MOST`` at most (every spacing and symmetry
+    kept), else the gaps alone where they stay within ``GAPS_LEAST`` to ``GAPS_MOST`` of
+    their size, else all alike squeezed down to 1 / ``SQUEEZE_MOST``; None otherwise."""
     cuts = sorted({v for b in blocks for v in b})
     pieces: list[tuple[float, float, bool]] = []  # lo, hi, wall
     for lo, hi, times in stretches:
@@ -303,7 +330,7 @@ def _laid(
     rest = sum(b - a for a, b, is_wall in pieces if not is_wall)
     alike = new_extent / (wall + rest)
     gaps = (new_extent - rest) / wall if wall > 0 else 0.0
-    if 1 / SHRINK_MOST <= alike <= WIDEN_MOST:
+    if 1 / WIDEN_MOST <= alike <= WIDEN_MOST:
         gap_scale = block_scale = alike
     elif GAPS_LEAST <= gaps <= GAPS_MOST:
         gap_scale, block_scale = gaps, 1.0
@@ -321,13 +348,10 @@ def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[fl
     """Where the source interval ``lo``-``hi`` lies after a plan: once, or once per copy
     of a unit it lies in. Where the interval goes on across the end of a segment and the
     next segment starts inside it (a band across a copied unit), the two parts are one;
-    an interval exactly as long as a unit is laid once per copy. A band (an interval at
-    least ``BAND`` of the source long) is one, also where it starts or ends inside a copied
-    unit (a cornice across a copied end bay). Overlaps of ``near`` or
+    an interval exactly as long as a unit is laid once per copy. Overlaps of ``near`` or
     less are none (rounding in the source's coordinates)."""
     found: list[tuple[float, float]] = []
     at = 0.0
-    band = hi - lo >= BAND * max((s.hi for s in plan.segments), default=0.0)
     going_on = False  # the last part was cut where its segment ends, the interval going on
     for segment in plan.segments:
         length = (segment.hi - segment.lo) * segment.scale
@@ -336,8 +360,7 @@ def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[fl
             start = at + (a - segment.lo) * segment.scale
             end = at + (b - segment.lo) * segment.scale
             cut_here = a - segment.lo <= near and lo < segment.lo - near
-            joined = (going_on or cut_here) if band else (going_on and cut_here)
-            if found and joined:
+            if going_on and cut_here and found:
                 found[-1] = (found[-1][0], end)
             else:
                 found.append((start, end))

@@ -16,6 +16,7 @@ from facadecli.grammar.style import Box, Constraint, facade_of, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
+HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see _halves_joined)
 
 Span = tuple[float, float]
 
@@ -33,8 +34,9 @@ def retargeted(
 
     Floors are copied across the whole width. Bays are copied floor by floor (a floor, or
     the wall between floors, is a stratum): one unit, where a stratum lets it be cut out
-    there or a little to one side (:func:`~facadecli.grammar.retarget.shifted`); a
-    stratum that cannot be cut near it (a ground floor of shops) is stretched instead, so
+    there or a little to one side (:func:`~facadecli.grammar.retarget.shifted`; through
+    pilasters where a copy puts their halves together again, :func:`_cut`); a stratum
+    that cannot be cut near it (a ground floor of shops) is stretched instead, so
     the floors above keep their columns whatever the ground floor does. The units tried
     first hold a column of the style's (one pitch of it, centred on a column, is a period
     by construction), then those that most strata can be cut at. Every stratum stretches
@@ -71,11 +73,14 @@ def retargeted(
                     for x0, x1 in retarget.place(plan, p.x0, p.x1):
                         for y0, y1 in retarget.place(along_y, max(p.y0, lo), min(p.y1, hi)):
                             parts[k].append((x0, x1, y0, y1))
-        moved = [
-            Piece(pieces[k].label, x0, y0, x1, y1, pieces[k].source_w, pieces[k].source_h)
-            for k in sorted(parts)
-            for x0, x1, y0, y1 in _stacked(parts[k])
-        ]
+        moved = _halves_joined(
+            [
+                Piece(pieces[k].label, x0, y0, x1, y1, pieces[k].source_w, pieces[k].source_h)
+                for k in sorted(parts)
+                for x0, x1, y0, y1 in _stacked(parts[k])
+            ],
+            1e-9 * width,
+        )
         stretch = max(plan.stretch for plan in across) ** 2 + along_y.stretch**2
         texts = [t for t in (text_x, f"y {along_y.text}" if along_y.text else "") if t]
         laid.append((moved, stretch, "; ".join(texts) or "stretched"))
@@ -154,8 +159,9 @@ def _bays(
     where none of ``elements`` crosses."""
     extent = source[0]
     strata = retarget.strata([(b.y0, b.y1) for b in floors], source[1])
-    spans = [[(b.x0, b.x1) for b in elements if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
-    cleanly = [[(b.x0, b.x1) for b in clean if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
+    stratum_elements = [[b for b in elements if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
+    stratum_clean = [[b for b in clean if b.y0 < hi and b.y1 > lo] for lo, hi in strata]
+    spans = [[(b.x0, b.x1) for b in here] for here in stratum_elements]
     # a unit's worth: the height of the strata it can be cut out of, less their height
     # times how far it is from a period there
     listed = [
@@ -170,7 +176,10 @@ def _bays(
     pitched = [u for mirrored in pairs for u in _pitched(columns, extent, mirrored)]
     # where each unit is cut in each stratum (None: nowhere near)
     cuts = {
-        unit: [retarget.shifted(here, extent, unit) for here in spans]
+        unit: [
+            _cut(here, stratum, extent, unit)
+            for here, stratum in zip(stratum_elements, strata, strict=True)
+        ]
         for unit in [*pitched, *(u for here in listed for u in here)]
     }
     worth = {
@@ -190,8 +199,8 @@ def _bays(
     # crosses only pieces of labels that make bands
     best_cuts = {
         unit: [
-            retarget.shifted(whole, extent, unit) or cut
-            for whole, cut in zip(cleanly, cuts[unit], strict=True)
+            _cut(whole, stratum, extent, unit) or cut
+            for whole, stratum, cut in zip(stratum_clean, strata, cuts[unit], strict=True)
         ]
         for unit in ranked
     }
@@ -226,6 +235,35 @@ def _bays(
     return found
 
 
+def _cut(
+    boxes: Sequence[Box], stratum: Span, extent: float, unit: tuple[Span, ...]
+) -> tuple[Span, ...] | None:
+    """Where a stratum holding ``boxes`` is cut for a unit (see
+    :func:`~facadecli.grammar.retarget.shifted`): through elements only where what is cut
+    at one end is cut at the other, one unit along, of the same label and height there
+    (so a copy puts the halves together again); else between elements."""
+    spans = [(b.x0, b.x1) for b in boxes]
+    cut = retarget.shifted(spans, extent, unit)
+    if cut is None or all(_rejoined(boxes, stratum, extent, lo, hi) for lo, hi in cut):
+        return cut
+    return retarget.shifted(spans, extent, unit, through=False)
+
+
+def _rejoined(boxes: Sequence[Box], stratum: Span, extent: float, lo: float, hi: float) -> bool:
+    """Whether each element a cut at ``lo`` crosses has one of its label and height (in the
+    stratum) that a cut at ``hi`` crosses."""
+    near = retarget.NEAR * extent
+
+    def crossed(at: float) -> set[tuple[str, float, float]]:
+        return {
+            (b.label, round(max(b.y0, stratum[0]), 6), round(min(b.y1, stratum[1]), 6))
+            for b in boxes
+            if b.x0 + near < at < b.x1 - near and b.x1 - b.x0 < retarget.BAND * extent
+        }
+
+    return crossed(lo) == crossed(hi)
+
+
 def _pitched(
     columns: Sequence[Sequence[float]], extent: float, mirrored: bool
 ) -> list[tuple[Span, ...]]:
@@ -252,6 +290,37 @@ def _pitched(
 
 def _holds_column(unit: Sequence[Span], columns: Sequence[Sequence[float]]) -> bool:
     return any(lo < c < hi for lo, hi in unit for centres in columns for c in centres)
+
+
+def _halves_joined(pieces: list[Piece], near: float) -> list[Piece]:
+    """The pieces, those cut at the ends of a copied unit (a part much narrower than its
+    source) joined to the part of their label and height they touch (the pilaster the two
+    halves make), in the order of the first."""
+
+    def cut(p: Piece) -> bool:
+        return p.x1 - p.x0 < HALF * p.source_w
+
+    joined: dict[int, Piece] = {}
+    order = sorted(range(len(pieces)), key=lambda k: (pieces[k].label, pieces[k].y0, pieces[k].x0))
+    last = None
+    for k in order:
+        p = pieces[k]
+        q = joined.get(last) if last is not None else None
+        if (
+            q is not None
+            and q.label == p.label
+            and abs(q.x1 - p.x0) <= near
+            and abs(q.y0 - p.y0) <= near
+            and abs(q.y1 - p.y1) <= near
+            and (cut(q) or cut(p))
+        ):
+            joined[last] = Piece(
+                q.label, q.x0, q.y0, p.x1, q.y1, max(q.source_w, p.source_w), q.source_h
+            )
+            continue
+        joined[k] = p
+        last = k
+    return [joined[k] for k in sorted(joined)]
 
 
 def _stacked(parts: list[tuple[float, float, float, float]]) -> list[tuple[float, ...]]:

@@ -8,7 +8,8 @@ Found on the (regularised) input, over its elements (the background is not one):
 - ``columns``: rows of one label (elements at one height) whose centres are the same set of
   columns, floor after floor;
 - ``axis``: every element of another label (narrower than half the façade) is centred on
-  one of those columns (a door under a window column: Bao's Figure 16);
+  one of those columns, of elements as narrow (a door under a window column: Bao's
+  Figure 16);
 - ``spacing``: rows of three or more elements of one label at one pitch (at least two
   pitches apart; up to ``SKIPPED`` places of the pitch may be empty between two: the
   windows each side of a staircase's, which sit half a floor lower);
@@ -256,7 +257,8 @@ def find_style(facade: Facade) -> list[Constraint]:
         if len(best) >= 2:
             text = f"{len(best)} of {rows} rows of {label} on the same {len(best[0])} columns"
             found.append(Constraint("columns", label, text, len(best) / rows))
-            columned.append(label)
+            if all(b.x1 - b.x0 < facade.width / 2 for b in best[0]):
+                columned.append(label)  # columns of bands (their centres) are no axes
         even, rows = _evenly_spaced(facade, label)
         if even:
             text = f"{even} of {rows} rows of three or more {label} evenly spaced"
