@@ -97,7 +97,7 @@ def _floors(
     stack shop fronts, doors or bands)."""
     spans = [(b.y0, b.y1) for b in elements]
     found: list[retarget.Plan | None] = [retarget.copied(spans, extent, height, (), 0)]
-    ends = [c for centres in rows if centres for c in (centres[0], centres[-1])]
+    ends = [c for centres in rows if len(centres) > 2 for c in (centres[0], centres[-1])]
     units = [  # holding no label's lowest or highest row
         unit
         for unit in _pitched(rows, extent, False)
@@ -293,12 +293,12 @@ def _holds_column(unit: Sequence[Span], columns: Sequence[Sequence[float]]) -> b
 
 
 def _halves_joined(pieces: list[Piece], near: float) -> list[Piece]:
-    """The pieces, those cut at the ends of a copied unit (a part much narrower than its
-    source) joined to the part of their label and height they touch (the pilaster the two
-    halves make), in the order of the first."""
+    """The pieces, the elements' cut at the ends of a copied unit (a part much narrower
+    than its source) joined to the part of their label and height they touch (the pilaster
+    the two halves make), in the order of the first."""
 
     def cut(p: Piece) -> bool:
-        return p.x1 - p.x0 < HALF * p.source_w
+        return p.label != BACKGROUND and p.x1 - p.x0 < HALF * p.source_w
 
     joined: dict[int, Piece] = {}
     order = sorted(range(len(pieces)), key=lambda k: (pieces[k].label, pieces[k].y0, pieces[k].x0))

@@ -5,12 +5,13 @@ Found on the (regularised) input, over its elements (the background is not one):
 
 - ``symmetry``: the elements are mirror images of each other about the vertical centre line
   (at least ``MIRRORED`` of them have a partner of their label);
-- ``columns``: rows of one label (elements at one height) whose centres are the same set of
-  columns, floor after floor;
+- ``columns``: rows of one label (elements at one height, narrower than half the façade:
+  a band across it is on no column) whose centres are the same set of columns, floor
+  after floor;
 - ``axis``: every element of another label (narrower than half the façade) is centred on
-  one of those columns, of elements as narrow (a door under a window column: Bao's
-  Figure 16);
-- ``spacing``: rows of three or more elements of one label at one pitch (at least two
+  one of those columns (a door under a window column: Bao's Figure 16);
+- ``spacing``: rows of three or more elements of one label and width at one pitch (a
+  row of balconies of two widths is two rows; at least two
   pitches apart; up to ``SKIPPED`` places of the pitch may be empty between two: the
   windows each side of a staircase's, which sit half a floor lower);
 - ``ends`` and ``centre``: a label at both ends of the façade, or on its centre line
@@ -215,7 +216,7 @@ def _even(row: list[Box], near: float) -> bool:
 def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
     """The largest set of a label's rows on the same columns, and how many rows it has."""
     near = TOLERANCE * facade.width
-    rows = facade.rows(label)
+    rows = _column_rows(facade, label)
     groups: list[list[list[Box]]] = []
     for row in rows:
         group = next((g for g in groups if _same(_centres(g[0]), _centres(row), near)), None)
@@ -226,6 +227,12 @@ def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
     return max(groups, key=len, default=[]), len(rows)
 
 
+def _column_rows(facade: Facade, label: str) -> list[list[Box]]:
+    """A label's rows, bands across the façade left out (a band is on no column)."""
+    narrow = ([b for b in row if b.x1 - b.x0 < facade.width / 2] for row in facade.rows(label))
+    return [row for row in narrow if row]
+
+
 def shared_rows(facade: Facade, label: str) -> list[list[Box]]:
     """The largest set of a label's rows on the same columns, floor after floor, bottom
     up (none when no two rows share them)."""
@@ -233,11 +240,28 @@ def shared_rows(facade: Facade, label: str) -> list[list[Box]]:
     return best if len(best) >= 2 else []
 
 
-def _evenly_spaced(facade: Facade, label: str) -> tuple[int, int]:
-    """How many of a label's rows of three or more are evenly spaced, of how many."""
+def _runs(facade: Facade, label: str) -> list[list[Box]]:
+    """A label's rows of three or more elements as wide as each other (within the
+    tolerance; a row of elements of two widths is two), each left to right."""
     near = TOLERANCE * facade.width
-    rows = [row for row in facade.rows(label) if len(row) >= 3]
-    return sum(_even(row, near) for row in rows), len(rows)
+    found = []
+    for row in facade.rows(label):
+        groups: list[list[Box]] = []
+        for box in sorted(row, key=lambda b: b.x1 - b.x0):
+            last = groups[-1] if groups else None
+            if last is not None and (box.x1 - box.x0) - (last[0].x1 - last[0].x0) <= near:
+                last.append(box)
+            else:
+                groups.append([box])
+        found += [sorted(g, key=lambda b: b.x0) for g in groups if len(g) >= 3]
+    return found
+
+
+def _evenly_spaced(facade: Facade, label: str) -> tuple[int, int]:
+    """How many of a label's rows of three or more alike are evenly spaced, of how many."""
+    near = TOLERANCE * facade.width
+    runs = _runs(facade, label)
+    return sum(_even(run, near) for run in runs), len(runs)
 
 
 def find_style(facade: Facade) -> list[Constraint]:
@@ -257,8 +281,7 @@ def find_style(facade: Facade) -> list[Constraint]:
         if len(best) >= 2:
             text = f"{len(best)} of {rows} rows of {label} on the same {len(best[0])} columns"
             found.append(Constraint("columns", label, text, len(best) / rows))
-            if all(b.x1 - b.x0 < facade.width / 2 for b in best[0]):
-                columned.append(label)  # columns of bands (their centres) are no axes
+            columned.append(label)
         even, rows = _evenly_spaced(facade, label)
         if even:
             text = f"{even} of {rows} rows of three or more {label} evenly spaced"
@@ -330,7 +353,7 @@ def equations(style: Sequence[Constraint], facade: Facade, near: float) -> list[
                 if column is not None and 0 < abs(_cx(column) - _cx(box)) <= near:
                     found.append((_same_centre(box, column), 0.0))
         elif constraint.kind == "columns":
-            rows = facade.rows(label)
+            rows = _column_rows(facade, label)
             counts = [len(row) for row in rows]
             common = max(set(counts), key=lambda n: (counts.count(n), n), default=0)
             same = [row for row in rows if len(row) == common]
@@ -339,10 +362,10 @@ def equations(style: Sequence[Constraint], facade: Facade, near: float) -> list[
                     if 0 < abs(_cx(box) - _cx(model)) <= near:
                         found.append((_same_centre(box, model), 0.0))
         elif constraint.kind == "spacing":
-            for row in facade.rows(label):
+            for row in _runs(facade, label):
                 centres = _centres(row)
                 pitches = [b - a for a, b in itertools.pairwise(centres)]
-                if len(row) >= 3 and 0 < max(pitches) - min(pitches) <= near:
+                if 0 < max(pitches) - min(pitches) <= near:
                     for a, b, c in zip(row, row[1:], row[2:], strict=False):
                         terms = ((a.x0, 1.0), (a.x1, 1.0), (b.x0, -2.0), (b.x1, -2.0))
                         found.append(((*terms, (c.x0, 1.0), (c.x1, 1.0)), 0.0))
