@@ -82,6 +82,27 @@ def test_a_row_on_one_pitch_with_an_empty_place_is_evenly_spaced() -> None:
     assert not even(row(2.0, 3.0, 15.0, 16.0))  # 1, 12, 1: more than one place empty
 
 
+def test_a_band_across_the_facade_is_on_no_column() -> None:
+    bands = [Box("cornice", 0.2, y, 11.2, y + 0.3) for y in (3.1, 5.6, 8.1)]
+    style = find_style(facade_of(_palazzo() + bands, 11.4, 10.0, BACKGROUND))
+    assert ("columns", "cornice") not in _kinds(style)  # three rows, each one band
+    assert all(c.other != "cornice" for c in style)  # and no axis of anything
+
+
+def test_spacing_is_of_elements_as_wide_as_each_other() -> None:
+    def balconies(*boxes: tuple[float, float]) -> list[Box]:
+        return [Box("balcony", x0, 3.0, x1, 3.5) for x0, x1 in boxes]
+
+    # two wide end balconies and three narrow ones between, the narrow ones 3 m apart
+    row = balconies((0.5, 2.5), (3.5, 4.5), (6.5, 7.5), (9.5, 10.5), (11.5, 13.5))
+    spacing = [c for c in find_style(facade_of(row, 14.0, 10.0, BACKGROUND)) if c.kind == "spacing"]
+    assert [c.text for c in spacing] == ["1 of 1 rows of three or more balcony evenly spaced"]
+    uneven = balconies((0.5, 2.5), (3.5, 4.5), (6.5, 7.5), (8.5, 9.5), (11.5, 13.5))
+    assert not any(
+        c.kind == "spacing" for c in find_style(facade_of(uneven, 14.0, 10.0, BACKGROUND))
+    )
+
+
 def test_tiles_of_one_element_are_joined_back() -> None:
     window = [Box("window", 1.0, 1.0, 1.5, 2.0), Box("window", 1.5, 1.0, 2.0, 2.0)]
     window += [Box("window", 1.0, 2.0, 2.0, 2.5)]
