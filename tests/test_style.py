@@ -103,6 +103,21 @@ def test_spacing_is_of_elements_as_wide_as_each_other() -> None:
     )
 
 
+def test_floors_copied_that_were_never_even_leave_the_even_one_even() -> None:
+    def row(y: float, *xs: float) -> list[Box]:
+        return [Box("window", x - 0.5, y, x + 0.5, y + 1.0) for x in xs]
+
+    source = row(1.0, 2.0, 5.0, 8.0) + row(4.0, 2.0, 5.0, 9.0) + row(7.0, 2.0, 5.0, 9.0)
+    style = [
+        c for c in find_style(facade_of(source, 11.0, 10.0, BACKGROUND)) if c.kind == "spacing"
+    ]
+    assert [c.text for c in style] == ["1 of 3 rows of three or more window evenly spaced"]
+    taller = source + row(10.0, 2.0, 5.0, 9.0) + row(13.0, 2.0, 5.0, 9.0)  # 1 of 5 even
+    assert not check(style, facade_of(taller, 11.0, 16.0, BACKGROUND)).broken
+    uneven = row(1.0, 2.0, 5.0, 9.0) + taller[3:]  # the even floor made uneven: none is
+    assert check(style, facade_of(uneven, 11.0, 16.0, BACKGROUND)).broken
+
+
 def test_tiles_of_one_element_are_joined_back() -> None:
     window = [Box("window", 1.0, 1.0, 1.5, 2.0), Box("window", 1.5, 1.0, 2.0, 2.0)]
     window += [Box("window", 1.0, 2.0, 2.0, 2.5)]

@@ -18,8 +18,9 @@ Found on the (regularised) input, over its elements (the background is not one):
   (pilasters at the corners and in the middle: a frequency pattern).
 
 A derived layout keeps a constraint when it holds there too (for ``columns`` and
-``spacing``, in as large a share of the label's rows: a taller façade has more floors);
-distances are compared within ``TOLERANCE`` of the façade's extent.
+``spacing``, in as large a share of the label's rows, or in as many rows: a taller façade
+has more floors, and floors copied that did not hold it leave those that do); distances
+are compared within ``TOLERANCE`` of the façade's extent.
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ class Constraint:
     text: str  # what it says, for people
     share: float = 1.0  # for ``columns`` and ``spacing``: the share of the label's rows
     other: str = ""  # for ``axis``: the label whose columns it is centred on
+    rows: int = 0  # for ``columns`` and ``spacing``: how many of the label's rows
 
     def summary(self) -> dict[str, object]:
         return {"kind": self.kind, "label": self.label, "text": self.text}
@@ -266,8 +268,9 @@ def _evenly_spaced(facade: Facade, label: str) -> tuple[int, int]:
 
 def find_style(facade: Facade) -> list[Constraint]:
     """The constraints a layout holds (see the module). ``columns`` and ``spacing`` hold
-    for a share of a label's rows (``Constraint.share``): a derived layout keeps them when
-    as large a share of its rows does, however many floors it has."""
+    for a share of a label's rows (``Constraint.share``, ``Constraint.rows``): a derived
+    layout keeps them when as large a share of its rows does, however many floors it has,
+    or as many rows."""
     found: list[Constraint] = []
     near = TOLERANCE * facade.width
     share = facade.mirrored()
@@ -280,12 +283,12 @@ def find_style(facade: Facade) -> list[Constraint]:
         best, rows = _shared_columns(facade, label)
         if len(best) >= 2:
             text = f"{len(best)} of {rows} rows of {label} on the same {len(best[0])} columns"
-            found.append(Constraint("columns", label, text, len(best) / rows))
+            found.append(Constraint("columns", label, text, len(best) / rows, rows=len(best)))
             columned.append(label)
         even, rows = _evenly_spaced(facade, label)
         if even:
             text = f"{even} of {rows} rows of three or more {label} evenly spaced"
-            found.append(Constraint("spacing", label, text, even / rows))
+            found.append(Constraint("spacing", label, text, even / rows, rows=even))
         boxes = [b for b in facade.boxes if b.label == label]
         if any(b.x0 <= near for b in boxes) and any(b.x1 >= facade.width - near for b in boxes):
             found.append(Constraint("ends", label, f"{label} at both ends"))
@@ -311,10 +314,10 @@ def holds(constraint: Constraint, facade: Facade) -> bool:
     boxes = [b for b in facade.boxes if b.label == label]
     if kind == "columns":
         best, rows = _shared_columns(facade, label)
-        return len(best) >= 2 and len(best) >= constraint.share * rows - 1e-9
+        return len(best) >= 2 and _as_many(constraint, len(best), rows)
     if kind == "spacing":
         even, rows = _evenly_spaced(facade, label)
-        return rows > 0 and even >= constraint.share * rows - 1e-9
+        return rows > 0 and _as_many(constraint, even, rows)
     if kind == "ends":
         return any(b.x0 <= near for b in boxes) and any(b.x1 >= facade.width - near for b in boxes)
     if kind == "centre":
@@ -325,6 +328,12 @@ def holds(constraint: Constraint, facade: Facade) -> bool:
         narrow = [b for b in boxes if b.x1 - b.x0 < facade.width / 2]
         return bool(narrow) and all(any(abs(_cx(b) - c) <= near for c in centres) for b in narrow)
     raise ValueError(f"unknown constraint kind {kind!r}")
+
+
+def _as_many(constraint: Constraint, holding: int, rows: int) -> bool:
+    """Whether as large a share of the rows, or as many rows, hold a constraint as in the
+    input (floors copied that did not hold it leave the ones that do)."""
+    return holding >= constraint.share * rows - 1e-9 or holding >= constraint.rows > 0
 
 
 # -- equations that make a derived layout keep its style --------------------------------
