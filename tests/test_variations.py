@@ -8,9 +8,11 @@ from pathlib import Path
 
 import pytest
 
+from facadecli.grammar import slabs
 from facadecli.grammar.run import Extraction, Options, extract_grammar
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Part
+from facadecli.grammar.style import Box as StyleBox
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.grammar.variation import (
     Piece,
@@ -400,3 +402,15 @@ def test_a_taller_facade_gains_floors_copied_whole(tmp_path: Path) -> None:
     assert all(p.y1 - p.y0 <= 1.1 * p.source_h for p in windows)
     assert not variation.kept.broken
     assert variation.retarget.startswith("y copied")
+
+
+def test_floors_whose_rows_make_no_pitch_are_copied_between_the_gaps() -> None:
+    """A shop floor, two floors and an attic, the style's rows too close to make a floor
+    (a pitch of 0.5 m): a floor is still copied, one that runs between the gaps of wall
+    and holds a row, never the shop floor or the attic."""
+    spans = [(0.0, 3.0), (4.0, 5.5), (6.5, 8.0), (9.0, 10.0)]
+    elements = [StyleBox("window", 1.0, lo, 2.0, hi) for lo, hi in spans]
+    plans = slabs._floors(elements, 10.0, 15.0, [[4.75, 5.25]])
+    copied = [plan.text for plan in plans if plan.text]
+    assert "copied 2x: 3.5-6" in copied  # one floor, with the wall half way to the next
+    assert all(text.endswith((": 3.5-6", ": 3.5-8.5")) for text in copied)  # never 0-3, 9-10

@@ -92,9 +92,12 @@ def _floors(
 ) -> list[retarget.Plan]:
     """Ways to lay the façade up its height: the façade stretched, then floors copied
     across the whole width: a unit one pitch of ``rows`` (the style's rows, of windows
-    say), centred on one of them, holding no label's lowest or highest row, so that a copy
-    is the next floor up (a strip of a ground floor, an attic or a frieze copied would
-    stack shop fronts, doors or bands)."""
+    say), centred on one of them, holding no lowest or highest row of a label with three
+    rows or more, so that a copy is the next floor up (a strip of a ground floor, an attic
+    or a frieze copied would stack shop fronts, doors or bands); then a unit between the
+    gaps of wall between floors, holding one of those rows and as few ends, and neither
+    the lowest floor nor the highest (a façade of two floors and an attic, whose rows
+    make no pitch)."""
     spans = [(b.y0, b.y1) for b in elements]
     found: list[retarget.Plan | None] = [retarget.copied(spans, extent, height, (), 0)]
     ends = [c for centres in rows if len(centres) > 2 for c in (centres[0], centres[-1])]
@@ -103,6 +106,17 @@ def _floors(
         for unit in _pitched(rows, extent, False)
         if not any(unit[0][0] < c < unit[0][1] for c in ends)
     ]
+    blocks = retarget.blocks_of(spans, extent)
+    centres = [c for row in rows for c in row]
+    if len(blocks) > 2:
+        units += [
+            ((lo, hi),)
+            for _, lo, hi in retarget.units(spans, extent)
+            if lo >= blocks[0][1]
+            and hi <= blocks[-1][0]
+            and any(lo < c < hi for c in centres)
+            and not any(lo < c < hi for c in ends)
+        ]
     for unit in units:
         cut = retarget.shifted(spans, extent, unit)
         if cut is not None:
