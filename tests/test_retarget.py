@@ -57,6 +57,12 @@ def test_a_unit_is_cut_through_pilasters_that_a_copy_puts_together_again() -> No
     assert halves == [(4.0, 4.5), (4.5, 5.0)]  # one pilaster between the bay and its copy
 
 
+def test_a_scaled_plan_lays_everything_alike() -> None:
+    plan = retarget.scaled(7.0, 8.4)
+    assert plan.text == "scaled" and _length(plan) == pytest.approx(8.4)
+    assert retarget.place(plan, 1.0, 2.0) == [(pytest.approx(1.2), pytest.approx(2.4))]
+
+
 def test_gaps_stretched_too_far_or_elements_widened_make_no_plan() -> None:
     assert retarget.copied(ROW, 7.0, 14.0, [], 0) is None  # the wall alone: 4 m -> 11 m
     assert retarget.copied(ROW, 7.0, 7.5, [], 0) is not None

@@ -314,17 +314,23 @@ def test_a_much_wider_facade_gains_whole_bays_on_every_floor_and_keeps_its_style
     assert not variation.kept.broken and len(variation.kept.kept) == len(extraction.style)
 
 
+def _pilasters() -> list[Rect]:
+    """Pilasters 1 m wide every 4 m on a 13 x 10 façade, three floors of windows between
+    them, ledges from the middle of one pilaster to the middle of the next."""
+    rects = [Rect("pillar", x, 0.0, x + 1.0, 10.0, 1) for x in (0.0, 4.0, 8.0, 12.0)]
+    for y in (1.0, 4.0, 7.0):
+        rects += [Rect("window", x, y, x + 2.0, y + 1.5, 1) for x in (1.5, 5.5, 9.5)]
+        rects += [Rect("ledge", x, y - 0.5, x + 4.0, y, 1) for x in (0.5, 4.5, 8.5)]
+    return rects
+
+
 def test_bays_between_pilasters_with_no_wall_between_are_copied_whole(
     tmp_path: Path,
 ) -> None:
     """Pilasters 1 m wide every 4 m, ledges running from the middle of one to the middle of
     the next (no wall to cut at between bays): 8 m wider, the bay is copied twice, cut
     through the middles of the pilasters and put together again, every pilaster whole."""
-    rects = [Rect("pillar", x, 0.0, x + 1.0, 10.0, 1) for x in (0.0, 4.0, 8.0, 12.0)]
-    for y in (1.0, 4.0, 7.0):
-        rects += [Rect("window", x, y, x + 2.0, y + 1.5, 1) for x in (1.5, 5.5, 9.5)]
-        rects += [Rect("ledge", x, y - 0.5, x + 4.0, y, 1) for x in (0.5, 4.5, 8.5)]
-    extraction = _extract(tmp_path, LabelledLayout(13.0, 10.0, tuple(rects)))
+    extraction = _extract(tmp_path, LabelledLayout(13.0, 10.0, tuple(_pilasters())))
     source = (13.0, 10.0)
     pieces = derive_at(extraction.grammar, source, *source)
     laid = retargeted(pieces, source, 21.0, 10.0, extraction.style)
@@ -334,6 +340,20 @@ def test_bays_between_pilasters_with_no_wall_between_are_copied_whole(
     whole = [(x, x + 1.0) for x in (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)]
     assert pillars - set(whole) == {(0.0, 0.5), (20.5, 21.0)}  # under the end ledges
     assert set(whole) <= pillars
+
+
+def test_bays_copied_across_a_facade_whose_wall_cannot_stretch_up_are_scaled_alike(
+    tmp_path: Path,
+) -> None:
+    """1.2 times as tall, the pilastered façade's wall between floors cannot take the
+    height alone: with bays copied across, everything is scaled alike up it (never the
+    layout unchanged across: that is the grammar's)."""
+    source = (13.0, 10.0)
+    extraction = _extract(tmp_path, LabelledLayout(*source, tuple(_pilasters())))
+    pieces = derive_at(extraction.grammar, source, *source)
+    texts = [text for _, _, text in retargeted(pieces, source, 21.0, 12.0, extraction.style)]
+    assert "x copied 2x: 4.5-8.5; y scaled" in texts
+    assert not any(text.startswith("y") or text == "stretched" for text in texts)
 
 
 def test_bays_copied_on_a_symmetric_facade_keep_it_symmetric(tmp_path: Path) -> None:

@@ -163,6 +163,11 @@ def copied(
     return _laid(blocks, extent, new_extent, stretches, describe(laid, copies))
 
 
+def scaled(extent: float, new_extent: float) -> Plan:
+    """The source scaled alike to ``new_extent``, whatever that does to its elements."""
+    return Plan((Segment(0.0, extent, new_extent / extent),), "scaled")
+
+
 def describe(laid: Sequence[tuple[float, float]], copies: int) -> str:
     """What copying the units ``laid`` does, for people (empty: nothing)."""
     where = " and ".join(f"{a:.3g}-{b:.3g}" for a, b in sorted(laid))

@@ -65,7 +65,14 @@ def retargeted(
     floors = _floors(in_floors, source[1], height, rows)
     bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
     laid = []
-    for (text_x, strata, across), along_y in itertools.product(bays, floors[:RETARGETS_MAX]):
+    # where the wall alone cannot stretch up the façade, everything is scaled alike, so
+    # that bays copied across still make a layout (never the layout unchanged across)
+    along = floors[:RETARGETS_MAX]
+    if not any(plan.text == "" for plan in along):
+        along.append(retarget.scaled(source[1], height))
+    for (text_x, strata, across), along_y in itertools.product(bays, along):
+        if along_y.text == "scaled" and not text_x:
+            continue
         parts: dict[int, list[tuple[float, float, float, float]]] = defaultdict(list)
         for k, p in enumerate(pieces):
             for (lo, hi), plan in zip(strata, across, strict=True):
