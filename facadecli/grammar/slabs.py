@@ -102,13 +102,13 @@ def _floors(
     say), centred on one of them, holding no lowest or highest row of a label with three
     rows or more, so that a copy is the next floor up (a strip of a ground floor, an attic
     or a frieze copied would stack shop fronts, doors or bands); then a unit between the
-    gaps of wall between floors, holding one of those rows and as few ends, and neither
-    the lowest floor nor the highest (a façade of two floors and an attic, whose rows
-    make no pitch)."""
+    gaps of wall between floors, holding one of those rows and none of those ends, and
+    neither the lowest floor nor the highest (a façade of two floors and an attic, whose
+    rows make no pitch)."""
     spans = [(b.y0, b.y1) for b in elements]
     found: list[retarget.Plan | None] = [retarget.copied(spans, extent, height, (), 0)]
     ends = [c for centres in rows if len(centres) > 2 for c in (centres[0], centres[-1])]
-    units = [  # holding no label's lowest or highest row
+    units = [  # holding no end
         unit
         for unit in _pitched(rows, extent, False)
         if not any(unit[0][0] < c < unit[0][1] for c in ends)
@@ -314,9 +314,9 @@ def _holds_column(unit: Sequence[Span], columns: Sequence[Sequence[float]]) -> b
 
 
 def _halves_joined(pieces: list[Piece], near: float) -> list[Piece]:
-    """The pieces, the elements' cut at the ends of a copied unit (a part much narrower
-    than its source) joined to the part of their label and height they touch (the pilaster
-    the two halves make), in the order of the first."""
+    """The pieces, each part of an element cut at the end of a copied unit (much narrower
+    than its source) joined to the part of its label and height that it touches (the two
+    halves of a pilaster make one), in the order of the first."""
 
     def cut(p: Piece) -> bool:
         return p.label != BACKGROUND and p.x1 - p.x0 < HALF * p.source_w

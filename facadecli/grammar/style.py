@@ -11,9 +11,9 @@ Found on the (regularised) input, over its elements (the background is not one):
 - ``axis``: every element of another label (narrower than half the façade) is centred on
   one of those columns (a door under a window column: Bao's Figure 16);
 - ``spacing``: rows of three or more elements of one label and width at one pitch (a
-  row of balconies of two widths is two rows; at least two
-  pitches apart; up to ``SKIPPED`` places of the pitch may be empty between two: the
-  windows each side of a staircase's, which sit half a floor lower);
+  row of balconies of two widths is two rows), at least two pitches apart and up to
+  ``SKIPPED`` places of the pitch empty between two (the windows each side of a
+  staircase's, which sit half a floor lower);
 - ``ends`` and ``centre``: a label at both ends of the façade, or on its centre line
   (pilasters at the corners and in the middle: a frequency pattern).
 
