@@ -10,6 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from facadecli.grammar import retarget
+from facadecli.grammar.pieces import Piece
+from facadecli.grammar.slabs import retargeted
+from facadecli.grammar.style import Box, facade_of, find_style
+from facadecli.grammar.tiling import BACKGROUND
 
 ROW = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]  # three windows 1 m wide, 1 m apart, in 7 m
 
@@ -158,3 +162,45 @@ def test_every_plan_fills_the_new_extent_and_keeps_elements_whole(
                 for c, d, _ in parts
                 if abs(c - b) < 1e-9 or abs(d - a) < 1e-9
             )
+
+
+@st.composite
+def _grids(draw: st.DrawFn) -> tuple[list[Piece], tuple[float, float]]:
+    """A façade tiled by a grid of cells, whole metres or halves, each wall or an element
+    (a run of cells of one label in a row or a column makes a longer element)."""
+    widths = draw(st.lists(st.integers(1, 6), min_size=2, max_size=9))
+    heights = draw(st.lists(st.integers(1, 6), min_size=2, max_size=6))
+    labels = st.sampled_from([BACKGROUND, BACKGROUND, "window", "pillar", "ledge"])
+    xs = list(itertools.accumulate([0.0, *(w / 2 for w in widths)]))
+    ys = list(itertools.accumulate([0.0, *(h / 2 for h in heights)]))
+    pieces = [
+        Piece(draw(labels), x0, y0, x1, y1, x1 - x0, y1 - y0)
+        for x0, x1 in itertools.pairwise(xs)
+        for y0, y1 in itertools.pairwise(ys)
+    ]
+    return pieces, (xs[-1], ys[-1])
+
+
+@settings(max_examples=60, deadline=None)
+@given(_grids(), st.sampled_from([(0.7, 1.0), (1.5, 1.0), (2.0, 1.0), (1.0, 1.5), (1.6, 1.4)]))
+def test_every_facade_laid_out_anew_tiles_its_new_size(
+    grid: tuple[list[Piece], tuple[float, float]], factors: tuple[float, float]
+) -> None:
+    """Whatever the façade and the new size, every layout made by copying bays and floors
+    (and halves of elements put together again) tiles the new façade: its pieces lie on
+    it, overlap nowhere and cover it."""
+    pieces, source = grid
+    width, height = source[0] * factors[0], source[1] * factors[1]
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    style = find_style(facade_of(boxes, *source, BACKGROUND))
+    for moved, _, text in retargeted(pieces, source, width, height, style):
+        area = 0.0
+        for p in moved:
+            assert -1e-9 <= p.x0 < p.x1 <= width + 1e-9 and -1e-9 <= p.y0 < p.y1 <= height + 1e-9
+            area += (p.x1 - p.x0) * (p.y1 - p.y0)
+        assert area == pytest.approx(width * height), text
+        cells = sorted(moved, key=lambda p: (p.x0, p.y0))
+        for a, b in itertools.combinations(cells, 2):
+            overlap_x = min(a.x1, b.x1) - max(a.x0, b.x0)
+            overlap_y = min(a.y1, b.y1) - max(a.y0, b.y0)
+            assert overlap_x <= 1e-9 or overlap_y <= 1e-9, text
