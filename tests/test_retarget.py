@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from facadecli.grammar import retarget
+from facadecli.grammar import retarget, slabs
 from facadecli.grammar.pieces import Piece
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.style import Box, facade_of, find_style
@@ -204,3 +204,19 @@ def test_every_facade_laid_out_anew_tiles_its_new_size(
             overlap_x = min(a.x1, b.x1) - max(a.x0, b.x0)
             overlap_y = min(a.y1, b.y1) - max(a.y0, b.y0)
             assert overlap_x <= 1e-9 or overlap_y <= 1e-9, text
+
+
+def test_no_facade_is_laid_out_anew_many_times_its_size() -> None:
+    """A work budget: a layout of more than ``PIECES_MOST`` pieces is not made (a façade
+    many times its source's size is the grammar's alone)."""
+    pieces = [
+        Piece("window" if (i + j) % 2 else BACKGROUND, i, j, i + 1.0, j + 1.0, 1.0, 1.0)
+        for i in range(5)
+        for j in range(4)
+    ]
+    style = find_style(
+        facade_of([Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces], 5, 4, BACKGROUND)
+    )
+    assert retargeted(pieces, (5.0, 4.0), 10.0, 4.0, style)
+    grown = slabs.PIECES_MOST / len(pieces) + 1  # times the area
+    assert retargeted(pieces, (5.0, 4.0), 5.0 * grown, 4.0, style) == []

@@ -16,6 +16,8 @@ from facadecli.grammar.style import Box, Constraint, facade_of, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
+PIECES_MOST = 20_000  # pieces a copied layout would have at most (more: none is made)
+LAID_MOST = 60_000  # pieces laid over all the copied layouts (the rest are not made)
 HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see _halves_joined)
 
 Span = tuple[float, float]
@@ -30,7 +32,9 @@ def retargeted(
 ) -> list[tuple[list[Piece], float, str]]:
     """The source's pieces laid out at a new size by :mod:`~facadecli.grammar.retarget`:
     each layout, how far its wall stretched (the squares of the log-ratios, a term of its
-    score) and what was done; none at the source's size.
+    score) and what was done; none at the source's size, nor where a layout would have
+    more than ``PIECES_MOST`` pieces, and no more once ``LAID_MOST`` pieces are laid
+    (budgets counted in work: a façade many times its source's size is the grammar's).
 
     Floors are copied across the whole width. Bays are copied floor by floor (a floor, or
     the wall between floors, is a stratum): one unit, where a stratum lets it be cut out
@@ -43,7 +47,8 @@ def retargeted(
     the wall that is wall in all of them, so strata cut alike stay lined up. ``style``
     gives the columns and whether the façade is mirrored (units are then copied with
     their mirror images)."""
-    if (width, height) == source:
+    grown = max(1.0, width / source[0]) * max(1.0, height / source[1])
+    if (width, height) == source or len(pieces) * grown > PIECES_MOST:
         return []
     boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
     facade = facade_of(boxes, *source, BACKGROUND)
@@ -65,14 +70,20 @@ def retargeted(
     floors = _floors(in_floors, source[1], height, rows)
     bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
     laid = []
-    # where the wall alone cannot stretch up the façade, everything is scaled alike, so
-    # that bays copied across still make a layout (never the layout unchanged across)
+    # where the wall alone cannot stretch up the façade, everything is scaled alike (by
+    # as much as elements may be squeezed, at most), so that bays copied across still
+    # make a layout (never the layout unchanged across)
     along = floors[:RETARGETS_MAX]
-    if not any(plan.text == "" for plan in along):
+    alike = height / source[1]
+    near = 1 / retarget.SQUEEZE_MOST <= alike <= retarget.SQUEEZE_MOST
+    if near and not any(plan.text == "" for plan in along):
         along.append(retarget.scaled(source[1], height))
+    budget = LAID_MOST
     for (text_x, strata, across), along_y in itertools.product(bays, along):
         if along_y.text == "scaled" and not text_x:
             continue
+        if budget <= 0:
+            break
         parts: dict[int, list[tuple[float, float, float, float]]] = defaultdict(list)
         for k, p in enumerate(pieces):
             for (lo, hi), plan in zip(strata, across, strict=True):
@@ -88,6 +99,7 @@ def retargeted(
             ],
             1e-9 * width,
         )
+        budget -= len(moved)
         stretch = max(plan.stretch for plan in across) ** 2 + along_y.stretch**2
         texts = [t for t in (text_x, f"y {along_y.text}" if along_y.text else "") if t]
         laid.append((moved, stretch, "; ".join(texts) or "stretched"))

@@ -142,6 +142,12 @@ def main() -> None:
     started = time.perf_counter()
     derive_layout(last.grammar, last.tiling, 24.0, 15.0, "bench")
     print(f"derive {files[-1].stem} at 24x15 with alignment: {time.perf_counter() - started:.2f}s")
+    big = min(4, len(files) - 1)  # cmp_b0005 when all 12 are there
+    for size in ((60.0, 60.0), (360.0, 360.0)):  # 4x and 24x both ways: the work budgets
+        started = time.perf_counter()
+        derive_layout(extractions[big].grammar, extractions[big].tiling, *size, "bench")
+        elapsed = time.perf_counter() - started
+        print(f"derive {files[big].stem} at {size[0]:g}x{size[1]:g}: {elapsed:.2f}s")
     variations(extractions)
 
 
