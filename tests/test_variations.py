@@ -434,3 +434,28 @@ def test_floors_whose_rows_make_no_pitch_are_copied_between_the_gaps() -> None:
     copied = [plan.text for plan in plans if plan.text]
     assert "copied 2x: 3.5-6" in copied  # one floor, with the wall half way to the next
     assert all(text.endswith((": 3.5-6", ": 3.5-8.5")) for text in copied)  # never 0-3, 9-10
+
+
+def test_a_stratum_no_unit_can_be_cut_out_of_is_scaled_alike(tmp_path: Path) -> None:
+    """Three floors of four windows under an attic of staggered ornaments that leave no
+    cut (nor one a bay along): a bay is still copied through the floors, and the attic,
+    a tenth of the height, is scaled alike across instead."""
+    rects = []
+    for y in (1.0, 4.0, 7.0):
+        rects += [Rect("window", x, y, x + 1.5, y + 1.5, 1) for x in (1.0, 4.0, 7.0, 10.0)]
+    rects += [Rect("deco", x, 9.0, x + 2.6, 9.7, 1) for x in (0.2, 3.4, 6.6, 9.8)]
+    rects += [Rect("sign", x, 9.4, x + 1.5, 10.0, 2) for x in (2.4, 5.6, 8.8)]
+    source = (12.5, 10.0)
+    extraction = _extract(tmp_path, LabelledLayout(*source, tuple(rects)))
+    pieces = derive_at(extraction.grammar, source, *source)
+    laid = {
+        text: moved for moved, _, text in retargeted(pieces, source, 15.0, 10.0, extraction.style)
+    }
+    moved = laid["x copied 1x: 3.21-6.25"]
+    assert sum(p.label == "window" for p in moved) == 15
+    windows = [p.x1 - p.x0 for p in moved if p.label == "window"]
+    assert all(1.5 / 1.1 <= w <= 1.5 * 1.1 for w in windows)  # copied, not stretched
+    signs = [p for p in moved if p.label == "sign"]
+    assert len(signs) == 3 and all(
+        p.x1 - p.x0 == pytest.approx(1.2 * p.source_w) for p in signs
+    )  # 15 / 12.5

@@ -17,6 +17,7 @@ from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
 PIECES_MOST = 20_000  # pieces a copied layout would have at most (more: none is made)
+SCALED_MOST = 0.25  # of the height: strata a unit cannot be cut out of, scaled alike instead
 LAID_MOST = 60_000  # pieces laid over all the copied layouts (the rest are not made)
 HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see _halves_joined)
 
@@ -41,7 +42,9 @@ def retargeted(
     there or a little to one side (:func:`~facadecli.grammar.retarget.shifted`; through
     pilasters where a copy puts their halves together again, :func:`_cut`); a stratum
     that cannot be cut near it (a ground floor of shops) is stretched instead, so
-    the floors above keep their columns whatever the ground floor does. The units tried
+    the floors above keep their columns whatever the ground floor does (where its wall
+    cannot take the width, it is scaled alike, by 1.5 at most, if such strata are at
+    most ``SCALED_MOST`` of the height: an attic of staggered ornaments). The units tried
     first hold a column of the style's (one pitch of it, centred on a column, is a period
     by construction), then those that most strata can be cut at. Every stratum stretches
     the wall that is wall in all of them, so strata cut alike stay lined up. ``style``
@@ -254,12 +257,16 @@ def _bays(
         if c
     ]:
         across = []
-        for k in range(len(strata)):
+        scaled = 0.0  # the height of the strata scaled alike
+        for k, (lo, hi) in enumerate(strata):
             cut = best_cuts[unit][k] if unit else ()
             plan = None if cut is None else plan_of(cut, copies)
             if plan is None:  # the stratum stretched (its own bays copied would not line up)
                 plan = plan_of((), 0)
-            if plan is None:
+            if plan is None and unit and width / extent <= retarget.SQUEEZE_MOST:
+                plan = retarget.scaled(extent, width)
+                scaled += hi - lo
+            if plan is None or scaled > SCALED_MOST * source[1]:
                 break
             across.append(plan)
         else:
