@@ -249,6 +249,9 @@ def _bays(
             plans[(cut, copies)] = retarget.copied(every, extent, width, cut, copies)
         return plans[(cut, copies)]
 
+    # a stratum no unit can be cut out of may be scaled alike, by as much as elements may
+    # be squeezed at most
+    scalable = 1 / retarget.SQUEEZE_MOST <= width / extent <= retarget.SQUEEZE_MOST
     found = []
     for unit, copies in [((), 0)] + [
         (u, c)
@@ -263,7 +266,7 @@ def _bays(
             plan = None if cut is None else plan_of(cut, copies)
             if plan is None:  # the stratum stretched (its own bays copied would not line up)
                 plan = plan_of((), 0)
-            if plan is None and unit and width / extent <= retarget.SQUEEZE_MOST:
+            if plan is None and unit and scalable:
                 plan = retarget.scaled(extent, width)
                 scaled += hi - lo
             if plan is None or scaled > SCALED_MOST * source[1]:
