@@ -63,6 +63,7 @@ def test_a_unit_is_cut_through_pilasters_that_a_copy_puts_together_again() -> No
 
 def test_a_scaled_plan_lays_everything_alike() -> None:
     plan = retarget.scaled(7.0, 8.4)
+    assert plan is not None
     assert plan.text == "scaled" and _length(plan) == pytest.approx(8.4)
     assert retarget.place(plan, 1.0, 2.0) == [(pytest.approx(1.2), pytest.approx(2.4))]
 

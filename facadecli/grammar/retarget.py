@@ -163,9 +163,13 @@ def copied(
     return _laid(blocks, extent, new_extent, stretches, describe(laid, copies))
 
 
-def scaled(extent: float, new_extent: float) -> Plan:
-    """The source scaled alike to ``new_extent``, whatever that does to its elements."""
-    return Plan((Segment(0.0, extent, new_extent / extent),), "scaled")
+def scaled(extent: float, new_extent: float) -> Plan | None:
+    """The source scaled alike to ``new_extent``, its elements too (None beyond what an
+    element may be squeezed or stretched by: ``SQUEEZE_MOST`` either way)."""
+    alike = new_extent / extent
+    if not 1 / SQUEEZE_MOST <= alike <= SQUEEZE_MOST:
+        return None
+    return Plan((Segment(0.0, extent, alike),), "scaled")
 
 
 def describe(laid: Sequence[tuple[float, float]], copies: int) -> str:

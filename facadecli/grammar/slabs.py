@@ -73,17 +73,15 @@ def retargeted(
     floors = _floors(in_floors, source[1], height, rows)
     bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
     laid = []
-    # where the wall alone cannot stretch up the façade, everything is scaled alike (by
-    # as much as elements may be squeezed, at most), so that bays copied across still
-    # make a layout (never the layout unchanged across)
+    # where the wall alone cannot stretch up the façade, everything is scaled alike, so
+    # that bays copied across still make a layout (never the layout unchanged across)
     along = floors[:RETARGETS_MAX]
-    alike = height / source[1]
-    near = 1 / retarget.SQUEEZE_MOST <= alike <= retarget.SQUEEZE_MOST
-    if near and not any(plan.text == "" for plan in along):
-        along.append(retarget.scaled(source[1], height))
+    scaled_up = retarget.scaled(source[1], height)
+    if scaled_up is not None and not any(plan.text == "" for plan in along):
+        along.append(scaled_up)
     budget = LAID_MOST
     for (text_x, strata, across), along_y in itertools.product(bays, along):
-        if along_y.text == "scaled" and not text_x:
+        if along_y is scaled_up and not text_x:
             continue
         if budget <= 0:
             break
@@ -249,9 +247,7 @@ def _bays(
             plans[(cut, copies)] = retarget.copied(every, extent, width, cut, copies)
         return plans[(cut, copies)]
 
-    # a stratum no unit can be cut out of may be scaled alike, by as much as elements may
-    # be squeezed at most
-    scalable = 1 / retarget.SQUEEZE_MOST <= width / extent <= retarget.SQUEEZE_MOST
+    scaled_across = retarget.scaled(extent, width)  # a stratum no unit can be cut out of
     found = []
     for unit, copies in [((), 0)] + [
         (u, c)
@@ -266,8 +262,8 @@ def _bays(
             plan = None if cut is None else plan_of(cut, copies)
             if plan is None:  # the stratum stretched (its own bays copied would not line up)
                 plan = plan_of((), 0)
-            if plan is None and unit and scalable:
-                plan = retarget.scaled(extent, width)
+            if plan is None and unit and scaled_across is not None:
+                plan = scaled_across
                 scaled += hi - lo
             if plan is None or scaled > SCALED_MOST * source[1]:
                 break

@@ -667,13 +667,14 @@ class _Candidate:
         )
 
 
+def _misfit(p: Piece) -> float:
+    """How far a piece's size is from its source's: the squares of the log-ratios."""
+    return math.log((p.x1 - p.x0) / p.source_w) ** 2 + math.log((p.y1 - p.y0) / p.source_h) ** 2
+
+
 def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
     """How far the elements' sizes are from the source's (0: the same)."""
-    terms = [
-        math.log((p.x1 - p.x0) / p.source_w) ** 2 + math.log((p.y1 - p.y0) / p.source_h) ** 2
-        for p in pieces
-        if p.label != background and p.x1 > p.x0 and p.y1 > p.y0
-    ]
+    terms = [_misfit(p) for p in pieces if p.label != background and p.x1 > p.x0 and p.y1 > p.y0]
     return sum(terms) / len(terms) if terms else 0.0
 
 
@@ -681,15 +682,9 @@ def likeness(pieces: list[Piece]) -> float:
     """How far the pieces' sizes are from the source's, the wall included, each weighted by
     its area (0: the same): a derivation that widens its wall into blank margins is as far
     from the source as one that widens its windows."""
-    total = 0.0
-    area = 0.0
-    for p in pieces:
-        w, h = p.x1 - p.x0, p.y1 - p.y0
-        if w > 0 and h > 0:
-            terms = math.log(w / p.source_w) ** 2 + math.log(h / p.source_h) ** 2
-            total += w * h * terms
-            area += w * h
-    return total / area if area else 0.0
+    weighted = [((p.x1 - p.x0) * (p.y1 - p.y0), p) for p in pieces if p.x1 > p.x0 and p.y1 > p.y0]
+    area = sum(a for a, _ in weighted)
+    return sum(a * _misfit(p) for a, p in weighted) / area if area else 0.0
 
 
 def _key(pieces: list[Piece]) -> tuple[tuple[str, float, float, float, float], ...]:
