@@ -4,6 +4,7 @@ by varying repeat counts (Bao et al. 2013)."""
 from __future__ import annotations
 
 import itertools
+import random
 from pathlib import Path
 
 import pytest
@@ -13,10 +14,13 @@ from facadecli.grammar.run import Extraction, Options, extract_grammar
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Part
 from facadecli.grammar.style import Box as StyleBox
+from facadecli.grammar.style import Kept, check, facade_of
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.grammar.variation import (
     Piece,
     Variation,
+    _key,
+    _proportioned_copies,
     _run_of,
     align,
     derive_at,
@@ -459,3 +463,48 @@ def test_a_stratum_no_unit_can_be_cut_out_of_is_scaled_alike(tmp_path: Path) -> 
     assert len(signs) == 3 and all(
         p.x1 - p.x0 == pytest.approx(1.2 * p.source_w) for p in signs
     )  # 15 / 12.5
+
+
+def _three_bays() -> LabelledLayout:
+    """A mirrored façade 15 x 9 m of three bays: windows 1.5 m wide each side, a door
+    under wide windows in the middle."""
+    rects = [Rect("door", 6.75, 0.0, 8.25, 2.4, 1)]
+    for j in range(3):
+        y = 0.8 + 3 * j
+        rects += [Rect("window", 1.75, y, 3.25, y + 1.6, 1)]
+        rects += [Rect("window", 11.75, y, 13.25, y + 1.6, 1)]
+        if j:
+            rects += [Rect("window", 6.25, y, 8.75, y + 1.6, 1)]
+    return LabelledLayout(15.0, 9.0, tuple(rects))
+
+
+def test_copied_bays_with_drawn_proportions_keep_the_style(tmp_path: Path) -> None:
+    """Bao et al. 2013 vary a layout's sizes as well as its counts: the source's
+    terminals are given new proportions (a mirrored warp of each axis) and copied again,
+    so a façade with one good way to be copied still has variations that keep its style.
+    At most ``count`` draws are copied, and none once ``count`` layouts keep it."""
+    extraction = _extract(tmp_path, _three_bays())
+    style = extraction.style
+    assert {c.kind for c in style} >= {"symmetry", "centre", "columns"}
+    source, size = (15.0, 9.0), (22.5, 9.0)
+    pieces = derive_at(extraction.grammar, source, *source)
+
+    def kept(found: list[Piece]) -> Kept:
+        boxes = [StyleBox(p.label, p.x0, p.y0, p.x1, p.y1) for p in found]
+        return check(style, facade_of(boxes, *size, "wall"))
+
+    plain = {_key(moved) for moved, _, _ in retargeted(pieces, source, *size, style)}
+    drawn = _proportioned_copies(
+        pieces, source, size, style, random.Random(0), kept, (len(style), 3, set())
+    )
+    assert drawn and all(c.retarget.endswith("; proportions drawn") for c in drawn)
+    assert 1 <= len({c.proportions for c in drawn}) <= 3
+    good = [c for c in drawn if not c.kept.broken]
+    assert any(c.retarget.startswith("x copied") for c in good)
+    assert not {_key(c.pieces) for c in good} & plain  # new layouts, not the plain copies
+    for candidate in good:  # the source's sizes kept for the score
+        assert candidate.score > 0 and all(p.source_w > 0 for p in candidate.pieces)
+    enough = {_key(c.pieces) for c in good[:3]}
+    assert len(enough) < 3 or not _proportioned_copies(
+        pieces, source, size, style, random.Random(0), kept, (len(style), 3, enough)
+    )

@@ -26,6 +26,7 @@ and :func:`place` lays a source interval by a plan.
 
 from __future__ import annotations
 
+import bisect
 import itertools
 import math
 from collections.abc import Sequence
@@ -139,10 +140,12 @@ def mirror(
 
 
 def snapped(points: Sequence[float], at: float, extent: float) -> float:
-    """A cut moved onto the nearest of ``points`` (elements' edges and middles) within
+    """A cut moved onto the nearest of ``points`` (elements' edges and middles, sorted) within
     ``SNAP`` of the extent (so that a hand-drawn façade's bays and mirror images are
     found, and no element is cut a sliver off); else where it is."""
-    near = min(points, key=lambda e: abs(e - at), default=None)
+    i = bisect.bisect_left(points, at)
+    beside = points[max(0, i - 1) : i + 1]  # sorted: the nearest is one of these two
+    near = min(beside, key=lambda e: abs(e - at), default=None)
     return near if near is not None and abs(near - at) <= SNAP * extent else at
 
 
@@ -174,7 +177,7 @@ def scaled(extent: float, new_extent: float) -> Plan | None:
 
 def describe(laid: Sequence[tuple[float, float]], copies: int) -> str:
     """What copying the units ``laid`` does, for people (empty: nothing)."""
-    where = " and ".join(f"{a:.3g}-{b:.3g}" for a, b in sorted(laid))
+    where = " and ".join(f"{round(a, 6):.3g}-{round(b, 6):.3g}" for a, b in sorted(laid))
     return "" if copies == 0 else f"{'left out' if copies < 0 else f'copied {copies}x'}: {where}"
 
 

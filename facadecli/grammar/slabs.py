@@ -6,6 +6,7 @@ derivations in :mod:`facadecli.grammar.variation`, which compares them.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections import defaultdict
 from collections.abc import Sequence
@@ -281,11 +282,20 @@ def _cut(
     :func:`~facadecli.grammar.retarget.shifted`): through elements only where what is cut
     at one end is cut at the other, one unit along, of the same label and height there
     (so a copy puts the halves together again); else between elements."""
-    spans = [(b.x0, b.x1) for b in boxes]
-    cut = retarget.shifted(spans, extent, unit)
+    spans = tuple(sorted((b.x0, b.x1) for b in boxes))
+    cut = _shifted(spans, extent, unit, True)
     if cut is None or all(_rejoined(boxes, stratum, extent, lo, hi) for lo, hi in cut):
         return cut
-    return retarget.shifted(spans, extent, unit, through=False)
+    return _shifted(spans, extent, unit, False)
+
+
+@functools.lru_cache(maxsize=4096)
+def _shifted(
+    spans: tuple[Span, ...], extent: float, unit: tuple[Span, ...], through: bool
+) -> tuple[Span, ...] | None:
+    """:func:`~facadecli.grammar.retarget.shifted`, once for the strata with the same
+    elements across (floors alike): a pure function of its arguments."""
+    return retarget.shifted(spans, extent, unit, through)
 
 
 def _rejoined(boxes: Sequence[Box], stratum: Span, extent: float, lo: float, hi: float) -> bool:

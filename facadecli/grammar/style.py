@@ -122,7 +122,7 @@ def facade_of(tiles: Sequence[Box], width: float, height: float, background: str
     side in a row are joined, then such runs stacked in a column (so a window cut by the
     edges of other elements is one window again)."""
     near = 1e-6 * max(width, height)
-    boxes = [b for b in _cells(tiles, near) if b.label != background]
+    boxes = _cells(tiles, near, background)
     rows = _joined(sorted(boxes, key=lambda b: (b.label, b.y0, b.y1, b.x0)), True, near)
     return Facade(
         tuple(_joined(sorted(rows, key=lambda b: (b.label, b.x0, b.x1, b.y0)), False, near)),
@@ -131,12 +131,14 @@ def facade_of(tiles: Sequence[Box], width: float, height: float, background: str
     )
 
 
-def _cells(tiles: Sequence[Box], near: float) -> list[Box]:
-    """The tiles cut at every edge of every tile."""
+def _cells(tiles: Sequence[Box], near: float, background: str) -> list[Box]:
+    """The tiles cut at every edge of every tile, those of the background left out."""
     xs = _distinct([v for t in tiles for v in (t.x0, t.x1)], near)
     ys = _distinct([v for t in tiles for v in (t.y0, t.y1)], near)
     cells = []
     for label, x0, y0, x1, y1 in tiles:  # the edges within reach, found in the sorted edges
+        if label == background:
+            continue
         inner_x = xs[bisect.bisect_left(xs, x0 - near) : bisect.bisect_right(xs, x1 + near)]
         inner_y = ys[bisect.bisect_left(ys, y0 - near) : bisect.bisect_right(ys, y1 + near)]
         for a, b in itertools.pairwise(inner_x):
@@ -167,7 +169,8 @@ def _joined(boxes: list[Box], along_x: bool, near: float) -> list[Box]:
                 touching = abs(last.y1 - box.y0) <= near
                 matching = abs(last.x0 - box.x0) <= near and abs(last.x1 - box.x1) <= near
             if touching and matching:
-                joined[-1] = last._replace(x1=box.x1) if along_x else last._replace(y1=box.y1)
+                x1, y1 = (box.x1, last.y1) if along_x else (last.x1, box.y1)
+                joined[-1] = Box(last.label, last.x0, last.y0, x1, y1)
                 continue
         joined.append(box)
     return joined

@@ -770,6 +770,14 @@ def derive_variations(
         rng = random.Random(seed)
         draws = _proportions(grammar, source, rng, proportions.DRAWS * count)
         candidates += [candidate({}, None, factors) for factors in draws]
+        if (width, height) != source:  # until enough keep the most of the style
+            size = (width, height)
+            made = [c for c in candidates if c is not None]
+            most = max(len(c.kept.kept) for c in made)
+            good = {_key(c.pieces) for c in made if len(c.kept.kept) >= most}
+            candidates += _proportioned_copies(
+                at_source, source, size, style, random.Random(seed), kept, (most, count, good)
+            )
     # most constraints kept, then the best fit, then nearest the source; the same pieces once
     seen: set[tuple[tuple[str, float, float, float, float], ...]] = set()
     ranked = []
@@ -878,6 +886,67 @@ def _proportions(
             if (axis, number) not in factors:
                 factors[(axis, number)] = proportions.factor(rng)
         found.append(tuple((axis, size, factors[(axis, number)]) for axis, size, number in keys))
+    return found
+
+
+def _proportioned_copies(
+    source_pieces: list[Piece],
+    source: tuple[float, float],
+    size: tuple[float, float],
+    style: Sequence[Constraint],
+    rng: random.Random,
+    kept: Callable[[list[Piece]], Kept],
+    wanted: tuple[int, int, set[tuple[tuple[str, float, float, float, float], ...]]],
+) -> list[_Candidate]:
+    """Whole bays and floors copied (:func:`~facadecli.grammar.slabs.retargeted`) from the
+    source's terminals with new proportions (:func:`facadecli.proportions.warp` along
+    each axis): variations of a copied layout that keep its style, where a façade has
+    one good way to be copied. A draw that keeps less of the style at the source's size
+    is skipped; the pieces keep their sizes in the source, so the score says how far the
+    draw moved them. ``wanted`` = (most, count, good): draws stop once ``count``
+    different layouts keep ``most`` of the style (``good`` holds those found already,
+    :func:`_key`), and after ``count`` copied or ``proportions.DRAWS`` times as many
+    drawn (the work counted in draws, not time)."""
+
+    def kept_at_source(pieces: list[Piece]) -> int:
+        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+        return len(check(style, facade_of(boxes, *source, BACKGROUND)).kept)
+
+    whole = kept_at_source(source_pieces)
+    found: list[_Candidate] = []
+    most, count, good = wanted
+    good = set(good)
+    copied = 0
+    for _ in range(proportions.DRAWS * count):
+        if copied == count or len(good) >= count:
+            break
+        xs, drawn_x = proportions.warp(
+            [(p.x0, p.x1, p.label) for p in source_pieces],
+            source[0],
+            ALIGN * source[0],
+            rng,
+            mirrored=any(c.kind in ("symmetry", "centre") for c in style),
+        )
+        ys, drawn_y = proportions.warp(
+            [(p.y0, p.y1, p.label) for p in source_pieces], source[1], ALIGN * source[1], rng
+        )
+        moved = [
+            replace(p, x0=xs[p.x0], x1=xs[p.x1], y0=ys[p.y0], y1=ys[p.y1]) for p in source_pieces
+        ]
+        if kept_at_source(moved) < whole:
+            continue
+        copied += 1
+        drawn: Proportions = (
+            *(("x", kind, f) for kind, f in drawn_x),
+            *(("y", kind, f) for kind, f in drawn_y),
+        )
+        for pieces, stretch, text in retargeted(moved, source, *size, style):
+            made = f"{text}; proportions drawn"
+            found.append(
+                _Candidate(score(pieces) + stretch, (), None, pieces, kept(pieces), drawn, made)
+            )
+            if len(found[-1].kept.kept) >= most:
+                good.add(_key(pieces))
     return found
 
 
