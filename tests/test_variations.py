@@ -5,10 +5,13 @@ from __future__ import annotations
 
 import itertools
 import random
+import warnings
 from pathlib import Path
 
 import pytest
 
+from facadecli import load_spec
+from facadecli.export.report import report_text
 from facadecli.grammar import slabs
 from facadecli.grammar.run import Extraction, Options, extract_grammar
 from facadecli.grammar.slabs import retargeted
@@ -29,9 +32,11 @@ from facadecli.grammar.variation import (
     likeness,
 )
 from facadecli.layout import Layout
+from facadecli.solve import solve
 from tests.test_grammar import _facade, _floors, _write_plain
 
 Box = tuple[str, float, float, float, float]
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def _symmetric() -> LabelledLayout:
@@ -508,3 +513,43 @@ def test_copied_bays_with_drawn_proportions_keep_the_style(tmp_path: Path) -> No
     assert len(enough) < 3 or not _proportioned_copies(
         pieces, source, size, style, random.Random(0), kept, (len(style), 3, enough)
     )
+
+
+def test_a_stratum_no_unit_can_be_cut_out_of_is_scaled_by_two_at_most(tmp_path: Path) -> None:
+    """The attic of staggered ornaments at twice the width is scaled by 2 while the bays
+    below are copied (cmp_b0010 at 30 m had blank margins instead); wider, it is not."""
+    rects = []
+    for y in (1.0, 4.0, 7.0):
+        rects += [Rect("window", x, y, x + 1.5, y + 1.5, 1) for x in (1.0, 4.0, 7.0, 10.0)]
+    rects += [Rect("deco", x, 9.0, x + 2.6, 9.7, 1) for x in (0.2, 3.4, 6.6, 9.8)]
+    rects += [Rect("sign", x, 9.4, x + 1.5, 10.0, 2) for x in (2.4, 5.6, 8.8)]
+    source = (12.5, 10.0)
+    extraction = _extract(tmp_path, LabelledLayout(*source, tuple(rects)))
+    pieces = derive_at(extraction.grammar, source, *source)
+
+    def copied(width: float) -> list[list[Piece]]:
+        laid = retargeted(pieces, source, width, 10.0, extraction.style)
+        return [moved for moved, _, text in laid if text.startswith("x copied")]
+
+    wide = copied(25.0)
+    assert wide
+    for moved in wide:
+        signs = [p for p in moved if p.label == "sign"]
+        assert len(signs) == 3 and all(p.x1 - p.x0 == pytest.approx(2 * p.source_w) for p in signs)
+        windows = [p.x1 - p.x0 for p in moved if p.label == "window"]
+        assert len(windows) > 12 and all(w <= 1.5 * 1.1 for w in windows)
+    assert not copied(26.0)  # the attic would be scaled by 2.08
+
+
+def test_variations_print_no_solver_warnings(tmp_path: Path) -> None:
+    """The townhouse derived at 30 x 12 m (3.2 times its width): an alignment attempt that
+    fails made cvxpy warn of an overflow evaluating its objective, on the user's terminal;
+    the attempt's status says it failed, and nothing is printed."""
+    layout = solve(load_spec(ROOT / "specs" / "townhouse.yaml"))
+    path = tmp_path / "house.layout.json"
+    path.write_text(report_text(layout, timings=False))
+    extraction = extract_grammar(path, Options(iterations=150))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        variations = _draw(extraction, (30.0, 12.0), 6)
+    assert len(variations) == 6

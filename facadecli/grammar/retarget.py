@@ -166,11 +166,12 @@ def copied(
     return _laid(blocks, extent, new_extent, stretches, describe(laid, copies))
 
 
-def scaled(extent: float, new_extent: float) -> Plan | None:
+def scaled(extent: float, new_extent: float, most: float = SQUEEZE_MOST) -> Plan | None:
     """The source scaled alike to ``new_extent``, its elements too (None beyond what an
-    element may be squeezed or stretched by: ``SQUEEZE_MOST`` either way)."""
+    element may be squeezed or stretched by: ``most`` either way, ``SQUEEZE_MOST`` unless
+    said)."""
     alike = new_extent / extent
-    if not 1 / SQUEEZE_MOST <= alike <= SQUEEZE_MOST:
+    if not 1 / most <= alike <= most:
         return None
     return Plan((Segment(0.0, extent, alike),), "scaled")
 

@@ -19,6 +19,7 @@ from facadecli.grammar.tiling import BACKGROUND
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
 PIECES_MOST = 20_000  # pieces a copied layout would have at most (more: none is made)
 SCALED_MOST = 0.25  # of the height: strata a unit cannot be cut out of, scaled alike instead
+SCALED_ACROSS = 2.0  # ... by this at most, either way (an attic of ornaments at twice the width)
 LAID_MOST = 60_000  # pieces laid over all the copied layouts (the rest are not made)
 HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see _halves_joined)
 
@@ -44,13 +45,13 @@ def retargeted(
     pilasters where a copy puts their halves together again, :func:`_cut`); a stratum
     that cannot be cut near it (a ground floor of shops) is stretched instead, so
     the floors above keep their columns whatever the ground floor does (where its wall
-    cannot take the width, it is scaled alike, by 1.5 at most, if such strata are at
-    most ``SCALED_MOST`` of the height: an attic of staggered ornaments). The units tried
-    first hold a column of the style's (one pitch of it, centred on a column, is a period
-    by construction), then those that most strata can be cut at. Every stratum stretches
-    the wall that is wall in all of them, so strata cut alike stay lined up. ``style``
-    gives the columns and whether the façade is mirrored (units are then copied with
-    their mirror images)."""
+    cannot take the width, it is scaled alike, by ``SCALED_ACROSS`` at most, if such
+    strata are at most ``SCALED_MOST`` of the height: an attic of staggered ornaments).
+    The units tried first hold a column of the style's (one pitch of it, centred on a
+    column, is a period by construction), then those that most strata can be cut at.
+    Every stratum stretches the wall that is wall in all of them, so strata cut alike
+    stay lined up. ``style`` gives the columns and whether the façade is mirrored (units
+    are then copied with their mirror images)."""
     grown = max(1.0, width / source[0]) * max(1.0, height / source[1])
     if (width, height) == source or len(pieces) * grown > PIECES_MOST:
         return []
@@ -248,7 +249,9 @@ def _bays(
             plans[(cut, copies)] = retarget.copied(every, extent, width, cut, copies)
         return plans[(cut, copies)]
 
-    scaled_across = retarget.scaled(extent, width)  # a stratum no unit can be cut out of
+    scaled_across = retarget.scaled(
+        extent, width, SCALED_ACROSS
+    )  # a stratum no unit can be cut out of
     found = []
     for unit, copies in [((), 0)] + [
         (u, c)

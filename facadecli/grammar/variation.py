@@ -442,6 +442,8 @@ def _align_axis(
         try:
             with warnings_module.catch_warnings():  # "may be inaccurate": the style is checked
                 warnings_module.simplefilter("ignore", UserWarning)
+                # overflow evaluating the objective of an attempt that failed: its status says
+                warnings_module.simplefilter("ignore", RuntimeWarning)
                 problem.solve(solver=cp.CLARABEL)
         except cp.error.SolverError:
             continue
