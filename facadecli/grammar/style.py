@@ -75,17 +75,13 @@ class Facade:
         each left to right."""
         near = TOLERANCE * self.height
         found: list[list[Box]] = []
+        open_rows: list[list[Box]] = []  # those a box further up may still join, in order
         for box in sorted((b for b in self.boxes if b.label == label), key=lambda b: (b.y0, b.y1)):
-            row = next(
-                (
-                    r
-                    for r in found
-                    if abs(r[0].y0 - box.y0) <= near and abs(r[0].y1 - box.y1) <= near
-                ),
-                None,
-            )
+            open_rows = [r for r in open_rows if r[0].y0 >= box.y0 - near]
+            row = next((r for r in open_rows if abs(r[0].y1 - box.y1) <= near), None)
             if row is None:
                 found.append([box])
+                open_rows.append(found[-1])
             else:
                 row.append(box)
         return [sorted(row, key=lambda b: b.x0) for row in found]
