@@ -445,17 +445,23 @@ def test_floors_whose_rows_make_no_pitch_are_copied_between_the_gaps() -> None:
     assert all(text.endswith((": 3.5-6", ": 3.5-8.5")) for text in copied)  # never 0-3, 9-10
 
 
-def test_a_stratum_no_unit_can_be_cut_out_of_is_scaled_alike(tmp_path: Path) -> None:
-    """Three floors of four windows under an attic of staggered ornaments that leave no
-    cut (nor one a bay along): a bay is still copied through the floors, and the attic,
-    a tenth of the height, is scaled alike across instead."""
+def _under_an_attic() -> LabelledLayout:
+    """Three floors of four windows, 12.5 x 10 m, under an attic of staggered ornaments
+    that leave no cut (nor one a bay along)."""
     rects = []
     for y in (1.0, 4.0, 7.0):
         rects += [Rect("window", x, y, x + 1.5, y + 1.5, 1) for x in (1.0, 4.0, 7.0, 10.0)]
     rects += [Rect("deco", x, 9.0, x + 2.6, 9.7, 1) for x in (0.2, 3.4, 6.6, 9.8)]
     rects += [Rect("sign", x, 9.4, x + 1.5, 10.0, 2) for x in (2.4, 5.6, 8.8)]
+    return LabelledLayout(12.5, 10.0, tuple(rects))
+
+
+def test_a_stratum_no_unit_can_be_cut_out_of_is_scaled_alike(tmp_path: Path) -> None:
+    """Three floors of four windows under an attic of staggered ornaments that leave no
+    cut (nor one a bay along): a bay is still copied through the floors, and the attic,
+    a tenth of the height, is scaled alike across instead."""
     source = (12.5, 10.0)
-    extraction = _extract(tmp_path, LabelledLayout(*source, tuple(rects)))
+    extraction = _extract(tmp_path, _under_an_attic())
     pieces = derive_at(extraction.grammar, source, *source)
     laid = {
         text: moved for moved, _, text in retargeted(pieces, source, 15.0, 10.0, extraction.style)
@@ -518,13 +524,8 @@ def test_copied_bays_with_drawn_proportions_keep_the_style(tmp_path: Path) -> No
 def test_a_stratum_no_unit_can_be_cut_out_of_is_scaled_by_two_at_most(tmp_path: Path) -> None:
     """The attic of staggered ornaments at twice the width is scaled by 2 while the bays
     below are copied (cmp_b0010 at 30 m had blank margins instead); wider, it is not."""
-    rects = []
-    for y in (1.0, 4.0, 7.0):
-        rects += [Rect("window", x, y, x + 1.5, y + 1.5, 1) for x in (1.0, 4.0, 7.0, 10.0)]
-    rects += [Rect("deco", x, 9.0, x + 2.6, 9.7, 1) for x in (0.2, 3.4, 6.6, 9.8)]
-    rects += [Rect("sign", x, 9.4, x + 1.5, 10.0, 2) for x in (2.4, 5.6, 8.8)]
     source = (12.5, 10.0)
-    extraction = _extract(tmp_path, LabelledLayout(*source, tuple(rects)))
+    extraction = _extract(tmp_path, _under_an_attic())
     pieces = derive_at(extraction.grammar, source, *source)
 
     def copied(width: float) -> list[list[Piece]]:
