@@ -89,6 +89,33 @@ def test_a_band_across_the_facade_is_on_no_column() -> None:
     assert all(c.other != "cornice" for c in style)  # and no axis of anything
 
 
+def test_an_ornament_across_bays_is_on_no_column_with_the_awnings_under_it() -> None:
+    """cmp_b0007: two awnings over the middle window column and an attic ornament 47%
+    of the width centred over them made "3 rows of deco on the same column"; copying a
+    bay adds awnings but not the attic's ornament, so every copy broke it. An element
+    wider than 40% of the façade spans bays: it is on no column (the centre line keeps
+    it centred)."""
+    awnings = [Box("deco", 4.8, y, 6.6, y + 0.4) for y in (5.2, 7.7)]
+    ornament = [Box("deco", 3.0, 9.6, 8.4, 9.9)]  # 5.4 of 11.4 m
+    style = find_style(facade_of(_palazzo() + awnings + ornament, 11.4, 10.0, BACKGROUND))
+    (columns,) = [c for c in style if c.kind == "columns" and c.label == "deco"]
+    assert columns.rows == 2  # the awnings alone
+    assert ("centre", "deco") in _kinds(style)
+
+
+def test_a_window_stretched_across_bays_in_a_derived_layout_is_still_checked() -> None:
+    """A derived layout whose top floor is one window 5 m wide (44% of the façade, wider
+    than the input's bands) does not keep the windows' columns: in a derived layout
+    only elements of half the width or more are bands."""
+    palazzo = _palazzo()
+    style = find_style(facade_of(palazzo, 11.4, 10.0, BACKGROUND))
+    assert ("columns", "window") in _kinds(style)
+    top = [b for b in palazzo if b.label == "window" and b.y0 == 8.5]
+    stretched = [b for b in palazzo if b not in top] + [Box("window", 1.5, 8.5, 6.5, 10.1)]
+    kept = check(style, facade_of(stretched, 11.4, 10.2, BACKGROUND))
+    assert ("columns", "window") in {(c.kind, c.label) for c in kept.broken}
+
+
 def test_spacing_is_of_elements_as_wide_as_each_other() -> None:
     def balconies(*boxes: tuple[float, float]) -> list[Box]:
         return [Box("balcony", x0, 3.0, x1, 3.5) for x0, x1 in boxes]

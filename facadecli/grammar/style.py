@@ -5,9 +5,10 @@ Found on the (regularised) input, over its elements (the background is not one):
 
 - ``symmetry``: the elements are mirror images of each other about the vertical centre line
   (at least ``MIRRORED`` of them have a partner of their label);
-- ``columns``: rows of one label (elements at one height, narrower than half the façade:
-  a band across it is on no column) whose centres are the same set of columns, floor
-  after floor;
+- ``columns``: rows of one label (elements at one height, narrower than ``BAND`` of the
+  façade: an element across bays, an attic's ornament, is on no column) whose centres are
+  the same set of columns, floor after floor (checked on a derived layout over elements
+  narrower than ``CHECKED_BAND``: an element stretched there is not let off);
 - ``axis``: every element of another label (narrower than half the façade) is centred on
   one of those columns (a door under a window column: Bao's Figure 16);
 - ``spacing``: rows of three or more elements of one label and width at one pitch (a
@@ -37,6 +38,8 @@ from facadecli.grammar.tiling import BACKGROUND, Tiling
 SKIPPED = 1  # places of a row's pitch that may be empty between two elements
 TOLERANCE = 0.01  # of the façade's extent along the axis compared
 MIRRORED = 0.9  # share of the elements with a mirror partner for a symmetric façade
+BAND = 0.4  # of the input's width: a wider element is a band across bays, on no column
+CHECKED_BAND = 0.5  # ... of a derived layout's (an element stretched there is still checked)
 
 
 class Box(NamedTuple):
@@ -214,10 +217,13 @@ def _even(row: list[Box], near: float) -> bool:
     return all(on_pitch) and sum(abs(p - pitch) <= near for p in pitches) >= 2
 
 
-def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
-    """The largest set of a label's rows on the same columns, and how many rows it has."""
+def _shared_columns(
+    facade: Facade, label: str, band: float = CHECKED_BAND
+) -> tuple[list[list[Box]], int]:
+    """The largest set of a label's rows on the same columns, and how many rows it has
+    (elements ``band`` of the façade's width or wider left out)."""
     near = TOLERANCE * facade.width
-    rows = _column_rows(facade, label)
+    rows = _column_rows(facade, label, band)
     groups: list[list[list[Box]]] = []
     for row in rows:
         group = next((g for g in groups if _same(_centres(g[0]), _centres(row), near)), None)
@@ -228,9 +234,9 @@ def _shared_columns(facade: Facade, label: str) -> tuple[list[list[Box]], int]:
     return max(groups, key=len, default=[]), len(rows)
 
 
-def _column_rows(facade: Facade, label: str) -> list[list[Box]]:
+def _column_rows(facade: Facade, label: str, band: float = CHECKED_BAND) -> list[list[Box]]:
     """A label's rows, bands across the façade left out (a band is on no column)."""
-    narrow = ([b for b in row if b.x1 - b.x0 < facade.width / 2] for row in facade.rows(label))
+    narrow = ([b for b in row if b.x1 - b.x0 < band * facade.width] for row in facade.rows(label))
     return [row for row in narrow if row]
 
 
@@ -279,7 +285,7 @@ def find_style(facade: Facade) -> list[Constraint]:
     labels = sorted({b.label for b in facade.boxes})
     columned = []
     for label in labels:
-        best, rows = _shared_columns(facade, label)
+        best, rows = _shared_columns(facade, label, BAND)
         if len(best) >= 2:
             text = f"{len(best)} of {rows} rows of {label} on the same {len(best[0])} columns"
             found.append(Constraint("columns", label, text, len(best) / rows, rows=len(best)))
@@ -324,7 +330,7 @@ def holds(constraint: Constraint, facade: Facade) -> bool:
     if kind == "axis":
         best, _ = _shared_columns(facade, constraint.other)
         centres = _centres(best[0]) if best else []
-        narrow = [b for b in boxes if b.x1 - b.x0 < facade.width / 2]
+        narrow = [b for b in boxes if b.x1 - b.x0 < CHECKED_BAND * facade.width]
         return bool(narrow) and all(any(abs(_cx(b) - c) <= near for c in centres) for b in narrow)
     raise ValueError(f"unknown constraint kind {kind!r}")
 
@@ -356,7 +362,7 @@ def equations(style: Sequence[Constraint], facade: Facade, near: float) -> list[
         elif constraint.kind == "axis":
             best, _ = _shared_columns(facade, constraint.other)
             columns = best[0] if best else []
-            for box in (b for b in boxes if b.x1 - b.x0 < width / 2):
+            for box in (b for b in boxes if b.x1 - b.x0 < CHECKED_BAND * width):
                 column = min(columns, key=lambda c: abs(_cx(c) - _cx(box)), default=None)
                 if column is not None and 0 < abs(_cx(column) - _cx(box)) <= near:
                     found.append((_same_centre(box, column), 0.0))
