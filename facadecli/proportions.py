@@ -6,7 +6,9 @@ A factor's log is drawn from N(0, ``SPREAD``) and cut at ``MOST``, so sizes stay
 0.9 to 1.1 times their own. Sizes close to each other (``size_classes``; the caller says
 how close) form one *class* and get one factor: what was as long as something else still
 is (columns over columns, mirrored halves, floors of one kind), and hand-drawn sizes a
-little apart do not drift further apart.
+little apart do not drift further apart. ``warp`` draws the same factors for a layout
+already laid out (the stretches between its edges), so that its bays can then be copied
+with new proportions (``facade grammar --variations``).
 """
 
 from __future__ import annotations

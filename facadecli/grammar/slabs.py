@@ -249,9 +249,8 @@ def _bays(
             plans[(cut, copies)] = retarget.copied(every, extent, width, cut, copies)
         return plans[(cut, copies)]
 
-    scaled_across = retarget.scaled(
-        extent, width, SCALED_ACROSS
-    )  # a stratum no unit can be cut out of
+    # a stratum no unit can be cut out of
+    scaled_across = retarget.scaled(extent, width, SCALED_ACROSS)
     found = []
     for unit, copies in [((), 0)] + [
         (u, c)
