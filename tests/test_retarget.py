@@ -31,6 +31,19 @@ def test_a_copied_unit_lays_its_elements_twice_and_lengthens_a_band_across_it() 
     assert retarget.place(plan, 0.0, 7.0) == [(0.0, 9.0)]  # a band: one, longer
 
 
+def test_an_element_across_bays_is_a_band_that_a_cut_may_cross() -> None:
+    """cmp_b0003's attic molding runs 44% of the width, over one building and half the
+    next: at 40% of the width or longer an element is a band (as the style counts it),
+    so a unit may be cut through it and the copy lengthens it; the attic then gains the
+    bays the floors gain instead of being scaled."""
+    spans = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0), (2.2, 8.8)]  # the last: 6.6 of 15
+    assert retarget.cuttable(spans, 15.0, 2.5, 4.5)  # through the molding at both ends
+    plan = retarget.copied(spans, 15.0, 17.0, [(2.5, 4.5)], 1)
+    assert plan is not None
+    assert retarget.place(plan, 2.2, 8.8) == [(2.2, 10.8)]  # one, 2 m longer
+    assert retarget.place(plan, 3.0, 4.0) == [(3.0, 4.0), (5.0, 6.0)]
+
+
 def test_a_unit_left_out_takes_its_elements_with_it() -> None:
     plan = retarget.copied(ROW, 7.0, 5.0, [(2.5, 4.5)], -1)
     assert plan is not None

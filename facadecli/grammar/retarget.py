@@ -32,7 +32,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-BAND = 0.5  # of the extent: a longer element is a band, which a copy lengthens
+BAND = 0.4  # of the extent: a longer element is a band across bays, which a copy lengthens
 UNIT_BLOCKS = 3  # blocks a unit holds at most
 UNITS_TRIED = 6  # units made into plans, the most regular first
 GAPS_LEAST = 0.5  # of their source size: gaps squeezed further squeeze everything instead

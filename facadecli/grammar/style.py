@@ -33,12 +33,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from facadecli.grammar import retarget
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
 SKIPPED = 1  # places of a row's pitch that may be empty between two elements
 TOLERANCE = 0.01  # of the façade's extent along the axis compared
 MIRRORED = 0.9  # share of the elements with a mirror partner for a symmetric façade
-BAND = 0.4  # of the input's width: a wider element is a band across bays, on no column
+BAND = retarget.BAND  # of the input's width: a wider element is a band, on no column
 CHECKED_BAND = 0.5  # ... of a derived layout's (an element stretched there is still checked)
 
 
