@@ -17,7 +17,7 @@ from facadecli.grammar.regularize import regularize
 from facadecli.grammar.run import Options, extract_grammar
 from facadecli.grammar.style import Box, check, facade_of, find_style, holds
 from facadecli.grammar.tiling import LabelledLayout, Rect
-from facadecli.grammar.variation import Piece, align, derive_variations
+from facadecli.grammar.variation import Piece, align, derive_at, derive_variations
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -268,3 +268,19 @@ def test_variations_shuffle_parts_of_one_size_and_the_first_keeps_the_style(
         doors = [s for s in variation.layout.shapes if s.layer == "door" and s.visible]
         assert doors and all(abs(s.x0 + s.x1 - 11.4) > 1.0 for s in doors)
         assert len(variation.kept.broken) >= 1  # off the centre line
+
+
+def test_a_layout_derived_at_its_own_size_is_the_input(tmp_path: Path) -> None:
+    """At the input's size the best fit re-derives the input; the tidying QP is not run
+    there (on cmp_b0001 it halved every window, keeping as much of the style): a door
+    drawn a little off the centre line stays where it was drawn."""
+    boxes = [b for b in _palazzo() if b.label != "door"] + [Box("door", 5.2, 0.0, 6.4, 2.6)]
+    extraction = _extracted(tmp_path, boxes, 11.4, 10.0)
+    assert ("centre", "door") in _kinds(extraction.style)  # 0.05 m off: near enough
+    source = derive_at(extraction.grammar, (11.4, 10.0), 11.4, 10.0)
+    found, _ = derive_variations(
+        extraction.grammar, extraction.tiling, 11.4, 10.0, "p", 1, 0, extraction.style
+    )
+    assert sorted(found[0].pieces, key=str) == sorted(source, key=str)
+    door = next(p for p in found[0].pieces if p.label == "door")
+    assert (door.x0, door.x1) == pytest.approx((5.2, 6.4))

@@ -795,8 +795,12 @@ def derive_variations(
         next((c for c in ranked if not c.proportions and bool(c.retarget) is copied), None)
         for copied in (False, True)
     ]
+    # at the input's own size the best fit is the input itself: nothing to tidy (the QP
+    # once halved cmp_b0001's windows there, keeping as much of the style)
     tidied = [
-        (c, *_tidied(c.pieces, c.kept, kept, width, height, style, bool(c.retarget)))
+        (c, c.pieces, [], c.kept)
+        if (width, height) == source and not c.offsets and c.shuffle is None
+        else (c, *_tidied(c.pieces, c.kept, kept, width, height, style, bool(c.retarget)))
         for c in finalists
         if c is not None
     ]
