@@ -46,6 +46,7 @@ from facadecli.grammar.style import (
     Box,
     Constraint,
     Equation,
+    Facade,
     Kept,
     check,
     equations,
@@ -689,6 +690,12 @@ def likeness(pieces: list[Piece]) -> float:
     return sum(a * _misfit(p) for a, p in weighted) / area if area else 0.0
 
 
+def _facade(pieces: Sequence[Piece], width: float, height: float) -> Facade:
+    """A derivation's elements, to check the style on."""
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    return facade_of(boxes, width, height, BACKGROUND)
+
+
 def _key(pieces: list[Piece]) -> tuple[tuple[str, float, float, float, float], ...]:
     """The pieces as they would be written (to tell two derivations apart)."""
     return tuple(
@@ -731,8 +738,7 @@ def derive_variations(
         return stem if count == 1 else f"{stem}-v{k}"
 
     def kept(pieces: list[Piece]) -> Kept:
-        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-        return check(style, facade_of(boxes, width, height, BACKGROUND))
+        return check(style, _facade(pieces, width, height))
 
     def candidate(
         offsets: dict[str, int], shuffle: Shuffle | None = None, drawn: Proportions = ()
@@ -915,8 +921,7 @@ def _proportioned_copies(
     drawn (the work counted in draws, not time)."""
 
     def kept_at_source(pieces: list[Piece]) -> int:
-        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-        return len(check(style, facade_of(boxes, *source, BACKGROUND)).kept)
+        return len(check(style, _facade(pieces, *source)).kept)
 
     whole = kept_at_source(source_pieces)
     found: list[_Candidate] = []
