@@ -234,3 +234,79 @@ def test_no_facade_is_laid_out_anew_many_times_its_size() -> None:
     assert retargeted(pieces, (5.0, 4.0), 10.0, 4.0, style)
     grown = slabs.PIECES_MOST / len(pieces) + 1  # times the area
     assert retargeted(pieces, (5.0, 4.0), 5.0 * grown, 4.0, style) == []
+
+
+def test_a_level_is_where_hand_drawn_floors_overlap_by_a_sliver() -> None:
+    """cmp_b0010's cornice runs 10 cm into the next floor's molding, so every cut across
+    the façade crosses something; a cut that only trims slivers (at most ``SLIVER`` of the
+    extent and ``SLIVER_PART`` of the element: 8 cm here) is a level, the one that trims
+    least."""
+    cornice_in_two = [(1.0, 2.88), (2.8, 3.3), (2.8, 3.3), (3.3, 5.2)]
+    assert retarget.levels(cornice_in_two, 10.0) == [pytest.approx(2.8)]  # the window trimmed
+    assert retarget.levels([(1.0, 2.9), (2.6, 3.3)], 10.0) == []  # 30 cm: no sliver
+    assert retarget.levels([(1.0, 2.8), (2.8, 3.3)], 10.0) == []  # cut there already
+
+
+def _floor(x0: float, x1: float, y: float, ledge: float, window: float) -> list[Piece]:
+    """A floor of one bay: a ledge across it, then a window between wall, up to ``window``."""
+    pieces = [Piece("ledge", x0, y, x1, y + ledge, x1 - x0, ledge)]
+    top, middle = y + ledge, (x0 + x1) / 2
+    for a, b, label in (
+        (x0, middle - 0.8, BACKGROUND),
+        (middle - 0.8, middle + 0.8, "window"),
+        (middle + 0.8, x1, BACKGROUND),
+    ):
+        pieces.append(Piece(label, a, top, b, window, b - a, window - top))
+    return pieces
+
+
+def _two_buildings() -> list[Piece]:
+    """Two buildings side by side, 8 x 11 m: floors 2.5 m apart on the left, 3 m on the
+    right, each floor a ledge and a window up to the next (no floor can be cut across
+    both, nor through one where the other's windows would come apart)."""
+    pieces = [
+        Piece(BACKGROUND, 0.0, 0.0, 4.0, 2.5, 4.0, 2.5),
+        Piece(BACKGROUND, 4.0, 0.0, 8.0, 2.0, 4.0, 2.0),
+    ]
+    for y in (2.5, 5.0, 7.5):
+        pieces += _floor(0.0, 4.0, y, 0.3, y + 2.5)
+    pieces.append(Piece(BACKGROUND, 0.0, 10.0, 4.0, 11.0, 4.0, 1.0))
+    for y in (2.0, 5.0, 8.0):
+        pieces += _floor(4.0, 8.0, y, 0.3, y + 3.0)
+    return pieces
+
+
+def test_a_row_of_buildings_whose_floors_differ_gains_floors_building_by_building() -> None:
+    """cmp_b0003 is three buildings whose floors are at different heights: taller, each
+    copies its own middle floor (the ends of a label's rows are a ground floor or an
+    attic), and the two stay side by side."""
+    pieces = _two_buildings()
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    style = find_style(facade_of(boxes, 8.0, 11.0, BACKGROUND))
+    laid = retargeted(pieces, (8.0, 11.0), 8.0, 16.5, style)
+    by_buildings = [(moved, text) for moved, _, text in laid if text.startswith("by buildings")]
+    assert by_buildings, [text for _, _, text in laid]
+    moved, text = by_buildings[0]
+    windows = [p for p in moved if p.label == "window"]
+    assert sum(p.x1 <= 4.0 for p in windows) == 5 and sum(p.x0 >= 4.0 for p in windows) == 5, text
+    for p in windows:  # copies, not taller windows, fill the height
+        own = 2.2 if p.x1 <= 4.0 else 2.7
+        assert own / retarget.WIDEN_MOST <= p.y1 - p.y0 <= own * retarget.WIDEN_MOST, text
+    assert not any(text.startswith("y ") for _, _, text in laid)  # none across both
+
+
+def test_what_goes_on_a_sliver_past_a_level_is_trimmed_and_made_wall() -> None:
+    """The window on the left runs 8 cm past the floor the cornice on the right starts: it
+    is trimmed to that level and the 8 cm become wall, so the façade stays tiled."""
+    pieces = [
+        Piece("window", 0.0, 0.0, 1.0, 2.08, 1.0, 2.08),
+        Piece("cornice", 0.0, 2.08, 1.0, 2.5, 1.0, 0.42),
+        Piece("window", 1.0, 0.0, 2.0, 2.0, 1.0, 2.0),
+        Piece("cornice", 1.0, 2.0, 2.0, 2.5, 1.0, 0.5),
+        Piece(BACKGROUND, 0.0, 2.5, 2.0, 10.0, 2.0, 7.5),
+    ]
+    levelled = slabs._levelled(pieces, (2.0, 10.0))
+    assert Piece("window", 0.0, 0.0, 1.0, 2.0, 1.0, 2.08) in levelled
+    assert Piece(BACKGROUND, 0.0, 2.0, 1.0, 2.08, 1.0, pytest.approx(0.08)) in levelled
+    assert sum((p.x1 - p.x0) * (p.y1 - p.y0) for p in levelled) == pytest.approx(20.0)
+    assert slabs._levelled(pieces, (2.0, 2.5)) == pieces  # 8 cm is no sliver of 2.5 m

@@ -32,6 +32,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 BAND = 0.4  # of the extent: a longer element is a band across bays, which a copy lengthens
 UNIT_BLOCKS = 3  # blocks a unit holds at most
 UNITS_TRIED = 6  # units made into plans, the most regular first
@@ -43,6 +45,8 @@ NEAR = 1e-9  # of the extent: spans closer than this touch
 SNAP = 1e-3  # of the extent: a cut this near an element's edge is moved onto it
 ALIKE = 0.02  # of the extent: elements cut at both ends of a unit this near one unit apart
 ALIKE_PART = 0.05  # ... and this near, of their length
+SLIVER = 0.01  # of the extent: an element that goes on this little past a cut (and at most
+SLIVER_PART = 0.25  # ... this much of its length) is trimmed to it (see :func:`levels`)
 
 
 @dataclass(frozen=True)
@@ -123,6 +127,30 @@ def _cut_points(spans: Sequence[tuple[float, float]], extent: float) -> list[flo
     """Where a cut may go: the elements' edges and middles (bands aside)."""
     kept = [(lo, hi) for lo, hi in spans if hi - lo < BAND * extent]
     return sorted({v for lo, hi in kept for v in (lo, hi, (lo + hi) / 2)})
+
+
+def levels(spans: Sequence[tuple[float, float]], extent: float) -> list[float]:
+    """Where the façade can be cut across once the elements that go on a sliver past the
+    cut are trimmed to it (a hand-drawn cornice that overlaps the next floor's molding by a
+    hand's breadth): at most ``SLIVER`` of the extent and ``SLIVER_PART`` of their length
+    past it; of such cuts near each other (within twice that), the one that trims least.
+    Cuts that cross no element are not levels: they are there already."""
+    kept = np.array([(lo, hi) for lo, hi in spans if hi - lo < BAND * extent]).reshape(-1, 2)
+    lo, hi = kept[:, 0], kept[:, 1]
+    trimmed = []
+    for at in _cut_points(spans, extent):
+        crossed = (lo + NEAR * extent < at) & (at < hi - NEAR * extent)
+        past = np.minimum(at - lo, hi - at)[crossed]
+        most = np.minimum(SLIVER * extent, SLIVER_PART * (hi - lo)[crossed])
+        if past.size and bool(np.all(past <= most)):
+            trimmed.append((float(past.sum()), at))
+    clean = [v for block in blocks_of(spans, extent) for v in block]
+    found: list[float] = []
+    near = 2 * SLIVER * extent
+    for _, at in sorted(trimmed):
+        if all(abs(at - v) > near for v in [*found, *clean]):
+            found.append(at)
+    return sorted(found)
 
 
 def mirror(

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 from facadecli.grammar import retarget
 from facadecli.grammar.pieces import Piece
-from facadecli.grammar.style import Box, Constraint, facade_of, shared_rows
+from facadecli.grammar.style import Box, Constraint, Facade, facade_of, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
@@ -22,6 +22,7 @@ SCALED_MOST = 0.25  # of the height: strata a unit cannot be cut out of, scaled 
 SCALED_ACROSS = 2.0  # ... by this at most, either way (an attic of ornaments at twice the width)
 LAID_MOST = 60_000  # pieces laid over all the copied layouts (the rest are not made)
 HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see _halves_joined)
+BUILDINGS_TRIED = 64  # stretches of the width looked at for a building's floors, at most
 
 Span = tuple[float, float]
 
@@ -51,10 +52,17 @@ def retargeted(
     column, is a period by construction), then those that most strata can be cut at.
     Every stratum stretches the wall that is wall in all of them, so strata cut alike
     stay lined up. ``style`` gives the columns and whether the façade is mirrored (units
-    are then copied with their mirror images)."""
+    are then copied with their mirror images).
+
+    Taller, the floors are cut where hand-drawn floors overlap by a sliver, the sliver
+    trimmed (:func:`_levelled`); where no floor can be cut across the whole width and
+    only the height changes, each building of a row of them gains its own floors
+    (:func:`_by_buildings`)."""
     grown = max(1.0, width / source[0]) * max(1.0, height / source[1])
     if (width, height) == source or len(pieces) * grown > PIECES_MOST:
         return []
+    if height != source[1]:  # floors cut where hand-drawn floors overlap by a sliver
+        pieces = _levelled(pieces, source)
     boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
     facade = facade_of(boxes, *source, BACKGROUND)
     joined = facade.boxes
@@ -82,6 +90,11 @@ def retargeted(
     if scaled_up is not None and not any(plan.text == "" for plan in along):
         along.append(scaled_up)
     budget = LAID_MOST
+    if width == source[0] and not any(plan.text for plan in floors):
+        # no floor across the whole width: each building of a row of them its own floors
+        for layout in _by_buildings(pieces, facade, in_floors, in_bays, source, height, style):
+            budget -= len(layout[0])
+            laid.append(layout)
     for (text_x, strata, across), along_y in itertools.product(bays, along):
         if along_y is scaled_up and not text_x:
             continue
@@ -107,6 +120,119 @@ def retargeted(
         texts = [t for t in (text_x, f"y {along_y.text}" if along_y.text else "") if t]
         laid.append((moved, stretch, "; ".join(texts) or "stretched"))
     return laid
+
+
+def _by_buildings(
+    pieces: list[Piece],
+    facade: Facade,
+    in_floors: Sequence[Box],
+    in_bays: Sequence[Box],
+    source: tuple[float, float],
+    height: float,
+    style: Sequence[Constraint],
+) -> list[tuple[list[Piece], float, str]]:
+    """The façade made ``height`` tall with floors copied building by building, for a row
+    of buildings whose floors are at different heights (no floor can be cut across the
+    whole width): cut up the façade where no element crosses (``in_bays``: bands across
+    aside), into buildings from the left, each as wide as lets it copy a floor of its own
+    (see :func:`_floors`, with the style's rows in it); a layout of the k-th plan of each
+    (its last where it has fewer), for the first ``RETARGETS_MAX``. None where some
+    building has no floor to copy, or the whole width is one building, or more than
+    ``BUILDINGS_TRIED`` stretches were looked at (a budget counted in work)."""
+    strata = retarget.strata([(b.x0, b.x1) for b in in_bays], source[0])
+    ends = [0.0, *(hi for _, hi in strata)]
+    labels = [c.label for c in style if c.kind == "columns"]
+
+    def floors_of(lo: float, hi: float) -> list[retarget.Plan]:
+        here = [b for b in in_floors if b.x0 < hi and b.x1 > lo]
+        part = Facade(tuple(b for b in facade.boxes if lo <= (b.x0 + b.x1) / 2 <= hi), *source)
+        rows = [
+            sorted((r[0].y0 + r[0].y1) / 2 for r in group)
+            for group in (shared_rows(part, label) for label in labels)
+            if group
+        ]
+        return [plan for plan in _floors(here, source[1], height, rows) if plan.text]
+
+    buildings: list[tuple[float, float, list[retarget.Plan]]] = []
+    tried, i = 0, 0
+    while i < len(ends) - 1:
+        for j in range(len(ends) - 1, i, -1):
+            tried += 1
+            if tried > BUILDINGS_TRIED:
+                return []
+            plans = floors_of(ends[i], ends[j])
+            if plans:
+                buildings.append((ends[i], ends[j], plans))
+                break
+        else:
+            return []
+        i = j
+    if len(buildings) < 2:
+        return []
+    laid = []
+    for k in range(RETARGETS_MAX):
+        if k and all(k >= len(plans) for _, _, plans in buildings):
+            break
+        chosen = [(lo, hi, plans[min(k, len(plans) - 1)]) for lo, hi, plans in buildings]
+        moved = [
+            Piece(p.label, max(p.x0, lo), y0, min(p.x1, hi), y1, p.source_w, p.source_h)
+            for p in pieces
+            for lo, hi, plan in chosen
+            if p.x0 < hi and p.x1 > lo
+            for y0, y1 in retarget.place(plan, p.y0, p.y1)
+        ]
+        stretch = max(plan.stretch for _, _, plan in chosen) ** 2
+        text = "; ".join(f"{lo:.3g}-{hi:.3g}: y {plan.text}" for lo, hi, plan in chosen)
+        laid.append((moved, stretch, f"by buildings: {text}"))
+    return laid
+
+
+def _levelled(pieces: list[Piece], source: tuple[float, float]) -> list[Piece]:
+    """The pieces with the elements that go on a sliver past a level
+    (:func:`~facadecli.grammar.retarget.levels`) trimmed to it, the sliver made wall: a
+    floor whose cornice overlaps the next floor's molding by a hand's breadth can then be
+    copied, and the wall stays whole."""
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    joined = facade_of(boxes, *source, BACKGROUND).boxes
+    elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
+    unbanded = _unbanded(elements, joined, "y", source[1])
+    levels = retarget.levels([(b.y0, b.y1) for b in unbanded], source[1])
+    near = retarget.NEAR * source[1]
+    # the elements (and pieces of them) each level crosses, and whether they keep their
+    # part below it
+    crossed = [
+        (b, at, at - b.y0 > b.y1 - at)
+        for at in levels
+        for b in unbanded
+        if b.y0 + near < at < b.y1 - near
+    ]
+    if not crossed:
+        return pieces
+    found = []
+    for p in pieces:
+        lo, hi = p.y0, p.y1
+        for b, at, below in crossed:
+            if p.label == b.label and _inside(p, b, near):
+                lo, hi = (lo, min(hi, at)) if below else (max(lo, at), hi)
+        if (lo, hi) == (p.y0, p.y1):
+            found.append(p)
+            continue
+        if hi <= lo:  # all of it a sliver
+            lo = hi = p.y1
+        else:
+            found.append(Piece(p.label, p.x0, lo, p.x1, hi, p.source_w, p.source_h))
+        found += [
+            Piece(BACKGROUND, p.x0, y0, p.x1, y1, p.x1 - p.x0, y1 - y0)
+            for y0, y1 in ((p.y0, lo), (hi, p.y1))
+            if y1 > y0
+        ]
+    return found
+
+
+def _inside(p: Piece, b: Box, near: float) -> bool:
+    return (
+        b.x0 - near <= p.x0 and p.x1 <= b.x1 + near and b.y0 - near <= p.y0 and p.y1 <= b.y1 + near
+    )
 
 
 def _floors(
