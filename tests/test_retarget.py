@@ -14,6 +14,7 @@ from facadecli.grammar.pieces import Piece
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.style import Box, facade_of, find_style
 from facadecli.grammar.tiling import BACKGROUND
+from facadecli.grammar.variation import likeness
 
 ROW = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]  # three windows 1 m wide, 1 m apart, in 7 m
 
@@ -310,3 +311,27 @@ def test_what_goes_on_a_sliver_past_a_level_is_trimmed_and_made_wall() -> None:
     assert Piece(BACKGROUND, 0.0, 2.0, 1.0, 2.08, 1.0, pytest.approx(0.08)) in levelled
     assert sum((p.x1 - p.x0) * (p.y1 - p.y0) for p in levelled) == pytest.approx(20.0)
     assert slabs._levelled(pieces, (2.0, 2.5)) == pieces  # 8 cm is no sliver of 2.5 m
+
+
+def test_a_band_laid_across_copies_of_a_unit_is_made_of_that_much_source() -> None:
+    plan = retarget.copied(ROW, 7.0, 9.0, [(2.5, 4.5)], 1)
+    assert plan is not None
+    assert retarget.laid(plan, 0.0, 7.0) == [(0.0, 9.0, pytest.approx(9.0))]
+    assert retarget.laid(plan, 3.0, 4.0) == [(3.0, 4.0, 1.0), (5.0, 6.0, 1.0)]
+
+
+def test_the_wall_beside_copied_floors_is_as_long_as_they_are_not_stretched() -> None:
+    """cmp_b0008 at twice the height: the wall beside its frame runs up across the copied
+    floors; laid one floor taller by copying one, nothing is stretched, so the layout is
+    as near the input's sizes as can be (the wall once counted as stretched, and the
+    grammar's layout, with blank wall, was taken instead)."""
+    pieces = [Piece(BACKGROUND, 0.0, 0.0, 1.0, 9.0, 1.0, 9.0)]
+    for y in (0.0, 3.0, 6.0):
+        pieces += _floor(1.0, 3.0, y, 0.3, y + 3.0) + _floor(3.0, 5.0, y, 0.3, y + 3.0)
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    style = find_style(facade_of(boxes, 5.0, 9.0, BACKGROUND))
+    laid = {text: moved for moved, _, text in retargeted(pieces, (5.0, 9.0), 5.0, 12.0, style)}
+    assert "y copied 1x: 3-6" in laid, list(laid)
+    moved = laid["y copied 1x: 3-6"]
+    assert [p.y1 - p.y0 for p in moved if p.x1 <= 1.0] == [pytest.approx(12.0)]
+    assert likeness(moved) == pytest.approx(0.0, abs=1e-12)

@@ -391,7 +391,14 @@ def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[fl
     next segment starts inside it (a band across a copied unit), the two parts are one;
     an interval exactly as long as a unit is laid once per copy. Overlaps of ``near`` or
     less are none (rounding in the source's coordinates)."""
-    found: list[tuple[float, float]] = []
+    return [(start, end) for start, end, _ in laid(plan, lo, hi, near)]
+
+
+def laid(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[float, float, float]]:
+    """:func:`place`, each part with the length of source it is made of (longer than the
+    interval where a band goes on across copies of a unit: its length as copied, which a
+    copy does not stretch)."""
+    found: list[tuple[float, float, float]] = []
     at = 0.0
     going_on = False  # the last part was cut where its segment ends, the interval going on
     for segment in plan.segments:
@@ -402,9 +409,9 @@ def place(plan: Plan, lo: float, hi: float, near: float = 1e-9) -> list[tuple[fl
             end = at + (b - segment.lo) * segment.scale
             cut_here = a - segment.lo <= near and lo < segment.lo - near
             if going_on and cut_here and found:
-                found[-1] = (found[-1][0], end)
+                found[-1] = (found[-1][0], end, found[-1][2] + b - a)
             else:
-                found.append((start, end))
+                found.append((start, end, b - a))
             going_on = segment.hi - b <= near and hi > segment.hi + near
         else:
             going_on = False

@@ -25,6 +25,7 @@ HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see 
 BUILDINGS_TRIED = 64  # stretches of the width looked at for a building's floors, at most
 
 Span = tuple[float, float]
+Part = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, source across, up
 
 
 def retargeted(
@@ -100,19 +101,15 @@ def retargeted(
             continue
         if budget <= 0:
             break
-        parts: dict[int, list[tuple[float, float, float, float]]] = defaultdict(list)
+        parts: dict[int, list[Part]] = defaultdict(list)
         for k, p in enumerate(pieces):
             for (lo, hi), plan in zip(strata, across, strict=True):
                 if p.y0 < hi and p.y1 > lo:
-                    for x0, x1 in retarget.place(plan, p.x0, p.x1):
-                        for y0, y1 in retarget.place(along_y, max(p.y0, lo), min(p.y1, hi)):
-                            parts[k].append((x0, x1, y0, y1))
+                    for x0, x1, along_x in retarget.laid(plan, p.x0, p.x1):
+                        for y0, y1, up in retarget.laid(along_y, max(p.y0, lo), min(p.y1, hi)):
+                            parts[k].append((x0, x1, y0, y1, along_x, up))
         moved = _halves_joined(
-            [
-                Piece(pieces[k].label, x0, y0, x1, y1, pieces[k].source_w, pieces[k].source_h)
-                for k in sorted(parts)
-                for x0, x1, y0, y1 in _stacked(parts[k])
-            ],
+            [_moved(pieces[k], part) for k in sorted(parts) for part in _stacked(parts[k])],
             1e-9 * width,
         )
         budget -= len(moved)
@@ -175,11 +172,11 @@ def _by_buildings(
             break
         chosen = [(lo, hi, plans[min(k, len(plans) - 1)]) for lo, hi, plans in buildings]
         moved = [
-            Piece(p.label, max(p.x0, lo), y0, min(p.x1, hi), y1, p.source_w, p.source_h)
+            _moved(p, (max(p.x0, lo), min(p.x1, hi), y0, y1, min(p.x1, hi) - max(p.x0, lo), up))
             for p in pieces
             for lo, hi, plan in chosen
             if p.x0 < hi and p.x1 > lo
-            for y0, y1 in retarget.place(plan, p.y0, p.y1)
+            for y0, y1, up in retarget.laid(plan, p.y0, p.y1)
         ]
         stretch = max(plan.stretch for _, _, plan in chosen) ** 2
         text = "; ".join(f"{lo:.3g}-{hi:.3g}: y {plan.text}" for lo, hi, plan in chosen)
@@ -500,13 +497,25 @@ def _halves_joined(pieces: list[Piece], near: float) -> list[Piece]:
     return [joined[k] for k in sorted(joined)]
 
 
-def _stacked(parts: list[tuple[float, float, float, float]]) -> list[tuple[float, ...]]:
+def _stacked(parts: list[Part]) -> list[Part]:
     """A piece's parts, those one above the other across the same span joined."""
-    joined: list[tuple[float, ...]] = []
-    for x0, x1, y0, y1 in sorted(parts):
+    joined: list[Part] = []
+    for x0, x1, y0, y1, along, up in sorted(parts):
         last = joined[-1] if joined else None
         if last is not None and (last[0], last[1]) == (x0, x1) and abs(last[3] - y0) < 1e-12:
-            joined[-1] = (x0, x1, last[2], y1)
+            joined[-1] = (x0, x1, last[2], y1, along, last[5] + up)
         else:
-            joined.append((x0, x1, y0, y1))
+            joined.append((x0, x1, y0, y1, along, up))
     return joined
+
+
+def _moved(p: Piece, part: Part) -> Piece:
+    """A part of a piece as laid; a piece of wall made of more source than itself (across
+    copies of a unit) has that as its source size: the wall beside copied floors is as
+    long as they are, not stretched (an element's band lengthened still counts against
+    the layout's fit, which keeps strips of ornament from being copied for bays)."""
+    x0, x1, y0, y1, along, up = part
+    if p.label != BACKGROUND or p.x1 <= p.x0 or p.y1 <= p.y0:
+        return Piece(p.label, x0, y0, x1, y1, p.source_w, p.source_h)
+    lengthened_x, lengthened_y = max(1.0, along / (p.x1 - p.x0)), max(1.0, up / (p.y1 - p.y0))
+    return Piece(p.label, x0, y0, x1, y1, p.source_w * lengthened_x, p.source_h * lengthened_y)

@@ -6,8 +6,9 @@ moved, the greedy baseline's cost and ADP's (2,000 iterations, seed 0), ADP's ru
 iteration that found the best grammar, the search's time and the whole pipeline's; derived
 at 0.7, 1.5 and 2 times the width, the style kept, the windows stretched and the façades
 with blank wall instead of bays (fewer windows a metre than the input); the same at 1.5
-times the height (windows taller, floors not gained). Then one derivation at a new size,
-and six variations at each width. Skips, saying so, when the data is not there.
+and 2 times the height (windows taller, floors not gained, floors copied). Then one
+derivation at a new size, and six variations at each width. Skips, saying so, when the
+data is not there.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from facadecli.grammar.variation import Piece, derive_layout, derive_variations 
 from facadecli.layout import Layout  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
+TALLER = (1.5, 2.0)  # derived heights, as multiples of the input's
 WIDER = 1.15  # a derived window wider than this times the annotation's widest is stretched
 SPARSE = 0.8  # a derived layout with fewer windows a metre than this times the input's
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
@@ -54,7 +56,9 @@ def main() -> None:
     grown: dict[float, int] = {}  # windows wider than their own piece in the source
     sparse: dict[float, int] = {}  # façades with fewer windows a metre than the input's
     style_total = 0
-    tall = [0, 0, 0, 0]  # 1.5x the height: style kept, windows taller, sparse façades, windows
+    # at TALLER times the height: style kept, windows taller, sparse façades, windows,
+    # façades whose floors were copied (not the grammar's)
+    tall = {scale: [0, 0, 0, 0, 0] for scale in TALLER}
     last = None
     for path in files:
         started = time.perf_counter()
@@ -87,14 +91,20 @@ def main() -> None:
             )
             density = _windows(drawn[0].pieces, 15.0 * scale) / (15.0 * scale)
             sparse[scale] = sparse.get(scale, 0) + (density < SPARSE * source_density)
-        drawn, _ = derive_variations(extraction.grammar, tiling, 15.0, 22.5, "bench", 1, 0, style)
-        pieces = [p for p in drawn[0].pieces if p.label == "window"]
-        tall[0] += len(drawn[0].kept.kept)
-        tall[1] += sum(p.y1 - p.y0 > WIDER * p.source_h for p in pieces)
-        tall[2] += (
-            _windows(drawn[0].pieces, 15.0) / 22.5 < SPARSE * len(_source_windows(tiling)) / 15.0
-        )
-        tall[3] += len(pieces)
+        for scale in TALLER:
+            height = 15.0 * scale
+            drawn, _ = derive_variations(
+                extraction.grammar, tiling, 15.0, height, "bench", 1, 0, style
+            )
+            pieces = [p for p in drawn[0].pieces if p.label == "window"]
+            tall[scale][0] += len(drawn[0].kept.kept)
+            tall[scale][1] += sum(p.y1 - p.y0 > WIDER * p.source_h for p in pieces)
+            tall[scale][2] += (
+                _windows(drawn[0].pieces, 15.0) / height
+                < SPARSE * len(_source_windows(tiling)) / 15.0
+            )
+            tall[scale][3] += len(pieces)
+            tall[scale][4] += bool(drawn[0].retarget)
         for scale, count in zip(SCALES, kept, strict=True):
             style_kept[scale] = style_kept.get(scale, 0) + count
         style_total += len(style)
@@ -131,11 +141,14 @@ def main() -> None:
         f"façades with under {SPARSE:.0%} of the input's windows a metre of width (blank wall "
         "instead of bays): " + ", ".join(f"{sparse[s]} of {len(files)} at {s}x" for s in SCALES)
     )
-    print(
-        f"at 1.5x the height (15 x 22.5 m): style kept {tall[0]} of {style_total}, windows more "
-        f"than 15% taller than their own piece {tall[1]} of {tall[3]}, façades with under "
-        f"{SPARSE:.0%} of the input's windows a metre of height {tall[2]} of {len(files)}"
-    )
+    for scale, (kept_tall, taller, sparse_tall, windows_tall, copied) in tall.items():
+        print(
+            f"at {scale}x the height (15 x {15 * scale:g} m): style kept {kept_tall} of "
+            f"{style_total}, windows more than 15% taller than their own piece {taller} of "
+            f"{windows_tall}, façades with under {SPARSE:.0%} of the input's windows a metre "
+            f"of height {sparse_tall} of {len(files)}, floors copied (not the grammar's "
+            f"layout) on {copied}"
+        )
     wins = sum(a < g for a, g in zip(adp, greedy, strict=True))
     print(f"ADP is cheaper than greedy on {wins} of {len(files)} façades")
     assert last is not None
