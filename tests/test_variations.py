@@ -20,6 +20,7 @@ from facadecli.grammar.style import Box as StyleBox
 from facadecli.grammar.style import Kept, check, facade_of
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.grammar.variation import (
+    KEPT_LEAST,
     Piece,
     Variation,
     _key,
@@ -396,6 +397,21 @@ def test_tidying_copied_bays_moves_their_elements_but_keeps_their_sizes() -> Non
     assert [round(p.x1 - p.x0, 6) for p in windows] == [1.0, 1.05]
     free, _ = align(pieces, 6.0, 5.0)
     assert len({round(p.x1 - p.x0, 6) for p in free if p.label == "window"}) == 1
+
+
+def test_tidying_shrinks_no_element_below_three_quarters_of_its_size() -> None:
+    """Two windows of one source size, derived 1 m and 40 cm wide, are made one size, but
+    not by shrinking the wider below 75 cm (``KEPT_LEAST``): with half allowed, the QP
+    halved cmp_b0001's windows in its variations at the input's own size, pairing them
+    with sills under half a window."""
+    pieces = [
+        Piece("window", 1.0, 1.0, 2.0, 2.0, 1.0, 1.0),
+        Piece("window", 4.0, 1.0, 4.4, 2.0, 1.0, 1.0),
+        Piece("facade", 0.0, 0.0, 6.0, 5.0, 6.0, 5.0),
+    ]
+    tidied, _ = align(pieces, 6.0, 5.0)
+    widths = [round(p.x1 - p.x0, 6) for p in tidied if p.label == "window"]
+    assert widths == [pytest.approx(KEPT_LEAST)] * 2
 
 
 def test_likeness_counts_the_wall_a_derivation_widens() -> None:

@@ -64,6 +64,7 @@ WIDTHS = 100.0  # ... with this weight against moving edges (bands are not: they
 BAND = 0.25  # of the new extent: a longer element is a band across the façade
 ALIGN = 0.02  # of the new extent: edges of equal terminals closer than this are lined up
 STYLE_NEAR = 0.05  # of the new width: near misses of the style this close are made exact
+KEPT_LEAST = 0.75  # of its size as derived: the alignment QP shrinks no element further
 SOFT = 100.0  # weight of equal sizes and line-ups when they cannot all hold exactly
 MAX_PIECES = 200_000  # a derivation making more terminals than this is refused
 REPEATS = ("repeat", "repeatABA", "run")  # rules whose count the derivation chooses
@@ -370,7 +371,7 @@ def _align_axis(
     for p in pieces:
         a, b = (p.x0, p.x1) if axis == "x" else (p.y0, p.y1)
         span = (index[joined[a]], index[joined[b]])
-        if p.label != background:  # elements keep at least half their size; wall may vanish
+        if p.label != background:  # elements keep KEPT_LEAST of their size; wall may vanish
             spans.append((span, edges[span[1]] - edges[span[0]]))
             source = p.source_w if axis == "x" else p.source_h
             groups[(p.label, round(source / (1e-6 * extent)))].append(span)
@@ -393,9 +394,9 @@ def _align_axis(
     base = [v[0] == 0.0, v[n - 1] == extent]
     if n > 1:
         base.append(v[1:] >= v[:-1])
-    floors = sorted(set(spans))  # elements keep at least half their size
+    floors = sorted(set(spans))  # elements keep KEPT_LEAST of their size
     if floors:
-        base.append(_lengths(cp, v, n, [(span, size / 2) for span, size in floors]) >= 0)
+        base.append(_lengths(cp, v, n, [(span, size * KEPT_LEAST) for span, size in floors]) >= 0)
     if held:
         base.append(_lengths(cp, v, n, sorted(held.items())) == 0)
     # every gap below one vector (a matrix times the edges): one expression each, however

@@ -7,8 +7,8 @@ iteration that found the best grammar, the search's time and the whole pipeline'
 at 0.7, 1.5 and 2 times the width, the style kept, the windows stretched and the façades
 with blank wall instead of bays (fewer windows a metre than the input); the same at 1.5
 and 2 times the height (windows taller, floors not gained, floors copied). Then one
-derivation at a new size, and six variations at each width. Skips, saying so, when the
-data is not there.
+derivation at a new size, and six variations at each width and at the input's own size.
+Skips, saying so, when the data is not there.
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ from facadecli.layout import Layout  # noqa: E402
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
 TALLER = (1.5, 2.0)  # derived heights, as multiples of the input's
 WIDER = 1.15  # a derived window wider than this times the annotation's widest is stretched
+SHRUNK = 0.7  # a derived window narrower or lower than this times its source piece
 SPARSE = 0.8  # a derived layout with fewer windows a metre than this times the input's
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
 
@@ -162,6 +163,7 @@ def main() -> None:
         elapsed = time.perf_counter() - started
         print(f"derive {files[big].stem} at {size[0]:g}x{size[1]:g}: {elapsed:.2f}s")
     variations(extractions)
+    own_size(extractions)
 
 
 def _input_widest(path: Path) -> float:
@@ -215,6 +217,31 @@ def variations(extractions: list[Extraction]) -> None:
         + " width; keeping as much of the style as the first: "
         + ", ".join(f"{full[s]}" for s in SCALES)
         + f" ({seconds / (len(extractions) * len(SCALES)):.1f} s a size)"
+    )
+
+
+def own_size(extractions: list[Extraction]) -> None:
+    """``--variations 6`` at the input's own size (15 x 15 m): distinct layouts, those
+    keeping as much of the style as the first, and windows shrunk below ``SHRUNK`` of their
+    source size either way."""
+    asked, made, full, shrunk, windows = 6, 0, 0, 0, 0
+    for extraction in extractions:
+        drawn, _ = derive_variations(
+            extraction.grammar, extraction.tiling, 15.0, 15.0, "bench", asked, 0, extraction.style
+        )
+        made += len(drawn)
+        full += sum(len(v.kept.kept) >= len(drawn[0].kept.kept) for v in drawn)
+        for variation in drawn:
+            pieces = [p for p in variation.pieces if p.label == "window"]
+            windows += len(pieces)
+            shrunk += sum(
+                p.x1 - p.x0 < SHRUNK * p.source_w or p.y1 - p.y0 < SHRUNK * p.source_h
+                for p in pieces
+            )
+    print(
+        f"--variations {asked} at the input's own size: {made} of {asked * len(extractions)}, "
+        f"keeping as much of the style as the first: {full}; windows shrunk below "
+        f"{SHRUNK:.0%} of their source size: {shrunk} of {windows}"
     )
 
 
