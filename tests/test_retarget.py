@@ -10,11 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from facadecli.grammar import retarget, slabs
-from facadecli.grammar.pieces import Piece
+from facadecli.grammar.pieces import Piece, likeness
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.style import Box, facade_of, find_style
 from facadecli.grammar.tiling import BACKGROUND
-from facadecli.grammar.variation import likeness
 
 ROW = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]  # three windows 1 m wide, 1 m apart, in 7 m
 
@@ -294,6 +293,11 @@ def test_a_row_of_buildings_whose_floors_differ_gains_floors_building_by_buildin
         own = 2.2 if p.x1 <= 4.0 else 2.7
         assert own / retarget.WIDEN_MOST <= p.y1 - p.y0 <= own * retarget.WIDEN_MOST, text
     assert not any(text.startswith("y ") for _, _, text in laid)  # none across both
+    # wider too: bays copied across first, then the floors building by building
+    both = [text for _, _, text in retargeted(pieces, (8.0, 11.0), 12.0, 16.5, style)]
+    assert any(
+        "copied" in text.split("; by buildings")[0] for text in both if "; by buildings" in text
+    ), both
 
 
 def test_what_goes_on_a_sliver_past_a_level_is_trimmed_and_made_wall() -> None:

@@ -1,10 +1,13 @@
 """A derived layout's terminals: each a labelled rectangle with its size in the source
 layout (the derivations of :mod:`facadecli.grammar.variation` and the copied bays of
-:mod:`facadecli.grammar.slabs` make them)."""
+:mod:`facadecli.grammar.slabs` make them), and how far their sizes are from the source's."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+
+from facadecli.grammar.inputs import BACKGROUND
 
 
 @dataclass(frozen=True)
@@ -18,3 +21,23 @@ class Piece:
     y1: float
     source_w: float
     source_h: float
+
+
+def _misfit(p: Piece) -> float:
+    """How far a piece's size is from its source's: the squares of the log-ratios."""
+    return math.log((p.x1 - p.x0) / p.source_w) ** 2 + math.log((p.y1 - p.y0) / p.source_h) ** 2
+
+
+def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
+    """How far the elements' sizes are from the source's (0: the same)."""
+    terms = [_misfit(p) for p in pieces if p.label != background and p.x1 > p.x0 and p.y1 > p.y0]
+    return sum(terms) / len(terms) if terms else 0.0
+
+
+def likeness(pieces: list[Piece]) -> float:
+    """How far the pieces' sizes are from the source's, the wall included, each weighted by
+    its area (0: the same): a derivation that widens its wall into blank margins is as far
+    from the source as one that widens its windows."""
+    weighted = [((p.x1 - p.x0) * (p.y1 - p.y0), p) for p in pieces if p.x1 > p.x0 and p.y1 > p.y0]
+    area = sum(a for a, _ in weighted)
+    return sum(a * _misfit(p) for a, p in weighted) / area if area else 0.0

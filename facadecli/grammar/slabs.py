@@ -12,8 +12,8 @@ from collections import defaultdict
 from collections.abc import Sequence
 
 from facadecli.grammar import retarget
-from facadecli.grammar.pieces import Piece
-from facadecli.grammar.style import Box, Constraint, Facade, facade_of, shared_rows
+from facadecli.grammar.pieces import Piece, score
+from facadecli.grammar.style import Box, Constraint, Facade, check, facade_of, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
@@ -23,6 +23,7 @@ SCALED_ACROSS = 2.0  # ... by this at most, either way (an attic of ornaments at
 LAID_MOST = 60_000  # pieces laid over all the copied layouts (the rest are not made)
 HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see _halves_joined)
 BUILDINGS_TRIED = 64  # stretches of the width looked at for a building's floors, at most
+WIDER_FIRST = 2  # wider layouts given floors building by building, at most
 
 Span = tuple[float, float]
 Part = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, source across, up
@@ -91,9 +92,12 @@ def retargeted(
     if scaled_up is not None and not any(plan.text == "" for plan in along):
         along.append(scaled_up)
     budget = LAID_MOST
-    if width == source[0] and not any(plan.text for plan in floors):
+    if height != source[1] and not any(plan.text for plan in floors):
         # no floor across the whole width: each building of a row of them its own floors
-        for layout in _by_buildings(pieces, facade, in_floors, in_bays, source, height, style):
+        # (wider too: on the façade made wider first, bays copied across)
+        for layout in _taller_by_buildings(
+            pieces, facade, (in_floors, in_bays), source, (width, height), style
+        ):
             budget -= len(layout[0])
             laid.append(layout)
     for (text_x, strata, across), along_y in itertools.product(bays, along):
@@ -117,6 +121,35 @@ def retargeted(
         texts = [t for t in (text_x, f"y {along_y.text}" if along_y.text else "") if t]
         laid.append((moved, stretch, "; ".join(texts) or "stretched"))
     return laid
+
+
+def _taller_by_buildings(
+    pieces: list[Piece],
+    facade: Facade,
+    elements: tuple[Sequence[Box], Sequence[Box]],
+    source: tuple[float, float],
+    size: tuple[float, float],
+    style: Sequence[Constraint],
+) -> list[tuple[list[Piece], float, str]]:
+    """:func:`_by_buildings` at the source's width; at a new width too, on the
+    ``WIDER_FIRST`` layouts at the source's height (bays copied across) that keep the most
+    of the style, then are nearest the source's sizes."""
+    width, height = size
+    if width == source[0]:
+        return _by_buildings(pieces, facade, *elements, source, height, style)
+
+    def rank(layout: tuple[list[Piece], float, str]) -> tuple[int, float]:
+        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in layout[0]]
+        kept = check(style, facade_of(boxes, width, source[1], BACKGROUND))
+        return -len(kept.kept), score(layout[0]) + layout[1]
+
+    wider = sorted(retargeted(pieces, source, width, source[1], style), key=rank)[:WIDER_FIRST]
+    return [
+        (taller, stretch + more, f"{text_x}; {text_y}")
+        for moved, stretch, text_x in wider
+        for taller, more, text_y in retargeted(moved, (width, source[1]), width, height, style)
+        if text_y.startswith("by buildings")
+    ]
 
 
 def _by_buildings(

@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from facadecli import proportions
-from facadecli.grammar.pieces import Piece
+from facadecli.grammar.pieces import Piece, likeness, score
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.style import (
@@ -669,26 +669,6 @@ class _Candidate:
             self.proportions,
             self.retarget,
         )
-
-
-def _misfit(p: Piece) -> float:
-    """How far a piece's size is from its source's: the squares of the log-ratios."""
-    return math.log((p.x1 - p.x0) / p.source_w) ** 2 + math.log((p.y1 - p.y0) / p.source_h) ** 2
-
-
-def score(pieces: list[Piece], background: str = BACKGROUND) -> float:
-    """How far the elements' sizes are from the source's (0: the same)."""
-    terms = [_misfit(p) for p in pieces if p.label != background and p.x1 > p.x0 and p.y1 > p.y0]
-    return sum(terms) / len(terms) if terms else 0.0
-
-
-def likeness(pieces: list[Piece]) -> float:
-    """How far the pieces' sizes are from the source's, the wall included, each weighted by
-    its area (0: the same): a derivation that widens its wall into blank margins is as far
-    from the source as one that widens its windows."""
-    weighted = [((p.x1 - p.x0) * (p.y1 - p.y0), p) for p in pieces if p.x1 > p.x0 and p.y1 > p.y0]
-    area = sum(a for a, _ in weighted)
-    return sum(a * _misfit(p) for a, p in weighted) / area if area else 0.0
 
 
 def _facade(pieces: Sequence[Piece], width: float, height: float) -> Facade:
