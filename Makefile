@@ -57,11 +57,13 @@ schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json
 
 CITY ?=
-grammar: $(STAMP) ## A split grammar of a solved façade, or LAYOUT=file (CMP .xml, JSON), and new sizes
+SIZE ?= 15x15
+grammar: $(STAMP) ## A split grammar of a solved façade, or LAYOUT=file (CMP .xml: SIZE=15x15 its size), and new sizes
 	@if [ -z "$(LAYOUT)" ]; then \
 	  $(BIN)/facade solve specs/townhouse.yaml -o $(OUT)/grammar --format json && \
 	  $(BIN)/facade grammar $(OUT)/grammar/townhouse.layout.json -o $(OUT)/grammar --derive 14x15 --derive 6x9; \
-	else $(BIN)/facade grammar $(LAYOUT) -o $(OUT)/grammar --derive 24x15; fi
+	else $(BIN)/facade grammar $(LAYOUT) -o $(OUT)/grammar $(if $(filter %.xml,$(LAYOUT)),--size $(SIZE)) \
+	  --derive 24x15 --derive 15x22.5; fi
 
 city: $(STAMP) ## Build a city: the generated demo district, or CITY=path/to/manifest.yaml
 	@if [ -z "$(CITY)" ]; then \
