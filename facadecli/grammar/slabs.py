@@ -57,9 +57,9 @@ def retargeted(
     are then copied with their mirror images).
 
     Taller, the floors are cut where hand-drawn floors overlap by a sliver, the sliver
-    trimmed (:func:`_levelled`); where no floor can be cut across the whole width and
-    only the height changes, each building of a row of them gains its own floors
-    (:func:`_by_buildings`)."""
+    trimmed (:func:`_levelled`); where no floor can be cut across the whole width, each
+    building of a row of them gains its own floors (:func:`_by_buildings`; wider too, on
+    the façade made wider first: :func:`_taller_by_buildings`)."""
     grown = max(1.0, width / source[0]) * max(1.0, height / source[1])
     if (width, height) == source or len(pieces) * grown > PIECES_MOST:
         return []
