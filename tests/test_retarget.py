@@ -339,3 +339,61 @@ def test_the_wall_beside_copied_floors_is_as_long_as_they_are_not_stretched() ->
     moved = laid["y copied 1x: 3-6"]
     assert [p.y1 - p.y0 for p in moved if p.x1 <= 1.0] == [pytest.approx(12.0)]
     assert likeness(moved) == pytest.approx(0.0, abs=1e-12)
+
+
+def _tiled(
+    rects: list[tuple[str, float, float, float, float]], size: tuple[float, float]
+) -> list[Piece]:
+    """The façade cut at every edge of ``rects`` into cells, each of the label of the rect
+    it lies in (the wall elsewhere)."""
+    xs = sorted({0.0, size[0], *(v for _, x0, _, x1, _ in rects for v in (x0, x1))})
+    ys = sorted({0.0, size[1], *(v for _, _, y0, _, y1 in rects for v in (y0, y1))})
+    return [
+        Piece(
+            next(
+                (
+                    label
+                    for label, a, b, c, d in rects
+                    if a <= x0 and x1 <= c and b <= y0 and y1 <= d
+                ),
+                BACKGROUND,
+            ),
+            x0,
+            y0,
+            x1,
+            y1,
+            x1 - x0,
+            y1 - y0,
+        )
+        for x0, x1 in itertools.pairwise(xs)
+        for y0, y1 in itertools.pairwise(ys)
+    ]
+
+
+def test_a_giant_order_of_pilasters_is_a_band_that_floors_are_copied_across() -> None:
+    """cmp_b0009's pilasters run up four floors of windows, 39% of the height (under the
+    40% of a band): across three rows of a label or more they are a band for copying
+    floors, which lengthens them, so a taller façade gains floors between them."""
+    rects = [("door", 2.5, 0.0, 3.5, 2.5)]
+    rects += [("pillar", x, 4.0, x + 0.2, 9.8) for x in (1.9, 3.9)]
+    rects += [
+        ("window", x, 4.2 + 1.4 * k, x + 1.0, 5.2 + 1.4 * k)
+        for x in (0.5, 2.5, 4.5)
+        for k in range(4)
+    ]
+    pieces = _tiled(rects, (6.0, 15.0))
+    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+    style = find_style(facade_of(boxes, 6.0, 15.0, BACKGROUND))
+    laid = {text: moved for moved, _, text in retargeted(pieces, (6.0, 15.0), 6.0, 21.0, style)}
+    floors = [text for text in laid if text.startswith("y copied")]
+    assert floors, list(laid)
+    moved = laid[floors[0]]
+    windows = [p for p in moved if p.label == "window"]
+    assert len(windows) > 12 and all(p.y1 - p.y0 <= 1.0 * retarget.WIDEN_MOST for p in windows)
+    pillars = facade_of(
+        [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in moved if p.label == "pillar"],
+        6.0,
+        21.0,
+        BACKGROUND,
+    ).boxes
+    assert len(pillars) == 2 and all(b.y1 - b.y0 > 5.8 for b in pillars)  # whole, longer

@@ -24,6 +24,7 @@ LAID_MOST = 60_000  # pieces laid over all the copied layouts (the rest are not 
 HALF = 0.6  # of its source's width: a part of a piece this narrow was cut (see _halves_joined)
 BUILDINGS_TRIED = 64  # stretches of the width looked at for a building's floors, at most
 WIDER_FIRST = 2  # wider layouts given floors building by building, at most
+GIANT = 3  # rows of a label an element runs across, up the façade, to be a band there
 
 Span = tuple[float, float]
 Part = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, source across, up
@@ -82,7 +83,10 @@ def retargeted(
     clean = _unbanded(elements, joined, "x", source[0], whole_labels=False)
     in_floors = _unbanded(elements, joined, "y", source[1])
     rows = [sorted((r[0].y0 + r[0].y1) / 2 for r in group) for group in shared if group]
-    floors = _floors(in_floors, source[1], height, rows)
+    # a giant order of pilasters across several floors is a band too, for copying floors
+    giant = _unbanded(elements, joined, "y", source[1], rows=rows)
+    # (taller only: at the source's height the floors are stretched, as before)
+    floors = _floors(in_floors if height == source[1] else giant, source[1], height, rows)
     bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
     laid = []
     # where the wall alone cannot stretch up the façade, everything is scaled alike, so
@@ -308,6 +312,7 @@ def _unbanded(
     axis: str,
     extent: float,
     whole_labels: bool = True,
+    rows: Sequence[Sequence[float]] = (),
 ) -> list[Box]:
     """The elements but bands along the axis (a cornice, a balcony across the façade) and
     the pieces they are made of; with ``whole_labels``, but every element of a label that
@@ -317,7 +322,10 @@ def _unbanded(
     def length(b: Box) -> float:
         return (b.x1 - b.x0) if axis == "x" else (b.y1 - b.y0)
 
-    bands = [b for b in joined if length(b) >= retarget.BAND * extent]
+    def spans_rows(b: Box) -> bool:  # a giant order: across GIANT of a label's rows
+        return any(sum(b.y0 < c < b.y1 for c in centres) >= GIANT for centres in rows)
+
+    bands = [b for b in joined if length(b) >= retarget.BAND * extent or spans_rows(b)]
     if whole_labels:
         labels = {b.label for b in bands}
         return [e for e in elements if e.label not in labels]

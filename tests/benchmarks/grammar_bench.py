@@ -6,7 +6,8 @@ moved, the greedy baseline's cost and ADP's (2,000 iterations, seed 0), ADP's ru
 iteration that found the best grammar, the search's time and the whole pipeline's; derived
 at 0.7, 1.5 and 2 times the width, the style kept, the windows stretched and the façades
 with blank wall instead of bays (fewer windows a metre than the input); the same at 1.5
-and 2 times the height (windows taller, floors not gained, floors copied). Then one
+and 2 times the height and 1.5 times both (windows taller, floors not gained, floors
+copied). Then one
 derivation at a new size, and six variations at each width and at the input's own size.
 Skips, saying so, when the data is not there.
 """
@@ -29,7 +30,7 @@ from facadecli.grammar.variation import Piece, derive_layout, derive_variations 
 from facadecli.layout import Layout  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
-TALLER = (1.5, 2.0)  # derived heights, as multiples of the input's
+TALLER = ((1.0, 1.5), (1.0, 2.0), (1.5, 1.5))  # derived sizes taller, as multiples of the input's
 WIDER = 1.15  # a derived window wider than this times the annotation's widest is stretched
 SHRUNK = 0.7  # a derived window narrower or lower than this times its source piece
 SPARSE = 0.8  # a derived layout with fewer windows a metre than this times the input's
@@ -57,9 +58,9 @@ def main() -> None:
     grown: dict[float, int] = {}  # windows wider than their own piece in the source
     sparse: dict[float, int] = {}  # façades with fewer windows a metre than the input's
     style_total = 0
-    # at TALLER times the height: style kept, windows taller, sparse façades, windows,
+    # at TALLER sizes: style kept, windows taller (or wider), sparse façades, windows,
     # façades whose floors were copied (not the grammar's)
-    tall = {scale: [0, 0, 0, 0, 0] for scale in TALLER}
+    tall = {scales: [0, 0, 0, 0, 0] for scales in TALLER}
     last = None
     for path in files:
         started = time.perf_counter()
@@ -92,20 +93,22 @@ def main() -> None:
             )
             density = _windows(drawn[0].pieces, 15.0 * scale) / (15.0 * scale)
             sparse[scale] = sparse.get(scale, 0) + (density < SPARSE * source_density)
-        for scale in TALLER:
-            height = 15.0 * scale
+        for scales in TALLER:
+            width, height = 15.0 * scales[0], 15.0 * scales[1]
             drawn, _ = derive_variations(
-                extraction.grammar, tiling, 15.0, height, "bench", 1, 0, style
+                extraction.grammar, tiling, width, height, "bench", 1, 0, style
             )
             pieces = [p for p in drawn[0].pieces if p.label == "window"]
-            tall[scale][0] += len(drawn[0].kept.kept)
-            tall[scale][1] += sum(p.y1 - p.y0 > WIDER * p.source_h for p in pieces)
-            tall[scale][2] += (
-                _windows(drawn[0].pieces, 15.0) / height
-                < SPARSE * len(_source_windows(tiling)) / 15.0
+            tall[scales][0] += len(drawn[0].kept.kept)
+            tall[scales][1] += sum(
+                p.y1 - p.y0 > WIDER * p.source_h or p.x1 - p.x0 > WIDER * p.source_w for p in pieces
             )
-            tall[scale][3] += len(pieces)
-            tall[scale][4] += bool(drawn[0].retarget)
+            tall[scales][2] += (
+                _windows(drawn[0].pieces, width) / (width * height)
+                < SPARSE * len(_source_windows(tiling)) / 225.0
+            )
+            tall[scales][3] += len(pieces)
+            tall[scales][4] += "y " in drawn[0].retarget or "by buildings" in drawn[0].retarget
         for scale, count in zip(SCALES, kept, strict=True):
             style_kept[scale] = style_kept.get(scale, 0) + count
         style_total += len(style)
@@ -142,13 +145,13 @@ def main() -> None:
         f"façades with under {SPARSE:.0%} of the input's windows a metre of width (blank wall "
         "instead of bays): " + ", ".join(f"{sparse[s]} of {len(files)} at {s}x" for s in SCALES)
     )
-    for scale, (kept_tall, taller, sparse_tall, windows_tall, copied) in tall.items():
+    for (across, up), (kept_tall, taller, sparse_tall, windows_tall, copied) in tall.items():
         print(
-            f"at {scale}x the height (15 x {15 * scale:g} m): style kept {kept_tall} of "
-            f"{style_total}, windows more than 15% taller than their own piece {taller} of "
-            f"{windows_tall}, façades with under {SPARSE:.0%} of the input's windows a metre "
-            f"of height {sparse_tall} of {len(files)}, floors copied (not the grammar's "
-            f"layout) on {copied}"
+            f"at {across}x the width and {up}x the height ({15 * across:g} x {15 * up:g} m): "
+            f"style kept {kept_tall} of {style_total}, windows more than 15% taller or wider "
+            f"than their own piece {taller} of {windows_tall}, façades with under "
+            f"{SPARSE:.0%} of the input's windows a square metre {sparse_tall} of "
+            f"{len(files)}, floors copied (not the grammar's) on {copied}"
         )
     wins = sum(a < g for a, g in zip(adp, greedy, strict=True))
     print(f"ADP is cheaper than greedy on {wins} of {len(files)} façades")
