@@ -317,7 +317,9 @@ def _unbanded(
     """The elements but bands along the axis (a cornice, a balcony across the façade) and
     the pieces they are made of; with ``whole_labels``, but every element of a label that
     makes a band somewhere (the molding around a floor's windows, beside the molding
-    across the façade)."""
+    across the façade). Given ``rows`` (centres of a label's rows, up the façade), an
+    element across ``GIANT`` of one label's rows or more is a band too (a giant order of
+    pilasters)."""
 
     def length(b: Box) -> float:
         return (b.x1 - b.x0) if axis == "x" else (b.y1 - b.y0)
