@@ -5,9 +5,11 @@ layout (the derivations of :mod:`facadecli.grammar.variation` and the copied bay
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from facadecli.grammar.inputs import BACKGROUND
+from facadecli.grammar.style import Box, Facade, facade_of
 
 
 @dataclass(frozen=True)
@@ -21,6 +23,19 @@ class Piece:
     y1: float
     source_w: float
     source_h: float
+
+
+def boxes_of(pieces: Sequence[Piece]) -> list[Box]:
+    """The pieces as the style's boxes (their source sizes left out)."""
+    return [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
+
+
+def elements_of(
+    pieces: Sequence[Piece], width: float, height: float, background: str = BACKGROUND
+) -> Facade:
+    """A derivation's elements (its pieces of one element joined, the wall left out), to
+    check the style on."""
+    return facade_of(boxes_of(pieces), width, height, background)
 
 
 def _misfit(p: Piece) -> float:

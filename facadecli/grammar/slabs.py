@@ -12,8 +12,8 @@ from collections import defaultdict
 from collections.abc import Sequence
 
 from facadecli.grammar import retarget
-from facadecli.grammar.pieces import Piece, score
-from facadecli.grammar.style import Box, Constraint, Facade, check, facade_of, shared_rows
+from facadecli.grammar.pieces import Piece, boxes_of, elements_of, score
+from facadecli.grammar.style import Box, Constraint, Facade, check, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)
@@ -64,10 +64,12 @@ def retargeted(
     grown = max(1.0, width / source[0]) * max(1.0, height / source[1])
     if (width, height) == source or len(pieces) * grown > PIECES_MOST:
         return []
+    facade = elements_of(pieces, *source)
     if height != source[1]:  # floors cut where hand-drawn floors overlap by a sliver
-        pieces = _levelled(pieces, source)
-    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-    facade = facade_of(boxes, *source, BACKGROUND)
+        levelled = _levelled(pieces, facade.boxes, source)
+        if levelled is not pieces:
+            pieces, facade = levelled, elements_of(levelled, *source)
+    boxes = boxes_of(pieces)
     joined = facade.boxes
     # a mirrored façade copies a unit with its mirror image; one with an element on the
     # centre line may (so it stays there) or may not (the centred unit itself copied)
@@ -84,9 +86,11 @@ def retargeted(
     in_floors = _unbanded(elements, joined, "y", source[1])
     rows = [sorted((r[0].y0 + r[0].y1) / 2 for r in group) for group in shared if group]
     # a giant order of pilasters across several floors is a band too, for copying floors
-    giant = _unbanded(elements, joined, "y", source[1], rows=rows)
     # (taller only: at the source's height the floors are stretched, as before)
-    floors = _floors(in_floors if height == source[1] else giant, source[1], height, rows)
+    in_giant = in_floors
+    if height != source[1]:
+        in_giant = _unbanded(elements, joined, "y", source[1], rows=rows)
+    floors = _floors(in_giant, source[1], height, rows)
     bays = _bays(in_bays, in_floors, source, width, pairs, columns, clean)
     laid = []
     # where the wall alone cannot stretch up the façade, everything is scaled alike, so
@@ -143,8 +147,7 @@ def _taller_by_buildings(
         return _by_buildings(pieces, facade, *elements, source, height, style)
 
     def rank(layout: tuple[list[Piece], float, str]) -> tuple[int, float]:
-        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in layout[0]]
-        kept = check(style, facade_of(boxes, width, source[1], BACKGROUND))
+        kept = check(style, elements_of(layout[0], width, source[1]))
         return -len(kept.kept), score(layout[0]) + layout[1]
 
     wider = sorted(retargeted(pieces, source, width, source[1], style), key=rank)[:WIDER_FIRST]
@@ -221,14 +224,15 @@ def _by_buildings(
     return laid
 
 
-def _levelled(pieces: list[Piece], source: tuple[float, float]) -> list[Piece]:
+def _levelled(
+    pieces: list[Piece], joined: Sequence[Box], source: tuple[float, float]
+) -> list[Piece]:
     """The pieces with the elements that go on a sliver past a level
     (:func:`~facadecli.grammar.retarget.levels`) trimmed to it, the sliver made wall: a
     floor whose cornice overlaps the next floor's molding by a hand's breadth can then be
-    copied, and the wall stays whole."""
-    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-    joined = facade_of(boxes, *source, BACKGROUND).boxes
-    elements = [*joined, *(b for b in boxes if b.label != BACKGROUND)]
+    copied, and the wall stays whole (``joined``: the pieces' elements; the pieces
+    themselves where nothing is trimmed)."""
+    elements = [*joined, *(b for b in boxes_of(pieces) if b.label != BACKGROUND)]
     unbanded = _unbanded(elements, joined, "y", source[1])
     levels = retarget.levels([(b.y0, b.y1) for b in unbanded], source[1])
     near = retarget.NEAR * source[1]
@@ -263,7 +267,8 @@ def _levelled(pieces: list[Piece], source: tuple[float, float]) -> list[Piece]:
     return found
 
 
-def _inside(p: Piece, b: Box, near: float) -> bool:
+def _inside(p: Piece | Box, b: Box, near: float) -> bool:
+    """Whether ``p`` lies within ``b`` (``near`` either way)."""
     return (
         b.x0 - near <= p.x0 and p.x1 <= b.x1 + near and b.y0 - near <= p.y0 and p.y1 <= b.y1 + near
     )
@@ -333,16 +338,7 @@ def _unbanded(
         return [e for e in elements if e.label not in labels]
     near = 1e-9 * extent
     return [
-        e
-        for e in elements
-        if not any(
-            e.label == b.label
-            and b.x0 - near <= e.x0
-            and e.x1 <= b.x1 + near
-            and b.y0 - near <= e.y0
-            and e.y1 <= b.y1 + near
-            for b in bands
-        )
+        e for e in elements if not any(e.label == b.label and _inside(e, b, near) for b in bands)
     ]
 
 

@@ -38,19 +38,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from facadecli import proportions
-from facadecli.grammar.pieces import Piece, likeness, score
+from facadecli.grammar.pieces import Piece, elements_of, likeness, score
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.style import (
     NOTHING_KEPT,
-    Box,
     Constraint,
     Equation,
-    Facade,
     Kept,
     check,
     equations,
-    facade_of,
     style_of,
 )
 from facadecli.grammar.tiling import BACKGROUND, CMP_Z_ORDER, Tiling, snap
@@ -326,8 +323,7 @@ def align(
     mapping = {}
     kept: list[Equation] = []
     if style:
-        boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-        kept = equations(style, facade_of(boxes, width, height, background), STYLE_NEAR * width)
+        kept = equations(style, elements_of(pieces, width, height, background), STYLE_NEAR * width)
     axes: tuple[tuple[Axis, float, list[Equation]], ...] = (("x", width, kept), ("y", height, []))
     for axis, extent, extra in axes:
         mapping[axis], axis_warnings = _align_axis(
@@ -671,12 +667,6 @@ class _Candidate:
         )
 
 
-def _facade(pieces: Sequence[Piece], width: float, height: float) -> Facade:
-    """A derivation's elements, to check the style on."""
-    boxes = [Box(p.label, p.x0, p.y0, p.x1, p.y1) for p in pieces]
-    return facade_of(boxes, width, height, BACKGROUND)
-
-
 def _key(pieces: list[Piece]) -> tuple[tuple[str, float, float, float, float], ...]:
     """The pieces as they would be written (to tell two derivations apart)."""
     return tuple(
@@ -719,7 +709,7 @@ def derive_variations(
         return stem if count == 1 else f"{stem}-v{k}"
 
     def kept(pieces: list[Piece]) -> Kept:
-        return check(style, _facade(pieces, width, height))
+        return check(style, elements_of(pieces, width, height))
 
     def candidate(
         offsets: dict[str, int], shuffle: Shuffle | None = None, drawn: Proportions = ()
@@ -902,7 +892,7 @@ def _proportioned_copies(
     drawn (the work counted in draws, not time)."""
 
     def kept_at_source(pieces: list[Piece]) -> int:
-        return len(check(style, _facade(pieces, *source)).kept)
+        return len(check(style, elements_of(pieces, *source)).kept)
 
     whole = kept_at_source(source_pieces)
     found: list[_Candidate] = []
