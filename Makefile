@@ -77,5 +77,10 @@ golden: $(STAMP) ## Regenerate the golden SVG elevations of the examples (tests/
 pictures: $(STAMP) ## Render the README's pictures into docs/pictures (needs chromium)
 	$(BIN)/python docs/pictures.py
 
+.PHONY: docs
+docs: $(STAMP) ## Build the documentation site strictly into site/ (installs the docs extra)
+	test -x $(BIN)/mkdocs || $(BIN)/python -m pip install --quiet -e '.[docs]'
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site
+
 clean: ## Remove the venv, caches and outputs
 	rm -rf $(VENV) $(OUT) .pytest_cache .mypy_cache .ruff_cache .hypothesis
