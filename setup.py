@@ -3,7 +3,7 @@ else is in pyproject.toml.
 
 Both are optional: where they cannot be built (no C compiler, no Python headers) the
 install goes on without them, and facadecli runs the same searches in pure Python
-(``facadecli.native`` says which is in use; ``facade --version`` prints it)."""
+(``facadecli.native`` says which is in use: ``facadecli.native.describe()``)."""
 
 import sys
 

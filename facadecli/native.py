@@ -28,7 +28,7 @@ EXACT_COMPILED: bool = _exact is not None
 
 
 def describe() -> str:
-    """One line on which searches run compiled, for ``facade --version``."""
+    """One line on which searches run compiled (for a bug report, or a doctor command)."""
 
     def which(compiled: bool) -> str:
         return "compiled" if compiled else "pure Python (no C compiler at install)"
