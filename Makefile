@@ -9,10 +9,10 @@ OUT    ?= out
 VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 
 .DEFAULT_GOAL := help
-.PHONY: help install demo test lint format bench bench-large schema golden grammar city pictures clean
+.PHONY: help install demo test test-fast lint format bench bench-large schema golden grammar city pictures clean
 
 help: ## Show the targets
-	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-8s %s\n", $$1, $$2}'
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-9s %s\n", $$1, $$2}'
 
 $(STAMP): pyproject.toml setup.py facadecli/grammar/_adp.c facadecli/solver/_exact.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -34,6 +34,9 @@ $(VALIDATOR): | $(STAMP)
 
 test: $(STAMP) $(VALIDATOR) ## Run the whole test suite
 	$(BIN)/python -m pytest
+
+test-fast: $(STAMP) ## Run the tests not marked slow (under a minute; make test runs them all)
+	$(BIN)/python -m pytest -m "not slow"
 
 lint: $(STAMP) ## ruff (lint + format check) and mypy
 	$(BIN)/ruff check facadecli tests docs

@@ -14,7 +14,7 @@ import traceback
 from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -31,9 +31,9 @@ from facadecli.export import (
     write_outputs,
 )
 from facadecli.limits import CANVAS_MAX
-from facadecli.preview import preview_words
-from facadecli.solve import retarget, solve, solve_variants
-from facadecli.spec import Spec, load_spec, parse_spec, spec_schema_text
+
+if TYPE_CHECKING:  # the commands import the stages they use: start-up stays fast
+    from facadecli.spec import Spec
 
 app = typer.Typer(
     name="facade",
@@ -81,6 +81,8 @@ class _Run:
         self.codes: list[int] = []
 
     def specs(self) -> Iterator[tuple[Path, Spec]]:
+        from facadecli.spec import load_spec
+
         for path in self.paths:
             try:
                 spec = load_spec(path)
@@ -161,6 +163,8 @@ def solve_command(
     ] = False,
 ) -> None:
     """Solve specs into layouts and write their outputs to OUTDIR."""
+    from facadecli.solve import retarget, solve
+
     chosen = _formats(formats)
     width = _length(width, "--width")
     height = _length(height, "--height")
@@ -239,8 +243,11 @@ def vary(
     width_list = _sizes(widths, "--widths")
     height_list = _sizes(heights, "--heights")
     check_output_folder(outdir)
-    spec = load_spec(spec_path)
     from facadecli.export.contact import Variant, contact_sheet  # only vary draws sheets
+    from facadecli.solve import retarget, solve_variants
+    from facadecli.spec import load_spec
+
+    spec = load_spec(spec_path)
 
     rows: list[list[Variant]] = []
     failed = 0
@@ -464,6 +471,7 @@ def infer(
     from facadecli.grammar.run import Options, stem
     from facadecli.infer.run import check as check_spec
     from facadecli.infer.run import infer as infer_spec
+    from facadecli.spec import parse_spec
 
     name = stem(layout)
     target = output or Path("out") / f"{name}.yaml"
@@ -648,6 +656,8 @@ def schema(
     ] = None,
 ) -> None:
     """Print the JSON Schema of the spec format (point your editor's YAML plugin at it)."""
+    from facadecli.spec import spec_schema_text
+
     if output is not None:
         check_output_file(output)
     text = spec_schema_text()
@@ -712,6 +722,8 @@ def words(
     limit: Annotated[int, typer.Option("--limit", "-n", min=1, help="Words per layer axis.")] = 5,
 ) -> None:
     """List the words each layer's patterns make that fit the canvas, nearest first."""
+    from facadecli.preview import preview_words
+
     run = _Run(specs)
     for path, spec in run.specs():
         typer.echo(f"# {path} ({spec.name})")

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import re
 import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -483,7 +484,7 @@ def test_the_cga_is_the_same_bytes_for_the_same_input() -> None:
 
 def _facade(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [str(ROOT / ".venv" / "bin" / "facade"), *args], capture_output=True, text=True, timeout=300
+        [sys.executable, "-m", "facadecli", *args], capture_output=True, text=True
     )
 
 

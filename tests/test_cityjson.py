@@ -372,7 +372,6 @@ def _cjio(*args: str, stdin: str | None = None) -> subprocess.CompletedProcess[s
         input=stdin,
         capture_output=True,
         text=True,
-        timeout=120,
     )
 
 

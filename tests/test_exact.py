@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from facadecli import InfeasibleError, load_spec, make_word, parse_spec, retarget, solve
 from facadecli.export.svg import svg_text
+from facadecli.native import EXACT_COMPILED
 from facadecli.solver import axis, candidates, exact, sizing
 from facadecli.solver.alignment import Alignment, Move, _Row
 from facadecli.solver.exact import Budget, align_exactly
@@ -491,6 +492,11 @@ def test_planted_layouts_the_generator_once_missed(text: str, bays: int) -> None
 
 
 # -- the compiled search (_exact.c) against the Python reference ---------------------------
+needs_exact = pytest.mark.skipif(
+    not EXACT_COMPILED, reason="compares _exact.c with Python: this install has no compiled _exact"
+)
+
+
 def _both_engines(spec: object, rows: list[Row], canvas: float, incumbent: float) -> list[object]:
     seen = []
     for compiled in (True, False):
@@ -510,6 +516,7 @@ def _both_engines(spec: object, rows: list[Row], canvas: float, incumbent: float
     return seen
 
 
+@needs_exact
 @SETTINGS
 @given(tiny_specs(), st.sampled_from([float("inf"), 0.05, 0.0]))
 def test_the_compiled_search_takes_the_references_every_step(text: str, incumbent: float) -> None:
@@ -520,21 +527,24 @@ def test_the_compiled_search_takes_the_references_every_step(text: str, incumben
     assert compiled == reference
 
 
+@needs_exact
 @settings(derandomize=True, max_examples=15, deadline=None, suppress_health_check=list(HealthCheck))
 @given(planted_specs())
 def test_the_compiled_search_solves_planted_layouts_as_the_reference(text: str) -> None:
     """Whole solves, every candidate of both axes: the same drawing to the byte."""
     spec = parse_spec(text, "planted.yaml")
     drawings = []
+    default = exact.COMPILED
     try:
         for compiled in (True, False):
             exact.COMPILED = compiled
             drawings.append(svg_text(solve(spec), labels=True))
     finally:
-        exact.COMPILED = True
+        exact.COMPILED = default
     assert drawings[0] == drawings[1]
 
 
+@needs_exact
 @pytest.mark.parametrize("source", ["terraced-house", "centred-bay", "palace"])
 def test_the_compiled_search_spends_the_references_work_on_every_candidate(
     source: str, monkeypatch: pytest.MonkeyPatch
@@ -567,6 +577,7 @@ def test_the_compiled_search_spends_the_references_work_on_every_candidate(
     assert runs[0] == runs[1]
 
 
+@needs_exact
 def test_a_finished_compiled_search_is_collected() -> None:
     """The compiled search holds its leaf(), which holds the search: the cycle must be
     collectable, or every search keeps its moves (a city leaked megabytes a façade)."""
@@ -724,6 +735,7 @@ def test_the_least_bound_of_a_candidate_is_never_above_its_bound() -> None:
                 assert least(c) <= exact.candidate_bound(rows, canvas) + 1e-12
 
 
+@needs_exact
 def test_a_finished_search_is_let_go_without_the_garbage_collector() -> None:
     """Each candidate's compiled search holds its moves and options (megabytes for a long
     row): once it ends, nothing holds it, so it is freed at once, even with the garbage

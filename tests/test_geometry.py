@@ -7,6 +7,7 @@ import json
 import random
 import shutil
 import subprocess
+import sys
 import types
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from tests.rays import directions, missing, nearest
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "specs").glob("*.yaml"))
-VALIDATOR = ROOT / ".venv" / "node" / "node_modules"
+VALIDATOR = Path(sys.prefix) / "node" / "node_modules"  # make test installs it in the venv
 
 
 @pytest.mark.parametrize("name", sorted(PRIMITIVES))
@@ -107,7 +108,6 @@ def test_every_example_passes_the_khronos_validator(tmp_path: Path) -> None:
         ["node", str(ROOT / "tests" / "gltf_validate.js"), str(VALIDATOR), *files],
         capture_output=True,
         text=True,
-        timeout=120,
         check=True,
     )
     reports = [json.loads(line) for line in result.stdout.splitlines()]

@@ -1,5 +1,5 @@
 """The search's fast tables give what the plain definitions give, to the bit: the compiled
-inner loop (``_adp``) what the plain Python loop gives (tests/adp_reference.py), the merged
+inner loop (``_adp``) what the plain Python loop gives (``facadecli.grammar.plain``), the merged
 cost what ``Search.canonical`` gives, the rank of a cut in two, and the size test that spares
 computing contents."""
 
@@ -11,10 +11,15 @@ import random
 
 import pytest
 
+from facadecli.grammar import plain
 from facadecli.grammar.search import Action, Entry, Search
 from facadecli.grammar.split import Axis
 from facadecli.grammar.tiling import LabelledLayout, Rect, tile
-from tests import adp_reference
+from facadecli.native import GRAMMAR_COMPILED
+
+needs_adp = pytest.mark.skipif(
+    not GRAMMAR_COMPILED, reason="compares _adp.c with Python: this install has no compiled _adp"
+)
 
 
 def _layout(seed: int) -> LabelledLayout:
@@ -37,7 +42,7 @@ def _grammars(search: Search, seed: int, count: int) -> list[dict[int, Action]]:
     def any_action(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
         return rng.choice(search.actions_at(entry))
 
-    return [search.greedy(), *(adp_reference.build(search, any_action) for _ in range(count))]
+    return [search.greedy(), *(plain.build(search, any_action) for _ in range(count))]
 
 
 def _plain_cost(search: Search, rules: dict[int, Action]) -> float:
@@ -62,7 +67,7 @@ def test_the_survey_gives_the_merged_cost_and_what_each_rule_reaches(
         cost, reach = search.survey(rules)
         assert cost == _plain_cost(search, rules)  # the same sum, in the same order
         assert search.cost(rules) == cost
-        plain_cost, plain_reach = adp_reference.survey(search, rules)
+        plain_cost, plain_reach = plain.survey(search, rules)
         assert (cost, [set(r) for r in reach]) == (plain_cost, plain_reach)
 
 
@@ -74,6 +79,7 @@ def _described(search: Search, region: tuple[int, int, int, int]) -> list[tuple[
     ]
 
 
+@needs_adp
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("extensions", EXTENSIONS)
 def test_the_compiled_search_offers_each_region_the_actions_python_offers(
@@ -92,6 +98,7 @@ def test_the_compiled_search_offers_each_region_the_actions_python_offers(
     random.Random(seed).shuffle(regions)
     compared = 0
     for region in regions[:400]:
+        assert search._table is not None
         compiled = search._table.describe(search._table.entry(*region))
         assert compiled == _described(search, region), region
         compared += len(compiled)
@@ -104,13 +111,37 @@ def test_the_compiled_loop_builds_the_grammars_the_plain_loop_builds(
     seed: int, extensions: tuple[str, ...]
 ) -> None:
     layout = tile(_layout(seed), 0)
-    fast, plain = Search(layout, extensions=extensions), Search(layout, extensions=extensions)
-    assert _shape(fast.greedy()) == _shape(adp_reference.greedy(plain))
+    fast = Search(layout, extensions=extensions)
+    reference = Search(layout, extensions=extensions)
+    greedy = plain.greedy(reference)
+    assert greedy is not None  # no time limit
+    assert _shape(fast.greedy()) == _shape(greedy)
     for iterations in (1, 2, 60):
         rules, best_at, done = fast.adp(iterations, seed)
-        expected, expected_at, _ = adp_reference.adp(plain, iterations, seed)
+        expected, expected_at, _ = plain.adp(reference, iterations, seed)
         assert (_shape(rules), best_at, done) == (_shape(expected), expected_at, iterations)
-        assert fast.cost(rules) == plain.cost(expected)
+        assert fast.cost(rules) == reference.cost(expected)
+
+
+@needs_adp
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("extensions", EXTENSIONS)
+def test_the_search_without_adp_gives_the_compiled_searchs_grammars(
+    seed: int, extensions: tuple[str, ...]
+) -> None:
+    """Where the install has no compiled ``_adp`` the plain loop runs: the same contents
+    (each numbered as met), the same regions explored, the same grammars."""
+    layout = tile(_layout(seed), 0)
+    fast = Search(layout, extensions=extensions, compiled=True)
+    python = Search(layout, extensions=extensions, compiled=False)
+    assert python._table is None and python.grid.table is None
+    assert _shape(fast.greedy()) == _shape(python.greedy())
+    rules, best_at, done = fast.adp(60, seed)
+    found, found_at, found_done = python.adp(60, seed)
+    assert (_shape(found), found_at, found_done) == (_shape(rules), best_at, done)
+    assert python.survey(found) == fast.survey(rules)
+    assert python.grammar(found) == fast.grammar(rules)
+    assert python.regions_explored == fast.regions_explored
 
 
 def _shape(rules: dict[int, Action]) -> list[tuple[object, ...]]:
@@ -121,8 +152,9 @@ def _shape(rules: dict[int, Action]) -> list[tuple[object, ...]]:
     ]
 
 
-def test_a_time_limit_of_nothing_stops_adp_after_the_greedy_grammar() -> None:
-    search = Search(tile(_layout(3), 0))
+@pytest.mark.parametrize("compiled", [pytest.param(True, marks=needs_adp), False])
+def test_a_time_limit_of_nothing_stops_adp_after_the_greedy_grammar(compiled: bool) -> None:
+    search = Search(tile(_layout(3), 0), compiled=compiled)
     search.deadline.seconds = 0.0
     rules, best_at, done = search.adp(50, 0)
     assert (rules, best_at) == (search.greedy(), 0) and done == 1

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 import random
-import time
 from typing import get_args
 
 import numpy as np
@@ -384,7 +383,9 @@ def test_random_outlines_get_closed_roofs() -> None:
             assert _closed(part, cover, infill).is_watertight, (kind, part.wkt)
 
 
-def test_simple_roofs_are_quick() -> None:
+def test_simple_roofs_of_a_rectangle_and_a_40_gon_are_built() -> None:
+    """Gable and hip roofs of a rectangle and of a 40-vertex outline (how fast: ``make
+    bench``, never a test): each a non-empty cover that rises above the eaves."""
     rectangle = orient(FOOTPRINTS["rectangle"], sign=1.0)
     outline = Polygon(
         [
@@ -395,9 +396,8 @@ def test_simple_roofs_are_quick() -> None:
             for k in range(40)
         ]
     )
-    for part, budget in ((rectangle, 0.05), (orient(outline, sign=1.0), 0.3)):  # generous: CI
-        start = time.perf_counter()
+    for part in (rectangle, orient(outline, sign=1.0)):
         for kind in ("gable", "hip"):
             roofs._shape.cache_clear()
-            roof_meshes(part, EAVES, Roof(type=kind))  # type: ignore[arg-type]
-        assert (time.perf_counter() - start) / 2 < budget
+            cover, _ = roof_meshes(part, EAVES, Roof(type=kind))  # type: ignore[arg-type]
+            assert len(cover.faces) > 0 and cover.bounds[1][2] > EAVES

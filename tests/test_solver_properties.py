@@ -52,7 +52,7 @@ def specs(draw: st.DrawFn) -> str:
     lines.append("  - {name: base, x: base_x, y: rows}")
     for index in range(1, count):
         lines.append(f"  - {{name: layer{index}, x: x{index}, y: rows, offset: {index / 10}}}")
-    lines.append("solver: {time_limit: 5}")
+    lines.append("solver: {time_limit: 120}")  # the work budget decides, never the clock
     return "\n".join(lines) + "\n"
 
 
@@ -76,7 +76,7 @@ patterns:
 layers:
   - {name: base, x: base_x, y: rows}
   - {name: layer1, x: x1, y: rows, offset: 0.1}
-solver: {time_limit: 5}
+solver: {time_limit: 120}  # the work budget decides, never the clock
 """
 
 
@@ -103,7 +103,7 @@ layers:
   - {name: base, x: base_x, y: rows}
   - {name: layer1, x: x1, y: rows, offset: 0.1}
   - {name: layer2, x: x2, y: rows, offset: 0.2}
-solver: {time_limit: 5}
+solver: {time_limit: 120}  # the work budget decides, never the clock
 """
 
 

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from facadecli.grammar import _adp
 from facadecli.grammar.tiling import BACKGROUND, Tiling
+from facadecli.native import GRAMMAR_COMPILED, _adp
 
 Region = tuple[int, int, int, int]
 SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's extent)
@@ -23,7 +23,9 @@ SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's exte
 class Grid:
     """A tiling's cells as integers, with prefix sums for fast line tests."""
 
-    def __init__(self, tiling: Tiling, background: str = BACKGROUND):
+    def __init__(self, tiling: Tiling, background: str = BACKGROUND, compiled: bool | None = None):
+        """``compiled``: keep the contents in the compiled table (``_adp.c``; the default where
+        it was built, :mod:`facadecli.native`), else here in Python (the same contents)."""
         self.tiling = tiling
         self.background = background
         names = sorted({label for row in tiling.labels for label in row})
@@ -44,16 +46,21 @@ class Grid:
         self._cross_y = _prefix(same_y & (lab[1:, :] != bg), axis=1)
         self._content_of: dict[Region, int] = {}
         self.terminal: dict[int, str] = {}  # content -> its label, for one-label regions
-        self.table = _adp.Table(  # the contents, and the search over this tiling
-            self.labels.astype(np.int32).tobytes(),
-            self.rows,
-            self.columns,
-            np.asarray(tiling.xs, dtype=np.float64).tobytes(),
-            np.asarray(tiling.ys, dtype=np.float64).tobytes(),
-            self.quantum_x,
-            self.quantum_y,
-            bg,
-        )
+        self._xs = np.asarray(tiling.xs, dtype=np.float64)
+        self._ys = np.asarray(tiling.ys, dtype=np.float64)
+        self._keys: dict[tuple[int, ...], int] = {}  # content keys -> content, in Python
+        self.table: _adp.Table | None = None  # the contents, and the search over this tiling
+        if GRAMMAR_COMPILED if compiled is None else compiled:
+            self.table = _adp.Table(
+                self.labels.astype(np.int32).tobytes(),
+                self.rows,
+                self.columns,
+                self._xs.tobytes(),
+                self._ys.tobytes(),
+                self.quantum_x,
+                self.quantum_y,
+                bg,
+            )
 
     def content(self, region: Region) -> int:
         """The region's content number: equal for regions with the same labels at the same
@@ -63,11 +70,35 @@ class Grid:
         (``_adp.c``) keeps them, for the search too."""
         cid = self._content_of.get(region)
         if cid is None:
-            cid, label = self.table.content(*region)
+            cid, label = (
+                self._numbered(region) if self.table is None else self.table.content(*region)
+            )
             self._content_of[region] = cid
             if label >= 0:
                 self.terminal[cid] = self.names[label]
         return cid
+
+    def _numbered(self, region: Region) -> tuple[int, int]:
+        """``content`` in Python, as ``_adp.c`` numbers it: the key is the merged rows and
+        columns' counts, their labels (row by row) and their sizes in quanta; the content,
+        and its label when it is one merged cell (else -1)."""
+        r0, r1, c0, c1 = region
+        changes_x = self._change_x[r1, c0 : c1 - 1] - self._change_x[r0, c0 : c1 - 1]
+        changes_y = self._change_y[r0 : r1 - 1, c1] - self._change_y[r0 : r1 - 1, c0]
+        starts_c = np.concatenate(([0], np.nonzero(changes_x)[0] + 1))
+        starts_r = np.concatenate(([0], np.nonzero(changes_y)[0] + 1))
+        labels = self.labels[np.ix_(r0 + starts_r, c0 + starts_c)]
+        widths = np.diff(self._xs[c0 + np.append(starts_c, c1 - c0)]) / self.quantum_x
+        heights = np.diff(self._ys[r0 + np.append(starts_r, r1 - r0)]) / self.quantum_y
+        key = (
+            len(starts_r),
+            len(starts_c),
+            *labels.ravel().tolist(),
+            *np.rint(widths).astype(np.int64).tolist(),
+            *np.rint(heights).astype(np.int64).tolist(),
+        )
+        cid = self._keys.setdefault(key, len(self._keys))
+        return cid, int(labels[0, 0]) if labels.size == 1 else -1
 
     def contents_of(self, regions: list[Region]) -> list[int]:
         """``content`` of each region."""

@@ -24,11 +24,12 @@ the repeated regions that line cuts through over the cells of the region.
   is never worse than greedy's; the cheapest grammar of all iterations is returned. A seed
   makes it reproducible; a time limit stops early with the best grammar so far.
 
-The search runs compiled (``_adp.c``): the actions of each region it visits, building
-grammars from them, their merged cost and the value table. It computes what the Python here
-(``_make_actions`` and what it calls) and the plain loop in tests/adp_reference.py compute,
-to the bit (the tests compare them), some 20 times faster. Python then makes again the
-``Action``s of the rules chosen, from their regions and cuts, for the grammar.
+The search runs compiled (``_adp.c``) where the install built it (:mod:`facadecli.native`):
+the actions of each region it visits, building grammars from them, their merged cost and the
+value table. It computes what the Python here (``_make_actions`` and what it calls) and the
+plain loop of :mod:`facadecli.grammar.plain` compute, to the bit (the tests compare them),
+some 20 times faster. Python then makes again the ``Action``s of the rules chosen, from their
+regions and cuts, for the grammar. Without ``_adp`` the plain loop runs instead.
 
 The run's ``Deadline`` bounds the work: the greedy grammar checks its hard limit at every
 region (exit 4 when it passes), ADP stops at the soft limit, even within an iteration.
@@ -46,12 +47,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from facadecli.grammar import _adp
+from facadecli.grammar import plain
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.regions import Grid, Region
 from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Part, Rule, inlined
 from facadecli.grammar.symmetry import Repeats, find_repeats
 from facadecli.grammar.tiling import BACKGROUND, Tiling
+from facadecli.native import GRAMMAR_COMPILED, _adp
 
 GRID_CELLS = 48  # a gridsplit of more cells than this costs more than it can save
 TOP_ACTIONS = 8  # actions per region the search chooses among (the heuristic's best)
@@ -99,9 +101,13 @@ class Search:
         extensions: tuple[str, ...] = (),
         background: str = BACKGROUND,
         deadline: Deadline | None = None,
+        compiled: bool | None = None,
     ):
+        """``compiled``: search with ``_adp.c`` (the default where it was built,
+        :mod:`facadecli.native`) or with the plain loop (:mod:`facadecli.grammar.plain`)."""
         self.deadline = deadline or Deadline()
-        self.grid = Grid(tiling, background)
+        self.compiled = GRAMMAR_COMPILED if compiled is None else compiled
+        self.grid = Grid(tiling, background, self.compiled)
         self.costs = costs
         self.extensions = set(extensions)
         self.repeats: Repeats = find_repeats(self.grid, deadline=self.deadline)
@@ -114,13 +120,13 @@ class Search:
         self._actions_at: dict[Entry, list[Action]] = {}
         self._quanta: dict[tuple[str, int, int], int] = {}  # (axis, start, stop) -> size
         self.whole: Region = (0, self.grid.rows, 0, self.grid.columns)
-        self._table = self._compiled()
+        self._table = self._compiled() if self.compiled else None
         self._greedy_numbers: list[int] = []  # the greedy rules' actions in the table
 
     @property
     def regions_explored(self) -> int:
         """Regions that were offered actions."""
-        return self._table.explored()
+        return len(self._actions) if self._table is None else self._table.explored()
 
     # -- actions ------------------------------------------------------------------------
 
@@ -427,6 +433,7 @@ class Search:
         the repeated regions, the extensions and the costs."""
         extensions = {"repeatABA": 1, "symsplit": 2, "gridsplit": 4}
         table = self.grid.table
+        assert table is not None, "a grid of the compiled search"
         table.prepare(
             self._repeat_rows.astype(np.int32).tobytes(),
             sum(bit for name, bit in extensions.items() if name in self.extensions),
@@ -438,6 +445,7 @@ class Search:
     def _rules(self, pairs: list[tuple[int, int]]) -> dict[int, Action]:
         """A grammar from the compiled search, its rules in the order chosen, each action
         made again here from its region and cuts."""
+        assert self._table is not None, "the compiled search"
         rules: dict[int, Action] = {}
         for _, number in pairs:
             region, axis, bounds, across, heuristic = self._table.action(number)
@@ -454,6 +462,7 @@ class Search:
     def _action_ids(self, rules: dict[int, Action]) -> list[int]:
         """The table's numbers of a grammar's actions, by their places in their regions'
         actions (equal lists, in one order)."""
+        assert self._table is not None, "the compiled search"
         numbers = []
         for action in rules.values():
             region = _region_of(action)
@@ -465,7 +474,7 @@ class Search:
         """The whole façade's entry, None when it is one terminal."""
         if self.grid.content(self.whole) in self.grid.terminal:
             return None
-        return self._table.entry(*self.whole)
+        return 0 if self._table is None else self._table.entry(*self.whole)
 
     def actions_at(self, entry: Entry) -> list[Action]:
         """The actions of a heap entry's region."""
@@ -509,6 +518,9 @@ class Search:
         ``canonical``'s map)."""
         if not rules:
             return 0.0, []
+        if self._table is None:
+            cost, reach = plain.survey(self, rules)
+            return cost, [sorted(reached) for reached in reach]
         return self._table.survey(self._action_ids(rules))
 
     def greedy(self) -> dict[int, Action]:
@@ -520,23 +532,32 @@ class Search:
                 self._greedy = {}
             else:
                 deadline = self.deadline
-                pairs = self._table.greedy(start, _monotonic(deadline.start + deadline.hard))
-                if pairs is None:
+                hard = deadline.start + deadline.hard
+                if self._table is None:
+                    rules = plain.greedy(self, hard)
+                    pairs = None
+                else:
+                    pairs = self._table.greedy(start, _monotonic(hard))
+                    rules = None if pairs is None else self._rules(pairs)
+                if rules is None:
                     deadline.check("building the greedy grammar")
                     raise AssertionError("the hard time limit passed")  # check() raised
-                self._greedy = self._rules(pairs)
-                self._greedy_numbers = [number for _, number in pairs]
+                self._greedy = rules
+                self._greedy_numbers = [number for _, number in pairs or ()]
         return self._greedy
 
     def adp(self, iterations: int, seed: int) -> tuple[dict[int, Action], int, int]:
         """The cheapest grammar of ``iterations`` (see the module), the iteration it was
         found in (0 is the greedy one), and the iterations done: fewer when the deadline's
-        soft limit passes first. The loop runs in ``_adp`` (compiled); its draws are
-        ``random.Random(seed)``'s."""
+        soft limit passes first. The loop runs in ``_adp`` (compiled) or in
+        :mod:`facadecli.grammar.plain`; its draws are ``random.Random(seed)``'s."""
         greedy = self.greedy()
         start = self._start()
         if start is None or iterations < 2:
             return greedy, 0, max(iterations, 1)
+        if self._table is None:
+            stop_at = self.deadline.start + self.deadline.seconds
+            return plain.adp(self, iterations, seed, greedy, stop_at)
         optimistic = min(self.costs.split + 2, self.costs.repeat + 1)
         state = random.Random(seed).getstate()[1]
         stop = _monotonic(self.deadline.start + self.deadline.seconds)

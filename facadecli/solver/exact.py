@@ -36,8 +36,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from facadecli.native import EXACT_COMPILED, _exact
 from facadecli.patterns import Word
-from facadecli.solver import _exact, columns, sizing
+from facadecli.solver import columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row
 from facadecli.solver.rows import LetterTraits, Row
 from facadecli.spec.model import Spec
@@ -52,7 +53,7 @@ LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
 COMBINATION_WORK = 64  # partial columns built per work unit
 RECURSION_MARGIN = 1000  # frames beyond the search's deepest path (the callers', numpy's)
 SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
-COMPILED = True  # search with _exact.c (False: the Python reference, for the tests)
+COMPILED = EXACT_COMPILED  # search with _exact.c where built (False: the Python reference)
 _EXHAUSTED, _STOPPED = 2, 3  # what _exact.Search.run() returns besides 0 (done)
 
 

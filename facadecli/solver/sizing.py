@@ -25,7 +25,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from facadecli.solver import _exact
+from facadecli.native import EXACT_COMPILED, _exact
 from facadecli.solver.alignment import Alignment, Move
 from facadecli.spec.model import Spec
 
@@ -259,7 +259,9 @@ def _parametrized(
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """Every solution of the sparse equalities ``rows`` over ``n`` variables as
     ``z0 + N y`` (``y`` the free variables), or None when they contradict each other:
-    :func:`_parametrized_in_python`, compiled (``_exact.eliminate``)."""
+    :func:`_parametrized_in_python`, compiled (``_exact.eliminate``) where it was built."""
+    if not EXACT_COMPILED:
+        return _parametrized_in_python(rows, n)
     scale = max((abs(rhs) for _, rhs in rows), default=0.0)
     found = _exact.eliminate(rows, n, ZERO, 1e-9 * max(1.0, scale))
     if found is None:

@@ -1,10 +1,15 @@
-"""The grammar search's inner loop in plain Python: what ``facadecli/grammar/_adp.c`` must
-compute, to the bit (tests/test_grammar_search_tables.py compares them).
+"""The grammar search's inner loop in plain Python: what ``_adp.c`` computes, to the bit.
+
+It runs where the install has no compiled ``_adp`` (:mod:`facadecli.native`), some ten times
+slower, and it is the reference the tests compare the compiled loop with
+(tests/test_grammar_search_tables.py).
 
 It builds grammars region by region (bottom to top, left to right, each content split
 once), greedily or by ADP's choice (explore with probability epsilon by the heuristic's odds,
 else exploit the value table, Eq. 4), and values a grammar by Eq. 1 over its merged rules.
-Sums are written as loops, in the order the compiled loop adds them.
+Sums are written as loops, in the order the compiled loop adds them. ``stop_at`` is a
+``time.perf_counter()`` instant: like the compiled loop, a grammar being built stops before
+its next region once it has passed.
 """
 
 from __future__ import annotations
@@ -14,24 +19,32 @@ import heapq
 import itertools
 import math
 import random
+import time
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-from facadecli.grammar.search import Action, Entry, Search, _entry
+if TYPE_CHECKING:
+    from facadecli.grammar.search import Action, Entry, Search
 
-Choose = Callable[[Entry, dict[int, Action], set[int]], Action]
+Choose = Callable[["Entry", dict[int, "Action"], set[int]], "Action"]
 Learned = dict[int, tuple[float, frozenset[int]]]
 
 
-def build(search: Search, choose: Choose) -> dict[int, Action]:
-    """One grammar: regions bottom to top, left to right, each content split once."""
+def build(search: Search, choose: Choose, stop_at: float = math.inf) -> dict[int, Action] | None:
+    """One grammar: regions bottom to top, left to right, each content split once; None
+    when the clock passes ``stop_at`` first."""
     grid = search.grid
     rules: dict[int, Action] = {}
     start = grid.content(search.whole)
     if start in grid.terminal:
         return rules
     pending = {start}
-    heap = [_entry(search.whole, start)]
+    r0, r1, c0, c1 = search.whole
+    heap: list[Entry] = [(r0, c0, -r1, -c1, start)]
+    timed = not math.isinf(stop_at)
     while heap:
+        if timed and time.perf_counter() > stop_at:
+            return None
         entry = heapq.heappop(heap)
         cid = entry[4]
         pending.discard(cid)
@@ -92,16 +105,26 @@ def learn(rules: dict[int, Action], reach: list[set[int]], learned: Learned) -> 
             learned[cid] = (total, frozenset(order[p] for p in reached))
 
 
-def greedy(search: Search) -> dict[int, Action]:
-    return build(search, lambda entry, rules, pending: search.actions_at(entry)[0])
+def greedy(search: Search, stop_at: float = math.inf) -> dict[int, Action] | None:
+    """Every region takes its first action; None when the clock passes ``stop_at`` first."""
+    return build(search, lambda entry, rules, pending: search.actions_at(entry)[0], stop_at)
 
 
-def adp(search: Search, iterations: int, seed: int) -> tuple[dict[int, Action], int, int]:
-    """``Search.adp`` without a time limit."""
+def adp(
+    search: Search,
+    iterations: int,
+    seed: int,
+    greedy_rules: dict[int, Action] | None = None,
+    stop_at: float = math.inf,
+) -> tuple[dict[int, Action], int, int]:
+    """``Search.adp``: the cheapest grammar of ``iterations``, the iteration it was found in
+    and the iterations done (fewer when the clock passes ``stop_at``, even within one).
+    ``greedy_rules``: the greedy grammar when it is known."""
     rng = random.Random(seed)
     learned: Learned = {}
     optimistic = min(search.costs.split + 2, search.costs.repeat + 1)
-    best = greedy(search)
+    best = greedy_rules if greedy_rules is not None else greedy(search)
+    assert best is not None  # no time limit
     best_cost, reach = survey(search, best)
     learn(best, reach, learned)
     best_at, epsilon = 0, 1.0
@@ -142,7 +165,9 @@ def adp(search: Search, iterations: int, seed: int) -> tuple[dict[int, Action], 
         return best, 0, iterations
     for t in range(1, iterations):
         epsilon = 1.0 - t / iterations
-        rules = build(search, choose)
+        rules = build(search, choose, stop_at)
+        if rules is None:
+            return best, best_at, t
         signature = tuple(map(id, rules.values()))
         if signature in seen:
             continue
