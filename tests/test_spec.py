@@ -147,8 +147,8 @@ def test_mesh_files_next_to_the_spec_are_accepted(tmp_path: Path) -> None:
         load_spec(tmp_path / "spec.yaml")
 
 
-def test_the_readme_first_spec_is_valid() -> None:
-    readme = (ROOT / "README.md").read_text()
-    first = readme.split("```yaml\n", 1)[1].split("```", 1)[0]
-    spec = parse_spec(first, "README.md")
-    assert spec.name == "residential-house"
+def test_the_tutorials_first_spec_is_valid() -> None:
+    tutorial = (ROOT / "docs" / "tutorials" / "first-facade.md").read_text()
+    first = tutorial.split("```yaml\n", 1)[1].split("```", 1)[0]
+    spec = parse_spec(first, "first-facade.md")
+    assert [layer.name for layer in spec.layers] == ["wall"]

@@ -81,6 +81,9 @@ def report(layout: Layout) -> dict[str, Any]:
         ],
         "alignment": {"x": _alignment(layout.x, layout), "y": _alignment(layout.y, layout)},
         "objective": {"x": layout.x.objective, "y": layout.y.objective},
+        "proof": {
+            axis.axis: {"proven": axis.proven, "bound": axis.bound} for axis in (layout.x, layout.y)
+        },
         "candidate": {
             axis.axis: {
                 "words": dict(sorted(axis.words.items())),

@@ -231,6 +231,13 @@ class _Row:
         traits = self.row.traits
         if piece_of is not None:
             yield self._move(start, 2 * k, _Whole(), piece_of=piece_of)
+            if (
+                k < self.n
+                and traits[k].transparent
+                and traits[k].segment == traits[piece_of].segment
+            ):
+                # the end of one split letter and the start of the next, nothing whole
+                yield self._move(start, 2 * k + 1, _Whole(), piece_of=piece_of, tail=k)
         segment = traits[k].segment if k < self.n else 0
         whole = _Whole()
         for index in range(k, self.n):

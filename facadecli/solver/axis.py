@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.patterns import CompiledPattern, Enumerated, Letter, Word, format_word
-from facadecli.solver import columns, exact, sizing
+from facadecli.solver import columns, construct, exact, sizing
 from facadecli.solver.alignment import (
     INF,
     MAX_NODES,
@@ -19,7 +19,7 @@ from facadecli.solver.alignment import (
     _Row,
     align,
 )
-from facadecli.solver.candidates import Candidate, PatternUse, generate_candidates, pattern_uses
+from facadecli.solver.candidates import Candidate, CandidateSpace, PatternUse, pattern_uses
 from facadecli.solver.rows import (
     Row,
     RowCache,
@@ -41,9 +41,12 @@ CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
 FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
 EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
 EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
-TIE = 1e-3  # m^2: objectives this close are equally good (SPEC 2.7's tie-breaks decide) on
-TIE_SCALE = 10.0  # a canvas of this length (m) or more; on a shorter one, less by the square
-# of its share of it, so a façade drawn at 1:10 solves as it does at full size
+TIE = 1e-11  # objectives this close, relative to the canvas squared (and never less than
+# TIE m^2), are equally good: numerical noise (SPEC 2.7: 4.5e-8 m^2 on a 67 m façade, where
+# an element 0.2 mm off its size already counts); its tie-breaks decide among them
+CONSTRUCTIONS = 16  # candidates laid out by construction, least bound first, until one fits
+VARIANTS = 48  # options of a cluster of patterns tried in place of the best layout's
+SWEEPS = 2  # passes over the clusters while a variant improves the best layout
 NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
@@ -83,6 +86,8 @@ class AxisLayout:
     mu: float
     candidates_tried: int
     warnings: tuple[str, ...] = ()
+    proven: bool = False  # no layout has a smaller objective (SPEC 3, ``proof``)
+    bound: float = 0.0  # the best lower bound on the objective the solver found
     timings: Mapping[str, float] = field(default_factory=dict)
 
     def stretched(self, canvas: float) -> AxisLayout:
@@ -136,16 +141,16 @@ class _Evaluated:
         )
 
     @property
-    def rank(self) -> tuple[float, int, int, float, int, tuple[float, ...]]:
-        """Least deviation; then fewest sized letters split; fewest holes made (room made
-        by layers in front); placeholders covering least; most columns; then the
-        candidate order."""
+    def rank(self) -> tuple[float, int, float, int, int, tuple[float, ...]]:
+        """SPEC 2.7: least deviation; then most columns; then placeholders covering least;
+        then the project's own: fewest sized letters split, fewest holes made (room made
+        by layers in front), the candidate order."""
         return (
-            round(self.estimate.objective, 8),
+            self.estimate.objective,
+            -self.columns,
+            round(self.estimate.coverage, 6),
             self.splits,
             self.empties,
-            round(self.estimate.coverage, 6),
-            -self.columns,
             self.candidate.key,
         )
 
@@ -191,6 +196,8 @@ class _SearchMemory:
     made: RowCache = field(default_factory=RowCache)  # make_rows()'s
     counted: dict[tuple[int, bool], exact.Counted] = field(default_factory=dict)
     cores: dict[_CoreKey, _Core] = field(default_factory=dict)  # candidates' relaxations
+    relaxed: dict[int, construct.Relaxation] = field(default_factory=dict)  # by order
+    bounds: dict[int, float] = field(default_factory=dict)  # candidates' bounds, by order
 
 
 # a candidate without one pattern's layers: that pattern, and the other patterns' words
@@ -250,8 +257,11 @@ def solve_axis_alternatives(
     """The best layouts of one axis, best first: the best, and up to ``alternatives`` - 1
     others whose sizing objective is within NEAR_EQUAL of it (for ``facade vary``).
 
-    Candidates go first through the heuristic alignment, then through the exact search
-    (:mod:`facadecli.solver.exact`) while they could still beat the best layout found.
+    Primal first: candidates are laid out by construction (:mod:`facadecli.solver.construct`)
+    in the order of their lower bounds; then the exact search
+    (:mod:`facadecli.solver.exact`) looks, candidate by candidate, for better layouts and
+    proves that none exists; the heuristic alignment offers variations and is a last
+    resort. Each layout says whether it is proven optimal, and the best lower bound found.
     Every budget is counted in work, so the answer does not depend on the machine;
     ``deadline`` (wall clock) is only a safety net, and when it fires the layout says so.
 
@@ -259,9 +269,10 @@ def solve_axis_alternatives(
     :class:`SearchLimitError` when the search stopped before it found one."""
     started = time.perf_counter()
     uses = pattern_uses(spec, axis_words(spec, axis))
-    candidates = generate_candidates(spec, uses, canvas, CANDIDATE_LIMIT)
+    space = CandidateSpace.of(spec, uses, canvas)
+    candidates = [] if space is None else space.best(CANDIDATE_LIMIT)
     generated = time.perf_counter()
-    if not candidates:
+    if space is None or not candidates:
         raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
     tolerance = spec.solver.tolerance
     memory = _SearchMemory(full_layers(spec, axis))
@@ -269,7 +280,9 @@ def solve_axis_alternatives(
     budget = exact.Budget(EXACT_WORK, deadline)
     evaluated: list[_Evaluated] = []
     failures: list[str] = []
-    unproven = len(candidates) >= CANDIDATE_LIMIT  # candidates beyond the list are unseen
+    # candidates beyond the list, or cut by a cap, are unseen
+    truncated = space.truncated or len(candidates) >= CANDIDATE_LIMIT
+    unproven = truncated
     timed_out = False
     tried = 0
     step = max(tolerance, TIER * canvas)
@@ -277,6 +290,8 @@ def solve_axis_alternatives(
     effort = MAX_NODES  # once something aligned, a candidate that needs far more search
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     compare = max(FEASIBLE_TO_COMPARE, alternatives)
+    # what is known of each candidate's objective beyond its bound: none within this
+    above: dict[int, float] = {}
 
     def relaxation(candidate: Candidate) -> _CoreKey | None:
         return shared.get(candidate.order)
@@ -313,6 +328,7 @@ def solve_axis_alternatives(
         why = ruled_out(candidate, target)
         if why is not None:
             failures.append(why)
+            above[candidate.order] = max(above.get(candidate.order, -INF), target)
             return
         rows = _candidate_rows(spec, uses, candidate, memory)
         share = exact.Budget(min(budget.left, TIE_SHARE if tie else EXACT_SHARE), deadline)
@@ -325,10 +341,14 @@ def solve_axis_alternatives(
         if outcome.found is None:
             failures.append(outcome.reason)
             key = relaxation(candidate)
-            if outcome.complete and key is not None:  # proven: its relaxation may have none
-                memory.cores.setdefault(key, _Core(reason=outcome.reason)).failed += 1
+            if outcome.complete:
+                above[candidate.order] = max(above.get(candidate.order, -INF), target)
+                if key is not None:  # proven: its relaxation may have none
+                    memory.cores.setdefault(key, _Core(reason=outcome.reason)).failed += 1
             return
         found = outcome.found
+        if outcome.complete and not tie:  # its best is found: nothing of it is left open
+            above[candidate.order] = INF
         key = relaxation(candidate)
         if key is not None:
             core = memory.cores.setdefault(key, _Core())
@@ -382,27 +402,35 @@ def solve_axis_alternatives(
     visited: list[int] = []  # search states of each heuristic alignment
     if alternatives > 1:  # variations: layouts near the best, as the heuristic meets them
         heuristic_pass()
+    bounds = _InBoundOrder(
+        candidates,
+        lambda c: _candidate_bound(spec, uses, c, canvas, memory),
+        _least_bounds(uses, canvas, memory.full),
+    )
+    # primal first: candidates laid out by construction, least bound first, then each
+    # cluster of patterns' other options in place of the best one's (a layer's words
+    # chosen given the others); a candidate whose layout meets its bound needs no search
+    built = _constructions(spec, uses, space, bounds, canvas, memory, tie)
+    evaluated.extend(built)
+    for e in built:
+        if e.estimate.objective <= memory.bounds.get(e.candidate.order, -INF) + tie:
+            above[e.candidate.order] = INF
     # the exact search, in passes (the paper's iterative deepening, on the exact
     # objective): a pass searches every candidate whose lower bound is within its
     # threshold for a layout within it, in the order of those bounds, and ends the solve
     # once the best layout found is within it: nothing better can exist. Low thresholds cut
     # hopeless columns at once, so the first passes are cheap.
-    bounds = _InBoundOrder(
-        candidates,
-        lambda c: exact.candidate_bound(
-            _candidate_rows(spec, uses, c, memory), canvas, memory.counted
-        ),
-        _least_bounds(uses, canvas, memory.full),
-    )
     heuristic_done = alternatives > 1
     for threshold in DEEPENING:
         failures.clear()  # each pass searches again every candidate it reaches: the last
-        unproven = len(candidates) >= CANDIDATE_LIMIT  # one run says what is proven
+        unproven = truncated  # one run says what is proven
         for bound, _, candidate in bounds:
             # ties too (SPEC 2.7 breaks them); for variations, layouts near the best
             target = min(threshold, best_objective() + (NEAR_EQUAL if alternatives > 1 else tie))
             if timed_out or bound > target:
                 break
+            if above.get(candidate.order, -INF) >= target:
+                continue  # its best is known, or it has none within the target
             if budget.left == 0:
                 unproven = True
                 break
@@ -419,6 +447,7 @@ def solve_axis_alternatives(
     if not evaluated and unproven and not timed_out and not heuristic_done:
         heuristic_pass()  # the exact search ran out of work: the heuristic may still align
     aligned_at = time.perf_counter()
+    lower = _lower_bound(bounds, above, best_objective(), tie, truncated) if evaluated else 0.0
     ranked = _by_rank(evaluated, tie)
     layouts: list[AxisLayout] = []
     first: float | None = None
@@ -432,7 +461,9 @@ def solve_axis_alternatives(
             failures.append(sizing.explain_infeasible(choice.program))
             continue
         first = final.objective if first is None else first
-        layouts.append(_finish(spec, axis, canvas, choice, final, uses, timed_out))
+        layouts.append(
+            _finish(spec, axis, canvas, choice, final, uses, timed_out, min(lower, first), tie)
+        )
     if not layouts:
         if timed_out:
             raise SearchLimitError(
@@ -455,8 +486,190 @@ def solve_axis_alternatives(
 
 
 def tie_window(canvas: float) -> float:
-    """How close two objectives (m^2) on an axis of this length are equally good."""
-    return TIE * min(1.0, (canvas / TIE_SCALE) ** 2)
+    """How close two objectives (m^2) on an axis of this length are equally good: numerical
+    noise, relative to the canvas squared (SPEC 2.7)."""
+    return TIE * max(1.0, canvas * canvas)
+
+
+def _candidate_bound(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    candidate: Candidate,
+    canvas: float,
+    memory: _SearchMemory,
+) -> float:
+    """A lower bound on the objective of a candidate: its relaxation's (kept in
+    ``memory.relaxed`` for the constructions) or its rows' one at a time, the larger."""
+    known = memory.bounds.get(candidate.order)
+    if known is not None:
+        return known
+    rows = _candidate_rows(spec, uses, candidate, memory)
+    bound = exact.candidate_bound(rows, canvas, memory.counted)
+    relaxed = construct.relax(spec, rows, canvas)
+    if relaxed is None:  # not even the relaxation has sizes: the candidate has no layout
+        bound = INF
+    else:
+        memory.relaxed[candidate.order] = relaxed
+        bound = max(bound, relaxed.bound)
+    memory.bounds[candidate.order] = bound
+    return bound
+
+
+def _constructions(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    space: CandidateSpace,
+    bounds: _InBoundOrder,
+    canvas: float,
+    memory: _SearchMemory,
+    tie: float,
+) -> list[_Evaluated]:
+    """Layouts by construction (:mod:`facadecli.solver.construct`): of the candidates in
+    the order of their bounds until one has a layout (CONSTRUCTIONS at most), then of its
+    variants, a cluster of patterns at a time (VARIANTS options each, SWEEPS passes), each
+    kept when it ranks better (SPEC 2.7: less objective, then more columns, then
+    placeholders covering less)."""
+    made: list[_Evaluated] = []
+
+    def build(candidate: Candidate) -> _Evaluated | None:
+        _candidate_bound(spec, uses, candidate, canvas, memory)  # its relaxation, once
+        relaxed = memory.relaxed.get(candidate.order)
+        if relaxed is None:
+            return None
+        rows = _candidate_rows(spec, uses, candidate, memory)
+        built = construct.construct(spec, rows, canvas, memory.prepared, relaxed, tie)
+        if built is None:
+            return None
+        found = _Evaluated(candidate, built.groups, built.program, built.sizing)
+        made.append(found)
+        return found
+
+    def bound(candidate: Candidate) -> float:
+        return _candidate_bound(spec, uses, candidate, canvas, memory)
+
+    def descended(candidate: Candidate) -> Candidate:
+        """The candidate with each cluster's option of least bound, the others kept, until
+        no cluster changes (SWEEPS passes): the words of one layer chosen to fit the
+        others', as a perfect layout's must."""
+        for _ in range(SWEEPS):
+            changed = False
+            for cluster in range(len(space.clusters)):
+                for variant in space.variants(candidate, cluster, VARIANTS):
+                    if bound(variant) < bound(candidate) - tie:
+                        candidate, changed = variant, True
+            if not changed:
+                break
+        return candidate
+
+    best: _Evaluated | None = None
+    for number, (_, _, candidate) in enumerate(bounds):
+        if number >= CONSTRUCTIONS:
+            break
+        best = build(candidate)
+        if best is None:
+            descent = descended(candidate)
+            best = None if descent is candidate else build(descent)
+            if best is None:
+                fitted = _fitted_to_backs(spec, uses, space, descent, canvas, memory)
+                best = None if fitted is descent else build(fitted)
+        if best is not None:
+            break
+    if best is None:
+        return made
+    for _ in range(SWEEPS):
+        improved = False
+        for cluster in range(len(space.clusters)):
+            for variant in space.variants(best.candidate, cluster, VARIANTS):
+                if _candidate_bound(spec, uses, variant, canvas, memory) > (
+                    best.estimate.objective + tie
+                ):
+                    continue
+                found = build(variant)
+                if found is not None and _better(found, best, tie):
+                    best, improved = found, True
+        if not improved:
+            break
+    return made
+
+
+def _fitted_to_backs(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    space: CandidateSpace,
+    candidate: Candidate,
+    canvas: float,
+    memory: _SearchMemory,
+) -> Candidate:
+    """The candidate with each cluster's words chosen on their own to fit the rows at the
+    back of their groups (the base: its boundaries laid at the relaxation's sizes): the
+    first option (best first, VARIANTS at most) whose rows end every visible letter on
+    one of those boundaries and fill the canvas (:func:`construct.fits`). Layers that meet
+    only through the base's columns align independently given them."""
+    relaxed = memory.relaxed.get(candidate.order)
+    if relaxed is None:
+        return candidate
+    rows = _candidate_rows(spec, uses, candidate, memory)
+    laid = construct.placeholders_laid(rows, relaxed, canvas) or dict(relaxed.lengths)
+    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
+    backs = {group: members[0] for group, members in rows.items() if members}
+    points = {group: construct.boundaries(row, laid) for group, row in backs.items()}
+    fixed = {pattern_of[layer] for row in backs.values() for layer in row.layers}
+    sizes = {name: size for name, size in relaxed.lengths.items() if spec.size(name) is not None}
+    for cluster, members in enumerate(space.clusters):
+        keys = {use.key for use in members}
+        if keys & fixed:
+            continue
+        for variant in [candidate, *space.variants(candidate, cluster, VARIANTS)]:
+            grouped = _candidate_rows(spec, uses, variant, memory)
+            own = [
+                (group, row)
+                for group, members_ in grouped.items()
+                for row in members_
+                if any(pattern_of[layer] in keys for layer in row.layers)
+            ]
+            known = {**_sized(spec, [row for _, row in own]), **sizes}
+            if all(
+                group in points and construct.fits(row, known, points[group], canvas)
+                for group, row in own
+            ):
+                candidate = variant
+                break
+    return candidate
+
+
+def _sized(spec: Spec, rows: Sequence[Row]) -> dict[str, float]:
+    """The preferred sizes of the rows' sized symbols."""
+    sizes = {}
+    for row in rows:
+        for letter in row.word:
+            size = spec.size(letter.symbol)
+            if size is not None:
+                sizes[letter.symbol] = size
+    return sizes
+
+
+def _better(a: _Evaluated, b: _Evaluated, tie: float) -> bool:
+    """Whether ``a`` ranks before ``b`` (SPEC 2.7, objectives within ``tie`` equal)."""
+    if abs(a.estimate.objective - b.estimate.objective) > tie:
+        return a.estimate.objective < b.estimate.objective
+    return a.rank[1:] < b.rank[1:]
+
+
+def _lower_bound(
+    bounds: _InBoundOrder, above: Mapping[int, float], best: float, tie: float, truncated: bool
+) -> float:
+    """The best lower bound on the axis' objective once the searches are done: the least
+    bound of a candidate whose layouts were not all ruled out below ``best`` (each beyond
+    what its searches proved), or ``best`` itself when there is none. Candidates that
+    were never generated (the list was cut) bound nothing: 0."""
+    if truncated:
+        return 0.0
+    lower = best
+    for bound, _, candidate in bounds:
+        if bound >= lower - tie:
+            break
+        lower = min(lower, max(bound, above.get(candidate.order, -INF)))
+    return lower
 
 
 def _by_rank(evaluated: Sequence[_Evaluated], tie: float) -> list[_Evaluated]:
@@ -624,9 +837,19 @@ def _finish(
     final: sizing.Sizing,
     uses: Sequence[PatternUse],
     timed_out: bool,
+    lower: float,
+    tie: float,
 ) -> AxisLayout:
-    """The placed letters of a chosen candidate, with the warnings a user should see."""
+    """The placed letters of a chosen candidate, with the warnings a user should see;
+    ``lower``: the best lower bound found on its objective."""
     warnings = []
+    proven = lower >= final.objective - tie
+    if not proven:
+        warnings.append(
+            f"{axis}: the layout is not proven optimal: its objective is {final.objective:.6g} "
+            f"m2, the best lower bound found {lower:.6g} m2 (the search stopped at its work "
+            "budget)"
+        )
     if timed_out:
         warnings.append(
             f"{axis}: the time limit ({spec.solver.time_limit:g} s) ran out; "
@@ -638,6 +861,7 @@ def _finish(
             "for the words to fit the canvas"
         )
     layout = _place(spec, axis, canvas, choice, final, uses)
+    layout = replace(layout, proven=proven, bound=round(min(lower, final.objective), 9))
     for name, (preferred, size) in layout.symbols.items():
         if preferred and abs(size - preferred) > 0.1 * preferred:
             warnings.append(

@@ -94,54 +94,97 @@ def generate_candidates(
     spec: Spec, uses: Sequence[PatternUse], canvas: float, limit: int = 500
 ) -> list[Candidate]:
     """Up to ``limit`` candidates, best first (by needed mu, then misfit)."""
-    sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
-    transparent = frozenset(n for n in spec.symbols if spec.qualifiers(n).transparent)
-    bounds = {name: counter.bounds for name, counter in spec.counters.items()}
-    words: dict[str, list[Enumerated]] = {}
-    for use in uses:
-        enumerated = enumerate_words(
-            use.pattern,
-            sizes=sizes,
-            max_length=2.0 * canvas,
-            transparent=transparent,
-            counters=bounds,
-            max_letters=MAX_LETTERS,
-        )
-        words[use.key] = list(itertools.islice(enumerated, WORDS_PER_PATTERN))
-        if not words[use.key]:
-            return []
-        bounds.update(_seen_counters(use.pattern, words[use.key]))
-    opaque_of = _opaque_sizes(spec)
-    opaque = {
-        id(item): sum(
-            opaque_of.get(letter.symbol, 0.0) for letter in item.word if not letter.transparent
-        )
-        for found in words.values()
-        for item in found
-    }
-    clusters = _clusters(uses)
-    options = [_cluster_options(cluster, words) for cluster in clusters]
-    if any(not cluster_options for cluster_options in options):
-        return []
-    # rank each cluster's options by a context-free estimate, then merge best-first
-    room = {use.key: _max_room_above(use, uses, words, opaque) for use in uses}
-    ranked = []
-    for cluster_options in options:
-        scored = [
-            (_estimate(spec, option, canvas, room), index, option)
-            for index, option in enumerate(cluster_options)
-        ]
-        scored.sort(key=lambda item: (item[0], item[1]))
-        ranked.append([option for _, _, option in scored])
-    candidates = []
-    above = _layers_above(uses)
-    for order, combination in enumerate(_best_combinations(ranked, limit)):
+    space = CandidateSpace.of(spec, uses, canvas)
+    return [] if space is None else space.best(limit)
+
+
+@dataclass
+class CandidateSpace:
+    """Every pattern's words on one axis, joined into options per cluster of patterns that
+    share counters; a candidate is one option per cluster."""
+
+    canvas: float
+    clusters: list[list[PatternUse]]
+    options: list[list[dict[str, Enumerated]]]  # per cluster, best first
+    above: list[tuple[str, tuple[str, ...]]]
+    opaque: dict[int, float]
+    truncated: bool  # a cap cut the words or options: some candidates are never made
+    made: int = 0  # candidates made so far (their order)
+
+    @classmethod
+    def of(cls, spec: Spec, uses: Sequence[PatternUse], canvas: float) -> CandidateSpace | None:
+        """The space of an axis; None when some pattern makes no word."""
+        sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
+        transparent = frozenset(n for n in spec.symbols if spec.qualifiers(n).transparent)
+        bounds = {name: counter.bounds for name, counter in spec.counters.items()}
+        words: dict[str, list[Enumerated]] = {}
+        truncated = False
+        for use in uses:
+            enumerated = enumerate_words(
+                use.pattern,
+                sizes=sizes,
+                max_length=2.0 * canvas,
+                transparent=transparent,
+                counters=bounds,
+                max_letters=MAX_LETTERS,
+            )
+            words[use.key] = list(itertools.islice(enumerated, WORDS_PER_PATTERN + 1))
+            if len(words[use.key]) > WORDS_PER_PATTERN:
+                truncated = True
+                del words[use.key][WORDS_PER_PATTERN:]
+            if not words[use.key]:
+                return None
+            bounds.update(_seen_counters(use.pattern, words[use.key]))
+        opaque_of = _opaque_sizes(spec)
+        opaque = {
+            id(item): sum(
+                opaque_of.get(letter.symbol, 0.0) for letter in item.word if not letter.transparent
+            )
+            for found in words.values()
+            for item in found
+        }
+        clusters = _clusters(uses)
+        options = [_cluster_options(cluster, words) for cluster in clusters]
+        if any(not cluster_options for cluster_options in options):
+            return None
+        truncated = truncated or any(len(o) >= OPTIONS_PER_CLUSTER for o in options)
+        # rank each cluster's options by a context-free estimate
+        room = {use.key: _max_room_above(use, uses, words, opaque) for use in uses}
+        ranked = []
+        for cluster_options in options:
+            scored = [
+                (_estimate(spec, option, canvas, room), index, option)
+                for index, option in enumerate(cluster_options)
+            ]
+            scored.sort(key=lambda item: (item[0], item[1]))
+            ranked.append([option for _, _, option in scored])
+        return cls(canvas, clusters, ranked, _layers_above(uses), opaque, truncated)
+
+    def candidate(self, choice: Sequence[dict[str, Enumerated]]) -> Candidate:
+        """The candidate of one option per cluster (numbered in the order made)."""
         merged: dict[str, Enumerated] = {}
-        for option in combination:
+        for option in choice:
             merged.update(option)
-        candidates.append(_candidate(above, merged, canvas, order, opaque))
-    candidates.sort(key=lambda candidate: candidate.key)
-    return candidates
+        made = _candidate(self.above, merged, self.canvas, self.made, self.opaque)
+        self.made += 1
+        return made
+
+    def best(self, limit: int) -> list[Candidate]:
+        """Up to ``limit`` candidates, best first (by needed mu, then misfit): the
+        combinations of options by increasing sum of ranks."""
+        found = [self.candidate(c) for c in _best_combinations(self.options, limit)]
+        found.sort(key=lambda candidate: candidate.key)
+        return found
+
+    def variants(self, candidate: Candidate, cluster: int, most: int) -> list[Candidate]:
+        """The candidate with another option of one cluster (its first ``most``)."""
+        keys = {use.key for use in self.clusters[cluster]}
+        kept = {key: item for key, item in candidate.words.items() if key not in keys}
+        return [
+            self.candidate([kept, option])
+            for option in self.options[cluster][:most]
+            if any(option[key] is not candidate.words[key] for key in keys)
+        ]
 
 
 def _seen_counters(

@@ -1,0 +1,394 @@
+"""Primal constructions and the relaxation bound of one candidate (DESIGN.md: primal first).
+
+Before any search, a candidate's words are laid out at given lengths, every row from 0 on,
+and cut where all rows agree: a column boundary wherever every row has a letter boundary
+or is inside a transparent letter (which may be split, SPEC 2.4). The rules of SPEC 2.4
+are then checked column by column, and the sizing QP gives the layout its objective. Laid
+at preferred sizes (placeholders sized by the rows' lengths), a façade whose layout keeps
+every symbol at its preferred size is found this way with no search; laid again at the
+sizes the QP solved, a construction often improves (the paper's cutting of aligned rows).
+
+The *relaxation* of a candidate is the QP over its symbols' sizes alone: a row that no
+layer in front may make room in fills the canvas, any other row fits in it. Every layout
+of the candidate meets these constraints (its rows are laid out on the canvas, gaps only
+under opaque letters in front), so the relaxation's objective is a lower bound on the
+candidate's, and its sizes are the first lengths a construction lays the rows at.
+"""
+
+from __future__ import annotations
+
+import bisect
+import itertools
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from facadecli.solver import columns, sizing
+from facadecli.solver.alignment import Alignment, Move, _Row
+from facadecli.solver.rows import Row
+from facadecli.spec.model import Spec
+
+NEAR = 1e-7  # metres (times the canvas, at least 1 m): boundaries this close are one
+# tolerances (shares of the shortest letter) within which boundaries laid at the
+# relaxation's sizes are taken for one cut; the QP then makes them meet
+SNAP = (0.0, 0.1, 0.25, 0.45)
+ROUNDS = 3  # constructions at solved sizes after the first
+# weight of the relaxation's placeholders and gaps: it only makes the optimum unique (a
+# larger one moves the sizes, and so the boundaries the rows are cut at)
+FAINT = 1e-12
+
+
+@dataclass(frozen=True)
+class Relaxation:
+    """A candidate's relaxation: its objective (a lower bound) and its sizes."""
+
+    bound: float
+    lengths: Mapping[str, float]  # symbol -> length (placeholders included)
+
+
+def relax(spec: Spec, groups: Mapping[str, Sequence[Row]], canvas: float) -> Relaxation | None:
+    """The relaxation of a candidate's rows; None when even it has no solution (then the
+    candidate has no layout: its rows cannot all fit the canvas)."""
+    names: list[str] = []
+    index: dict[str, int] = {}
+    for rows in groups.values():
+        for row in rows:
+            for letter in row.word:
+                if letter.symbol not in index:
+                    index[letter.symbol] = len(names)
+                    names.append(letter.symbol)
+    equalities: list[tuple[dict[int, float], float]] = []
+    seen: set[tuple[tuple[int, float], ...]] = set()
+    slacks = 0
+    for rows in groups.values():
+        for row in rows:
+            counts: dict[int, float] = {}
+            for letter in row.word:
+                j = index[letter.symbol]
+                counts[j] = counts.get(j, 0.0) + 1.0
+            may_give_way = any(other.covers(row) for other in rows)
+            key = (*sorted(counts.items()), (-1, 1.0 if may_give_way else 0.0))
+            if key in seen:
+                continue
+            seen.add(key)
+            if may_give_way:  # it fits: its letters and a slack (its gaps) fill the canvas
+                counts[len(names) + slacks] = 1.0
+                slacks += 1
+            equalities.append((counts, canvas))
+    n = len(names) + slacks
+    target = np.zeros(n)
+    weight = np.full(n, FAINT)
+    lower = np.zeros(n)
+    upper = np.full(n, np.inf)
+    sized: list[int] = []
+    for name, j in index.items():
+        symbol = spec.symbols.get(name)
+        if symbol is None or symbol.size is None:
+            continue
+        target[j], weight[j] = symbol.size, 1.0
+        lower[j] = max(sizing.MIN_SIZE, symbol.min or 0.0)
+        upper[j] = np.inf if symbol.max is None else symbol.max
+        sized.append(j)
+    program = sizing.Program(
+        names=[*names, *(f"gap {i}" for i in range(slacks))],
+        target=target,
+        weight=weight,
+        lower=lower,
+        upper=upper,
+        rhs=np.array([rhs for _, rhs in equalities]),
+        rows=equalities,
+        symbols={name: j for name, j in index.items()},
+        columns={},
+        pieces={},
+        sized=sized,
+    )
+    solved = sizing.search_solve(program)
+    if solved is None:
+        return None
+    lengths = {name: solved.of(j) for name, j in index.items()}
+    for name in index:  # the placeholders' tiny weight moves sizes by noise: drop it
+        size = spec.size(name)
+        if size is not None and abs(lengths[name] - size) <= NEAR * max(1.0, canvas):
+            lengths[name] = size
+    return Relaxation(solved.objective, lengths)
+
+
+def cut(
+    rows: Sequence[Row],
+    lengths: Mapping[str, float],
+    canvas: float,
+    prepared: dict[Row, _Row],
+    snap: float = 0.0,
+) -> Alignment | None:
+    """The rows of one group laid at ``lengths`` and cut where they all agree (within
+    ``snap`` metres), as an alignment; None when a row does not fill the canvas or the
+    cuts break a rule of SPEC 2.4."""
+    near = max(NEAR * max(1.0, canvas), snap)
+    laid: list[list[float]] = []
+    for row in rows:
+        x = [0.0]
+        for letter in row.word:
+            x.append(x[-1] + lengths[letter.symbol])
+        if abs(x[-1] - canvas) > near:
+            return None  # a row with gaps: not constructed here
+        x[-1] = canvas
+        laid.append(x)
+    points = sorted({p for x in laid for p in x[1:-1]})
+    cuts = [0.0]
+    for p in points:
+        if p - cuts[-1] <= near or canvas - p <= near:
+            continue
+        if all(_position(x, row, p, near) is not None for x, row in zip(laid, rows, strict=True)):
+            cuts.append(p)
+    cuts.append(canvas)
+    prepared_rows = [_prepared(row, prepared) for row in rows]
+    entries: list[tuple[Move | None, ...]] = []
+    for a, b in itertools.pairwise(cuts):
+        column: list[Move | None] = []
+        for x, row, ready in zip(laid, rows, prepared_rows, strict=True):
+            start, end = _position(x, row, a, near), _position(x, row, b, near)
+            assert start is not None and end is not None
+            if b == canvas:  # the row's last letters, those of no length too
+                end = 2 * len(row.word)
+            move = ready.spanning(start, end)
+            if move is None:
+                return None  # e.g. transparent and visible letters in one entry
+            column.append(move)
+        if not _valid(rows, column):
+            return None
+        entries.append(tuple(column))
+    return Alignment(
+        tuple(rows),
+        tuple(entries),
+        0.0,
+        tuple(b - a for a, b in itertools.pairwise(cuts)),
+        tuple(False for _ in entries),
+    )
+
+
+def _position(x: Sequence[float], row: Row, p: float, near: float) -> int | None:
+    """Where coordinate ``p`` falls in a laid row, in half-steps: ``2k`` at the boundary
+    before letter k, ``2k + 1`` inside transparent letter k; None inside a visible one."""
+    k = bisect.bisect_left(x, p - near)
+    if k < len(x) and abs(x[k] - p) <= near:
+        return 2 * k
+    inside = k - 1
+    if 0 <= inside < len(row.word) and row.traits[inside].transparent:
+        return 2 * inside + 1
+    return None
+
+
+def _valid(rows: Sequence[Row], column: Sequence[Move | None]) -> bool:
+    """SPEC 2.4 on a column without gaps: an opaque entry, and nothing visible in front
+    of an unoccludable letter."""
+    if not any(move is not None and move.opaque for move in column):
+        return False
+    for r, move in enumerate(column):
+        if move is None or not move.unoccludable:
+            continue
+        for a, other in enumerate(column):
+            if other is not None and not other.transparent and rows[a].is_above(rows[r]):
+                return False
+    return True
+
+
+def _prepared(row: Row, known: dict[Row, _Row]) -> _Row:
+    found = known.get(row)
+    if found is None:
+        found = known[row] = _Row(row)
+    return found
+
+
+def shortest_letter(groups: Mapping[str, Sequence[Row]], lengths: Mapping[str, float]) -> float:
+    return min(
+        (lengths[letter.symbol] for rows in groups.values() for row in rows for letter in row.word),
+        default=0.0,
+    )
+
+
+def placeholders_laid(
+    groups: Mapping[str, Sequence[Row]], relaxed: Relaxation, canvas: float
+) -> dict[str, float] | None:
+    """The relaxation's sizes with the placeholders sized so that the rows agree: a
+    placeholder that is the only one a row leaves open takes what the row leaves of the
+    canvas; where a row leaves several open, they are sized (:func:`_fitted`) so that the
+    row's boundaries fall on those of the rows already laid in its group. None when a row
+    cannot be laid so (then the relaxation's own placeholder sizes are all there is)."""
+    lengths = {name: size for name, size in relaxed.lengths.items()}
+    open_ = {
+        letter.symbol
+        for rows in groups.values()
+        for row in rows
+        for letter, traits in zip(row.word, row.traits, strict=True)
+        if traits.size is None
+    }
+    for name in open_:
+        del lengths[name]
+    # every row laid without gaps (those are all that :func:`cut` makes)
+    rows_of = [(name, row) for name, rows in sorted(groups.items()) for row in rows]
+    while True:
+        progress = False
+        for _, row in rows_of:
+            missing = {letter.symbol for letter in row.word if letter.symbol not in lengths}
+            if len(missing) == 1:
+                name = missing.pop()
+                count = sum(letter.symbol == name for letter in row.word)
+                rest = sum(lengths[letter.symbol] for letter in row.word if letter.symbol != name)
+                lengths[name] = max(0.0, (canvas - rest) / count)
+                progress = True
+        if progress:
+            continue
+        waiting = [
+            (group, row)
+            for group, row in rows_of
+            if any(letter.symbol not in lengths for letter in row.word)
+        ]
+        if not waiting:
+            return {**relaxed.lengths, **lengths}
+        group, row = waiting[0]
+        laid = [
+            other
+            for other in groups[group]
+            if all(letter.symbol in lengths for letter in other.word)
+        ]
+        points = sorted({p for other in laid for p in boundaries(other, lengths)})
+        fitted = _fitted(row, lengths, points, canvas)
+        if fitted is None:
+            return None
+        lengths.update(fitted)
+
+
+def fits(row: Row, sizes: Mapping[str, float], points: Sequence[float], canvas: float) -> bool:
+    """Whether a row at ``sizes`` (its placeholders sized as it needs) fills the canvas
+    with every visible letter starting and ending on one of ``points``."""
+    return _fitted(row, sizes, sorted(points), canvas) is not None
+
+
+def boundaries(row: Row, lengths: Mapping[str, float]) -> list[float]:
+    x = [0.0]
+    for letter in row.word:
+        x.append(x[-1] + lengths[letter.symbol])
+    return x
+
+
+FITTING_WORK = 2000  # letters laid at most while fitting one row's placeholders
+
+
+def _fitted(
+    row: Row, lengths: Mapping[str, float], points: Sequence[float], canvas: float
+) -> dict[str, float] | None:
+    """Sizes of a row's open placeholders that end each of them on one of ``points`` and
+    the row on the canvas' end; of those found (depth first, nearest first, within
+    FITTING_WORK), the ones covering least (SPEC 2.7); None when none is found."""
+    near = NEAR * max(1.0, canvas)
+    word = [letter.symbol for letter in row.word]
+    # boundaries before letter k that a visible letter starts or ends at: they are cuts,
+    # so they must fall on the laid rows' boundaries
+    edge = [
+        k == 0
+        or k == len(word)
+        or not row.traits[k - 1].transparent
+        or not row.traits[k].transparent
+        for k in range(len(word) + 1)
+    ]
+    work = 0
+    best: dict[str, float] | None = None
+
+    def on_point(x: float) -> bool:
+        at = bisect.bisect_left(points, x - near)
+        return at < len(points) and points[at] <= x + near
+
+    def lay(k: int, x: float, sizes: dict[str, float]) -> None:
+        nonlocal work, best
+        while k < len(word):
+            work += 1
+            if work > FITTING_WORK or x > canvas + near or (edge[k] and not on_point(x)):
+                return
+            symbol = word[k]
+            size = lengths.get(symbol, sizes.get(symbol))
+            if size is None:
+                break
+            x += size
+            k += 1
+        if k == len(word):
+            if abs(x - canvas) <= near and (
+                best is None or sum(sizes.values()) < sum(best.values()) - near
+            ):
+                best = sizes
+            return
+        symbol = word[k]
+        still = {s for s in word[k:] if s not in lengths and s not in sizes}
+        if len(still) == 1:  # the last open one takes what the row leaves
+            count = word[k:].count(symbol)
+            rest = sum(lengths.get(s, sizes.get(s, 0.0)) for s in word[k:] if s != symbol)
+            size = (canvas - x - rest) / count
+            if size >= 0.0:
+                lay(k, x, {**sizes, symbol: size})
+            return
+        at = bisect.bisect_right(points, x + near)
+        for end in points[at:]:
+            if work > FITTING_WORK:
+                return
+            lay(k, x, {**sizes, symbol: end - x})
+
+    lay(0, 0.0, {})
+    return best
+
+
+@dataclass(frozen=True)
+class Constructed:
+    """A candidate's layout by construction: its alignments, sizing program and sizes."""
+
+    groups: dict[str, Alignment]
+    program: sizing.Program
+    sizing: sizing.Sizing
+
+
+def construct(
+    spec: Spec,
+    groups: Mapping[str, Sequence[Row]],
+    canvas: float,
+    prepared: dict[Row, _Row],
+    relaxed: Relaxation,
+    same: float,
+) -> Constructed | None:
+    """The best layout the constructions find for a candidate's rows: laid at the
+    relaxation's sizes (cut where the rows agree exactly, then within growing shares of
+    the shortest letter), then again at each layout's solved sizes while that improves;
+    it stops as soon as a layout reaches the relaxation's bound (``same``: objectives this
+    close are equal). None when no construction gives a valid layout."""
+    best: Constructed | None = None
+    shortest = shortest_letter(groups, relaxed.lengths)
+    laid = placeholders_laid(groups, relaxed, canvas)
+    # at shares of 0: the placeholders laid to fit, then the relaxation's own sizes; then
+    # snapped within growing shares of the shortest letter
+    exact = [relaxed.lengths] if laid is None else [laid, relaxed.lengths]
+    tries = [(0.0, lengths) for lengths in exact]
+    tries += [(share, laid or relaxed.lengths) for share in SNAP[1:]]
+    for share, start in tries:
+        lengths = start
+        snap = share * shortest
+        for _ in range(1 + ROUNDS):
+            aligned = {}
+            for name, rows in sorted(groups.items()):
+                alignment = cut(rows, lengths, canvas, prepared, snap)
+                if alignment is None:
+                    break
+                aligned[name] = alignment
+            else:
+                program = sizing.build_program(spec, aligned, canvas)
+                solved = sizing.search_solve(program)
+                if solved is None:
+                    break
+                finer, program, solved = columns.finest(spec, canvas, aligned, program, solved)
+                if best is not None and solved.objective >= best.sizing.objective - same:
+                    break
+                best = Constructed(finer, program, solved)
+                if solved.objective <= relaxed.bound + same:
+                    return best
+                lengths = {name: solved.of(j) for name, j in program.symbols.items()}
+                snap = 0.0
+                continue
+            break
+    return best

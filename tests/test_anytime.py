@@ -1,0 +1,179 @@
+"""The anytime solver: layouts by construction, a bound beside every answer, SPEC 2.7's ties.
+
+Reproducers from the solver issue, each with the answer the SPEC requires, and a family
+of generated façades whose perfect layout is known in advance (every symbol at its
+preferred size), which the constructions must find with no search."""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+
+from facadecli import parse_spec, solve
+from facadecli.export.report import report
+from tests.solving import letters, solve_text
+
+THREE_LAYERS = """
+version: 1
+name: three-layers
+canvas: {width: 27.85, height: 3.0}
+symbol_defaults: {opaque: true}
+symbols:
+  E: 1.1
+  E2: 0.7
+  F: 0.3
+  P: 1.15
+  W: 2.25
+  V1: 1.1
+  V3: {size: 1.15, opaque: false}
+  V43: 1.1
+  T44: {size: 3.4, transparent: true}
+  T45: {size: 2.95, transparent: true}
+  H: 3.0
+counters: {k: {min: 1}, k1: 7}
+patterns:
+  base: E (W P)^k W (E2 | F F)
+  control: {control: s2 (W s4)^k1 W g5, where: {s2: V1, s4: V3}}
+  third: V43 (T44)^k T45
+layers:
+  - {name: base, x: base, y: H}
+  - {name: control, x: control, y: H}
+  - {name: third, x: third, y: H}
+"""
+
+
+def test_a_perfect_layout_of_three_distinct_layers_is_found_and_proven() -> None:
+    """It came out at 155 m2, unproven and unwarned, where a layout at 0 exists."""
+    layout = solve_text(THREE_LAYERS)
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
+    assert layout.counters["k"] == 7
+    assert layout.x.proven and layout.y.proven
+    assert report(layout)["proof"]["x"] == {"proven": True, "bound": layout.x.bound}
+    assert not any("not proven" in warning for warning in layout.warnings)
+
+
+FIG_4C = """
+version: 1
+name: fig-4c
+canvas: {width: 93.4, height: 3.0}
+symbol_defaults: {opaque: true}
+symbols:
+  A: 1.4
+  D: {size: 0.6, unoccludable: true}
+  B: {size: 1.2, attached: true}
+  P: 0.4
+  H: 3.0
+counters: {m: {min: 1}, n: {min: 1}}
+patterns:
+  base: A (D B D A)^m
+  pilasters: {control: a (d b d a)^n, where: {d: P}}
+layers:
+  - {name: base, x: base, y: H}
+  - {name: pilasters, x: pilasters, y: H}
+"""
+
+
+def test_more_columns_break_ties_before_fewer_holes() -> None:
+    """The paper's Fig. 4c: every pilaster pair at objective 0, so the one with the most
+    columns wins (SPEC 2.7), not one pair (a "fewer holes" rule once came first)."""
+    layout = solve_text(FIG_4C)
+    assert layout.counters["m"] == 20
+    assert layout.counters["n"] == 20
+    assert [p.symbol for p in letters(layout, "pilasters", "x")].count("P") == 40
+
+
+def test_an_exact_fit_beats_more_columns_with_every_size_a_little_off() -> None:
+    """SPEC 2.7: objectives equal only up to numerical noise. A balcony layer whose floors
+    must stretch with the base (Z tied to S) loses to the layout without it when the floors
+    do not fill the canvas at preferred sizes; on a canvas they fill, it wins on columns."""
+    text = """
+    version: 1
+    name: balconies
+    canvas: {{width: 5.0, height: {height}}}
+    symbol_defaults: {{opaque: true}}
+    symbols: {{G: 4.0, S: 3.0, Z: 3.0, T: 2.0, W: 5.0}}
+    counters: {{m: {{min: 1}}, p: {{min: 0}}}}
+    patterns:
+      floors: G S^m T
+      balcony_y: {{control: G (z S)^p v, where: {{z: Z}}}}
+    layers:
+      - {{name: base, x: W, y: floors}}
+      - {{name: balconies, x: W, y: balcony_y, offset: 1.0}}
+    """
+    exact = solve_text(text.format(height=15.0))
+    assert exact.counters["m"] == 3 and exact.counters["p"] == 1
+    off = solve_text(text.format(height=15.3))
+    assert off.counters["p"] == 0
+
+
+def _planted(seed: int) -> tuple[str, dict[str, int]]:
+    """A façade with a planted perfect layout: a base of bays (head, unit^k, tail) and
+    layers that repeat every ``period`` bays over it: windows through placeholders (their
+    spacers unsized), a transparent spacer pattern, and a reuse of the base."""
+    rng = random.Random(seed)
+    q = 0.05
+    head, wall, pier, tail = (rng.randint(8, 30) * q for _ in range(4))
+    k = rng.choice([2, 3, 4, 6, 8, 12])
+    period = rng.choice([d for d in (1, 2, 3, 4) if k % d == 0])
+    width = round(head + k * (wall + pier) + tail, 6)
+    lines = [
+        "version: 1",
+        f"name: planted-{seed}",
+        f"canvas: {{width: {width}, height: 3.0}}",
+        "symbol_defaults: {opaque: true}",
+        "symbols:",
+        f"  E: {head}",
+        f"  W: {wall}",
+        f"  P: {pier}",
+        f"  F: {tail}",
+        "  H: 3.0",
+        f"  V: {{size: {wall}, unoccludable: true}}",
+        f"  T: {{size: {round(period * (wall + pier), 6)}, transparent: true}}",
+        f"  N: {{size: {head}, opaque: false}}",
+        "counters: {k: {min: 1}, j: {min: 1}, i: {min: 1}}",
+        "patterns:",
+        "  base: E (W P)^k F",
+        "  windows: {control: s (v t)^j u, where: {v: V}}",
+        "  spacers: {control: n (T)^i u2, where: {n: N}}",
+        "layers:",
+        "  - {name: base, x: base, y: H}",
+        "  - {name: windows, x: windows, y: H, offset: 0.1}",
+        "  - {name: spacers, x: spacers, y: H, offset: 0.2}",
+    ]
+    return "\n".join(lines) + "\n", {"k": k, "i": k // period}
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_planted_layouts_are_found_exactly_and_proven(seed: int) -> None:
+    text, counters = _planted(seed)
+    layout = solve(parse_spec(text, "planted.yaml"))
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9), text
+    assert layout.x.proven
+    assert layout.counters["k"] == counters["k"]
+    windows = [p for p in letters(layout, "windows", "x") if p.symbol == "V"]
+    walls = {(round(p.start, 6), round(p.end, 6)) for p in letters(layout, "base", "x")}
+    assert windows and all((round(w.start, 6), round(w.end, 6)) in walls for w in windows)
+
+
+def test_the_relaxation_bounds_every_layout_of_its_candidate() -> None:
+    """Rows that fill the canvas alone cannot all keep their preferred sizes: the bound is
+    the least squared deviation that lets each fill it, and the layout is no better."""
+    layout = solve_text(
+        """
+        version: 1
+        name: tight
+        canvas: {width: 10.0, height: 3.0}
+        symbol_defaults: {opaque: true}
+        symbols: {A: 3.0, B: 2.0, H: 3.0}
+        counters: {k: 3}
+        patterns: {a: A^k, b: B^4}
+        layers:
+          - {name: a, x: a, y: H}
+          - {name: b, x: b, y: H}
+        """
+    )
+    # A: 3 a = 10, B: 4 b = 10 (they share no symbol): deviation (1/3)^2 + (0.5)^2
+    assert layout.x.objective == pytest.approx((1 / 3) ** 2 + 0.5**2, rel=1e-6)
+    assert layout.x.proven
+    assert report(layout)["proof"]["x"]["bound"] == pytest.approx(layout.x.objective, rel=1e-6)
