@@ -49,6 +49,7 @@ format: $(STAMP) ## Reformat the code with ruff
 
 bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extraction on CMP, cities, and infer on CMP
 	$(BIN)/python tests/benchmarks/bench.py
+	$(BIN)/python tests/benchmarks/solver_bench.py
 	$(BIN)/python tests/benchmarks/grammar_bench.py
 	$(BIN)/python tests/benchmarks/city_bench.py
 	$(BIN)/python tests/benchmarks/infer_bench.py

@@ -6,12 +6,14 @@ preferred size), which the constructions must find with no search."""
 
 from __future__ import annotations
 
+import itertools
 import random
 
 import pytest
 
 from facadecli import parse_spec, solve
 from facadecli.export.report import report
+from tests.benchmarks.distinct import GRAND_HALL_PERIODS, distinct_palace, grand_hall
 from tests.solving import letters, solve_text
 
 THREE_LAYERS = """
@@ -177,3 +179,51 @@ def test_the_relaxation_bounds_every_layout_of_its_candidate() -> None:
     assert layout.x.objective == pytest.approx((1 / 3) ** 2 + 0.5**2, rel=1e-6)
     assert layout.x.proven
     assert report(layout)["proof"]["x"]["bound"] == pytest.approx(layout.x.objective, rel=1e-6)
+
+
+@pytest.mark.parametrize("decorations", [4, 16])
+def test_the_grand_hall_is_perfect_and_proven(decorations: int) -> None:
+    """The solver issue's 8-layer front (and with 16 decoration layers): it ended in exit 4
+    although every symbol fits at its preferred size at k = 12."""
+    layout = solve(parse_spec(grand_hall(decorations), "grand-hall.yaml"))
+    assert layout.counters["k"] == 12
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
+    assert layout.y.objective == pytest.approx(0.0, abs=1e-9)
+    assert layout.x.proven and layout.y.proven
+    for i in range(decorations):  # each decoration on its own period of bays
+        period = GRAND_HALL_PERIODS[i % len(GRAND_HALL_PERIODS)]
+        assert layout.counters[f"kx{i}"] == 12 // period
+
+
+def test_a_palace_of_distinct_layers_is_perfect_and_proven() -> None:
+    layout = solve(parse_spec(distinct_palace(8, 20), "palace.yaml"))
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
+    assert layout.y.objective == pytest.approx(0.0, abs=1e-9)
+    assert layout.x.proven and layout.y.proven
+
+
+@pytest.mark.parametrize("bays", [8, 11, 14])
+def test_an_alignment_skipping_letters_of_a_row_is_no_crash(bays: int) -> None:
+    """A layer whose words end in letters of no length (placeholders the base leaves no
+    room for) once crashed with a KeyError in the placing of letters."""
+    width = round(1.15 + 4.55 * bays, 6)
+    layout = solve_text(
+        f"""
+        version: 1
+        name: skipped
+        canvas: {{width: {width}, height: 3.0}}
+        symbol_defaults: {{opaque: true}}
+        symbols: {{E: 0.2, W: 0.75, P: 0.4, M: 0.7, V4: 1.1, V5: 2.0, V8: 0.2, S: 3.0}}
+        counters: {{j: 3, k: {bays}}}
+        patterns:
+          base: E ((W P)^j M P)^k W E
+          layer: {{control: E (g1 g2 g3 s6 g7)^k W s9, where: {{s6: V5 V5 | V4, s9: V8}}}}
+        layers:
+          - {{name: base, x: base, y: S}}
+          - {{name: layer, x: layer, y: S}}
+        """
+    )
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
+    placed = letters(layout, "layer", "x")
+    assert placed[-1].end == pytest.approx(width)
+    assert all(a.end == pytest.approx(b.start) for a, b in itertools.pairwise(placed))

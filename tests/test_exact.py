@@ -545,7 +545,7 @@ def test_the_compiled_search_solves_planted_layouts_as_the_reference(text: str) 
 
 
 @needs_exact
-@pytest.mark.parametrize("source", ["terraced-house", "centred-bay", "palace"])
+@pytest.mark.parametrize("source", ["townhouse", "centred-bay", "palace"])
 def test_the_compiled_search_spends_the_references_work_on_every_candidate(
     source: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -47,6 +47,7 @@ TIE = 1e-11  # objectives this close, relative to the canvas squared (and never 
 CONSTRUCTIONS = 16  # candidates laid out by construction, least bound first, until one fits
 VARIANTS = 48  # options of a cluster of patterns tried in place of the best layout's
 SWEEPS = 2  # passes over the clusters while a variant improves the best layout
+TRIED = 3  # of a cluster's options that fit, those laid out (least covering first)
 NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
@@ -410,7 +411,7 @@ def solve_axis_alternatives(
     # primal first: candidates laid out by construction, least bound first, then each
     # cluster of patterns' other options in place of the best one's (a layer's words
     # chosen given the others); a candidate whose layout meets its bound needs no search
-    built = _constructions(spec, uses, space, bounds, canvas, memory, tie)
+    built = _constructions(spec, uses, space, candidates, canvas, memory, tie)
     evaluated.extend(built)
     for e in built:
         if e.estimate.objective <= memory.bounds.get(e.candidate.order, -INF) + tie:
@@ -421,7 +422,10 @@ def solve_axis_alternatives(
     # once the best layout found is within it: nothing better can exist. Low thresholds cut
     # hopeless columns at once, so the first passes are cheap.
     heuristic_done = alternatives > 1
-    for threshold in DEEPENING:
+    # a layout at objective 0 is optimal: no candidate can beat it (only tie, and the
+    # constructions chose among those)
+    perfect = alternatives == 1 and best_objective() <= tie
+    for threshold in () if perfect else DEEPENING:
         failures.clear()  # each pass searches again every candidate it reaches: the last
         unproven = truncated  # one run says what is proven
         for bound, _, candidate in bounds:
@@ -447,7 +451,12 @@ def solve_axis_alternatives(
     if not evaluated and unproven and not timed_out and not heuristic_done:
         heuristic_pass()  # the exact search ran out of work: the heuristic may still align
     aligned_at = time.perf_counter()
-    lower = _lower_bound(bounds, above, best_objective(), tie, truncated) if evaluated else 0.0
+    if perfect:
+        lower = 0.0
+    elif evaluated:
+        lower = _lower_bound(bounds, above, best_objective(), tie, truncated)
+    else:
+        lower = 0.0
     ranked = _by_rank(evaluated, tie)
     layouts: list[AxisLayout] = []
     first: float | None = None
@@ -497,14 +506,19 @@ def _candidate_bound(
     candidate: Candidate,
     canvas: float,
     memory: _SearchMemory,
+    above: float = INF,
 ) -> float:
     """A lower bound on the objective of a candidate: its relaxation's (kept in
-    ``memory.relaxed`` for the constructions) or its rows' one at a time, the larger."""
+    ``memory.relaxed`` for the constructions) or its rows' one at a time, the larger.
+    When the rows' bound alone is beyond ``above``, that one is returned (it is all the
+    caller needs) and the relaxation is left for later."""
     known = memory.bounds.get(candidate.order)
     if known is not None:
         return known
     rows = _candidate_rows(spec, uses, candidate, memory)
     bound = exact.candidate_bound(rows, canvas, memory.counted)
+    if bound > above:
+        return bound
     relaxed = construct.relax(spec, rows, canvas)
     if relaxed is None:  # not even the relaxation has sizes: the candidate has no layout
         bound = INF
@@ -519,16 +533,19 @@ def _constructions(
     spec: Spec,
     uses: Sequence[PatternUse],
     space: CandidateSpace,
-    bounds: _InBoundOrder,
+    candidates: Sequence[Candidate],
     canvas: float,
     memory: _SearchMemory,
     tie: float,
 ) -> list[_Evaluated]:
-    """Layouts by construction (:mod:`facadecli.solver.construct`): of the candidates in
-    the order of their bounds until one has a layout (CONSTRUCTIONS at most), then of its
-    variants, a cluster of patterns at a time (VARIANTS options each, SWEEPS passes), each
-    kept when it ranks better (SPEC 2.7: less objective, then more columns, then
-    placeholders covering less)."""
+    """Layouts by construction (:mod:`facadecli.solver.construct`), best first kept:
+    the candidates in their order (CONSTRUCTIONS at most) until one has a layout, each
+    as it is, then with the other layers' words fitted to the rows at the back
+    (:func:`_fitted_to_backs`), then with each cluster's words of least bound; then that
+    layout's variants, a cluster of patterns at a time (SWEEPS passes): of the options
+    whose rows fit the layout's other boundaries, the TRIED least covering are laid out,
+    and one is kept when it ranks better (SPEC 2.7: less objective, then more columns,
+    then placeholders covering less)."""
     made: list[_Evaluated] = []
 
     def build(candidate: Candidate) -> _Evaluated | None:
@@ -544,8 +561,8 @@ def _constructions(
         made.append(found)
         return found
 
-    def bound(candidate: Candidate) -> float:
-        return _candidate_bound(spec, uses, candidate, canvas, memory)
+    def bound(candidate: Candidate, above: float = INF) -> float:
+        return _candidate_bound(spec, uses, candidate, canvas, memory, above)
 
     def descended(candidate: Candidate) -> Candidate:
         """The candidate with each cluster's option of least bound, the others kept, until
@@ -555,38 +572,48 @@ def _constructions(
             changed = False
             for cluster in range(len(space.clusters)):
                 for variant in space.variants(candidate, cluster, VARIANTS):
-                    if bound(variant) < bound(candidate) - tie:
+                    least = bound(candidate) - tie
+                    if bound(variant, least) < least:
                         candidate, changed = variant, True
             if not changed:
                 break
         return candidate
 
     best: _Evaluated | None = None
-    for number, (_, _, candidate) in enumerate(bounds):
-        if number >= CONSTRUCTIONS:
-            break
+    for candidate in candidates[:CONSTRUCTIONS]:
         best = build(candidate)
-        if best is None:
+        if best is None:  # the other layers' words chosen to fit the rows at the back
+            fitted = _fitted_to_backs(spec, uses, space, candidate, canvas, memory)
+            best = None if fitted is candidate else build(fitted)
+        if best is None:  # each cluster's words of least bound, the others kept
             descent = descended(candidate)
             best = None if descent is candidate else build(descent)
-            if best is None:
-                fitted = _fitted_to_backs(spec, uses, space, descent, canvas, memory)
-                best = None if fitted is descent else build(fitted)
         if best is not None:
             break
     if best is None:
         return made
+    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
     for _ in range(SWEEPS):
         improved = False
         for cluster in range(len(space.clusters)):
+            keys = {use.key for use in space.clusters[cluster]}
+            points = _points_without(best, keys, pattern_of)
+            # the options whose rows fit the layout's other boundaries, least covering
+            # first (SPEC 2.7's last tie-break; those covering as little as the
+            # layout's own do not beat it): built until one improves it
+            own = _fits_among(spec, uses, best.candidate, keys, pattern_of, points, canvas, memory)
+            fitting = []
             for variant in space.variants(best.candidate, cluster, VARIANTS):
-                if _candidate_bound(spec, uses, variant, canvas, memory) > (
-                    best.estimate.objective + tie
-                ):
+                if bound(variant, best.estimate.objective + tie) > best.estimate.objective + tie:
                     continue
+                covered = _fits_among(spec, uses, variant, keys, pattern_of, points, canvas, memory)
+                if covered is not None and (own is None or covered < own - tie):
+                    fitting.append((covered, variant.order, variant))
+            for _, _, variant in sorted(fitting, key=lambda item: item[:2])[:TRIED]:
                 found = build(variant)
                 if found is not None and _better(found, best, tie):
                     best, improved = found, True
+                    break
         if not improved:
             break
     return made
@@ -605,13 +632,29 @@ def _fitted_to_backs(
     first option (best first, VARIANTS at most) whose rows end every visible letter on
     one of those boundaries and fill the canvas (:func:`construct.fits`). Layers that meet
     only through the base's columns align independently given them."""
-    relaxed = memory.relaxed.get(candidate.order)
+    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
+    # first the backs: each cluster holding a group's back row takes the option whose back
+    # rows fit the canvas best on their own
+    rows = _candidate_rows(spec, uses, candidate, memory)
+    at_back = {pattern_of[layer] for members in rows.values() for layer in members[0].layers}
+    for cluster, members in enumerate(space.clusters):
+        keys = {use.key for use in members}
+        if not keys & at_back:
+            continue
+        options = [candidate, *space.variants(candidate, cluster, VARIANTS)]
+        candidate = min(
+            options, key=lambda option: _backs_bound(spec, uses, option, canvas, memory)
+        )
+    # the backs laid at their own relaxation's sizes: their boundaries are what the
+    # other rows must meet
+    rows = _candidate_rows(spec, uses, candidate, memory)
+    backs = {group: members[0] for group, members in rows.items() if members}
+    relaxed = construct.relax(spec, {group: [row] for group, row in backs.items()}, canvas)
     if relaxed is None:
         return candidate
-    rows = _candidate_rows(spec, uses, candidate, memory)
-    laid = construct.placeholders_laid(rows, relaxed, canvas) or dict(relaxed.lengths)
-    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
-    backs = {group: members[0] for group, members in rows.items() if members}
+    laid = construct.placeholders_laid(
+        {group: [row] for group, row in backs.items()}, relaxed, canvas
+    ) or dict(relaxed.lengths)
     points = {group: construct.boundaries(row, laid) for group, row in backs.items()}
     fixed = {pattern_of[layer] for row in backs.values() for layer in row.layers}
     sizes = {name: size for name, size in relaxed.lengths.items() if spec.size(name) is not None}
@@ -635,6 +678,65 @@ def _fitted_to_backs(
                 candidate = variant
                 break
     return candidate
+
+
+def _points_without(
+    layout: _Evaluated, keys: set[str], pattern_of: Mapping[int, str]
+) -> dict[str, list[float]]:
+    """Per group, the boundaries of a sized layout's rows, but those of the patterns
+    ``keys`` (the rows another option of theirs must meet)."""
+    program, solved = layout.program, layout.estimate
+    lengths = {name: solved.of(index) for name, index in program.symbols.items()}
+    points: dict[str, list[float]] = {}
+    for group, alignment in layout.groups.items():
+        found: set[float] = set()
+        for row in alignment.rows:
+            if not any(pattern_of[layer] in keys for layer in row.layers):
+                found.update(construct.boundaries(row, lengths))
+        points[group] = sorted(found)
+    return points
+
+
+def _fits_among(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    candidate: Candidate,
+    keys: set[str],
+    pattern_of: Mapping[int, str],
+    points: Mapping[str, list[float]],
+    canvas: float,
+    memory: _SearchMemory,
+) -> float | None:
+    """How much the placeholders of the patterns ``keys`` in a candidate cover when their
+    rows fit ``points`` at preferred sizes (:func:`construct.coverage`); None when one
+    does not fit. Rows of a group with no points fit and cover nothing."""
+    rows = _candidate_rows(spec, uses, candidate, memory)
+    total = 0.0
+    for group, members in rows.items():
+        own = [row for row in members if any(pattern_of[i] in keys for i in row.layers)]
+        if not own or not points.get(group):
+            continue
+        sizes = _sized(spec, own)
+        for row in own:
+            covered = construct.coverage(row, sizes, points[group], canvas)
+            if covered is None:
+                return None
+            total += covered
+    return total
+
+
+def _backs_bound(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    candidate: Candidate,
+    canvas: float,
+    memory: _SearchMemory,
+) -> float:
+    """How far the back row of each group is from fitting the canvas on its own (the
+    rows' bound of :func:`exact.candidate_bound`, over those rows alone)."""
+    rows = _candidate_rows(spec, uses, candidate, memory)
+    backs = {group: [members[0]] for group, members in rows.items() if members}
+    return exact.candidate_bound(backs, canvas, memory.counted)
 
 
 def _sized(spec: Spec, rows: Sequence[Row]) -> dict[str, float]:

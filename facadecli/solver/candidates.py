@@ -57,8 +57,11 @@ class Candidate:
 
 
 def word_need(length: float, elastic: bool, canvas: float, made_room: float) -> float:
-    """Least mu with ``canvas - mu - made_room <= length <= canvas + mu`` (Eq. 7)."""
+    """Least mu with ``canvas - mu - made_room <= length <= canvas + mu`` (Eq. 7); a
+    length that misses the canvas by rounding only (a sum of many sizes) fits it."""
     over = length - canvas
+    if abs(over) <= 1e-9 * max(1.0, canvas):
+        over = 0.0
     if elastic:
         return max(0.0, over)
     under = canvas - made_room - length

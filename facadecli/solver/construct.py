@@ -262,7 +262,16 @@ def placeholders_laid(
 def fits(row: Row, sizes: Mapping[str, float], points: Sequence[float], canvas: float) -> bool:
     """Whether a row at ``sizes`` (its placeholders sized as it needs) fills the canvas
     with every visible letter starting and ending on one of ``points``."""
-    return _fitted(row, sizes, sorted(points), canvas) is not None
+    return coverage(row, sizes, points, canvas) is not None
+
+
+def coverage(
+    row: Row, sizes: Mapping[str, float], points: Sequence[float], canvas: float
+) -> float | None:
+    """How much the row's placeholders cover (the sum of their sizes) when it fits
+    ``points`` as :func:`fits` asks; None when it does not fit."""
+    found = _fitted(row, sizes, sorted(points), canvas)
+    return None if found is None else sum(found.values())
 
 
 def boundaries(row: Row, lengths: Mapping[str, float]) -> list[float]:
@@ -273,6 +282,7 @@ def boundaries(row: Row, lengths: Mapping[str, float]) -> list[float]:
 
 
 FITTING_WORK = 2000  # letters laid at most while fitting one row's placeholders
+BRANCHES = 12  # ends tried for a placeholder, nearest first
 
 
 def _fitted(
@@ -327,7 +337,7 @@ def _fitted(
                 lay(k, x, {**sizes, symbol: size})
             return
         at = bisect.bisect_right(points, x + near)
-        for end in points[at:]:
+        for end in points[at : at + BRANCHES]:
             if work > FITTING_WORK:
                 return
             lay(k, x, {**sizes, symbol: end - x})
