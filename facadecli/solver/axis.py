@@ -133,12 +133,25 @@ class _Evaluated:
 
     @property
     def splits(self) -> int:
-        """Sized transparent letters cut into pieces (a last resort, section 5.2)."""
+        """Transparent letters cut into pieces (a last resort, section 5.2): a letter that
+        lies across a column boundary rather than on it."""
         return sum(
-            entry is not None and entry.tail is not None and entry.tail != INF
+            entry is not None and entry.tail is not None
             for a in self.groups.values()
             for column in a.entries
             for entry in column
+        )
+
+    @property
+    def coverage(self) -> float:
+        """How much the placeholders cover: the length of all their letters."""
+        solved, symbols = self.estimate, self.program.symbols
+        return sum(
+            solved.of(symbols[letter.symbol])
+            for a in self.groups.values()
+            for row in a.rows
+            for letter, traits in zip(row.word, row.traits, strict=True)
+            if traits.size is None
         )
 
     @property
@@ -149,7 +162,7 @@ class _Evaluated:
         return (
             self.estimate.objective,
             -self.columns,
-            round(self.estimate.coverage, 6),
+            round(self.coverage, 6),
             self.splits,
             self.empties,
             self.candidate.key,
@@ -602,14 +615,18 @@ def _constructions(
             # first (SPEC 2.7's last tie-break; those covering as little as the
             # layout's own do not beat it): built until one improves it
             own = _fits_among(spec, uses, best.candidate, keys, pattern_of, points, canvas, memory)
+            perfect = best.estimate.objective <= tie  # only the tie-breaks can improve it
             fitting = []
             for variant in space.variants(best.candidate, cluster, VARIANTS):
-                if bound(variant, best.estimate.objective + tie) > best.estimate.objective + tie:
+                least = bound(variant, best.estimate.objective + tie)
+                if least > best.estimate.objective + tie:
                     continue
                 covered = _fits_among(spec, uses, variant, keys, pattern_of, points, canvas, memory)
-                if covered is not None and (own is None or covered < own - tie):
-                    fitting.append((covered, variant.order, variant))
-            for _, _, variant in sorted(fitting, key=lambda item: item[:2])[:TRIED]:
+                if covered is None:
+                    continue
+                if not perfect or own is None or covered < own - tie:
+                    fitting.append((0.0 if perfect else least, covered, variant.order, variant))
+            for *_, variant in sorted(fitting, key=lambda item: item[:3])[:TRIED]:
                 found = build(variant)
                 if found is not None and _better(found, best, tie):
                     best, improved = found, True

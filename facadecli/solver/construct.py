@@ -253,7 +253,9 @@ def placeholders_laid(
             if all(letter.symbol in lengths for letter in other.word)
         ]
         points = sorted({p for other in laid for p in boundaries(other, lengths)})
-        fitted = _fitted(row, lengths, points, canvas)
+        fitted = _fitted(row, lengths, points, canvas, _visible(laid, lengths))
+        if fitted is None:  # the rows laid may be the ones in the way: theirs alone
+            fitted = _fitted(row, lengths, points, canvas)
         if fitted is None:
             return None
         lengths.update(fitted)
@@ -271,7 +273,9 @@ def coverage(
     """How much the row's placeholders cover (the sum of their sizes) when it fits
     ``points`` as :func:`fits` asks; None when it does not fit."""
     found = _fitted(row, sizes, sorted(points), canvas)
-    return None if found is None else sum(found.values())
+    if found is None:
+        return None
+    return sum(found.get(letter.symbol, 0.0) for letter in row.word)
 
 
 def boundaries(row: Row, lengths: Mapping[str, float]) -> list[float]:
@@ -285,13 +289,65 @@ FITTING_WORK = 2000  # letters laid at most while fitting one row's placeholders
 BRANCHES = 12  # ends tried for a placeholder, nearest first
 
 
+Visible = tuple[list[tuple[float, float]], list[float]]  # see _visible()
+
+
+def _visible(rows: Sequence[Row], lengths: Mapping[str, float]) -> Visible:
+    """What laid rows ask of the column boundaries: the interiors of their visible
+    letters (open intervals, overlapping ones merged), where none may fall, and where
+    they turn between transparent and visible (:func:`_changes`), where one must."""
+    spans = []
+    changes: set[float] = set()
+    for row in rows:
+        x = boundaries(row, lengths)
+        spans += [
+            (x[k], x[k + 1])
+            for k, traits in enumerate(row.traits)
+            if not traits.transparent and x[k + 1] > x[k]
+        ]
+        changes.update(x[k] for k in range(1, len(row.word)) if _changes(row, k))
+    merged: list[tuple[float, float]] = []
+    for a, b in sorted(spans):
+        if merged and a < merged[-1][1]:
+            merged[-1] = (merged[-1][0], max(merged[-1][1], b))
+        else:
+            merged.append((a, b))
+    return merged, sorted(changes)
+
+
+def _changes(row: Row, k: int) -> bool:
+    """Whether the row turns between transparent and visible before letter k: a column
+    boundary, as no entry holds both."""
+    return row.traits[k - 1].transparent != row.traits[k].transparent
+
+
 def _fitted(
-    row: Row, lengths: Mapping[str, float], points: Sequence[float], canvas: float
+    row: Row,
+    lengths: Mapping[str, float],
+    points: Sequence[float],
+    canvas: float,
+    visible: Visible = ([], []),
 ) -> dict[str, float] | None:
     """Sizes of a row's open placeholders that end each of them on one of ``points`` and
-    the row on the canvas' end; of those found (depth first, nearest first, within
-    FITTING_WORK), the ones covering least (SPEC 2.7); None when none is found."""
+    the row on the canvas' end, with no boundary the row needs inside a ``visible``
+    letter of the rows laid, nor one they need inside a visible letter of the row; of
+    those found
+    (depth first, nearest first, within FITTING_WORK), the ones whose letters cover least
+    (SPEC 2.7); None when none is found."""
     near = NEAR * max(1.0, canvas)
+    interiors, ends = visible  # the laid rows' visible interiors, and boundaries needed
+    starts = [a for a, _ in interiors]
+
+    def inside(x: float) -> bool:
+        """``x`` strictly inside a visible letter laid."""
+        at = bisect.bisect_right(starts, x - near) - 1
+        return at >= 0 and interiors[at][1] > x + near
+
+    def across(a: float, b: float) -> bool:
+        """A boundary the laid rows need strictly between ``a`` and ``b``."""
+        at = bisect.bisect_right(ends, a + near)
+        return at < len(ends) and ends[at] < b - near
+
     word = [letter.symbol for letter in row.word]
     # boundaries before letter k that a visible letter starts or ends at: they are cuts,
     # so they must fall on the laid rows' boundaries
@@ -305,6 +361,9 @@ def _fitted(
     work = 0
     best: dict[str, float] | None = None
 
+    def covered(sizes: Mapping[str, float]) -> float:
+        return sum(sizes.get(symbol, 0.0) for symbol in word)
+
     def on_point(x: float) -> bool:
         at = bisect.bisect_left(points, x - near)
         return at < len(points) and points[at] <= x + near
@@ -313,18 +372,22 @@ def _fitted(
         nonlocal work, best
         while k < len(word):
             work += 1
-            if work > FITTING_WORK or x > canvas + near or (edge[k] and not on_point(x)):
+            if work > FITTING_WORK or x > canvas + near:
+                return
+            if edge[k] and not on_point(x):
+                return
+            if 0 < k < len(word) and _changes(row, k) and inside(x):
                 return
             symbol = word[k]
             size = lengths.get(symbol, sizes.get(symbol))
             if size is None:
                 break
+            if not row.traits[k].transparent and across(x, x + size):
+                return
             x += size
             k += 1
         if k == len(word):
-            if abs(x - canvas) <= near and (
-                best is None or sum(sizes.values()) < sum(best.values()) - near
-            ):
+            if abs(x - canvas) <= near and (best is None or covered(sizes) < covered(best) - near):
                 best = sizes
             return
         symbol = word[k]
