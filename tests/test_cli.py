@@ -104,7 +104,7 @@ def test_solve_writes_the_report_and_the_elevation(tmp_path: Path) -> None:
     report = json.loads((tmp_path / "residential-house.layout.json").read_text())
     assert set(report) >= REPORT_KEYS
     assert report["canvas"] == {"width": 6.0, "height": 3.0}
-    assert report["counters"]["k"] == 4  # 0.0288 m2 of deviation; k = 3 deviates 0.0788
+    assert report["counters"]["k"] == 4  # 0.4 + 4 x 1.4 = 6 m: every symbol at its size
     assert {"time_ms"} <= set(report["stats"])
     base = report["layers"][0]
     assert base["x"][0]["start"] == 0.0 and base["x"][-1]["end"] == 6.0

@@ -49,6 +49,7 @@ def planted() -> None:
 
     chosen = seeds()
     tally: Counter[str] = Counter()
+    seen: dict[str, list[int]] = {}
     unproven = 0
     worst: list[tuple[float, int]] = []
     started = time.process_time()
@@ -63,6 +64,7 @@ def planted() -> None:
                 layout = solve(parse_spec(text, str(path)))
             except SearchLimitError:
                 tally["exit 4 (search budget)"] += 1
+                seen.setdefault("exit 4 (search budget)", []).append(seed)
                 continue
             except InfeasibleError:
                 tally["exit 3 (infeasible: wrong)"] += 1
@@ -72,6 +74,7 @@ def planted() -> None:
                 continue
             except Exception as error:  # a crash is a finding, not the end of the bench
                 tally[f"crash: {type(error).__name__}"] += 1
+                seen.setdefault(f"crash: {type(error).__name__}", []).append(seed)
                 continue
             worst.append((time.process_time() - at, seed))
             data = report(layout)
@@ -84,11 +87,13 @@ def planted() -> None:
                 tally["exact"] += 1
             else:
                 tally["suboptimal"] += 1
+                seen.setdefault("suboptimal", []).append(seed)
     total = time.process_time() - started
     worst.sort(reverse=True)
     print(f"planted specs, seeds {chosen[0]}-{chosen[-1]} ({len(chosen)}):")
     for outcome, count in sorted(tally.items(), key=lambda item: -item[1]):
-        print(f"  {outcome:34} {count:5}")
+        some = " ".join(map(str, seen.get(outcome, [])[:12]))
+        print(f"  {outcome:34} {count:5}  {some}")
     print(f"  {'unproven answers':34} {unproven:5}")
     print(
         f"  CPU total {total:.1f} s; slowest: "
