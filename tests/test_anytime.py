@@ -227,3 +227,58 @@ def test_an_alignment_skipping_letters_of_a_row_is_no_crash(bays: int) -> None:
     placed = letters(layout, "layer", "x")
     assert placed[-1].end == pytest.approx(width)
     assert all(a.end == pytest.approx(b.start) for a, b in itertools.pairwise(placed))
+
+
+def test_a_symmetric_facade_gets_a_window_over_every_bay() -> None:
+    """Windows `e (q p)^j c (q p)^-j e` over `E (W P)^k C (W P)^-k E`: every j fits with
+    its placeholders stretched, so the tie-breaks decide, and the layout whose placeholders
+    cover least has a window over every one of the 18 bays (once j = 1, two windows)."""
+    layout = solve_text(
+        """
+        version: 1
+        name: symmetric
+        canvas: {width: 45.6, height: 3.0}
+        symbol_defaults: {opaque: true}
+        symbols: {E: 0.6, W: 1.6, P: 0.8, C: 1.2, H: 3.0, Q: {size: 1.6, opaque: false}}
+        counters: {k: {min: 1}, j: {min: 1}}
+        patterns:
+          base: E (W P)^k C (W P)^-k E
+          windows: {control: e (q p)^j c (q p)^-j e, where: {q: Q}}
+        layers:
+          - {name: base, x: base, y: H}
+          - {name: windows, x: windows, y: H, offset: 0.1}
+        """
+    )
+    assert layout.counters["k"] == 9 and layout.counters["j"] == 9
+    windows = [p for p in letters(layout, "windows", "x") if p.symbol == "Q"]
+    walls = [p for p in letters(layout, "base", "x") if p.symbol == "W"]
+    assert [(w.start, w.end) for w in windows] == [(w.start, w.end) for w in walls]
+
+
+@pytest.mark.parametrize(
+    ("pattern", "width", "counters"),
+    [
+        ("A^510", 306.0, {}),  # 510 letters: words were cut at 400, and "no layout" said
+        ("A (B A)^n", 239.0, {"n": 199}),  # 200 bays: n = 198 was the answer
+        ("A A A", 1.0, {}),  # longer than twice the canvas: "no layout" was said
+    ],
+)
+def test_caps_on_words_never_make_no_layout(
+    pattern: str, width: float, counters: dict[str, int]
+) -> None:
+    layout = solve_text(
+        f"""
+        version: 1
+        name: capped
+        canvas: {{width: {width}, height: 3.0}}
+        symbol_defaults: {{opaque: true}}
+        symbols: {{A: {0.6 if width > 1 else 1.0}, B: 0.6, H: 3.0}}
+        counters: {{n: {{min: 1}}}}
+        patterns: {{row: "{pattern}"}}
+        layers: [{{name: base, x: row, y: H}}]
+        """
+    )
+    for name, value in counters.items():
+        assert layout.counters[name] == value
+    assert layout.x.proven
+    assert sum(p.end - p.start for p in letters(layout, "base", "x")) == pytest.approx(width)

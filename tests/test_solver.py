@@ -322,12 +322,16 @@ def test_infeasible_spec_exits_with_the_reason() -> None:
         solve(parse_spec(text))
 
 
-def test_a_fixed_counter_that_cannot_fit_is_infeasible() -> None:
+def test_a_fixed_counter_too_long_for_the_canvas_shrinks_its_letters() -> None:
+    """A^40 far longer than the canvas is no proof that nothing fits (SPEC 4: exit 3 only
+    when proven): every A shrinks to a fortieth of the canvas, and the user is warned."""
     text = EQ8.replace('base: "A B A B A"', 'base: "A^n"').replace(
         "symbols:", "counters: {n: 40}\nsymbols:"
     )
-    with pytest.raises(InfeasibleError, match="pattern 'base'"):
-        solve(parse_spec(text))
+    layout = solve(parse_spec(text))
+    (size,) = {round(p.end - p.start, 6) for p in letters(layout, "base", "x")}
+    assert size == pytest.approx(layout.width / 40, abs=1e-6)
+    assert any("'A'" in warning and "off its preferred" in warning for warning in layout.warnings)
 
 
 def test_same_spec_same_layout() -> None:

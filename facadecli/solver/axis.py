@@ -19,7 +19,13 @@ from facadecli.solver.alignment import (
     _Row,
     align,
 )
-from facadecli.solver.candidates import Candidate, CandidateSpace, PatternUse, pattern_uses
+from facadecli.solver.candidates import (
+    MAX_LETTERS,
+    Candidate,
+    CandidateSpace,
+    PatternUse,
+    pattern_uses,
+)
 from facadecli.solver.rows import (
     Row,
     RowCache,
@@ -289,8 +295,8 @@ def solve_axis_alternatives(
     space = CandidateSpace.of(spec, uses, canvas)
     candidates = [] if space is None else space.best(CANDIDATE_LIMIT)
     generated = time.perf_counter()
-    if space is None or not candidates:
-        raise InfeasibleError(_no_candidate_reason(spec, axis, uses, canvas))
+    if space is None or not candidates:  # within the caps on words: not a proof
+        raise SearchLimitError(_no_candidate_reason(axis, canvas))
     tolerance = spec.solver.tolerance
     memory = _SearchMemory(full_layers(spec, axis))
     shared = _relaxations(spec, uses, candidates, memory.full)
@@ -470,7 +476,7 @@ def solve_axis_alternatives(
     if perfect:
         lower = 0.0
     elif evaluated:
-        lower = _lower_bound(bounds, above, best_objective(), tie, truncated)
+        lower = _lower_bound(bounds, above, best_objective(), tie, truncated, space.beyond)
     else:
         lower = 0.0
     ranked = _by_rank(evaluated, tie)
@@ -778,15 +784,21 @@ def _better(a: _Evaluated, b: _Evaluated, tie: float) -> bool:
 
 
 def _lower_bound(
-    bounds: _InBoundOrder, above: Mapping[int, float], best: float, tie: float, truncated: bool
+    bounds: _InBoundOrder,
+    above: Mapping[int, float],
+    best: float,
+    tie: float,
+    truncated: bool,
+    beyond: float,
 ) -> float:
     """The best lower bound on the axis' objective once the searches are done: the least
     bound of a candidate whose layouts were not all ruled out below ``best`` (each beyond
     what its searches proved), or ``best`` itself when there is none. Candidates that
-    were never generated (the list was cut) bound nothing: 0."""
+    were never generated bound nothing (0) where a cap cut the list, and ``beyond`` where
+    their words are longer than twice the canvas."""
     if truncated:
         return 0.0
-    lower = best
+    lower = min(best, beyond)
     for bound, _, candidate in bounds:
         if bound >= lower - tie:
             break
@@ -970,7 +982,7 @@ def _finish(
         warnings.append(
             f"{axis}: the layout is not proven optimal: its objective is {final.objective:.6g} "
             f"m2, the best lower bound found {lower:.6g} m2 (the search stopped at its work "
-            "budget)"
+            "budget, or a cap on the words left candidates unseen)"
         )
     if timed_out:
         warnings.append(
@@ -1075,32 +1087,12 @@ def _entry_text(word: Word, move: object) -> str:
     return " ".join(word[k].symbol + mark for k, mark in items)
 
 
-def _no_candidate_reason(spec: Spec, axis: Axis, uses: Sequence[PatternUse], canvas: float) -> str:
-    from facadecli.patterns import enumerate_words
-
-    sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
-    bounds = {name: counter.bounds for name, counter in spec.counters.items()}
-    for use in uses:
-        if (
-            next(
-                iter(
-                    enumerate_words(
-                        use.pattern, sizes=sizes, max_length=2 * canvas, counters=bounds
-                    )
-                ),
-                None,
-            )
-            is None
-        ):
-            layers = ", ".join(f"'{spec.layers[layer].name}'" for layer, _ in use.layers)
-            return (
-                f"{axis} axis: pattern '{use.key}' (layer {layers}) makes no word shorter "
-                f"than twice the canvas ({2 * canvas:g} m); make the canvas larger or the "
-                "symbols or fixed counts smaller"
-            )
+def _no_candidate_reason(axis: Axis, canvas: float) -> str:
     return (
-        f"{axis} axis: the patterns share counters whose values cannot agree "
-        f"within the canvas ({canvas:g} m)"
+        f"{axis} axis: the patterns share counters whose values agree on no words up to "
+        f"twice the canvas ({2 * canvas:g} m) and {MAX_LETTERS:,} letters; a layout may "
+        "still exist with every symbol shrunk by half or more: make the canvas larger, or "
+        "the symbols or the counters' minimums smaller"
     )
 
 

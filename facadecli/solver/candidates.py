@@ -24,7 +24,7 @@ from facadecli.spec.model import Spec
 
 WORDS_PER_PATTERN = 4000  # words looked at per pattern
 OPTIONS_PER_CLUSTER = 2000  # joint choices kept per cluster of patterns sharing counters
-MAX_LETTERS = 400  # longest word considered
+MAX_LETTERS = 2000  # longest word considered (a longer one makes the answer unproven)
 
 
 @dataclass(frozen=True)
@@ -112,6 +112,9 @@ class CandidateSpace:
     above: list[tuple[str, tuple[str, ...]]]
     opaque: dict[int, float]
     truncated: bool  # a cap cut the words or options: some candidates are never made
+    # a lower bound on the objective of every candidate with a word longer than twice the
+    # canvas (never made; see of())
+    beyond: float = math.inf
     made: int = 0  # candidates made so far (their order)
 
     @classmethod
@@ -122,21 +125,35 @@ class CandidateSpace:
         bounds = {name: counter.bounds for name, counter in spec.counters.items()}
         words: dict[str, list[Enumerated]] = {}
         truncated = False
+        beyond = math.inf
         for use in uses:
-            enumerated = enumerate_words(
-                use.pattern,
-                sizes=sizes,
-                max_length=2.0 * canvas,
-                transparent=transparent,
-                counters=bounds,
-                max_letters=MAX_LETTERS,
-            )
-            words[use.key] = list(itertools.islice(enumerated, WORDS_PER_PATTERN + 1))
-            if len(words[use.key]) > WORDS_PER_PATTERN:
+            # words up to twice the canvas: a longer one has sized letters whose preferred
+            # sizes add up to more than twice the canvas, so laid on it they shrink by more
+            # than half their length in all: its objective is at least (l - L)^2 / n >=
+            # (smallest size)^2 / 4 (n letters, l >= n * smallest, l - L > l / 2)
+            found = []
+            if not use.pattern.counter_names():  # all its words, if they are few
+                found = _words(use, sizes, transparent, bounds, math.inf)
+                if len(found) > WORDS_PER_PATTERN or any(
+                    len(item.word) >= MAX_LETTERS for item in found
+                ):
+                    found = []
+            if not found:
+                smallest = min(
+                    (size for size in (sizes.get(n) for n in _names(use)) if size), default=0.0
+                )
+                beyond = min(beyond, smallest * smallest / 4.0)
+                found = _words(use, sizes, transparent, bounds, 2.0 * canvas)
+            if not found:  # not one word that short: the shortest there are
+                found = _words(use, sizes, transparent, bounds, math.inf)
+            if len(found) > WORDS_PER_PATTERN:
                 truncated = True
-                del words[use.key][WORDS_PER_PATTERN:]
-            if not words[use.key]:
+                del found[WORDS_PER_PATTERN:]
+            if not found or any(len(item.word) >= MAX_LETTERS for item in found):
+                truncated = True  # words of MAX_LETTERS letters or more are not made
+            if not found:
                 return None
+            words[use.key] = found
             bounds.update(_seen_counters(use.pattern, words[use.key]))
         opaque_of = _opaque_sizes(spec)
         opaque = {
@@ -161,7 +178,7 @@ class CandidateSpace:
             ]
             scored.sort(key=lambda item: (item[0], item[1]))
             ranked.append([option for _, _, option in scored])
-        return cls(canvas, clusters, ranked, _layers_above(uses), opaque, truncated)
+        return cls(canvas, clusters, ranked, _layers_above(uses), opaque, truncated, beyond)
 
     def candidate(self, choice: Sequence[dict[str, Enumerated]]) -> Candidate:
         """The candidate of one option per cluster (numbered in the order made)."""
@@ -188,6 +205,31 @@ class CandidateSpace:
             for option in self.options[cluster][:most]
             if any(option[key] is not candidate.words[key] for key in keys)
         ]
+
+
+def _names(use: PatternUse) -> set[str]:
+    from facadecli.patterns.ast import symbols
+
+    return {symbol.name for symbol in symbols(use.pattern.root)}
+
+
+def _words(
+    use: PatternUse,
+    sizes: Mapping[str, float | None],
+    transparent: frozenset[str],
+    bounds: Mapping[str, tuple[int, int | None]],
+    longest: float,
+) -> list[Enumerated]:
+    """A pattern's words up to ``longest`` metres, WORDS_PER_PATTERN + 1 at most."""
+    enumerated = enumerate_words(
+        use.pattern,
+        sizes=sizes,
+        max_length=longest,
+        transparent=transparent,
+        counters=bounds,
+        max_letters=MAX_LETTERS,
+    )
+    return list(itertools.islice(enumerated, WORDS_PER_PATTERN + 1))
 
 
 def _seen_counters(
