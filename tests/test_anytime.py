@@ -11,8 +11,12 @@ import random
 
 import pytest
 
-from facadecli import parse_spec, solve
+from facadecli import make_word, parse_spec, solve
 from facadecli.export.report import report
+from facadecli.solver import columns
+from facadecli.solver.alignment import _Row
+from facadecli.solver.rows import make_rows
+from facadecli.spec.resolve import layer_pattern
 from tests.benchmarks.distinct import GRAND_HALL_PERIODS, distinct_palace, grand_hall
 from tests.solving import letters, solve_text
 
@@ -282,3 +286,27 @@ def test_caps_on_words_never_make_no_layout(
         assert layout.counters[name] == value
     assert layout.x.proven
     assert sum(p.end - p.start for p in letters(layout, "base", "x")) == pytest.approx(width)
+
+
+def test_a_column_cut_keeps_letters_of_no_length_at_its_end() -> None:
+    """An entry `[T] [g]` whose placeholder g has no length, cut inside T: the last part
+    ends where the entry does (g kept). Cutting by coordinates alone named the first
+    position at the entry's end and dropped g (a KeyError in the placing of letters)."""
+    spec = parse_spec(
+        """
+        version: 1
+        name: cut
+        canvas: {width: 2.5, height: 3.0}
+        symbols: {T: 1.5, H: {size: 3.0, opaque: true}, U: 1.0}
+        patterns: {row: {control: T g u, where: {u: U}}}
+        layers: [{name: base, x: row, y: H}]
+        """,
+        "cut.yaml",
+    )
+    word = make_word(layer_pattern(spec, spec.layers[0], "x"), {})
+    (row,) = make_rows(spec, [(0, word)])
+    prepared = _Row(row)
+    whole = prepared.spanning(0, 4)  # [T] [g], both transparent (control letters)
+    assert whole is not None
+    parts = columns._cut((whole,), {0: [(0.0, 0), (1.5, 2), (1.5, 4)]}, [prepared], [0, 0.75, 1.5])
+    assert [(part[0].start, part[0].end) for part in parts] == [(0, 1), (1, 4)]

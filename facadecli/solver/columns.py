@@ -150,12 +150,17 @@ def _cut(
     edges: Sequence[float],
 ) -> list[tuple[Move | None, ...]]:
     parts = []
-    for a, b in itertools.pairwise(edges):
+    last = len(edges) - 2
+    for j, (a, b) in enumerate(itertools.pairwise(edges)):
         entries: list[Move | None] = []
         for r, move in enumerate(column):
             if move is None:
                 entries.append(None)
                 continue
-            entries.append(_entry(rows[r], _position(points[r], a), _position(points[r], b)))
+            # the column's own ends where the entry has them: letters of no length at an
+            # end stay in it (a coordinate alone would name the first of them)
+            start = move.start if j == 0 else _position(points[r], a)
+            end = move.end if j == last else _position(points[r], b)
+            entries.append(_entry(rows[r], start, end))
         parts.append(tuple(entries))
     return parts
