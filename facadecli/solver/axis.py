@@ -561,8 +561,8 @@ def _constructions(
     tie: float,
 ) -> list[_Evaluated]:
     """Layouts by construction (:mod:`facadecli.solver.construct`), best first kept:
-    the candidates in their order (CONSTRUCTIONS at most) until one has a layout, each
-    as it is, then with the other layers' words fitted to the rows at the back
+    the candidates in their order (CONSTRUCTIONS at most) until one has a layout, the
+    first also with the other layers' words fitted to the rows at the back
     (:func:`_fitted_to_backs`), then with each cluster's words of least bound; then that
     layout's variants, a cluster of patterns at a time (SWEEPS passes): of the options
     whose rows fit the layout's other boundaries, the TRIED least covering are laid out,
@@ -602,12 +602,12 @@ def _constructions(
         return candidate
 
     best: _Evaluated | None = None
-    for candidate in candidates[:CONSTRUCTIONS]:
+    for number, candidate in enumerate(candidates[:CONSTRUCTIONS]):
         best = build(candidate)
-        if best is None:  # the other layers' words chosen to fit the rows at the back
+        if best is None and number == 0:  # the others' words fitted to the rows at the back
             fitted = _fitted_to_backs(spec, uses, space, candidate, canvas, memory)
             best = None if fitted is candidate else build(fitted)
-        if best is None:  # each cluster's words of least bound, the others kept
+        if best is None and number == 0:  # each cluster's words of least bound
             descent = descended(candidate)
             best = None if descent is candidate else build(descent)
         if best is not None:

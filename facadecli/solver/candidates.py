@@ -20,6 +20,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 from facadecli.patterns import CompiledPattern, Enumerated, enumerate_words
+from facadecli.patterns.ast import Anonymous, Named, Repeat, symbols, walk
 from facadecli.spec.model import Spec
 
 WORDS_PER_PATTERN = 4000  # words looked at per pattern
@@ -132,7 +133,7 @@ class CandidateSpace:
             # than half their length in all: its objective is at least (l - L)^2 / n >=
             # (smallest size)^2 / 4 (n letters, l >= n * smallest, l - L > l / 2)
             found = []
-            if not use.pattern.counter_names():  # all its words, if they are few
+            if _finite(use):  # all its words, if they are few
                 found = _words(use, sizes, transparent, bounds, math.inf)
                 if len(found) > WORDS_PER_PATTERN or any(
                     len(item.word) >= MAX_LETTERS for item in found
@@ -208,9 +209,19 @@ class CandidateSpace:
 
 
 def _names(use: PatternUse) -> set[str]:
-    from facadecli.patterns.ast import symbols
+    """The symbols of a pattern, its contents' too."""
+    roots = (use.pattern.root, *use.pattern.contents.values())
+    return {symbol.name for root in roots for symbol in symbols(root)}
 
-    return {symbol.name for symbol in symbols(use.pattern.root)}
+
+def _finite(use: PatternUse) -> bool:
+    """Whether a pattern makes finitely many words: no counter, named or anonymous."""
+    roots = (use.pattern.root, *use.pattern.contents.values())
+    return not any(
+        isinstance(node, Repeat) and isinstance(node.count, Named | Anonymous)
+        for root in roots
+        for node in walk(root)
+    )
 
 
 def _words(
