@@ -627,14 +627,12 @@ def _constructions(
             perfect = best.estimate.objective <= tie  # only the tie-breaks can improve it
             fitting = []
             for variant in space.variants(best.candidate, cluster, VARIANTS):
-                least = bound(variant, best.estimate.objective + tie)
-                if least > best.estimate.objective + tie:
-                    continue
                 covered = _fits_among(spec, uses, variant, keys, pattern_of, points, canvas, memory)
-                if covered is None:
-                    continue
-                if not perfect or own is None or covered < own - tie:
-                    fitting.append((0.0 if perfect else least, covered, variant.order, variant))
+                if covered is None or (perfect and own is not None and covered >= own - tie):
+                    continue  # it cannot fit, or cannot improve the tie-breaks
+                least = 0.0 if perfect else bound(variant, best.estimate.objective + tie)
+                if least <= best.estimate.objective + tie:
+                    fitting.append((least, covered, variant.order, variant))
             for *_, variant in sorted(fitting, key=lambda item: item[:3])[:TRIED]:
                 found = build(variant)
                 if found is not None and _better(found, best, tie):

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import bisect
 import itertools
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -361,8 +362,11 @@ def _fitted(
     work = 0
     best: dict[str, float] | None = None
 
+    counts = Counter(word)
+
     def covered(sizes: Mapping[str, float]) -> float:
-        return sum(sizes.get(symbol, 0.0) for symbol in word)
+        """What the placeholders sized so far cover in the whole row (no less at the end)."""
+        return sum(counts[symbol] * size for symbol, size in sizes.items())
 
     def on_point(x: float) -> bool:
         at = bisect.bisect_left(points, x - near)
@@ -370,6 +374,8 @@ def _fitted(
 
     def lay(k: int, x: float, sizes: dict[str, float]) -> None:
         nonlocal work, best
+        if best is not None and covered(sizes) >= covered(best) - near:
+            return  # it can only cover more than the best found
         while k < len(word):
             work += 1
             if work > FITTING_WORK or x > canvas + near:
