@@ -52,6 +52,7 @@ TIE = 1e-11  # objectives this close, relative to the canvas squared (and never 
 # an element 0.2 mm off its size already counts); its tie-breaks decide among them
 CONSTRUCTIONS = 16  # candidates laid out by construction, least bound first, until one fits
 VARIANTS = 48  # options of a cluster of patterns tried in place of the best layout's
+FITTED = 2000  # options of a cluster tried for a fit to the rows at the back (cheap tests)
 SWEEPS = 2  # passes over the clusters while a variant improves the best layout
 TRIED = 3  # of a cluster's options that fit, those laid out (least covering first)
 NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
@@ -686,7 +687,7 @@ def _fitted_to_backs(
         keys = {use.key for use in members}
         if keys & fixed:
             continue
-        for variant in [candidate, *space.variants(candidate, cluster, VARIANTS)]:
+        for variant in [candidate, *space.variants(candidate, cluster, FITTED)]:
             grouped = _candidate_rows(spec, uses, variant, memory)
             own = [
                 (group, row)

@@ -25,7 +25,8 @@ from facadecli.spec.model import Spec
 
 WORDS_PER_PATTERN = 4000  # words looked at per pattern
 OPTIONS_PER_CLUSTER = 2000  # joint choices kept per cluster of patterns sharing counters
-MAX_LETTERS = 2000  # longest word considered (a longer one makes the answer unproven)
+MAX_LETTERS = 400  # longest word with a counter considered (longer: the answer is unproven)
+FINITE_LETTERS = 20_000  # longest word of a pattern without counters (all of them are made)
 
 
 @dataclass(frozen=True)
@@ -134,9 +135,9 @@ class CandidateSpace:
             # (smallest size)^2 / 4 (n letters, l >= n * smallest, l - L > l / 2)
             found = []
             if _finite(use):  # all its words, if they are few
-                found = _words(use, sizes, transparent, bounds, math.inf)
+                found = _words(use, sizes, transparent, bounds, math.inf, FINITE_LETTERS)
                 if len(found) > WORDS_PER_PATTERN or any(
-                    len(item.word) >= MAX_LETTERS for item in found
+                    len(item.word) >= FINITE_LETTERS for item in found
                 ):
                     found = []
             if not found:
@@ -230,15 +231,17 @@ def _words(
     transparent: frozenset[str],
     bounds: Mapping[str, tuple[int, int | None]],
     longest: float,
+    letters: int = MAX_LETTERS,
 ) -> list[Enumerated]:
-    """A pattern's words up to ``longest`` metres, WORDS_PER_PATTERN + 1 at most."""
+    """A pattern's words up to ``longest`` metres and ``letters`` letters,
+    WORDS_PER_PATTERN + 1 at most."""
     enumerated = enumerate_words(
         use.pattern,
         sizes=sizes,
         max_length=longest,
         transparent=transparent,
         counters=bounds,
-        max_letters=MAX_LETTERS,
+        max_letters=letters,
     )
     return list(itertools.islice(enumerated, WORDS_PER_PATTERN + 1))
 
