@@ -683,24 +683,62 @@ def _fitted_to_backs(
     points = {group: construct.boundaries(row, laid) for group, row in backs.items()}
     fixed = {pattern_of[layer] for row in backs.values() for layer in row.layers}
     sizes = {name: size for name, size in relaxed.lengths.items() if spec.size(name) is not None}
-    for cluster, members in enumerate(space.clusters):
-        keys = {use.key for use in members}
-        if keys & fixed:
-            continue
-        for variant in [candidate, *space.variants(candidate, cluster, FITTED)]:
-            grouped = _candidate_rows(spec, uses, variant, memory)
-            own = [
-                (group, row)
-                for group, members_ in grouped.items()
-                for row in members_
-                if any(pattern_of[layer] in keys for layer in row.layers)
-            ]
-            known = {**_sized(spec, [row for _, row in own]), **sizes}
-            if all(
-                group in points and construct.fits(row, known, points[group], canvas)
-                for group, row in own
-            ):
-                candidate = variant
+    # rows chosen so far, with their sizes: a row chosen later keeps its turns between
+    # transparent and visible out of their visible letters, and theirs out of its own
+    placed = {group: [(row, laid)] for group, row in backs.items()}
+
+    def own_rows(variant: Candidate, keys: set[str]) -> list[tuple[str, Row]]:
+        grouped = _candidate_rows(spec, uses, variant, memory)
+        return [
+            (group, row)
+            for group, members in grouped.items()
+            for row in members
+            if any(pattern_of[layer] in keys for layer in row.layers)
+        ]
+
+    def fitted(
+        variant: Candidate, keys: set[str], apart: bool
+    ) -> list[tuple[str, Row, dict[str, float]]] | None:
+        own = own_rows(variant, keys)
+        known = {**_sized(spec, [row for _, row in own]), **sizes}
+        found = []
+        for group, row in own:
+            if group not in points:
+                return None
+            visible = construct.visible_of(placed[group]) if apart else ([], [])
+            fit = construct.fit(row, known, points[group], canvas, visible)
+            if fit is None:
+                return None
+            found.append((group, row, {**known, **fit}))
+        return found
+
+    # the clusters with fewest placeholders first: their rows have least choice
+    order = sorted(
+        (
+            cluster
+            for cluster, members in enumerate(space.clusters)
+            if not {u.key for u in members} & fixed
+        ),
+        key=lambda cluster: (
+            sum(
+                traits.size is None
+                for _, row in own_rows(candidate, {u.key for u in space.clusters[cluster]})
+                for traits in row.traits
+            ),
+            cluster,
+        ),
+    )
+    for cluster in order:
+        keys = {use.key for use in space.clusters[cluster]}
+        options = [candidate, *space.variants(candidate, cluster, FITTED)]
+        for apart in (True, False):
+            chosen = next(
+                ((v, f) for v in options if (f := fitted(v, keys, apart)) is not None), None
+            )
+            if chosen is not None:
+                candidate = chosen[0]
+                for group, row, lengths in chosen[1]:
+                    placed[group].append((row, lengths))
                 break
     return candidate
 

@@ -254,12 +254,25 @@ def placeholders_laid(
             if all(letter.symbol in lengths for letter in other.word)
         ]
         points = sorted({p for other in laid for p in boundaries(other, lengths)})
-        fitted = _fitted(row, lengths, points, canvas, _visible(laid, lengths))
+        fitted = _fitted(row, lengths, points, canvas, visible_of([(o, lengths) for o in laid]))
         if fitted is None:  # the rows laid may be the ones in the way: theirs alone
             fitted = _fitted(row, lengths, points, canvas)
         if fitted is None:
             return None
         lengths.update(fitted)
+
+
+def fit(
+    row: Row,
+    sizes: Mapping[str, float],
+    points: Sequence[float],
+    canvas: float,
+    visible: Visible = ([], []),
+) -> dict[str, float] | None:
+    """The sizes of a row's open placeholders when it fits ``points`` as :func:`fits`
+    asks, and keeps apart from the ``visible`` letters of rows laid (:func:`visible_of`);
+    None when it does not fit."""
+    return _fitted(row, sizes, sorted(points), canvas, visible)
 
 
 def fits(row: Row, sizes: Mapping[str, float], points: Sequence[float], canvas: float) -> bool:
@@ -290,16 +303,16 @@ FITTING_WORK = 2000  # letters laid at most while fitting one row's placeholders
 BRANCHES = 12  # ends tried for a placeholder, nearest first
 
 
-Visible = tuple[list[tuple[float, float]], list[float]]  # see _visible()
+Visible = tuple[list[tuple[float, float]], list[float]]  # see visible_of()
 
 
-def _visible(rows: Sequence[Row], lengths: Mapping[str, float]) -> Visible:
+def visible_of(laid: Sequence[tuple[Row, Mapping[str, float]]]) -> Visible:
     """What laid rows ask of the column boundaries: the interiors of their visible
     letters (open intervals, overlapping ones merged), where none may fall, and where
     they turn between transparent and visible (:func:`_changes`), where one must."""
     spans = []
     changes: set[float] = set()
-    for row in rows:
+    for row, lengths in laid:
         x = boundaries(row, lengths)
         spans += [
             (x[k], x[k + 1])
