@@ -919,6 +919,15 @@ def compose(
     )
 
 
+def prepared_row(row: Row, known: dict[Row, _Row]) -> _Row:
+    """A row with its moves cached, kept in ``known`` (shared by the searches and
+    constructions of one axis)."""
+    found = known.get(row)
+    if found is None:
+        found = known[row] = _Row(row)
+    return found
+
+
 def _entry(row: _Row, start: int, end: int) -> Move:
     """The entry of a row from ``start`` to ``end`` (positions in half-steps)."""
     moves, _ = row.moves(start)

@@ -655,7 +655,7 @@ def _fitted_to_backs(
     """The candidate with each cluster's words chosen on their own to fit the rows at the
     back of their groups (the base: its boundaries laid at the relaxation's sizes): the
     first option (best first, VARIANTS at most) whose rows end every visible letter on
-    one of those boundaries and fill the canvas (:func:`construct.fits`). Layers that meet
+    one of those boundaries and fill the canvas (:func:`construct.fit`). Layers that meet
     only through the base's columns align independently given them."""
     pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
     # first the backs: each cluster holding a group's back row takes the option whose back

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from facadecli.solver import columns, sizing
-from facadecli.solver.alignment import Alignment, Move, _Row
+from facadecli.solver.alignment import Alignment, Move, _Row, prepared_row
 from facadecli.solver.rows import Row
 from facadecli.spec.model import Spec
 
@@ -128,9 +128,7 @@ def cut(
     near = max(NEAR * max(1.0, canvas), snap)
     laid: list[list[float]] = []
     for row in rows:
-        x = [0.0]
-        for letter in row.word:
-            x.append(x[-1] + lengths[letter.symbol])
+        x = boundaries(row, lengths)
         if abs(x[-1] - canvas) > near:
             return None  # a row with gaps: not constructed here
         x[-1] = canvas
@@ -143,7 +141,7 @@ def cut(
         if all(_position(x, row, p, near) is not None for x, row in zip(laid, rows, strict=True)):
             cuts.append(p)
     cuts.append(canvas)
-    prepared_rows = [_prepared(row, prepared) for row in rows]
+    prepared_rows = [prepared_row(row, prepared) for row in rows]
     entries: list[tuple[Move | None, ...]] = []
     for a, b in itertools.pairwise(cuts):
         column: list[Move | None] = []
@@ -192,13 +190,6 @@ def _valid(rows: Sequence[Row], column: Sequence[Move | None]) -> bool:
             if other is not None and not other.transparent and rows[a].is_above(rows[r]):
                 return False
     return True
-
-
-def _prepared(row: Row, known: dict[Row, _Row]) -> _Row:
-    found = known.get(row)
-    if found is None:
-        found = known[row] = _Row(row)
-    return found
 
 
 def shortest_letter(groups: Mapping[str, Sequence[Row]], lengths: Mapping[str, float]) -> float:
@@ -269,24 +260,18 @@ def fit(
     canvas: float,
     visible: Visible = ([], []),
 ) -> dict[str, float] | None:
-    """The sizes of a row's open placeholders when it fits ``points`` as :func:`fits`
-    asks, and keeps apart from the ``visible`` letters of rows laid (:func:`visible_of`);
-    None when it does not fit."""
+    """The sizes of a row's open placeholders when the row fills the canvas with every
+    visible letter starting and ending on one of ``points``, apart from the ``visible``
+    letters of rows laid (:func:`visible_of`); None when it does not fit."""
     return _fitted(row, sizes, sorted(points), canvas, visible)
-
-
-def fits(row: Row, sizes: Mapping[str, float], points: Sequence[float], canvas: float) -> bool:
-    """Whether a row at ``sizes`` (its placeholders sized as it needs) fills the canvas
-    with every visible letter starting and ending on one of ``points``."""
-    return coverage(row, sizes, points, canvas) is not None
 
 
 def coverage(
     row: Row, sizes: Mapping[str, float], points: Sequence[float], canvas: float
 ) -> float | None:
-    """How much the row's placeholders cover (the sum of their sizes) when it fits
-    ``points`` as :func:`fits` asks; None when it does not fit."""
-    found = _fitted(row, sizes, sorted(points), canvas)
+    """How much the row's placeholders cover (the length of all their letters) when it
+    fits ``points`` (:func:`fit`); None when it does not fit."""
+    found = fit(row, sizes, points, canvas)
     if found is None:
         return None
     return sum(found.get(letter.symbol, 0.0) for letter in row.word)
@@ -345,9 +330,8 @@ def _fitted(
     """Sizes of a row's open placeholders that end each of them on one of ``points`` and
     the row on the canvas' end, with no boundary the row needs inside a ``visible``
     letter of the rows laid, nor one they need inside a visible letter of the row; of
-    those found
-    (depth first, nearest first, within FITTING_WORK), the ones whose letters cover least
-    (SPEC 2.7); None when none is found."""
+    those found (depth first, nearest first, within FITTING_WORK), the ones whose letters
+    cover least (SPEC 2.7); None when none is found."""
     near = NEAR * max(1.0, canvas)
     interiors, ends = visible  # the laid rows' visible interiors, and boundaries needed
     starts = [a for a, _ in interiors]

@@ -39,7 +39,7 @@ import numpy as np
 from facadecli.native import EXACT_COMPILED, _exact
 from facadecli.patterns import Word
 from facadecli.solver import columns, sizing
-from facadecli.solver.alignment import INF, Alignment, Move, _Row
+from facadecli.solver.alignment import INF, Alignment, Move, _Row, prepared_row
 from facadecli.solver.rows import LetterTraits, Row
 from facadecli.spec.model import Spec
 
@@ -852,14 +852,6 @@ class _Compiled:
         return search.incumbent, False
 
 
-def _prepared(row: Row, known: dict[Row, _Row]) -> _Row:
-    """A row with its moves cached, shared by the searches of one axis."""
-    found = known.get(row)
-    if found is None:
-        found = known[row] = _Row(row)
-    return found
-
-
 def _has_opaque(row: Row) -> bool:
     """Only an opaque letter makes a row behind give way (SPEC 2.4)."""
     return any(traits.opaque for traits in row.traits)
@@ -1018,7 +1010,7 @@ def _search_of(
         prepared.append(
             _Group(
                 name,
-                [_prepared(row, known) for row in rows],
+                [prepared_row(row, known) for row in rows],
                 [[j for j, other in enumerate(rows) if other.is_above(row)] for row in rows],
                 [
                     [j for j, other in enumerate(rows) if other.covers(row) and _has_opaque(other)]
