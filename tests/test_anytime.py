@@ -13,9 +13,9 @@ import pytest
 
 from facadecli import make_word, parse_spec, solve
 from facadecli.export.report import report
-from facadecli.solver import columns
+from facadecli.solver import columns, construct
 from facadecli.solver.alignment import _Row
-from facadecli.solver.rows import make_rows
+from facadecli.solver.rows import Row, make_rows
 from facadecli.spec.resolve import layer_pattern
 from tests.benchmarks.distinct import GRAND_HALL_PERIODS, distinct_palace, grand_hall
 from tests.solving import letters, solve_text
@@ -310,3 +310,61 @@ def test_a_column_cut_keeps_letters_of_no_length_at_its_end() -> None:
     assert whole is not None
     parts = columns._cut((whole,), {0: [(0.0, 0), (1.5, 2), (1.5, 4)]}, [prepared], [0, 0.75, 1.5])
     assert [(part[0].start, part[0].end) for part in parts] == [(0, 1), (1, 4)]
+
+
+def _rows_of(text: str) -> list[Row]:
+    """The x rows of a spec's layers, in layer order (one row each)."""
+    spec = parse_spec(text, "rows.yaml")
+    found = []
+    for index, layer in enumerate(spec.layers):
+        word = make_word(layer_pattern(spec, layer, "x"), {})
+        (row,) = make_rows(spec, [(index, word)])
+        found.append(row)
+    return found
+
+
+def test_a_placeholder_reaches_any_boundary_of_the_rows_laid() -> None:
+    """`h V h2` over twenty bays and an end bay: V fits only over the end bay, the 21st
+    boundary on (the fit once tried a placeholder's twelve nearest ends only)."""
+    base, row = _rows_of(
+        """
+        version: 1
+        name: reach
+        canvas: {width: 23.5, height: 3.0}
+        symbols: {S: 1.0, T: 2.5, E: 1.0, H: {size: 3.0, opaque: true}, V: 2.5, h: {}, h2: {}}
+        patterns:
+          bays: S S S S S S S S S S S S S S S S S S S S T E
+          sign: {control: h v h2, where: {v: V}}
+        layers: [{name: base, x: bays, y: H}, {name: sign, x: sign, y: H}]
+        """
+    )
+    sizes = {"S": 1.0, "T": 2.5, "E": 1.0, "V": 2.5}
+    fit = construct.fit(row, sizes, construct.boundaries(base, sizes), 23.5)
+    assert fit == pytest.approx({"h": 20.0, "h2": 1.0})
+
+
+def test_a_visible_letter_is_not_fitted_over_an_unoccludable_one_below() -> None:
+    """SPEC 2.4: a window of the upper layer skips the bay whose pier is unoccludable."""
+    base, pier, window = _rows_of(
+        """
+        version: 1
+        name: unoccludable
+        canvas: {width: 4.0, height: 3.0}
+        symbols: {S: 1.0, H: {size: 3.0, opaque: true}, U: {size: 1.0, unoccludable: true},
+                  V: 1.0, g: {}, g2: {}, h: {}, h2: {}}
+        patterns:
+          bays: S S S S
+          pier: {control: g u g2, where: {u: U}}
+          window: {control: h v h2, where: {v: V}}
+        layers: [{name: base, x: bays, y: H}, {name: pier, x: pier, y: H},
+                 {name: window, x: window, y: H}]
+        """
+    )
+    sizes = {"S": 1.0, "U": 1.0, "V": 1.0}
+    points = construct.boundaries(base, sizes)
+    laid_pier = {**sizes, "g": 1.0, "g2": 2.0}
+    free = construct.fit(window, sizes, points, 4.0)
+    assert free == pytest.approx({"h": 1.0, "h2": 2.0})  # nearest: over the pier
+    among = construct.laid_for(window, [(base, sizes), (pier, laid_pier)])
+    fit = construct.fit(window, sizes, points, 4.0, among)
+    assert fit == pytest.approx({"h": 2.0, "h2": 1.0})

@@ -55,6 +55,7 @@ VARIANTS = 48  # options of a cluster of patterns tried in place of the best lay
 FITTED = 2000  # options of a cluster tried for a fit to the rows at the back (cheap tests)
 SWEEPS = 2  # passes over the clusters while a variant improves the best layout
 TRIED = 3  # of a cluster's options that fit, those laid out (least covering first)
+REPAIRS = 3  # passes fitting the clusters to the backs, those in conflict first
 NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
@@ -571,13 +572,13 @@ def _constructions(
     then placeholders covering less)."""
     made: list[_Evaluated] = []
 
-    def build(candidate: Candidate) -> _Evaluated | None:
+    def build(candidate: Candidate, fitted: Mapping[str, float] | None = None) -> _Evaluated | None:
         _candidate_bound(spec, uses, candidate, canvas, memory)  # its relaxation, once
         relaxed = memory.relaxed.get(candidate.order)
         if relaxed is None:
             return None
         rows = _candidate_rows(spec, uses, candidate, memory)
-        built = construct.construct(spec, rows, canvas, memory.prepared, relaxed, tie)
+        built = construct.construct(spec, rows, canvas, memory.prepared, relaxed, tie, fitted)
         if built is None:
             return None
         found = _Evaluated(candidate, built.groups, built.program, built.sizing)
@@ -605,9 +606,12 @@ def _constructions(
     best: _Evaluated | None = None
     for number, candidate in enumerate(candidates[:CONSTRUCTIONS]):
         best = build(candidate)
-        if best is None and number == 0:  # the others' words fitted to the rows at the back
-            fitted = _fitted_to_backs(spec, uses, space, candidate, canvas, memory)
-            best = None if fitted is candidate else build(fitted)
+        if number == 0 and (best is None or best.estimate.objective > tie):
+            # the others' words fitted to the rows at the back
+            fitted, lengths = _fitted_to_backs(spec, uses, space, candidate, canvas, memory, tie)
+            found = build(fitted, lengths)
+            if found is not None and (best is None or _better(found, best, tie)):
+                best = found
         if best is None and number == 0:  # each cluster's words of least bound
             descent = descended(candidate)
             best = None if descent is candidate else build(descent)
@@ -651,37 +655,44 @@ def _fitted_to_backs(
     candidate: Candidate,
     canvas: float,
     memory: _SearchMemory,
-) -> Candidate:
+    tie: float,
+) -> tuple[Candidate, dict[str, float] | None]:
     """The candidate with each cluster's words chosen on their own to fit the rows at the
     back of their groups (the base: its boundaries laid at the relaxation's sizes): the
     first option (best first, VARIANTS at most) whose rows end every visible letter on
     one of those boundaries and fill the canvas (:func:`construct.fit`). Layers that meet
-    only through the base's columns align independently given them."""
+    only through the base's columns align independently given them. With it, the sizes
+    the fits found (every symbol's, when each row was laid; else None)."""
     pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
     # first the backs: each cluster holding a group's back row takes the option whose back
     # rows fit the canvas best on their own
     rows = _candidate_rows(spec, uses, candidate, memory)
     at_back = {pattern_of[layer] for members in rows.values() for layer in members[0].layers}
+    tied: dict[int, list[dict[str, Enumerated]]] = {}  # per back cluster, its best options
     for cluster, members in enumerate(space.clusters):
         keys = {use.key for use in members}
         if not keys & at_back:
             continue
         options = [candidate, *space.variants(candidate, cluster, VARIANTS)]
-        candidate = min(
-            options, key=lambda option: _backs_bound(spec, uses, option, canvas, memory)
-        )
+        bounds = [_backs_bound(spec, uses, option, canvas, memory) for option in options]
+        least = min(bounds)
+        tied[cluster] = [
+            {key: option.words[key] for key in keys}
+            for option, bound in zip(options, bounds, strict=True)
+            if bound <= least + tie
+        ]
+        candidate = options[bounds.index(least)]
     # the backs laid at their own relaxation's sizes: their boundaries are what the
     # other rows must meet
     rows = _candidate_rows(spec, uses, candidate, memory)
     backs = {group: members[0] for group, members in rows.items() if members}
     relaxed = construct.relax(spec, {group: [row] for group, row in backs.items()}, canvas)
     if relaxed is None:
-        return candidate
+        return candidate, None
     laid = construct.placeholders_laid(
         {group: [row] for group, row in backs.items()}, relaxed, canvas
     ) or dict(relaxed.lengths)
     points = {group: construct.boundaries(row, laid) for group, row in backs.items()}
-    fixed = {pattern_of[layer] for row in backs.values() for layer in row.layers}
     sizes = {name: size for name, size in relaxed.lengths.items() if spec.size(name) is not None}
     # rows chosen so far, with their sizes: a row chosen later keeps its turns between
     # transparent and visible out of their visible letters, and theirs out of its own
@@ -705,8 +716,12 @@ def _fitted_to_backs(
         for group, row in own:
             if group not in points:
                 return None
-            visible = construct.visible_of(placed[group]) if apart else ([], [])
-            fit = construct.fit(row, known, points[group], canvas, visible)
+            if row == backs[group]:
+                continue  # laid
+            if any(layer in backs[group].layers for layer in row.layers):
+                return None  # another word at the back: the backs are laid
+            laid = construct.laid_for(row, placed[group]) if apart else construct.NOTHING_LAID
+            fit = construct.fit(row, known, points[group], canvas, laid)
             if fit is None:
                 return None
             found.append((group, row, {**known, **fit}))
@@ -714,11 +729,7 @@ def _fitted_to_backs(
 
     # the clusters with fewest placeholders first: their rows have least choice
     order = sorted(
-        (
-            cluster
-            for cluster, members in enumerate(space.clusters)
-            if not {u.key for u in members} & fixed
-        ),
+        range(len(space.clusters)),
         key=lambda cluster: (
             sum(
                 traits.size is None
@@ -728,19 +739,49 @@ def _fitted_to_backs(
             cluster,
         ),
     )
-    for cluster in order:
-        keys = {use.key for use in space.clusters[cluster]}
-        options = [candidate, *space.variants(candidate, cluster, FITTED)]
-        for apart in (True, False):
-            chosen = next(
-                ((v, f) for v in options if (f := fitted(v, keys, apart)) is not None), None
-            )
-            if chosen is not None:
-                candidate = chosen[0]
-                for group, row, lengths in chosen[1]:
-                    placed[group].append((row, lengths))
-                break
-    return candidate
+
+    def laid_in(order: Sequence[int], candidate: Candidate) -> tuple[Candidate, list[int]]:
+        """One pass over the clusters in ``order``: each takes its first option whose rows
+        fit the backs and the rows placed so far (or, failing that, the backs alone: it is
+        in conflict)."""
+        for group, row in backs.items():
+            placed[group] = [(row, laid)]
+        conflicted = []
+        for cluster in order:
+            keys = {use.key for use in space.clusters[cluster]}
+            if cluster in tied:  # the backs' words are chosen: only their options as good
+                others = {key: word for key, word in candidate.words.items() if key not in keys}
+                options = [candidate] + [
+                    space.candidate([others, option])
+                    for option in tied[cluster]
+                    if any(option[key] is not candidate.words[key] for key in keys)
+                ]
+            else:
+                options = [candidate, *space.variants(candidate, cluster, FITTED)]
+            for apart in (True, False):
+                chosen = next(
+                    ((v, f) for v in options if (f := fitted(v, keys, apart)) is not None), None
+                )
+                if chosen is not None:
+                    candidate = chosen[0]
+                    for group, row, lengths in chosen[1]:
+                        placed[group].append((row, lengths))
+                    if not apart:
+                        conflicted.append(cluster)
+                    break
+        return candidate, conflicted
+
+    # passes again with the clusters in conflict first (their rows are the rigid ones)
+    for _ in range(REPAIRS):
+        candidate, conflicted = laid_in(order, candidate)
+        if not conflicted:
+            break
+        order = conflicted + [cluster for cluster in order if cluster not in conflicted]
+    found: dict[str, float] = {}
+    for laid_rows in placed.values():
+        for _, lengths in laid_rows:
+            found.update(lengths)
+    return candidate, found
 
 
 def _points_without(

@@ -21,7 +21,7 @@ import bisect
 import itertools
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -192,6 +192,63 @@ def _valid(rows: Sequence[Row], column: Sequence[Move | None]) -> bool:
     return True
 
 
+Span = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Laid:
+    """What the rows laid in a group ask of a row fitted among them (:func:`laid_for`)."""
+
+    interiors: list[Span] = field(default_factory=list)  # of their visible letters: no cut
+    ends: list[float] = field(default_factory=list)  # where they turn transparent: cuts
+    guarded: list[Span] = field(default_factory=list)  # their unoccludable letters below it
+    covering: list[Span] = field(default_factory=list)  # their visible letters above it
+
+
+NOTHING_LAID = Laid()
+
+
+def laid_for(row: Row, laid: Sequence[tuple[Row, Mapping[str, float]]]) -> Laid:
+    """What laid rows ask of the column boundaries of ``row``: the interiors of their
+    visible letters (open spans, overlapping ones merged), where none may fall, and
+    where they turn between transparent and visible (:func:`_changes`), where one must;
+    and SPEC 2.4's unoccludable letters: those of rows below ``row``, which no visible
+    letter of it may overlap, and the visible letters of rows above it, which none of its
+    unoccludable letters may."""
+    spans, guarded, covering = [], [], []
+    changes: set[float] = set()
+    for other, lengths in laid:
+        x = boundaries(other, lengths)
+        for k, traits in enumerate(other.traits):
+            if traits.transparent or x[k + 1] <= x[k]:
+                continue
+            spans.append((x[k], x[k + 1]))
+            if traits.unoccludable and row.is_above(other):
+                guarded.append((x[k], x[k + 1]))
+            if other.is_above(row):
+                covering.append((x[k], x[k + 1]))
+        changes.update(x[k] for k in range(1, len(other.word)) if _changes(other, k))
+    return Laid(_merged(spans), sorted(changes), _merged(guarded), _merged(covering))
+
+
+def _merged(spans: list[Span]) -> list[Span]:
+    merged: list[Span] = []
+    for a, b in sorted(spans):
+        if merged and a < merged[-1][1]:
+            merged[-1] = (merged[-1][0], max(merged[-1][1], b))
+        else:
+            merged.append((a, b))
+    return merged
+
+
+def _overlaps(
+    spans: Sequence[Span], starts: Sequence[float], a: float, b: float, near: float
+) -> bool:
+    """Whether ``(a, b)`` overlaps one of the merged ``spans`` by more than ``near``."""
+    at = bisect.bisect_right(starts, b - near) - 1
+    return at >= 0 and spans[at][1] > a + near
+
+
 def shortest_letter(groups: Mapping[str, Sequence[Row]], lengths: Mapping[str, float]) -> float:
     return min(
         (lengths[letter.symbol] for rows in groups.values() for row in rows for letter in row.word),
@@ -245,7 +302,7 @@ def placeholders_laid(
             if all(letter.symbol in lengths for letter in other.word)
         ]
         points = sorted({p for other in laid for p in boundaries(other, lengths)})
-        fitted = _fitted(row, lengths, points, canvas, visible_of([(o, lengths) for o in laid]))
+        fitted = _fitted(row, lengths, points, canvas, laid_for(row, [(o, lengths) for o in laid]))
         if fitted is None:  # the rows laid may be the ones in the way: theirs alone
             fitted = _fitted(row, lengths, points, canvas)
         if fitted is None:
@@ -258,12 +315,12 @@ def fit(
     sizes: Mapping[str, float],
     points: Sequence[float],
     canvas: float,
-    visible: Visible = ([], []),
+    laid: Laid = NOTHING_LAID,
 ) -> dict[str, float] | None:
     """The sizes of a row's open placeholders when the row fills the canvas with every
-    visible letter starting and ending on one of ``points``, apart from the ``visible``
-    letters of rows laid (:func:`visible_of`); None when it does not fit."""
-    return _fitted(row, sizes, sorted(points), canvas, visible)
+    visible letter starting and ending on one of ``points``, among the rows ``laid``
+    (:func:`laid_for`); None when it does not fit."""
+    return _fitted(row, sizes, sorted(points), canvas, laid)
 
 
 def coverage(
@@ -285,33 +342,6 @@ def boundaries(row: Row, lengths: Mapping[str, float]) -> list[float]:
 
 
 FITTING_WORK = 2000  # letters laid at most while fitting one row's placeholders
-BRANCHES = 12  # ends tried for a placeholder, nearest first
-
-
-Visible = tuple[list[tuple[float, float]], list[float]]  # see visible_of()
-
-
-def visible_of(laid: Sequence[tuple[Row, Mapping[str, float]]]) -> Visible:
-    """What laid rows ask of the column boundaries: the interiors of their visible
-    letters (open intervals, overlapping ones merged), where none may fall, and where
-    they turn between transparent and visible (:func:`_changes`), where one must."""
-    spans = []
-    changes: set[float] = set()
-    for row, lengths in laid:
-        x = boundaries(row, lengths)
-        spans += [
-            (x[k], x[k + 1])
-            for k, traits in enumerate(row.traits)
-            if not traits.transparent and x[k + 1] > x[k]
-        ]
-        changes.update(x[k] for k in range(1, len(row.word)) if _changes(row, k))
-    merged: list[tuple[float, float]] = []
-    for a, b in sorted(spans):
-        if merged and a < merged[-1][1]:
-            merged[-1] = (merged[-1][0], max(merged[-1][1], b))
-        else:
-            merged.append((a, b))
-    return merged, sorted(changes)
 
 
 def _changes(row: Row, k: int) -> bool:
@@ -325,16 +355,19 @@ def _fitted(
     lengths: Mapping[str, float],
     points: Sequence[float],
     canvas: float,
-    visible: Visible = ([], []),
+    laid: Laid = NOTHING_LAID,
 ) -> dict[str, float] | None:
     """Sizes of a row's open placeholders that end each of them on one of ``points`` and
-    the row on the canvas' end, with no boundary the row needs inside a ``visible``
-    letter of the rows laid, nor one they need inside a visible letter of the row; of
-    those found (depth first, nearest first, within FITTING_WORK), the ones whose letters
-    cover least (SPEC 2.7); None when none is found."""
+    the row on the canvas' end, with no boundary the row needs inside a visible letter
+    of the rows ``laid``, nor one they need inside a visible letter of the row, and no
+    visible letter over an unoccludable one (SPEC 2.4); of those found (depth first,
+    nearest first, within FITTING_WORK), the ones whose letters cover least (SPEC 2.7);
+    None when none is found."""
     near = NEAR * max(1.0, canvas)
-    interiors, ends = visible  # the laid rows' visible interiors, and boundaries needed
+    interiors, ends = laid.interiors, laid.ends
     starts = [a for a, _ in interiors]
+    guarded_starts = [a for a, _ in laid.guarded]
+    covering_starts = [a for a, _ in laid.covering]
 
     def inside(x: float) -> bool:
         """``x`` strictly inside a visible letter laid."""
@@ -345,6 +378,12 @@ def _fitted(
         """A boundary the laid rows need strictly between ``a`` and ``b``."""
         at = bisect.bisect_right(ends, a + near)
         return at < len(ends) and ends[at] < b - near
+
+    def hides(k: int, a: float, b: float) -> bool:
+        """Letter k, laid over ``(a, b)``, and an unoccludable letter meet, one over the other."""
+        if row.traits[k].unoccludable and _overlaps(laid.covering, covering_starts, a, b, near):
+            return True
+        return _overlaps(laid.guarded, guarded_starts, a, b, near)
 
     word = [letter.symbol for letter in row.word]
     # boundaries before letter k that a visible letter starts or ends at: they are cuts,
@@ -385,7 +424,7 @@ def _fitted(
             size = lengths.get(symbol, sizes.get(symbol))
             if size is None:
                 break
-            if not row.traits[k].transparent and across(x, x + size):
+            if not row.traits[k].transparent and (across(x, x + size) or hides(k, x, x + size)):
                 return
             x += size
             k += 1
@@ -402,8 +441,11 @@ def _fitted(
             if size >= 0.0:
                 lay(k, x, {**sizes, symbol: size})
             return
+        # the ends the rest of the row leaves room for, nearest first
+        rest = sum(lengths.get(s, sizes.get(s, 0.0)) for s in word[k:] if s != symbol)
         at = bisect.bisect_right(points, x + near)
-        for end in points[at : at + BRANCHES]:
+        last = bisect.bisect_right(points, canvas - rest + near)
+        for end in points[at:last]:
             if work > FITTING_WORK:
                 return
             lay(k, x, {**sizes, symbol: end - x})
@@ -428,18 +470,24 @@ def construct(
     prepared: dict[Row, _Row],
     relaxed: Relaxation,
     same: float,
+    fitted: Mapping[str, float] | None = None,
 ) -> Constructed | None:
     """The best layout the constructions find for a candidate's rows: laid at the
     relaxation's sizes (cut where the rows agree exactly, then within growing shares of
     the shortest letter), then again at each layout's solved sizes while that improves;
     it stops as soon as a layout reaches the relaxation's bound (``same``: objectives this
-    close are equal). None when no construction gives a valid layout."""
+    close are equal). ``fitted``: sizes found to lay the rows (every letter's; see
+    ``axis._fitted_to_backs``), tried first. None when no construction gives a valid
+    layout."""
     best: Constructed | None = None
     shortest = shortest_letter(groups, relaxed.lengths)
     laid = placeholders_laid(groups, relaxed, canvas)
-    # at shares of 0: the placeholders laid to fit, then the relaxation's own sizes; then
-    # snapped within growing shares of the shortest letter
+    # at shares of 0: the sizes fitted, the placeholders laid to fit, then the
+    # relaxation's own sizes; then snapped within growing shares of the shortest letter
     exact = [relaxed.lengths] if laid is None else [laid, relaxed.lengths]
+    names = {letter.symbol for rows in groups.values() for row in rows for letter in row.word}
+    if fitted is not None and names <= fitted.keys():
+        exact.insert(0, fitted)
     tries = [(0.0, lengths) for lengths in exact]
     tries += [(share, laid or relaxed.lengths) for share in SNAP[1:]]
     for share, start in tries:
