@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import heapq
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from facadecli.errors import InfeasibleError, SearchLimitError
@@ -55,6 +55,7 @@ VARIANTS = 48  # options of a cluster of patterns tried in place of the best lay
 FITTED = 2000  # options of a cluster tried for a fit to the rows at the back (cheap tests)
 SWEEPS = 2  # passes over the clusters while a variant improves the best layout
 TRIED = 3  # of a cluster's options that fit, those laid out (least covering first)
+NEAR_CANVAS = 1e-9  # a word this close to the canvas (relative) fits it at preferred sizes
 REPAIRS = 3  # passes fitting the clusters to the backs, those in conflict first
 NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
 TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
@@ -622,19 +623,31 @@ def _constructions(
     pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
     for _ in range(SWEEPS):
         improved = False
+        if best.estimate.objective <= tie:  # every cluster's tie-break at once
+            joint = _least_covering_together(spec, uses, space, best, canvas, memory, tie)
+            found = None if joint is None else build(joint)
+            if found is not None and _better(found, best, tie):
+                best, improved = found, True
         for cluster in range(len(space.clusters)):
             keys = {use.key for use in space.clusters[cluster]}
             points = _points_without(best, keys, pattern_of)
             # the options whose rows fit the layout's other boundaries, least covering
             # first (SPEC 2.7's last tie-break; those covering as little as the
             # layout's own do not beat it): built until one improves it
-            own = _fits_among(spec, uses, best.candidate, keys, pattern_of, points, canvas, memory)
             perfect = best.estimate.objective <= tie  # only the tie-breaks can improve it
+            words = best.candidate.words
+            own = _covering({key: words[key] for key in keys}, canvas)
+            others = {key: word for key, word in words.items() if key not in keys}
             fitting = []
-            for variant in space.variants(best.candidate, cluster, VARIANTS):
+            for option in space.options[cluster][:VARIANTS]:
+                if all(option[key] is words[key] for key in keys):
+                    continue
+                if perfect and _covering(option, canvas) >= own - tie:
+                    continue  # it cannot improve the tie-breaks
+                variant = space.candidate([others, option])
                 covered = _fits_among(spec, uses, variant, keys, pattern_of, points, canvas, memory)
-                if covered is None or (perfect and own is not None and covered >= own - tie):
-                    continue  # it cannot fit, or cannot improve the tie-breaks
+                if covered is None:
+                    continue  # it cannot fit
                 least = 0.0 if perfect else bound(variant, best.estimate.objective + tie)
                 if least <= best.estimate.objective + tie:
                     fitting.append((least, covered, variant.order, variant))
@@ -740,6 +753,18 @@ def _fitted_to_backs(
         ),
     )
 
+    def options_of(candidate: Candidate, cluster: int, keys: set[str]) -> Iterable[Candidate]:
+        """The candidate, then with the cluster's other options to try, in order."""
+        if cluster not in tied:
+            return _least_covering_first(space, candidate, cluster, FITTED)
+        # the backs' words are chosen: only their options as good
+        others = {key: word for key, word in candidate.words.items() if key not in keys}
+        return [candidate] + [
+            space.candidate([others, option])
+            for option in tied[cluster]
+            if any(option[key] is not candidate.words[key] for key in keys)
+        ]
+
     def laid_in(order: Sequence[int], candidate: Candidate) -> tuple[Candidate, list[int]]:
         """One pass over the clusters in ``order``: each takes its first option whose rows
         fit the backs and the rows placed so far (or, failing that, the backs alone: it is
@@ -749,18 +774,10 @@ def _fitted_to_backs(
         conflicted = []
         for cluster in order:
             keys = {use.key for use in space.clusters[cluster]}
-            if cluster in tied:  # the backs' words are chosen: only their options as good
-                others = {key: word for key, word in candidate.words.items() if key not in keys}
-                options = [candidate] + [
-                    space.candidate([others, option])
-                    for option in tied[cluster]
-                    if any(option[key] is not candidate.words[key] for key in keys)
-                ]
-            else:
-                options = [candidate, *space.variants(candidate, cluster, FITTED)]
             for apart in (True, False):
+                tried = options_of(candidate, cluster, keys)
                 chosen = next(
-                    ((v, f) for v in options if (f := fitted(v, keys, apart)) is not None), None
+                    ((v, f) for v in tried if (f := fitted(v, keys, apart)) is not None), None
                 )
                 if chosen is not None:
                     candidate = chosen[0]
@@ -782,6 +799,72 @@ def _fitted_to_backs(
         for _, lengths in laid_rows:
             found.update(lengths)
     return candidate, found
+
+
+def _least_covering_together(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    space: CandidateSpace,
+    layout: _Evaluated,
+    canvas: float,
+    memory: _SearchMemory,
+    tie: float,
+) -> Candidate | None:
+    """A perfect layout's candidate with every cluster's option that covers least of those
+    covering less than its own and fitting the layout's other boundaries
+    (:func:`_fits_among`), all at once: one layout to build where a sweep builds one per
+    cluster. None when no cluster has such an option."""
+    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
+    words = layout.candidate.words
+    chosen: dict[str, Enumerated] = {}
+    for cluster, members in enumerate(space.clusters):
+        keys = {use.key for use in members}
+        points = _points_without(layout, keys, pattern_of)
+        own = _covering({key: words[key] for key in keys}, canvas)
+        others = {key: word for key, word in words.items() if key not in keys}
+        options = space.options[cluster][:VARIANTS]
+        for option in sorted(options, key=lambda option: _covering(option, canvas)):
+            if _covering(option, canvas) >= own - tie:
+                break
+            variant = space.candidate([others, option])
+            if (
+                _fits_among(spec, uses, variant, keys, pattern_of, points, canvas, memory)
+                is not None
+            ):
+                chosen.update(option)
+                break
+    if not chosen:
+        return None
+    return space.candidate([dict(words), chosen])
+
+
+def _least_covering_first(
+    space: CandidateSpace, candidate: Candidate, cluster: int, most: int
+) -> Iterator[Candidate]:
+    """The candidate with each of a cluster's first ``most`` options (its own too), those
+    whose placeholders cover least first (:func:`_covering`), made as they are needed."""
+    keys = {use.key for use in space.clusters[cluster]}
+    words = candidate.words
+    others = {key: word for key, word in words.items() if key not in keys}
+    chosen = [{key: words[key] for key in keys}, *space.options[cluster][:most]]
+    for i in sorted(range(len(chosen)), key=lambda i: (_covering(chosen[i], space.canvas), i)):
+        if i == 0:
+            yield candidate
+        elif any(chosen[i][key] is not words[key] for key in keys):
+            yield space.candidate([others, chosen[i]])
+
+
+def _covering(option: Mapping[str, Enumerated], canvas: float) -> float:
+    """How much the placeholders of an option's words cover when they fill the canvas at
+    preferred sizes (what the words' sized letters leave of it; SPEC 2.7's last
+    tie-break); infinite when a word fits the canvas only with sizes off their preferred."""
+    total = 0.0
+    for word in option.values():
+        if word.elastic and word.length <= canvas:
+            total += canvas - word.length
+        elif abs(word.length - canvas) > NEAR_CANVAS * canvas:
+            return INF
+    return total
 
 
 def _points_without(

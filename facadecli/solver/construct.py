@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import bisect
 import itertools
-from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -360,98 +359,141 @@ def _fitted(
     """Sizes of a row's open placeholders that end each of them on one of ``points`` and
     the row on the canvas' end, with no boundary the row needs inside a visible letter
     of the rows ``laid``, nor one they need inside a visible letter of the row, and no
-    visible letter over an unoccludable one (SPEC 2.4); of those found (depth first,
-    nearest first, within FITTING_WORK), the ones whose letters cover least (SPEC 2.7);
-    None when none is found."""
-    near = NEAR * max(1.0, canvas)
-    interiors, ends = laid.interiors, laid.ends
-    starts = [a for a, _ in interiors]
-    guarded_starts = [a for a, _ in laid.guarded]
-    covering_starts = [a for a, _ in laid.covering]
+    visible letter over an unoccludable one (SPEC 2.4): the first found, depth first,
+    nearest first, within FITTING_WORK; None when none is found."""
+    fitting = _Fitting(row, lengths, points, canvas, laid)
+    fitting.lay(0, 0.0, {})
+    return fitting.best
 
-    def inside(x: float) -> bool:
+
+class _Fitting:
+    """The depth-first search of :func:`_fitted`: placeholders sized in the order the row
+    meets them, each to end on one of the points, nearest first."""
+
+    def __init__(
+        self,
+        row: Row,
+        lengths: Mapping[str, float],
+        points: Sequence[float],
+        canvas: float,
+        laid: Laid,
+    ) -> None:
+        self.row, self.lengths, self.points, self.canvas, self.laid = (
+            row,
+            lengths,
+            points,
+            canvas,
+            laid,
+        )
+        self.near = NEAR * max(1.0, canvas)
+        self.word = [letter.symbol for letter in row.word]
+        n = len(self.word)
+        self.starts = [a for a, _ in laid.interiors]
+        self.guarded_starts = [a for a, _ in laid.guarded]
+        self.covering_starts = [a for a, _ in laid.covering]
+        # boundaries before letter k that a visible letter starts or ends at: they are
+        # cuts, so they must fall on the laid rows' boundaries
+        traits = row.traits
+        self.edge = [
+            k == 0 or k == n or not traits[k - 1].transparent or not traits[k].transparent
+            for k in range(n + 1)
+        ]
+        self.turns = [0 < k < n and _changes(row, k) for k in range(n + 1)]
+        self.open = [s for s in dict.fromkeys(self.word) if s not in lengths]
+        # per letter k: the sized letters' length from k on, and each open one's count
+        self.known_after = [0.0] * (n + 1)
+        self.open_after = {s: [0] * (n + 1) for s in self.open}
+        for k in range(n - 1, -1, -1):
+            symbol = self.word[k]
+            self.known_after[k] = self.known_after[k + 1] + lengths.get(symbol, 0.0)
+            for s, after in self.open_after.items():
+                after[k] = after[k + 1] + (s == symbol)
+        self.work = 0
+        self.best: dict[str, float] | None = None
+
+    def _on_point(self, x: float) -> bool:
+        at = bisect.bisect_left(self.points, x - self.near)
+        return at < len(self.points) and self.points[at] <= x + self.near
+
+    def _inside(self, x: float) -> bool:
         """``x`` strictly inside a visible letter laid."""
-        at = bisect.bisect_right(starts, x - near) - 1
-        return at >= 0 and interiors[at][1] > x + near
+        interiors = self.laid.interiors
+        at = bisect.bisect_right(self.starts, x - self.near) - 1
+        return at >= 0 and interiors[at][1] > x + self.near
 
-    def across(a: float, b: float) -> bool:
+    def _across(self, a: float, b: float) -> bool:
         """A boundary the laid rows need strictly between ``a`` and ``b``."""
-        at = bisect.bisect_right(ends, a + near)
-        return at < len(ends) and ends[at] < b - near
+        ends = self.laid.ends
+        at = bisect.bisect_right(ends, a + self.near)
+        return at < len(ends) and ends[at] < b - self.near
 
-    def hides(k: int, a: float, b: float) -> bool:
-        """Letter k, laid over ``(a, b)``, and an unoccludable letter meet, one over the other."""
-        if row.traits[k].unoccludable and _overlaps(laid.covering, covering_starts, a, b, near):
+    def _hides(self, k: int, a: float, b: float) -> bool:
+        """Letter k, laid over ``(a, b)``, and an unoccludable letter meet, one over the
+        other."""
+        laid, near = self.laid, self.near
+        if self.row.traits[k].unoccludable and _overlaps(
+            laid.covering, self.covering_starts, a, b, near
+        ):
             return True
-        return _overlaps(laid.guarded, guarded_starts, a, b, near)
+        return _overlaps(laid.guarded, self.guarded_starts, a, b, near)
 
-    word = [letter.symbol for letter in row.word]
-    # boundaries before letter k that a visible letter starts or ends at: they are cuts,
-    # so they must fall on the laid rows' boundaries
-    edge = [
-        k == 0
-        or k == len(word)
-        or not row.traits[k - 1].transparent
-        or not row.traits[k].transparent
-        for k in range(len(word) + 1)
-    ]
-    work = 0
-    best: dict[str, float] | None = None
-
-    counts = Counter(word)
-
-    def covered(sizes: Mapping[str, float]) -> float:
-        """What the placeholders sized so far cover in the whole row (no less at the end)."""
-        return sum(counts[symbol] * size for symbol, size in sizes.items())
-
-    def on_point(x: float) -> bool:
-        at = bisect.bisect_left(points, x - near)
-        return at < len(points) and points[at] <= x + near
-
-    def lay(k: int, x: float, sizes: dict[str, float]) -> None:
-        nonlocal work, best
-        if best is not None and covered(sizes) >= covered(best) - near:
-            return  # it can only cover more than the best found
+    def _advance(self, k: int, x: float, sizes: Mapping[str, float]) -> tuple[int, float] | None:
+        """The row laid from letter k at ``x`` up to its next letter of unknown size (or
+        its end): where that is, or None when a rule is broken on the way."""
+        word, lengths, traits = self.word, self.lengths, self.row.traits
         while k < len(word):
-            work += 1
-            if work > FITTING_WORK or x > canvas + near:
-                return
-            if edge[k] and not on_point(x):
-                return
-            if 0 < k < len(word) and _changes(row, k) and inside(x):
-                return
+            self.work += 1
+            if self.work > FITTING_WORK or x > self.canvas + self.near:
+                return None
+            if self.edge[k] and not self._on_point(x):
+                return None
+            if self.turns[k] and self._inside(x):
+                return None
             symbol = word[k]
             size = lengths.get(symbol, sizes.get(symbol))
             if size is None:
-                break
-            if not row.traits[k].transparent and (across(x, x + size) or hides(k, x, x + size)):
-                return
+                return k, x
+            if not traits[k].transparent and (
+                self._across(x, x + size) or self._hides(k, x, x + size)
+            ):
+                return None
             x += size
             k += 1
-        if k == len(word):
-            if abs(x - canvas) <= near and (best is None or covered(sizes) < covered(best) - near):
-                best = sizes
-            return
-        symbol = word[k]
-        still = {s for s in word[k:] if s not in lengths and s not in sizes}
-        if len(still) == 1:  # the last open one takes what the row leaves
-            count = word[k:].count(symbol)
-            rest = sum(lengths.get(s, sizes.get(s, 0.0)) for s in word[k:] if s != symbol)
-            size = (canvas - x - rest) / count
-            if size >= 0.0:
-                lay(k, x, {**sizes, symbol: size})
-            return
-        # the ends the rest of the row leaves room for, nearest first
-        rest = sum(lengths.get(s, sizes.get(s, 0.0)) for s in word[k:] if s != symbol)
-        at = bisect.bisect_right(points, x + near)
-        last = bisect.bisect_right(points, canvas - rest + near)
-        for end in points[at:last]:
-            if work > FITTING_WORK:
-                return
-            lay(k, x, {**sizes, symbol: end - x})
+        return k, x
 
-    lay(0, 0.0, {})
-    return best
+    def lay(self, k: int, x: float, sizes: dict[str, float]) -> bool:
+        """Lay the row from letter k at ``x`` with the placeholders sized so far; keep the
+        first fit found (every fit of a row covers as much: what its sized letters leave
+        of the canvas)."""
+        reached = self._advance(k, x, sizes)
+        if reached is None:
+            return False
+        k, x = reached
+        word = self.word
+        if k == len(word):
+            if abs(x - self.canvas) > self.near:
+                return False
+            self.best = sizes
+            return True
+        symbol = word[k]
+        still = [s for s in self.open if s not in sizes and self.open_after[s][k]]
+        # what the rest of the row takes besides this placeholder
+        rest = self.known_after[k] + sum(size * self.open_after[s][k] for s, size in sizes.items())
+        ahead = self.open_after[symbol][k]
+        if len(still) == 1:  # the last open one takes what the row leaves
+            size = (self.canvas - x - rest) / ahead
+            return size >= 0.0 and self.lay(k, x, {**sizes, symbol: size})
+        # its ends the rest of the row leaves room for (it comes ``ahead`` times more),
+        # nearest first
+        points = self.points
+        first = bisect.bisect_right(points, x + self.near)
+        last = bisect.bisect_right(points, x + (self.canvas - x - rest) / ahead + self.near)
+        for end in points[first:last]:
+            if self.work > FITTING_WORK:
+                return False
+            if self.lay(k, x, {**sizes, symbol: end - x}):
+                return True
+        return False
 
 
 @dataclass(frozen=True)
