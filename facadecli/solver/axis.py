@@ -296,12 +296,20 @@ def solve_axis_alternatives(
     started = time.perf_counter()
     uses = pattern_uses(spec, axis_words(spec, axis))
     space = CandidateSpace.of(spec, uses, canvas)
-    candidates = [] if space is None else space.best(CANDIDATE_LIMIT)
-    generated = time.perf_counter()
-    if space is None or not candidates:  # within the caps on words: not a proof
+    leading = [] if space is None else space.best(CONSTRUCTIONS)
+    if space is None or not leading:  # within the caps on words: not a proof
         raise SearchLimitError(_no_candidate_reason(axis, canvas))
-    tolerance = spec.solver.tolerance
+    tie = tie_window(canvas)
     memory = _SearchMemory(full_layers(spec, axis))
+    # a perfect layout of the first candidates, by construction, is optimal: then no
+    # other candidate is made (nor searched)
+    perfect_built: list[_Evaluated] = []
+    if alternatives == 1:
+        built = _constructions(spec, uses, space, leading, canvas, memory, tie)
+        perfect_built = [e for e in built if e.estimate.objective <= tie]
+    candidates = [] if perfect_built else space.best(CANDIDATE_LIMIT)
+    generated = time.perf_counter()
+    tolerance = spec.solver.tolerance
     shared = _relaxations(spec, uses, candidates, memory.full)
     budget = exact.Budget(EXACT_WORK, deadline)
     evaluated: list[_Evaluated] = []
@@ -312,7 +320,6 @@ def solve_axis_alternatives(
     timed_out = False
     tried = 0
     step = max(tolerance, TIER * canvas)
-    tie = tie_window(canvas)
     effort = MAX_NODES  # once something aligned, a candidate that needs far more search
     worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
     compare = max(FEASIBLE_TO_COMPARE, alternatives)
@@ -436,7 +443,7 @@ def solve_axis_alternatives(
     # primal first: candidates laid out by construction, least bound first, then each
     # cluster of patterns' other options in place of the best one's (a layer's words
     # chosen given the others); a candidate whose layout meets its bound needs no search
-    built = _constructions(spec, uses, space, candidates, canvas, memory, tie)
+    built = perfect_built or _constructions(spec, uses, space, candidates, canvas, memory, tie)
     evaluated.extend(built)
     for e in built:
         if e.estimate.objective <= memory.bounds.get(e.candidate.order, -INF) + tie:
