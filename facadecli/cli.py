@@ -385,16 +385,18 @@ def vary(
                 sized = retarget(spec, width, height, seed)
                 size = (sized.canvas.width, sized.canvas.height)
                 stem = f"{spec.name}-{size[0]:g}x{size[1]:g}"
+                at = f"{size[0]:g} x {size[1]:g} m"
+                if len(width_list) * len(height_list) > 1:  # progress: a line per size
+                    _warn(f"{shown}: {at}: drawing {count} layout{'s' * (count > 1)}...")
                 try:
                     layouts = solve_variants(sized, count)
                 except (InfeasibleError, SearchLimitError) as error:
-                    at = f"{size[0]:g} x {size[1]:g} m"
                     typer.echo(f"{shown}: {at}: no layout: {error}", err=True)
                     rows.append([Variant(None, size, sized.solver.seed, 0, "no layout")])
                     failed += 1
                     continue
                 row = []
-                _detail(f"{shown}: {size[0]:g} x {size[1]:g} m: {len(layouts)} layouts")
+                _detail(f"{shown}: {at}: {len(layouts)} different layouts")
                 for index, layout in enumerate(layouts):
                     named = replace(layout, spec=retarget(layout.spec, name=f"{stem}-{index}"))
                     options = OutputOptions(base_dir=spec_path.parent)

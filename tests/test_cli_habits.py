@@ -174,6 +174,17 @@ def test_grammar_and_infer_tell_their_stages_on_standard_error(tmp_path: Path) -
     assert "IoU of window: 1.0000" in inferred.stderr
 
 
+def test_vary_tells_each_size_on_standard_error(tmp_path: Path) -> None:
+    args = ["vary", str(HOUSE), "--widths", "8,12", "-o", str(tmp_path), "-f", "json"]
+    result = facade(*args)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr.splitlines() == [
+        f"{HOUSE}: 8 x 3 m: drawing 1 layout...",
+        f"{HOUSE}: 12 x 3 m: drawing 1 layout...",
+    ]
+    assert facade(*args, "-q").stderr == ""
+
+
 # facade examples DIR
 
 
