@@ -56,6 +56,7 @@ class BuildPyWithExamples(build_py):
         super().run()
         root = Path(__file__).resolve().parent
         target = Path(self.build_lib) / "facadecli" / "_examples"
+        shutil.rmtree(target, ignore_errors=True)  # a build folder left by an earlier build
         for folder in EXAMPLES:
             if (root / folder).is_dir():  # an sdist without them builds a wheel without them
                 shutil.copytree(root / folder, target / folder, dirs_exist_ok=True)
