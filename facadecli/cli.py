@@ -15,7 +15,7 @@ import traceback
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, NoReturn
 
 import typer
 
@@ -831,14 +831,11 @@ def schema(
     """Print the JSON Schema of the spec format (point your editor's YAML plugin at it)."""
     from facadecli.spec import spec_schema_text
 
-    to_stdout = output is None or str(output) == STDIN
-    if output is not None and not to_stdout:
-        check_output_file(output)
-    text = spec_schema_text()
-    if to_stdout or output is None:
-        sys.stdout.write(text)
-    else:
-        write_atomic(output, text)
+    if output is None or str(output) == STDIN:
+        sys.stdout.write(spec_schema_text())
+        return
+    check_output_file(output)
+    write_atomic(output, spec_schema_text())
 
 
 @app.command(epilog=EPILOG)
@@ -856,7 +853,7 @@ def watch(
     if not spec.is_file():
         raise SpecError.at(str(spec), None, None, "no such file", "check the path")
     try:
-        serve(spec, port, _log)
+        serve(spec, port, _watch_log())
     except OSError as error:
         raise typer.BadParameter(
             f"cannot serve on port {port}: {error.strerror}", param_hint="--port"
@@ -865,12 +862,21 @@ def watch(
         raise typer.Exit(0) from None
 
 
-def _log(line: str, error: bool) -> None:
-    """A line of ``facade watch``'s log: errors always, the rest unless --quiet."""
-    if error:
-        typer.echo(line, err=True)
-    else:
-        _say(line)
+def _watch_log() -> Callable[[str, bool], None]:
+    """The log of ``facade watch``: its first line, the page's address, and errors always
+    (a quiet preview still needs its address), the other lines unless --quiet."""
+    told = {"address": False}
+
+    def log(line: str, error: bool) -> None:
+        if error:
+            typer.echo(line, err=True)
+        elif not told["address"]:
+            told["address"] = True
+            typer.echo(line)
+        else:
+            _say(line)
+
+    return log
 
 
 @app.command(epilog=EPILOG)
@@ -975,7 +981,7 @@ def main() -> None:
         _internal(error)
 
 
-def _internal(error: Exception) -> None:
+def _internal(error: Exception) -> NoReturn:
     if _state["debug"]:
         traceback.print_exc()
     else:

@@ -315,3 +315,18 @@ def test_an_import_past_the_door_names_its_extra() -> None:
     assert extra_of("distributed") == "dask"
     assert extra_of("pyogrio.raw") == "gdal"
     assert extra_of("numpy") is None and extra_of(None) is None
+
+
+def test_a_quiet_watch_still_gives_its_address(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from facadecli import cli
+
+    monkeypatch.setitem(cli._state, "quiet", True)
+    log = cli._watch_log()
+    log("x.yaml: serving http://127.0.0.1:8765/ (Ctrl-C to stop)", False)
+    log("x.yaml: solved in 3 ms", False)
+    log("x.yaml:1:1: error: bad", True)
+    out, err = capsys.readouterr()
+    assert out == "x.yaml: serving http://127.0.0.1:8765/ (Ctrl-C to stop)\n"
+    assert err == "x.yaml:1:1: error: bad\n"
