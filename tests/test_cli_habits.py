@@ -4,6 +4,7 @@ input and output, progress on standard error, ``facade city`` without a manifest
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import re
@@ -15,6 +16,7 @@ import pytest
 
 from facadecli.examples import example_files, examples_folder
 from facadecli.extras import EXTRAS, extra_of
+from tests.running import facade as run
 
 ROOT = Path(__file__).resolve().parent.parent
 HOUSE = ROOT / "specs" / "residential-house.yaml"
@@ -64,75 +66,83 @@ def test_completion_completes_commands_and_options() -> None:
 # -q, -v, --debug: before or after the command
 
 
-@pytest.mark.parametrize("where", ["before", "after"])
-def test_quiet_keeps_errors_only(where: str, tmp_path: Path) -> None:
+def test_quiet_keeps_errors_only(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     args = ["solve", str(HOUSE), "-o", str(tmp_path), "-f", "json", "--width", "4"]
-    loud = facade(*args)
-    assert loud.returncode == 0 and "warning: x: symbol 'A'" in loud.stderr
-    assert "solved in" in loud.stdout
-    quiet = facade(*(["-q", *args] if where == "before" else [*args, "--quiet"]))
-    assert quiet.returncode == 0
-    assert quiet.stdout == "" and quiet.stderr == ""
+    code, out, err = run(capsys, *args)
+    assert code == 0 and "warning: x: symbol 'A'" in err and "solved in" in out
+    for quiet in (["-q", *args], [*args, "--quiet"]):  # before or after the command
+        assert run(capsys, *quiet) == (0, "", "")
     assert (tmp_path / "residential-house.layout.json").is_file()  # the work is done
-    failed = facade("solve", str(UNKNOWN_SYMBOL), "-o", str(tmp_path), "-q")
-    assert failed.returncode == 2 and "error:" in failed.stderr  # errors stay
+    code, out, err = run(capsys, "solve", str(UNKNOWN_SYMBOL), "-o", str(tmp_path), "-q")
+    assert code == 2 and "error:" in err  # errors stay
 
 
-@pytest.mark.parametrize("where", ["before", "after"])
-def test_verbose_adds_each_axis_on_standard_error(where: str, tmp_path: Path) -> None:
+def test_verbose_adds_each_axis_on_standard_error(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
     args = ["solve", str(HOUSE), "-o", str(tmp_path), "-f", "json"]
-    plain = facade(*args)
-    assert "axis:" not in plain.stderr
-    verbose = facade(*(["-v", *args] if where == "before" else [*args, "-v"]))
-    assert verbose.returncode == 0, verbose.stderr
-    lines = verbose.stderr.splitlines()
-    assert [line.split(": ")[1].split(" axis")[0] for line in lines if " axis:" in line] == [
-        "x",
-        "y",
-    ]
-    assert "objective" in verbose.stderr and "(proven)" in verbose.stderr
+    _, plain, plain_err = run(capsys, *args)
+    assert "axis:" not in plain_err
     untimed = re.compile(r"in [0-9.]+ ms")
-    assert untimed.sub("", verbose.stdout) == untimed.sub("", plain.stdout)  # stdout the same
+    for verbose in (["-v", *args], [*args, "--verbose"]):  # before or after the command
+        code, out, err = run(capsys, *verbose)
+        assert code == 0, err
+        axes = [line.split(": ")[1].split(" axis")[0] for line in err.splitlines()]
+        assert axes == ["x", "y"] and "objective" in err and "(proven)" in err
+        assert untimed.sub("", out) == untimed.sub("", plain)  # standard output the same
 
 
-def test_quiet_and_verbose_together_are_a_usage_error() -> None:
-    both = facade("validate", str(HOUSE), "-q", "-v")
-    assert both.returncode == 2 and "not both" in both.stderr
+def test_quiet_and_verbose_together_are_a_usage_error(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, _, err = run(capsys, "validate", str(HOUSE), "-q", "-v")
+    assert code == 2 and "not both" in err
 
 
-def test_debug_after_the_command_and_flags_after_double_dash(tmp_path: Path) -> None:
-    assert facade("validate", str(HOUSE), "--debug").returncode == 0
+def test_debug_after_the_command_and_flags_after_double_dash(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert run(capsys, "validate", str(HOUSE), "--debug")[0] == 0
     # after --, -q is a file name (a missing spec), not the flag
-    result = facade("validate", "--", "-q")
-    assert result.returncode == 2 and "-q: error: no such file" in result.stderr
+    code, _, err = run(capsys, "validate", "--", "-q")
+    assert code == 2 and "-q: error: no such file" in err
 
 
 # - for standard input and standard output
 
 
-def test_validate_reads_standard_input_and_names_it_in_errors() -> None:
-    good = facade("validate", "-", stdin=HOUSE.read_text())
-    assert good.returncode == 0 and good.stdout.startswith("<stdin>: ok (residential-house")
-    bad = facade("validate", "-", stdin=UNKNOWN_SYMBOL.read_text())
+def _stdin(monkeypatch: pytest.MonkeyPatch, text: str) -> None:
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(text.encode())))
+
+
+def test_validate_reads_standard_input_and_names_it_in_errors(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _stdin(monkeypatch, HOUSE.read_text())
+    code, out, _ = run(capsys, "validate", "-")
+    assert code == 0 and out.startswith("<stdin>: ok (residential-house")
+    _stdin(monkeypatch, UNKNOWN_SYMBOL.read_text())
+    code, _, err = run(capsys, "validate", "-")
     line, col = UNKNOWN_SYMBOL.read_text().split()[2].split(":")
-    assert bad.returncode == 2
-    assert f"<stdin>:{line}:{col}: error: " in bad.stderr
-    assert facade("validate", "-", "-", stdin="").returncode == 2  # read once only
+    assert code == 2 and f"<stdin>:{line}:{col}: error: " in err
+    code, _, err = run(capsys, "validate", "-", "-")
+    assert code == 2 and "read once" in err
 
 
-def test_solve_from_standard_input_to_a_folder_and_to_standard_output(tmp_path: Path) -> None:
-    spec = HOUSE.read_text()
-    to_folder = facade("solve", "-", "-o", str(tmp_path), "-f", "json", stdin=spec)
-    assert to_folder.returncode == 0, to_folder.stderr
-    assert to_folder.stdout.startswith("<stdin>: solved in")
+def test_solve_from_standard_input_to_a_folder_and_to_standard_output(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    _stdin(monkeypatch, HOUSE.read_text())
+    code, out, err = run(capsys, "solve", "-", "-o", str(tmp_path), "-f", "json")
+    assert code == 0 and out.startswith("<stdin>: solved in"), err
     written = (tmp_path / "residential-house.layout.json").read_text()
-    to_stdout = facade("solve", "-", "-o", "-", "-f", "json", stdin=spec)
-    assert to_stdout.returncode == 0, to_stdout.stderr
-    assert to_stdout.stdout == written  # the file itself, nothing else
-    assert "-> standard output" in to_stdout.stderr
-    assert json.loads(to_stdout.stdout)["name"] == "residential-house"
-    svg = facade("solve", str(HOUSE), "-o", "-", "-f", "svg")
-    assert svg.returncode == 0 and svg.stdout.startswith("<?xml")
+    _stdin(monkeypatch, HOUSE.read_text())
+    code, out, err = run(capsys, "solve", "-", "-o", "-", "-f", "json")
+    assert code == 0, err
+    assert out == written  # the file itself, nothing else
+    assert "-> standard output" in err
+    code, out, _ = run(capsys, "solve", str(HOUSE), "-o", "-", "-f", "svg")
+    assert code == 0 and out.startswith("<?xml")
 
 
 @pytest.mark.parametrize(
@@ -143,63 +153,67 @@ def test_solve_from_standard_input_to_a_folder_and_to_standard_output(tmp_path: 
         [str(HOUSE), "-f", "json"],  # two specs
     ],
 )
-def test_standard_output_takes_one_file(args: list[str], tmp_path: Path) -> None:
-    result = facade("solve", str(HOUSE), "-o", "-", *args)
-    assert result.returncode == 2 and "standard output" in result.stderr
-    assert result.stdout == ""
+def test_standard_output_takes_one_file(
+    capsys: pytest.CaptureFixture[str], args: list[str]
+) -> None:
+    code, out, err = run(capsys, "solve", str(HOUSE), "-o", "-", *args)
+    assert code == 2 and "standard output" in err and out == ""
 
 
-def test_schema_to_standard_output_with_dash() -> None:
-    assert facade("schema", "-o", "-").stdout == facade("schema").stdout
+def test_schema_to_standard_output_with_dash(capsys: pytest.CaptureFixture[str]) -> None:
+    assert run(capsys, "schema", "-o", "-")[1] == run(capsys, "schema")[1]
 
 
 # progress
 
 
-def test_grammar_and_infer_tell_their_stages_on_standard_error(tmp_path: Path) -> None:
+def test_grammar_and_infer_tell_their_stages_on_standard_error(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
     sample = ROOT / "samples" / "five-bays.json"
-    args = ["grammar", str(sample), "-o", str(tmp_path / "g"), "-n", "50"]
-    result = facade(*args)
-    assert result.returncode == 0, result.stderr
-    stages = [line for line in result.stderr.splitlines() if line.endswith("...")]
-    assert [line.split(": ")[1] for line in stages][:2] == [
-        "reading...",
-        "snapping 37 rectangles...",
-    ]
-    assert any("searching (adp, 50 iterations)" in line for line in stages)
-    assert facade(*args[:-4], "-o", str(tmp_path / "q"), "-n", "50", "-q").stderr == ""
-    inferred = facade("infer", str(sample), "-o", str(tmp_path / "i" / "s.yaml"), "-v")
-    assert inferred.returncode == 0, inferred.stderr
-    assert "finding the grids of each label (at " in inferred.stderr
-    assert "IoU of window: 1.0000" in inferred.stderr
+    args = ["grammar", str(sample), "-n", "50", "--method", "greedy"]
+    code, _, err = run(capsys, *args, "-o", str(tmp_path / "g"))
+    assert code == 0, err
+    stages = [line.split(": ")[1] for line in err.splitlines() if line.endswith("...")]
+    assert stages[:2] == ["reading...", "snapping 37 rectangles..."]
+    assert "searching (greedy)..." in stages
+    assert run(capsys, *args, "-o", str(tmp_path / "q"), "-q") == (0, "", "")
+    target = str(tmp_path / "i" / "s.yaml")
+    code, _, err = run(capsys, "infer", str(sample), "-o", target, "--no-check", "-v")
+    assert code == 0, err
+    assert "finding the grids of each label (at " in err
 
 
-def test_vary_tells_each_size_on_standard_error(tmp_path: Path) -> None:
+def test_vary_tells_each_size_on_standard_error(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
     args = ["vary", str(HOUSE), "--widths", "8,12", "-o", str(tmp_path), "-f", "json"]
-    result = facade(*args)
-    assert result.returncode == 0, result.stderr
-    assert result.stderr.splitlines() == [
+    code, _, err = run(capsys, *args)
+    assert code == 0, err
+    assert err.splitlines() == [
         f"{HOUSE}: 8 x 3 m: drawing 1 layout...",
         f"{HOUSE}: 12 x 3 m: drawing 1 layout...",
     ]
-    assert facade(*args, "-q").stderr == ""
+    assert run(capsys, *args, "-q")[2] == ""
 
 
 # facade examples DIR
 
 
-def test_examples_copies_the_specs_and_samples_once(tmp_path: Path) -> None:
+def test_examples_copies_the_specs_and_samples_once(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
     target = tmp_path / "start"
-    result = facade("examples", str(target))
-    assert result.returncode == 0, result.stderr
+    code, _, err = run(capsys, "examples", str(target))
+    assert code == 0, err
     copied = sorted(p.relative_to(target) for p in target.rglob("*") if p.is_file())
     assert copied == example_files()
     assert Path("specs/townhouse.yaml") in copied and Path("samples/town.osm") in copied
     for path in copied:
         assert (target / path).read_bytes() == (examples_folder() / path).read_bytes()
-    assert facade("validate", *map(str, sorted((target / "specs").glob("*.yaml")))).returncode == 0
-    again = facade("examples", str(target))
-    assert again.returncode == 2 and "already exist" in again.stderr
+    assert run(capsys, "validate", *map(str, sorted((target / "specs").glob("*.yaml"))))[0] == 0
+    code, _, err = run(capsys, "examples", str(target))
+    assert code == 2 and "already exist" in err
 
 
 def test_the_examples_are_the_repository_s_own() -> None:
@@ -228,16 +242,19 @@ def test_city_name_and_default_rules() -> None:
     assert {chosen.choose({"building": kind}).facade for kind in ("retail", "yes")} == {str(HOUSE)}
 
 
-def test_city_checks_its_input_before_any_work(tmp_path: Path) -> None:
+def test_city_checks_its_input_before_any_work(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
     town = str(ROOT / "samples" / "town.osm")
-    bad_spec = facade("city", town, "-o", str(tmp_path / "a"), "--spec", str(UNKNOWN_SYMBOL))
-    assert bad_spec.returncode == 2 and f"{UNKNOWN_SYMBOL}:" in bad_spec.stderr
-    with_manifest = facade(
-        "city", str(ROOT / "samples" / "town.yaml"), "-o", str(tmp_path / "b"), "--spec", town
+    code, _, err = run(
+        capsys, "city", town, "-o", str(tmp_path / "a"), "--spec", str(UNKNOWN_SYMBOL)
     )
-    assert with_manifest.returncode == 2 and "--spec" in with_manifest.stderr
-    missing = facade("city", str(tmp_path / "none.osm"), "-o", str(tmp_path / "c"))
-    assert missing.returncode == 2 and "no such file" in missing.stderr
+    assert code == 2 and f"{UNKNOWN_SYMBOL}:" in err
+    manifest = str(ROOT / "samples" / "town.yaml")
+    code, _, err = run(capsys, "city", manifest, "-o", str(tmp_path / "b"), "--spec", town)
+    assert code == 2 and "--spec" in err
+    code, _, err = run(capsys, "city", str(tmp_path / "none.osm"), "-o", str(tmp_path / "c"))
+    assert code == 2 and "no such file" in err
     assert not any((tmp_path / name).exists() for name in "abc")
 
 
@@ -293,12 +310,18 @@ def _without(
     ],
 )
 def test_a_missing_extra_is_one_line_naming_it(
-    modules: list[str], args: list[str], message: str, tmp_path: Path
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    modules: list[str],
+    args: list[str],
+    message: str,
+    tmp_path: Path,
 ) -> None:
-    result = _without(modules, [*args, "-o", str(tmp_path / "out")], tmp_path)
-    assert result.returncode == 2, result.stderr
-    assert result.stderr.strip().splitlines() == [message] or result.stderr.startswith(message)
-    assert len(result.stderr.strip().splitlines()) == 1
+    for name in modules:  # as after a pip install without the extra
+        monkeypatch.setitem(sys.modules, name, None)
+    code, out, err = run(capsys, *args, "-o", str(tmp_path / "out"))
+    assert code == 2 and out == ""
+    assert len(err.splitlines()) == 1 and err.startswith(message), err
     assert not (tmp_path / "out").exists()
 
 
