@@ -975,10 +975,16 @@ def main() -> None:
         if extra is None or _state["debug"]:
             _internal(error)
         else:
-            typer.echo(missing_message(extra, "this command", str(error.name)), err=True)
+            named = next((f"facade {arg}" for arg in sys.argv[1:] if arg in COMMANDS), "facade")
+            typer.echo(missing_message(extra, named, str(error.name)), err=True)
             sys.exit(2)
     except Exception as error:  # the last line of defence: no traceback for users
         _internal(error)
+
+
+COMMANDS = {  # the commands' names, for messages (a command is named after its function)
+    info.name or getattr(info.callback, "__name__", "") for info in app.registered_commands
+}
 
 
 def _internal(error: Exception) -> NoReturn:

@@ -273,14 +273,17 @@ def test_city_from_an_osm_extract_without_a_manifest(tmp_path: Path) -> None:
 
 
 def _without(
-    modules: list[str], args: list[str], tmp_path: Path
+    modules: list[str], args: list[str], tmp_path: Path, doors: bool = True
 ) -> subprocess.CompletedProcess[str]:
     """``facade ARGS`` in a Python where ``modules`` cannot be imported, as after a
-    ``pip install facadecli`` without the extra."""
+    ``pip install facadecli`` without the extra; without the checks at the commands'
+    doors unless ``doors``."""
     code = (
         "import sys\n"
         f"for name in {modules!r}:\n    sys.modules[name] = None\n"
-        "from facadecli.cli import main\n"
+        "import facadecli.extras\n"
+        + ("" if doors else "facadecli.extras.require = lambda extra, needed_by: None\n")
+        + "from facadecli.cli import main\n"
         f"sys.argv = ['facade', *{args!r}]\n"
         "main()\n"
     )
@@ -333,7 +336,17 @@ def test_the_core_commands_need_no_extra(tmp_path: Path) -> None:
     assert len(list(tmp_path.iterdir())) == 7
 
 
-def test_an_import_past_the_door_names_its_extra() -> None:
+def test_an_import_past_the_door_names_its_extra(tmp_path: Path) -> None:
+    """A module of an extra that a command imports without checking it first (a bug) is
+    still one line naming the extra, not an internal error."""
+    result = _without(
+        ["pyproj"], ["city", "samples/town.osm", "-o", str(tmp_path)], tmp_path, False
+    )
+    assert result.returncode == 2
+    assert result.stderr == (
+        "facade city needs the [city] extra (pyproj is not installed): "
+        "pip install 'facadecli[city]'\n"
+    )
     assert extra_of("shapely.geometry") == "city"
     assert extra_of("distributed") == "dask"
     assert extra_of("pyogrio.raw") == "gdal"

@@ -178,7 +178,7 @@ Progress = Callable[[str], None]  # told the name of each stage as it starts
 
 
 def no_progress(stage: str) -> None:
-    pass
+    """The default ``progress``: stages told to no one."""
 
 
 def tidy_layout(
