@@ -17,10 +17,10 @@ help: ## Show the targets
 $(STAMP): pyproject.toml setup.py facadecli/grammar/_adp.c facadecli/solver/_exact.c
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test,lint,docs]'
+	$(BIN)/python -m pip install --quiet -e '.[all,test,lint,docs]'
 	touch $(STAMP)
 
-install: $(STAMP) ## Create .venv and install facadecli with its test, lint and docs tools
+install: $(STAMP) ## Create .venv and install facadecli with every extra and its test, lint and docs tools
 
 demo: $(STAMP) ## Validate the example specs and solve them into out/ (report + SVG)
 	$(BIN)/facade validate $(SPECS)

@@ -10,11 +10,12 @@ from __future__ import annotations
 import json
 import math
 import sys
+import time
 import traceback
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, NoReturn
 
 import typer
 
@@ -22,6 +23,7 @@ from facadecli import __version__
 from facadecli.errors import FacadeError, InfeasibleError, SearchLimitError, SpecError
 from facadecli.export import (
     DEFAULT_FORMATS,
+    SINGLE_FILE_FORMATS,
     WRITERS,
     OutputOptions,
     check_output_file,
@@ -29,25 +31,34 @@ from facadecli.export import (
     staged,
     write_atomic,
     write_outputs,
+    write_stream,
 )
-from facadecli.limits import CANVAS_MAX
+from facadecli.limits import CANVAS_MAX, SPEC_BYTES_MAX
 
 if TYPE_CHECKING:  # the commands import the stages they use: start-up stays fast
+    from facadecli.solver.axis import AxisLayout
     from facadecli.spec import Spec
 
 app = typer.Typer(
     name="facade",
     help="Turn declarative YAML façade specs into layered, aligned building façades.",
-    add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
 
-_state = {"debug": False}
+# the global options of this run: set by the options, read by the printing functions
+_state = {"debug": False, "quiet": False, "verbose": False}
+STDIN = "-"  # a spec path or --output that means standard input or output
+STDIN_NAME = "<stdin>"  # how errors name a spec read from standard input
 
 SpecPaths = Annotated[
-    list[Path], typer.Argument(help="Spec files (YAML).", metavar="SPEC", show_default=False)
+    list[Path],
+    typer.Argument(
+        help="Spec files (YAML); - reads one from standard input.",
+        metavar="SPEC",
+        show_default=False,
+    ),
 ]
 
 
@@ -57,19 +68,95 @@ def _version(value: bool) -> None:
         raise typer.Exit(0)
 
 
-@app.callback()
+GLOBAL_FLAGS = {  # accepted before and after the command: main() moves them before it
+    "quiet": (("-q", "--quiet"), "Errors only: no warnings, progress or summaries."),
+    "verbose": (("-v", "--verbose"), "More detail on standard error (stage times, items)."),
+    "debug": (("--debug",), "Show tracebacks of internal errors."),
+}
+EPILOG = "The global options -q, -v and --debug may come before or after the command."
+
+
+@app.callback(epilog=EPILOG)
 def _main(
     version: Annotated[
         bool,
         typer.Option("--version", callback=_version, is_eager=True, help="Print the version."),
     ] = False,
-    debug: Annotated[bool, typer.Option("--debug", help="Show tracebacks of errors.")] = False,
+    quiet: Annotated[bool, typer.Option("-q", "--quiet", help=GLOBAL_FLAGS["quiet"][1])] = False,
+    verbose: Annotated[
+        bool, typer.Option("-v", "--verbose", help=GLOBAL_FLAGS["verbose"][1])
+    ] = False,
+    debug: Annotated[bool, typer.Option("--debug", help=GLOBAL_FLAGS["debug"][1])] = False,
 ) -> None:
-    _state["debug"] = debug
+    if quiet and verbose:
+        raise typer.BadParameter("give -q/--quiet or -v/--verbose, not both", param_hint="-q")
+    _state.update(quiet=quiet, verbose=verbose, debug=debug)
+
+
+def _hoisted(args: list[str]) -> list[str]:
+    """The command line with the global flags moved before the command, wherever they were
+    given (up to a ``--``), so that ``facade solve x.yaml -q`` is ``facade -q solve
+    x.yaml``."""
+    names = {name for flags, _ in GLOBAL_FLAGS.values() for name in flags}
+    flags: list[str] = []
+    rest: list[str] = []
+    for index, arg in enumerate(args):
+        if arg == "--":
+            rest += args[index:]
+            break
+        (flags if arg in names else rest).append(arg)
+    return flags + rest
+
+
+def _say(text: str) -> None:
+    """A result line (what was written): standard output, unless --quiet."""
+    if not _state["quiet"]:
+        typer.echo(text)
+
+
+def _warn(text: str) -> None:
+    """A warning or a progress line: standard error, unless --quiet."""
+    if not _state["quiet"]:
+        typer.echo(text, err=True)
+
+
+def _detail(text: str) -> None:
+    """More detail: standard error, with --verbose only."""
+    if _state["verbose"]:
+        typer.echo(text, err=True)
 
 
 def _report(error: FacadeError) -> None:
     typer.echo(str(error), err=True)
+
+
+def _load(path: Path) -> Spec:
+    """A spec from its file, or from standard input for ``-`` (named ``<stdin>`` in
+    errors; the files it names are relative to the current folder)."""
+    from facadecli.spec import load_spec, parse_spec
+
+    if str(path) != STDIN:
+        return load_spec(path)
+    raw = sys.stdin.buffer.read(SPEC_BYTES_MAX + 1)
+    if len(raw) > SPEC_BYTES_MAX:
+        raise SpecError.at(
+            STDIN_NAME,
+            None,
+            None,
+            f"the input is longer than specs are limited to ({SPEC_BYTES_MAX:,} bytes)",
+            "a spec is a page of YAML: generate repeated layers with patterns",
+        )
+    return parse_spec(raw, STDIN_NAME, base_dir=Path.cwd())
+
+
+def _shown(path: Path) -> str:
+    """How messages name a spec path: ``<stdin>`` for ``-``."""
+    return STDIN_NAME if str(path) == STDIN else str(path)
+
+
+def _check_stdin(paths: list[Path]) -> None:
+    if sum(str(path) == STDIN for path in paths) > 1:
+        raise typer.BadParameter("standard input (-) can be read once", param_hint="SPEC")
 
 
 class _Run:
@@ -77,15 +164,14 @@ class _Run:
     spec's own code when there is one spec, 1 when some of several failed."""
 
     def __init__(self, paths: list[Path]):
+        _check_stdin(paths)
         self.paths = paths
         self.codes: list[int] = []
 
     def specs(self) -> Iterator[tuple[Path, Spec]]:
-        from facadecli.spec import load_spec
-
         for path in self.paths:
             try:
-                spec = load_spec(path)
+                spec = _load(path)
             except SpecError as error:
                 self.fail(path, error)
                 continue
@@ -93,9 +179,9 @@ class _Run:
 
     def fail(self, path: Path, error: FacadeError) -> None:
         if isinstance(error, InfeasibleError):
-            typer.echo(f"{path}: error: no layout: {error}", err=True)
+            typer.echo(f"{_shown(path)}: error: no layout: {error}", err=True)
         elif isinstance(error, SearchLimitError):
-            typer.echo(f"{path}: error: search stopped: {error}", err=True)
+            typer.echo(f"{_shown(path)}: error: search stopped: {error}", err=True)
         else:
             _report(error)
         self.codes.append(error.exit_code)
@@ -109,12 +195,12 @@ class _Run:
             raise typer.Exit(failed[0] if len(self.paths) == 1 else 1)
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def validate(specs: SpecPaths) -> None:
     """Check specs without solving them; print every problem with file:line:col."""
     run = _Run(specs)
     for path, spec in run.specs():
-        typer.echo(f"{path}: ok ({spec.name}: {len(spec.layers)} layers)")
+        _say(f"{_shown(path)}: ok ({spec.name}: {len(spec.layers)} layers)")
         run.succeed()
     failed = sum(1 for code in run.codes if code)
     if failed:
@@ -134,12 +220,18 @@ def _formats(value: str | None) -> list[str]:
     return names
 
 
-@app.command("solve")
+@app.command("solve", epilog=EPILOG)
 def solve_command(
     specs: SpecPaths,
-    outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
-        "out"
-    ),
+    outdir: Annotated[
+        Path,
+        typer.Option(
+            "--output",
+            "-o",
+            help="Folder for the outputs; - writes the one file of one spec and one "
+            f"format ({','.join(SINGLE_FILE_FORMATS)}) to standard output.",
+        ),
+    ] = Path("out"),
     formats: Annotated[
         str | None,
         typer.Option(
@@ -168,7 +260,11 @@ def solve_command(
     chosen = _formats(formats)
     width = _length(width, "--width")
     height = _length(height, "--height")
-    check_output_folder(outdir)
+    to_stdout = str(outdir) == STDIN
+    if to_stdout:
+        _check_stdout(specs, chosen)
+    else:
+        check_output_folder(outdir)
     run = _Run(specs)
     for path, spec in run.specs():
         try:
@@ -177,18 +273,46 @@ def solve_command(
             run.fail(path, error)
             continue
         for warning in layout.warnings:
-            typer.echo(f"{path}: warning: {warning}", err=True)
+            _warn(f"{_shown(path)}: warning: {warning}")
+        for axis in (layout.x, layout.y):
+            _detail(f"{_shown(path)}: {_axis_detail(axis)}")
         options = OutputOptions(timings, labels, path.parent)
-        written = write_outputs(layout, outdir, chosen, options)
         counters = ", ".join(f"{k}={v}" for k, v in sorted(layout.counters.items()))
-        typer.echo(
-            f"{path}: solved in {layout.time_ms:.1f} ms"
-            + (f" ({counters})" if counters else "")
-            + " -> "
-            + ", ".join(str(p) for p in written)
+        solved = f"{_shown(path)}: solved in {layout.time_ms:.1f} ms" + (
+            f" ({counters})" if counters else ""
         )
+        if to_stdout:
+            write_stream(layout, chosen[0], options, sys.stdout.buffer)
+            sys.stdout.buffer.flush()
+            _warn(f"{solved} -> standard output")  # standard output holds the file
+        else:
+            written = write_outputs(layout, outdir, chosen, options)
+            _say(f"{solved} -> " + ", ".join(str(p) for p in written))
         run.succeed()
     run.finish()
+
+
+def _check_stdout(specs: list[Path], formats: list[str]) -> None:
+    if len(specs) != 1 or len(formats) != 1 or formats[0] not in SINGLE_FILE_FORMATS:
+        raise typer.BadParameter(
+            "- (standard output) takes one spec and one format that is one file: "
+            f"-f {' or -f '.join(SINGLE_FILE_FORMATS)}",
+            param_hint="--output",
+        )
+
+
+def _axis_detail(axis: AxisLayout) -> str:
+    """One line on how an axis was solved: the objective and its proof, the time of each
+    stage, the words chosen (long ones cut)."""
+    proof = "proven" if axis.proven else f"unproven, bound {axis.bound:.6g} m2"
+    stages = ", ".join(
+        f"{stage.removesuffix('_ms')} {ms:.1f} ms" for stage, ms in axis.timings.items()
+    )
+    words = "; ".join(
+        f"{key}: {word if len(word) <= 60 else word[:57] + '...'}"
+        for key, word in sorted(axis.words.items())
+    )
+    return f"{axis.axis} axis: objective {axis.objective:.6g} m2 ({proof}); {stages}; {words}"
 
 
 def _length(value: float | None, option: str) -> float | None:
@@ -217,9 +341,12 @@ def _sizes(text: str | None, option: str) -> list[float | None]:
     return [_length(size, option) for size in sizes]
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def vary(
-    spec_path: Annotated[Path, typer.Argument(help="Spec file (YAML).", metavar="SPEC")],
+    spec_path: Annotated[
+        Path,
+        typer.Argument(help="Spec file (YAML); - reads it from standard input.", metavar="SPEC"),
+    ],
     widths: Annotated[
         str | None, typer.Option("--widths", help="Canvas widths, e.g. 8,10,12 (metres).")
     ] = None,
@@ -245,9 +372,9 @@ def vary(
     check_output_folder(outdir)
     from facadecli.export.contact import Variant, contact_sheet  # only vary draws sheets
     from facadecli.solve import retarget, solve_variants
-    from facadecli.spec import load_spec
 
-    spec = load_spec(spec_path)
+    spec = _load(spec_path)
+    shown = _shown(spec_path)
 
     rows: list[list[Variant]] = []
     failed = 0
@@ -258,16 +385,18 @@ def vary(
                 sized = retarget(spec, width, height, seed)
                 size = (sized.canvas.width, sized.canvas.height)
                 stem = f"{spec.name}-{size[0]:g}x{size[1]:g}"
+                at = f"{size[0]:g} x {size[1]:g} m"
+                if len(width_list) * len(height_list) > 1:  # progress: a line per size
+                    _warn(f"{shown}: {at}: drawing {count} layout{'s' * (count > 1)}...")
                 try:
                     layouts = solve_variants(sized, count)
                 except (InfeasibleError, SearchLimitError) as error:
-                    typer.echo(
-                        f"{spec_path}: {size[0]:g} x {size[1]:g} m: no layout: {error}", err=True
-                    )
+                    typer.echo(f"{shown}: {at}: no layout: {error}", err=True)
                     rows.append([Variant(None, size, sized.solver.seed, 0, "no layout")])
                     failed += 1
                     continue
                 row = []
+                _detail(f"{shown}: {at}: {len(layouts)} different layouts")
                 for index, layout in enumerate(layouts):
                     named = replace(layout, spec=retarget(layout.spec, name=f"{stem}-{index}"))
                     options = OutputOptions(base_dir=spec_path.parent)
@@ -279,17 +408,34 @@ def vary(
                     )
                 rows.append(row)
         write_atomic(stage / "contact-sheet.svg", contact_sheet(rows, spec.name))
-    typer.echo("\n".join([*lines, f"contact sheet: {outdir / 'contact-sheet.svg'}"]))
+    _say("\n".join([*lines, f"contact sheet: {outdir / 'contact-sheet.svg'}"]))
     if failed:
         raise typer.Exit(1)
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def city(
-    manifest: Annotated[Path, typer.Argument(help="City manifest (YAML).", metavar="MANIFEST")],
+    source: Annotated[
+        Path,
+        typer.Argument(
+            help="A city manifest (YAML), or a footprints file to build with the defaults: "
+            "OSM (.osm, .osm.pbf), GeoJSON, GeoPackage (.gpkg), Shapefile, FlatGeobuf.",
+            metavar="MANIFEST|FOOTPRINTS",
+        ),
+    ],
     outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
         "out/city"
     ),
+    spec: Annotated[
+        Path | None,
+        typer.Option(
+            "--spec",
+            metavar="SPEC",
+            help="Without a manifest: the façade spec of every building [default: the "
+            "examples by OSM building tag].",
+            show_default=False,
+        ),
+    ] = None,
     jobs: Annotated[
         int | None, typer.Option("--jobs", "-j", min=1, help="Worker processes.")
     ] = None,
@@ -315,24 +461,39 @@ def city(
         ),
     ] = None,
 ) -> None:
-    """Build every footprint of a city manifest into whole buildings (SPEC 5)."""
+    """Build every footprint of a city manifest, or of a footprints file with sensible
+    defaults, into whole buildings (SPEC 5)."""
     import os
 
+    from facadecli.extras import require
+
+    require("city", "facade city")
+    if scheduler is not None:
+        if not scheduler.startswith(("tcp://", "tls://", "inproc://")):
+            raise SpecError.at(
+                "--scheduler",
+                None,
+                None,
+                f"'{scheduler}' is not a scheduler address",
+                "write tcp://HOST:PORT",
+            )
+        require("dask", "facade city --scheduler")
+    from facadecli.city.default import default_city
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
 
-    if scheduler is not None and not scheduler.startswith(("tcp://", "tls://", "inproc://")):
-        raise SpecError.at(
-            "--scheduler",
-            None,
-            None,
-            f"'{scheduler}' is not a scheduler address",
-            "write tcp://HOST:PORT",
-        )
     box = _bbox(bbox) if bbox is not None else None
-    loaded = load_city(manifest)
+    is_manifest = source.suffix.lower() in (".yaml", ".yml")
+    if is_manifest and spec is not None:
+        raise typer.BadParameter(
+            "is for a footprints file given without a manifest: the manifest names its specs",
+            param_hint="--spec",
+        )
+    loaded = load_city(source) if is_manifest else default_city(source, spec)
     workers = jobs or os.cpu_count() or 1
-    if sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
+    if _state["quiet"]:
+        report = run_city(loaded, outdir, workers, limit, resume, None, scheduler, box, usd)
+    elif sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
         from rich.progress import Progress
 
         with Progress(transient=True) as bar:
@@ -355,12 +516,18 @@ def city(
         where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
         if entry["line"] is None:
             where = f"{loaded.footprints}: features[{entry['feature']}]"
-        typer.echo(f"{where}: rejected: feature '{entry['id']}': {entry['error']}", err=True)
+        _warn(f"{where}: rejected: feature '{entry['id']}': {entry['error']}")
     for entry in report["buildings"]:
         if entry["status"] != "ok":
-            typer.echo(f"{manifest}: building {entry['id']}: {entry['error']}", err=True)
+            typer.echo(f"{source}: building {entry['id']}: {entry['error']}", err=True)
+        else:
+            _detail(
+                f"{source}: building {entry['id']}: {entry.get('facades')} façades, "
+                f"{entry.get('height')} m -> {outdir}/{entry.get('file')} "
+                f"({entry.get('time_ms')} ms)"
+            )
     rejected = f", {summary['rejected']} footprints rejected" if summary["rejected"] else ""
-    typer.echo(
+    _say(
         f"{summary['ok']} of {summary['buildings']} buildings built{rejected} in "
         f"{summary['seconds']} s -> {outdir}/{report['name']}.glb, "
         f"{outdir}/{report['name']}.city.json, {outdir}/{report['name']}.report.json"
@@ -441,7 +608,7 @@ SizeOption = Annotated[
 ]
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def infer(
     layout: LayoutArgument,
     output: Annotated[
@@ -479,10 +646,11 @@ def infer(
     check_output_file(target)
     check_output_file(report_path)
     options = Options(snap=snap, tolerance=tolerance, size=_size(size, "--size") if size else None)
-    inferred = infer_spec(layout, name, options)
+    progress = _progress(str(layout))
+    inferred = infer_spec(layout, name, options, progress)
     spec = parse_spec(inferred.text, str(target))  # a bug if it fails: never the user's input
     if check:
-        inferred.checks = check_spec(inferred, spec)
+        inferred.checks = check_spec(inferred, spec, progress)
     report = inferred.report()
     target.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(target, inferred.text)
@@ -492,18 +660,18 @@ def infer(
         f"{report['rectangles']} rectangles"
     )
     if check and not report.get("solves"):
-        typer.echo(f"{layout}: warning: the spec does not solve: {report.get('error')}", err=True)
+        _warn(f"{layout}: warning: the spec does not solve: {report.get('error')}")
     elif check:
         summary += f", IoU at least {report['iou_min']:.3f}"
         for entry in report["retargets"]:  # type: ignore[attr-defined]
             if not entry["solves"]:
-                typer.echo(
-                    f"{layout}: warning: at {entry['width']:g} m wide: {entry['error']}", err=True
-                )
-    typer.echo(f"{layout}: {summary} -> {target}, {report_path}")
+                _warn(f"{layout}: warning: at {entry['width']:g} m wide: {entry['error']}")
+        for label, iou in sorted(report.get("iou", {}).items()):  # type: ignore[attr-defined]
+            _detail(f"{layout}: IoU of {label}: {iou:.4f}")
+    _say(f"{layout}: {summary} -> {target}, {report_path}")
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def grammar(
     layout: LayoutArgument,
     outdir: Annotated[Path, typer.Option("--output", "-o", help="Folder for the outputs.")] = Path(
@@ -610,7 +778,8 @@ def grammar(
         time_limit=time_limit,
         size=_size(size, "--size") if size else None,
     )
-    extraction = extract_grammar(layout, options)
+    progress = _progress(str(layout))
+    extraction = extract_grammar(layout, options, progress)
     if extraction.problems:  # a bug, never a user's error
         raise RuntimeError(
             "the grammar does not derive its layout: " + "; ".join(extraction.problems)
@@ -618,20 +787,24 @@ def grammar(
     found = extraction.grammar
     name = stem(layout)
     for warning in extraction.warnings:
-        typer.echo(f"{layout}: warning: {warning}", err=True)
+        _warn(f"{layout}: warning: {warning}")
+    _detail(
+        f"{layout}: {len(extraction.tiling.xs) - 1} x {len(extraction.tiling.ys) - 1} tiling, "
+        f"search {extraction.time_ms:.0f} ms"
+    )
     try:  # every size is derived before anything is written
-        derived = derive_sizes(extraction, name, sizes, variations, seed)
+        derived = derive_sizes(extraction, name, sizes, variations, seed, progress)
     except TooLarge as error:
         raise typer.BadParameter(str(error), param_hint="--derive") from None
     outputs = grammar_files(extraction, name, timings, derived)
     for new in derived:
         at = f"{layout}: warning: {new.width:g}x{new.height:g}"
         for note in new.notes:
-            typer.echo(f"{at}: {note}", err=True)
+            _warn(f"{at}: {note}")
         for k, (result, keeps) in enumerate(zip(new.layouts, new.kept, strict=True)):
             which = f" v{k}" if variations > 1 else ""
             for warning in [*result.warnings, *keeps.warnings()]:
-                typer.echo(f"{at}{which}: {warning}", err=True)
+                _warn(f"{at}{which}: {warning}")
     if variations > 1 and derived:
         outputs[f"{name}.variations.svg"] = variations_sheet(derived, name, seed)
     written = [outdir / file for file in outputs]
@@ -642,32 +815,30 @@ def grammar(
             written += [
                 outdir / path.name for path in write_outputs(result, stage, kinds, OutputOptions())
             ]
-    typer.echo(
+    _say(
         f"{layout}: {len(found.rules)} rules, cost {found.cost:.1f} "
         f"(greedy {extraction.found.greedy_cost:.1f}) -> " + ", ".join(str(p) for p in written)
     )
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def schema(
     output: Annotated[
         Path | None,
-        typer.Option("--output", "-o", help="Write to this file instead of standard output."),
+        typer.Option("--output", "-o", help="Write to this file instead of standard output (-)."),
     ] = None,
 ) -> None:
     """Print the JSON Schema of the spec format (point your editor's YAML plugin at it)."""
     from facadecli.spec import spec_schema_text
 
-    if output is not None:
-        check_output_file(output)
-    text = spec_schema_text()
-    if output is None:
-        sys.stdout.write(text)
-    else:
-        write_atomic(output, text)
+    if output is None or str(output) == STDIN:
+        sys.stdout.write(spec_schema_text())
+        return
+    check_output_file(output)
+    write_atomic(output, spec_schema_text())
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def watch(
     spec: Annotated[Path, typer.Argument(help="The spec to preview.", metavar="SPEC")],
     port: Annotated[
@@ -682,7 +853,7 @@ def watch(
     if not spec.is_file():
         raise SpecError.at(str(spec), None, None, "no such file", "check the path")
     try:
-        serve(spec, port, lambda line, error: typer.echo(line, err=error))
+        serve(spec, port, _watch_log())
     except OSError as error:
         raise typer.BadParameter(
             f"cannot serve on port {port}: {error.strerror}", param_hint="--port"
@@ -691,7 +862,24 @@ def watch(
         raise typer.Exit(0) from None
 
 
-@app.command()
+def _watch_log() -> Callable[[str, bool], None]:
+    """The log of ``facade watch``: its first line, the page's address, and errors always
+    (a quiet preview still needs its address), the other lines unless --quiet."""
+    told = {"address": False}
+
+    def log(line: str, error: bool) -> None:
+        if error:
+            typer.echo(line, err=True)
+        elif not told["address"]:
+            told["address"] = True
+            typer.echo(line)
+        else:
+            _say(line)
+
+    return log
+
+
+@app.command(epilog=EPILOG)
 def view(
     folder: Annotated[
         Path,
@@ -713,10 +901,10 @@ def view(
 
     written = write_gallery(folder, output)
     count = len(written.models)
-    typer.echo(f"{count} model{'' if count == 1 else 's'} -> {written.page}")
+    _say(f"{count} model{'' if count == 1 else 's'} -> {written.page}")
 
 
-@app.command()
+@app.command(epilog=EPILOG)
 def words(
     specs: SpecPaths,
     limit: Annotated[int, typer.Option("--limit", "-n", min=1, help="Words per layer axis.")] = 5,
@@ -726,30 +914,86 @@ def words(
 
     run = _Run(specs)
     for path, spec in run.specs():
-        typer.echo(f"# {path} ({spec.name})")
+        _say(f"# {_shown(path)} ({spec.name})")
         for preview in preview_words(spec, limit):
-            typer.echo("\n".join(preview.lines()))
+            _say("\n".join(preview.lines()))
         run.succeed()
     run.finish()
 
 
+@app.command(epilog=EPILOG)
+def examples(
+    folder: Annotated[
+        Path,
+        typer.Argument(help="The folder to copy them into (made if missing).", metavar="DIR"),
+    ],
+) -> None:
+    """Copy the example specs (specs/) and the samples for grammar, infer and city
+    (samples/) into DIR, to start from; nothing already there is overwritten."""
+    from facadecli.examples import copy_examples
+
+    written = copy_examples(folder)
+    for path in written:
+        _detail(str(path))
+    _say(
+        f"{len(written)} files -> {folder / 'specs'}, {folder / 'samples'} "
+        f"(try: facade solve {folder / 'specs' / 'townhouse.yaml'} -o out)"
+    )
+
+
+def _progress(subject: str) -> Callable[[str], None]:
+    """Progress lines on standard error for a run that may take seconds: each stage as it
+    starts (plain lines, safe in logs); with --verbose, the seconds since the start."""
+    started = time.perf_counter()
+
+    def progress(stage: str) -> None:
+        if _state["verbose"]:
+            _warn(f"{subject}: {stage} (at {time.perf_counter() - started:.1f} s)")
+        else:
+            _warn(f"{subject}: {stage}...")
+
+    return progress
+
+
 def main() -> None:
     """Entry point: run the app, turning every error into a message and an exit code."""
+    from facadecli.extras import extra_of, missing_message
+
+    _state.update(debug=False, quiet=False, verbose=False)  # a fresh run (tests call main)
     try:
-        app()  # typer reports usage errors itself (exit 2) and exits
+        args = _hoisted(sys.argv[1:])
+        _state["debug"] = "--debug" in args  # for an error before the options are read
+        app(args=args, prog_name="facade")  # typer reports usage errors itself (exit 2)
     except FacadeError as error:
         _report(error)
         sys.exit(error.exit_code)
     except KeyboardInterrupt:
         typer.echo("interrupted", err=True)
         sys.exit(130)
-    except Exception as error:  # the last line of defence: no traceback for users
-        if _state["debug"]:
-            traceback.print_exc()
+    except ImportError as error:  # an extra's module that went missing past the door
+        extra = extra_of(error.name)
+        if extra is None or _state["debug"]:
+            _internal(error)
         else:
-            typer.echo(
-                f"facade: internal error: {type(error).__name__}: {error} "
-                "(run with --debug for a traceback, and please report it)",
-                err=True,
-            )
-        sys.exit(1)
+            named = next((f"facade {arg}" for arg in sys.argv[1:] if arg in COMMANDS), "facade")
+            typer.echo(missing_message(extra, named, str(error.name)), err=True)
+            sys.exit(2)
+    except Exception as error:  # the last line of defence: no traceback for users
+        _internal(error)
+
+
+COMMANDS = {  # the commands' names, for messages (a command is named after its function)
+    info.name or getattr(info.callback, "__name__", "") for info in app.registered_commands
+}
+
+
+def _internal(error: Exception) -> NoReturn:
+    if _state["debug"]:
+        traceback.print_exc()
+    else:
+        typer.echo(
+            f"facade: internal error: {type(error).__name__}: {error} "
+            "(run with --debug for a traceback, and please report it)",
+            err=True,
+        )
+    sys.exit(1)

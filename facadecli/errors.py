@@ -85,3 +85,11 @@ class OutputError(FacadeError):
     code 1, and nothing of the run is left behind."""
 
     exit_code = 1
+
+
+class MissingExtraError(FacadeError):
+    """A command or option needs an optional part of facadecli that is not installed
+    (exit code 2, as for any input the installation cannot take); the message names the
+    extra and the command that installs it."""
+
+    exit_code = 2

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, BinaryIO
 
 from facadecli.export.atomic import check_output_file, check_output_folder, staged, write_atomic
 
@@ -108,6 +109,8 @@ WRITERS: dict[str, Writer] = {
     "usd": _write_usd,
 }
 DEFAULT_FORMATS = ("glb", "obj", "json", "svg")
+#: the formats that are one file, which can go to a stream (``facade solve -o -``)
+SINGLE_FILE_FORMATS = ("json", "svg", "glb", "html", "usd")
 
 
 def write_outputs(
@@ -121,8 +124,19 @@ def write_outputs(
     return written
 
 
+def write_stream(layout: Layout, name: str, options: OutputOptions, stream: BinaryIO) -> None:
+    """Write a layout in one of ``SINGLE_FILE_FORMATS`` to a binary stream (standard
+    output): the writer writes into a temporary folder, and its one file is copied."""
+    if name not in SINGLE_FILE_FORMATS:
+        raise ValueError(f"{name} is not one file: use one of {', '.join(SINGLE_FILE_FORMATS)}")
+    with tempfile.TemporaryDirectory(prefix="facade-") as folder:
+        (path,) = WRITERS[name](layout, Path(folder), options)
+        stream.write(path.read_bytes())
+
+
 __all__ = [
     "DEFAULT_FORMATS",
+    "SINGLE_FILE_FORMATS",
     "WRITERS",
     "OutputOptions",
     "check_output_file",
@@ -130,4 +144,5 @@ __all__ = [
     "staged",
     "write_atomic",
     "write_outputs",
+    "write_stream",
 ]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import bisect
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
@@ -174,10 +174,20 @@ class Tidied:
     snapped: LabelledLayout  # before regularising: its rectangles in the same order
 
 
-def tidy_layout(path: Path, options: Options, deadline: Deadline) -> Tidied:
+Progress = Callable[[str], None]  # told the name of each stage as it starts
+
+
+def no_progress(stage: str) -> None:
+    """The default ``progress``: stages told to no one."""
+
+
+def tidy_layout(
+    path: Path, options: Options, deadline: Deadline, progress: Progress = no_progress
+) -> Tidied:
     """Read a labelled layout (``options`` checked first), stretch it to ``options.size``,
     snap it and regularise it, with the defaults of its kind (``TIDY``)."""
     check_options(options)
+    progress("reading")
     layout, kind = read_layout(path)
     if not layout.rects:
         raise SpecError.at(str(path), None, None, "no rectangles", "label some elements")
@@ -185,17 +195,28 @@ def tidy_layout(path: Path, options: Options, deadline: Deadline) -> Tidied:
         layout = resize(layout, *options.size)
     snap = options.snap if options.snap is not None else TIDY[kind][0]
     tolerance = options.tolerance if options.tolerance is not None else TIDY[kind][1]
+    progress(f"snapping {len(layout.rects)} rectangles")
     snapped, snapping = snap_and_count(layout, snap, deadline)
     check_cells(path, snapped, snap)
+    progress("regularising")
     regular, regularization = regularize(snapped, tolerance, deadline=deadline)
     return Tidied(regular, snapping, regularization, snapped)
 
 
-def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
+def extract_grammar(
+    path: Path, options: Options = Options(), progress: Progress = no_progress
+) -> Extraction:
+    """The grammar of a labelled layout; ``progress`` is told each stage as it starts."""
     deadline = Deadline(options.time_limit, str(path))
-    tidied = tidy_layout(path, options, deadline)
+    tidied = tidy_layout(path, options, deadline, progress)
     regular, regularization, snapping = tidied.layout, tidied.regularization, tidied.snapping
+    progress("tiling")
     tiling = tile(regular, tolerance=0.0, deadline=deadline)
+    progress(
+        f"searching ({options.method}, {options.iterations} iterations)"
+        if options.method == "adp"
+        else "searching (greedy)"
+    )
     started = time.perf_counter()
     found = extract(
         tiling,
@@ -208,6 +229,7 @@ def extract_grammar(path: Path, options: Options = Options()) -> Extraction:
     )
     elapsed = (time.perf_counter() - started) * 1000
     extraction = Extraction(path.name, regular, tiling, found, regularization, options, elapsed)
+    progress("checking the grammar derives the layout")
     extraction.problems = rederivation_problems(found.grammar, tiling)
     extraction.snapping = snapping
     return extraction
@@ -309,6 +331,7 @@ def derive_sizes(
     sizes: list[tuple[float, float]],
     variations: int = 1,
     seed: int = 0,
+    progress: Progress = no_progress,
 ) -> list[DerivedSize]:
     """The grammar derived at every size, with up to ``variations`` layouts each (raises
     :class:`~facadecli.grammar.variation.TooLarge` for a size too large to derive)."""
@@ -318,6 +341,7 @@ def derive_sizes(
     style = extraction.style
     source = (extraction.tiling.xs[-1], extraction.tiling.ys[-1])
     for width, height in sizes:
+        progress(f"deriving at {width:g}x{height:g}")
         drawn, notes = derive_variations(
             extraction.grammar, extraction.tiling, width, height, name, variations, seed, style
         )

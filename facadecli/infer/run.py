@@ -14,7 +14,7 @@ import numpy as np
 from facadecli.errors import FacadeError, SpecError
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout
-from facadecli.grammar.run import Options, tidy_layout
+from facadecli.grammar.run import Options, Progress, no_progress, tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
 from facadecli.infer.layers import BAND, Grid, grids, to_edges
 from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
@@ -46,13 +46,17 @@ class Inference:
         }
 
 
-def infer(path: Path, name: str, options: Options | None = None) -> Inference:
-    """The spec of a labelled layout (``options``: its size, snap and tolerance)."""
+def infer(
+    path: Path, name: str, options: Options | None = None, progress: Progress = no_progress
+) -> Inference:
+    """The spec of a labelled layout (``options``: its size, snap and tolerance);
+    ``progress`` is told each stage as it starts."""
     options = options or Options()
-    tidied = tidy_layout(path, options, Deadline(options.time_limit, str(path)))
+    tidied = tidy_layout(path, options, Deadline(options.time_limit, str(path)), progress)
     regular = tidied.layout
     if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
+    progress("finding the grids of each label")
     found = [to_edges(grid, regular.width, regular.height) for grid in grids(regular)]
     spread = size_spread(regular, tidied.snapped)
     text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread)
@@ -80,10 +84,11 @@ def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:
     return spread
 
 
-def check(inference: Inference, spec: Spec) -> dict[str, object]:
+def check(inference: Inference, spec: Spec, progress: Progress = no_progress) -> dict[str, object]:
     """Solve the spec at the input's size and at other widths (see the module)."""
     from facadecli.solve import retarget, solve
 
+    progress("checking: solving the spec at the input's size")
     checks: dict[str, object] = {}
     try:
         layout = solve(spec)
@@ -106,6 +111,7 @@ def check(inference: Inference, spec: Spec) -> dict[str, object]:
     for share in WIDTHS:
         width = round(inference.layout.width * share, 4)
         entry: dict[str, object] = {"width": width, "height": inference.layout.height}
+        progress(f"checking: solving it {width:g} m wide")
         try:
             solve(retarget(spec, width, inference.layout.height))
             entry["solves"] = True
