@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 from facadecli.errors import FacadeError
 from facadecli.patterns import Enumerated, format_word
-from facadecli.solver.axis import CANDIDATE_LIMIT, axis_words, solve_axis
+from facadecli.solver.axis import axis_words, solve_axis
+from facadecli.solver.budgets import CANDIDATE_LIMIT
 from facadecli.solver.candidates import generate_candidates, pattern_uses
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import AXES, Axis

@@ -19,8 +19,30 @@ from facadecli.solver.alignment import (
     _Row,
     align,
 )
-from facadecli.solver.candidates import (
+from facadecli.solver.budgets import (
+    CANDIDATE_LIMIT,
+    CANDIDATES_TO_TRY,
+    CONSTRUCTIONS,
+    DEEPENING,
+    EFFORT_FACTOR,
+    EFFORT_FLOOR,
+    EXACT_SHARE,
+    EXACT_WORK,
+    FEASIBLE_TO_COMPARE,
+    FITTED,
+    HEURISTIC_WORK,
     MAX_LETTERS,
+    NEAR_CANVAS,
+    NEAR_EQUAL,
+    REPAIRS,
+    SWEEPS,
+    TIE,
+    TIE_SHARE,
+    TIER,
+    TRIED,
+    VARIANTS,
+)
+from facadecli.solver.candidates import (
     Candidate,
     CandidateSpace,
     PatternUse,
@@ -37,30 +59,6 @@ from facadecli.solver.rows import (
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import Axis, layer_pattern
 
-EXACT_WORK = 40_000  # work units of the exact searches of one axis (see solver.exact)
-HEURISTIC_WORK = 5_000  # search states of the heuristic alignment per axis
-EXACT_SHARE = 16_000  # work units at most of one candidate's search in one pass
-TIE_SHARE = 500  # ... and of a search for a layout that can only tie with the best
-# objectives (m^2) the passes of the exact search look within, the last one without limit
-DEEPENING = (0.05, 0.2, 0.8, 3.2, 12.8, 51.2, INF)
-CANDIDATE_LIMIT = 500  # candidates generated per axis (more are not looked at)
-FEASIBLE_TO_COMPARE = 6  # candidates that align, compared by the sizing objective
-EFFORT_FLOOR = 2000  # search states any candidate may use once one has aligned
-EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
-TIE = 1e-11  # objectives this close, relative to the canvas squared (and never less than
-# TIE m^2), are equally good: numerical noise (SPEC 2.7: 4.5e-8 m^2 on a 67 m façade, where
-# an element 0.2 mm off its size already counts); its tie-breaks decide among them
-CONSTRUCTIONS = 16  # candidates laid out by construction, least bound first, until one fits
-VARIANTS = 48  # options of a cluster of patterns tried in place of the best layout's
-FITTED = 2000  # options of a cluster tried for a fit to the rows at the back (cheap tests)
-SWEEPS = 2  # passes over the clusters while a variant improves the best layout
-TRIED = 3  # of a cluster's options that fit, those laid out (least covering first)
-NEAR_CANVAS = 1e-9  # a word this close to the canvas (relative) fits it at preferred sizes
-REPAIRS = 3  # passes fitting the clusters to the backs, those in conflict first
-NEAR_EQUAL = 0.05  # m^2 of squared deviation: alternatives this close to the best are offered
-TIER = 0.01  # candidates needing up to this share of the canvas more than the first that
-# aligns (in tolerance, or in room made by opaque letters) still compete with it
-CANDIDATES_TO_TRY = 200
 PRECISION = 6  # decimals of metres kept in the layout (micrometres)
 # a symbol solved this far from its preferred size is a warning: more than this share of
 # it and more than this length (4 cm on a 30 cm string course is no news)
@@ -288,242 +286,291 @@ def solve_axis_alternatives(
     (:mod:`facadecli.solver.exact`) looks, candidate by candidate, for better layouts and
     proves that none exists; the heuristic alignment offers variations and is a last
     resort. Each layout says whether it is proven optimal, and the best lower bound found.
-    Every budget is counted in work, so the answer does not depend on the machine;
-    ``deadline`` (wall clock) is only a safety net, and when it fires the layout says so.
+    Every budget is counted in work (:mod:`facadecli.solver.budgets`), so the answer does
+    not depend on the machine; ``deadline`` (wall clock) is only a safety net, and when it
+    fires the layout says so.
 
     Raises :class:`InfeasibleError` when no layout exists (proven), and
     :class:`SearchLimitError` when the search stopped before it found one."""
-    started = time.perf_counter()
-    uses = pattern_uses(spec, axis_words(spec, axis))
-    space = CandidateSpace.of(spec, uses, canvas)
-    leading = [] if space is None else space.best(CONSTRUCTIONS)
-    if space is None or not leading:  # within the caps on words: not a proof
-        raise SearchLimitError(_no_candidate_reason(axis, canvas))
-    tie = tie_window(canvas)
-    memory = _SearchMemory(full_layers(spec, axis))
-    # a perfect layout of the first candidates, by construction, is optimal: then no
-    # other candidate is made (nor searched)
-    perfect_built: list[_Evaluated] = []
-    if alternatives == 1:
-        built = _constructions(spec, uses, space, leading, canvas, memory, tie)
-        perfect_built = [e for e in built if e.estimate.objective <= tie]
-    candidates = [] if perfect_built else space.best(CANDIDATE_LIMIT)
-    generated = time.perf_counter()
-    tolerance = spec.solver.tolerance
-    shared = _relaxations(spec, uses, candidates, memory.full)
-    budget = exact.Budget(EXACT_WORK, deadline)
-    evaluated: list[_Evaluated] = []
-    failures: list[str] = []
-    # candidates beyond the list, or cut by a cap, are unseen
-    truncated = space.truncated or len(candidates) >= CANDIDATE_LIMIT
-    unproven = truncated
-    timed_out = False
-    tried = 0
-    step = max(tolerance, TIER * canvas)
-    effort = MAX_NODES  # once something aligned, a candidate that needs far more search
-    worse = 0  # than it did is not pursued; nor are candidates once two in a row did worse
-    compare = max(FEASIBLE_TO_COMPARE, alternatives)
-    # what is known of each candidate's objective beyond its bound: none within this
-    above: dict[int, float] = {}
+    problem = _AxisProblem(spec, axis, canvas, deadline, alternatives)
+    if alternatives > 1:  # variations: layouts near the best, as the heuristic meets them
+        problem.heuristic_pass()
+    problem.construct()
+    problem.search()
+    return problem.layouts()
 
-    def relaxation(candidate: Candidate) -> _CoreKey | None:
-        return shared.get(candidate.order)
 
-    def ruled_out(candidate: Candidate, target: float) -> str | None:
+class _AxisProblem:
+    """One axis of a spec being solved: its patterns' uses, candidates and their bounds,
+    the layouts found (incumbents), the work spent and what is proven. The stages are its
+    methods, in the order :func:`solve_axis_alternatives` calls them."""
+
+    def __init__(
+        self, spec: Spec, axis: Axis, canvas: float, deadline: float, alternatives: int
+    ) -> None:
+        self.started = time.perf_counter()
+        self.spec, self.axis, self.canvas = spec, axis, canvas
+        self.deadline, self.alternatives = deadline, alternatives
+        self.uses = pattern_uses(spec, axis_words(spec, axis))
+        space = CandidateSpace.of(spec, self.uses, canvas)
+        leading = [] if space is None else space.best(CONSTRUCTIONS)
+        if space is None or not leading:  # within the caps on words: not a proof
+            raise SearchLimitError(_no_candidate_reason(axis, canvas))
+        self.space = space
+        self.tie = tie_window(canvas)
+        self.memory = _SearchMemory(full_layers(spec, axis))
+        self.evaluated: list[_Evaluated] = []
+        # a perfect layout of the first candidates, by construction, is optimal: then no
+        # other candidate is made (nor searched)
+        self.perfect_built: list[_Evaluated] = []
+        if alternatives == 1:
+            built = _constructions(spec, self.uses, space, leading, canvas, self.memory, self.tie)
+            self.perfect_built = [e for e in built if e.estimate.objective <= self.tie]
+        self.candidates = [] if self.perfect_built else space.best(CANDIDATE_LIMIT)
+        self.generated = time.perf_counter()
+        self.shared = _relaxations(spec, self.uses, self.candidates, self.memory.full)
+        self.budget = exact.Budget(EXACT_WORK, deadline)
+        self.failures: list[str] = []
+        # candidates beyond the list, or cut by a cap, are unseen
+        self.truncated = space.truncated or len(self.candidates) >= CANDIDATE_LIMIT
+        self.unproven = self.truncated
+        self.timed_out = False
+        self.tried = 0
+        self.step = max(spec.solver.tolerance, TIER * canvas)
+        # once something aligned, a candidate that needs far more search than it did is
+        # not pursued; nor are candidates once two in a row did worse
+        self.effort = MAX_NODES
+        self.worse = 0
+        self.compare = max(FEASIBLE_TO_COMPARE, alternatives)
+        # what is known of each candidate's objective beyond its bound: none within this
+        self.above: dict[int, float] = {}
+        self.visited: list[int] = []  # search states of each heuristic alignment
+        self.heuristic_done = alternatives > 1
+        self.bounds = _InBoundOrder(
+            self.candidates,
+            lambda c: _candidate_bound(spec, self.uses, c, canvas, self.memory),
+            _least_bounds(self.uses, canvas, self.memory.full),
+        )
+        self.perfect = False
+
+    def best_objective(self) -> float:
+        return min((e.estimate.objective for e in self.evaluated), default=INF)
+
+    def _spent(self, share: exact.Budget) -> None:
+        self.budget.used += share.used
+        self.timed_out = self.timed_out or share.timed_out
+
+    def ruled_out(self, candidate: Candidate, target: float) -> str | None:
         """Why the candidate has no layout within ``target``, when a relaxation of it has
         none: known, or searched for (once a candidate sharing it had none) when it may
         have none; None when that is not known."""
-        nonlocal timed_out
-        key = relaxation(candidate)
-        core = None if key is None else memory.cores.get(key)
+        key = self.shared.get(candidate.order)
+        core = None if key is None else self.memory.cores.get(key)
         if key is None or core is None:
             return None
         if target <= core.none_within:
             return core.reason
         if core.failed and target < core.reached:
-            share = exact.Budget(min(budget.left, EXACT_SHARE), deadline)
-            rows = _relaxed_rows(spec, uses, candidate, key[0], memory)
-            found = not rows or exact.reaches(spec, rows, canvas, share, target, memory.prepared)
-            budget.used += share.used
-            timed_out = timed_out or share.timed_out
+            share = exact.Budget(min(self.budget.left, EXACT_SHARE), self.deadline)
+            rows = _relaxed_rows(self.spec, self.uses, candidate, key[0], self.memory)
+            found = not rows or exact.reaches(
+                self.spec, rows, self.canvas, share, target, self.memory.prepared
+            )
+            self._spent(share)
             if not found:
                 core.none_within = target
                 return core.reason
             core.reached = target
         return None
 
-    def search_exactly(candidate: Candidate, target: float, tie: bool) -> None:
+    def search_exactly(self, candidate: Candidate, target: float, tie: bool) -> None:
         """Search a candidate exactly for a layout with an objective at most ``target``;
         ``tie``: it cannot beat the best found, only tie with it: a search for the
         tie-breaks, which ends at its first layout (the least bound first, so the
         candidate's best as a rule) or after a little work, and proves nothing."""
-        nonlocal unproven, timed_out
-        why = ruled_out(candidate, target)
+        above = self.above
+        why = self.ruled_out(candidate, target)
         if why is not None:
-            failures.append(why)
+            self.failures.append(why)
             above[candidate.order] = max(above.get(candidate.order, -INF), target)
             return
-        rows = _candidate_rows(spec, uses, candidate, memory)
-        share = exact.Budget(min(budget.left, TIE_SHARE if tie else EXACT_SHARE), deadline)
-        outcome = exact.align_exactly(
-            spec, rows, canvas, share, target, memory.prepared, first_only=tie
+        rows = _candidate_rows(self.spec, self.uses, candidate, self.memory)
+        share = exact.Budget(
+            min(self.budget.left, TIE_SHARE if tie else EXACT_SHARE), self.deadline
         )
-        budget.used += share.used
-        timed_out = timed_out or share.timed_out
-        unproven = unproven or not (outcome.complete or tie)
+        outcome = exact.align_exactly(
+            self.spec, rows, self.canvas, share, target, self.memory.prepared, first_only=tie
+        )
+        self._spent(share)
+        self.unproven = self.unproven or not (outcome.complete or tie)
+        key = self.shared.get(candidate.order)
         if outcome.found is None:
-            failures.append(outcome.reason)
-            key = relaxation(candidate)
+            self.failures.append(outcome.reason)
             if outcome.complete:
                 above[candidate.order] = max(above.get(candidate.order, -INF), target)
                 if key is not None:  # proven: its relaxation may have none
-                    memory.cores.setdefault(key, _Core(reason=outcome.reason)).failed += 1
+                    core = self.memory.cores.setdefault(key, _Core(reason=outcome.reason))
+                    core.failed += 1
             return
         found = outcome.found
         if outcome.complete and not tie:  # its best is found: nothing of it is left open
             above[candidate.order] = INF
-        key = relaxation(candidate)
         if key is not None:
-            core = memory.cores.setdefault(key, _Core())
+            core = self.memory.cores.setdefault(key, _Core())
             core.reached = min(core.reached, found.sizing.objective)
-        evaluated.append(_Evaluated(candidate, found.groups, found.program, found.sizing))
+        self.evaluated.append(_Evaluated(candidate, found.groups, found.program, found.sizing))
 
-    def align_heuristically(candidate: Candidate, most: int = MAX_NODES) -> float | None:
+    def align_heuristically(self, candidate: Candidate) -> float | None:
         """The heuristic alignment of a candidate, sized: its objective, None if none."""
-        nonlocal tried, timed_out, effort
-        tried += 1
-        nodes = min(effort, most)
-        attempt = _align_candidate(spec, uses, candidate, canvas, deadline, nodes, memory)
-        visited.append(attempt.nodes)
-        timed_out = timed_out or attempt.timed_out
+        self.tried += 1
+        attempt = _align_candidate(
+            self.spec, self.uses, candidate, self.canvas, self.deadline, self.effort, self.memory
+        )
+        self.visited.append(attempt.nodes)
+        self.timed_out = self.timed_out or attempt.timed_out
         if attempt.groups is None:
             return None
-        program = sizing.build_program(spec, attempt.groups, canvas)
+        program = sizing.build_program(self.spec, attempt.groups, self.canvas)
         estimate = sizing.search_solve(program)
         if estimate is None:
             return None
-        finest = columns.finest(spec, canvas, attempt.groups, program, estimate)
-        evaluated.append(_Evaluated(candidate, *finest))
-        effort = min(effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
+        finest = columns.finest(self.spec, self.canvas, attempt.groups, program, estimate)
+        self.evaluated.append(_Evaluated(candidate, *finest))
+        self.effort = min(self.effort, max(EFFORT_FLOOR, EFFORT_FACTOR * attempt.nodes))
         return estimate.objective
 
-    def best_objective() -> float:
-        return min((e.estimate.objective for e in evaluated), default=INF)
-
-    def heuristic_pass() -> None:
+    def heuristic_pass(self) -> None:
         """The heuristic alignment, candidates in the order of the tolerance they need: the
         tolerance is raised only until something aligns (the paper's order and ties)."""
-        nonlocal timed_out, worse
-        visited.clear()
-        for candidate in candidates[:CANDIDATES_TO_TRY]:
-            if sum(visited) > HEURISTIC_WORK:
+        self.visited.clear()
+        evaluated = self.evaluated
+        for candidate in self.candidates[:CANDIDATES_TO_TRY]:
+            if sum(self.visited) > HEURISTIC_WORK:
                 break
-            if len(evaluated) >= compare or worse >= 2 or time.perf_counter() > deadline:
-                timed_out = timed_out or time.perf_counter() > deadline
+            late = time.perf_counter() > self.deadline
+            if len(evaluated) >= self.compare or self.worse >= 2 or late:
+                self.timed_out = self.timed_out or late
                 break
-            if alternatives == 1 and evaluated:
+            if self.alternatives == 1 and evaluated:
                 break
-            if evaluated and _beyond_tier(candidate, evaluated[0].candidate, step):
+            if evaluated and _beyond_tier(candidate, evaluated[0].candidate, self.step):
                 break
-            before = best_objective()
-            objective = align_heuristically(candidate)
+            before = self.best_objective()
+            objective = self.align_heuristically(candidate)
             if objective is None:
-                worse += 1 if evaluated else 0
+                self.worse += 1 if evaluated else 0
             else:
-                worse = worse + 1 if before < INF and objective > before + 1e-9 else 0
+                worse = before < INF and objective > before + 1e-9
+                self.worse = self.worse + 1 if worse else 0
 
-    visited: list[int] = []  # search states of each heuristic alignment
-    if alternatives > 1:  # variations: layouts near the best, as the heuristic meets them
-        heuristic_pass()
-    bounds = _InBoundOrder(
-        candidates,
-        lambda c: _candidate_bound(spec, uses, c, canvas, memory),
-        _least_bounds(uses, canvas, memory.full),
-    )
-    # primal first: candidates laid out by construction, least bound first, then each
-    # cluster of patterns' other options in place of the best one's (a layer's words
-    # chosen given the others); a candidate whose layout meets its bound needs no search
-    built = perfect_built or _constructions(spec, uses, space, candidates, canvas, memory, tie)
-    evaluated.extend(built)
-    for e in built:
-        if e.estimate.objective <= memory.bounds.get(e.candidate.order, -INF) + tie:
-            above[e.candidate.order] = INF
-    # the exact search, in passes (the paper's iterative deepening, on the exact
-    # objective): a pass searches every candidate whose lower bound is within its
-    # threshold for a layout within it, in the order of those bounds, and ends the solve
-    # once the best layout found is within it: nothing better can exist. Low thresholds cut
-    # hopeless columns at once, so the first passes are cheap.
-    heuristic_done = alternatives > 1
-    # a layout at objective 0 is optimal: no candidate can beat it (only tie, and the
-    # constructions chose among those)
-    perfect = alternatives == 1 and best_objective() <= tie
-    for threshold in () if perfect else DEEPENING:
-        failures.clear()  # each pass searches again every candidate it reaches: the last
-        unproven = truncated  # one run says what is proven
-        for bound, _, candidate in bounds:
-            # ties too (SPEC 2.7 breaks them); for variations, layouts near the best
-            target = min(threshold, best_objective() + (NEAR_EQUAL if alternatives > 1 else tie))
-            if timed_out or bound > target:
-                break
-            if above.get(candidate.order, -INF) >= target:
-                continue  # its best is known, or it has none within the target
-            if budget.left == 0:
-                unproven = True
-                break
-            search_exactly(candidate, target, bound > best_objective() - tie)
-        if timed_out or budget.left == 0 or best_objective() <= threshold:
-            break
-        if not evaluated and not heuristic_done and unproven:
-            # nothing within the threshold, and the search ran out of work before it proved
-            # so: the heuristic's layout, if it finds one, bounds the next passes (they then
-            # only look for better ones). A proof needs no such help: the next pass's own
-            # threshold bounds it as well (the heuristic took a fifth of the 60-bay palace)
-            heuristic_done = True
-            heuristic_pass()
-    if not evaluated and unproven and not timed_out and not heuristic_done:
-        heuristic_pass()  # the exact search ran out of work: the heuristic may still align
-    aligned_at = time.perf_counter()
-    if perfect:
-        lower = 0.0
-    elif evaluated:
-        lower = _lower_bound(bounds, above, best_objective(), tie, truncated, space.beyond)
-    else:
-        lower = 0.0
-    ranked = _by_rank(evaluated, tie)
-    layouts: list[AxisLayout] = []
-    first: float | None = None
-    for choice in ranked:
-        if first is not None and (
-            len(layouts) >= alternatives or choice.estimate.objective > first + NEAR_EQUAL
-        ):
-            break
-        final = sizing.exact(choice.program)
-        if final is None:
-            failures.append(sizing.explain_infeasible(choice.program))
-            continue
-        first = final.objective if first is None else first
-        layouts.append(
-            _finish(spec, axis, canvas, choice, final, uses, timed_out, min(lower, first), tie)
+    def construct(self) -> None:
+        """Primal first: candidates laid out by construction, least bound first, then each
+        cluster of patterns' other options in place of the best one's (a layer's words
+        chosen given the others); a candidate whose layout meets its bound needs no
+        search."""
+        built = self.perfect_built or _constructions(
+            self.spec, self.uses, self.space, self.candidates, self.canvas, self.memory, self.tie
         )
-    if not layouts:
-        if timed_out:
-            raise SearchLimitError(
-                f"{axis} axis: the time limit ({spec.solver.time_limit:g} s) was reached "
-                "before any layout was found; raise solver.time_limit"
+        self.evaluated.extend(built)
+        for e in built:
+            if e.estimate.objective <= self.memory.bounds.get(e.candidate.order, -INF) + self.tie:
+                self.above[e.candidate.order] = INF
+        # a layout at objective 0 is optimal: no candidate can beat it (only tie, and the
+        # constructions chose among those)
+        self.perfect = self.alternatives == 1 and self.best_objective() <= self.tie
+
+    def search(self) -> None:
+        """The exact search, in passes (the paper's iterative deepening, on the exact
+        objective): a pass searches every candidate whose lower bound is within its
+        threshold for a layout within it, in the order of those bounds, and ends the solve
+        once the best layout found is within it: nothing better can exist. Low thresholds
+        cut hopeless columns at once, so the first passes are cheap."""
+        near = NEAR_EQUAL if self.alternatives > 1 else self.tie
+        for threshold in () if self.perfect else DEEPENING:
+            self.failures.clear()  # each pass searches again every candidate it reaches:
+            self.unproven = self.truncated  # the last one run says what is proven
+            for bound, _, candidate in self.bounds:
+                # ties too (SPEC 2.7 breaks them); for variations, layouts near the best
+                target = min(threshold, self.best_objective() + near)
+                if self.timed_out or bound > target:
+                    break
+                if self.above.get(candidate.order, -INF) >= target:
+                    continue  # its best is known, or it has none within the target
+                if self.budget.left == 0:
+                    self.unproven = True
+                    break
+                self.search_exactly(candidate, target, bound > self.best_objective() - self.tie)
+            if self.timed_out or self.budget.left == 0 or self.best_objective() <= threshold:
+                break
+            if not self.evaluated and not self.heuristic_done and self.unproven:
+                # nothing within the threshold, and the search ran out of work before it
+                # proved so: the heuristic's layout, if it finds one, bounds the next
+                # passes (they then only look for better ones). A proof needs no such
+                # help: the next pass's own threshold bounds it as well
+                self.heuristic_done = True
+                self.heuristic_pass()
+        if not self.evaluated and self.unproven and not self.timed_out and not self.heuristic_done:
+            self.heuristic_pass()  # the exact search ran out of work: the heuristic may align
+
+    def layouts(self) -> list[AxisLayout]:
+        """The layouts found, best first (SPEC 2.7), sized exactly, each with what is
+        proven of it."""
+        aligned_at = time.perf_counter()
+        if self.perfect or not self.evaluated:
+            lower = 0.0
+        else:
+            lower = _lower_bound(
+                self.bounds,
+                self.above,
+                self.best_objective(),
+                self.tie,
+                self.truncated,
+                self.space.beyond,
             )
-        if unproven:
-            raise SearchLimitError(
-                f"{axis} axis: no layout was found within the search budget "
-                f"({EXACT_WORK:,} work units); a layout may still exist: simplify the "
-                "patterns or fix more counters"
+        layouts: list[AxisLayout] = []
+        first: float | None = None
+        for choice in _by_rank(self.evaluated, self.tie):
+            if first is not None and (
+                len(layouts) >= self.alternatives or choice.estimate.objective > first + NEAR_EQUAL
+            ):
+                break
+            final = sizing.exact(choice.program)
+            if final is None:
+                self.failures.append(sizing.explain_infeasible(choice.program))
+                continue
+            first = final.objective if first is None else first
+            layouts.append(
+                _finish(
+                    self.spec,
+                    self.axis,
+                    self.canvas,
+                    choice,
+                    final,
+                    self.uses,
+                    self.timed_out,
+                    min(lower, first),
+                    self.tie,
+                )
             )
-        raise InfeasibleError(_no_layout_reason(axis, failures))
-    timings = {
-        "candidates_ms": (generated - started) * 1000,
-        "alignment_ms": (aligned_at - generated) * 1000,
-        "sizing_ms": (time.perf_counter() - aligned_at) * 1000,
-    }
-    return [replace(layout, timings=timings, candidates_tried=tried) for layout in layouts]
+        if not layouts:
+            if self.timed_out:
+                raise SearchLimitError(
+                    f"{self.axis} axis: the time limit ({self.spec.solver.time_limit:g} s) "
+                    "was reached before any layout was found; raise solver.time_limit"
+                )
+            if self.unproven:
+                raise SearchLimitError(
+                    f"{self.axis} axis: no layout was found within the search budget "
+                    f"({EXACT_WORK:,} work units); a layout may still exist: simplify the "
+                    "patterns or fix more counters"
+                )
+            raise InfeasibleError(_no_layout_reason(self.axis, self.failures))
+        timings = {
+            "candidates_ms": (self.generated - self.started) * 1000,
+            "alignment_ms": (aligned_at - self.generated) * 1000,
+            "sizing_ms": (time.perf_counter() - aligned_at) * 1000,
+        }
+        return [replace(layout, timings=timings, candidates_tried=self.tried) for layout in layouts]
 
 
 def tie_window(canvas: float) -> float:

@@ -21,12 +21,13 @@ from dataclasses import dataclass, field
 
 from facadecli.patterns import CompiledPattern, Enumerated, enumerate_words
 from facadecli.patterns.ast import Anonymous, Named, Repeat, symbols, walk
+from facadecli.solver.budgets import (
+    FINITE_LETTERS,
+    MAX_LETTERS,
+    OPTIONS_PER_CLUSTER,
+    WORDS_PER_PATTERN,
+)
 from facadecli.spec.model import Spec
-
-WORDS_PER_PATTERN = 4000  # words looked at per pattern
-OPTIONS_PER_CLUSTER = 2000  # joint choices kept per cluster of patterns sharing counters
-MAX_LETTERS = 400  # longest word with a counter considered (longer: the answer is unproven)
-FINITE_LETTERS = 20_000  # longest word of a pattern without counters (all of them are made)
 
 
 @dataclass(frozen=True)

@@ -26,17 +26,15 @@ import numpy as np
 
 from facadecli.solver import columns, sizing
 from facadecli.solver.alignment import Alignment, Move, _Row, prepared_row
+from facadecli.solver.budgets import (
+    FAINT,
+    FITTING_WORK,
+    NEAR,
+    ROUNDS,
+    SNAP,
+)
 from facadecli.solver.rows import Row
 from facadecli.spec.model import Spec
-
-NEAR = 1e-7  # metres (times the canvas, at least 1 m): boundaries this close are one
-# tolerances (shares of the shortest letter) within which boundaries laid at the
-# relaxation's sizes are taken for one cut; the QP then makes them meet
-SNAP = (0.0, 0.1, 0.25, 0.45)
-ROUNDS = 3  # constructions at solved sizes after the first
-# weight of the relaxation's placeholders and gaps: it only makes the optimum unique (a
-# larger one moves the sizes, and so the boundaries the rows are cut at)
-FAINT = 1e-12
 
 
 @dataclass(frozen=True)
@@ -338,9 +336,6 @@ def boundaries(row: Row, lengths: Mapping[str, float]) -> list[float]:
     for letter in row.word:
         x.append(x[-1] + lengths[letter.symbol])
     return x
-
-
-FITTING_WORK = 2000  # letters laid at most while fitting one row's placeholders
 
 
 def _changes(row: Row, k: int) -> bool:
