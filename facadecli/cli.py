@@ -712,8 +712,11 @@ def view(
     from facadecli.viewer.gallery import write_gallery
 
     written = write_gallery(folder, output)
-    count = len(written.models)
-    typer.echo(f"{count} model{'' if count == 1 else 's'} -> {written.page}")
+    for file in written.skipped:
+        typer.echo(f"{file.path}: warning: left out: {file.reason}", err=True)
+    count, left = len(written.models), len(written.skipped)
+    note = f" ({left} file{'' if left == 1 else 's'} left out)" if left else ""
+    typer.echo(f"{count} model{'' if count == 1 else 's'} -> {written.page}{note}")
 
 
 @app.command()
