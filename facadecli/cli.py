@@ -674,15 +674,23 @@ def watch(
         int,
         typer.Option("--port", min=0, max=65535, help="Port on 127.0.0.1 (0: any free one)."),
     ] = 8765,
+    poll: Annotated[
+        bool,
+        typer.Option(
+            "--poll",
+            help="Look at the file 20 times a second instead of waiting for the system's "
+            "file events (for network drives and mounts that send none).",
+        ),
+    ] = False,
 ) -> None:
     """Preview a spec live: solve it again on every save and serve its page (the 3D model
-    and the elevation) on 127.0.0.1, which reloads itself; errors show on the page."""
+    and the elevation) on 127.0.0.1, which the server updates; errors show on the page."""
     from facadecli.viewer.watch import serve
 
     if not spec.is_file():
         raise SpecError.at(str(spec), None, None, "no such file", "check the path")
     try:
-        serve(spec, port, lambda line, error: typer.echo(line, err=error))
+        serve(spec, port, lambda line, error: typer.echo(line, err=error), poll)
     except OSError as error:
         raise typer.BadParameter(
             f"cannot serve on port {port}: {error.strerror}", param_hint="--port"
