@@ -289,6 +289,7 @@ def test_connections_and_event_streams_are_bounded(small: Running) -> None:
     try:
         answer = _ask(port, f"GET /events HTTP/1.1\r\nHost: localhost:{port}\r\n\r\n".encode())
         assert answer.startswith(b"HTTP/1.0 503 "), answer
+        _until(lambda: slots._value == 2, "the refused connection done")  # the stream's
         held = [socket.create_connection(("127.0.0.1", port), timeout=WAIT)]
         _until(lambda: slots._value == 1, "two connections held")
         held.append(socket.create_connection(("127.0.0.1", port), timeout=WAIT))
@@ -300,7 +301,19 @@ def test_connections_and_event_streams_are_bounded(small: Running) -> None:
             client.close()
     finally:
         stream.close()
-    _until(lambda: _state(small.url)["ok"] is True, "a connection again")
+    _until(lambda: _served(lambda: _state(small.url)["ok"] is True), "a connection again")
+    _until(
+        lambda: _served(lambda: Events(port, since=1).head.startswith(b"HTTP/1.0 200 ")),
+        "a stream again",
+    )
+
+
+def _served(check: Callable[[], bool]) -> bool:
+    """``check()``, False when the connection was closed before an answer (all in use)."""
+    try:
+        return check()
+    except (OSError, AssertionError):
+        return False
 
 
 def test_a_spec_that_is_no_file_or_too_long_is_an_error_on_the_page(

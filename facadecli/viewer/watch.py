@@ -25,6 +25,8 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
+import select
+import socket
 import socketserver
 import sys
 import threading
@@ -47,6 +49,7 @@ from facadecli.limits import (
 from facadecli.viewer.saves import Saves, watch_saves
 
 KEEP_ALIVE = 5.0  # seconds between comments on a quiet event stream (a gone page shows)
+LOOK = 0.5  # seconds between looks at whether a quiet stream's page closed it
 RETRY_MS = 1000  # how soon a page's event stream connects again after losing the server
 WAIT = 0.2  # seconds between the serving loop's looks at whether it should stop
 
@@ -57,9 +60,17 @@ LIVE = """
 background:#7a1d1d;color:#fff;font:13px monospace;white-space:pre-wrap;z-index:9"></div>
 <script>
 (function () {
-  var banner = document.getElementById('watch-error');
-  var events = new EventSource('/events?since=VERSION');
-  events.addEventListener('layout', function (event) {
+  var box = document.getElementById('watch-error');
+  var shown = VERSION, events;
+  function follow() {  // a stream closed for good (a 503: too many pages) is opened again
+    events = new EventSource('/events?since=' + shown);
+    events.addEventListener('layout', swap);
+    events.addEventListener('state', banner);
+    events.onerror = function () {
+      if (events.readyState === EventSource.CLOSED) setTimeout(follow, 3000);
+    };
+  }
+  function swap(event) {
     var layout = JSON.parse(event.data);
     var model = document.getElementById('glb');
     if (!model || !window.facadeShow) { location.reload(); return; }
@@ -67,13 +78,15 @@ background:#7a1d1d;color:#fff;font:13px monospace;white-space:pre-wrap;z-index:9
     var old = document.querySelector('#side svg');
     if (old) old.outerHTML = layout.svg;
     window.facadeShow('glb', true);
+    shown = layout.version;
     document.documentElement.dataset.version = layout.version;
-  });
-  events.addEventListener('state', function (event) {
+  }
+  function banner(event) {
     var state = JSON.parse(event.data);
-    banner.style.display = state.error ? 'block' : 'none';
-    banner.textContent = state.error || '';
-  });
+    box.style.display = state.error ? 'block' : 'none';
+    box.textContent = state.error || '';
+  }
+  follow();
 })();
 </script>
 """
@@ -341,18 +354,23 @@ def _handler(preview: Preview) -> type[BaseHTTPRequestHandler]:
                 shown = self._since()
                 self._head(200, "text/event-stream", None)
                 self.wfile.write(f"retry: {RETRY_MS}\n\n".encode())
-                serial = -1
+                serial, spoke = -1, time.monotonic()
                 while True:
                     with preview.changed:
-                        preview.changed.wait_for(partial(preview.moved, serial), KEEP_ALIVE)
+                        preview.changed.wait_for(partial(preview.moved, serial), LOOK)
                         if preview.closing:
                             return
                         quiet, serial = preview.serial == serial, preview.serial
                         state, version = preview.state(), preview.version
                         glb, svg = preview.glb, preview.svg
                     if quiet:
-                        self.wfile.write(b": still here\n\n")
+                        if self._gone():  # its slot is free for the page's next stream
+                            return
+                        if time.monotonic() - spoke > KEEP_ALIVE:
+                            self.wfile.write(b": still here\n\n")
+                            spoke = time.monotonic()
                         continue
+                    spoke = time.monotonic()
                     message = b""
                     if version != shown and glb:
                         shown = version
@@ -361,6 +379,17 @@ def _handler(preview: Preview) -> type[BaseHTTPRequestHandler]:
                     self.wfile.write(message + _event("state", state))
             finally:
                 self.server.streams.release()
+
+        def _gone(self) -> bool:
+            """Whether the client closed the stream (a page sends nothing after its
+            request, so an end to read means it went)."""
+            readable, _, _ = select.select([self.connection], [], [], 0)
+            if not readable:
+                return False
+            try:
+                return bool(self.connection.recv(1, socket.MSG_PEEK) == b"")
+            except OSError:
+                return True
 
         def log_message(self, format: str, *args: object) -> None:  # quiet
             return
