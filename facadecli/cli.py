@@ -688,7 +688,8 @@ def watch(
     from facadecli.viewer.watch import serve
 
     if not spec.is_file():
-        raise SpecError.at(str(spec), None, None, "no such file", "check the path")
+        what = "not a regular file" if spec.exists() else "no such file"
+        raise SpecError.at(str(spec), None, None, what, "check the path")
     try:
         serve(spec, port, lambda line, error: typer.echo(line, err=error), poll)
     except OSError as error:

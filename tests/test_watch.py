@@ -236,6 +236,9 @@ def test_only_requests_for_this_machine_are_answered(running: tuple[Path, Runnin
             answer = _ask(port, request.replace("/state", path).encode())
             assert answer.startswith(b"HTTP/1.0 403 "), (hosts, path, answer[:200])
             assert b"version" not in answer and b"glTF" not in answer
+    for line in ("GET /state", "GET /state HTTP/0.9"):  # HTTP/0.9: refused, with a status
+        answer = _ask(port, f"{line}\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode())
+        assert answer.startswith(b"HTTP/1.0 400 "), (line, answer)
     assert served.reports == []
 
 

@@ -186,10 +186,10 @@ class Preview:
             return self._change(
                 error=f"{self.spec}: internal error: {type(error).__name__}: {error}"
             )
-        self._change(page=page, glb=glb, svg=svg, error="", version=self.version + 1)
-        with self.changed:
-            self.solved_ms = (time.perf_counter() - started) * 1000
-        return True
+        solved_ms = (time.perf_counter() - started) * 1000
+        return self._change(
+            page=page, glb=glb, svg=svg, error="", version=self.version + 1, solved_ms=solved_ms
+        )
 
     def moved(self, serial: int) -> bool:
         """Whether anything changed since ``serial`` (or the preview is closing)."""
@@ -298,8 +298,9 @@ def _handler(preview: Preview) -> type[BaseHTTPRequestHandler]:
         def parse_request(self) -> bool:
             if not super().parse_request():
                 return False
-            if len(self.requestline.split()) < 3 or self.request_version < "HTTP/1.0":
-                self.request_version = "HTTP/1.0"  # HTTP/0.9: answered as 1.0, refused
+            major = self.request_version.partition("/")[2].partition(".")[0]
+            if len(self.requestline.split()) < 3 or int(major) < 1:
+                self.request_version = "HTTP/1.0"  # HTTP/0.9 or 0.x: refused
                 self.send_error(400, "Bad request: HTTP/1.0 or 1.1 only")
                 return False
             hosts = self.headers.get_all("Host") or []
@@ -307,6 +308,13 @@ def _handler(preview: Preview) -> type[BaseHTTPRequestHandler]:
                 self.send_error(403, "Forbidden: ask for http://127.0.0.1:PORT/")
                 return False
             return True
+
+        def send_error(
+            self, code: int, message: str | None = None, explain: str | None = None
+        ) -> None:
+            if self.request_version == "HTTP/0.9":  # not a bare body: every answer has a status
+                self.request_version = "HTTP/1.0"
+            super().send_error(code, message, explain)
 
         def do_GET(self) -> None:
             path = self.path.split("?", 1)[0]
