@@ -486,3 +486,27 @@ def test_a_browser_page_follows_the_saves(running: tuple[Path, Running], tmp_pat
         assert status == "drag to orbit, scroll to zoom"
 
     _in_browser(served.url, tmp_path / "profile", steps)
+
+
+def test_a_spec_that_is_a_link_follows_the_file_it_names(tmp_path: Path) -> None:
+    (tmp_path / "real").mkdir()
+    (tmp_path / "work").mkdir()
+    real = tmp_path / "real" / "house.yaml"
+    real.write_text((ROOT / "specs" / "residential-house.yaml").read_text())
+    spec = tmp_path / "work" / "house.yaml"
+    spec.symlink_to(real)
+    served = Running(spec)
+    try:
+        _until(lambda: _state(served.url)["version"] == 1, "first layout")
+        real.write_text(_wider(real.read_text(), 8.5))  # saved where the file is
+        _until(lambda: _state(served.url)["version"] == 2, "a save of the linked file")
+        other = tmp_path / "real" / "other.yaml"
+        other.write_text(_wider(real.read_text(), 9.5))
+        fresh = tmp_path / "work" / ".link"
+        fresh.symlink_to(other)
+        os.replace(fresh, spec)  # the link now names another file
+        _until(lambda: _state(served.url)["version"] == 3, "the newly linked file")
+        other.write_text(_wider(other.read_text(), 7.5))
+        _until(lambda: _state(served.url)["version"] == 4, "a save of that file")
+    finally:
+        served.close()
