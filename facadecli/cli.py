@@ -845,15 +845,24 @@ def watch(
         int,
         typer.Option("--port", min=0, max=65535, help="Port on 127.0.0.1 (0: any free one)."),
     ] = 8765,
+    poll: Annotated[
+        bool,
+        typer.Option(
+            "--poll",
+            help="Look at the file 20 times a second instead of waiting for the system's "
+            "file events (for network drives and mounts that send none).",
+        ),
+    ] = False,
 ) -> None:
     """Preview a spec live: solve it again on every save and serve its page (the 3D model
-    and the elevation) on 127.0.0.1, which reloads itself; errors show on the page."""
+    and the elevation) on 127.0.0.1, which the server updates; errors show on the page."""
     from facadecli.viewer.watch import serve
 
     if not spec.is_file():
-        raise SpecError.at(str(spec), None, None, "no such file", "check the path")
+        what = "not a regular file" if spec.exists() else "no such file"
+        raise SpecError.at(str(spec), None, None, what, "check the path")
     try:
-        serve(spec, port, _watch_log())
+        serve(spec, port, _watch_log(), poll)
     except OSError as error:
         raise typer.BadParameter(
             f"cannot serve on port {port}: {error.strerror}", param_hint="--port"
@@ -900,8 +909,11 @@ def view(
     from facadecli.viewer.gallery import write_gallery
 
     written = write_gallery(folder, output)
-    count = len(written.models)
-    _say(f"{count} model{'' if count == 1 else 's'} -> {written.page}")
+    for file in written.skipped:
+        _warn(f"{file.path}: warning: left out: {file.reason}")
+    count, left = len(written.models), len(written.skipped)
+    note = f" ({left} file{'' if left == 1 else 's'} left out)" if left else ""
+    _say(f"{count} model{'' if count == 1 else 's'} -> {written.page}{note}")
 
 
 @app.command(epilog=EPILOG)

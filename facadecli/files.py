@@ -3,7 +3,11 @@ a bad byte. Shared by the spec, GeoJSON and layout readers."""
 
 from __future__ import annotations
 
+import errno
+import os
+import stat
 from pathlib import Path
+from typing import BinaryIO
 
 from facadecli.errors import SpecError
 
@@ -13,14 +17,40 @@ CHUNK = 1 << 20  # bytes read at a time
 def read_at_most(path: Path, limit: int) -> bytes | None:
     """The file's bytes, or None when it holds more than ``limit``: at most one byte past
     the limit is read (a device such as /dev/zero never ends). OSError propagates."""
+    with path.open("rb") as handle:
+        return _read_handle(handle, limit)
+
+
+class NotRegularFile(OSError):
+    """The path names a device, a pipe, a socket or a folder, not a file of bytes."""
+
+
+def read_regular_at_most(
+    path: Path, limit: int, follow_links: bool = True
+) -> tuple[bytes | None, os.stat_result]:
+    """Like :func:`read_at_most` for a regular file only (NotRegularFile otherwise, before
+    reading a byte: a pipe would wait for a writer, a device never end), with the file's
+    status when it was opened; ``follow_links=False`` refuses a link as the last part of
+    ``path`` (OSError ELOOP)."""
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    if not follow_links:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
+    descriptor = os.open(path, flags)  # non-blocking: a pipe opens at once, unread
+    with os.fdopen(descriptor, "rb") as handle:
+        status = os.fstat(descriptor)
+        if not stat.S_ISREG(status.st_mode):
+            raise NotRegularFile(errno.EINVAL, "not a regular file", str(path))
+        return _read_handle(handle, limit), status
+
+
+def _read_handle(handle: BinaryIO, limit: int) -> bytes | None:
     chunks, size = [], 0
-    with path.open("rb") as handle:  # in chunks: one read of limit + 1 bytes would claim
-        while size <= limit:  # that much memory first, however small the file
-            chunk = handle.read(min(CHUNK, limit + 1 - size))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
+    while size <= limit:  # in chunks: one read of limit + 1 bytes would claim that much
+        chunk = handle.read(min(CHUNK, limit + 1 - size))  # memory first, however small
+        if not chunk:
+            break
+        chunks.append(chunk)
+        size += len(chunk)
     return None if size > limit else b"".join(chunks)
 
 

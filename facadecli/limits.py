@@ -27,6 +27,9 @@ LAYOUT_EXTENT_MAX = 1e6  # a layout's size and any coordinate, in the file's own
 LAYOUT_CELLS_MAX = 1_000_000  # cells of a snapped tiling (1000 x 1000)
 LABEL_CHARS_MAX = 100  # characters of a label
 GALLERY_BYTES_MAX = 256 * 1024 * 1024  # bytes of the models a ``facade view`` page inlines
+WATCH_CONNECTIONS_MAX = 32  # connections ``facade watch`` serves at once (more: closed)
+WATCH_STREAMS_MAX = 8  # of those, open event streams (pages following the spec; more: 503)
+WATCH_IDLE_SECONDS = 10.0  # a connection that sends or takes nothing this long is closed
 
 #: bytes of a city's single merged glb (a glb's lengths are 32-bit); beyond, tiles only
 MERGED_GLB_MAX = 2**31

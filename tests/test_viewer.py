@@ -194,3 +194,57 @@ def test_a_browser_shows_the_gallery(
     assert '<img src="data:image/svg+xml;base64,' in dom.split('id="elevation"')[1]
     assert '<p id="status">drag to orbit, scroll to zoom</p>' in dom  # not "cannot show"
     assert _drawn(shot, 0.25, 0.65)  # the viewer, between the list and the elevation
+
+
+# what a page inlines: regular files inside the folder, each what its name says
+
+
+def test_view_leaves_out_links_out_of_the_folder_and_mislabelled_files(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path
+) -> None:
+    name = "residential-house-8x3-0"
+    glb, svg = (varied / f"{name}.glb").read_bytes(), (varied / f"{name}.svg").read_bytes()
+    (tmp_path / "house.glb").write_bytes(glb)
+    (tmp_path / "house.svg").write_bytes(svg)
+    outside = tmp_path.parent / f"{tmp_path.name}-secret.txt"
+    outside.write_text("root:x:0:0:leaked-7c1e\n")
+    (tmp_path / "shadow.glb").write_bytes(glb)  # a real model whose elevation links out
+    (tmp_path / "shadow.svg").symlink_to(outside)
+    (tmp_path / "passwd.glb").symlink_to(outside)
+    (tmp_path / "copy.glb").symlink_to(tmp_path / "house.glb")  # a link inside: fine
+    (tmp_path / "text.glb").write_text("root:x:0:0:leaked-7c1e\n")  # not glTF
+    (tmp_path / "text.svg").write_text("root:x:0:0:leaked-7c1e\n")  # not read: no model to show
+    (tmp_path / "dtd.glb").write_bytes(glb)
+    (tmp_path / "dtd.svg").write_text(
+        f'<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY x SYSTEM "file://{outside}">]>'
+        '<svg xmlns="http://www.w3.org/2000/svg"><text>&x;</text></svg>'
+    )
+    (tmp_path / "folder.glb").mkdir()
+    page = tmp_path / "page.html"
+    code, out, err = facade(capsys, "view", tmp_path, "-o", page)
+    assert code == 0 and out.strip() == f"4 models -> {page} (5 files left out)", err
+    text = page.read_text()
+    assert re.findall(r'data-name="([^"]+)"', text) == ["copy", "dtd", "house", "shadow"]
+    leaked = outside.read_bytes()
+    assert "leaked-7c1e" not in text and base64.b64encode(leaked).decode() not in text
+    assert text.count("<img") == 1  # house's: the others have none or it is left out
+    for file, why in [
+        ("shadow.svg", f"a link to {outside.resolve()}, outside the folder"),
+        ("passwd.glb", "outside the folder"),
+        ("text.glb", "not a glTF binary"),
+        ("dtd.svg", "declares a document type (DTD)"),
+        ("folder.glb", "not a regular file"),
+    ]:
+        line = rf"{re.escape(str(tmp_path / file))}: warning: left out: .*{re.escape(why)}"
+        assert re.search(line, err), (file, err)
+
+
+def test_view_refuses_a_folder_whose_every_model_is_left_out(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    (tmp_path / "shadow.glb").symlink_to("/etc/passwd")
+    (tmp_path / "empty.glb").write_bytes(b"")
+    code, out, err = facade(capsys, "view", tmp_path)
+    assert code == 2 and out == "" and files(tmp_path) == ["empty.glb", "shadow.glb"]
+    assert f"{tmp_path}: error: no model to show" in err
+    assert f"{tmp_path / 'shadow.glb'}: error: left out: a link to /etc/passwd" in err

@@ -5,22 +5,30 @@ thumbnail, beside the shared three.js viewer; a click shows that model and its e
 The models are the folder's top-level ``*.glb`` files (a city's ``buildings/*.glb`` only
 when there are none), each with the ``.svg`` of the same stem when there is one, in
 natural order (``8x3`` before ``12x3``). What the page inlines is capped at
-:data:`~facadecli.limits.GALLERY_BYTES_MAX`; the same folder gives the same bytes."""
+:data:`~facadecli.limits.GALLERY_BYTES_MAX`; the same folder gives the same bytes.
+
+A page is made to be sent to others, so it inlines only regular files inside the folder
+(a link to another file of the folder is fine, a link out of it is not: ``shadow.svg ->
+/etc/shadow`` never reaches a page) that are what their names say (glTF binary, SVG with
+no DTD); every file left out is listed with why."""
 
 from __future__ import annotations
 
 import base64
+import errno
+import os
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from html import escape
 from pathlib import Path
 
-from facadecli.errors import OutputError, SpecError
+from facadecli.errors import OutputError, Problem, SpecError
 from facadecli.export.atomic import atomic_output, check_output_file
-from facadecli.files import read_at_most
+from facadecli.files import NotRegularFile, read_regular_at_most
 from facadecli.limits import GALLERY_BYTES_MAX
 from facadecli.viewer import document_parts, glb_element
+from facadecli.viewer.kinds import kind_problem
 
 PAGE_NAME = "index.html"
 BUILDINGS = "buildings"  # where ``facade city`` writes one glb per building
@@ -28,6 +36,7 @@ HINT = (
     "run 'facade solve SPEC -o FOLDER' first, or facade vary or facade city: "
     "they write the .glb models this page shows"
 )
+SKIP_HINT = "a page shows only glTF (.glb) and SVG files that are inside the folder"
 
 
 @dataclass(frozen=True)
@@ -58,14 +67,15 @@ def _glbs(folder: Path) -> list[Path]:
     found = [
         path
         for path in folder.glob("*.glb")
-        if path.is_file() and not path.name.startswith(".")  # not a run's temporary file
+        if not path.name.startswith(".")  # not a run's temporary file
     ]
     return sorted(found, key=lambda path: natural_key(path.name))
 
 
 def find_models(folder: Path) -> list[Model]:
     """The models of ``folder``, in order; a SpecError (exit 2) when there are none or the
-    folder cannot be read."""
+    folder cannot be read. Every ``*.glb`` name is listed here, whatever it names:
+    :func:`read_models` skips those that are not glTF files inside the folder."""
     where = str(folder)
     if not folder.exists():
         raise SpecError.at(where, None, None, "no such folder", HINT)
@@ -84,21 +94,60 @@ def find_models(folder: Path) -> list[Model]:
     models = []
     for glb in glbs:
         svg = glb.with_suffix(".svg")
-        models.append(Model(glb.stem, glb, svg if svg.is_file() else None))
+        models.append(Model(glb.stem, glb, svg if os.path.lexists(svg) else None))
     return models
 
 
-def read_models(models: list[Model], folder: Path, limit: int | None = None) -> list[Loaded]:
+@dataclass(frozen=True)
+class Skipped:
+    """A file the page leaves out, and why."""
+
+    path: Path
+    reason: str
+
+
+class _Skip(Exception):
+    pass
+
+
+def _inside(path: Path, root: Path) -> Path:
+    """The file ``path`` names, when it is a regular file inside ``root`` (a link to one is
+    fine: a link between two files of the folder shows nothing new); _Skip otherwise."""
+    try:
+        target = path.resolve(strict=True)
+    except (OSError, RuntimeError):  # a link to nothing, a loop of links
+        raise _Skip("a link to nothing" if path.is_symlink() else "cannot be read") from None
+    if not target.is_relative_to(root):
+        raise _Skip(f"a link to {target}, outside the folder")
+    if not target.is_file():
+        raise _Skip("not a regular file (a folder, a device or a pipe)")
+    return target
+
+
+def read_models(
+    models: list[Model], folder: Path, limit: int | None = None
+) -> tuple[list[Loaded], list[Skipped]]:
     """Every model's bytes, never more than ``limit`` (:data:`GALLERY_BYTES_MAX`) in all:
-    past it, a SpecError naming the limit, having read at most one byte more."""
+    past it, a SpecError naming the limit, having read at most one byte more. Only regular
+    files inside ``folder`` are read, and only what is of its name's kind
+    (:mod:`facadecli.viewer.kinds`) is kept: a model whose glb is not is skipped, one whose
+    svg is not is shown without its elevation; each is listed in the second list."""
     cap = GALLERY_BYTES_MAX if limit is None else limit
+    root = folder.resolve()
     used = 0
+    loaded: list[Loaded] = []
+    skipped: list[Skipped] = []
 
     def read(path: Path) -> bytes:
         nonlocal used
-        try:
-            data = read_at_most(path, cap - used)
+        target = _inside(path, root)
+        try:  # the file checked, not a link put in its place since
+            data, _ = read_regular_at_most(target, cap - used, follow_links=False)
+        except NotRegularFile:
+            raise _Skip("not a regular file (a folder, a device or a pipe)") from None
         except OSError as error:
+            if error.errno == errno.ELOOP:
+                raise _Skip("replaced by a link while read") from None
             raise SpecError.at(
                 str(path), None, None, f"cannot read: {error.strerror}", "check its permissions"
             ) from None
@@ -112,12 +161,26 @@ def read_models(models: list[Model], folder: Path, limit: int | None = None) -> 
                 "view a folder with fewer models (move some out), or open the .glb files "
                 "one at a time",
             )
+        problem = kind_problem(path.suffix, data)
+        if problem is not None:
+            raise _Skip(problem)
         used += len(data)
         return data
 
-    return [
-        Loaded(model, read(model.glb), read(model.svg) if model.svg else None) for model in models
-    ]
+    for model in models:
+        try:
+            glb = read(model.glb)
+        except _Skip as skip:
+            skipped.append(Skipped(model.glb, str(skip)))
+            continue
+        svg = None
+        if model.svg is not None:
+            try:
+                svg = read(model.svg)
+            except _Skip as skip:
+                skipped.append(Skipped(model.svg, str(skip)))
+        loaded.append(Loaded(model, glb, svg))
+    return loaded, skipped
 
 
 STYLE = (
@@ -199,19 +262,29 @@ def gallery_parts(title: str, models: list[Loaded], note: str = "") -> Iterator[
 
 @dataclass(frozen=True)
 class Written:
-    """What ``facade view`` wrote: the page and the models it shows."""
+    """What ``facade view`` wrote: the page, the models it shows and the files it left out."""
 
     page: Path
     models: list[Model]
+    skipped: list[Skipped]
 
 
 def write_gallery(folder: Path, page: Path | None = None) -> Written:
     """``facade view``: the gallery of ``folder``'s models, written atomically to ``page``
-    (default ``FOLDER/index.html``)."""
+    (default ``FOLDER/index.html``). A SpecError when no model is left to show."""
     target = folder / PAGE_NAME if page is None else page
     models = find_models(folder)
     check_output_file(target)
-    loaded = read_models(models, folder)
+    loaded, skipped = read_models(models, folder)
+    if not loaded:
+        where = str(models[0].glb.parent)
+        raise SpecError(
+            [Problem(where, None, None, "no model to show: every .glb file here is left out")]
+            + [
+                Problem(str(file.path), None, None, f"left out: {file.reason}", SKIP_HINT)
+                for file in skipped
+            ]
+        )
     title = folder.resolve().name or str(folder)
     note = f" in {BUILDINGS}/" if models[0].glb.parent != folder else ""
     try:
@@ -220,4 +293,4 @@ def write_gallery(folder: Path, page: Path | None = None) -> Written:
                 handle.write(part.encode("utf-8"))
     except OSError as error:
         raise OutputError(f"{target}: cannot write the page: {error.strerror}") from None
-    return Written(target, models)
+    return Written(target, [item.model for item in loaded], skipped)
