@@ -185,7 +185,7 @@ def test_the_relaxation_bounds_every_layout_of_its_candidate() -> None:
     assert report(layout)["proof"]["x"]["bound"] == pytest.approx(layout.x.objective, rel=1e-6)
 
 
-@pytest.mark.parametrize("decorations", [4, 16])
+@pytest.mark.parametrize("decorations", [4, 16, 24])
 def test_the_grand_hall_is_perfect_and_proven(decorations: int) -> None:
     """The solver issue's 8-layer front (and with 16 decoration layers): it ended in exit 4
     although every symbol fits at its preferred size at k = 12."""
