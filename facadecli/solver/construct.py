@@ -477,7 +477,7 @@ class _Fitting:
         ahead = self.open_after[symbol][k]
         if len(still) == 1:  # the last open one takes what the row leaves
             size = (self.canvas - x - rest) / ahead
-            return size >= 0.0 and self.lay(k, x, {**sizes, symbol: size})
+            return size > self.near and self.lay(k, x, {**sizes, symbol: size})
         # its ends the rest of the row leaves room for (it comes ``ahead`` times more),
         # nearest first
         points = self.points
