@@ -460,7 +460,11 @@ def test_a_seed_varies_layouts_and_colours_per_building(tmp_path: Path) -> None:
 def test_a_city_in_tiles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     report = _run(tmp_path, "tiles: 50\n")
     index = json.loads((tmp_path / "out" / "tags.tiles.json").read_text())
-    assert report["models"] == {"merged": "tags.glb", "tiles": "tags.tiles.json"}
+    assert report["models"] == {
+        "merged": "tags.glb",
+        "tiles": "tags.tiles.json",
+        "georef": "tags.georef.json",
+    }
     assert sum(t["buildings"] for t in index["tiles"]) == report["summary"]["ok"]
     names = {(t["column"], t["row"]) for t in index["tiles"]}
     assert names == {(0, 0), (1, 0)}  # centroids at x 4-85 m, y 4-45 m: two 50 m tiles
@@ -473,7 +477,11 @@ def test_a_city_in_tiles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     monkeypatch.setattr(tiles, "MERGED_GLB_MAX", 1000)
     (tmp_path / "big").mkdir()
     report = _run(tmp_path / "big", "")
-    assert report["models"] == {"merged": None, "tiles": "tags.tiles.json"}
+    assert report["models"] == {
+        "merged": None,
+        "tiles": "tags.tiles.json",
+        "georef": "tags.georef.json",
+    }
     assert not (tmp_path / "big" / "out" / "tags.glb").exists()
 
 

@@ -24,7 +24,6 @@ import itertools
 import json
 import math
 import os
-import re
 import shutil
 import tempfile
 from collections import Counter, deque
@@ -35,9 +34,9 @@ from types import TracebackType
 from typing import Any, BinaryIO
 
 import numpy as np
-import pyproj
 import trimesh
 
+from facadecli.city.georef import reference_system
 from facadecli.city.roofs import roof_meshes
 from facadecli.city.s3db import Volume
 from facadecli.export.atomic import atomic_output, write_atomic
@@ -98,25 +97,6 @@ def building_object(building: BuildingSolids) -> dict[str, Any]:
         "CityObjects": objects,
         "vertices": [list(p) for p in vertices.points],
     }
-
-
-def reference_system(crs: str) -> str | None:
-    """The OGC URL (``https://www.opengis.net/def/crs/EPSG/0/<code>``) of ``crs`` when it is
-    an EPSG code of a projected CRS in metres; None otherwise, and the metadata then has no
-    referenceSystem: lon/lat input is projected to a local transverse Mercator for the run
-    (not an EPSG CRS), and a CRS in feet was scaled to metres, so neither describes the
-    vertices. Heights are metres above the buildings' ground, in no vertical datum."""
-    match = re.fullmatch(r"(?:EPSG:|urn:ogc:def:crs:EPSG::)(\d+)", crs.strip(), re.IGNORECASE)
-    if match is None:
-        return None
-    try:
-        found = pyproj.CRS.from_epsg(int(match.group(1)))
-    except pyproj.exceptions.CRSError:
-        return None
-    units = {axis.unit_name for axis in found.axis_info}
-    if not found.is_projected or units != {"metre"}:
-        return None
-    return f"https://www.opengis.net/def/crs/EPSG/0/{match.group(1)}"
 
 
 def cityjson_header(crs: str, origin: tuple[float, float], name: str) -> dict[str, Any]:

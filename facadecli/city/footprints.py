@@ -1,8 +1,8 @@
 """Building footprints from GeoJSON, in local metres (SPEC 5).
 
-RFC 7946 lon/lat is projected with pyproj to a transverse Mercator centred on the data (a
-few millimetres of distortion across a district); a projected CRS named in the file's
-legacy ``crs`` member is used as it is (scaled to metres if its unit is not). Either way
+Lon/lat (RFC 7946, OSM) is projected with pyproj into the UTM zone of the middle of the
+data (georef.py: a named CRS, so the outputs can go back on a map); a projected CRS named
+in the file is used as it is (scaled to metres if its unit is not). Either way
 coordinates are then shifted so the data's south-west corner is the origin, which keeps
 glTF's 32-bit floats precise. Invalid rings are repaired with shapely's make_valid;
 outlines of more than MAX_VERTICES vertices are simplified. What cannot be used is
@@ -27,6 +27,7 @@ from shapely.geometry.polygon import orient
 
 from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
 from facadecli.city.geopackage import read_geopackage
+from facadecli.city.georef import utm_epsg
 from facadecli.city.ogr import is_ogr, read_ogr
 from facadecli.city.osm import is_osm, read_osm
 from facadecli.errors import Problem, SpecError
@@ -82,9 +83,10 @@ class Rejected:
 class FootprintSet:
     footprints: tuple[Footprint, ...]
     rejected: tuple[Rejected, ...]
-    crs: str  # what the input was in
-    origin: tuple[float, float]  # where local (0, 0) is, in the projected CRS
+    crs: str  # the projected CRS of the outputs: the input's, or a UTM zone for lon/lat
+    origin: tuple[float, float]  # where local (0, 0) is, in that CRS (scaled to metres)
     outside: int = 0  # features left out by a bounding box
+    unit: float = 1.0  # metres per unit of ``crs`` (a CRS in feet is scaled to metres)
 
 
 def feature_id(feature: Any, index: int) -> str:
@@ -128,7 +130,8 @@ def read_footprints(path: Path, bbox: BBox | None = None) -> FootprintSet:
     rejected: list[Rejected] = []
     readable = _readable(document, ids, rejected)
     inside = readable if bbox is None else [f for f in readable if _within(f[3], bbox)]
-    found = _in_metres(document, inside, rejected)
+    crs = _projected(document.crs, [geometry for *_, geometry in inside])
+    found = _in_metres(document, crs, inside, rejected)
     minx = min((geometry.bounds[0] for *_, geometry in found), default=0.0)
     miny = min((geometry.bounds[1] for *_, geometry in found), default=0.0)
     footprints = []
@@ -142,8 +145,10 @@ def read_footprints(path: Path, bbox: BBox | None = None) -> FootprintSet:
     if rejected and not footprints:
         raise _nothing_usable(document, rejected)
     outside = len(readable) - len(inside)
-    crs = document.crs.to_string()
-    return FootprintSet(tuple(footprints), tuple(rejected), crs, (minx, miny), outside)
+    unit = _unit(crs)
+    return FootprintSet(
+        tuple(footprints), tuple(rejected), crs.to_string(), (minx, miny), outside, unit
+    )
 
 
 def _within(geometry: Any, bbox: BBox) -> bool:
@@ -165,9 +170,11 @@ def _readable(document: GeoJSON, ids: list[str], rejected: list[Rejected]) -> li
     return found
 
 
-def _in_metres(document: GeoJSON, found: list[Found], rejected: list[Rejected]) -> list[Found]:
-    """The features projected to metres, without those far from the others."""
-    transform = _projection(document.crs, [geometry for *_, geometry in found])
+def _in_metres(
+    document: GeoJSON, crs: pyproj.CRS, found: list[Found], rejected: list[Rejected]
+) -> list[Found]:
+    """The features projected to metres in ``crs``, without those far from the others."""
+    transform = _projection(document.crs, crs)
     projected = [
         (index, fid, properties, shapely.transform(geometry, transform, interleaved=False))
         for index, fid, properties, geometry in found
@@ -279,20 +286,27 @@ def _polygons(geometry: Any) -> list[Polygon]:
     return []
 
 
-def _projection(source: pyproj.CRS, geometries: list[Any]) -> Any:
-    """A function (x, y) -> (x, y) in metres: lon/lat to a transverse Mercator centred on
-    the middle of the data; a projected CRS as it is, scaled from its unit to metres."""
+def _projected(source: pyproj.CRS, geometries: list[Any]) -> pyproj.CRS:
+    """The CRS of the outputs: a projected ``source`` itself; for lon/lat, the UTM zone
+    of the middle of the data (see georef.py)."""
     if not source.is_geographic:
-        scale = source.axis_info[0].unit_conversion_factor if source.axis_info else 1.0
-        if scale == 1.0:
-            return lambda x, y: (x, y)
-        return lambda x, y: (x * scale, y * scale)
-    lon, lat = _middle(geometries)
-    local = pyproj.CRS.from_proj4(
-        f"+proj=tmerc +lat_0={lat:.7f} +lon_0={lon:.7f} +k=1 +x_0=0 +y_0=0 +ellps=WGS84 +units=m"
-    )
-    transformer = pyproj.Transformer.from_crs(source, local, always_xy=True)
-    return transformer.transform
+        return source
+    return pyproj.CRS.from_epsg(utm_epsg(*_middle(geometries)))
+
+
+def _unit(crs: pyproj.CRS) -> float:
+    return float(crs.axis_info[0].unit_conversion_factor) if crs.axis_info else 1.0
+
+
+def _projection(source: pyproj.CRS, target: pyproj.CRS) -> Any:
+    """A function (x, y) -> (x, y) in metres: lon/lat into ``target``; a projected CRS
+    (``target`` is ``source``) as it is, scaled from its unit to metres."""
+    if source.is_geographic:
+        return pyproj.Transformer.from_crs(source, target, always_xy=True).transform
+    scale = _unit(source)
+    if scale == 1.0:
+        return lambda x, y: (x, y)
+    return lambda x, y: (x * scale, y * scale)
 
 
 def _middle(geometries: list[Any]) -> tuple[float, float]:

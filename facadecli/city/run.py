@@ -40,6 +40,7 @@ from facadecli.city.cityjson import (
     write_cityjson,
 )
 from facadecli.city.footprints import BBox, Footprint, Rejected, Simplified, read_footprints
+from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
@@ -398,6 +399,7 @@ def check_output(outdir: Path, name: str) -> None:
         outdir / f"{name}.report.json",
         outdir / f"{name}.city.json",
         outdir / f"{name}.tiles.json",
+        outdir / f"{name}.georef.json",
         outdir / f"{name}.report.jsonl",
     ):
         if os.path.isdir(output):
@@ -426,6 +428,7 @@ def run_city(
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
     found = read_footprints(city.footprints, bbox)
+    georef = Georef(found.crs, found.origin, found.unit)
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
     footprints, kept = standing(city, found.footprints, replaced)
     footprints = footprints[: limit if limit is not None else None]
@@ -479,7 +482,7 @@ def run_city(
             outdir,
             city.manifest.name,
             city.manifest.tiles,
-            found.origin,
+            georef,
         )
     except OSError as error:  # a full disk: the buildings stay, for --resume
         raise OutputError(
@@ -508,6 +511,7 @@ def run_city(
         "name": city.manifest.name,
         "crs": found.crs,
         "origin": list(found.origin),
+        "georeference": georeference(georef),
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
         "replaced": [

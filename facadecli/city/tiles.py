@@ -4,7 +4,10 @@ map, so a district of any size loads in pieces (a glb's lengths are 32-bit: 4 Gi
 
 A building belongs to the tile its footprint's centroid lies in; tiles are named by their
 column and row from the run's origin (``tiles/<name>_<i>_<j>.glb``) and listed, with
-their bounds in local metres and in the footprints' CRS, in ``<name>.tiles.json``."""
+their bounds in local metres, in the outputs' CRS (named in the index) and in WGS 84
+lon/lat, in ``<name>.tiles.json``. Every merged model carries the georeference of the
+run's frame (georef.py) in its scene's ``extras``, and ``<name>.georef.json`` beside them
+holds it too, with the CRS's WKT: it places every glb of the run, buildings' included."""
 
 from __future__ import annotations
 
@@ -14,6 +17,9 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+import pyproj
+
+from facadecli.city.georef import Georef, georeference
 from facadecli.export.atomic import write_atomic
 from facadecli.export.glb_merge import merge_glb
 from facadecli.limits import MERGED_GLB_MAX
@@ -30,40 +36,53 @@ def merge_city(
     outdir: Path,
     name: str,
     size: float | None,
-    origin: tuple[float, float],
+    georef: Georef,
 ) -> dict[str, Any]:
     """Write the merged model(s) of the built buildings (id, glb file, centroid in local
-    metres); returns what was written for the report: ``merged`` (the one glb, or None
-    when it would pass MERGED_GLB_MAX) and ``tiles`` (the index file, or None)."""
+    metres) and ``<name>.georef.json``; returns what was written for the report:
+    ``merged`` (the one glb, or None when it would pass MERGED_GLB_MAX), ``tiles`` (the
+    index file, or None) and ``georef``."""
     buildings = list(buildings)
+    frame = georeference(georef)
+    extras = {"georeference": frame}
+    sidecar = f"{name}.georef.json"
+    wkt = pyproj.CRS.from_user_input(georef.crs).to_wkt()
+    write_atomic(outdir / sidecar, json.dumps({**frame, "crs_wkt": wkt}, indent=2) + "\n")
     total = sum(path.stat().st_size for _, path, _ in buildings)
     merged: str | None = f"{name}.glb"
     if total <= MERGED_GLB_MAX:
-        merge_glb(((bid, path) for bid, path, _ in buildings), outdir / f"{name}.glb")
+        merge_glb(((bid, path) for bid, path, _ in buildings), outdir / f"{name}.glb", extras)
     else:
         merged = None
         size = size or DEFAULT_TILE
     if size is None:
-        return {"merged": merged, "tiles": None}
+        return {"merged": merged, "tiles": None, "georef": sidecar}
     groups: dict[tuple[int, int], list[tuple[str, Path]]] = {}
     for bid, path, centroid in buildings:
         groups.setdefault(tile_of(centroid, size), []).append((bid, path))
     index = []
     for (i, j), members in sorted(groups.items()):
         file = f"tiles/{name}_{i}_{j}.glb"
-        merge_glb(members, outdir / file)
-        x0, y0 = i * size, j * size
-        ox, oy = origin
+        merge_glb(members, outdir / file, extras)
+        bounds = (i * size, j * size, (i + 1) * size, (j + 1) * size)
         index.append(
             {
                 "file": file,
                 "column": i,
                 "row": j,
                 "buildings": len(members),
-                "bounds": [x0, y0, x0 + size, y0 + size],
-                "bounds_crs": [ox + x0, oy + y0, ox + x0 + size, oy + y0 + size],
+                "bounds": list(bounds),
+                "bounds_crs": [*georef.in_crs(*bounds[:2]), *georef.in_crs(*bounds[2:])],
+                "bounds_lonlat": georef.bounds_lonlat(bounds),
             }
         )
-    document = {"name": name, "size": size, "origin": list(origin), "tiles": index}
+    document = {
+        "name": name,
+        "size": size,
+        "crs": frame["crs"],
+        "crs_url": frame["crs_url"],
+        "origin": frame["origin"][:2],
+        "tiles": index,
+    }
     write_atomic(outdir / f"{name}.tiles.json", json.dumps(document, indent=2) + "\n")
-    return {"merged": merged, "tiles": f"{name}.tiles.json"}
+    return {"merged": merged, "tiles": f"{name}.tiles.json", "georef": sidecar}

@@ -54,12 +54,18 @@ def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
     return document, binary
 
 
-def merge_glb(parts: Iterable[tuple[str, Path]], target: Path) -> None:
-    """Write one glb holding every (name, file) part under a root node of that name."""
+def merge_glb(
+    parts: Iterable[tuple[str, Path]], target: Path, extras: dict[str, Any] | None = None
+) -> None:
+    """Write one glb holding every (name, file) part under a root node of that name; with
+    ``extras``, as the scene's ``extras`` (glTF's place for application data)."""
     merged: dict[str, Any] = {key: [] for key in _REFERENCES}
+    scene: dict[str, Any] = {"nodes": []}
+    if extras is not None:
+        scene["extras"] = extras
     merged.update(
         asset={"version": "2.0", "generator": "facadecli"},
-        scenes=[{"nodes": []}],
+        scenes=[scene],
         scene=0,
         extensionsUsed=[],
     )
