@@ -328,7 +328,8 @@ def test_the_reference_system_is_an_epsg_projected_crs_in_metres() -> None:
     assert reference_system("urn:ogc:def:crs:EPSG::3067") == (
         "https://www.opengis.net/def/crs/EPSG/0/3067"
     )
-    assert reference_system("EPSG:4326") is None  # lon/lat: the run's own transverse Mercator
+    assert reference_system("EPSG:32632") == "https://www.opengis.net/def/crs/EPSG/0/32632"
+    assert reference_system("EPSG:4326") is None  # lon/lat is never the vertices' CRS
     assert reference_system("EPSG:2263") is None  # US feet, scaled to metres
     assert reference_system("+proj=tmerc +lat_0=60") is None
     document = cityjson_document([], "EPSG:4326", (0.0, 0.0), "lonlat")
