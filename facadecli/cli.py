@@ -356,6 +356,11 @@ def city(
         if entry["line"] is None:
             where = f"{loaded.footprints}: features[{entry['feature']}]"
         typer.echo(f"{where}: rejected: feature '{entry['id']}': {entry['error']}", err=True)
+    for entry in report["warnings"]:  # tags ignored: the building is built without them
+        where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
+        if entry["line"] is None:
+            where = f"{loaded.footprints}: features[{entry['feature']}]"
+        typer.echo(f"{where}: warning: feature '{entry['id']}': {entry['warning']}", err=True)
     for entry in report["buildings"]:
         if entry["status"] != "ok":
             typer.echo(f"{manifest}: building {entry['id']}: {entry['error']}", err=True)

@@ -425,7 +425,7 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    found = read_footprints(city.footprints, bbox)
+    found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
     footprints, kept = standing(city, found.footprints, replaced)
     footprints = footprints[: limit if limit is not None else None]
@@ -510,6 +510,7 @@ def run_city(
         "origin": list(found.origin),
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
+        "warnings": [_warning(w) for w in found.warnings if w.id in by_id],
         "replaced": [
             {"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())
         ],
@@ -519,6 +520,7 @@ def run_city(
             "ok": len(results) - len(failed),
             "failed": len(failed),
             "rejected": len(found.rejected),
+            "warnings": sum(1 for w in found.warnings if w.id in by_id),
             "outside_bbox": found.outside,
             "replaced": sum(1 for area in kept.values() if area == 0),
             "trimmed": sum(1 for area in kept.values() if area > 0),
@@ -546,6 +548,17 @@ def _rejected(rejected: Rejected) -> dict[str, Any]:
         "feature": rejected.index,
         "line": rejected.line,
         "column": rejected.column,
+    }
+
+
+def _warning(warned: Rejected) -> dict[str, Any]:
+    """A built feature's report entry for what of its tags was ignored, and where."""
+    return {
+        "id": warned.id,
+        "warning": warned.reason,
+        "feature": warned.index,
+        "line": warned.line,
+        "column": warned.column,
     }
 
 

@@ -1,0 +1,199 @@
+"""Checking an OSM XML extract (``.osm``, ``.osm.gz``, ``.osm.bz2``) before libosmium reads
+it: one streaming pass with expat, inflating a compressed file a chunk at a time.
+
+libosmium stops at the first value it cannot take (a coordinate ``nan``, an id past
+int64, a tag value past 1,024 bytes) with a message that names no place, and reads any
+number of inflated bytes. This pass holds the file to the limits (inflated bytes, tag
+text, ids) and to the value formats libosmium takes, and a value that is not one is a
+SpecError at its line and column, naming the element. It also finds where each element
+tagged as a building starts, to place the features libosmium cannot draw.
+"""
+
+from __future__ import annotations
+
+import bz2
+import gzip
+import io
+import re
+import zlib
+from collections.abc import Callable
+from pathlib import Path
+from xml.parsers import expat
+
+from facadecli.errors import SpecError
+from facadecli.limits import (
+    OSM_ID_MAX,
+    OSM_INFLATION_FREE,
+    OSM_INFLATION_MAX,
+    OSM_TEXT_CHARS_MAX,
+    OSM_XML_BYTES_MAX,
+)
+
+CHUNK = 1 << 20  # bytes inflated and parsed at a time
+HINT = "export the extract again (osmium cat, JOSM, the OSM website), or fix the value"
+KEYS = ("building", "building:part")
+Places = dict[tuple[str, int], tuple[int, int]]  # (kind, id) -> (line, column)
+
+_ID = re.compile(r"-?\d{1,19}", re.ASCII)
+_COUNT = re.compile(r"\d{1,10}", re.ASCII)  # version, changeset: 32-bit
+_UID = re.compile(r"-?\d{1,10}", re.ASCII)
+_COORDINATE = re.compile(r"-?(?:\d{1,12}(?:\.\d{0,20})?|\.\d{1,20})(?:[eE][-+]?\d{1,2})?", re.ASCII)
+_TIMESTAMP = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", re.ASCII)
+_BOUNDS = {"lat": 90.0, "lon": 180.0}
+
+
+def xml_opener(path: Path) -> tuple[Callable[[], io.BufferedIOBase], bool]:
+    """How to open the file as XML bytes, and whether it is compressed."""
+    name = path.name.lower()
+    if name.endswith(".gz"):
+        return lambda: gzip.open(path, "rb"), True
+    if name.endswith(".bz2"):
+        return lambda: bz2.open(path, "rb"), True
+    return lambda: path.open("rb"), False
+
+
+def inflated_limit(compressed_bytes: int) -> int:
+    """Bytes a compressed extract of this size may inflate to (OSM_INFLATION_MAX times its
+    size, at least OSM_INFLATION_FREE, at most OSM_XML_BYTES_MAX)."""
+    ratio = max(OSM_INFLATION_FREE, OSM_INFLATION_MAX * compressed_bytes)
+    return min(OSM_XML_BYTES_MAX, ratio)
+
+
+def too_big(file: str, most: int, compressed: bool) -> SpecError:
+    if compressed:
+        message = (
+            f"the extract inflates to more than {most:,} bytes (limits: {OSM_INFLATION_MAX} "
+            f"times its compressed size, {OSM_XML_BYTES_MAX:,} bytes of OSM XML)"
+        )
+    else:
+        message = f"the extract is longer than {most:,} bytes (limit of OSM XML)"
+    return SpecError.at(
+        file,
+        None,
+        None,
+        message,
+        "cut the extract to the district (osmium extract --bbox), or give it as .osm.pbf",
+    )
+
+
+def check_xml(path: Path) -> Places:
+    """Check the extract (see the module); the places of its building ways and relations."""
+    file = str(path)
+    opener, compressed = xml_opener(path)
+    size = path.stat().st_size
+    most = inflated_limit(size) if compressed else OSM_XML_BYTES_MAX
+    if not compressed and size > most:
+        raise too_big(file, most, compressed)
+    parser = expat.ParserCreate()
+    checker = _Checker(file, parser)
+    parser.StartElementHandler = checker.start
+    parser.EndElementHandler = checker.end
+    parser.EntityDeclHandler = checker.entity
+    inflated = 0
+    try:
+        with opener() as stream:
+            while chunk := stream.read(CHUNK):
+                inflated += len(chunk)
+                if inflated > most:
+                    raise too_big(file, most, compressed)
+                parser.Parse(chunk, False)
+        parser.Parse(b"", True)
+    except expat.ExpatError as error:
+        message = f"not OSM XML: {expat.ErrorString(error.code)}"
+        raise SpecError.at(file, error.lineno, error.offset + 1, message, HINT) from None
+    except (OSError, EOFError, zlib.error, ValueError) as error:  # a bad gz or bz2 stream
+        kind = "gzip" if path.name.lower().endswith(".gz") else "bzip2"
+        message = f"cannot inflate the {kind} stream: {error}" if compressed else str(error)
+        raise SpecError.at(file, None, None, message, HINT) from None
+    if not checker.root:
+        raise SpecError.at(file, 1, 1, "not OSM XML: no <osm> element", HINT)
+    return checker.places
+
+
+class _Checker:
+    """expat's handlers: each element's attributes checked as it starts."""
+
+    def __init__(self, file: str, parser: expat.XMLParserType):
+        self.file = file
+        self.parser = parser
+        self.root = False
+        self.object: tuple[str, int] | None = None  # the node, way or relation open
+        self.places: Places = {}
+        self.at = (1, 1)  # where the open object starts
+
+    def fail(self, message: str, hint: str = HINT) -> SpecError:
+        line, col = self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1
+        return SpecError.at(self.file, line, col, message, hint)
+
+    def entity(self, *_: object) -> None:
+        raise self.fail("an entity declaration: OSM XML has none", "remove the DOCTYPE")
+
+    def start(self, name: str, attributes: dict[str, str]) -> None:
+        if not self.root:
+            if name != "osm":
+                raise self.fail(f"not OSM XML: the root element is <{name}>, not <osm>")
+            self.root = True
+            return
+        who = self._who(name, attributes)
+        for key, value in attributes.items():
+            problem = _problem(name, key, value)
+            if problem is not None:
+                raise self.fail(f"{who}: {problem}")
+        if name in ("node", "way", "relation"):
+            self.object = (name, int(attributes.get("id", "0")))
+            self.at = (self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1)
+        elif name == "tag" and self.object is not None and attributes.get("k") in KEYS:
+            self.places.setdefault(self.object, self.at)
+
+    def end(self, name: str) -> None:
+        if name in ("node", "way", "relation"):
+            self.object = None
+
+    def _who(self, name: str, attributes: dict[str, str]) -> str:
+        """The element, for a message: 'way 10', 'a tag of way 10', '<bounds>'."""
+        if name in ("node", "way", "relation", "changeset"):
+            text = attributes.get("id", "")
+            plain = text.removeprefix("-").isdigit() and len(text) < 40
+            return f"{name} {text if plain else _show(text)}"
+        if self.object is not None:
+            kind, oid = self.object
+            article = "an" if name[0] in "aeiou" else "a"
+            return f"{article} <{name}> of {kind} {oid}"
+        return f"<{name}>"
+
+
+def _problem(element: str, key: str, value: str) -> str | None:
+    """Why an attribute's value is one libosmium (or the limits) refuses, if it is."""
+    if key in ("id", "ref"):
+        if not _ID.fullmatch(value) or abs(int(value)) > OSM_ID_MAX:
+            return f"{key} {_show(value)} is not an OSM id (an integer of at most {OSM_ID_MAX:,})"
+    elif key in ("version", "changeset", "num_changes", "comments_count"):
+        if not _COUNT.fullmatch(value) or int(value) >= 2**32:
+            return f"{key} {_show(value)} is not a count (0 to 4,294,967,295)"
+    elif key == "uid":
+        if not _UID.fullmatch(value) or not -(2**31) <= int(value) < 2**32:
+            return f"uid {_show(value)} is not a user id"
+    elif key in ("timestamp", "created_at", "closed_at"):
+        if not _TIMESTAMP.fullmatch(value):
+            return f"{key} {_show(value)} is not a time (YYYY-MM-DDThh:mm:ssZ)"
+    elif key in ("visible", "open"):
+        if value not in ("true", "false"):
+            return f"{key} {_show(value)} is neither true nor false"
+    elif (axis := key.replace("_", "").removeprefix("min").removeprefix("max")) in _BOUNDS:
+        if not _COORDINATE.fullmatch(value) or abs(float(value)) > _BOUNDS[axis]:
+            return f"{key} {_show(value)} is not a {'latitude' if axis == 'lat' else 'longitude'}"
+    elif key in ("k", "v", "role", "user"):
+        if len(value) > OSM_TEXT_CHARS_MAX:
+            what = {"k": "a tag key", "v": "a tag value", "role": "a role", "user": "a user name"}
+            return (
+                f"{what[key]} of {len(value):,} characters (limit: {OSM_TEXT_CHARS_MAX}, "
+                "as in OSM itself)"
+            )
+    elif key == "type" and element == "member" and value not in ("node", "way", "relation"):
+        return f"member type {_show(value)} is not node, way or relation"
+    return None
+
+
+def _show(value: str, width: int = 40) -> str:
+    text = value if len(value) <= width else value[: width - 3] + "..."
+    return "'" + text.encode("unicode_escape").decode("ascii") + "'"
