@@ -29,6 +29,7 @@ OSM_ID_MAX = 2**62 - 1  # an OSM id or reference, either sign (libosmium's area 
 GPKG_ROWS_MAX = 1_000_000  # rows read from a GeoPackage's feature table
 GPKG_STEPS_PER_BYTE = 100  # SQLite steps reading the feature table, a byte of the file
 GPKG_STEPS_FREE = 50_000_000  # SQLite steps allowed whatever the file's size
+GPKG_BYTES_FREE = 16 * 1024 * 1024  # bytes of values read from a feature table past the file's
 LAYOUT_BYTES_MAX = 32_000_000  # bytes of one layout file read by ``facade grammar``
 LAYOUT_RECTS_MAX = 20_000  # rectangles of one layout
 LAYOUT_EXTENT_MAX = 1e6  # a layout's size and any coordinate, in the file's own units

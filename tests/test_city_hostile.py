@@ -9,6 +9,7 @@ from __future__ import annotations
 import bz2
 import gzip
 import json
+import sqlite3
 from pathlib import Path
 from typing import Any
 
@@ -236,3 +237,46 @@ def test_feet_and_inches_and_the_manifest_scale() -> None:
     assert kept == {"height": "9"} and warnings == [
         "H '400' is more than a building's 1000 m: ignored"
     ]
+
+
+VIEWS = {  # a feature table that is a view, and what the error says
+    "never ends": (
+        "WITH RECURSIVE c(fid) AS (SELECT 1 UNION ALL SELECT fid + 1 FROM c) "
+        "SELECT fid, NULL AS geom FROM c",
+        "the feature table 'buildings' has more than 1,000,000 rows",
+    ),
+    "sorts what never ends": (
+        "WITH RECURSIVE c(fid) AS (SELECT 1 UNION ALL SELECT fid + 1 FROM c) "
+        "SELECT fid, NULL AS geom FROM c ORDER BY fid DESC",
+        "reading the feature table takes more than",
+    ),
+    "makes megabytes a row": (
+        "WITH RECURSIVE c(fid) AS (SELECT 1 UNION ALL SELECT fid + 1 FROM c LIMIT 100) "
+        "SELECT fid, NULL AS geom, printf('%.*c', 1000000, 'x') AS name FROM c",
+        "reading the feature table 'buildings' makes more than",
+    ),
+    "a value longer than the file": (
+        "SELECT 1 AS fid, zeroblob(100000000) AS geom",
+        "a value of the feature table is longer than the file",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(VIEWS))
+def test_a_geopackage_view_that_never_ends_is_exit_2_naming_the_limit(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, case: str
+) -> None:
+    from tests.test_geopackage import geopackage
+
+    view, expected = VIEWS[case]
+    path = geopackage(tmp_path / "f.gpkg", [])
+    db = sqlite3.connect(path)
+    db.executescript(f"DROP TABLE buildings; CREATE VIEW buildings AS {view};")
+    db.commit()
+    db.close()
+    assert path.stat().st_size < 40_000
+    manifest = town(tmp_path, "f.gpkg", path.read_bytes())
+    code, _, err = city(capsys, manifest)
+    assert code == 2 and f"{path}: error: {expected}" in err, err
+    assert f"{path}: error: " in err and "(" in err
+    assert not (tmp_path / "out").exists()
