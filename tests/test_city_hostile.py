@@ -9,6 +9,7 @@ from __future__ import annotations
 import bz2
 import gzip
 import json
+import os
 import sqlite3
 from pathlib import Path
 from typing import Any
@@ -17,7 +18,7 @@ import pytest
 
 from facadecli.city.footprints import checked_properties, length
 from facadecli.limits import OSM_INFLATION_MAX, OSM_TEXT_CHARS_MAX
-from tests.running import facade
+from tests.running import facade, files
 from tests.test_city_inputs import MANIFEST, SPEC
 
 LON, LAT = 24.94, 60.17
@@ -280,3 +281,57 @@ def test_a_geopackage_view_that_never_ends_is_exit_2_naming_the_limit(
     assert code == 2 and f"{path}: error: {expected}" in err, err
     assert f"{path}: error: " in err and "(" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_run_cleans_what_a_killed_run_left_and_nothing_else(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    import tempfile
+
+    from tests.test_city_inputs import square
+
+    manifest = town(tmp_path, "f.geojson", "")
+    features = ",\n".join(square(f"b{i}", x=20.0 * i) for i in range(2))
+    crs = '{"type": "name", "properties": {"name": "EPSG:28992"}}'
+    (tmp_path / "f.geojson").write_text(
+        f'{{"type": "FeatureCollection", "crs": {crs}, "features": [\n{features}\n]}}'
+    )
+    code, _, err = city(capsys, manifest)
+    assert code == 0, err
+    out = tmp_path / "out"
+    before = set(files(out))
+    made = []  # what a run killed at any point leaves: named as the writers name them
+    for folder, prefix, suffix in [
+        (out, ".town.glb.", ".bin"),
+        (out, ".town.glb.", ".tmp"),
+        (out, ".town.city.json.", ".objects"),
+        (out, ".town.city.json.", ".vertices"),
+        (out, ".town.report.json.", ".tmp"),
+        (out / "buildings", ".b0.glb.", ".tmp"),
+        (out / "buildings", ".b1.city.jsonl.", ".tmp"),
+        (out / "tiles", ".town_0_-1.glb.", ".bin"),
+    ]:
+        folder.mkdir(exist_ok=True)
+        fd, name = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=folder)
+        os.write(fd, b"half")
+        os.close(fd)
+        made.append(Path(name))
+    others = [  # someone else's: kept
+        out / ".town.glb.keep",
+        out / "notes.tmp",
+        out / ".other.glb.abcdefgh.tmp",
+        out / "buildings" / ".b0.glb.tmp",
+        out / "buildings" / "b0.glb.abcdefgh.tmp",
+    ]
+    for path in others:
+        path.write_text("mine")
+    (out / ".town.glb.zzzzzzzz.tmp").symlink_to(tmp_path / "f.geojson")
+    code, _, err = facade(capsys, "city", manifest, "-o", out, "-j", "1", "--resume")
+    assert code == 0, err
+    assert not any(path.exists() for path in made)
+    assert all(path.read_text() == "mine" for path in others)
+    assert (out / ".town.glb.zzzzzzzz.tmp").is_symlink()
+    assert set(files(out)) == before | {p.name for p in others} | {
+        ".town.glb.zzzzzzzz.tmp",
+        "tiles",
+    }
