@@ -214,5 +214,5 @@ def _missing(nodes: list[int]) -> str:
     text = f"nodes {shown}{more} are" if len(unique) > 1 else f"node {shown} is"
     text += " not in the file"
     if any(i < 0 for i in unique):
-        text += " (libosmium keeps no location of a node with a negative id: renumber)"
-    return text
+        return text + " (libosmium keeps no location of a node with a negative id: renumber)"
+    return text + ", or without a valid location"
