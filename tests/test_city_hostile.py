@@ -335,3 +335,17 @@ def test_a_run_cleans_what_a_killed_run_left_and_nothing_else(
         ".town.glb.zzzzzzzz.tmp",
         "tiles",
     }
+
+
+def test_an_unsorted_extract_or_one_with_an_object_twice_is_exit_2_at_its_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    ways_first = way(10, [1, 2, 3, 4, 1], building="yes") + nodes()  # Overpass's 'out; >;'
+    manifest = town(tmp_path, "f.osm", osm(ways_first))
+    code, _, err = city(capsys, manifest)
+    assert code == 2 and ":3:3: error: feature 'way/10' is not a footprint: node 1 comes " in err
+    assert "the extract is not sorted (osmium sort FILE -o SORTED.osm)" in err
+    manifest = town(tmp_path, "f.osm", osm(GOOD + way(10, [1, 2, 3, 4, 1], building="yes")))
+    code, _, err = city(capsys, manifest)
+    assert code == 2 and ":8:3: error: way 10 is in the file twice" in err
+    assert not (tmp_path / "out").exists()

@@ -157,11 +157,15 @@ def _undrawn(file: str, drawn: _Drawn) -> None:
     a geometry, each with the reason (a missing node or member way, an open ring)."""
     done = {f["id"] for f in drawn.features}
     in_relations = {ref for _, members in drawn.relations.values() for t, ref, _ in members}
-    for oid, (tags, closed, missing) in sorted(drawn.ways.items()):
-        if f"way/{oid}" in done or oid in in_relations:
-            continue
+    undrawn = [
+        (oid, way)
+        for oid, way in sorted(drawn.ways.items())
+        if f"way/{oid}" not in done and oid not in in_relations
+    ]
+    late = _present_nodes(file, {node for _, (_, _, missing) in undrawn for node in missing})
+    for oid, (tags, closed, missing) in undrawn:
         if missing:
-            reason = _missing(missing)
+            reason = _missing(missing, late)
         elif not closed:
             reason = "the way is not closed (its first and last nodes differ)"
         else:
@@ -185,7 +189,7 @@ def _undrawn(file: str, drawn: _Drawn) -> None:
             verb = "are" if len(absent) > 1 else "is"
             reason = f"its {', '.join(absent[:LISTED])}{more} {verb} not in the file"
         elif nodes:
-            reason = f"its ways name nodes the file lacks: {_missing(nodes)}"
+            reason = f"its ways name nodes the file lacks: {_missing(nodes, set())}"
         elif not ways:
             reason = "the multipolygon has no member way"
         else:
@@ -206,8 +210,25 @@ def _member_ways(file: str, ids: set[int]) -> dict[int, list[int]]:
     return found
 
 
-def _missing(nodes: list[int]) -> str:
-    """'node 99 is not in the file', 'nodes 1, 2 are ...', with a word on negative ids."""
+def _present_nodes(file: str, ids: set[int]) -> set[int]:
+    """Which of these nodes the file holds (after the ways naming them, then)."""
+    import osmium
+
+    if not ids:
+        return set()
+    processor = osmium.FileProcessor(file, osmium.osm.NODE).with_filter(osmium.filter.IdFilter(ids))
+    return {item.id for item in processor if isinstance(item, osmium.osm.Node)}
+
+
+def _missing(nodes: list[int], late: set[int]) -> str:
+    """'node 99 is not in the file', 'nodes 1, 2 are ...', with a word on negative ids;
+    or, when the file holds them after the way, that it is not sorted."""
+    found = [node for node in nodes if node in late]
+    if found:
+        return (
+            f"node {found[0]} comes after the way in the file: the extract is not sorted "
+            "(osmium sort FILE -o SORTED.osm)"
+        )
     unique = list(dict.fromkeys(nodes))
     shown = ", ".join(str(i) for i in unique[:LISTED])
     more = f" and {len(unique) - LISTED} more" if len(unique) > LISTED else ""

@@ -104,7 +104,7 @@ def check_xml(path: Path) -> Places:
     except (OSError, EOFError, zlib.error, ValueError) as error:  # a bad gz or bz2 stream
         kind = "gzip" if path.name.lower().endswith(".gz") else "bzip2"
         message = f"cannot inflate the {kind} stream: {error}" if compressed else str(error)
-        raise SpecError.at(file, None, None, message, HINT) from None
+        raise SpecError.at(file, None, None, message, "download the extract again") from None
     if not checker.root:
         raise SpecError.at(file, 1, 1, "not OSM XML: no <osm> element", HINT)
     return checker.places
@@ -120,6 +120,7 @@ class _Checker:
         self.object: tuple[str, int] | None = None  # the node, way or relation open
         self.places: Places = {}
         self.at = (1, 1)  # where the open object starts
+        self.seen: set[tuple[str, int]] = set()  # ways and relations (nodes may repeat)
 
     def fail(self, message: str, hint: str = HINT) -> SpecError:
         line, col = self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1
@@ -142,8 +143,19 @@ class _Checker:
         if name in ("node", "way", "relation"):
             self.object = (name, int(attributes.get("id", "0")))
             self.at = (self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1)
+            self._once(name, who)
         elif name == "tag" and self.object is not None and attributes.get("k") in KEYS:
             self.places.setdefault(self.object, self.at)
+
+    def _once(self, name: str, who: str) -> None:
+        """Each way and relation once: libosmium refuses an extract with two versions."""
+        if self.object is not None and name != "node":
+            if self.object in self.seen:
+                raise self.fail(
+                    f"{who} is in the file twice (a history or change file?)",
+                    "give an extract with one version of each object",
+                )
+            self.seen.add(self.object)
 
     def end(self, name: str) -> None:
         if name in ("node", "way", "relation"):
