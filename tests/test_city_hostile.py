@@ -349,3 +349,19 @@ def test_an_unsorted_extract_or_one_with_an_object_twice_is_exit_2_at_its_line(
     code, _, err = city(capsys, manifest)
     assert code == 2 and ":8:3: error: way 10 is in the file twice" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_ways_out_of_order_are_exit_2_with_the_fix(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    body = nodes() + way(11, [1, 2, 3, 4, 1], building="yes") + way(10, [1, 2, 3, 4, 1])
+    manifest = town(tmp_path, "f.osm", osm(body))
+    code, _, err = city(capsys, manifest)
+    assert code == 2 and ":8:3: error: way 10 comes after way 11: the extract is not sorted" in err
+    assert "(sort it: osmium sort FILE -o SORTED.osm)" in err
+
+
+def test_huge_ids_of_missing_nodes_are_not_looked_up() -> None:
+    from facadecli.city.osm import _present_nodes
+
+    assert _present_nodes("no such file", {-5, 2**62, 2**63 - 1}) == set()

@@ -33,7 +33,9 @@ from facadecli.limits import OSM_ID_MAX, OSM_TEXT_CHARS_MAX
 
 SUFFIXES = (".osm.pbf", ".pbf", ".osm", ".osm.bz2", ".osm.gz")
 HINT = "give an OpenStreetMap extract (.osm.pbf or .osm), a GeoPackage or a GeoJSON file"
+SORT = "sort it: osmium sort FILE -o SORTED.osm.pbf"
 LISTED = 5  # missing nodes or members named in a reason
+LOOKED_UP = 2**48  # ids looked up in a second pass: below (libosmium's id set grows with them)
 
 
 def is_osm(path: Path) -> bool:
@@ -79,7 +81,8 @@ def read_osm(path: Path) -> GeoJSON:
         raise
     except Exception as error:  # libosmium's own refusals: RuntimeError, ValueError, ...
         message = f"libosmium cannot read it: {error}" if str(error) else type(error).__name__
-        raise SpecError.at(file, None, None, message, HINT) from None
+        unsorted = "out of order" in message or "twice" in message
+        raise SpecError.at(file, None, None, message, SORT if unsorted else HINT) from None
     at = {}
     for index, feature in enumerate(drawn.features):
         kind, oid = feature["id"].split("/")
@@ -202,7 +205,10 @@ def _member_ways(file: str, ids: set[int]) -> dict[int, list[int]]:
     """The member ways the file holds, each with the nodes it names that are missing."""
     import osmium
 
-    found = {}
+    found: dict[int, list[int]] = {}
+    ids = {i for i in ids if 0 <= i < LOOKED_UP}
+    if not ids:
+        return found
     processor = osmium.FileProcessor(file).with_locations().with_filter(osmium.filter.IdFilter(ids))
     for item in processor:
         if isinstance(item, osmium.osm.Way):
@@ -214,6 +220,7 @@ def _present_nodes(file: str, ids: set[int]) -> set[int]:
     """Which of these nodes the file holds (after the ways naming them, then)."""
     import osmium
 
+    ids = {i for i in ids if 0 <= i < LOOKED_UP}
     if not ids:
         return set()
     processor = osmium.FileProcessor(file, osmium.osm.NODE).with_filter(osmium.filter.IdFilter(ids))

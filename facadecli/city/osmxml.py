@@ -32,6 +32,7 @@ from facadecli.limits import (
 CHUNK = 1 << 20  # bytes inflated and parsed at a time
 HINT = "export the extract again (osmium cat, JOSM, the OSM website), or fix the value"
 KEYS = ("building", "building:part")
+SORT = "sort it: osmium sort FILE -o SORTED.osm"
 Places = dict[tuple[str, int], tuple[int, int]]  # (kind, id) -> (line, column)
 
 _ID = re.compile(r"-?\d{1,19}", re.ASCII)
@@ -121,6 +122,7 @@ class _Checker:
         self.places: Places = {}
         self.at = (1, 1)  # where the open object starts
         self.seen: set[tuple[str, int]] = set()  # ways and relations (nodes may repeat)
+        self.way = 0  # the largest way id so far
 
     def fail(self, message: str, hint: str = HINT) -> SpecError:
         line, col = self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1
@@ -148,14 +150,20 @@ class _Checker:
             self.places.setdefault(self.object, self.at)
 
     def _once(self, name: str, who: str) -> None:
-        """Each way and relation once: libosmium refuses an extract with two versions."""
-        if self.object is not None and name != "node":
-            if self.object in self.seen:
-                raise self.fail(
-                    f"{who} is in the file twice (a history or change file?)",
-                    "give an extract with one version of each object",
-                )
-            self.seen.add(self.object)
+        """Each way and relation once, and the ways in the order of their ids, as
+        libosmium takes them (it refuses two versions, or ways out of order)."""
+        if self.object is None or name == "node":
+            return
+        if self.object in self.seen:
+            raise self.fail(
+                f"{who} is in the file twice (a history or change file?)",
+                "give an extract with one version of each object",
+            )
+        self.seen.add(self.object)
+        oid = self.object[1]
+        if name == "way" and 0 < oid < self.way:
+            raise self.fail(f"{who} comes after way {self.way}: the extract is not sorted", SORT)
+        self.way = max(self.way, oid) if name == "way" else self.way
 
     def end(self, name: str) -> None:
         if name in ("node", "way", "relation"):
