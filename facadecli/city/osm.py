@@ -60,8 +60,8 @@ class _Drawn:
 
     features: list[dict[str, Any]]
     reasons: dict[int, str]  # feature index -> why it has no geometry
-    ways: dict[int, tuple[dict[str, str], bool, list[int]]]  # id -> tags, closed, missing
-    relations: dict[int, tuple[dict[str, str], list[tuple[str, int, str]]]]  # tags, members
+    ways: dict[int, tuple[bool, list[int]]]  # id -> closed, missing nodes
+    relations: dict[int, tuple[str, list[tuple[str, int, str]]]]  # id -> type, members
 
 
 def read_osm(path: Path) -> GeoJSON:
@@ -104,30 +104,31 @@ def _read(file: str) -> _Drawn:
     for item in processor:
         if isinstance(item, osmium.osm.Area):
             kind = "way" if item.from_way() else "relation"
-            reason = None
+            reason = ""
             try:
                 geometry = json.loads(factory.create_multipolygon(item))
             except RuntimeError as error:
                 geometry, reason = None, f"libosmium cannot draw its outline: {error}"
-            _add(drawn, kind, item.orig_id(), _tags(file, kind, item.orig_id(), item.tags))
+            _add(drawn, kind, item.orig_id(), _tags(file, kind, item.orig_id(), item.tags), reason)
             drawn.features[-1]["geometry"] = geometry
-            if reason is not None:
-                drawn.reasons[len(drawn.features) - 1] = reason
         elif isinstance(item, osmium.osm.Way):
-            tags = _tags(file, "way", _id(file, "way", item.id), item.tags)
+            _tags(file, "way", _id(file, "way", item.id), item.tags)
             missing = [node.ref for node in item.nodes if not node.location.valid()]
-            drawn.ways[item.id] = (tags, item.is_closed(), missing)
+            drawn.ways[item.id] = (item.is_closed(), missing)
         elif isinstance(item, osmium.osm.Relation):
             tags = _tags(file, "relation", _id(file, "relation", item.id), item.tags)
             members = [(m.type, m.ref, m.role) for m in item.members]
-            drawn.relations[item.id] = (tags, members)
+            drawn.relations[item.id] = (tags.get("type", ""), members)
     return drawn
 
 
-def _add(drawn: _Drawn, kind: str, oid: int, tags: dict[str, str]) -> None:
+def _add(drawn: _Drawn, kind: str, oid: int, tags: dict[str, str], reason: str = "") -> None:
+    """A feature; one without a geometry has the reason (and no need of its tags)."""
     drawn.features.append(
         {"type": "Feature", "id": f"{kind}/{oid}", "properties": tags, "geometry": None}
     )
+    if reason:
+        drawn.reasons[len(drawn.features) - 1] = reason
 
 
 def _id(file: str, kind: str, oid: int) -> int:
@@ -159,30 +160,32 @@ def _undrawn(file: str, drawn: _Drawn) -> None:
     """The building ways and multipolygons libosmium drew no area of, as features without
     a geometry, each with the reason (a missing node or member way, an open ring)."""
     done = {f["id"] for f in drawn.features}
-    in_relations = {ref for _, members in drawn.relations.values() for t, ref, _ in members}
+    in_relations = {
+        ref for _, members in drawn.relations.values() for kind, ref, _ in members if kind == "w"
+    }
     undrawn = [
         (oid, way)
         for oid, way in sorted(drawn.ways.items())
         if f"way/{oid}" not in done and oid not in in_relations
     ]
-    late = _present_nodes(file, {node for _, (_, _, missing) in undrawn for node in missing})
-    for oid, (tags, closed, missing) in undrawn:
+    late = _present_nodes(file, {node for _, (_, missing) in undrawn for node in missing})
+    for oid, (closed, missing) in undrawn:
         if missing:
             reason = _missing(missing, late)
         elif not closed:
             reason = "the way is not closed (its first and last nodes differ)"
         else:
             reason = "libosmium could not make a ring of it (too few nodes?)"
-        _add(drawn, "way", oid, tags)
-        drawn.reasons[len(drawn.features) - 1] = reason
+        _add(drawn, "way", oid, {}, reason)
     broken = {
         oid: members
-        for oid, (tags, members) in drawn.relations.items()
-        if f"relation/{oid}" not in done and tags.get("type") in ("multipolygon", "boundary")
+        for oid, (kind, members) in drawn.relations.items()
+        if f"relation/{oid}" not in done and kind in ("multipolygon", "boundary")
     }
     if not broken:
         return
-    found = _member_ways(file, {ref for members in broken.values() for t, ref, _ in members})
+    refs = {ref for members in broken.values() for kind, ref, _ in members if kind == "w"}
+    found = _member_ways(file, refs)
     for oid, members in sorted(broken.items()):
         ways = [(ref, role) for t, ref, role in members if t == "w"]
         absent = [f"{role or 'member'} way {ref}" for ref, role in ways if ref not in found]
@@ -197,8 +200,7 @@ def _undrawn(file: str, drawn: _Drawn) -> None:
             reason = "the multipolygon has no member way"
         else:
             reason = "its member ways do not close into rings"
-        _add(drawn, "relation", oid, drawn.relations[oid][0])
-        drawn.reasons[len(drawn.features) - 1] = reason
+        _add(drawn, "relation", oid, {}, reason)
 
 
 def _member_ways(file: str, ids: set[int]) -> dict[int, list[int]]:
