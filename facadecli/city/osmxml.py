@@ -121,7 +121,7 @@ class _Checker:
         self.object: tuple[str, int] | None = None  # the node, way or relation open
         self.places: Places = {}
         self.at = (1, 1)  # where the open object starts
-        self.seen: set[tuple[str, int]] = set()  # ways and relations (nodes may repeat)
+        self.seen: set[tuple[str, int]] = set()  # relations and new ways (negative ids)
         self.way = 0  # the largest way id so far
 
     def fail(self, message: str, hint: str = HINT) -> SpecError:
@@ -154,16 +154,20 @@ class _Checker:
         libosmium takes them (it refuses two versions, or ways out of order)."""
         if self.object is None or name == "node":
             return
-        if self.object in self.seen:
+        oid = self.object[1]
+        if name == "way" and oid > 0:  # in order: a repeat is one too few to be sorted
+            if oid < self.way:
+                message = f"{who} comes after way {self.way}: the extract is not sorted"
+                raise self.fail(message, SORT)
+            twice, self.way = oid == self.way, oid
+        else:  # relations (and negative ids, JOSM's new objects): fewer, kept in a set
+            twice = self.object in self.seen
+            self.seen.add(self.object)
+        if twice:
             raise self.fail(
                 f"{who} is in the file twice (a history or change file?)",
                 "give an extract with one version of each object",
             )
-        self.seen.add(self.object)
-        oid = self.object[1]
-        if name == "way" and 0 < oid < self.way:
-            raise self.fail(f"{who} comes after way {self.way}: the extract is not sorted", SORT)
-        self.way = max(self.way, oid) if name == "way" else self.way
 
     def end(self, name: str) -> None:
         if name in ("node", "way", "relation"):
