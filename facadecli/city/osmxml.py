@@ -40,7 +40,6 @@ _COUNT = re.compile(r"\d{1,10}", re.ASCII)  # version, changeset: 32-bit
 _UID = re.compile(r"-?\d{1,10}", re.ASCII)
 _COORDINATE = re.compile(r"-?(?:\d{1,12}(?:\.\d{0,20})?|\.\d{1,20})(?:[eE][-+]?\d{1,2})?", re.ASCII)
 _TIMESTAMP = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", re.ASCII)
-_BOUNDS = {"lat": 90.0, "lon": 180.0}
 
 
 def xml_opener(path: Path) -> tuple[Callable[[], io.BufferedIOBase], bool]:
@@ -186,34 +185,79 @@ class _Checker:
         return f"<{name}>"
 
 
+def _an_id(key: str, value: str) -> str | None:
+    if _ID.fullmatch(value) and abs(int(value)) <= OSM_ID_MAX:
+        return None
+    return f"{key} {_show(value)} is not an OSM id (an integer of at most {OSM_ID_MAX:,})"
+
+
+def _a_count(key: str, value: str) -> str | None:
+    if _COUNT.fullmatch(value) and int(value) < 2**32:
+        return None
+    return f"{key} {_show(value)} is not a count (0 to 4,294,967,295)"
+
+
+def _a_user(key: str, value: str) -> str | None:
+    if _UID.fullmatch(value) and -(2**31) <= int(value) < 2**32:
+        return None
+    return f"uid {_show(value)} is not a user id"
+
+
+def _a_time(key: str, value: str) -> str | None:
+    if _TIMESTAMP.fullmatch(value):
+        return None
+    return f"{key} {_show(value)} is not a time (YYYY-MM-DDThh:mm:ssZ)"
+
+
+def _a_truth(key: str, value: str) -> str | None:
+    return None if value in ("true", "false") else f"{key} {_show(value)} is neither true nor false"
+
+
+def _a_latitude(key: str, value: str) -> str | None:
+    if _COORDINATE.fullmatch(value) and abs(float(value)) <= 90:
+        return None
+    return f"{key} {_show(value)} is not a latitude"
+
+
+def _a_longitude(key: str, value: str) -> str | None:
+    if _COORDINATE.fullmatch(value) and abs(float(value)) <= 180:
+        return None
+    return f"{key} {_show(value)} is not a longitude"
+
+
+def _a_text(key: str, value: str) -> str | None:
+    if len(value) <= OSM_TEXT_CHARS_MAX:
+        return None
+    what = {"k": "a tag key", "v": "a tag value", "role": "a role", "user": "a user name"}[key]
+    return f"{what} of {len(value):,} characters (limit: {OSM_TEXT_CHARS_MAX}, as in OSM itself)"
+
+
+Check = Callable[[str, str], "str | None"]
+CHECKS: dict[str, Check] = {  # attribute -> why its value is one libosmium or the limits refuse
+    "id": _an_id,
+    "ref": _an_id,
+    "version": _a_count,
+    "changeset": _a_count,
+    "num_changes": _a_count,
+    "comments_count": _a_count,
+    "uid": _a_user,
+    "timestamp": _a_time,
+    "created_at": _a_time,
+    "closed_at": _a_time,
+    "visible": _a_truth,
+    "open": _a_truth,
+    **dict.fromkeys(("lat", "minlat", "maxlat", "min_lat", "max_lat"), _a_latitude),
+    **dict.fromkeys(("lon", "minlon", "maxlon", "min_lon", "max_lon"), _a_longitude),
+    **dict.fromkeys(("k", "v", "role", "user"), _a_text),
+}
+
+
 def _problem(element: str, key: str, value: str) -> str | None:
     """Why an attribute's value is one libosmium (or the limits) refuses, if it is."""
-    if key in ("id", "ref"):
-        if not _ID.fullmatch(value) or abs(int(value)) > OSM_ID_MAX:
-            return f"{key} {_show(value)} is not an OSM id (an integer of at most {OSM_ID_MAX:,})"
-    elif key in ("version", "changeset", "num_changes", "comments_count"):
-        if not _COUNT.fullmatch(value) or int(value) >= 2**32:
-            return f"{key} {_show(value)} is not a count (0 to 4,294,967,295)"
-    elif key == "uid":
-        if not _UID.fullmatch(value) or not -(2**31) <= int(value) < 2**32:
-            return f"uid {_show(value)} is not a user id"
-    elif key in ("timestamp", "created_at", "closed_at"):
-        if not _TIMESTAMP.fullmatch(value):
-            return f"{key} {_show(value)} is not a time (YYYY-MM-DDThh:mm:ssZ)"
-    elif key in ("visible", "open"):
-        if value not in ("true", "false"):
-            return f"{key} {_show(value)} is neither true nor false"
-    elif (axis := key.replace("_", "").removeprefix("min").removeprefix("max")) in _BOUNDS:
-        if not _COORDINATE.fullmatch(value) or abs(float(value)) > _BOUNDS[axis]:
-            return f"{key} {_show(value)} is not a {'latitude' if axis == 'lat' else 'longitude'}"
-    elif key in ("k", "v", "role", "user"):
-        if len(value) > OSM_TEXT_CHARS_MAX:
-            what = {"k": "a tag key", "v": "a tag value", "role": "a role", "user": "a user name"}
-            return (
-                f"{what[key]} of {len(value):,} characters (limit: {OSM_TEXT_CHARS_MAX}, "
-                "as in OSM itself)"
-            )
-    elif key == "type" and element == "member" and value not in ("node", "way", "relation"):
+    check = CHECKS.get(key)
+    if check is not None:
+        return check(key, value)
+    if key == "type" and element == "member" and value not in ("node", "way", "relation"):
         return f"member type {_show(value)} is not node, way or relation"
     return None
 
