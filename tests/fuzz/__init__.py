@@ -4,6 +4,7 @@ is run in this process. ``tests/fuzz/run.py`` explains the protocol and runs the
 from __future__ import annotations
 
 import contextlib
+import inspect
 import io
 import sys
 from collections.abc import Callable
@@ -20,7 +21,8 @@ class FuzzCase:
     is replaced by the folder), or ``call(folder)`` runs and returns (exit code, stdout,
     stderr) for a door that is no command line (a server). Exit codes outside ``codes``
     fail the case; with a code outside ``whole`` (a refusal), each of ``outputs`` (paths
-    in the folder) must be absent or an empty folder: nothing half-written."""
+    in the folder) must be absent or an empty folder: nothing half-written; after a
+    success they hold no temporary file (a name starting with '.' or ending in '.tmp')."""
 
     files: dict[str, bytes]
     argv: tuple[str, ...] = ()
@@ -42,6 +44,19 @@ class Outcome:
 
     def ok(self, case: FuzzCase) -> bool:
         return self.code in case.codes and not self.internal and not self.partial
+
+
+Door = Callable[[int], FuzzCase] | Callable[[int, Path], list[str]]
+
+
+def make_case(door: Door, seed: int, folder: Path) -> FuzzCase:
+    """Case ``seed`` of a door: a door of one parameter returns its FuzzCase; a door of two
+    writes its files into ``folder`` itself and returns ``facade``'s arguments, its
+    outputs under ``folder / "out"``."""
+    if len(inspect.signature(door).parameters) >= 2:
+        argv = door(seed, folder)  # type: ignore[call-arg]
+        return FuzzCase(files={}, argv=tuple(str(a) for a in argv), outputs=("out",))
+    return door(seed)  # type: ignore[call-arg,return-value]
 
 
 def write(case: FuzzCase, folder: Path) -> None:
@@ -78,11 +93,15 @@ def run_case(case: FuzzCase, folder: Path) -> Outcome:
         code, _, err = facade_in_process([a.replace("{dir}", str(folder)) for a in case.argv])
     internal = "internal error" in err or "Traceback" in err
     partial = []
-    if code not in case.whole:
-        for name in case.outputs:
-            path = folder / name
-            if path.is_dir():
-                partial += [str(p.relative_to(folder)) for p in sorted(path.rglob("*"))]
-            elif path.exists():
-                partial.append(name)
+    for name in case.outputs:
+        path = folder / name
+        found = sorted(path.rglob("*")) if path.is_dir() else [path] if path.exists() else []
+        if code not in case.whole:  # a refusal writes nothing
+            partial += [str(p.relative_to(folder)) for p in found]
+        else:  # a success leaves no temporary file
+            partial += [
+                str(p.relative_to(folder))
+                for p in found
+                if p.name.startswith(".") or p.name.endswith(".tmp")
+            ]
     return Outcome(code, internal, partial, err)

@@ -6,11 +6,14 @@ A module ``tests/fuzz/<topic>_doors.py`` exposes::
 
     DOORS: dict[str, Callable[[int], FuzzCase]]
 
-a door's name (unique across modules: ``osm-xml``, ``spec``, ``watch-http``) -> a function
-that makes case number ``seed`` of that door. A case is a :class:`tests.fuzz.FuzzCase`:
-files to write into a fresh folder, and the ``facade`` arguments to run on them (or a
-``call`` for a door that is no command line), the exit codes that are fine, the outputs a
-refusal must not leave. The same seed must give the same case on every machine (seed a
+a door's name (unique across modules: ``city-osm-xml``, ``spec``, ``watch-http``) -> a
+function that makes case number ``seed`` of that door. A case is a
+:class:`tests.fuzz.FuzzCase`: files to write into a fresh folder, and the ``facade``
+arguments to run on them (or a ``call`` for a door that is no command line), the exit
+codes that are fine, the outputs a refusal must not leave. A door may instead be
+``Callable[[int, Path], list[str]]``: it writes its files into the folder it is given and
+returns ``facade``'s arguments, with the defaults of a FuzzCase (exit 0, 2 or 3; outputs
+in ``<folder>/out``). The same seed must give the same case on every machine (seed a
 ``random.Random`` with it; no clock, no global state), so a failure is reproduced with
 ``--doors NAME --seed N --cases 1``. Keep a case small: thousands run in minutes.
 
@@ -37,7 +40,6 @@ import sys
 import tempfile
 import time
 from collections import Counter
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -46,9 +48,9 @@ ROOT = HERE.parent.parent
 if str(ROOT) not in sys.path:  # run as a script: tests.fuzz importable
     sys.path.insert(0, str(ROOT))
 
-from tests.fuzz import FuzzCase, Outcome, run_case  # noqa: E402
+from tests.fuzz import Door, Outcome, make_case, run_case  # noqa: E402
 
-Doors = dict[str, Callable[[int], FuzzCase]]
+Doors = dict[str, Door]
 
 
 def discover(only: set[str] | None = None) -> dict[str, str]:
@@ -75,8 +77,8 @@ def _worker(connection: multiprocessing.connection.Connection, memory_mb: int) -
         if job is None:
             return
         module, door, seed = job
-        case = importlib.import_module(module).DOORS[door](seed)
         with tempfile.TemporaryDirectory(prefix="facade-fuzz-") as folder:
+            case = make_case(importlib.import_module(module).DOORS[door], seed, Path(folder))
             try:
                 outcome = run_case(case, Path(folder))
             except BaseException as error:  # the harness itself, or a case's own call
