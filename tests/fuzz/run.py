@@ -19,14 +19,16 @@ in ``<folder>/out``). The same seed must give the same case on every machine (se
 
 How cases run
 -------------
-In a worker process that imports facadecli once and runs case after case in-process
-(``facade``'s ``main``), each in its own temporary folder. The runner waits ``--timeout``
-seconds (wall clock, generous: the only place a duration is judged) for each case; past
-it, the case is a hang and the worker is killed and replaced. The worker's address space
-is capped (``--memory-mb``), so a memory bomb ends as a MemoryError (an internal error)
-rather than taking the machine down. A case fails on an exit code outside its ``codes``,
-"internal error" or a traceback on stderr, a hang, or files left by a refusal; the tally
-counts each by door, the failing seeds are listed, and the exit status is 1 if any.
+In a worker process (one a door; ``--jobs`` doors at once) that imports facadecli once and
+runs case after case in-process (``facade``'s ``main``), each in its own temporary
+folder. The runner waits ``--timeout`` seconds (wall clock, generous: the only place a
+duration is judged) for each case; past it, the case is a hang and the worker is killed
+and replaced. The worker's address space is capped (``--memory-mb``), so a memory bomb
+ends as a MemoryError (an internal error) rather than taking the machine down. A case
+fails on an exit code outside its ``codes``, "internal error" or a traceback on stderr, a
+hang, files left by a refusal or temporary files by a success; the tally counts each by
+door (with the worker's peak memory), the failing seeds are listed, and the exit status
+is 1 if any.
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ import sys
 import tempfile
 import time
 from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -116,40 +119,53 @@ class Worker:
         self.process.join(5)
 
 
+def door_row(
+    door: str, module: str, cases: int, first: int, timeout: float, memory_mb: int
+) -> dict[str, Any]:
+    """Run one door's cases in a worker of its own; its tally row."""
+    worker = Worker(memory_mb)
+    codes: Counter[int] = Counter()
+    row: dict[str, Any] = {"door": door, "cases": 0, "internal": 0, "hangs": 0, "partial": 0}
+    row.update(failures=[], peak_mb=0, seconds=0.0)
+    started = time.perf_counter()
+    for seed in range(first, first + cases):
+        result = worker.run((module, door, seed), timeout)
+        row["cases"] += 1
+        if result is None:
+            row["hangs"] += 1
+            row["failures"].append((seed, "hang", f"no answer in {timeout:g} s"))
+            worker.stop(kill=True)
+            worker = Worker(memory_mb)
+            continue
+        code, internal, partial, stderr, ok, peak = result
+        codes[code] += 1
+        row["peak_mb"] = max(row["peak_mb"], peak)
+        row["internal"] += int(internal)
+        row["partial"] += int(bool(partial))
+        if not ok:
+            why = "internal error" if internal else "partial output" if partial else "exit"
+            first_line = (stderr.strip().splitlines() or [""])[-1][:200]
+            row["failures"].append((seed, f"{why} {code}", first_line))
+    worker.stop()
+    row["codes"] = dict(sorted(codes.items()))
+    row["seconds"] = round(time.perf_counter() - started, 1)
+    return row
+
+
 def fuzz(
-    doors: dict[str, str], cases: int, first: int, timeout: float, memory_mb: int
+    doors: dict[str, str], cases: int, first: int, timeout: float, memory_mb: int, jobs: int
 ) -> list[dict[str, Any]]:
-    """Run every door's cases; one tally row a door."""
-    rows = []
-    for door, module in doors.items():
-        worker = Worker(memory_mb)
-        codes: Counter[int] = Counter()
-        row: dict[str, Any] = {"door": door, "cases": 0, "internal": 0, "hangs": 0, "partial": 0}
-        row.update(failures=[], peak_mb=0, seconds=0.0)
-        started = time.perf_counter()
-        for seed in range(first, first + cases):
-            result = worker.run((module, door, seed), timeout)
-            row["cases"] += 1
-            if result is None:
-                row["hangs"] += 1
-                row["failures"].append((seed, "hang", f"no answer in {timeout:g} s"))
-                worker.stop(kill=True)
-                worker = Worker(memory_mb)
-                continue
-            code, internal, partial, stderr, ok, peak = result
-            codes[code] += 1
-            row["peak_mb"] = max(row["peak_mb"], peak)
-            row["internal"] += int(internal)
-            row["partial"] += int(bool(partial))
-            if not ok:
-                why = "internal error" if internal else "partial output" if partial else "exit"
-                first_line = (stderr.strip().splitlines() or [""])[-1][:200]
-                row["failures"].append((seed, f"{why} {code}", first_line))
-        worker.stop()
-        row["codes"] = dict(sorted(codes.items()))
-        row["seconds"] = round(time.perf_counter() - started, 1)
-        rows.append(row)
-        print(_line(row), flush=True)
+    """Run every door's cases, ``jobs`` doors at a time; one tally row a door, printed as
+    each door ends."""
+    with ThreadPoolExecutor(max(1, jobs)) as pool:
+        futures = [
+            pool.submit(door_row, door, module, cases, first, timeout, memory_mb)
+            for door, module in doors.items()
+        ]
+        rows = []
+        for future in futures:
+            rows.append(future.result())
+            print(_line(rows[-1]), flush=True)
     return rows
 
 
@@ -174,6 +190,7 @@ def main() -> int:
     parser.add_argument("--doors", default="", help="comma-separated doors (default: all)")
     parser.add_argument("--timeout", type=float, default=120.0, help="seconds before a hang")
     parser.add_argument("--memory-mb", type=int, default=4000, help="a worker's address space")
+    parser.add_argument("--jobs", type=int, default=1, help="doors fuzzed at once")
     parser.add_argument("--list", action="store_true", help="list the doors and stop")
     options = parser.parse_args()
     only = {d.strip() for d in options.doors.split(",") if d.strip()} or None
@@ -182,7 +199,9 @@ def main() -> int:
         print("\n".join(f"{door}  ({module})" for door, module in doors.items()) or "no door")
         return 0
     print(HEADER, flush=True)
-    rows = fuzz(doors, options.cases, options.seed, options.timeout, options.memory_mb)
+    rows = fuzz(
+        doors, options.cases, options.seed, options.timeout, options.memory_mb, options.jobs
+    )
     failures = [(row["door"], *failure) for row in rows for failure in row["failures"]]
     for door, seed, why, line in failures[:50]:
         print(f"FAIL {door} seed {seed}: {why}: {line}")
