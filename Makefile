@@ -43,8 +43,9 @@ lint: $(STAMP) ## ruff (lint + format check) and mypy
 	$(BIN)/ruff format --check facadecli tests docs
 	$(BIN)/mypy
 
+FUZZ_JOBS ?= 1
 fuzz: $(STAMP) ## Fuzz every door (tests/fuzz/*_doors.py), 1,000 cases a door, and print the tally
-	$(BIN)/python tests/fuzz/run.py --cases 1000
+	$(BIN)/python tests/fuzz/run.py --cases 1000 --jobs $(FUZZ_JOBS)
 
 format: $(STAMP) ## Reformat the code with ruff
 	$(BIN)/ruff check --fix facadecli tests
