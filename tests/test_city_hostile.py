@@ -91,10 +91,11 @@ REFUSED = {  # an extract's body, and where and what the error says
         f"{OSM_TEXT_CHARS_MAX}",
     ),
     "a timestamp": (
-        nodes().replace('id="1"', 'id="1" timestamp="yesterday"') + GOOD[-200:],
+        nodes().replace('id="1"', 'id="1" timestamp="yesterday"')
+        + way(10, [1, 2, 3, 4, 1], building="yes"),
         ":3:3: error: node 1: timestamp 'yesterday' is not a time",
     ),
-    "not XML": (GOOD.replace("<way", "<way <"), "not OSM XML: not well-formed"),
+    "not XML": (GOOD.replace("<way", "<way <"), ":7:8: error: not OSM XML: not well-formed"),
 }
 
 
