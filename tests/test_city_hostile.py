@@ -95,6 +95,14 @@ REFUSED = {  # an extract's body, and where and what the error says
         + way(10, [1, 2, 3, 4, 1], building="yes"),
         ":3:3: error: node 1: timestamp 'yesterday' is not a time",
     ),
+    "an element libosmium does not take": (
+        nodes() + way(10, [1, 2, 3, 4, 1], building="yes").replace("</way>", "<member/></way>"),
+        ":7:108: error: a <member> of way 10: libosmium takes only <nd> and <tag> inside <way>",
+    ),
+    "ways out of libosmium's order": (
+        nodes() + way(-1, [1, 2, 3, 4, 1], building="yes") + way(0, [1, 2, 3, 4, 1]),
+        ":8:3: error: way 0 comes after way -1: the extract is not sorted",
+    ),
     "not XML": (GOOD.replace("<way", "<way <"), ":7:8: error: not OSM XML: not well-formed"),
 }
 

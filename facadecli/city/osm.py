@@ -81,8 +81,12 @@ def read_osm(path: Path) -> GeoJSON:
         raise
     except Exception as error:  # libosmium's own refusals: RuntimeError, ValueError, ...
         message = f"libosmium cannot read it: {error}" if str(error) else type(error).__name__
-        unsorted = "out of order" in message or "twice" in message
-        raise SpecError.at(file, None, None, message, SORT if unsorted else HINT) from None
+        hint = HINT
+        if "out of order" in message or "twice" in message:
+            hint = SORT
+        elif "uncompress" in message:
+            hint = "download the extract again"
+        raise SpecError.at(file, None, None, message, hint) from None
     at = {}
     for index, feature in enumerate(drawn.features):
         kind, oid = feature["id"].split("/")

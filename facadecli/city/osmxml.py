@@ -32,6 +32,14 @@ from facadecli.limits import (
 CHUNK = 1 << 20  # bytes inflated and parsed at a time
 HINT = "export the extract again (osmium cat, JOSM, the OSM website), or fix the value"
 KEYS = ("building", "building:part")
+INSIDE = {  # what libosmium takes inside an element (anything else is an error)
+    "node": ("tag",),
+    "way": ("nd", "tag"),
+    "relation": ("member", "tag"),
+    "tag": (),
+    "nd": (),
+    "member": (),
+}
 SORT = "sort it: osmium sort FILE -o SORTED.osm"
 Places = dict[tuple[str, int], tuple[int, int]]  # (kind, id) -> (line, column)
 
@@ -120,8 +128,9 @@ class _Checker:
         self.object: tuple[str, int] | None = None  # the node, way or relation open
         self.places: Places = {}
         self.at = (1, 1)  # where the open object starts
-        self.seen: set[tuple[str, int]] = set()  # relations and new ways (negative ids)
-        self.way = 0  # the largest way id so far
+        self.seen: set[tuple[str, int]] = set()  # relations (ways are checked in order)
+        self.way: tuple[int, int] | None = None  # the last way's place in libosmium's order
+        self.open: list[str] = []  # the elements open, outermost first
 
     def fail(self, message: str, hint: str = HINT) -> SpecError:
         line, col = self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1
@@ -137,6 +146,14 @@ class _Checker:
             self.root = True
             return
         who = self._who(name, attributes)
+        parent = self.open[-1] if self.open else "osm"
+        self.open.append(name)
+        if name not in INSIDE.get(parent, (name,)):
+            allowed = " and ".join(f"<{e}>" for e in INSIDE[parent])
+            takes = f"only {allowed}" if allowed else "no element"
+            raise self.fail(f"{who}: libosmium takes {takes} inside <{parent}>")
+        if name == "member" and "type" not in attributes:
+            raise self.fail(f"{who}: a member without a type (node, way or relation)")
         for key, value in attributes.items():
             problem = _problem(name, key, value)
             if problem is not None:
@@ -154,12 +171,12 @@ class _Checker:
         if self.object is None or name == "node":
             return
         oid = self.object[1]
-        if name == "way" and oid > 0:  # in order: a repeat is one too few to be sorted
-            if oid < self.way:
-                message = f"{who} comes after way {self.way}: the extract is not sorted"
+        if name == "way":  # in order (:func:`_order`): a repeat is one too few to be sorted
+            if self.way is not None and _order(oid) < self.way:
+                message = f"{who} comes after way {_id_of(self.way)}: the extract is not sorted"
                 raise self.fail(message, SORT)
-            twice, self.way = oid == self.way, oid
-        else:  # relations (and negative ids, JOSM's new objects): fewer, kept in a set
+            twice, self.way = _order(oid) == self.way, _order(oid)
+        else:  # relations: fewer, kept in a set
             twice = self.object in self.seen
             self.seen.add(self.object)
         if twice:
@@ -169,6 +186,8 @@ class _Checker:
             )
 
     def end(self, name: str) -> None:
+        if self.open:
+            self.open.pop()
         if name in ("node", "way", "relation"):
             self.object = None
 
@@ -183,6 +202,15 @@ class _Checker:
             article = "an" if name[0] in "aeiou" else "a"
             return f"{article} <{name}> of {kind} {oid}"
         return f"<{name}>"
+
+
+def _order(oid: int) -> tuple[int, int]:
+    """An id's place in libosmium's order: 0, -1, -2, ..., then 1, 2, ..."""
+    return (0, -oid) if oid <= 0 else (1, oid)
+
+
+def _id_of(order: tuple[int, int]) -> int:
+    return order[1] if order[0] else -order[1]
 
 
 def _an_id(key: str, value: str) -> str | None:
