@@ -4,9 +4,10 @@ it: one streaming pass with expat, inflating a compressed file a chunk at a time
 libosmium stops at the first value it cannot take (a coordinate ``nan``, an id past
 int64, a tag value past 1,024 bytes) with a message that names no place, and reads any
 number of inflated bytes. This pass holds the file to the limits (inflated bytes, tag
-text, ids) and to the value formats libosmium takes, and a value that is not one is a
-SpecError at its line and column, naming the element. It also finds where each element
-tagged as a building starts, to place the features libosmium cannot draw.
+text, ids) and to what libosmium takes: the formats of its values, the elements inside a
+node, way or relation, each way once and in libosmium's order. What breaks one is a
+SpecError at its line and column, naming the element, with the fix. It also finds where
+each element tagged as a building starts, to place the features libosmium cannot draw.
 """
 
 from __future__ import annotations
