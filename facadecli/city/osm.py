@@ -245,8 +245,9 @@ def _missing(nodes: list[int], late: set[int]) -> str:
     unique = list(dict.fromkeys(nodes))
     shown = ", ".join(str(i) for i in unique[:LISTED])
     more = f" and {len(unique) - LISTED} more" if len(unique) > LISTED else ""
-    text = f"nodes {shown}{more} are" if len(unique) > 1 else f"node {shown} is"
+    several = len(unique) > 1
+    text = f"nodes {shown}{more} are" if several else f"node {shown} is"
     text += " not in the file"
     if any(i < 0 for i in unique):
         return text + " (libosmium keeps no location of a node with a negative id: renumber)"
-    return text + ", or without a valid location"
+    return text + (" (or have no valid location)" if several else " (or has no valid location)")
