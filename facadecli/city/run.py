@@ -4,8 +4,10 @@ The unit of work is a building; each writes ``buildings/<id>.glb`` through a tem
 file, so an interrupted run resumes (``--resume``) where it stopped. Results are gathered
 in the manifest's order, so the report and the merged model do not depend on scheduling.
 Everything a user can fix (the output folder, the GeoJSON file, duplicate ids) is checked
-before the first building. Features that are not footprints are listed as rejected, apart
-from the buildings: they do not fail the run; a building that fails to build does.
+before the first building; then the run locks its output folder and removes the temporary
+files a killed run left there (:func:`claimed`), and only those. Features that are not
+footprints are listed as rejected, apart from the buildings: they do not fail the run; a
+building that fails to build does.
 """
 
 from __future__ import annotations
