@@ -9,7 +9,7 @@ OUT    ?= out
 VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 
 .DEFAULT_GOAL := help
-.PHONY: help install demo test test-fast lint format bench bench-large schema golden grammar city pictures clean
+.PHONY: help install demo test test-fast lint format fuzz bench bench-large schema golden grammar city pictures clean
 
 help: ## Show the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-9s %s\n", $$1, $$2}'
@@ -42,6 +42,10 @@ lint: $(STAMP) ## ruff (lint + format check) and mypy
 	$(BIN)/ruff check facadecli tests docs
 	$(BIN)/ruff format --check facadecli tests docs
 	$(BIN)/mypy
+
+FUZZ_JOBS ?= 1
+fuzz: $(STAMP) ## Fuzz every door (tests/fuzz/*_doors.py), 1,000 cases a door, and print the tally
+	$(BIN)/python tests/fuzz/run.py --cases 1000 --jobs $(FUZZ_JOBS)
 
 format: $(STAMP) ## Reformat the code with ruff
 	$(BIN)/ruff check --fix facadecli tests

@@ -517,6 +517,11 @@ def city(
         if entry["line"] is None:
             where = f"{loaded.footprints}: features[{entry['feature']}]"
         _warn(f"{where}: rejected: feature '{entry['id']}': {entry['error']}")
+    for entry in report["warnings"]:  # tags ignored: the building is built without them
+        where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
+        if entry["line"] is None:
+            where = f"{loaded.footprints}: features[{entry['feature']}]"
+        _warn(f"{where}: warning: feature '{entry['id']}': {entry['warning']}")
     for entry in report["buildings"]:
         if entry["status"] != "ok":
             typer.echo(f"{source}: building {entry['id']}: {entry['error']}", err=True)

@@ -87,6 +87,7 @@ class FootprintSet:
     origin: tuple[float, float]  # where local (0, 0) is, in that CRS (scaled to metres)
     outside: int = 0  # features left out by a bounding box
     unit: float = 1.0  # metres per unit of ``crs`` (a CRS in feet is scaled to metres)
+    warnings: tuple[Rejected, ...] = ()  # footprints built without some of their tags
 
 
 def feature_id(feature: Any, index: int) -> str:
@@ -120,17 +121,22 @@ def _document(path: Path) -> GeoJSON:
 BBox = tuple[float, float, float, float]  # west, south, east, north in the file's CRS
 
 
-def read_footprints(path: Path, bbox: BBox | None = None) -> FootprintSet:
+def read_footprints(
+    path: Path, bbox: BBox | None = None, names: Names | None = None
+) -> FootprintSet:
     """Footprints of every usable feature; rejected features with a reason and place.
     With ``bbox``, only the features whose footprint has a point inside it (in the
-    file's CRS: lon/lat for OSM extracts) are read."""
+    file's CRS: lon/lat for OSM extracts) are read. ``names``: the manifest's properties
+    holding heights and levels, checked as the OSM tags are."""
     document = _document(path)
     ids = [feature_id(feature, index) for index, feature in enumerate(document.features)]
     _check_unique(document, ids)
     rejected: list[Rejected] = []
-    readable = _readable(document, ids, rejected)
+    warned: list[Rejected] = []
+    readable = _readable(document, ids, rejected, warned, names)
     inside = readable if bbox is None else [f for f in readable if _within(f[3], bbox)]
     crs = _projected(document.crs, [geometry for *_, geometry in inside])
+    inside_ids = {index for index, *_ in inside}
     found = _in_metres(document, crs, inside, rejected)
     minx = min((geometry.bounds[0] for *_, geometry in found), default=0.0)
     miny = min((geometry.bounds[1] for *_, geometry in found), default=0.0)
@@ -145,9 +151,16 @@ def read_footprints(path: Path, bbox: BBox | None = None) -> FootprintSet:
     if rejected and not footprints:
         raise _nothing_usable(document, rejected)
     outside = len(readable) - len(inside)
-    unit = _unit(crs)
+    built = {footprint.id for footprint in footprints}
+    warnings = tuple(w for w in warned if w.index in inside_ids and w.id in built)
     return FootprintSet(
-        tuple(footprints), tuple(rejected), crs.to_string(), (minx, miny), outside, unit
+        tuple(footprints),
+        tuple(rejected),
+        crs.to_string(),
+        (minx, miny),
+        outside,
+        unit=_unit(crs),
+        warnings=warnings,
     )
 
 
@@ -156,17 +169,25 @@ def _within(geometry: Any, bbox: BBox) -> bool:
     return bbox[0] <= x <= bbox[2] and bbox[1] <= y <= bbox[3]
 
 
-def _readable(document: GeoJSON, ids: list[str], rejected: list[Rejected]) -> list[Found]:
-    """The features that are polygons with plausible properties, in the file's CRS."""
+def _readable(
+    document: GeoJSON,
+    ids: list[str],
+    rejected: list[Rejected],
+    warned: list[Rejected],
+    names: Names | None,
+) -> list[Found]:
+    """The features that are polygons, in the file's CRS, their properties checked
+    (:func:`checked_properties`: what is left out is in ``warned``)."""
     found = []
     for index, (fid, feature) in enumerate(zip(ids, document.features, strict=True)):
-        read = read_feature(feature, document.crs)
-        if not isinstance(read, str):
-            read = _implausible(read[0]) or read
+        reason = document.reasons.get(index)
+        read = reason if reason is not None else read_feature(feature, document.crs)
         if isinstance(read, str):
             rejected.append(_rejected(document, index, fid, read))
-        else:
-            found.append((index, fid, *read))
+            continue
+        properties, problems = checked_properties(read[0], names)
+        warned.extend(_rejected(document, index, fid, problem) for problem in problems)
+        found.append((index, fid, properties, read[1]))
     return found
 
 
@@ -340,37 +361,84 @@ def _far(geometry: Any, middle: tuple[float, float]) -> str | None:
     )
 
 
-_NUMBER = re.compile(r"[-+]?\d+(?:[.,]\d+)?")
+_NUMBER = re.compile(r"[-+]?(?:\d+(?:[.,]\d+)?|[.,]\d+)(?:[eE][-+]?\d+)?", re.ASCII)
+_FEET = re.compile(
+    r"\s*(\d+(?:\.\d+)?)\s*(?:'|ft|feet|foot)\s*(?:(\d+(?:\.\d+)?)\s*(?:\"|in))?\s*", re.ASCII
+)
+FOOT = 0.3048  # metres
+INCH = 0.0254
 
 
 def number(value: Any) -> float | None:
-    """A number from a property: 12, 12.5, "12.5", "12,5 m", "3;4" (the first one)."""
+    """A finite number from a property: 12, 12.5, "12.5", "12,5 m", "1e3", "3;4" (the
+    first one); None for anything else (NaN, "inf", "1e999", "tall")."""
     if isinstance(value, bool) or value is None:
         return None
     if isinstance(value, (int, float)):
-        return float(value) if math.isfinite(value) else None
+        try:
+            found = float(value)
+        except OverflowError:  # an integer beyond any float
+            return None
+        return found if math.isfinite(found) else None
     match = _NUMBER.search(str(value))
-    return float(match.group().replace(",", ".")) if match else None
+    if match is None:
+        return None
+    found = float(match.group().replace(",", "."))
+    return found if math.isfinite(found) else None
 
 
-def _implausible(properties: dict[str, Any]) -> str | None:
-    """Why the feature's height or levels cannot be a building's, if they cannot."""
-    for key, most, unit in (
-        ("height", MAX_HEIGHT, " m"),
-        ("measuredHeight", MAX_HEIGHT, " m"),
-        ("levels", MAX_LEVELS, ""),
-        ("building:levels", MAX_LEVELS, ""),
-    ):
-        value = number(properties.get(key))
-        if value is not None and value > most:
-            return f"{key} {value:g}{unit} is not a building's (at most {most:g}{unit})"
-    return None
+def length(value: Any) -> float | None:
+    """Metres from a property: a number (metres, "12 m"), or feet and inches as OSM
+    allows them ("40'", "12'6\"", "40 ft")."""
+    if isinstance(value, str):
+        feet = _FEET.fullmatch(value)
+        if feet is not None:
+            return float(feet.group(1)) * FOOT + float(feet.group(2) or 0) * INCH
+    return number(value)
+
+
+LENGTHS = ("height", "measuredHeight", "min_height", "roof:height")  # metres
+COUNTS = ("levels", "building:levels", "building:min_level", "roof:levels")  # levels
+Names = dict[str, tuple[str, float]]  # height, eaves, levels, min_height -> (property, scale)
+
+
+def checked_properties(
+    properties: dict[str, Any], names: Names | None = None
+) -> tuple[dict[str, Any], list[str]]:
+    """The properties without the heights and levels no building has (not a finite
+    number, below 0, above BUILDING_HEIGHT_MAX metres or BUILDING_LEVELS_MAX levels, the
+    manifest's scale applied), and a warning for each value left out: the building is
+    then built from its other tags, or the manifest's defaults."""
+    quantities = {key: (1.0, True) for key in LENGTHS} | {key: (1.0, False) for key in COUNTS}
+    for key, (name, scale) in (names or {}).items():
+        quantities[name] = (scale, key != "levels")
+    kept = dict(properties)
+    warnings = []
+    for name, (scale, metres) in quantities.items():
+        value = properties.get(name)
+        if value is None or value == "":
+            continue
+        found = length(value) if metres else number(value)
+        most, unit = (MAX_HEIGHT, " m") if metres else (MAX_LEVELS, " levels")
+        if found is None:
+            problem = "is not a number"
+        elif found < 0:
+            problem = "is below 0"
+        elif found * scale > most:
+            problem = f"is more than a building's {most:g}{unit}"
+        else:
+            continue
+        del kept[name]
+        shown = printable(str(value))
+        shown = shown if len(shown) <= 40 else shown[:37] + "..."
+        warnings.append(f"{name} '{shown}' {problem}: ignored")
+    return kept, warnings
 
 
 def building_height(properties: dict[str, Any], default: float, floor_height: float) -> float:
     """``height`` (or ``measuredHeight``), else levels x floor height, else the default."""
     for key in ("height", "measuredHeight"):
-        height = number(properties.get(key))
+        height = length(properties.get(key))
         if height is not None and height > 0:
             return height
     for key in ("levels", "building:levels"):

@@ -11,8 +11,8 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from typing import Any, overload
@@ -80,6 +80,7 @@ class GeoJSON:
     features: Sequence[Any]  # as read: each may be anything
     crs: pyproj.CRS
     places: Places
+    reasons: Mapping[int, str] = field(default_factory=dict)  # index -> why it has no geometry
 
 
 def read_geojson(path: Path) -> GeoJSON:

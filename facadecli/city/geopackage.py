@@ -8,10 +8,17 @@ are checked exactly as a GeoJSON file's are. The table's CRS comes from
 ``gpkg_spatial_ref_sys`` (an EPSG code, else the WKT definition). A file that is not a
 GeoPackage, or has no feature table or no CRS, is a SpecError (exit 2); a row whose
 geometry cannot be read is a feature the caller rejects with its reason.
+
+A feature table may be a view, and a view may never end (a recursive query) or make
+values far larger than the file: the rows are counted first (at most GPKG_ROWS_MAX),
+SQLite's work is counted in its virtual machine's steps (a budget from the file's size,
+never seconds), a value may not be longer than the file, and the values read may not
+pass the file's size by more than GPKG_BYTES_FREE. Each is exit 2 naming the limit.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sqlite3
 from pathlib import Path
@@ -22,21 +29,49 @@ import pyproj.exceptions
 import shapely
 import shapely.errors
 
-from facadecli.city.geojson import GeoJSON, NoPlaces, too_long
+from facadecli.city.geojson import GeoJSON, NoPlaces, printable, too_long
 from facadecli.errors import SpecError
-from facadecli.limits import GEOJSON_BYTES_MAX
+from facadecli.limits import (
+    GEOJSON_BYTES_MAX,
+    GPKG_BYTES_FREE,
+    GPKG_ROWS_MAX,
+    GPKG_STEPS_FREE,
+    GPKG_STEPS_PER_BYTE,
+)
 
 ENVELOPES = {0: 0, 1: 32, 2: 48, 3: 48, 4: 64}  # envelope code -> bytes (GeoPackage 2.1.3)
 HINT = "give a GeoPackage (.gpkg) with a feature table, or a GeoJSON file"
 
 
+STEPS = 10_000  # SQLite steps between two counts of the budget
+LIMIT_HINT = "give the buildings as a plain table, or cut the district into smaller files"
+
+
+class _Budget:
+    """SQLite's progress handler: counts the steps and stops the query past ``steps``."""
+
+    def __init__(self, steps: int):
+        self.left = steps
+        self.spent = False
+
+    def __call__(self) -> int:
+        self.left -= STEPS
+        self.spent = self.left < 0
+        return int(self.spent)
+
+
 def read_geopackage(path: Path) -> GeoJSON:
     """The features and CRS of the first feature table (see the module)."""
     file = str(path)
-    if path.stat().st_size > GEOJSON_BYTES_MAX:
+    size = path.stat().st_size
+    if size > GEOJSON_BYTES_MAX:
         raise too_long(path)
+    steps = GPKG_STEPS_FREE + GPKG_STEPS_PER_BYTE * size
+    budget = _Budget(steps)
     try:
-        with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as db:
+        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as db:
+            db.setlimit(sqlite3.SQLITE_LIMIT_LENGTH, max(size, 1 << 20))
+            db.set_progress_handler(budget, STEPS)
             tables = db.execute(
                 "SELECT c.table_name, g.column_name, g.srs_id FROM gpkg_contents c "
                 "JOIN gpkg_geometry_columns g ON c.table_name = g.table_name "
@@ -46,13 +81,49 @@ def read_geopackage(path: Path) -> GeoJSON:
                 raise SpecError.at(file, None, None, "the GeoPackage has no feature table", HINT)
             table, column, srs = tables[0]
             crs = _crs(db, srs, file)
-            rows = db.execute(f'SELECT * FROM "{str(table).replace(chr(34), chr(34) * 2)}"')
-            names = [description[0] for description in rows.description]
-            key = _primary_key(db, str(table))
-            features = [_feature(dict(zip(names, row, strict=True)), column, key) for row in rows]
+            features = _features(db, str(table), column, size, file)
     except sqlite3.Error as error:
+        if budget.spent:
+            message = (
+                f"reading the feature table takes more than {steps:,} steps of SQLite's work "
+                f"(limit: {GPKG_STEPS_PER_BYTE} a byte of the file and {GPKG_STEPS_FREE:,}: "
+                "a view that does not end?)"
+            )
+            raise SpecError.at(file, None, None, message, LIMIT_HINT) from None
+        if getattr(error, "sqlite_errorname", "") == "SQLITE_TOOBIG":
+            message = f"a value of the feature table is longer than the file ({size:,} bytes)"
+            raise SpecError.at(file, None, None, message, LIMIT_HINT) from None
         raise SpecError.at(file, None, None, f"not a GeoPackage: {error}", HINT) from None
     return GeoJSON(file, features, crs, NoPlaces())
+
+
+def _features(
+    db: sqlite3.Connection, table: str, column: str, size: int, file: str
+) -> list[dict[str, Any]]:
+    """The table's rows as features: counted first, their values' bytes as they come."""
+    quoted = table.replace('"', '""')
+    name = printable(table)
+    (count,) = db.execute(
+        f'SELECT count(*) FROM (SELECT 1 FROM "{quoted}" LIMIT {GPKG_ROWS_MAX + 1})'
+    ).fetchone()
+    if count > GPKG_ROWS_MAX:
+        message = f"the feature table '{name}' has more than {GPKG_ROWS_MAX:,} rows"
+        raise SpecError.at(file, None, None, message, LIMIT_HINT)
+    rows = db.execute(f'SELECT * FROM "{quoted}"')
+    names = [description[0] for description in rows.description]
+    key = _primary_key(db, table)
+    features = []
+    most, read = size + GPKG_BYTES_FREE, 0
+    for row in rows:
+        read += sum(len(v) for v in row if isinstance(v, (str, bytes)))
+        if read > most:
+            message = (
+                f"reading the feature table '{name}' makes more than {most:,} bytes (the "
+                f"file's size and {GPKG_BYTES_FREE:,}: a view?)"
+            )
+            raise SpecError.at(file, None, None, message, LIMIT_HINT)
+        features.append(_feature(dict(zip(names, row, strict=True)), column, key))
+    return features
 
 
 def _crs(db: sqlite3.Connection, srs: Any, file: str) -> pyproj.CRS:

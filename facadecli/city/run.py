@@ -4,12 +4,15 @@ The unit of work is a building; each writes ``buildings/<id>.glb`` through a tem
 file, so an interrupted run resumes (``--resume``) where it stopped. Results are gathered
 in the manifest's order, so the report and the merged model do not depend on scheduling.
 Everything a user can fix (the output folder, the GeoJSON file, duplicate ids) is checked
-before the first building. Features that are not footprints are listed as rejected, apart
-from the buildings: they do not fail the run; a building that fails to build does.
+before the first building; then the run locks its output folder and removes the temporary
+files a killed run left there (:func:`claimed`), and only those. Features that are not
+footprints are listed as rejected, apart from the buildings: they do not fail the run; a
+building that fails to build does.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -39,7 +42,14 @@ from facadecli.city.cityjson import (
     building_object,
     write_cityjson,
 )
-from facadecli.city.footprints import BBox, Footprint, Rejected, Simplified, read_footprints
+from facadecli.city.footprints import (
+    BBox,
+    Footprint,
+    FootprintSet,
+    Rejected,
+    Simplified,
+    read_footprints,
+)
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.s3db import (
@@ -62,6 +72,11 @@ from facadecli.export.usd import city_usda, usda_text
 from facadecli.geometry.facade import transmissions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
+
+try:
+    import fcntl
+except ImportError:  # Windows: runs are not locked
+    fcntl = None  # type: ignore[assignment]
 
 
 @dataclass(frozen=True)
@@ -408,6 +423,65 @@ def check_output(outdir: Path, name: str) -> None:
         raise SpecError.at("--output", None, None, problem, "give another folder, or move it")
 
 
+# mkstemp's names: a prefix, 8 characters of these, a suffix (facadecli.export.atomic,
+# glb_merge, cityjson write ``.<target>.<8>.tmp``, ``.bin``, ``.objects``, ``.vertices``)
+_RANDOM = r"\.[a-z0-9_]{8}\."
+
+
+def leftovers(outdir: Path, name: str) -> list[Path]:
+    """The temporary files a killed run of the city ``name`` left in ``outdir``: only
+    regular files named as this tool names them, beside the outputs it writes."""
+    plain = re.escape(name)
+    patterns = {
+        outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda)"
+        rf"{_RANDOM}(?:tmp|bin|objects|vertices)",
+        outdir / "buildings": rf"\.[A-Za-z0-9._~-]+\.(?:glb|city\.jsonl|usda){_RANDOM}tmp",
+        outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
+    }
+    found = []
+    for folder, pattern in patterns.items():
+        matcher = re.compile(pattern, re.ASCII)
+        try:
+            entries = list(os.scandir(folder))
+        except OSError:  # no such folder (yet)
+            continue
+        for entry in entries:
+            if matcher.fullmatch(entry.name) and entry.is_file(follow_symlinks=False):
+                found.append(Path(entry.path))
+    return sorted(found)
+
+
+@contextlib.contextmanager
+def claimed(outdir: Path, name: str) -> Iterator[None]:
+    """The output folder, made and locked for this run (``flock``: another run into it
+    is exit 2), with what a killed run left in it removed (:func:`leftovers`)."""
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+        folder = os.open(outdir, os.O_RDONLY)
+    except OSError as error:
+        raise OutputError(f"{outdir}: cannot write the outputs: {error.strerror}") from None
+    try:
+        if fcntl is not None:
+            try:
+                fcntl.flock(folder, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise SpecError.at(
+                    "--output",
+                    None,
+                    None,
+                    f"another facade city run is writing in '{outdir}'",
+                    "wait for it to end, or give another folder",
+                ) from None
+            except OSError:  # a file system without locks: run unlocked
+                pass
+        for path in leftovers(outdir, name):
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+        yield
+    finally:
+        os.close(folder)  # and with it the lock
+
+
 def run_city(
     city: City,
     outdir: Path,
@@ -427,12 +501,45 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    found = read_footprints(city.footprints, bbox)
-    georef = Georef(found.crs, found.origin, found.unit)
+    found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
     footprints, kept = standing(city, found.footprints, replaced)
     footprints = footprints[: limit if limit is not None else None]
     tasks = plan(city, footprints, outdir, usd)
+    with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
+        return _build(
+            city,
+            outdir,
+            tasks,
+            found,
+            replaced,
+            kept,
+            jobs,
+            resume,
+            progress,
+            scheduler,
+            usd,
+            started,
+        )
+
+
+def _build(
+    city: City,
+    outdir: Path,
+    tasks: list[Task],
+    found: FootprintSet,
+    replaced: dict[str, list[str]],
+    kept: dict[str, float],
+    jobs: int,
+    resume: bool,
+    progress: Callable[[int, int], None] | None,
+    scheduler: str | None,
+    usd: bool,
+    started: float,
+) -> dict[str, Any]:
+    """The planned buildings built (those built before skipped with ``resume``), then
+    the merged models, the CityJSON and the report written; returns the report."""
+    georef = Georef(found.crs, found.origin, found.unit)
     results: list[dict[str, Any]] = []
     todo = []
     for task in tasks:
@@ -514,6 +621,7 @@ def run_city(
         "georeference": georeference(georef),
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
+        "warnings": [_warning(w) for w in found.warnings if w.id in by_id],
         "replaced": [
             {"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())
         ],
@@ -523,6 +631,7 @@ def run_city(
             "ok": len(results) - len(failed),
             "failed": len(failed),
             "rejected": len(found.rejected),
+            "warnings": sum(1 for w in found.warnings if w.id in by_id),
             "outside_bbox": found.outside,
             "replaced": sum(1 for area in kept.values() if area == 0),
             "trimmed": sum(1 for area in kept.values() if area > 0),
@@ -550,6 +659,17 @@ def _rejected(rejected: Rejected) -> dict[str, Any]:
         "feature": rejected.index,
         "line": rejected.line,
         "column": rejected.column,
+    }
+
+
+def _warning(warned: Rejected) -> dict[str, Any]:
+    """A built feature's report entry for what of its tags was ignored, and where."""
+    return {
+        "id": warned.id,
+        "warning": warned.reason,
+        "feature": warned.index,
+        "line": warned.line,
+        "column": warned.column,
     }
 
 

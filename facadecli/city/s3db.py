@@ -28,7 +28,7 @@ from shapely import STRtree
 from shapely.geometry import LineString, Polygon
 from shapely.geometry.polygon import orient
 
-from facadecli.city.footprints import MIN_AREA, Footprint, number
+from facadecli.city.footprints import MAX_HEIGHT, MIN_AREA, Footprint, length, number
 from facadecli.city.manifest import Roof
 from facadecli.city.roofs import roof_height
 
@@ -109,30 +109,32 @@ def tagged_heights(
 
     def read(key: str, *osm: str) -> float | None:
         """The named property (scaled) if the feature has it, else the OSM tags."""
+        parse = number if key == "levels" else length
         if key in names:
             name, scale = names[key]
-            value = number(properties.get(name))
+            value = parse(properties.get(name))
             if value is not None and value > 0:
                 return value * scale
         for tag in osm:
-            value = number(properties.get(tag))
+            value = parse(properties.get(tag))
             if value is not None and value > 0:
                 return value
         return None
 
+    def storeys(levels: float | None) -> float | None:
+        """Levels as metres, at most MAX_HEIGHT (300 levels of 20 m would pass it)."""
+        return None if levels is None or levels <= 0 else min(levels * floor_height, MAX_HEIGHT)
+
     top = read("height", "height", "measuredHeight")
     eaves = read("eaves")
-    levels = read("levels", "building:levels", "levels")
-    if eaves is None and levels is not None:
-        eaves = levels * floor_height
+    if eaves is None:
+        eaves = storeys(read("levels", "building:levels", "levels"))
     base = read("min_height", "min_height")
     if base is None:
-        min_level = number(properties.get("building:min_level"))
-        base = min_level * floor_height if min_level is not None and min_level > 0 else 0.0
-    roof = number(properties.get("roof:height"))
+        base = storeys(number(properties.get("building:min_level"))) or 0.0
+    roof = length(properties.get("roof:height"))
     if roof is None or roof <= 0:
-        roof_levels = number(properties.get("roof:levels"))
-        roof = roof_levels * floor_height if roof_levels is not None and roof_levels > 0 else None
+        roof = storeys(number(properties.get("roof:levels")))
     if top is not None and eaves is not None and roof is None:
         roof = max(0.0, top - eaves)  # both known: the roof is what lies between
     return Heights(top, eaves, base, roof, default)
