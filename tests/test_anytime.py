@@ -368,3 +368,25 @@ def test_a_visible_letter_is_not_fitted_over_an_unoccludable_one_below() -> None
     among = construct.laid_for(window, [(base, sizes), (pier, laid_pier)])
     fit = construct.fit(window, sizes, points, 4.0, among)
     assert fit == pytest.approx({"h": 2.0, "h2": 1.0})
+
+
+def test_a_fitted_placeholder_has_a_length() -> None:
+    """`g (h V)^2 E` over bays: the only fit of four bays gives h no length, so that the
+    transparent h and the visible V would share a column entry, which no cut can make: no
+    fit. With a fifth bay, h takes one."""
+    for width, expected in ((5.0, None), (6.0, {"g": 1.0, "h": 1.0})):
+        base, row = _rows_of(
+            f"""
+            version: 1
+            name: lengths
+            canvas: {{width: {width}, height: 3.0}}
+            symbols: {{S: 1.0, E: 1.0, H: {{size: 3.0, opaque: true}}, V: 1.0, g: {{}}, h: {{}}}}
+            patterns:
+              bays: {"S " * int(width - 1)}E
+              windows: {{control: g (h v)^2 e, where: {{v: V, e: E}}}}
+            layers: [{{name: base, x: bays, y: H}}, {{name: windows, x: windows, y: H}}]
+            """
+        )
+        sizes = {"S": 1.0, "E": 1.0, "V": 1.0}
+        fit = construct.fit(row, sizes, construct.boundaries(base, sizes), width)
+        assert fit == (None if expected is None else pytest.approx(expected))
