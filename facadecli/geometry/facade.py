@@ -16,9 +16,16 @@ import trimesh
 from trimesh.visual.material import PBRMaterial
 
 from facadecli.errors import SpecError
-from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
+from facadecli.geometry.primitives import GLAZED, PANES, PRIMITIVES, Cell, asset, recess
 from facadecli.geometry.runs import built
-from facadecli.layout import BUILTIN_GLASS, PANE_MATERIAL, Layout, Shape
+from facadecli.layout import (
+    BUILTIN_GLASS,
+    BUILTIN_INTERIOR,
+    INTERIOR_MATERIAL,
+    PANE_MATERIAL,
+    Layout,
+    Shape,
+)
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.spec.model import Material, Spec
 
@@ -91,7 +98,10 @@ def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
 
 def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     """The visible shapes of a layout as a scene (hidden ones are culled). A frame or an
-    arch is two meshes: its bars in the shape's material and its pane in the pane's."""
+    arch is two meshes: its bars in the shape's material and its pane in the pane's. Every
+    window is backed here, in one place: behind each see-through pane, and behind each box
+    or panel of a see-through material, a closed dark recess (:func:`.recess`) in the
+    ``interior`` material, so that no view through a window passes through the model."""
     spec = layout.spec
     materials = {name: pbr(name, m, base_dir) for name, m in spec.materials.items()}
     assets: dict[str, trimesh.Trimesh] = {}
@@ -155,16 +165,36 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             node = f"{layer.name}/{shape.x}.{shape.y}/{count}"
             count += 1
             cell = Cell.of(shape)
-            place(shape, "", shape.material, partial(_build, shape, cell, base_dir, assets), node)
+            build = partial(_build, shape, cell, base_dir, assets)
+            place(shape, "", shape.material, build, node)
+            if shape.mesh in GLAZED and _see_through(spec, shape.material):
+                place(shape, "recess", INTERIOR_MATERIAL, partial(_recess, build), f"{node}/recess")
             pane = PANES.get(shape.mesh)
             if pane is not None:
                 glass = shape.look.pane_material if shape.look else PANE_MATERIAL
                 place(shape, "pane", glass, partial(pane, cell), f"{node}/pane")
+                if _see_through(spec, glass):
+                    back = partial(_recess, partial(pane, cell))
+                    place(shape, "pane-recess", INTERIOR_MATERIAL, back, f"{node}/recess")
     return scene
+
+
+def _see_through(spec: Spec, name: str) -> bool:
+    """Whether a material lets the view through (blended or transmitting): glass."""
+    material = spec.materials.get(name) or _builtin(name)
+    return material.opacity < 1.0 or material.transmission > 0.0
+
+
+def _recess(glass: Callable[[], trimesh.Trimesh | None]) -> trimesh.Trimesh | None:
+    """The dark recess behind the glass a builder makes (none when it makes none)."""
+    mesh = glass()
+    return None if mesh is None else recess(mesh)
 
 
 def _builtin(material: str) -> Material:
     """The built-in material of a name a spec does not define."""
+    if material == INTERIOR_MATERIAL:
+        return BUILTIN_INTERIOR
     return BUILTIN_GLASS if material == PANE_MATERIAL else FALLBACK_MATERIAL
 
 

@@ -26,7 +26,10 @@ from facadecli.geometry.cell import (
     shutter_plan,
 )
 
-__all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset"]
+__all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset", "recess"]
+
+RECESS_DEPTH = 0.12  # metres from the back of a window's glass to the plate behind it
+RECESS_WALL = 0.02  # how thick the recess's back plate and its reveals are
 
 
 def _block(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> trimesh.Trimesh:
@@ -312,6 +315,27 @@ def shutter(cell: Cell) -> trimesh.Trimesh:
         parts.append(_extrude_x(profile, x0, x1))
     return trimesh.util.concatenate(parts)
 
+
+def recess(glass: trimesh.Trimesh) -> trimesh.Trimesh:
+    """The closed dark recess behind a window's glass (in the glass's frame): a back plate
+    :data:`RECESS_DEPTH` behind the back of the glass, as large as the glass seen head-on,
+    and four reveals from it up to the glass. A ray that passes the glass meets it, so the
+    street behind a façade never shows through its windows."""
+    (x0, y0, z0), (x1, y1, _) = glass.bounds
+    wall = min(RECESS_WALL, (x1 - x0) / 4, (y1 - y0) / 4)
+    back = z0 - RECESS_DEPTH
+    parts = [
+        _block(x0, x1, y0, y1, back - RECESS_WALL, back),  # the back plate
+        _block(x0, x0 + wall, y0, y1, back, z0),  # the reveals: sides, then bottom and top
+        _block(x1 - wall, x1, y0, y1, back, z0),
+        _block(x0 + wall, x1 - wall, y0, y0 + wall, back, z0),
+        _block(x0 + wall, x1 - wall, y1 - wall, y1, back, z0),
+    ]
+    return trimesh.util.concatenate(parts)
+
+
+#: meshes that are glass all over when their material is see-through: backed like a pane
+GLAZED = frozenset({"box", "panel"})
 
 #: the panes of the primitives that have one, in the shape rule's ``pane_material``
 PANES: dict[str, Callable[[Cell], trimesh.Trimesh | None]] = {
