@@ -64,6 +64,19 @@ def _hits(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> 
 
 def nearest(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
     """For each ray, the index of the first triangle it meets (−1 for none)."""
+    t = _distances(triangles, origins, direction)
+    first = t.argmin(axis=1)
+    return np.where(np.isfinite(t.min(axis=1)), first, -1)
+
+
+def reach(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """For each ray, how far along ``direction`` (a unit vector) it first meets a triangle
+    (infinity for none)."""
+    return _distances(triangles, origins, direction).min(axis=1)
+
+
+def _distances(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """(rays, triangles): where along each ray it meets each triangle, infinity if not."""
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     e1, e2 = b - a, c - a
     p = np.cross(direction, e2)
@@ -76,9 +89,7 @@ def nearest(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -
     v = (q * direction).sum(axis=2) * inv[None]
     t = (q * e2[None]).sum(axis=2) * inv[None]
     inside = usable[None] & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & (t > 0)
-    t = np.where(inside, t, np.inf)
-    first = t.argmin(axis=1)
-    return np.where(np.isfinite(t.min(axis=1)), first, -1)
+    return np.where(inside, t, np.inf)
 
 
 def opaque_triangles(scene: trimesh.Scene, see_through: set[str] = frozenset()) -> np.ndarray:

@@ -205,8 +205,29 @@ def column(cell: Cell) -> trimesh.Trimesh:
 def ledge(cell: Cell) -> trimesh.Trimesh:
     """A moulded horizontal band, one profile extruded along the cell (runs of ledges along
     a floor are merged into one before they are built, see :mod:`.runs`): a fillet, a cove
-    out to a corona, a sloped top that sheds rain; its back fills the cell."""
-    return _extrude_x(ledge_profile(cell), 0.0, cell.width)
+    out to a corona, a sloped top that sheds rain; its back fills the cell. Its ends are
+    capped: the grooves the profile leaves in its cell (under the cove, over the slope)
+    are closed by a thin return at both ends, so at a façade's free end, where the wall
+    behind the band is culled, no notch lets the sky through."""
+    w = cell.width
+    parts = [_extrude_x(ledge_profile(cell), 0.0, w)]
+    cap = min(LEDGE_CAP, w / 4)
+    for groove in ledge_grooves(cell):
+        parts += [_extrude_x(groove, 0.0, cap), _extrude_x(groove, w - cap, w)]
+    return trimesh.util.concatenate(parts)
+
+
+LEDGE_CAP = 0.01  # metres: how thick the returns closing a ledge's grooves at its ends are
+
+
+def ledge_grooves(cell: Cell) -> list[list[tuple[float, float]]]:
+    """What the profile leaves empty of its cell's section, as (y, z) outlines: the cove
+    under the corona and the wedge over the sloped top."""
+    profile = ledge_profile(cell)
+    h = cell.height
+    top = [profile[2], profile[3], (h, 0.0)]  # the slope's end, the corona's top, the corner
+    bottom = [*profile[4:], (0.0, 0.0)]  # the corona's foot, the cove, the fillet, the corner
+    return [top, bottom]
 
 
 def ledge_profile(cell: Cell) -> list[tuple[float, float]]:
