@@ -18,6 +18,7 @@ from trimesh.visual.material import PBRMaterial
 from facadecli.errors import SpecError
 from facadecli.geometry.primitives import GLAZED, PANES, PRIMITIVES, Cell, asset, recess
 from facadecli.geometry.runs import built
+from facadecli.geometry.walls import wall_mesh
 from facadecli.layout import (
     BUILTIN_GLASS,
     BUILTIN_INTERIOR,
@@ -98,7 +99,9 @@ def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
 
 def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     """The visible shapes of a layout as a scene (hidden ones are culled). A frame or an
-    arch is two meshes: its bars in the shape's material and its pane in the pane's. Every
+    arch is two meshes: its bars in the shape's material and its pane in the pane's. The
+    walls (opaque boxes) of a layer are one mesh per material and depth, whatever their
+    cells (:func:`.wall_mesh`): no seams between the cells. Every
     window is backed here, in one place: behind each see-through pane, and behind each box
     or panel of a see-through material, a closed dark recess (:func:`.recess`) in the
     ``interior`` material, so that no view through a window passes through the model."""
@@ -110,6 +113,17 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     shared: dict[tuple[object, ...], str | None] = {}  # a part already built -> its geometry
     faces: dict[str, int] = {}  # triangles of each shared mesh
     total = 0  # triangles of the whole model (every node)
+
+    def dress(mesh: trimesh.Trimesh, material: str) -> trimesh.Trimesh:
+        """The mesh in a material (with texture coordinates in metres if it has a texture)."""
+        declared = spec.materials.get(material)
+        look = materials.get(material) or pbr(material, _builtin(material))
+        if declared is not None and declared.texture is not None:
+            mesh = metric_uv(mesh, declared.texture_size)
+            mesh.visual.material = look
+        else:
+            mesh.visual = trimesh.visual.TextureVisuals(material=look)
+        return mesh
 
     def place(
         shape: Shape,
@@ -138,13 +152,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             shared[key] = None
             return
         _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
-        declared = spec.materials.get(material)
-        look = materials.get(material) or pbr(material, _builtin(material))
-        if declared is not None and declared.texture is not None:
-            mesh = metric_uv(mesh, declared.texture_size)
-            mesh.visual.material = look
-        else:
-            mesh.visual = trimesh.visual.TextureVisuals(material=look)
+        mesh = dress(mesh, material)
         name = f"{shape.mesh.replace('/', '_')}-{material}-{len(shared)}"
         shared[key] = name
         faces[name] = len(mesh.faces)
@@ -159,8 +167,14 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             continue
         scene.graph.update(frame_to=f"layer:{layer.name}", frame_from=world)
         count = 0
+        walls: dict[tuple[str, float, float], list[tuple[float, float, float, float]]] = {}
         for shape in pieces:
             if shape.layer != layer.name:
+                continue
+            if shape.mesh == "box" and not _see_through(spec, shape.material):
+                z0 = min(shape.z0, shape.z1 - 1e-4)  # as thin as a box may be
+                group = walls.setdefault((shape.material, z0, shape.z1), [])
+                group.append((shape.x0, shape.x1, shape.y0, shape.y1))
                 continue
             node = f"{layer.name}/{shape.x}.{shape.y}/{count}"
             count += 1
@@ -176,6 +190,17 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
                 if _see_through(spec, glass):
                     back = partial(_recess, partial(pane, cell))
                     place(shape, "pane-recess", INTERIOR_MATERIAL, back, f"{node}/recess")
+        for (material, z0, z1), cells in walls.items():  # one mesh each: no seams
+            mesh = dress(wall_mesh(cells, z0, z1), material)
+            name = f"walls-{layer.name}-{material}-{count}"
+            total = _count(spec.name, total, len(mesh.faces))
+            scene.add_geometry(
+                mesh,
+                geom_name=name,
+                node_name=f"{layer.name}/walls-{material}/{count}",
+                parent_node_name=f"layer:{layer.name}",
+            )
+            count += 1
     return scene
 
 
