@@ -17,6 +17,8 @@ PANE_MATERIAL = "glass"  # the panes of frames and arches: the spec's glass, els
 BUILTIN_GLASS = Material(
     color="#a9c8e4", metallic=0.0, roughness=0.05, opacity=0.35, transmission=0.9
 )
+INTERIOR_MATERIAL = "interior"  # the dark recess behind every window: the spec's, else this
+BUILTIN_INTERIOR = Material(color="#26282c", metallic=0.0, roughness=0.95)
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import trimesh
 
 TILT = math.radians(35)  # from the façade's normal
 
@@ -63,6 +64,19 @@ def _hits(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> 
 
 def nearest(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
     """For each ray, the index of the first triangle it meets (−1 for none)."""
+    t = _distances(triangles, origins, direction)
+    first = t.argmin(axis=1)
+    return np.where(np.isfinite(t.min(axis=1)), first, -1)
+
+
+def reach(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """For each ray, how far along ``direction`` (a unit vector) it first meets a triangle
+    (infinity for none)."""
+    return _distances(triangles, origins, direction).min(axis=1)
+
+
+def _distances(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """(rays, triangles): where along each ray it meets each triangle, infinity if not."""
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     e1, e2 = b - a, c - a
     p = np.cross(direction, e2)
@@ -75,6 +89,27 @@ def nearest(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -
     v = (q * direction).sum(axis=2) * inv[None]
     t = (q * e2[None]).sum(axis=2) * inv[None]
     inside = usable[None] & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & (t > 0)
-    t = np.where(inside, t, np.inf)
-    first = t.argmin(axis=1)
-    return np.where(np.isfinite(t.min(axis=1)), first, -1)
+    return np.where(inside, t, np.inf)
+
+
+def opaque_triangles(scene: trimesh.Scene, see_through: set[str] = frozenset()) -> np.ndarray:
+    """The triangles of a loaded model (a glb read back) that stop the view: those of every
+    material but the blended ones and those named in ``see_through`` (transmitting glass)."""
+    parts = []
+    for node in scene.graph.nodes_geometry:
+        transform, geometry = scene.graph[node]
+        mesh = scene.geometry[geometry]
+        material = mesh.visual.material
+        if material.alphaMode == "BLEND" or material.name in see_through:
+            continue
+        parts.append(mesh.copy().apply_transform(transform).triangles)
+    return np.concatenate(parts)
+
+
+def grid(low: np.ndarray, high: np.ndarray, step: float, margin: float) -> np.ndarray:
+    """Target points (x, y, 0) every ``step`` metres over the rectangle from ``low`` to
+    ``high`` (x, y), ``margin`` metres in from its edges: a ray that close to a free end
+    at 35° may leave through the wall's end, which is no window."""
+    xs = np.arange(low[0] + margin, high[0] - margin + 1e-9, step)
+    ys = np.arange(low[1] + margin, high[1] - margin + 1e-9, step)
+    return np.array([(x, y, 0.0) for x in xs for y in ys])

@@ -133,6 +133,9 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
     low, high = merged.bounds
     assert low[1] == pytest.approx(-0.01, abs=1e-3)  # the ground
     assert high[1] >= 9.0  # the tallest building's roof
+    looks = [g.visual.material for g in merged.geometry.values()]
+    interiors = [m for m in looks if m.name == "interior"]  # the recesses behind windows
+    assert interiors and all(max(m.baseColorFactor[:3]) < 64 for m in interiors)
     first = json.loads((out / "demo-district.report.json").read_text())["buildings"][0]
     assert first["facades"] >= 4 and first["id"] == "way/1000"
     again = run_city(city, out, jobs=1, resume=True)

@@ -16,7 +16,8 @@ from facadecli.export.svg import svg_text
 from facadecli.geometry.cell import Cell, railing_plan, shutter_plan
 from facadecli.geometry.facade import facade_scene, transmissions
 from facadecli.geometry.primitives import PANES, PRIMITIVES
-from tests.rays import directions, missing, nearest
+from facadecli.geometry.runs import built
+from tests.rays import directions, missing, nearest, reach
 
 ROOT = Path(__file__).resolve().parent.parent
 STRAIGHT = np.array([0.0, 0.0, -1.0])
@@ -150,6 +151,35 @@ def test_a_profile_breaks_where_its_material_or_a_gap_does() -> None:
     assert len(_pieces(brass)) == 4  # stone, brass, stone, brass
     gap = LEDGES.replace("visible: {y: [K]}", "visible: {x: [A], y: [K]}")
     assert len(_pieces(gap)) == 2  # the two A cells are not side by side
+
+
+@pytest.mark.parametrize(
+    "path", [None, *sorted((ROOT / "specs").glob("*.yaml"))], ids=lambda p: p and p.stem
+)
+def test_a_string_course_closes_the_free_ends_of_its_facade(path: Path | None) -> None:
+    """Rays along the façade plane, from beyond each free end (x = 0 and x = width), through
+    every point of the section of a string course that reaches that end: each meets the
+    model at the end itself. The grooves a ledge's profile leaves in its cell (under the
+    cove, over the slope) are capped; nothing lets the sky through along the course."""
+    layout = solve(parse_spec(LEDGES) if path is None else load_spec(path))
+    courses = [s for s in built(layout.shapes) if s.mesh == "ledge"]
+    ends = [s for s in courses if s.x0 < 1e-9 or s.x1 > layout.width - 1e-9]
+    if not ends:
+        pytest.skip("no string course reaches a free end")
+    triangles = facade_scene(layout).to_geometry().triangles
+    cast = 0
+    for course in ends:
+        ys = np.linspace(course.y0 + 1e-3, course.y1 - 1e-3, 24)
+        zs = np.linspace(course.z0 + 1e-3, course.z1 - 1e-3, 24)
+        section = np.array([(y, z) for y in ys for z in zs])
+        for end, towards in ((0.0, 1.0), (layout.width, -1.0)):
+            if abs(end - (course.x0 if towards > 0 else course.x1)) > 1e-9:
+                continue
+            origins = np.column_stack([np.full(len(section), end - towards), section])
+            met = reach(triangles, origins, np.array([towards, 0.0, 0.0]))
+            assert (met <= 1.0 + 1e-6).all(), section[met > 1.0 + 1e-6][:5].tolist()
+            cast += len(section)
+    assert cast > 0
 
 
 def test_glass_lets_light_through_in_the_glb(tmp_path: Path) -> None:

@@ -33,7 +33,13 @@ from facadecli.city.s3db import Heights, Volume, along, party_zone, volume
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
-from facadecli.layout import DEFAULT_MATERIAL, Layout, build_shapes
+from facadecli.layout import (
+    BUILTIN_INTERIOR,
+    DEFAULT_MATERIAL,
+    INTERIOR_MATERIAL,
+    Layout,
+    build_shapes,
+)
 from facadecli.solver.axis import AxisLayout, solve_axis_alternatives
 from facadecli.spec.model import Material, Spec
 
@@ -267,7 +273,8 @@ def build_building(
     materials.update(_materials(spec, base_dir, looks))
     for name in sorted(parts):
         merged = trimesh.util.concatenate(parts[name])
-        material = materials.get(name) or pbr(name, Material())
+        fallback = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
+        material = materials.get(name) or pbr(name, fallback)  # the recesses stay dark
         merged.visual = trimesh.visual.TextureVisuals(material=material)
         scene.add_geometry(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"

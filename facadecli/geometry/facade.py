@@ -16,9 +16,17 @@ import trimesh
 from trimesh.visual.material import PBRMaterial
 
 from facadecli.errors import SpecError
-from facadecli.geometry.primitives import PANES, PRIMITIVES, Cell, asset
+from facadecli.geometry.primitives import GLAZED, PANES, PRIMITIVES, Cell, asset, recess
 from facadecli.geometry.runs import built
-from facadecli.layout import BUILTIN_GLASS, PANE_MATERIAL, Layout, Shape
+from facadecli.geometry.walls import wall_mesh
+from facadecli.layout import (
+    BUILTIN_GLASS,
+    BUILTIN_INTERIOR,
+    INTERIOR_MATERIAL,
+    PANE_MATERIAL,
+    Layout,
+    Shape,
+)
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.spec.model import Material, Spec
 
@@ -91,7 +99,12 @@ def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
 
 def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     """The visible shapes of a layout as a scene (hidden ones are culled). A frame or an
-    arch is two meshes: its bars in the shape's material and its pane in the pane's."""
+    arch is two meshes: its bars in the shape's material and its pane in the pane's. The
+    walls (opaque boxes) of a layer are one mesh per material and depth, whatever their
+    cells (:func:`.wall_mesh`): no seams between the cells. Every
+    window is backed here, in one place: behind each see-through pane, and behind each box
+    or panel of a see-through material, a closed dark recess (:func:`.recess`) in the
+    ``interior`` material, so that no view through a window passes through the model."""
     spec = layout.spec
     materials = {name: pbr(name, m, base_dir) for name, m in spec.materials.items()}
     assets: dict[str, trimesh.Trimesh] = {}
@@ -100,6 +113,17 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     shared: dict[tuple[object, ...], str | None] = {}  # a part already built -> its geometry
     faces: dict[str, int] = {}  # triangles of each shared mesh
     total = 0  # triangles of the whole model (every node)
+
+    def dress(mesh: trimesh.Trimesh, material: str) -> trimesh.Trimesh:
+        """The mesh in a material (with texture coordinates in metres if it has a texture)."""
+        declared = spec.materials.get(material)
+        look = materials.get(material) or pbr(material, _builtin(material))
+        if declared is not None and declared.texture is not None:
+            mesh = metric_uv(mesh, declared.texture_size)
+            mesh.visual.material = look
+        else:
+            mesh.visual = trimesh.visual.TextureVisuals(material=look)
+        return mesh
 
     def place(
         shape: Shape,
@@ -128,13 +152,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             shared[key] = None
             return
         _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
-        declared = spec.materials.get(material)
-        look = materials.get(material) or pbr(material, _builtin(material))
-        if declared is not None and declared.texture is not None:
-            mesh = metric_uv(mesh, declared.texture_size)
-            mesh.visual.material = look
-        else:
-            mesh.visual = trimesh.visual.TextureVisuals(material=look)
+        mesh = dress(mesh, material)
         name = f"{shape.mesh.replace('/', '_')}-{material}-{len(shared)}"
         shared[key] = name
         faces[name] = len(mesh.faces)
@@ -149,22 +167,59 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             continue
         scene.graph.update(frame_to=f"layer:{layer.name}", frame_from=world)
         count = 0
+        walls: dict[tuple[str, float, float], list[tuple[float, float, float, float]]] = {}
         for shape in pieces:
             if shape.layer != layer.name:
+                continue
+            if shape.mesh == "box" and not _see_through(spec, shape.material):
+                z0 = min(shape.z0, shape.z1 - 1e-4)  # as thin as a box may be
+                group = walls.setdefault((shape.material, z0, shape.z1), [])
+                group.append((shape.x0, shape.x1, shape.y0, shape.y1))
                 continue
             node = f"{layer.name}/{shape.x}.{shape.y}/{count}"
             count += 1
             cell = Cell.of(shape)
-            place(shape, "", shape.material, partial(_build, shape, cell, base_dir, assets), node)
+            build = partial(_build, shape, cell, base_dir, assets)
+            place(shape, "", shape.material, build, node)
+            if shape.mesh in GLAZED and _see_through(spec, shape.material):
+                place(shape, "recess", INTERIOR_MATERIAL, partial(_recess, build), f"{node}/recess")
             pane = PANES.get(shape.mesh)
             if pane is not None:
                 glass = shape.look.pane_material if shape.look else PANE_MATERIAL
                 place(shape, "pane", glass, partial(pane, cell), f"{node}/pane")
+                if _see_through(spec, glass):
+                    back = partial(_recess, partial(pane, cell))
+                    place(shape, "pane-recess", INTERIOR_MATERIAL, back, f"{node}/recess")
+        for (material, z0, z1), cells in walls.items():  # one mesh each: no seams
+            mesh = dress(wall_mesh(cells, z0, z1), material)
+            name = f"walls-{layer.name}-{material}-{count}"
+            total = _count(spec.name, total, len(mesh.faces))
+            scene.add_geometry(
+                mesh,
+                geom_name=name,
+                node_name=f"{layer.name}/walls-{material}/{count}",
+                parent_node_name=f"layer:{layer.name}",
+            )
+            count += 1
     return scene
+
+
+def _see_through(spec: Spec, name: str) -> bool:
+    """Whether a material lets the view through (blended or transmitting): glass."""
+    material = spec.materials.get(name) or _builtin(name)
+    return material.opacity < 1.0 or material.transmission > 0.0
+
+
+def _recess(glass: Callable[[], trimesh.Trimesh | None]) -> trimesh.Trimesh | None:
+    """The dark recess behind the glass a builder makes (none when it makes none)."""
+    mesh = glass()
+    return None if mesh is None else recess(mesh)
 
 
 def _builtin(material: str) -> Material:
     """The built-in material of a name a spec does not define."""
+    if material == INTERIOR_MATERIAL:
+        return BUILTIN_INTERIOR
     return BUILTIN_GLASS if material == PANE_MATERIAL else FALLBACK_MATERIAL
 
 

@@ -26,7 +26,10 @@ from facadecli.geometry.cell import (
     shutter_plan,
 )
 
-__all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset"]
+__all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset", "recess"]
+
+RECESS_DEPTH = 0.12  # metres from the back of a window's glass to the plate behind it
+RECESS_WALL = 0.02  # how thick the recess's back plate and its reveals are
 
 
 def _block(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> trimesh.Trimesh:
@@ -202,8 +205,29 @@ def column(cell: Cell) -> trimesh.Trimesh:
 def ledge(cell: Cell) -> trimesh.Trimesh:
     """A moulded horizontal band, one profile extruded along the cell (runs of ledges along
     a floor are merged into one before they are built, see :mod:`.runs`): a fillet, a cove
-    out to a corona, a sloped top that sheds rain; its back fills the cell."""
-    return _extrude_x(ledge_profile(cell), 0.0, cell.width)
+    out to a corona, a sloped top that sheds rain; its back fills the cell. Its ends are
+    capped: the grooves the profile leaves in its cell (under the cove, over the slope)
+    are closed by a thin return at both ends, so at a façade's free end, where the wall
+    behind the band is culled, no notch lets the sky through."""
+    w = cell.width
+    parts = [_extrude_x(ledge_profile(cell), 0.0, w)]
+    cap = min(LEDGE_CAP, w / 4)
+    for groove in ledge_grooves(cell):
+        parts += [_extrude_x(groove, 0.0, cap), _extrude_x(groove, w - cap, w)]
+    return trimesh.util.concatenate(parts)
+
+
+LEDGE_CAP = 0.01  # metres: how thick the returns closing a ledge's grooves at its ends are
+
+
+def ledge_grooves(cell: Cell) -> list[list[tuple[float, float]]]:
+    """What the profile leaves empty of its cell's section, as (y, z) outlines: the cove
+    under the corona and the wedge over the sloped top."""
+    profile = ledge_profile(cell)
+    h = cell.height
+    top = [profile[2], profile[3], (h, 0.0)]  # the slope's end, the corona's top, the corner
+    bottom = [*profile[4:], (0.0, 0.0)]  # the corona's foot, the cove, the fillet, the corner
+    return [top, bottom]
 
 
 def ledge_profile(cell: Cell) -> list[tuple[float, float]]:
@@ -312,6 +336,27 @@ def shutter(cell: Cell) -> trimesh.Trimesh:
         parts.append(_extrude_x(profile, x0, x1))
     return trimesh.util.concatenate(parts)
 
+
+def recess(glass: trimesh.Trimesh) -> trimesh.Trimesh:
+    """The closed dark recess behind a window's glass (in the glass's frame): a back plate
+    :data:`RECESS_DEPTH` behind the back of the glass, as large as the glass seen head-on,
+    and four reveals from it up to the glass. A ray that passes the glass meets it, so the
+    street behind a façade never shows through its windows."""
+    (x0, y0, z0), (x1, y1, _) = glass.bounds
+    wall = min(RECESS_WALL, (x1 - x0) / 4, (y1 - y0) / 4)
+    back = z0 - RECESS_DEPTH
+    parts = [
+        _block(x0, x1, y0, y1, back - RECESS_WALL, back),  # the back plate
+        _block(x0, x0 + wall, y0, y1, back, z0),  # the reveals: sides, then bottom and top
+        _block(x1 - wall, x1, y0, y1, back, z0),
+        _block(x0 + wall, x1 - wall, y0, y0 + wall, back, z0),
+        _block(x0 + wall, x1 - wall, y1 - wall, y1, back, z0),
+    ]
+    return trimesh.util.concatenate(parts)
+
+
+#: meshes that are glass all over when their material is see-through: backed like a pane
+GLAZED = frozenset({"box", "panel"})
 
 #: the panes of the primitives that have one, in the shape rule's ``pane_material``
 PANES: dict[str, Callable[[Cell], trimesh.Trimesh | None]] = {
