@@ -5,6 +5,8 @@
 - the ``facade ...`` commands of the README's shell blocks exit 0, run from the repository's
   root with their outputs (``out/...``) moved into a temporary folder; solve and validate
   always, the others (vary, view, city) under ``@pytest.mark.slow``;
+- every ``facade`` command of the tutorials and how-to guides runs as written, in order,
+  with the files the guide asks the reader to create (slow);
 - ``mkdocs build --strict`` succeeds, where mkdocs is installed (the ``docs`` extra);
 - the shipped samples (samples/) go through grammar, infer and city.
 """
@@ -177,3 +179,74 @@ def test_site_builds_strictly(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stdout + done.stderr
     assert (tmp_path / "site" / "index.html").is_file()
     assert (tmp_path / "site" / "reference" / "spec" / "index.html").is_file()
+
+
+# -- the tutorials' and how-to guides' commands ------------------------------------------
+GUIDES = sorted([*(ROOT / "docs/tutorials").glob("*.md"), *(ROOT / "docs/how-to").glob("*.md")])
+# commands a guide shows that cannot run here: a server that runs until stopped, a cluster,
+# a manifest of the reader's own (the guide says so)
+NOT_HERE = re.compile(r"\bwatch\b|--scheduler|district\.yaml|/shared/")
+CREATE = re.compile(r"[Cc]reate `([^`/]+)`")
+
+
+def guide_steps(page: Path) -> list[tuple[str, str]]:
+    """A guide's steps in order: ("file", NAME + "\\n" + text) for a fenced block right after
+    "Create `NAME`", ("run", command) for each ``facade`` line of its shell blocks."""
+    steps: list[tuple[str, str]] = []
+    lines = page.read_text().splitlines()
+    creating, block, kind = None, [], None
+    for line in lines:
+        if kind is None:
+            fence = re.match(r"^```(\w*)", line)
+            if fence:
+                kind, block = fence.group(1) or "text", []
+                continue
+            found = CREATE.search(line)
+            if found:
+                creating = found.group(1)
+            elif line.strip():
+                creating = None if not line.startswith("Create") else creating
+            continue
+        if line.startswith("```"):
+            if creating is not None and kind not in ("sh", "bash", "shell", "console"):
+                steps.append(("file", creating + "\n" + "\n".join(block) + "\n"))
+            if kind in ("sh", "bash", "shell"):
+                for command in block:
+                    command = command.split("&&")[0].strip()
+                    if command.startswith("facade ") and not NOT_HERE.search(command):
+                        steps.append(("run", " ".join(shlex.split(command, comments=True))))
+            creating, kind = None, None
+            continue
+        block.append(line)
+    return steps
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page", GUIDES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_guides_commands_run_in_order(page: Path, tmp_path: Path) -> None:
+    """Every ``facade`` command of a tutorial or how-to guide runs as written, in order, in a
+    folder holding the repository's specs/ and samples/ and the files the guide creates."""
+    for name in ("specs", "samples"):
+        (tmp_path / name).symlink_to(ROOT / name)
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
+    }
+    for kind, text in guide_steps(page):
+        if kind == "file":
+            name, _, body = text.partition("\n")
+            (tmp_path / name).write_text(body)
+            continue
+        words = []  # the shell's globbing, as a reader's shell does it
+        for word in shlex.split(text)[1:]:
+            matched = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.glob(word))
+            words += matched if "*" in word and matched else [word]
+        done = subprocess.run(
+            [sys.executable, "-m", "facadecli", *words],
+            cwd=tmp_path,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
+        assert done.returncode == 0, f"{page.name}: {text}\n{done.stdout}\n{done.stderr}"
