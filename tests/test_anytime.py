@@ -390,3 +390,28 @@ def test_a_fitted_placeholder_has_a_length() -> None:
         sizes = {"S": 1.0, "E": 1.0, "V": 1.0}
         fit = construct.fit(row, sizes, construct.boundaries(base, sizes), width)
         assert fit == (None if expected is None else pytest.approx(expected))
+
+
+def test_letters_that_touch_within_rounding_leave_their_boundary_free() -> None:
+    """Three 0.1 m letters end at 0.30000000000000004, where a letter of another row starts
+    at 0.3: the letters touch, so a row may turn from transparent to visible there (joining
+    them as overlapping once shut such points, and the fit went on to 0.6)."""
+    base, over, row = _rows_of(
+        """
+        version: 1
+        name: rounding
+        canvas: {width: 1.0, height: 3.0}
+        symbols: {A: 0.1, C: 0.3, D: 0.4, H: {size: 3.0, opaque: true}, V: 0.3,
+                  u: {}, w: {}, g: {}, h: {}}
+        patterns:
+          bays: A A A C D
+          over: {control: u c w, where: {c: C}}
+          window: {control: g v h, where: {v: V}}
+        layers: [{name: base, x: bays, y: H}, {name: over, x: over, y: H},
+                 {name: window, x: window, y: H}]
+        """
+    )
+    sizes = {"A": 0.1, "C": 0.3, "D": 0.4, "V": 0.3}
+    points = construct.boundaries(base, sizes)
+    among = construct.laid_for(row, [(base, sizes), (over, {**sizes, "u": 0.3, "w": 0.4})])
+    assert construct.fit(row, sizes, points, 1.0, among) == pytest.approx({"g": 0.3, "h": 0.4})

@@ -229,9 +229,12 @@ def laid_for(row: Row, laid: Sequence[tuple[Row, Mapping[str, float]]]) -> Laid:
 
 
 def _merged(spans: list[Span]) -> list[Span]:
+    """Open spans, those that overlap joined; spans that only touch (within rounding: a
+    letter's end summed along one row and the next one's start along another) stay apart,
+    so that the boundary between them stays free."""
     merged: list[Span] = []
     for a, b in sorted(spans):
-        if merged and a < merged[-1][1]:
+        if merged and a < merged[-1][1] - NEAR * max(1.0, abs(merged[-1][1])):
             merged[-1] = (merged[-1][0], max(merged[-1][1], b))
         else:
             merged.append((a, b))
