@@ -10,13 +10,18 @@ import json
 import re
 import struct
 from pathlib import Path
+from typing import Any
 
 from facadecli.limits import (
+    GLTF_DEPTH_MAX,
+    GLTF_NODES_MAX,
     MESH_BYTES_MAX,
     MESH_FACES_MAX,
     TEXTURE_PIXELS_MAX,
     TEXTURE_SIDE_MAX,
 )
+
+INSTANCES_CAP = 2**62  # copies of one node counted (a shared subtree can double at each level)
 
 
 def mesh_problem(path: Path) -> str | None:
@@ -27,11 +32,16 @@ def mesh_problem(path: Path) -> str | None:
     if size > MESH_BYTES_MAX:
         return f"is {size:,} bytes, more than a mesh file may be ({MESH_BYTES_MAX:,})"
     data = path.read_bytes()
-    counted = _declared_faces(path.suffix.lower(), data)
+    suffix = path.suffix.lower()
+    counted = _declared_faces(suffix, data)
     if isinstance(counted, str):
         return counted
     if counted is not None and counted > MESH_FACES_MAX:
-        return f"has {counted:,} triangles, more than a mesh may have ({MESH_FACES_MAX:,})"
+        instanced = " (each instance in its scene counted)" if suffix in (".glb", ".gltf") else ""
+        return (
+            f"has {counted:,} triangles{instanced}, more than the limit of triangles of one "
+            f"mesh file ({MESH_FACES_MAX:,})"
+        )
     import numpy as np
     import trimesh  # only for specs that name mesh files
 
@@ -44,7 +54,10 @@ def mesh_problem(path: Path) -> str | None:
     if faces is None or vertices is None or len(faces) == 0:
         return "holds no triangles"
     if len(faces) > MESH_FACES_MAX:
-        return f"has {len(faces):,} triangles, more than a mesh may have ({MESH_FACES_MAX:,})"
+        return (
+            f"has {len(faces):,} triangles, more than the limit of triangles of one mesh "
+            f"file ({MESH_FACES_MAX:,})"
+        )
     if not np.isfinite(vertices).all():
         return "has vertices that are not finite numbers (NaN or infinity)"
     return None
@@ -87,17 +100,87 @@ def _gltf_faces(suffix: str, data: bytes) -> int | str:
     try:
         document = json.loads(text)
         accessors = document.get("accessors", [])
-        total = 0
+        mesh_faces = []
         for mesh in document.get("meshes", []):
+            faces = 0
             for primitive in mesh.get("primitives", []):
                 if "indices" in primitive:
-                    total += int(accessors[primitive["indices"]]["count"]) // 3
+                    accessor = primitive["indices"]
                 else:
-                    position = primitive["attributes"]["POSITION"]
-                    total += int(accessors[position]["count"]) // 3
+                    accessor = primitive["attributes"]["POSITION"]
+                faces += int(accessors[_index(accessor, len(accessors))]["count"]) // 3
+            mesh_faces.append(faces)
+        return _instanced_faces(document, mesh_faces)
     except (ValueError, KeyError, IndexError, TypeError, AttributeError, RecursionError):
         return "has a glTF JSON part that is not valid glTF"
-    return total
+
+
+def _instanced_faces(document: dict[str, Any], mesh_faces: list[int]) -> int | str:
+    """Triangles of the glTF's meshes as its scenes place them: a mesh counts once for every
+    path from a scene to a node that shows it (loading flattens the scenes, so 400 nodes
+    showing one mesh hold 400 copies of it). The node graph is read first, bounded by
+    ``GLTF_NODES_MAX`` nodes and ``GLTF_DEPTH_MAX`` levels, and must have no cycle."""
+    nodes = document.get("nodes", [])
+    if not isinstance(nodes, list):
+        raise TypeError("nodes")
+    if len(nodes) > GLTF_NODES_MAX:
+        return (
+            f"has {len(nodes):,} nodes, more than the limit of nodes of one mesh file "
+            f"({GLTF_NODES_MAX:,})"
+        )
+    children: list[list[int]] = []
+    for node in nodes:
+        kids = node.get("children", [])
+        children.append([_index(kid, len(nodes)) for kid in kids])
+    roots = [
+        _index(root, len(nodes))
+        for scene in document.get("scenes", [])
+        for root in scene.get("nodes", [])
+    ]
+    parents = [0] * len(nodes)
+    for kids in children:
+        for kid in kids:
+            parents[kid] += 1
+    if not roots:  # no scene: the nodes no other node holds
+        roots = [index for index, count in enumerate(parents) if count == 0]
+    # Kahn's order: parents before children; a node never reached is on a cycle
+    instances = [0] * len(nodes)
+    depth = [1] * len(nodes)
+    for root in roots:
+        instances[root] += 1
+    waiting = list(parents)
+    ready = [index for index, count in enumerate(waiting) if count == 0]
+    ordered = 0
+    while ready:
+        index = ready.pop()
+        ordered += 1
+        for kid in children[index]:
+            instances[kid] = min(instances[kid] + instances[index], INSTANCES_CAP)
+            depth[kid] = max(depth[kid], depth[index] + 1)
+            waiting[kid] -= 1
+            if waiting[kid] == 0:
+                ready.append(kid)
+    if ordered < len(nodes):
+        return "has a node graph with a cycle (a node is its own ancestor), which glTF forbids"
+    deepest = max(depth, default=0)
+    if deepest > GLTF_DEPTH_MAX:
+        return (
+            f"nests its nodes {deepest:,} levels deep, more than the limit of node depth "
+            f"of one mesh file ({GLTF_DEPTH_MAX})"
+        )
+    total = 0
+    for index, node in enumerate(nodes):
+        mesh = node.get("mesh")
+        if mesh is not None:
+            total += instances[index] * mesh_faces[_index(mesh, len(mesh_faces))]
+    return max(total, sum(mesh_faces))
+
+
+def _index(value: object, length: int) -> int:
+    """``value`` as an index into a glTF array of ``length`` items (a ValueError if not)."""
+    if type(value) is not int or not 0 <= value < length:
+        raise ValueError(f"{value!r} is not an index")
+    return value
 
 
 def texture_problem(path: Path) -> str | None:

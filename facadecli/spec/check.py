@@ -38,6 +38,7 @@ class Checker:
         self.base_dir = base_dir
         self.problems: list[Problem] = []
         self.parsed: dict[Path, Node | None] = {}
+        self.file_problems: dict[FilePath, str | None] = {}  # each file is read once
 
     def report(
         self, path: Path, message: str, hint: str = "", *, key: bool = False, offset: int = -1
@@ -345,7 +346,10 @@ class Checker:
                     f"put it at {resolved} or fix the path (relative to the spec file)",
                 )
             else:
-                problem = (mesh_problem if kind == "mesh" else texture_problem)(resolved)
+                if resolved not in self.file_problems:
+                    check = mesh_problem if kind == "mesh" else texture_problem
+                    self.file_problems[resolved] = check(resolved)
+                problem = self.file_problems[resolved]
                 if problem is not None:
                     self.report(
                         path,

@@ -1,0 +1,198 @@
+"""The reproducers of issue 37 at the spec, asset and grammar-layout doors, made small: each
+ends in exit 2 with its place and the limit's name (or a correct exit 0), before the
+expensive work, with nothing written."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from facadecli.native import GRAMMAR_COMPILED
+from tests.fuzz.spec_doors import (
+    ASSET_SPEC,
+    chain_glb,
+    glb,
+    instanced_glb,
+    layout_cmp,
+    layout_json,
+    mesh_document,
+    staggered_rects,
+)
+from tests.running import facade, files
+
+# -- glTF assets: counted through the scene graph, before they are loaded -------------------
+
+
+def _asset_spec(tmp_path: Path, data: bytes) -> Path:
+    (tmp_path / "thing.glb").write_bytes(data)
+    spec = tmp_path / "assets.yaml"
+    spec.write_text(ASSET_SPEC.format(mesh="thing.glb"))
+    return spec
+
+
+@pytest.mark.parametrize("command", ["validate", "solve"])
+def test_instances_of_one_mesh_count_against_the_triangle_limit(
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    command: str,
+) -> None:
+    """400 nodes showing one 81,920-triangle mesh were flattened into 32,768,000 triangles."""
+    from facadecli.spec import assets
+
+    monkeypatch.setattr(assets, "MESH_FACES_MAX", 1000)  # the same shape, 1/200 of the size
+    spec = _asset_spec(tmp_path, instanced_glb(triangles=500, instances=4))
+    out = tmp_path / "out"
+    code, _, err = facade(capsys, command, spec, *(["-o", out] if command == "solve" else []))
+    assert code == 2, err
+    assert "assets.yaml:8:" in err and "thing.glb" in err
+    assert "has 2,000 triangles (each instance in its scene counted)" in err
+    assert "limit of triangles of one mesh file (1,000)" in err
+    assert files(out) == []
+
+
+def test_instances_within_the_limit_solve(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    spec = _asset_spec(tmp_path, instanced_glb(triangles=5, instances=4))
+    code, _, err = facade(capsys, "solve", spec, "-o", tmp_path / "out", "-f", "glb")
+    assert code == 0, err
+    assert files(tmp_path / "out") == ["assets.glb"]
+
+
+@pytest.mark.parametrize(
+    ("data", "expected"),
+    [
+        (chain_glb(40), "nests its nodes 40 levels deep, more than the limit of node depth"),
+        (instanced_glb(1, 2049), "has 2,049 nodes, more than the limit of nodes of one mesh"),
+    ],
+)
+def test_node_graphs_are_bounded_before_loading(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, data: bytes, expected: str
+) -> None:
+    spec = _asset_spec(tmp_path, data)
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and expected in err and "assets.yaml:8:" in err, err
+
+
+def _glb_with_nodes(nodes: list[dict[str, object]], roots: list[int]) -> bytes:
+    document, binary = mesh_document(1, nodes)
+    document["scenes"] = [{"nodes": roots}]
+    return glb(document, binary)
+
+
+@pytest.mark.parametrize(
+    ("nodes", "roots", "expected"),
+    [
+        ([{"children": [1]}, {"children": [0], "mesh": 0}], [0], "a cycle"),
+        ([{"children": [0], "mesh": 0}], [0], "a cycle"),
+        ([{"children": [5]}], [0], "not valid glTF"),
+        ([{"children": [-1]}], [0], "not valid glTF"),
+        ([{"mesh": -1}], [0], "not valid glTF"),
+        ([{"mesh": 0}], [True], "not valid glTF"),
+    ],
+)
+def test_broken_node_graphs_are_refused(
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+    nodes: list[dict[str, object]],
+    roots: list[int],
+    expected: str,
+) -> None:
+    spec = _asset_spec(tmp_path, _glb_with_nodes(nodes, roots))
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and expected in err and "thing.glb" in err, err
+
+
+def test_a_shared_subtree_counts_once_per_path(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each level of 30 points twice at the next: 2^30 paths to the mesh, counted, not walked."""
+    from facadecli.spec import assets
+
+    nodes: list[dict[str, object]] = [{"children": [i + 1, i + 1]} for i in range(30)]
+    nodes.append({"mesh": 0})
+    spec = _asset_spec(tmp_path, _glb_with_nodes(nodes, [0]))
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and f"has {2**30:,} triangles" in err, err
+    monkeypatch.setattr(assets, "MESH_FACES_MAX", 2**31)
+    monkeypatch.setattr(assets, "GLTF_DEPTH_MAX", 2)
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and "31 levels deep" in err, err
+
+
+# -- facade grammar on rectangles whose regions all differ -------------------------------------
+
+
+@pytest.mark.parametrize("form", ["json", "xml"])
+def test_staggered_squares_are_refused_by_the_search_budget(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, form: str
+) -> None:
+    """300 squares on a slant took 5 GB, then a RecursionError; 40 with a budget 1/100 of the
+    real one are refused the same way, by the limit's name."""
+    from facadecli.grammar import regions
+
+    monkeypatch.setattr(regions, "CELLS_READ_MAX", 300_000)
+    rects = staggered_rects(40)
+    layout = tmp_path / f"slant.{form}"
+    layout.write_text(layout_json(rects) if form == "json" else layout_cmp(rects))
+    out = tmp_path / "out"
+    code, _, err = facade(capsys, "grammar", layout, "-o", out)
+    assert code == 2, err
+    assert f"slant.{form}: error:" in err and "limit of cells a grammar search reads" in err
+    assert "--snap" in err
+    assert files(out) == []
+
+
+def test_the_budget_stops_adp_with_the_best_grammar_so_far(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from facadecli.grammar import regions
+
+    monkeypatch.setattr(regions, "CELLS_READ_MAX", 300_000)  # the greedy grammar reads 140,033
+    layout = tmp_path / "slant.json"
+    layout.write_text(layout_json(staggered_rects(12)))
+    out = tmp_path / "out"
+    code, _, err = facade(capsys, "grammar", layout, "-o", out)
+    assert code == 0, err
+    assert "the search read the most cells of regions it may (300,000)" in err
+    assert len(files(out)) == 5
+
+
+def test_a_grammar_deeper_than_the_limit_is_refused(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from facadecli.grammar import search
+
+    monkeypatch.setattr(search, "DEPTH_MAX", 3)
+    layout = tmp_path / "slant.json"
+    layout.write_text(layout_json(staggered_rects(8)))
+    code, _, err = facade(capsys, "grammar", layout, "-o", tmp_path / "out", "--method", "greedy")
+    assert code == 2 and "limit of rules nested in a grammar (3)" in err, err
+    assert files(tmp_path / "out") == []
+
+
+@pytest.mark.skipif(not GRAMMAR_COMPILED, reason="compares the compiled search with Python")
+def test_the_compiled_search_and_python_read_the_same_cells(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from facadecli.grammar import regions, run
+    from facadecli.grammar.deadline import Deadline
+    from facadecli.grammar.search import Search
+    from facadecli.grammar.tiling import tile
+
+    layout = tmp_path / "slant.json"
+    layout.write_text(layout_json(staggered_rects(8)))
+    deadline = Deadline()
+    tiling = tile(run.tidy_layout(layout, run.Options(), deadline).layout, tolerance=0.0)
+    monkeypatch.setattr(regions, "CELLS_READ_MAX", 100_000)
+    found = []
+    for compiled in (True, False):
+        search = Search(tiling, deadline=deadline, compiled=compiled)
+        search.greedy()
+        greedy = search.grid.cells_read
+        _, best_at, done = search.adp(200, seed=1)
+        found.append((greedy, search.grid.cells_read, search.grid.spent, best_at, done))
+    assert found[0] == found[1]
+    assert found[0][0] == 85_116 and found[0][2] and found[0][4] < 200  # ADP stopped
