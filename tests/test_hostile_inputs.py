@@ -196,3 +196,47 @@ def test_the_compiled_search_and_python_read_the_same_cells(
         found.append((greedy, search.grid.cells_read, search.grid.spent, best_at, done))
     assert found[0] == found[1]
     assert found[0][0] == 85_116 and found[0][2] and found[0][4] < 200  # ADP stopped
+
+
+# -- "did you mean": bounded work ---------------------------------------------------------------
+
+HINT_SPEC = """\
+version: 1
+name: hint
+canvas: {{width: 4.0, height: 3.0}}
+symbol_defaults: {{opaque: true}}
+symbols: {{A: 1.0, F: 3.0}}
+patterns: {{x: "A^+", y: F}}
+shapes: [{{match: {{x: {name}, y: F}}}}]
+layers:
+  - {{name: wall, x: x, y: y}}
+"""
+
+
+@pytest.mark.parametrize(
+    ("name", "hint"),
+    [
+        ("AF", "did you mean 'A F'? symbols are separated by spaces"),
+        ("FF", "did you mean 'F F'?"),
+        ("W" * 30_000, "declare it under symbols"),  # took 12 s of CPU: no hint is sought
+        ("AF" * 15_000, "declare it under symbols"),
+    ],
+)
+def test_an_unknown_name_gets_a_hint_within_bounded_work(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, name: str, hint: str
+) -> None:
+    spec = tmp_path / "hint.yaml"
+    spec.write_text(HINT_SPEC.format(name=name))
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and "hint.yaml:7:" in err and hint in err, err[:500]
+
+
+def test_hints_compare_only_names_that_could_be_close() -> None:
+    from facadecli.hints import HINT_CHARS_MAX, closest, split_into
+
+    assert closest("windw", ["window", "door"]) == "window"
+    assert closest("w" * 40, ["w"]) is None  # too short to reach the cutoff: never compared
+    assert closest("x" * (HINT_CHARS_MAX + 1), ["x" * (HINT_CHARS_MAX + 1)]) is None
+    assert split_into("ABA", {"A", "B"}) == ["A", "B", "A"]
+    assert split_into("ABBA", {"AB", "BA", "A"}) == ["AB", "BA"]
+    assert split_into("A", {"A"}) is None

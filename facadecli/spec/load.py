@@ -6,7 +6,6 @@ Every problem, from the YAML parser, the model or the cross-checks, is reported 
 
 from __future__ import annotations
 
-import difflib
 import types
 import typing
 from pathlib import Path as FilePath
@@ -17,6 +16,7 @@ from pydantic_core import ErrorDetails
 
 from facadecli.errors import Problem, SpecError
 from facadecli.files import read_at_most
+from facadecli.hints import did_you_mean
 from facadecli.limits import SPEC_BYTES_MAX
 from facadecli.spec.check import check_spec
 from facadecli.spec.model import Spec
@@ -122,8 +122,7 @@ def _model_problem(
     if kind == "extra_forbidden":
         key = str(error["loc"][-1])
         allowed = _allowed_keys(error["loc"][:-1], model)
-        close = difflib.get_close_matches(key, allowed, n=1)
-        hint = (f"did you mean '{close[0]}'? " if close else "") + (
+        hint = did_you_mean(key, allowed) + (
             "allowed keys: " + ", ".join(allowed) if allowed else "remove it"
         )
         parent = format_path(path[:-1])
