@@ -240,3 +240,50 @@ def test_hints_compare_only_names_that_could_be_close() -> None:
     assert split_into("ABA", {"A", "B"}) == ["A", "B", "A"]
     assert split_into("ABBA", {"AB", "BA", "A"}) == ["AB", "BA"]
     assert split_into("A", {"A"}) is None
+
+
+# -- YAML: tags on collections, the size limit's place ---------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        ("!!python/object/apply:os.system {args: [ls]}", "tag '!!python/object/apply:os.system'"),
+        ("!!set {width, height}", "the mapping has the tag '!!set'"),
+        ("!custom {width: 4, height: 3}", "the mapping has the tag '!custom'"),
+        ("!!omap [{width: 4}, {height: 3}]", "the list has the tag '!!omap'"),
+        ("!!python/tuple [4, 3]", "the list has the tag '!!python/tuple'"),
+    ],
+)
+def test_tags_on_lists_and_mappings_are_refused_with_their_place(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, value: str, message: str
+) -> None:
+    spec = tmp_path / "tagged.yaml"
+    spec.write_text(f"version: 1\nname: t\ncanvas: {value}\n")
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and "tagged.yaml:3:9: error:" in err and message in err, err
+    assert "remove the '!' tag" in err
+
+
+def test_the_plain_tags_of_lists_and_mappings_are_kept(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    spec = tmp_path / "plain.yaml"
+    spec.write_text(HINT_SPEC.format(name="A").replace("canvas: {", "canvas: !!map {"))
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 0, err
+
+
+def test_a_spec_past_the_size_limit_is_refused_at_the_byte_past_it(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from facadecli.spec import load, source
+
+    monkeypatch.setattr(load, "SPEC_BYTES_MAX", 100)
+    monkeypatch.setattr(source, "MAX_BYTES", 100)
+    spec = tmp_path / "big.yaml"
+    spec.write_text("version: 1\n" + "# é\n" * 30)
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2, err
+    assert "big.yaml:19:4: error: the file is longer than specs are limited to (100 bytes" in err
+    assert "the limit of a spec file" in err

@@ -15,7 +15,7 @@ from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
 
 from facadecli.errors import Problem, SpecError
-from facadecli.files import read_at_most
+from facadecli.files import read_prefix
 from facadecli.hints import did_you_mean
 from facadecli.limits import SPEC_BYTES_MAX
 from facadecli.spec.check import check_spec
@@ -46,7 +46,7 @@ def load_spec(path: str | FilePath) -> Spec:
     """Read, validate and cross-check a spec file; raises :class:`SpecError`."""
     file = FilePath(path)
     try:
-        raw = read_at_most(file, SPEC_BYTES_MAX)
+        raw = read_prefix(file, SPEC_BYTES_MAX)  # past the limit: read_document says where
     except FileNotFoundError:
         raise SpecError.at(str(path), None, None, "no such file", "check the path") from None
     except IsADirectoryError:
@@ -61,14 +61,6 @@ def load_spec(path: str | FilePath) -> Spec:
             f"cannot read: {error.strerror}",
             "check the path and its permissions",
         ) from None
-    if raw is None:
-        raise SpecError.at(
-            str(path),
-            None,
-            None,
-            f"the file is longer than specs are limited to ({SPEC_BYTES_MAX:,} bytes)",
-            "a spec is a page of YAML: generate repeated layers with patterns",
-        )
     return parse_spec(raw, str(path), base_dir=file.parent)
 
 
