@@ -7,6 +7,8 @@ where the input is read, with a message that names the limit.
 from __future__ import annotations
 
 CANVAS_MAX = 1000.0  # metres: the longest side of a façade canvas
+LENGTH_MAX = 1000.0  # metres: any other length of a spec (sizes, depths, offsets, ...), +/-
+COUNT_MAX = 10_000  # a counter's bounds, a fixed count in a pattern
 SPEC_BYTES_MAX = 512 * 1024  # bytes of one spec file (or a city manifest)
 SPEC_VALUES_MAX = 100_000  # values a spec's YAML may expand to (aliases count each time)
 SPEC_DEPTH_MAX = 64  # nesting of a spec's YAML

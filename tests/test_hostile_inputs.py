@@ -287,3 +287,43 @@ def test_a_spec_past_the_size_limit_is_refused_at_the_byte_past_it(
     assert code == 2, err
     assert "big.yaml:19:4: error: the file is longer than specs are limited to (100 bytes" in err
     assert "the limit of a spec file" in err
+
+
+# -- numbers within the limits ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("line", "place", "message"),
+    [
+        ("counters: {n: 10001}", "7:15", "counters.n: Input should be less than or equal to 10000"),
+        ("counters: {n: 18446744073709551616}", "7:15", "counters.n: Input should be less"),
+        ("counters: {n: {min: 1, max: 10001}}", "7:29", "counters.n.max: Input should be less"),
+        ("shapes: [{depth: 1.0e+21}]", "7:18", "shapes[0].depth: Input should be less"),
+        ("defaults: {depth: -1.0e+300}", "7:19", "defaults.depth: Input should be greater"),
+        ("defaults: {thickness: 1001}", "7:23", "defaults.thickness: Input should be less"),
+        ("solver: {tolerance: 1.0e+200}", "7:21", "solver.tolerance: Input should be less"),
+    ],
+)
+def test_numbers_past_the_limits_are_refused_with_their_place(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, line: str, place: str, message: str
+) -> None:
+    text = HINT_SPEC.format(name="A").replace("shapes: [{match: {x: A, y: F}}]\n", line + "\n")
+    text = text.replace('x: "A^+"', 'x: "A^n"' if "counters" in line else 'x: "A^+"')
+    spec = tmp_path / "numbers.yaml"
+    spec.write_text(text)
+    out = tmp_path / "out"
+    for command in (["validate"], ["solve", "-o", str(out)]):
+        code, _, err = facade(capsys, *command, spec)
+        assert code == 2 and f"numbers.yaml:{place}: error: {message}" in err, err
+        assert "the limit of a" in err
+    assert files(out) == []
+
+
+def test_a_layer_offset_past_the_limit_is_refused(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    spec = tmp_path / "offset.yaml"
+    spec.write_text(HINT_SPEC.format(name="A").replace("y: y}", "y: y, offset: 1.0e+21}"))
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and "offset.yaml:9:38: error: layers[0].offset" in err, err
+    assert "the limit of a length: at most 1,000 m either way" in err

@@ -17,7 +17,7 @@ from pydantic_core import ErrorDetails
 from facadecli.errors import Problem, SpecError
 from facadecli.files import read_prefix
 from facadecli.hints import did_you_mean
-from facadecli.limits import SPEC_BYTES_MAX
+from facadecli.limits import COUNT_MAX, LENGTH_MAX, SPEC_BYTES_MAX
 from facadecli.spec.check import check_spec
 from facadecli.spec.model import Spec
 from facadecli.spec.source import Path, SourceMap, format_path, read_document
@@ -38,6 +38,10 @@ _HINTS = {
     "literal_error": "use one of the allowed values",
     "finite_number": "use a finite number",
     "value_error": "fix the values so they agree",
+}
+_LIMIT_HINTS = {  # a bound that is one of the limits: the hint names it
+    LENGTH_MAX: f"the limit of a length: at most {LENGTH_MAX:,g} m either way",
+    COUNT_MAX: f"the limit of a count: at most {COUNT_MAX:,}",
 }
 _NAME_HINT = "names start with a letter or '_', then letters, digits or '_'"
 
@@ -136,6 +140,9 @@ def _model_problem(
     if kind in ("string_type", "float_type", "int_type", "bool_type") and "input" in error:
         message += f", got {error['input']!r}"
     hint = _HINTS.get(kind, "see the spec reference in the README")
+    bound = error.get("ctx", {}).get("le", error.get("ctx", {}).get("ge"))
+    if kind in ("less_than_equal", "greater_than_equal") and isinstance(bound, (int, float)):
+        hint = _LIMIT_HINTS.get(abs(bound), hint)
     if kind == "string_pattern_mismatch":
         hint = (
             _NAME_HINT
