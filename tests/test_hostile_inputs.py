@@ -327,3 +327,80 @@ def test_a_layer_offset_past_the_limit_is_refused(
     code, _, err = facade(capsys, "validate", spec)
     assert code == 2 and "offset.yaml:9:38: error: layers[0].offset" in err, err
     assert "the limit of a length: at most 1,000 m either way" in err
+
+
+# -- staging left by a killed run ---------------------------------------------------------------
+
+
+def test_staging_of_runs_that_are_gone_is_removed_and_no_other(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    import os
+    import subprocess
+    import sys
+
+    from facadecli.export.atomic import _host, _started
+
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    dead = int(gone.stdout)
+    me, host = os.getpid(), _host()
+    out = tmp_path / "out"
+    out.mkdir()
+    stale = [
+        f".facade-{host}-{dead}-12345-abc_123",  # its process is gone
+        f".facade-{host}-{me}-1-xyz",  # this process id, but another start: a reused id
+    ]
+    kept = [
+        f".facade-{host}-{me}-{_started(me)}-live",  # a run still going
+        f".facade-other.host-{dead}-12345-abc",  # another machine's (a shared folder)
+        ".facade-abcd1234",  # named some other way (an older version's)
+        f".facade-{host}-notapid-1-abc",
+    ]
+    for name in stale + kept:
+        (out / name).mkdir()
+        (out / name / "half.glb").write_bytes(b"glTF\x02")
+    (out / f".facade-{host}-{dead}-1-file").write_text("a file, not a folder")
+    (out / "mine.txt").write_text("the user's")
+    spec = _asset_spec(tmp_path, instanced_glb(triangles=5, instances=2))
+    code, _, err = facade(capsys, "solve", spec, "-o", out, "-f", "json,glb")
+    assert code == 0, err
+    names = sorted(p.name for p in out.iterdir())
+    assert not any(name in names for name in stale)
+    assert all(name in names for name in kept)
+    assert f".facade-{host}-{dead}-1-file" in names and "mine.txt" in names
+    assert "assets.glb" in names and "assets.layout.json" in names
+    assert all((out / name / "half.glb").exists() for name in kept)
+
+
+def test_a_run_killed_while_staging_is_cleaned_up_by_the_next(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """kill -9 in the middle of writing: the half-written glb stays out of sight, in the
+    staging folder, which the next run into the folder removes."""
+    import signal
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    killed = (
+        "import os, signal, sys\n"
+        "from pathlib import Path\n"
+        "from facadecli.export.atomic import staged\n"
+        "with staged(sys.argv[1]) as stage:\n"
+        "    (stage / 'assets.glb').write_bytes(b'glTF half')\n"
+        "    os.kill(os.getpid(), signal.SIGKILL)\n"
+    )
+    run = subprocess.run([sys.executable, "-c", killed, str(out)], check=False)
+    assert run.returncode == -signal.SIGKILL
+    left = [p.name for p in out.iterdir()]
+    assert len(left) == 1 and left[0].startswith(".facade-"), left  # nothing visible
+    spec = _asset_spec(tmp_path, instanced_glb(triangles=5, instances=2))
+    code, _, err = facade(capsys, "solve", spec, "-o", out, "-f", "glb")
+    assert code == 0, err
+    assert files(out) == ["assets.glb"]
+    assert (out / "assets.glb").read_bytes() != b"glTF half"
