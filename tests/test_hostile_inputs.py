@@ -404,3 +404,41 @@ def test_a_run_killed_while_staging_is_cleaned_up_by_the_next(
     assert code == 0, err
     assert files(out) == ["assets.glb"]
     assert (out / "assets.glb").read_bytes() != b"glTF half"
+
+
+@pytest.mark.parametrize("uri", ["/dev/zero", "../outside.bin", "thing.bin", "http://x/y.bin"])
+def test_a_glb_reads_no_file_but_itself(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, uri: str
+) -> None:
+    document, binary = mesh_document(1, [{"mesh": 0}])
+    document["buffers"][0]["uri"] = uri
+    spec = _asset_spec(tmp_path, glb(document, binary))
+    code, _, err = facade(capsys, "validate", spec)
+    assert code == 2 and "a .glb holds its own" in err, err
+
+
+def test_a_gltf_reads_regular_files_in_its_folder_only(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    import base64
+    import json
+
+    document, binary = mesh_document(1, [{"mesh": 0}])
+    (tmp_path / "thing.bin").write_bytes(binary)
+    (tmp_path / "zero.bin").symlink_to("/dev/zero")
+    spec = tmp_path / "assets.yaml"
+    spec.write_text(ASSET_SPEC.format(mesh="thing.gltf"))
+    for uri, expected in [
+        ("thing.bin", None),
+        ("data:application/octet-stream;base64," + base64.b64encode(binary).decode(), None),
+        ("zero.bin", "not a file in its folder"),
+        ("../thing.bin", "not a file in its folder"),
+        ("missing.bin", "not a file in its folder"),
+    ]:
+        document["buffers"][0]["uri"] = uri
+        (tmp_path / "thing.gltf").write_text(json.dumps(document))
+        code, _, err = facade(capsys, "validate", spec)
+        if expected is None:
+            assert code == 0, err
+        else:
+            assert code == 2 and expected in err and "assets.yaml:8:" in err, err

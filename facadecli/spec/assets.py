@@ -33,7 +33,7 @@ def mesh_problem(path: Path) -> str | None:
         return f"is {size:,} bytes, more than a mesh file may be ({MESH_BYTES_MAX:,})"
     data = path.read_bytes()
     suffix = path.suffix.lower()
-    counted = _declared_faces(suffix, data)
+    counted = _declared_faces(suffix, data, path.parent)
     if isinstance(counted, str):
         return counted
     if counted is not None and counted > MESH_FACES_MAX:
@@ -63,7 +63,7 @@ def mesh_problem(path: Path) -> str | None:
     return None
 
 
-def _declared_faces(suffix: str, data: bytes) -> int | str | None:
+def _declared_faces(suffix: str, data: bytes, folder: Path) -> int | str | None:
     """The triangle count a mesh file's header declares (None when it does not say), or
     what is wrong with the header."""
     if suffix == ".obj":
@@ -83,11 +83,11 @@ def _declared_faces(suffix: str, data: bytes) -> int | str | None:
         found = re.search(rb"element face (\d+)", data[:4096])
         return int(found.group(1)) if found else "has no 'element face' in its header"
     if suffix in (".glb", ".gltf"):
-        return _gltf_faces(suffix, data)
+        return _gltf_faces(suffix, data, folder)
     return None
 
 
-def _gltf_faces(suffix: str, data: bytes) -> int | str:
+def _gltf_faces(suffix: str, data: bytes, folder: Path) -> int | str:
     if suffix == ".glb":
         if len(data) < 20 or data[:4] != b"glTF":
             return "is not a binary glTF file (no 'glTF' header)"
@@ -110,9 +110,32 @@ def _gltf_faces(suffix: str, data: bytes) -> int | str:
                     accessor = primitive["attributes"]["POSITION"]
                 faces += int(accessors[_index(accessor, len(accessors))]["count"]) // 3
             mesh_faces.append(faces)
-        return _instanced_faces(document, mesh_faces)
+        outside = _files_problem(document, suffix, folder)
+        return outside if outside is not None else _instanced_faces(document, mesh_faces)
     except (ValueError, KeyError, IndexError, TypeError, AttributeError, RecursionError):
         return "has a glTF JSON part that is not valid glTF"
+
+
+def _files_problem(document: dict[str, Any], suffix: str, folder: Path) -> str | None:
+    """What is wrong with the files a glTF names for its buffers and images, or None: a
+    .glb holds its own (a ``data:`` URI at most); a .gltf's are regular files next to it,
+    inside its folder (no link out of it), each within ``MESH_BYTES_MAX``."""
+    for kind in ("buffers", "images"):
+        for item in document.get(kind, []):
+            uri = item.get("uri")
+            if uri is None or (isinstance(uri, str) and uri.startswith("data:")):
+                continue
+            if not isinstance(uri, str):
+                raise TypeError("uri")
+            if suffix == ".glb":
+                return f"names a file for its {kind} ('{uri[:80]}'): a .glb holds its own"
+            base = folder.resolve()
+            named = (base / uri).resolve()
+            if ":" in uri or not named.is_relative_to(base) or not named.is_file():
+                return f"names '{uri[:80]}' for its {kind}: not a file in its folder"
+            if named.stat().st_size > MESH_BYTES_MAX:
+                return f"names '{uri[:80]}' for its {kind}, larger than {MESH_BYTES_MAX:,} bytes"
+    return None
 
 
 def _instanced_faces(document: dict[str, Any], mesh_faces: list[int]) -> int | str:
