@@ -442,3 +442,26 @@ def test_a_gltf_reads_regular_files_in_its_folder_only(
             assert code == 0, err
         else:
             assert code == 2 and expected in err and "assets.yaml:8:" in err, err
+
+
+# -- seeded fuzz, a few cases a door (``python -m tests.fuzz.spec_doors`` runs thousands) ------
+
+FUZZ_CASES = {"spec": 24, "asset": 30, "cmp-xml": 10, "json-layout": 10}
+
+
+@pytest.mark.parametrize("door", list(FUZZ_CASES))
+def test_hostile_inputs_at_each_door_end_cleanly(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, door: str
+) -> None:
+    """Exit 0, 2 or 3; no traceback; nothing left half-written or staged; all or nothing."""
+    from tests.fuzz.spec_doors import DOORS, judge
+
+    codes: dict[int, int] = {}
+    for seed in range(FUZZ_CASES[door]):
+        workdir = tmp_path / f"case{seed}"
+        workdir.mkdir()
+        argv = DOORS[door](seed, workdir)
+        code, _, err = facade(capsys, *argv)
+        codes[code] = codes.get(code, 0) + 1
+        assert judge(argv, code, err, workdir) is None, (seed, argv, err[-2000:])
+    assert codes.get(2, 0) >= FUZZ_CASES[door] // 4, codes  # the inputs are hostile

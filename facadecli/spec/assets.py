@@ -43,10 +43,9 @@ def mesh_problem(path: Path) -> str | None:
             f"mesh file ({MESH_FACES_MAX:,})"
         )
     import numpy as np
-    import trimesh  # only for specs that name mesh files
 
     try:
-        mesh = trimesh.load(path, force="mesh")
+        mesh = load_mesh(path, data)
     except Exception as error:  # a file trimesh cannot read, whatever the reason
         return f"cannot be read as a mesh ({type(error).__name__}: {error})"
     faces = getattr(mesh, "faces", None)
@@ -61,6 +60,20 @@ def mesh_problem(path: Path) -> str | None:
     if not np.isfinite(vertices).all():
         return "has vertices that are not finite numbers (NaN or infinity)"
     return None
+
+
+def load_mesh(path: Path, data: bytes | None = None) -> Any:
+    """The mesh in a file (its scenes flattened), as trimesh reads it, from its bytes: the
+    file names no other file trimesh would read (an OBJ's ``mtllib``, its textures), except
+    a .gltf's buffers and images, which ``mesh_problem`` checks first."""
+    import io
+
+    import trimesh  # only for specs that name mesh files
+
+    if path.suffix.lower() == ".gltf":
+        return trimesh.load(path, force="mesh")
+    data = path.read_bytes() if data is None else data
+    return trimesh.load(io.BytesIO(data), file_type=path.suffix.lower()[1:], force="mesh")
 
 
 def _declared_faces(suffix: str, data: bytes, folder: Path) -> int | str | None:
