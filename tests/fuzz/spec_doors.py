@@ -430,20 +430,39 @@ def judge(argv: list[str], code: int, stderr: str, workdir: Path) -> str | None:
     return None
 
 
-def run_case(door: str, seed: int, root: Path, timeout: float, memory: int) -> str | None:
-    """Run one case as a subprocess in a fresh folder; what went wrong, or None. The folder
-    is kept when something did."""
-    import resource
+def run_case(
+    door: str, seed: int, root: Path, timeout: float, memory: int, fork: bool = True
+) -> str | None:
+    """Run one case in a process of its own, in a fresh folder; what went wrong, or None.
+    The folder is kept when something did. ``fork``: the process is forked from this one,
+    with facadecli already imported (some ten times faster); else a new interpreter."""
     import shutil
-    import subprocess
-    import sys
 
     workdir = root / f"{door}-{seed}"
     workdir.mkdir(parents=True)
     argv = DOORS[door](seed, workdir)
+    code, stderr = (_forked if fork else _executed)(argv, workdir, timeout, memory)
+    problem = f"no end within {timeout:g} s" if code is None else judge(argv, code, stderr, workdir)
+    if problem is None:
+        shutil.rmtree(workdir, ignore_errors=True)
+    else:
+        (workdir / "argv.txt").write_text(" ".join(argv) + "\n")
+        (workdir / "stderr.txt").write_text(stderr)
+    return problem
 
-    def bounded() -> None:  # a memory bomb fails the case instead of the machine
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+
+def _bound(memory: int) -> None:
+    """A memory bomb fails the case instead of the machine."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+
+
+def _executed(
+    argv: list[str], workdir: Path, timeout: float, memory: int
+) -> tuple[int | None, str]:
+    import subprocess
+    import sys
 
     try:
         done = subprocess.run(
@@ -452,19 +471,58 @@ def run_case(door: str, seed: int, root: Path, timeout: float, memory: int) -> s
             text=True,
             errors="replace",
             timeout=timeout,
-            preexec_fn=bounded,
+            preexec_fn=lambda: _bound(memory),
             cwd=workdir,
         )
-        problem = judge(argv, done.returncode, done.stderr, workdir)
-        if problem is not None:
-            (workdir / "stderr.txt").write_text(done.stderr)
     except subprocess.TimeoutExpired:
-        problem = f"no end within {timeout:g} s"
-    if problem is None:
-        shutil.rmtree(workdir, ignore_errors=True)
-    else:
-        (workdir / "argv.txt").write_text(" ".join(argv) + "\n")
-    return problem
+        return None, ""
+    return done.returncode, done.stderr
+
+
+def _forked(argv: list[str], workdir: Path, timeout: float, memory: int) -> tuple[int | None, str]:
+    import os
+    import signal
+    import sys
+    import time
+
+    from facadecli.cli import main as facade_main
+
+    log = workdir / "stderr.log"
+    pid = os.fork()
+    if pid == 0:  # the case: its own process, output to the log, exit with the code
+        code = 1
+        try:
+            fd = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+            os.dup2(fd, 1)
+            os.dup2(fd, 2)
+            os.chdir(workdir)
+            _bound(memory)
+            sys.argv = ["facade", *argv]
+            facade_main()
+            code = 0
+        except SystemExit as stop:
+            code = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
+        except BaseException:
+            import traceback
+
+            traceback.print_exc()
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(code)
+    deadline = time.monotonic() + timeout
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            break
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            return None, log.read_text(errors="replace") if log.exists() else ""
+        time.sleep(0.01)
+    stderr = log.read_text(errors="replace")
+    log.unlink()
+    return os.waitstatus_to_exitcode(status), stderr
 
 
 def main() -> None:
@@ -485,7 +543,13 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--timeout", type=float, default=120.0)
     parser.add_argument("--memory", type=int, default=3 << 30, help="bytes of address space")
+    parser.add_argument("--exec", action="store_true", help="a new interpreter a case")
     options = parser.parse_args()
+    if not options.exec:  # imported once, before the forks
+        import importlib
+
+        for module in ("facadecli.cli", "facadecli.grammar.run", "facadecli.spec.load", "trimesh"):
+            importlib.import_module(module)
     root = Path(tempfile.mkdtemp(prefix="facade-fuzz-"))
     failed = 0
     for door in options.doors.split(","):
