@@ -503,8 +503,8 @@ class Search:
                     continue
                 action = rules[top]
                 waiting = [sub for sub in action.cids if sub not in terminal and sub not in same]
-                if waiting:
-                    stack.extend(waiting)
+                if waiting:  # the leftmost on top: the order a recursive visit takes
+                    stack.extend(reversed(waiting))
                     continue
                 symbols = tuple(
                     terminal[sub] if sub in terminal else same[sub] for sub in action.cids
