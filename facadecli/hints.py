@@ -12,7 +12,9 @@ from __future__ import annotations
 import difflib
 from collections.abc import Iterable
 
-HINT_CHARS_MAX = 200  # characters of a name that gets a "did you mean" hint
+from facadecli.limits import HINT_NAME_CHARS_MAX
+
+HINT_CHARS_MAX = HINT_NAME_CHARS_MAX
 CUTOFF = 0.6  # difflib's default similarity for a close match
 
 

@@ -32,6 +32,7 @@ LAYOUT_CELLS_MAX = 1_000_000  # cells of a snapped tiling (1000 x 1000)
 GRAMMAR_CELLS_MAX = 30_000_000  # cells the grammar search reads into its regions' contents
 GRAMMAR_DEPTH_MAX = 200  # rules nested in a grammar (each derived, written, varied in turn)
 LABEL_CHARS_MAX = 100  # characters of a label
+HINT_NAME_CHARS_MAX = 200  # characters of an unknown name that gets a "did you mean" hint
 GALLERY_BYTES_MAX = 256 * 1024 * 1024  # bytes of the models a ``facade view`` page inlines
 
 #: bytes of a city's single merged glb (a glb's lengths are 32-bit); beyond, tiles only
