@@ -432,8 +432,9 @@ def judge(argv: list[str], code: int, stderr: str, workdir: Path) -> str | None:
 
 def run_case(
     door: str, seed: int, root: Path, timeout: float, memory: int, fork: bool = True
-) -> str | None:
-    """Run one case in a process of its own, in a fresh folder; what went wrong, or None.
+) -> tuple[int | None, str | None]:
+    """Run one case in a process of its own, in a fresh folder: its exit code (None when
+    it did not end in time) and what went wrong, or None.
     The folder is kept when something did. ``fork``: the process is forked from this one,
     with facadecli already imported (some ten times faster); else a new interpreter."""
     import shutil
@@ -448,7 +449,7 @@ def run_case(
     else:
         (workdir / "argv.txt").write_text(" ".join(argv) + "\n")
         (workdir / "stderr.txt").write_text(stderr)
-    return problem
+    return code, problem
 
 
 def _bound(memory: int) -> None:
@@ -559,12 +560,18 @@ def main() -> None:
             case = partial(
                 run_case, door, root=root, timeout=options.timeout, memory=options.memory
             )
-            problems = list(pool.map(case, seeds))
+            results = list(pool.map(case, seeds))
+        problems = [problem for _, problem in results]
         tally = Counter("ok" if p is None else p.split(" ")[0] for p in problems)
+        codes = Counter(f"exit {code}" if code is not None else "hang" for code, _ in results)
         bad = [(seed, p) for seed, p in zip(seeds, problems, strict=True) if p is not None]
         failed += len(bad)
         seconds = time.perf_counter() - started
-        print(f"{door}: {options.cases} cases in {seconds:.0f} s: {dict(tally)}", flush=True)
+        print(
+            f"{door}: {options.cases} cases in {seconds:.0f} s: {dict(tally)}, "
+            f"{dict(sorted(codes.items()))}",
+            flush=True,
+        )
         for seed, problem in bad[:20]:
             print(f"  seed {seed}: {problem} ({root / f'{door}-{seed}'})", flush=True)
     print(f"{failed} failed; kept in {root}" if failed else "no failure")
