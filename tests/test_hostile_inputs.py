@@ -465,3 +465,29 @@ def test_hostile_inputs_at_each_door_end_cleanly(
         codes[code] = codes.get(code, 0) + 1
         assert judge(argv, code, err, workdir) is None, (seed, argv, err[-2000:])
     assert codes.get(2, 0) >= FUZZ_CASES[door] // 4, codes  # the inputs are hostile
+
+
+def test_a_grammar_at_the_depth_limit_is_written_derived_and_varied() -> None:
+    """The limit keeps every stage that goes down a grammar one rule at a time within
+    Python's recursion limit."""
+    from facadecli.grammar import variation
+    from facadecli.grammar.cga import grammar_cga
+    from facadecli.grammar.outputs import grammar_json
+    from facadecli.grammar.search import DEPTH_MAX
+    from facadecli.grammar.split import Grammar, Part, Rule, derive_tree, inlined
+
+    grammar = Grammar(start="N0", terminals={"a", "b"})
+    width = height = 1000.0
+    for level in range(DEPTH_MAX):  # each rule halves the region, across the last one's
+        axis = "x" if level % 2 == 0 else "y"
+        extent = width if axis == "x" else height
+        below = f"N{level + 1}" if level + 1 < DEPTH_MAX else "b"
+        grammar.rules[f"N{level}"] = Rule(
+            "split", axis, (Part(extent / 2, "a"), Part(extent / 2, below))
+        )
+        width, height = (width / 2, height) if axis == "x" else (width, height / 2)
+    assert len(derive_tree(grammar, 1000.0, 1000.0)) == 2 * DEPTH_MAX + 1
+    assert len(inlined(grammar).rules) == DEPTH_MAX
+    assert grammar_cga(grammar, 1000.0, 1000.0) and grammar_json(grammar) and grammar.text()
+    assert variation.derive_at(grammar, (1000.0, 1000.0), 1200.0, 900.0)
+    assert variation._with_runs(grammar, (1000.0, 1000.0)).rules
