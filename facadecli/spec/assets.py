@@ -67,13 +67,18 @@ def load_mesh(path: Path, data: bytes | None = None) -> Any:
     file names no other file trimesh would read (an OBJ's ``mtllib``, its textures), except
     a .gltf's buffers and images, which ``mesh_problem`` checks first."""
     import io
+    import warnings
 
+    import numpy as np
     import trimesh  # only for specs that name mesh files
 
-    if path.suffix.lower() == ".gltf":
-        return trimesh.load(path, force="mesh")
-    data = path.read_bytes() if data is None else data
-    return trimesh.load(io.BytesIO(data), file_type=path.suffix.lower()[1:], force="mesh")
+    # a node transform of 1e308 makes infinities: refused by the caller, not warned of here
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore", RuntimeWarning)
+        if path.suffix.lower() == ".gltf":
+            return trimesh.load(path, force="mesh")
+        data = path.read_bytes() if data is None else data
+        return trimesh.load(io.BytesIO(data), file_type=path.suffix.lower()[1:], force="mesh")
 
 
 def _declared_faces(suffix: str, data: bytes, folder: Path) -> int | str | None:
