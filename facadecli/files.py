@@ -17,8 +17,15 @@ CHUNK = 1 << 20  # bytes read at a time
 def read_at_most(path: Path, limit: int) -> bytes | None:
     """The file's bytes, or None when it holds more than ``limit``: at most one byte past
     the limit is read (a device such as /dev/zero never ends). OSError propagates."""
+    data = read_prefix(path, limit)
+    return None if len(data) > limit else data
+
+
+def read_prefix(path: Path, limit: int) -> bytes:
+    """The file's first ``limit + 1`` bytes at most: all of it when it is within the limit
+    (see ``read_at_most``), else enough to say where it goes past. OSError propagates."""
     with path.open("rb") as handle:
-        return _read_handle(handle, limit)
+        return _prefix(handle, limit)
 
 
 class NotRegularFile(OSError):
@@ -40,10 +47,11 @@ def read_regular_at_most(
         status = os.fstat(descriptor)
         if not stat.S_ISREG(status.st_mode):
             raise NotRegularFile(errno.EINVAL, "not a regular file", str(path))
-        return _read_handle(handle, limit), status
+        data = _prefix(handle, limit)
+        return (None if len(data) > limit else data), status
 
 
-def _read_handle(handle: BinaryIO, limit: int) -> bytes | None:
+def _prefix(handle: BinaryIO, limit: int) -> bytes:
     chunks, size = [], 0
     while size <= limit:  # in chunks: one read of limit + 1 bytes would claim that much
         chunk = handle.read(min(CHUNK, limit + 1 - size))  # memory first, however small
@@ -51,7 +59,14 @@ def _read_handle(handle: BinaryIO, limit: int) -> bytes | None:
             break
         chunks.append(chunk)
         size += len(chunk)
-    return None if size > limit else b"".join(chunks)
+    return b"".join(chunks)
+
+
+def place(data: bytes, offset: int) -> tuple[int, int]:
+    """The 1-based line and column (in characters) of byte ``offset`` of UTF-8 text."""
+    line = data.count(b"\n", 0, offset) + 1
+    start = data.rfind(b"\n", 0, offset) + 1
+    return line, len(data[start:offset].decode("utf-8", "replace")) + 1
 
 
 def decode_utf8(data: bytes, file: str, hint: str) -> str:
@@ -59,7 +74,5 @@ def decode_utf8(data: bytes, file: str, hint: str) -> str:
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
-        line = data.count(b"\n", 0, error.start) + 1
-        start = data.rfind(b"\n", 0, error.start) + 1
-        col = len(data[start : error.start].decode("utf-8", "replace")) + 1
+        line, col = place(data, error.start)
         raise SpecError.at(file, line, col, "not UTF-8 text", hint) from None

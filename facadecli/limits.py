@@ -7,11 +7,15 @@ where the input is read, with a message that names the limit.
 from __future__ import annotations
 
 CANVAS_MAX = 1000.0  # metres: the longest side of a façade canvas
+LENGTH_MAX = 1000.0  # metres: any other length of a spec (sizes, depths, offsets, ...), +/-
+COUNT_MAX = 10_000  # a counter's bounds, a fixed count in a pattern
 SPEC_BYTES_MAX = 512 * 1024  # bytes of one spec file (or a city manifest)
 SPEC_VALUES_MAX = 100_000  # values a spec's YAML may expand to (aliases count each time)
 SPEC_DEPTH_MAX = 64  # nesting of a spec's YAML
 MESH_BYTES_MAX = 32_000_000  # bytes of one mesh file named by a spec
-MESH_FACES_MAX = 200_000  # triangles of one mesh file
+MESH_FACES_MAX = 200_000  # triangles of one mesh file (each instance in its scene counted)
+GLTF_NODES_MAX = 2048  # nodes of one glTF mesh file
+GLTF_DEPTH_MAX = 32  # levels of a glTF mesh file's node hierarchy
 SCENE_FACES_MAX = 5_000_000  # triangles of one façade's model (every shape, every cell)
 TEXTURE_PIXELS_MAX = 4096 * 4096  # pixels of one texture image
 TEXTURE_SIDE_MAX = 8192  # pixels of a texture's longer side
@@ -34,7 +38,10 @@ LAYOUT_BYTES_MAX = 32_000_000  # bytes of one layout file read by ``facade gramm
 LAYOUT_RECTS_MAX = 20_000  # rectangles of one layout
 LAYOUT_EXTENT_MAX = 1e6  # a layout's size and any coordinate, in the file's own units
 LAYOUT_CELLS_MAX = 1_000_000  # cells of a snapped tiling (1000 x 1000)
+GRAMMAR_CELLS_MAX = 30_000_000  # cells the grammar search reads into its regions' contents
+GRAMMAR_DEPTH_MAX = 400  # rules nested in a grammar (each derived, written, varied in turn)
 LABEL_CHARS_MAX = 100  # characters of a label
+HINT_NAME_CHARS_MAX = 200  # characters of an unknown name that gets a "did you mean" hint
 GALLERY_BYTES_MAX = 256 * 1024 * 1024  # bytes of the models a ``facade view`` page inlines
 WATCH_CONNECTIONS_MAX = 32  # connections ``facade watch`` serves at once (more: closed)
 WATCH_STREAMS_MAX = 8  # of those, open event streams (pages following the spec; more: 503)

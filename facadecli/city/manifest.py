@@ -14,6 +14,8 @@ from pydantic import Field, StringConstraints
 
 from facadecli.city.footprints import MAX_HEIGHT, number
 from facadecli.errors import Problem, SpecError
+from facadecli.files import read_prefix
+from facadecli.limits import SPEC_BYTES_MAX
 from facadecli.spec import load_spec
 from facadecli.spec.load import validate_model
 from facadecli.spec.model import COLOR_RE, NAME_RE, Model, Spec
@@ -241,7 +243,7 @@ def _matches(properties: dict[str, Any], key: str, want: str | float | bool | Ra
 def load_city(path: Path) -> City:
     """Read and check a manifest and everything it names; raises SpecError (exit 2)."""
     try:
-        raw = path.read_bytes()
+        raw = read_prefix(path, SPEC_BYTES_MAX)  # past the limit: read_document says where
     except OSError as error:
         raise SpecError.at(
             str(path), None, None, f"cannot read: {error.strerror}", "check the path"

@@ -1,10 +1,20 @@
-"""Atomic file writes: a reader sees the old file or the new one, never half of one."""
+"""Atomic file writes: a reader sees the old file or the new one, never half of one.
+
+A run stages its outputs in a folder of its own inside the output folder
+(``.facade-HOST-PID-START-XXXXXXXX``: the host, the process id and its start time, so a
+later run can tell whether its owner is still running). A run killed outright (``kill -9``,
+a power cut) leaves its staging folder behind; the next run into the same folder removes
+such folders of processes that are gone, and only those: folders of runs still going, of
+other hosts, or named any other way are never touched.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
 import shutil
+import socket
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -72,17 +82,78 @@ def check_output_folder(folder: str | Path, option: str = "--output") -> None:
         )
 
 
+STAGING_PREFIX = ".facade-"
+_STAGING = re.compile(
+    r"\.facade-(?P<host>[A-Za-z0-9.]+)-(?P<pid>[0-9]+)-(?P<start>[0-9]+)-[a-z0-9_]+"
+)
+
+
+def _host() -> str:
+    """This machine's name, in the characters a staging folder's name allows."""
+    return re.sub(r"[^A-Za-z0-9.]", "", socket.gethostname())[:64] or "localhost"
+
+
+def _started(pid: int) -> int | None:
+    """When process ``pid`` started (clock ticks since boot, Linux), 0 where that cannot be
+    read but the process exists, None when there is no such process."""
+    if os.name == "nt":  # os.kill(pid, 0) would send it a Ctrl-C: take it to be running
+        return 0
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+        return int(stat.rsplit(")", 1)[1].split()[19])  # field 22: starttime
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return None
+    except OSError:  # it exists, owned by someone else
+        return 0
+    return 0
+
+
+def _staging_name() -> str:
+    pid = os.getpid()
+    return f"{STAGING_PREFIX}{_host()}-{pid}-{_started(pid) or 0}-"
+
+
+def remove_stale_staging(folder: Path) -> list[Path]:
+    """Remove the staging folders in ``folder`` whose run is gone (killed before it could
+    clean up): named as ``staged`` names them, on this host, by a process that no longer
+    runs (or a new process with the same id). Returns what was removed."""
+    removed: list[Path] = []
+    host = _host()
+    try:
+        entries = list(folder.iterdir())
+    except OSError:
+        return removed
+    for entry in entries:
+        found = _STAGING.fullmatch(entry.name)
+        if found is None or found["host"] != host:
+            continue
+        started, recorded = _started(int(found["pid"])), int(found["start"])
+        # a process with the id that started at another time took the id of a gone one
+        alive = started is not None and (0 in (started, recorded) or started == recorded)
+        if alive or entry.is_symlink() or not entry.is_dir():
+            continue
+        shutil.rmtree(entry, ignore_errors=True)
+        removed.append(entry)
+    return removed
+
+
 @contextlib.contextmanager
 def staged(folder: str | Path) -> Iterator[Path]:
     """A temporary folder inside ``folder`` for one run's outputs. When the block ends
     without an error its files move into ``folder`` (each an atomic rename); on an error
     they are removed, so a run's outputs appear together or not at all. A failure to
-    write (a full disk) is an :class:`OutputError`."""
+    write (a full disk) is an :class:`OutputError`. Staging folders that killed runs left
+    in ``folder`` are removed first (``remove_stale_staging``)."""
     target = Path(folder)
     moved: list[Path] = []
     try:
         target.mkdir(parents=True, exist_ok=True)
-        stage = Path(tempfile.mkdtemp(prefix=".facade-", dir=target))
+        remove_stale_staging(target)
+        stage = Path(tempfile.mkdtemp(prefix=_staging_name(), dir=target))
     except OSError as error:
         raise OutputError(f"{target}: cannot write the outputs: {error.strerror}") from None
     try:

@@ -28,6 +28,7 @@ from facadecli.layout import (
     Shape,
 )
 from facadecli.limits import SCENE_FACES_MAX
+from facadecli.spec.assets import load_mesh
 from facadecli.spec.model import Material, Spec
 
 FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
@@ -245,6 +246,5 @@ def _build(
         return builder(cell)
     if shape.mesh not in assets:
         path = (base_dir or Path(".")) / shape.mesh
-        loaded = trimesh.load(path, force="mesh")
-        assets[shape.mesh] = loaded
+        assets[shape.mesh] = load_mesh(path)
     return asset(assets[shape.mesh], cell)

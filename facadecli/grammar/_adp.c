@@ -15,6 +15,7 @@
 
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -195,7 +196,11 @@ typedef struct {
     SeqSet forms;      /* (op, axis, count, centre, sizes...) -> form */
     int *buffer;       /* scratch for keys */
     Py_ssize_t buffer_cap;
+    long long cells_read, cells_max; /* the contents' budget (``regions.CELLS_READ_MAX``) */
+    int spent;         /* a content was refused: the budget ran out */
 } Grid;
+
+static PyObject *BudgetError; /* regions.BudgetError's compiled twin */
 
 static void grid_free(Grid *g)
 {
@@ -266,6 +271,10 @@ static int grid_content(Grid *g, int r0, int r1, int c0, int c1)
     if (!added)
         return g->region_cid[at];
     int nr = 0, nc = 0, w = c1 - c0, h = r1 - r0;
+    if (g->spent) {
+        PyErr_SetString(BudgetError, "the contents' budget has run out");
+        return -1;
+    }
     if (buffer_room(g, 2 + (Py_ssize_t)w * h + 2 * (w + h) + 4) < 0)
         return -1;
     /* starts of merged columns and rows, kept at the end of the buffer */
@@ -278,6 +287,14 @@ static int grid_content(Grid *g, int r0, int r1, int c0, int c1)
             starts_r[nr++] = i;
     starts_c[nc] = w;
     starts_r[nr] = h;
+    /* what the key reads and keeps: counted first, so the budget bounds memory and time */
+    long long cost = 2 + (long long)nr * nc + nr + nc;
+    if (g->cells_read + cost > g->cells_max) {
+        g->spent = 1;
+        PyErr_SetString(BudgetError, "the contents' budget has run out");
+        return -1;
+    }
+    g->cells_read += cost;
     int *key = g->buffer, n = 0;
     key[n++] = nr;
     key[n++] = nc;
@@ -1750,6 +1767,12 @@ static PyObject *Table_adp(Table *t, PyObject *args)
     for (int it = 1; it < iterations; it++) {
         how.epsilon = 1.0 - (double)it / (double)iterations;
         int built = build(t, start, &how);
+        if (built == -1 && PyErr_ExceptionMatches(BudgetError)) {
+            PyErr_Clear(); /* stops as the time limit does: the best grammar so far */
+            clear_grammar(t);
+            done = it;
+            break;
+        }
         if (built == -1)
             goto end;
         if (built == TIME_UP) {
@@ -1842,6 +1865,7 @@ static int Table_init(Table *t, PyObject *args, PyObject *kwds)
     PyBuffer_Release(&ys);
     if (ok != 1 || grid_prefixes(g, background) < 0)
         return -1;
+    g->cells_max = LLONG_MAX; /* until ``limit`` */
     return 0;
 }
 
@@ -1890,6 +1914,26 @@ static PyObject *Table_content(Table *t, PyObject *args)
     return Py_BuildValue("(ii)", cid, t->grid.terminal[cid]);
 }
 
+/* limit(cells): the most cells the contents may read and keep (``regions.Grid``). */
+static PyObject *Table_limit(Table *t, PyObject *args)
+{
+    long long cells;
+    if (!PyArg_ParseTuple(args, "L", &cells))
+        return NULL;
+    t->grid.cells_max = cells;
+    Py_RETURN_NONE;
+}
+
+static PyObject *Table_spent(Table *t, PyObject *unused)
+{
+    return PyBool_FromLong(t->grid.spent);
+}
+
+static PyObject *Table_cells_read(Table *t, PyObject *unused)
+{
+    return PyLong_FromLongLong(t->grid.cells_read);
+}
+
 static void Table_dealloc(Table *t)
 {
     grid_free(&t->grid);
@@ -1920,6 +1964,12 @@ static void Table_dealloc(Table *t)
 static PyMethodDef Table_methods[] = {
     {"prepare", (PyCFunction)Table_prepare, METH_VARARGS,
      "prepare(repeats, extensions, split, repeat): ready the Table for the search."},
+    {"limit", (PyCFunction)Table_limit, METH_VARARGS,
+     "limit(cells): the most cells the contents may read (BudgetError past it)."},
+    {"spent", (PyCFunction)Table_spent, METH_NOARGS,
+     "spent() -> whether a content was refused because the budget ran out."},
+    {"cells_read", (PyCFunction)Table_cells_read, METH_NOARGS,
+     "cells_read() -> the cells the contents have read so far."},
     {"content", (PyCFunction)Table_content, METH_VARARGS,
      "content(r0, r1, c0, c1) -> (content, label or -1)."},
     {"entry", (PyCFunction)Table_entry, METH_VARARGS,
@@ -1970,5 +2020,12 @@ PyMODINIT_FUNC PyInit__adp(void)
         Py_DECREF(m);
         return NULL;
     }
+    BudgetError = PyErr_NewException("facadecli.grammar._adp.BudgetError", NULL, NULL);
+    if (!BudgetError || PyModule_AddObject(m, "BudgetError", BudgetError) < 0) {
+        Py_XDECREF(BudgetError);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_INCREF(BudgetError); /* the module holds one reference, this file the other */
     return m;
 }

@@ -23,6 +23,8 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from facadecli.grammar.regions import BUDGET_ERRORS
+
 if TYPE_CHECKING:
     from facadecli.grammar.search import Action, Entry, Search
 
@@ -165,7 +167,10 @@ def adp(
         return best, 0, iterations
     for t in range(1, iterations):
         epsilon = 1.0 - t / iterations
-        rules = build(search, choose, stop_at)
+        try:
+            rules = build(search, choose, stop_at)
+        except BUDGET_ERRORS:  # stops as the time limit does: the best grammar so far
+            return best, best_at, t
         if rules is None:
             return best, best_at, t
         signature = tuple(map(id, rules.values()))

@@ -14,10 +14,22 @@ from __future__ import annotations
 import numpy as np
 
 from facadecli.grammar.tiling import BACKGROUND, Tiling
+from facadecli.limits import GRAMMAR_CELLS_MAX
 from facadecli.native import GRAMMAR_COMPILED, _adp
 
 Region = tuple[int, int, int, int]
 SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's extent)
+CELLS_READ_MAX = GRAMMAR_CELLS_MAX  # cells the contents of one search read (see ``content``)
+
+
+class BudgetError(Exception):
+    """The regions' contents would read more than ``CELLS_READ_MAX`` cells."""
+
+
+#: what a spent budget raises, here or in the compiled table
+BUDGET_ERRORS: tuple[type[Exception], ...] = (
+    (BudgetError,) if _adp is None else (BudgetError, _adp.BudgetError)
+)
 
 
 class Grid:
@@ -49,6 +61,8 @@ class Grid:
         self._xs = np.asarray(tiling.xs, dtype=np.float64)
         self._ys = np.asarray(tiling.ys, dtype=np.float64)
         self._keys: dict[tuple[int, ...], int] = {}  # content keys -> content, in Python
+        self._cells_read = 0  # in Python: what the contents read so far
+        self._spent = False
         self.table: _adp.Table | None = None  # the contents, and the search over this tiling
         if GRAMMAR_COMPILED if compiled is None else compiled:
             self.table = _adp.Table(
@@ -61,13 +75,19 @@ class Grid:
                 self.quantum_y,
                 bg,
             )
+            self.table.limit(CELLS_READ_MAX)
 
     def content(self, region: Region) -> int:
         """The region's content number: equal for regions with the same labels at the same
         places, whatever cuts other elements make through them (neighbouring rows and
         columns with the same labels are merged first, and a merged row or column's size is
         the difference of its cuts, in steps of the size quantum). The compiled table
-        (``_adp.c``) keeps them, for the search too."""
+        (``_adp.c``) keeps them, for the search too.
+
+        A region's key holds a label per merged cell, so a layout whose regions all differ
+        (squares on a slant) makes keys of a size that grows with the square of the region's
+        side: the keys read, over the whole run, are bounded by ``CELLS_READ_MAX`` cells
+        (counted before each is made), past which :class:`BudgetError` is raised."""
         cid = self._content_of.get(region)
         if cid is None:
             cid, label = (
@@ -87,6 +107,11 @@ class Grid:
         changes_y = self._change_y[r0 : r1 - 1, c1] - self._change_y[r0 : r1 - 1, c0]
         starts_c = np.concatenate(([0], np.nonzero(changes_x)[0] + 1))
         starts_r = np.concatenate(([0], np.nonzero(changes_y)[0] + 1))
+        cost = 2 + len(starts_r) * len(starts_c) + len(starts_r) + len(starts_c)
+        if self._spent or self._cells_read + cost > CELLS_READ_MAX:
+            self._spent = True
+            raise BudgetError("the contents' budget has run out")
+        self._cells_read += cost
         labels = self.labels[np.ix_(r0 + starts_r, c0 + starts_c)]
         widths = np.diff(self._xs[c0 + np.append(starts_c, c1 - c0)]) / self.quantum_x
         heights = np.diff(self._ys[r0 + np.append(starts_r, r1 - r0)]) / self.quantum_y
@@ -99,6 +124,16 @@ class Grid:
         )
         cid = self._keys.setdefault(key, len(self._keys))
         return cid, int(labels[0, 0]) if labels.size == 1 else -1
+
+    @property
+    def cells_read(self) -> int:
+        """Cells the contents have read so far (counted against ``CELLS_READ_MAX``)."""
+        return self._cells_read if self.table is None else self.table.cells_read()
+
+    @property
+    def spent(self) -> bool:
+        """Whether a content was refused because ``CELLS_READ_MAX`` was reached."""
+        return self._spent if self.table is None else self.table.spent()
 
     def contents_of(self, regions: list[Region]) -> list[int]:
         """``content`` of each region."""

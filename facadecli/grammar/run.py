@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from facadecli.errors import Problem, SpecError
+from facadecli.grammar import regions
 from facadecli.grammar.cmp_xml import read_cmp
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.inputs import EXTENT_MAX, LabelledLayout
@@ -86,11 +87,21 @@ class Extraction:
         snapped = self.snapping.warning()
         if snapped:
             found.append(snapped)
-        if self.found.method == "adp" and self.found.iterations < self.options.iterations:
+        if (
+            self.found.method == "adp"
+            and self.found.iterations < self.options.iterations
+            and not self.found.budget_spent
+        ):
             found.append(
                 f"time limit of {self.options.time_limit:g} s reached after "
                 f"{self.found.iterations} of {self.options.iterations} iterations: the best "
                 "grammar so far is kept, and it depends on the machine's speed"
+            )
+        if self.found.budget_spent:
+            found.append(
+                f"the search read the most cells of regions it may ({regions.CELLS_READ_MAX:,}) "
+                f"after {self.found.iterations} of {self.options.iterations} iterations: the "
+                "best grammar so far is kept"
             )
         if not self.found.repeats_complete:
             found.append(

@@ -47,14 +47,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from facadecli.grammar import plain
+from facadecli.errors import SpecError
+from facadecli.grammar import plain, regions
 from facadecli.grammar.deadline import Deadline
-from facadecli.grammar.regions import Grid, Region
+from facadecli.grammar.regions import BUDGET_ERRORS, Grid, Region
 from facadecli.grammar.split import DEFAULT_COSTS, Axis, Costs, Grammar, Op, Part, Rule, inlined
 from facadecli.grammar.symmetry import Repeats, find_repeats
 from facadecli.grammar.tiling import BACKGROUND, Tiling
+from facadecli.limits import GRAMMAR_DEPTH_MAX
 from facadecli.native import GRAMMAR_COMPILED, _adp
 
+DEPTH_MAX = GRAMMAR_DEPTH_MAX  # rules nested in a grammar
 GRID_CELLS = 48  # a gridsplit of more cells than this costs more than it can save
 TOP_ACTIONS = 8  # actions per region the search chooses among (the heuristic's best)
 
@@ -91,6 +94,7 @@ class SearchResult:
     regions: int  # distinct regions given actions
     repeats: int  # repeated regions found by hashing (kinds)
     repeats_complete: bool = True  # False when the time limit stopped their search
+    budget_spent: bool = False  # True when ``CELLS_READ_MAX`` stopped ADP
 
 
 class Search:
@@ -487,25 +491,47 @@ class Search:
         """Each content's rule, merged with every other rule that reads the same (the same
         operation and sizes over the same symbols): regions of different sizes across the
         split axis can share a rule. Maps content -> the content whose rule stands for it."""
-        grid = self.grid
         same: dict[int, int] = {}
         seen: dict[tuple[object, ...], int] = {}
-
-        terminal = grid.terminal
-
-        def visit(cid: int) -> object:
-            found = same.get(cid)
-            if found is None:
-                action = rules[cid]
+        terminal = self.grid.terminal
+        for cid in rules:  # depth first, children before parents, with a stack of our own
+            stack = [cid]
+            while stack:
+                top = stack[-1]
+                if top in same:
+                    stack.pop()
+                    continue
+                action = rules[top]
+                waiting = [sub for sub in action.cids if sub not in terminal and sub not in same]
+                if waiting:  # the leftmost on top: the order a recursive visit takes
+                    stack.extend(reversed(waiting))
+                    continue
                 symbols = tuple(
-                    terminal[sub] if sub in terminal else visit(sub) for sub in action.cids
+                    terminal[sub] if sub in terminal else same[sub] for sub in action.cids
                 )
-                found = same[cid] = seen.setdefault((action.form, symbols), cid)
-            return found
-
-        for cid in rules:
-            visit(cid)
+                same[top] = seen.setdefault((action.form, symbols), top)
+                stack.pop()
         return same
+
+    def depth(self, rules: dict[int, Action]) -> int:
+        """The most rules on one path from the start to a terminal."""
+        terminal = self.grid.terminal
+        height: dict[int, int] = {}
+        for cid in rules:
+            stack = [cid]
+            while stack:
+                top = stack[-1]
+                if top in height:
+                    stack.pop()
+                    continue
+                subs = [sub for sub in rules[top].cids if sub not in terminal and sub in rules]
+                waiting = [sub for sub in subs if sub not in height]
+                if waiting:
+                    stack.extend(waiting)
+                    continue
+                height[top] = 1 + max((height[sub] for sub in subs), default=0)
+                stack.pop()
+        return max(height.values(), default=0)
 
     def cost(self, rules: dict[int, Action]) -> float:
         """Eq. 1 over the merged rules."""
@@ -672,11 +698,25 @@ def extract(
     """A split grammar for the tiling, by ``greedy`` or ``adp`` (see the module), within
     the run's deadline (else one of ``time_limit`` seconds from now)."""
     deadline = deadline or Deadline(time_limit)
-    search = Search(tiling, costs, extensions, background, deadline)
-    greedy = inlined(search.grammar(search.greedy()))
+    try:
+        search = Search(tiling, costs, extensions, background, deadline)
+        greedy_rules = search.greedy()
+        _check_depth(search, greedy_rules, deadline.source)
+        greedy = inlined(search.grammar(greedy_rules))
+    except BUDGET_ERRORS:
+        raise SpecError.at(
+            deadline.source,
+            None,
+            None,
+            f"the grammar search would read more than {regions.CELLS_READ_MAX:,} cells of regions "
+            "before its first grammar (the limit of cells a grammar search reads): the "
+            "layout's regions all differ, e.g. elements on a slant",
+            "join nearby edges with a larger --snap, or give fewer rectangles",
+        ) from None
     grammar, best_at, done = greedy, 0, 1
     if method != "greedy" and iterations > 1:
         rules, best_at, done = search.adp(iterations, seed)
+        _check_depth(search, rules, deadline.source)
         grammar = inlined(search.grammar(rules))
         if greedy.cost < grammar.cost - 1e-9:  # inlining can favour the greedy grammar
             grammar, best_at = greedy, 0
@@ -689,7 +729,23 @@ def extract(
         search.regions_explored,
         search.repeats.kinds,
         search.repeats.complete,
+        search.grid.spent,
     )
+
+
+def _check_depth(search: Search, rules: dict[int, Action], source: str) -> None:
+    """A grammar nests at most ``DEPTH_MAX`` rules (deriving it, writing it out and
+    varying it go down the rules one level at a time)."""
+    depth = search.depth(rules)
+    if depth > DEPTH_MAX:
+        raise SpecError.at(
+            source,
+            None,
+            None,
+            f"the grammar found nests {depth:,} rules deep, more than the limit of rules "
+            f"nested in a grammar ({DEPTH_MAX})",
+            "join nearby edges with a larger --snap, or give fewer rectangles",
+        )
 
 
 def greedy_grammar(tiling: Tiling, background: str = BACKGROUND) -> Grammar:

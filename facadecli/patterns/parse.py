@@ -13,11 +13,12 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from facadecli.limits import COUNT_MAX
 from facadecli.patterns.ast import Alt, Anonymous, Count, Fixed, Named, Node, Repeat, Seq, Sym
 
 MAX_PATTERN_LENGTH = 10_000
 MAX_NESTING = 64
-MAX_FIXED_COUNT = 10_000
+MAX_FIXED_COUNT = COUNT_MAX
 
 _TOKEN = re.compile(
     r"(?P<space>\s+)|(?P<name>[A-Za-z_][A-Za-z0-9_]*)|(?P<int>[0-9]+)|(?P<op>[()|^*+-])"

@@ -6,11 +6,11 @@ user sees every mistake at once, each with a way to fix it.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterator
 from pathlib import Path as FilePath
 
 from facadecli.errors import Problem
+from facadecli.hints import closest, did_you_mean, split_into
 from facadecli.patterns import PatternSyntaxError, parse_pattern
 from facadecli.patterns.ast import Named, Node, Repeat, Sym, named_counters, symbols, walk
 from facadecli.spec.assets import mesh_problem, texture_problem
@@ -38,6 +38,7 @@ class Checker:
         self.base_dir = base_dir
         self.problems: list[Problem] = []
         self.parsed: dict[Path, Node | None] = {}
+        self.file_problems: dict[FilePath, str | None] = {}  # each file is read once
 
     def report(
         self, path: Path, message: str, hint: str = "", *, key: bool = False, offset: int = -1
@@ -143,20 +144,19 @@ class Checker:
 
     def symbol_hint(self, name: str) -> str:
         known = sorted(self.spec.symbols)
-        split = _split_into(name, set(known))
+        split = split_into(name, set(known))
         if split:
             return f"did you mean '{' '.join(split)}'? symbols are separated by spaces"
-        close = difflib.get_close_matches(name, known, n=1)
-        if close:
-            return f"did you mean '{close[0]}'? or declare '{name}' under symbols"
+        close = closest(name, known)
+        if close is not None:
+            return f"did you mean '{close}'? or declare '{name}' under symbols"
         return f"declare it under symbols, e.g. '{name}: 1.0'"
 
     def check_counters_declared(self, text: PatternText, tree: Node) -> None:
         for counter in named_counters(tree):
             if counter.name in self.spec.counters:
                 continue
-            close = difflib.get_close_matches(counter.name, list(self.spec.counters), n=1)
-            hint = f"did you mean '{close[0]}'? " if close else ""
+            hint = did_you_mean(counter.name, self.spec.counters)
             self.report(
                 text.path,
                 f"{_describe(text)}: unknown counter '{counter.name}'",
@@ -200,10 +200,10 @@ class Checker:
             self.check_mask(index, axis, visible, used)
 
     def report_unknown_pattern(self, text: PatternText, name: str) -> None:
-        close = difflib.get_close_matches(name, list(self.spec.patterns), n=1)
+        close = closest(name, self.spec.patterns)
         hint = (
-            f"did you mean '{close[0]}'?"
-            if close
+            f"did you mean '{close}'?"
+            if close is not None
             else ("name one of: " + ", ".join(sorted(self.spec.patterns)) + ", or write a pattern")
         )
         self.report(text.path, f"unknown pattern '{name}'", hint)
@@ -278,8 +278,7 @@ class Checker:
     def check_material(self, path: Path, name: str) -> None:
         if name in self.spec.materials:
             return
-        close = difflib.get_close_matches(name, list(self.spec.materials), n=1)
-        hint = f"did you mean '{close[0]}'? " if close else ""
+        hint = did_you_mean(name, self.spec.materials)
         self.report(
             path,
             f"unknown material '{name}'",
@@ -291,8 +290,7 @@ class Checker:
             return
         candidate = FilePath(mesh)
         if candidate.suffix.lower() not in MESH_SUFFIXES:
-            close = difflib.get_close_matches(mesh, BUILTIN_MESHES, n=1)
-            hint = f"did you mean '{close[0]}'? " if close else ""
+            hint = did_you_mean(mesh, BUILTIN_MESHES)
             self.report(
                 path,
                 f"unknown mesh '{mesh}'",
@@ -345,7 +343,10 @@ class Checker:
                     f"put it at {resolved} or fix the path (relative to the spec file)",
                 )
             else:
-                problem = (mesh_problem if kind == "mesh" else texture_problem)(resolved)
+                if resolved not in self.file_problems:
+                    check = mesh_problem if kind == "mesh" else texture_problem
+                    self.file_problems[resolved] = check(resolved)
+                problem = self.file_problems[resolved]
                 if problem is not None:
                     self.report(
                         path,
@@ -370,18 +371,6 @@ def _describe(text: PatternText) -> str:
     if text.role == "content":
         return f"{label} '{name}' content of '{text.placeholder}'"
     return f"{label} '{name}'"
-
-
-def _split_into(name: str, known: set[str]) -> list[str] | None:
-    """``'BA'`` -> ``['B', 'A']`` when the name is a run of known symbols (two or more)."""
-    best: dict[int, list[str]] = {0: []}
-    for end in range(1, len(name) + 1):
-        for start in range(end):
-            if start in best and name[start:end] in known:
-                best[end] = [*best[start], name[start:end]]
-                break
-    result = best.get(len(name))
-    return result if result and len(result) > 1 else None
 
 
 def check_spec(

@@ -6,7 +6,6 @@ Every problem, from the YAML parser, the model or the cross-checks, is reported 
 
 from __future__ import annotations
 
-import difflib
 import types
 import typing
 from pathlib import Path as FilePath
@@ -16,8 +15,9 @@ from pydantic import BaseModel, ValidationError
 from pydantic_core import ErrorDetails
 
 from facadecli.errors import Problem, SpecError
-from facadecli.files import read_at_most
-from facadecli.limits import SPEC_BYTES_MAX
+from facadecli.files import read_prefix
+from facadecli.hints import did_you_mean
+from facadecli.limits import COUNT_MAX, LENGTH_MAX, SPEC_BYTES_MAX
 from facadecli.spec.check import check_spec
 from facadecli.spec.model import Spec
 from facadecli.spec.source import Path, SourceMap, format_path, read_document
@@ -39,6 +39,10 @@ _HINTS = {
     "finite_number": "use a finite number",
     "value_error": "fix the values so they agree",
 }
+_LIMIT_HINTS = {  # a bound that is one of the limits: the hint names it
+    LENGTH_MAX: f"the limit of a length: at most {LENGTH_MAX:,g} m either way",
+    COUNT_MAX: f"the limit of a count: at most {COUNT_MAX:,}",
+}
 _NAME_HINT = "names start with a letter or '_', then letters, digits or '_'"
 
 
@@ -46,7 +50,7 @@ def load_spec(path: str | FilePath) -> Spec:
     """Read, validate and cross-check a spec file; raises :class:`SpecError`."""
     file = FilePath(path)
     try:
-        raw = read_at_most(file, SPEC_BYTES_MAX)
+        raw = read_prefix(file, SPEC_BYTES_MAX)  # past the limit: read_document says where
     except FileNotFoundError:
         raise SpecError.at(str(path), None, None, "no such file", "check the path") from None
     except IsADirectoryError:
@@ -61,14 +65,6 @@ def load_spec(path: str | FilePath) -> Spec:
             f"cannot read: {error.strerror}",
             "check the path and its permissions",
         ) from None
-    if raw is None:
-        raise SpecError.at(
-            str(path),
-            None,
-            None,
-            f"the file is longer than specs are limited to ({SPEC_BYTES_MAX:,} bytes)",
-            "a spec is a page of YAML: generate repeated layers with patterns",
-        )
     return parse_spec(raw, str(path), base_dir=file.parent)
 
 
@@ -122,8 +118,7 @@ def _model_problem(
     if kind == "extra_forbidden":
         key = str(error["loc"][-1])
         allowed = _allowed_keys(error["loc"][:-1], model)
-        close = difflib.get_close_matches(key, allowed, n=1)
-        hint = (f"did you mean '{close[0]}'? " if close else "") + (
+        hint = did_you_mean(key, allowed) + (
             "allowed keys: " + ", ".join(allowed) if allowed else "remove it"
         )
         parent = format_path(path[:-1])
@@ -145,6 +140,9 @@ def _model_problem(
     if kind in ("string_type", "float_type", "int_type", "bool_type") and "input" in error:
         message += f", got {error['input']!r}"
     hint = _HINTS.get(kind, "see the spec reference in the README")
+    bound = error.get("ctx", {}).get("le", error.get("ctx", {}).get("ge"))
+    if kind in ("less_than_equal", "greater_than_equal") and isinstance(bound, (int, float)):
+        hint = _LIMIT_HINTS.get(abs(bound), hint)
     if kind == "string_pattern_mismatch":
         hint = (
             _NAME_HINT

@@ -22,7 +22,7 @@ from pydantic import (
     model_validator,
 )
 
-from facadecli.limits import CANVAS_MAX
+from facadecli.limits import CANVAS_MAX, COUNT_MAX, LENGTH_MAX
 
 NAME_RE = r"^[A-Za-z0-9_.-]+$"
 IDENT_RE = r"^[A-Za-z_][A-Za-z0-9_]*$"
@@ -43,8 +43,11 @@ BUILTIN_MESHES = (
 )
 
 Ident = Annotated[str, StringConstraints(pattern=IDENT_RE)]
-Length = Annotated[float, Field(allow_inf_nan=False)]
-PositiveLength = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+# every length within LENGTH_MAX (a depth of 1e21 m would make a model 1e21 m deep)
+Length = Annotated[float, Field(ge=-LENGTH_MAX, le=LENGTH_MAX, allow_inf_nan=False)]
+PositiveLength = Annotated[float, Field(gt=0, le=LENGTH_MAX, allow_inf_nan=False)]
+NonNegativeLength = Annotated[float, Field(ge=0, le=LENGTH_MAX, allow_inf_nan=False)]
+Count = Annotated[int, Field(ge=0, le=COUNT_MAX)]
 Unit = Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)]
 
 
@@ -90,7 +93,7 @@ class Symbol(Model):
     )
 
     size: PositiveLength | None = None
-    min: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
+    min: NonNegativeLength | None = None
     max: PositiveLength | None = None
     opaque: bool | None = None
     attached: bool | None = None
@@ -135,8 +138,8 @@ class Counter(Model):
         json_schema_extra=_shorthand_schema({"type": "integer", "minimum": 0})
     )
 
-    min: Annotated[int, Field(ge=0)] = 0
-    max: Annotated[int, Field(ge=0)] | None = None
+    min: Count = 0
+    max: Count | None = None
 
     @model_validator(mode="before")
     @classmethod
@@ -205,9 +208,9 @@ class ShapeRule(Model):
     material: Ident | None = None
     mesh: str | None = None
     depth: Length | None = None
-    thickness: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
+    thickness: NonNegativeLength | None = None
     frame_width: PositiveLength | None = None  # frame and arch: width of the frame's bars
-    pane_depth: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None  # pane recess
+    pane_depth: NonNegativeLength | None = None  # pane recess
     segments: Annotated[int, Field(ge=3, le=128)] | None = None  # arch and column smoothness
     pane_material: Ident | None = None  # frame, arch, door: the pane's (default: glass)
     sill: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None  # frame, arch
@@ -246,14 +249,14 @@ class Defaults(Model):
 
     mesh: str = "box"
     material: Ident | None = None
-    thickness: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.2
+    thickness: NonNegativeLength = 0.2
     depth: Length = 0.0
 
 
 class Solver(Model):
     """Solver options."""
 
-    tolerance: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    tolerance: NonNegativeLength = 0.0
     time_limit: Annotated[float, Field(gt=0, le=86_400)] = 10.0
     seed: Annotated[int, Field(ge=0)] = 0
 

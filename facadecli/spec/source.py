@@ -15,6 +15,7 @@ from typing import Any
 import yaml
 
 from facadecli.errors import Problem, SpecError
+from facadecli.files import place
 from facadecli.limits import SPEC_BYTES_MAX, SPEC_DEPTH_MAX, SPEC_VALUES_MAX
 
 MAX_BYTES = SPEC_BYTES_MAX
@@ -27,6 +28,11 @@ except AttributeError:  # pragma: no cover - depends on how PyYAML was built
     _Loader = yaml.SafeLoader
 
 _MERGE_TAG = "tag:yaml.org,2002:merge"
+# the tags a list or a mapping may have: its own kind's, given or not
+_PLAIN_TAGS: dict[type[yaml.Node], str] = {
+    yaml.SequenceNode: "tag:yaml.org,2002:seq",
+    yaml.MappingNode: "tag:yaml.org,2002:map",
+}
 _SCALAR_CONSTRUCTOR = yaml.constructor.SafeConstructor()
 
 Path = tuple[str | int, ...]
@@ -93,12 +99,15 @@ class Document:
 def read_document(raw: bytes, file: str) -> Document:
     """Parse one YAML document from bytes; raises :class:`SpecError` with positions."""
     if len(raw) > MAX_BYTES:
+        line, col = place(raw, MAX_BYTES)
         raise SpecError.at(
             file,
-            None,
-            None,
-            f"the file is {len(raw):,} bytes; specs are limited to {MAX_BYTES:,}",
-            "is this the right file? a spec is a short YAML text",
+            line,
+            col,
+            f"the file is longer than specs are limited to ({MAX_BYTES:,} bytes, the limit "
+            "of a spec file or manifest): its first byte past the limit is here",
+            "is this the right file? a spec is a page of YAML: generate repeated layers "
+            "with patterns",
         )
     text = _decode(raw, file)
     if not text.strip() or _only_comments(text):
@@ -218,6 +227,15 @@ class _Builder:
                 raise _yaml_problem(error, self.source.file) from None
             except (ValueError, TypeError) as error:  # pragma: no cover - defensive
                 raise self.fail(node, f"invalid value: {error}", "check the value") from None
+        plain = _PLAIN_TAGS.get(type(node))
+        if plain is not None and node.tag != plain:
+            tag = node.tag.replace("tag:yaml.org,2002:", "!!")
+            kind = "list" if isinstance(node, yaml.SequenceNode) else "mapping"
+            raise self.fail(
+                node,
+                f"the {kind} has the tag '{tag}': specs hold plain values only",
+                "remove the '!' tag",
+            )
         if id(node) in self.active:
             raise self.fail(
                 node, "a recursive alias: this value contains itself", "remove the alias"
