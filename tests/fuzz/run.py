@@ -57,11 +57,13 @@ Doors = dict[str, Door]
 
 
 def discover(only: set[str] | None = None) -> dict[str, str]:
-    """Door name -> its module's name, from every ``tests/fuzz/*_doors.py``."""
+    """Door name -> its module's name, from every ``tests/fuzz/*_doors.py``. (A door that
+    needs a server running, such as ``facade watch``'s HTTP, is in ``SERVER_DOORS`` instead:
+    name -> ``run(cases, first_seed) -> exit status``, which prints its own tally.)"""
     found: dict[str, str] = {}
     for path in sorted(HERE.glob("*_doors.py")):
         name = f"tests.fuzz.{path.stem}"
-        doors: Doors = importlib.import_module(name).DOORS
+        doors: Doors = getattr(importlib.import_module(name), "DOORS", {})
         for door in doors:
             if door in found:
                 raise SystemExit(f"door '{door}' is in {found[door]} and {name}")
@@ -195,9 +197,23 @@ def main() -> int:
     options = parser.parse_args()
     only = {d.strip() for d in options.doors.split(",") if d.strip()} or None
     doors = discover(only)
-    if options.list or not doors:
-        print("\n".join(f"{door}  ({module})" for door, module in doors.items()) or "no door")
+    servers = {
+        door: run
+        for path in sorted(HERE.glob("*_doors.py"))
+        for door, run in getattr(
+            importlib.import_module(f"tests.fuzz.{path.stem}"), "SERVER_DOORS", {}
+        ).items()
+        if only is None or door in only
+    }
+    if options.list:
+        print("\n".join([*doors, *servers]) or "no door")
         return 0
+    status = 0
+    for door, run in servers.items():
+        print(f"{door}: ", end="", flush=True)
+        status |= run(options.cases, options.seed)
+    if not doors:
+        return status
     print(HEADER, flush=True)
     rows = fuzz(
         doors, options.cases, options.seed, options.timeout, options.memory_mb, options.jobs
@@ -209,7 +225,7 @@ def main() -> int:
         print(f"... and {len(failures) - 50} more failures")
     if failures:
         print("reproduce one: tests/fuzz/run.py --doors DOOR --seed SEED --cases 1")
-    return 1 if failures else 0
+    return 1 if failures or status else 0
 
 
 if __name__ == "__main__":

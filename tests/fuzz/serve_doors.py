@@ -304,5 +304,8 @@ def main(argv: list[str]) -> int:
     return 1 if tally.failures else 0
 
 
+# for tests/fuzz/run.py: a door that needs ``facade watch`` running
+SERVER_DOORS = {"watch-http": lambda cases, first: main([str(cases), str(first)])}
+
 if __name__ == "__main__":
     sys.exit(main(sys.argv[1:]))
