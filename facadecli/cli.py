@@ -667,12 +667,22 @@ def infer(
     if check and not report.get("solves"):
         _warn(f"{layout}: warning: the spec does not solve: {report.get('error')}")
     elif check:
-        summary += f", IoU at least {report['iou_min']:.3f}"
+        faithful = report["fidelity"]
+        summary += (
+            f", IoU at least {report['iou_min']:.3f} against the tidied layout; against the "
+            f"annotation mean IoU {faithful['iou_mean']:.3f}, "  # type: ignore[index]
+            f"{faithful['lost']} lost, {faithful['fused']} fused"  # type: ignore[index]
+        )
+        if inferred.fidelity is not None:
+            for warning in inferred.fidelity.warnings("the spec solved at the input's size"):
+                _warn(f"{layout}: warning: {warning}")
         for entry in report["retargets"]:  # type: ignore[attr-defined]
             if not entry["solves"]:
                 _warn(f"{layout}: warning: at {entry['width']:g} m wide: {entry['error']}")
         for label, iou in sorted(report.get("iou", {}).items()):  # type: ignore[attr-defined]
-            _detail(f"{layout}: IoU of {label}: {iou:.4f}")
+            _detail(f"{layout}: IoU of {label}: {iou:.4f} against the tidied layout")
+        for label, iou in sorted(faithful["iou_per_label"].items()):  # type: ignore[index]
+            _detail(f"{layout}: IoU of {label}: {iou:.4f} against the annotation")
     _say(f"{layout}: {summary} -> {target}, {report_path}")
 
 
@@ -793,6 +803,9 @@ def grammar(
     name = stem(layout)
     for warning in extraction.warnings:
         _warn(f"{layout}: warning: {warning}")
+    if extraction.fidelity is not None:
+        for warning in extraction.fidelity.warnings("the grammar at the input's size"):
+            _warn(f"{layout}: warning: {warning}")
     _detail(
         f"{layout}: {len(extraction.tiling.xs) - 1} x {len(extraction.tiling.ys) - 1} tiling, "
         f"search {extraction.time_ms:.0f} ms"

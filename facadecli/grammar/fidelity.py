@@ -1,0 +1,247 @@
+"""How faithful an output is to what was drawn: the raw annotation (as read, before any
+snapping or regularising) and an output layout of the same size, both rasterised the same
+way, compared label by label and element by element.
+
+- **Rasterising.** Cells of ``RESOLUTION`` (2.5 cm, in the layout's units), at least
+  ``SIDE_MIN`` along the longer side (an annotation without a size, such as a CMP unit
+  square, is not in metres) and at most ``CELLS_MAX`` cells in all (a huge façade is
+  rasterised coarser, never a memory bomb). A cell takes the label of the front-most
+  rectangle over its centre, the background (``facade``) elsewhere. Rectangles are painted
+  by their ``z``, and among equal ``z`` in their order: for CMP that is the database's
+  z-order by label (``label_names.txt``: a window over a wall, a cornice over a window)
+  and, within a label, later objects over earlier ones (``cmp_xml``); for JSON lists the
+  ``z`` given, else the order of the list.
+- **IoU.** For every label drawn on either raster, intersection over union of its cells;
+  ``iou_mean`` is their mean, the background included.
+- **Elements.** An annotated element is its *visible* cells (where it is the front-most
+  rectangle; one wholly hidden, or smaller than a cell, is not counted), and so is an
+  output element. An annotated element is *lost* when no output element of its label
+  covers half or more of it; an output element is *fused* when it covers half or more of
+  each of two or more annotated elements of its label. Background rectangles are not
+  elements.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
+
+RESOLUTION = 0.025  # the side of a cell, in the layout's units (metres)
+SIDE_MIN = 400  # cells along the longer side, at least
+CELLS_MAX = 4_000_000  # cells of one raster, at most (2000 x 2000; 16 MB a raster)
+COVERED = 0.5  # share of an annotated element an output element must cover to keep it
+IOU_WARN = 0.85  # a mean IoU below this is warned about
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The cells of a raster: ``columns`` x ``rows`` of ``cell_w`` x ``cell_h``."""
+
+    width: float
+    height: float
+    columns: int
+    rows: int
+
+    @property
+    def cell_w(self) -> float:
+        return self.width / self.columns
+
+    @property
+    def cell_h(self) -> float:
+        return self.height / self.rows
+
+
+def grid(
+    width: float,
+    height: float,
+    resolution: float = RESOLUTION,
+    cells_max: int = CELLS_MAX,
+    side_min: int = SIDE_MIN,
+) -> Grid:
+    """The raster of a ``width`` x ``height`` façade: square cells of ``resolution``, made
+    finer to have ``side_min`` cells along the longer side and coarser to have at most
+    ``cells_max`` cells."""
+    longer = max(width, height)
+    cell = min(resolution, longer / side_min)
+    cell = max(cell, math.sqrt(width * height / cells_max))
+    columns = max(1, round(width / cell))
+    rows = max(1, round(height / cell))
+    while columns * rows > cells_max:  # rounding up may pass the limit by a row or column
+        cell *= 1.001
+        columns, rows = max(1, round(width / cell)), max(1, round(height / cell))
+    return Grid(width, height, columns, rows)
+
+
+def paint(
+    rects: Sequence[Rect], cells: Grid, code: dict[str, int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """The label (``code`` of it) and the rectangle (its index, -1 for none) at every cell's
+    centre, rows bottom up; rectangles painted by ``z``, among equals in their order."""
+    labels = np.full((cells.rows, cells.columns), code[BACKGROUND], dtype=np.int32)
+    owners = np.full((cells.rows, cells.columns), -1, dtype=np.int32)
+    for i in sorted(range(len(rects)), key=lambda k: rects[k].z):  # stable: later wins
+        r = rects[i]
+        c0, c1 = _span(r.x0, r.x1, cells.cell_w, cells.columns)
+        r0, r1 = _span(r.y0, r.y1, cells.cell_h, cells.rows)
+        if c1 > c0 and r1 > r0:
+            labels[r0:r1, c0:c1] = code[r.label]
+            owners[r0:r1, c0:c1] = i
+    return labels, owners
+
+
+def _span(low: float, high: float, cell: float, count: int) -> tuple[int, int]:
+    """The cells whose centres lie in ``[low, high)``."""
+    first = math.ceil(low / cell - 0.5)
+    stop = math.ceil(high / cell - 0.5)
+    return min(max(first, 0), count), min(max(stop, 0), count)
+
+
+@dataclass
+class LabelFidelity:
+    iou: float
+    elements: int = 0  # annotated elements counted (visible on the raster)
+    lost: int = 0
+    fused: int = 0  # output elements covering two or more annotated ones
+
+    def summary(self) -> dict[str, object]:
+        return {"iou": self.iou, "elements": self.elements, "lost": self.lost, "fused": self.fused}
+
+
+@dataclass
+class Fidelity:
+    """An output compared with the annotation (see the module)."""
+
+    cell: float  # the side of a cell used (the larger of the two, when not square)
+    columns: int
+    rows: int
+    labels: dict[str, LabelFidelity] = field(default_factory=dict)
+    fused_elements: int = 0  # annotated elements inside fused output elements
+
+    @property
+    def iou_mean(self) -> float:
+        values = [entry.iou for entry in self.labels.values()]
+        return round(sum(values) / len(values), 4) if values else 1.0
+
+    def iou_per_label(self) -> dict[str, float]:
+        return {label: entry.iou for label, entry in self.labels.items()}
+
+    @property
+    def elements(self) -> int:
+        return sum(entry.elements for entry in self.labels.values())
+
+    @property
+    def lost(self) -> int:
+        return sum(entry.lost for entry in self.labels.values())
+
+    @property
+    def fused(self) -> int:
+        return sum(entry.fused for entry in self.labels.values())
+
+    def summary(self) -> dict[str, object]:
+        return {
+            "against": "annotation",
+            "iou_mean": self.iou_mean,
+            "iou_per_label": self.iou_per_label(),
+            "elements": self.elements,
+            "lost": self.lost,
+            "fused": self.fused,
+            "fused_elements": self.fused_elements,
+            "per_label": {label: entry.summary() for label, entry in self.labels.items()},
+            "raster": {"columns": self.columns, "rows": self.rows, "cell": round(self.cell, 6)},
+        }
+
+    def warnings(self, what: str) -> list[str]:
+        """What is unfaithful, said of ``what`` (e.g. "the spec solved at the input's size")."""
+        found = []
+        if self.iou_mean < IOU_WARN:
+            worst = sorted(self.labels.items(), key=lambda item: item[1].iou)[:3]
+            found.append(
+                f"{what} differs from the annotation: mean IoU {self.iou_mean:.3f} (below "
+                f"{IOU_WARN:g}; lowest "
+                + ", ".join(f"{label} {entry.iou:.3f}" for label, entry in worst)
+                + ")"
+            )
+        if self.lost or self.fused:
+            by_label = ", ".join(
+                f"{label}: {entry.lost} lost, {entry.fused} fused"
+                for label, entry in self.labels.items()
+                if entry.lost or entry.fused
+            )
+            found.append(
+                f"{what} loses {self.lost} of the annotation's {self.elements} elements and "
+                f"fuses {self.fused_elements} into {self.fused} ({by_label})"
+            )
+        return found
+
+
+def fidelity(
+    annotation: LabelledLayout,
+    output: LabelledLayout,
+    drawn: Sequence[Rect] | None = None,
+    resolution: float = RESOLUTION,
+    cells_max: int = CELLS_MAX,
+) -> Fidelity:
+    """``output`` (its rectangles are its elements) compared with the raw ``annotation`` at
+    the annotation's size; ``drawn``, when given, is what the output shows instead of its
+    elements painted (a grammar's terminals: one element may be several of them)."""
+    cells = grid(annotation.width, annotation.height, resolution, cells_max)
+    shown = list(drawn) if drawn is not None else list(output.rects)
+    names = sorted({BACKGROUND, *(r.label for r in (*annotation.rects, *output.rects, *shown))})
+    code = {name: k for k, name in enumerate(names)}
+    given, given_owner = paint(annotation.rects, cells, code)
+    made, made_owner = paint(output.rects, cells, code)
+    if drawn is not None:
+        made = paint(shown, cells, code)[0]
+    result = Fidelity(max(cells.cell_w, cells.cell_h), cells.columns, cells.rows)
+    count = len(names)
+    both = np.bincount((given * count + made).ravel(), minlength=count * count)
+    both = both.reshape(count, count)
+    for k, name in enumerate(names):
+        union = int(both[k, :].sum() + both[:, k].sum() - both[k, k])
+        if union:
+            result.labels[name] = LabelFidelity(round(float(both[k, k]) / union, 4))
+    _elements(annotation, output, (given, given_owner), (made, made_owner), code, result)
+    return result
+
+
+def _elements(
+    annotation: LabelledLayout,
+    output: LabelledLayout,
+    given: tuple[np.ndarray, np.ndarray],
+    made: tuple[np.ndarray, np.ndarray],
+    code: dict[str, int],
+    result: Fidelity,
+) -> None:
+    """Lost and fused elements, counted into ``result`` (see the module)."""
+    given_code = np.array([code[r.label] for r in annotation.rects] + [-1], dtype=np.int32)
+    made_code = np.array([code[r.label] for r in output.rects] + [-2], dtype=np.int32)
+    # a cell belongs to an annotated element when it is its front-most rectangle, and to an
+    # output element when that is the front-most there and shows its label
+    owner, made_owner = given[1], made[1]
+    element = (owner >= 0) & (given_code[owner] != code[BACKGROUND])
+    visible = np.bincount(owner[element], minlength=len(annotation.rects))
+    shared = element & (made_owner >= 0) & (made_code[made_owner] == given_code[owner])
+    shared &= made[0] == given_code[owner]
+    pairs = owner[shared].astype(np.int64) * (len(output.rects) + 1) + made_owner[shared]
+    keys, counts = np.unique(pairs, return_counts=True)
+    kept: dict[int, list[int]] = {}  # output element -> annotated elements it keeps
+    covered = np.zeros(len(annotation.rects), dtype=bool)
+    for key, overlap in zip(keys.tolist(), counts.tolist(), strict=True):
+        e, o = divmod(key, len(output.rects) + 1)
+        if overlap >= COVERED * visible[e]:
+            covered[e] = True
+            kept.setdefault(o, []).append(e)
+    for e in np.flatnonzero(visible).tolist():
+        label = annotation.rects[e].label
+        entry = result.labels.setdefault(label, LabelFidelity(0.0))
+        entry.elements += 1
+        entry.lost += not covered[e]
+    for o, inside in kept.items():
+        if len(inside) >= 2:
+            result.labels[output.rects[o].label].fused += 1
+            result.fused_elements += len(inside)
