@@ -50,6 +50,24 @@ def test_two_windows_fused_into_one_are_found() -> None:
     assert "fuses 2 into 1" in warning and "window: 0 lost, 1 fused" in warning
 
 
+def test_windows_made_to_touch_are_fused_and_windows_drawn_touching_are_not() -> None:
+    """The tidy-up sized the wall between two windows 0: two rectangles in the output, one
+    region to whoever reads it (and one terminal to a grammar). A pillar drawn as base and
+    shaft touching is one region in the annotation already: kept as drawn, not fused."""
+    apart = (Rect("window", 0.5, 0.5, 1.5, 1.5, 10), Rect("window", 1.6, 0.5, 2.6, 1.5, 10))
+    touching = (Rect("window", 0.5, 0.5, 1.55, 1.5, 10), Rect("window", 1.55, 0.5, 2.6, 1.5, 10))
+    annotation = LabelledLayout(4.0, 2.0, apart)
+    found = fidelity(annotation, LabelledLayout(4.0, 2.0, touching))
+    assert (found.lost, found.fused, found.fused_elements) == (0, 1, 2)
+    drawn = [Rect("window", 0.5, 0.5, 2.6, 1.5)]  # a grammar's terminal over both
+    found = fidelity(annotation, LabelledLayout(4.0, 2.0, apart), drawn)
+    assert (found.lost, found.fused) == (0, 1) and found.iou_per_label()["window"] < 1.0
+    pillar = (Rect("pillar", 1.0, 0.0, 1.4, 0.5, 12), Rect("pillar", 1.0, 0.5, 1.4, 2.0, 12))
+    whole = (Rect("pillar", 1.0, 0.0, 1.4, 2.0, 12),)
+    found = fidelity(LabelledLayout(4.0, 2.0, pillar), LabelledLayout(4.0, 2.0, whole))
+    assert (found.elements, found.lost, found.fused, found.iou_mean) == (2, 0, 0, 1.0)
+
+
 def test_a_window_moved_off_its_place_is_lost() -> None:
     windows = _windows()
     annotation = LabelledLayout(10.0, 8.0, tuple(windows))

@@ -16,9 +16,14 @@ way, compared label by label and element by element.
 - **Elements.** An annotated element is its *visible* cells (where it is the front-most
   rectangle; one wholly hidden, or smaller than a cell, is not counted), and so is an
   output element. An annotated element is *lost* when no output element of its label
-  covers half or more of it; an output element is *fused* when it covers half or more of
-  each of two or more annotated elements of its label. Background rectangles are not
-  elements.
+  covers half or more of it. Background rectangles are not elements.
+- **Fused** is judged on regions, not rectangles, on both sides: an element is fused
+  when the connected region of its label on the output's raster that covers half or more
+  of it also covers half or more of another element that lies in another region of the
+  annotation (windows given a shared edge, the wall between them sized 0, are one region
+  to whoever reads the output, and one to a grammar). Elements drawn touching (a pillar's
+  base, shaft and capital) are one region already, and are not fused. ``fused`` counts
+  such regions of the output, ``fused_elements`` the annotated elements in them.
 """
 
 from __future__ import annotations
@@ -187,61 +192,90 @@ def fidelity(
     cells_max: int = CELLS_MAX,
 ) -> Fidelity:
     """``output`` (its rectangles are its elements) compared with the raw ``annotation`` at
-    the annotation's size; ``drawn``, when given, is what the output shows instead of its
-    elements painted (a grammar's terminals: one element may be several of them)."""
+    the annotation's size (see the module). ``drawn``, when given, is what the output
+    shows, when that is not its elements painted (a grammar's terminals)."""
     cells = grid(annotation.width, annotation.height, resolution, cells_max)
-    shown = list(drawn) if drawn is not None else list(output.rects)
-    names = sorted({BACKGROUND, *(r.label for r in (*annotation.rects, *output.rects, *shown))})
+    pieces = list(drawn) if drawn is not None else list(output.rects)
+    names = sorted({BACKGROUND, *(r.label for r in (*annotation.rects, *output.rects, *pieces))})
     code = {name: k for k, name in enumerate(names)}
-    given, given_owner = paint(annotation.rects, cells, code)
-    made, made_owner = paint(output.rects, cells, code)
-    if drawn is not None:
-        made = paint(shown, cells, code)[0]
+    given = _Painted(annotation.rects, cells, code)
+    made = _Painted(output.rects, cells, code)
+    shown = paint(pieces, cells, code)[0] if drawn is not None else made.labels
     result = Fidelity(max(cells.cell_w, cells.cell_h), cells.columns, cells.rows)
     count = len(names)
-    both = np.bincount((given * count + made).ravel(), minlength=count * count)
+    both = np.bincount((given.labels * count + shown).ravel(), minlength=count * count)
     both = both.reshape(count, count)
     for k, name in enumerate(names):
         union = int(both[k, :].sum() + both[:, k].sum() - both[k, k])
         if union:
             result.labels[name] = LabelFidelity(round(float(both[k, k]) / union, 4))
-    _elements(annotation, output, (given, given_owner), (made, made_owner), code, result)
+    # an annotated element's cells: where it is the front-most rectangle
+    element = (given.owners >= 0) & (given.codes[given.owners] != code[BACKGROUND])
+    visible = np.bincount(given.owners[element], minlength=len(annotation.rects))
+    kinds = {int(given.codes[e]) for e in np.flatnonzero(visible).tolist()}
+    own = given.codes[given.owners]  # the label of the element at each cell
+    kept = element & (made.owners >= 0) & (made.codes[made.owners] == own) & (shown == own)
+    covered = _covers(given.owners, made.owners, kept, visible)
+    for e in np.flatnonzero(visible).tolist():
+        entry = result.labels.setdefault(annotation.rects[e].label, LabelFidelity(0.0))
+        entry.elements += 1
+        entry.lost += e not in covered
+    apart = _regions(given.labels, kinds)  # the annotation's regions of each label
+    region_of = {e: found[0] for e, found in _covers(given.owners, apart, element, visible).items()}
+    together = _regions(shown, kinds)  # the output's regions
+    inside: dict[int, list[int]] = {}  # a region of the output -> the elements it covers
+    for e, found in _covers(given.owners, together, element & (shown == own), visible).items():
+        inside.setdefault(found[0], []).append(e)
+    for elements in inside.values():
+        if len({region_of.get(e, -1 - e) for e in elements}) >= 2:
+            result.labels[annotation.rects[elements[0]].label].fused += 1
+            result.fused_elements += len(elements)
     return result
 
 
-def _elements(
-    annotation: LabelledLayout,
-    output: LabelledLayout,
-    given: tuple[np.ndarray, np.ndarray],
-    made: tuple[np.ndarray, np.ndarray],
-    code: dict[str, int],
-    result: Fidelity,
-) -> None:
-    """Lost and fused elements, counted into ``result`` (see the module)."""
-    given_code = np.array([code[r.label] for r in annotation.rects] + [-1], dtype=np.int32)
-    made_code = np.array([code[r.label] for r in output.rects] + [-2], dtype=np.int32)
-    # a cell belongs to an annotated element when it is its front-most rectangle, and to an
-    # output element when that is the front-most there and shows its label
-    owner, made_owner = given[1], made[1]
-    element = (owner >= 0) & (given_code[owner] != code[BACKGROUND])
-    visible = np.bincount(owner[element], minlength=len(annotation.rects))
-    shared = element & (made_owner >= 0) & (made_code[made_owner] == given_code[owner])
-    shared &= made[0] == given_code[owner]
-    pairs = owner[shared].astype(np.int64) * (len(output.rects) + 1) + made_owner[shared]
-    keys, counts = np.unique(pairs, return_counts=True)
-    kept: dict[int, list[int]] = {}  # output element -> annotated elements it keeps
-    covered = np.zeros(len(annotation.rects), dtype=bool)
+class _Painted:
+    """A layout on the raster: the label code and the rectangle (-1: none) at every cell,
+    and the label code of every rectangle (the last one, -1, for none)."""
+
+    def __init__(self, rects: Sequence[Rect], cells: Grid, code: dict[str, int]):
+        self.labels, self.owners = paint(rects, cells, code)
+        self.codes = np.array([code[r.label] for r in rects] + [-1], dtype=np.int32)
+
+
+def _covers(
+    owners: np.ndarray, others: np.ndarray, where: np.ndarray, visible: np.ndarray
+) -> dict[int, list[int]]:
+    """For each annotated element (``owners``: its index at its cells), what of ``others``
+    (an output element's or a region's number at each cell, -1 for none) covers half or
+    more of its visible cells, counting the cells ``where`` holds (largest first)."""
+    where = where & (others >= 0)
+    span = int(others.max(initial=0)) + 1
+    keys, counts = np.unique(
+        owners[where].astype(np.int64) * span + others[where], return_counts=True
+    )
+    found: dict[int, list[tuple[int, int]]] = {}
     for key, overlap in zip(keys.tolist(), counts.tolist(), strict=True):
-        e, o = divmod(key, len(output.rects) + 1)
+        e, o = divmod(key, span)
         if overlap >= COVERED * visible[e]:
-            covered[e] = True
-            kept.setdefault(o, []).append(e)
-    for e in np.flatnonzero(visible).tolist():
-        label = annotation.rects[e].label
-        entry = result.labels.setdefault(label, LabelFidelity(0.0))
-        entry.elements += 1
-        entry.lost += not covered[e]
-    for o, inside in kept.items():
-        if len(inside) >= 2:
-            result.labels[output.rects[o].label].fused += 1
-            result.fused_elements += len(inside)
+            found.setdefault(e, []).append((overlap, o))
+    return {e: [o for _, o in sorted(pairs, reverse=True)] for e, pairs in found.items()}
+
+
+def _regions(labels: np.ndarray, kinds: set[int]) -> np.ndarray:
+    """The connected regions (4-neighbours) of each label of ``kinds`` on a raster, numbered
+    from 0 across labels; -1 elsewhere. Each label is labelled within the box of its
+    cells, so the work is the boxes, not the raster times the labels."""
+    from scipy import ndimage
+
+    region = np.full(labels.shape, -1, dtype=np.int64)
+    boxes = ndimage.find_objects(labels + 1)  # the box of label k at k
+    count = 0
+    for k in sorted(kinds):
+        box = boxes[k] if k < len(boxes) else None
+        if box is None:
+            continue
+        mask = labels[box] == k
+        numbered, found = ndimage.label(mask)
+        region[box][mask] = numbered[mask] - 1 + count
+        count += found
+    return region
