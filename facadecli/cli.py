@@ -633,7 +633,8 @@ def infer(
         bool,
         typer.Option(
             "--check/--no-check",
-            help="Solve the spec at the input's size (intersection over union per label) "
+            help="Solve the spec at the input's size (intersection over union per label "
+            "against the annotation, elements lost or fused; and against the tidied layout) "
             "and at 0.7 and 1.5 times its width, and report it.",
         ),
     ] = True,
@@ -804,8 +805,13 @@ def grammar(
     for warning in extraction.warnings:
         _warn(f"{layout}: warning: {warning}")
     if extraction.fidelity is not None:
-        for warning in extraction.fidelity.warnings("the grammar at the input's size"):
+        faithful = extraction.fidelity
+        for warning in faithful.warnings("the grammar at the input's size"):
             _warn(f"{layout}: warning: {warning}")
+        _detail(
+            f"{layout}: against the annotation: mean IoU {faithful.iou_mean:.3f}, "
+            f"{faithful.lost} lost, {faithful.fused} fused of {faithful.elements} elements"
+        )
     _detail(
         f"{layout}: {len(extraction.tiling.xs) - 1} x {len(extraction.tiling.ys) - 1} tiling, "
         f"search {extraction.time_ms:.0f} ms"
