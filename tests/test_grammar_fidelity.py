@@ -47,7 +47,7 @@ def test_two_windows_fused_into_one_are_found() -> None:
     assert (found.elements, found.lost, found.fused, found.fused_elements) == (6, 0, 1, 2)
     assert found.iou_per_label()["window"] < 1.0 and found.iou_mean < 1.0
     (warning,) = found.warnings("the output")
-    assert "fuses 2 into 1" in warning and "window: 0 lost, 1 fused" in warning
+    assert "fuses 2 into 1 of the annotation's 6 elements (window: 0 lost, 1 fused)" in warning
 
 
 def test_windows_made_to_touch_are_fused_and_windows_drawn_touching_are_not() -> None:
@@ -74,6 +74,8 @@ def test_a_window_moved_off_its_place_is_lost() -> None:
     moved = Rect("window", 1.6, 2.0, 2.6, 3.5, 10)  # 60% of its width off
     found = fidelity(annotation, LabelledLayout(10.0, 8.0, (moved, *windows[1:])))
     assert (found.lost, found.fused) == (1, 0)
+    (warning,) = found.warnings("it")
+    assert warning == "it loses 1 of the annotation's 6 elements (window: 1 lost, 0 fused)"
 
 
 def test_the_z_order_hides_what_is_behind() -> None:

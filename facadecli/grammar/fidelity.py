@@ -111,7 +111,7 @@ class LabelFidelity:
     iou: float
     elements: int = 0  # annotated elements counted (visible on the raster)
     lost: int = 0
-    fused: int = 0  # output elements covering two or more annotated ones
+    fused: int = 0  # regions of the output covering annotated elements drawn apart
 
     def summary(self) -> dict[str, object]:
         return {"iou": self.iou, "elements": self.elements, "lost": self.lost, "fused": self.fused}
@@ -125,7 +125,7 @@ class Fidelity:
     columns: int
     rows: int
     labels: dict[str, LabelFidelity] = field(default_factory=dict)
-    fused_elements: int = 0  # annotated elements inside fused output elements
+    fused_elements: int = 0  # annotated elements inside those regions
 
     @property
     def iou_mean(self) -> float:
@@ -177,9 +177,12 @@ class Fidelity:
                 for label, entry in self.labels.items()
                 if entry.lost or entry.fused
             )
+            done = [f"loses {self.lost}"] if self.lost else []
+            if self.fused:
+                done.append(f"fuses {self.fused_elements} into {self.fused}")
             found.append(
-                f"{what} loses {self.lost} of the annotation's {self.elements} elements and "
-                f"fuses {self.fused_elements} into {self.fused} ({by_label})"
+                f"{what} {' and '.join(done)} of the annotation's {self.elements} elements "
+                f"({by_label})"
             )
         return found
 
