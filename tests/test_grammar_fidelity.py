@@ -116,6 +116,8 @@ def test_the_raster_is_capped() -> None:
     assert huge.columns * huge.rows <= CELLS_MAX and huge.columns == pytest.approx(2828, abs=2)
     tiny = grid(1000.0, 500.0, cells_max=1000)
     assert tiny.columns * tiny.rows <= 1000 and tiny.cell_w == pytest.approx(tiny.cell_h, rel=0.05)
+    sliver = grid(1e-6, 1e6)  # one column: the rows alone are capped
+    assert sliver.columns == 1 and sliver.rows <= CELLS_MAX
     annotation = LabelledLayout(1000.0, 500.0, (Rect("window", 100, 100, 300, 200, 10),))
     found = fidelity(annotation, annotation, cells_max=1000)
     assert found.columns * found.rows <= 1000 and found.iou_mean == 1.0

@@ -73,7 +73,7 @@ def grid(
     ``cells_max`` cells."""
     longer = max(width, height)
     cell = min(resolution, longer / side_min)
-    cell = max(cell, math.sqrt(width * height / cells_max))
+    cell = max(cell, math.sqrt(width * height / cells_max), longer / cells_max)
     columns = max(1, round(width / cell))
     rows = max(1, round(height / cell))
     while columns * rows > cells_max:  # rounding up may pass the limit by a row or column
