@@ -633,7 +633,8 @@ def infer(
         bool,
         typer.Option(
             "--check/--no-check",
-            help="Solve the spec at the input's size (intersection over union per label) "
+            help="Solve the spec at the input's size (intersection over union per label "
+            "against the annotation, elements lost or fused; and against the tidied layout) "
             "and at 0.7 and 1.5 times its width, and report it.",
         ),
     ] = True,
@@ -667,12 +668,22 @@ def infer(
     if check and not report.get("solves"):
         _warn(f"{layout}: warning: the spec does not solve: {report.get('error')}")
     elif check:
-        summary += f", IoU at least {report['iou_min']:.3f}"
+        faithful = report["fidelity"]
+        summary += (
+            f", IoU at least {report['iou_min']:.3f} against the tidied layout; against the "
+            f"annotation mean IoU {faithful['iou_mean']:.3f}, "  # type: ignore[index]
+            f"{faithful['lost']} lost, {faithful['fused']} fused"  # type: ignore[index]
+        )
+        if inferred.fidelity is not None:
+            for warning in inferred.fidelity.warnings("the spec solved at the input's size"):
+                _warn(f"{layout}: warning: {warning}")
         for entry in report["retargets"]:  # type: ignore[attr-defined]
             if not entry["solves"]:
                 _warn(f"{layout}: warning: at {entry['width']:g} m wide: {entry['error']}")
         for label, iou in sorted(report.get("iou", {}).items()):  # type: ignore[attr-defined]
-            _detail(f"{layout}: IoU of {label}: {iou:.4f}")
+            _detail(f"{layout}: IoU of {label}: {iou:.4f} against the tidied layout")
+        for label, iou in sorted(faithful["iou_per_label"].items()):  # type: ignore[index]
+            _detail(f"{layout}: IoU of {label}: {iou:.4f} against the annotation")
     _say(f"{layout}: {summary} -> {target}, {report_path}")
 
 
@@ -793,6 +804,14 @@ def grammar(
     name = stem(layout)
     for warning in extraction.warnings:
         _warn(f"{layout}: warning: {warning}")
+    if extraction.fidelity is not None:
+        faithful = extraction.fidelity
+        for warning in faithful.warnings("the grammar at the input's size"):
+            _warn(f"{layout}: warning: {warning}")
+        _detail(
+            f"{layout}: against the annotation: mean IoU {faithful.iou_mean:.3f}, "
+            f"{faithful.lost} lost, {faithful.fused} fused of {faithful.elements} elements"
+        )
     _detail(
         f"{layout}: {len(extraction.tiling.xs) - 1} x {len(extraction.tiling.ys) - 1} tiling, "
         f"search {extraction.time_ms:.0f} ms"

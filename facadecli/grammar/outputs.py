@@ -149,6 +149,7 @@ def grammar_report(
         "regions_explored": found.regions,
         "repeated_regions": found.repeats,
         "rederives_exactly": not extraction.problems,
+        "fidelity": extraction.fidelity.summary() if extraction.fidelity else None,
         "snapping": extraction.snapping.summary(),
         "regularization": extraction.regularization.summary(),
         "warnings": extraction.warnings,

@@ -21,7 +21,8 @@ from facadecli.errors import Problem, SpecError
 from facadecli.grammar import regions
 from facadecli.grammar.cmp_xml import read_cmp
 from facadecli.grammar.deadline import Deadline
-from facadecli.grammar.inputs import EXTENT_MAX, LabelledLayout
+from facadecli.grammar.fidelity import Fidelity, fidelity
+from facadecli.grammar.inputs import EXTENT_MAX, LabelledLayout, Rect
 from facadecli.grammar.json_layouts import read_plain, read_report
 from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
@@ -70,6 +71,7 @@ class Extraction:
     time_ms: float = 0.0
     problems: list[str] = field(default_factory=list)
     snapping: Snapping = NO_SNAPPING  # what snapping changed
+    fidelity: Fidelity | None = None  # the derivation at the input's size vs the annotation
 
     @cached_property
     def style(self) -> list[Constraint]:
@@ -183,6 +185,7 @@ class Tidied:
     snapping: Snapping
     regularization: Regularization
     snapped: LabelledLayout  # before regularising: its rectangles in the same order
+    raw: LabelledLayout  # as read (stretched to the size): what fidelity is measured against
 
 
 Progress = Callable[[str], None]  # told the name of each stage as it starts
@@ -211,7 +214,7 @@ def tidy_layout(
     check_cells(path, snapped, snap)
     progress("regularising")
     regular, regularization = regularize(snapped, tolerance, deadline=deadline)
-    return Tidied(regular, snapping, regularization, snapped)
+    return Tidied(regular, snapping, regularization, snapped, layout)
 
 
 def extract_grammar(
@@ -243,6 +246,9 @@ def extract_grammar(
     progress("checking the grammar derives the layout")
     extraction.problems = rederivation_problems(found.grammar, tiling)
     extraction.snapping = snapping
+    progress("measuring the derivation against the annotation")
+    terminals = [Rect(*box) for box in derive(found.grammar, tiling.xs[-1], tiling.ys[-1])]
+    extraction.fidelity = fidelity(tidied.raw, regular, terminals)
     return extraction
 
 

@@ -1,7 +1,8 @@
 """``facade infer``'s pipeline, without the writing: read a labelled layout, snap and
 regularise it (as ``facade grammar`` does), find its grids, write them as a layered spec,
-and check the spec: solved at the input's size it must give the input back (the
-intersection over union of every label, on a raster), and it must solve at other widths.
+and check the spec: solved at the input's size it is compared with the raw annotation
+(``grammar.fidelity``: IoU per label, elements lost or fused) and with the tidied layout it
+was written from (``iou``), and it must solve at other widths.
 """
 
 from __future__ import annotations
@@ -9,11 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from facadecli.errors import FacadeError, SpecError
 from facadecli.grammar.deadline import Deadline
-from facadecli.grammar.inputs import BACKGROUND, LabelledLayout
+from facadecli.grammar.fidelity import Fidelity, fidelity
+from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.grammar.run import Options, Progress, no_progress, tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
 from facadecli.infer.layers import BAND, Grid, grids, to_edges
@@ -21,7 +21,6 @@ from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
 from facadecli.layout import Layout
 from facadecli.spec.model import Spec
 
-RASTER = 400  # samples along each axis of the IoU raster
 WIDTHS = (0.7, 1.5)  # other widths the spec must solve at, as shares of the input's
 
 
@@ -33,6 +32,8 @@ class Inference:
     grids: list[Grid]
     text: str  # the spec
     checks: dict[str, object] = field(default_factory=dict)
+    raw: LabelledLayout | None = None  # as read (stretched to the size); None: ``layout``
+    fidelity: Fidelity | None = None  # the spec solved at the input's size vs ``raw``
 
     def report(self) -> dict[str, object]:
         lines = [line for line in self.text.splitlines() if line.strip()[:1] not in ("", "#")]
@@ -60,7 +61,8 @@ def infer(
     found = [to_edges(grid, regular.width, regular.height) for grid in grids(regular)]
     spread = size_spread(regular, tidied.snapped)
     text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread)
-    return Inference(path.name, regular, tile(regular, tolerance=0.0), found, text)
+    tiling = tile(regular, tolerance=0.0)
+    return Inference(path.name, regular, tiling, found, text, raw=tidied.raw)
 
 
 def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:
@@ -96,16 +98,14 @@ def check(inference: Inference, spec: Spec, progress: Progress = no_progress) ->
         checks["solves"] = False
         checks["error"] = str(error)
         return checks
-    labels = sorted({r.label for r in inference.layout.rects} | {BACKGROUND})
-    drawn = _raster_of_layout(layout, spec, inference, labels)
-    given = _raster_of_tiling(inference.tiling, labels)
-    iou = {}
-    for k, label in enumerate(labels):
-        union = np.count_nonzero((drawn == k) | (given == k))
-        if union:
-            iou[label] = round(float(np.count_nonzero((drawn == k) & (given == k)) / union), 4)
+    solved = solved_layout(layout, spec, inference)
+    progress("checking: comparing it with the annotation")
+    faithful = fidelity(inference.raw or inference.layout, solved)
+    inference.fidelity = faithful
+    iou = fidelity(inference.layout, solved).iou_per_label()
     checks["solves"] = True
-    checks["iou"] = iou
+    checks["fidelity"] = faithful.summary()
+    checks["iou"] = iou  # against the tidied layout: what the spec writer was given
     checks["iou_min"] = min(iou.values())
     retargets = []
     for share in WIDTHS:
@@ -123,38 +123,18 @@ def check(inference: Inference, spec: Spec, progress: Progress = no_progress) ->
     return checks
 
 
-def _samples(extent: float) -> np.ndarray:
-    return (np.arange(RASTER) + 0.5) * extent / RASTER
-
-
-def _raster_of_tiling(tiling: Tiling, labels: list[str]) -> np.ndarray:
-    """The label of the tiling at every sample (rows bottom up)."""
-    xs, ys = _samples(tiling.xs[-1]), _samples(tiling.ys[-1])
-    columns = np.clip(np.searchsorted(tiling.xs, xs, side="right") - 1, 0, len(tiling.xs) - 2)
-    rows = np.clip(np.searchsorted(tiling.ys, ys, side="right") - 1, 0, len(tiling.ys) - 2)
-    index = {label: k for k, label in enumerate(labels)}
-    cells = np.array([[index[label] for label in row] for row in tiling.labels])
-    return cells[np.ix_(rows, columns)]
-
-
-def _raster_of_layout(
-    layout: Layout, spec: Spec, inference: Inference, labels: list[str]
-) -> np.ndarray:
-    """The label of the solved layout's front-most element at every sample: a layer is its
-    grid's label; its spacers, and the wall, are the background."""
-    index = {label: k for k, label in enumerate(labels)}
-    xs, ys = _samples(inference.layout.width), _samples(inference.layout.height)
-    raster = np.full((RASTER, RASTER), index[BACKGROUND])
+def solved_layout(layout: Layout, spec: Spec, inference: Inference) -> LabelledLayout:
+    """The solved spec as a labelled layout: each shape a rectangle with its layer's label
+    (a layer is one grid of a label; the wall is the background), layers back to front;
+    see-through shapes (transparent symbols) are left out."""
     names = ["wall", *layer_names(inference.grids)]
     label_of = {"wall": BACKGROUND} | {
         n: g.label for n, g in zip(names[1:], inference.grids, strict=True)
     }
     order = {n: k for k, n in enumerate(names)}
-    shapes = sorted(layout.shapes, key=lambda s: order.get(s.layer, 0))
-    for shape in shapes:
-        if spec.qualifiers(shape.x).transparent or spec.qualifiers(shape.y).transparent:
-            continue
-        columns = (xs >= shape.x0) & (xs < shape.x1)
-        rows = (ys >= shape.y0) & (ys < shape.y1)
-        raster[np.ix_(rows, columns)] = index[label_of.get(shape.layer, BACKGROUND)]
-    return raster
+    rects = [
+        Rect(label_of.get(s.layer, BACKGROUND), s.x0, s.y0, s.x1, s.y1, order.get(s.layer, 0))
+        for s in layout.shapes
+        if not (spec.qualifiers(s.x).transparent or spec.qualifiers(s.y).transparent)
+    ]
+    return LabelledLayout(inference.layout.width, inference.layout.height, tuple(rects))
