@@ -181,11 +181,18 @@ def test_site_builds_strictly(tmp_path: Path) -> None:
     assert (tmp_path / "site" / "reference" / "spec" / "index.html").is_file()
 
 
-# -- the tutorials' and how-to guides' commands ------------------------------------------
-GUIDES = sorted([*(ROOT / "docs/tutorials").glob("*.md"), *(ROOT / "docs/how-to").glob("*.md")])
+# -- the commands of the tutorials, how-to guides, CLI reference and home page -------------
+GUIDES = sorted(
+    [
+        *(ROOT / "docs/tutorials").glob("*.md"),
+        *(ROOT / "docs/how-to").glob("*.md"),
+        ROOT / "docs/reference/cli.md",
+        ROOT / "docs/index.md",
+    ]
+)
 # commands a guide shows that cannot run here: a server that runs until stopped, a cluster,
-# a manifest of the reader's own (the guide says so)
-NOT_HERE = re.compile(r"\bwatch\b|--scheduler|district\.yaml|/shared/")
+# a manifest of the reader's own (the guide says so), a change to the reader's shell
+NOT_HERE = re.compile(r"\bwatch\b|--scheduler|district\.yaml|/shared/|--install-completion")
 CREATE = re.compile(r"[Cc]reate `([^`/]+)`")
 
 
@@ -224,8 +231,9 @@ def guide_steps(page: Path) -> list[tuple[str, str]]:
 @pytest.mark.slow
 @pytest.mark.parametrize("page", GUIDES, ids=lambda p: str(p.relative_to(ROOT)))
 def test_guides_commands_run_in_order(page: Path, tmp_path: Path) -> None:
-    """Every ``facade`` command of a tutorial or how-to guide runs as written, in order, in a
-    folder holding the repository's specs/ and samples/ and the files the guide creates."""
+    """Every ``facade`` command of a guide (or the CLI reference, or the home page) runs
+    as written, in order, in a folder holding the repository's specs/ and samples/ and
+    the files the page asks the reader to create."""
     for name in ("specs", "samples"):
         (tmp_path / name).symlink_to(ROOT / name)
     env = {
