@@ -30,15 +30,17 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 from facadecli.patterns import Letter
+from facadecli.solver.budgets import (
+    BUDGET_STEP,
+    JOINT_ROWS,
+    MAX_NODES,
+    REFINE_NODES,
+    TARGETS_PER_STATE,
+)
 from facadecli.solver.rows import LetterTraits, Row
 
 INF = math.inf
 EPS = 1e-9
-TARGETS_PER_STATE = 24  # target widths tried from one state, smallest first
-MAX_NODES = 5_000  # states one search may visit before it gives up on a candidate
-JOINT_ROWS = 2  # rows searched together; more are added one at a time
-REFINE_NODES = 200  # least extra effort spent looking for a cheaper path than the first
-BUDGET_STEP = 0.01  # least deepening of the error budget, as a share of the canvas
 
 # what a row's previous entry means for the attached rule (SPEC 2.4)
 FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2

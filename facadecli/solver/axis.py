@@ -12,7 +12,6 @@ from facadecli.patterns import CompiledPattern, Enumerated, Letter, Word, format
 from facadecli.solver import columns, construct, exact, sizing
 from facadecli.solver.alignment import (
     INF,
-    MAX_NODES,
     Alignment,
     AlignmentResult,
     Prefixes,
@@ -32,6 +31,7 @@ from facadecli.solver.budgets import (
     FITTED,
     HEURISTIC_WORK,
     MAX_LETTERS,
+    MAX_NODES,
     NEAR_CANVAS,
     NEAR_EQUAL,
     REPAIRS,

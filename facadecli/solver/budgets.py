@@ -35,6 +35,19 @@ TIER = 0.01  # candidates needing up to this share of the canvas more than the f
 # aligns (in tolerance, or in room made by opaque letters) still compete with it
 CANDIDATES_TO_TRY = 200
 
+# -- the exact search (solver.exact) -------------------------------------------------------
+LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
+COMBINATION_WORK = 64  # partial columns built per work unit
+RECURSION_MARGIN = 1000  # frames beyond the search's deepest path (the callers', numpy's)
+SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
+
+# -- the heuristic alignment of the paper (solver.alignment) ------------------------------
+TARGETS_PER_STATE = 24  # target widths tried from one state, smallest first
+MAX_NODES = 5_000  # states one search may visit before it gives up on a candidate
+JOINT_ROWS = 2  # rows searched together; more are added one at a time
+REFINE_NODES = 200  # least extra effort spent looking for a cheaper path than the first
+BUDGET_STEP = 0.01  # least deepening of the error budget, as a share of the canvas
+
 # -- layouts by construction (solver.construct) ----------------------------------------
 NEAR = 1e-7  # metres (times the canvas, at least 1 m): boundaries this close are one
 # tolerances (shares of the shortest letter) within which boundaries laid at the

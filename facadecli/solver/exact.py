@@ -40,6 +40,12 @@ from facadecli.native import EXACT_COMPILED, _exact
 from facadecli.patterns import Word
 from facadecli.solver import columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row, prepared_row
+from facadecli.solver.budgets import (
+    COMBINATION_WORK,
+    LEAF_WORK,
+    RECURSION_MARGIN,
+    SAME,
+)
 from facadecli.solver.rows import LetterTraits, Row
 from facadecli.spec.model import Spec
 
@@ -49,10 +55,6 @@ NO_OPAQUE, ATTACHED_GAP, NO_COVER, GAP_BEFORE_ATTACHED, COVERED = 1, 2, 3, 4, 5
 Column = tuple[Move | None, ...]
 Option = tuple[Move | None, np.ndarray | None]  # an entry (None: a gap), its length if known
 Options = tuple[list[Option], list[int], np.ndarray]  # see _Search.options()
-LEAF_WORK = 20  # work units of sizing a complete layout (a bound costs 1)
-COMBINATION_WORK = 64  # partial columns built per work unit
-RECURSION_MARGIN = 1000  # frames beyond the search's deepest path (the callers', numpy's)
-SAME = 1e-9  # objectives this close are equal (the tie-breaks decide)
 COMPILED = EXACT_COMPILED  # search with _exact.c where built (False: the Python reference)
 _EXHAUSTED, _STOPPED = 2, 3  # what _exact.Search.run() returns besides 0 (done)
 
