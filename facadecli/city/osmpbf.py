@@ -53,6 +53,14 @@ def check_pbf(path: Path) -> None:
                 )
 
 
+def _exactly(stream: BinaryIO, count: int, what: str) -> bytes:
+    """The next ``count`` bytes of the file, which must not end inside ``what``."""
+    data = stream.read(count)
+    if len(data) < count:
+        raise _Broken(f"the file ends inside {what}")
+    return data
+
+
 def _block(stream: BinaryIO) -> int | None:
     """The inflated size of the next block (None at the end of the file)."""
     head = stream.read(4)
@@ -63,18 +71,14 @@ def _block(stream: BinaryIO) -> int | None:
     length = int.from_bytes(head, "big")
     if length > HEADER_MAX:
         raise _Broken(f"a block header of {length:,} bytes")
-    header = stream.read(length)
-    if len(header) < length:
-        raise _Broken("the file ends inside a block header")
+    header = _exactly(stream, length, "a block header")
     datasize = None
     for number, value in _fields(header):
         if number == 3 and isinstance(value, int):
             datasize = value
     if datasize is None or datasize > BLOB_MAX:
         raise _Broken("a block header without a valid data size")
-    blob = stream.read(datasize)
-    if len(blob) < datasize:
-        raise _Broken("the file ends inside a block")
+    blob = _exactly(stream, datasize, "a block")
     raw = None
     for number, value in _fields(blob):
         if number == 1 and isinstance(value, bytes):

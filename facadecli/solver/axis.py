@@ -877,8 +877,12 @@ def _least_covering_together(
         own = _covering({key: words[key] for key in keys}, canvas)
         others = {key: word for key, word in words.items() if key not in keys}
         options = space.options[cluster][:VARIANTS]
-        for option in sorted(options, key=lambda option: _covering(option, canvas)):
-            if _covering(option, canvas) >= own - tie:
+        covers = sorted(
+            ((_covering(option, canvas), i) for i, option in enumerate(options)),
+        )
+        for cover, i in covers:
+            option = options[i]
+            if cover >= own - tie:
                 break
             variant = space.candidate([others, option])
             if (

@@ -261,7 +261,7 @@ def placeholders_laid(
 ) -> dict[str, float] | None:
     """The relaxation's sizes with the placeholders sized so that the rows agree: a
     placeholder that is the only one a row leaves open takes what the row leaves of the
-    canvas; where a row leaves several open, they are sized (:func:`_fitted`) so that the
+    canvas; where a row leaves several open, they are sized (:func:`fit`) so that the
     row's boundaries fall on those of the rows already laid in its group. None when a row
     cannot be laid so (then the relaxation's own placeholder sizes are all there is)."""
     lengths = {name: size for name, size in relaxed.lengths.items()}
@@ -302,25 +302,12 @@ def placeholders_laid(
             if all(letter.symbol in lengths for letter in other.word)
         ]
         points = sorted({p for other in laid for p in boundaries(other, lengths)})
-        fitted = _fitted(row, lengths, points, canvas, laid_for(row, [(o, lengths) for o in laid]))
+        fitted = fit(row, lengths, points, canvas, laid_for(row, [(o, lengths) for o in laid]))
         if fitted is None:  # the rows laid may be the ones in the way: theirs alone
-            fitted = _fitted(row, lengths, points, canvas)
+            fitted = fit(row, lengths, points, canvas)
         if fitted is None:
             return None
         lengths.update(fitted)
-
-
-def fit(
-    row: Row,
-    sizes: Mapping[str, float],
-    points: Sequence[float],
-    canvas: float,
-    laid: Laid = NOTHING_LAID,
-) -> dict[str, float] | None:
-    """The sizes of a row's open placeholders when the row fills the canvas with every
-    visible letter starting and ending on one of ``points``, among the rows ``laid``
-    (:func:`laid_for`); None when it does not fit."""
-    return _fitted(row, sizes, sorted(points), canvas, laid)
 
 
 def coverage(
@@ -347,7 +334,7 @@ def _changes(row: Row, k: int) -> bool:
     return row.traits[k - 1].transparent != row.traits[k].transparent
 
 
-def _fitted(
+def fit(
     row: Row,
     lengths: Mapping[str, float],
     points: Sequence[float],
@@ -356,16 +343,16 @@ def _fitted(
 ) -> dict[str, float] | None:
     """Sizes of a row's open placeholders that end each of them on one of ``points`` and
     the row on the canvas' end, with no boundary the row needs inside a visible letter
-    of the rows ``laid``, nor one they need inside a visible letter of the row, and no
-    visible letter over an unoccludable one (SPEC 2.4): the first found, depth first,
-    nearest first, within FITTING_WORK; None when none is found."""
-    fitting = _Fitting(row, lengths, points, canvas, laid)
+    of the rows ``laid`` (:func:`laid_for`), nor one they need inside a visible letter
+    of the row, and no visible letter over an unoccludable one (SPEC 2.4): the first
+    found, depth first, nearest first, within FITTING_WORK; None when none is found."""
+    fitting = _Fitting(row, lengths, sorted(points), canvas, laid)
     fitting.lay(0, 0.0, {})
     return fitting.best
 
 
 class _Fitting:
-    """The depth-first search of :func:`_fitted`: placeholders sized in the order the row
+    """The depth-first search of :func:`fit`: placeholders sized in the order the row
     meets them, each to end on one of the points, nearest first."""
 
     def __init__(
