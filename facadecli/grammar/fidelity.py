@@ -126,6 +126,8 @@ class Fidelity:
     rows: int
     labels: dict[str, LabelFidelity] = field(default_factory=dict)
     fused_elements: int = 0  # annotated elements inside those regions
+    lost_at: list[int] = field(default_factory=list)  # the lost elements (the annotation's)
+    fused_at: list[list[int]] = field(default_factory=list)  # the elements of each fused region
 
     @property
     def iou_mean(self) -> float:
@@ -223,6 +225,8 @@ def fidelity(
         entry = result.labels.setdefault(annotation.rects[e].label, LabelFidelity(0.0))
         entry.elements += 1
         entry.lost += e not in covered
+        if e not in covered:
+            result.lost_at.append(e)
     apart = _regions(given.labels, kinds)  # the annotation's regions of each label
     region_of = {e: found[0] for e, found in _covers(given.owners, apart, element, visible).items()}
     together = _regions(shown, kinds)  # the output's regions
@@ -233,6 +237,7 @@ def fidelity(
         if len({region_of.get(e, -1 - e) for e in elements}) >= 2:
             result.labels[annotation.rects[elements[0]].label].fused += 1
             result.fused_elements += len(elements)
+            result.fused_at.append(sorted(elements))
     return result
 
 

@@ -15,10 +15,15 @@ edges keep their order, and
   so hand-drawn bays become a run a grammar can repeat;
 - *line-ups* (Bao's alignment): elements whose centres are nearer than the tolerance x the
   extent get one centre where they can (a door under a window column, a balcony under a
-  window): a soft constraint, weighted, as one element may line up with two that cannot.
+  window).
 
-If the equalities cannot all hold, the runs' are dropped, then the strips', then the
-elements'. What moved is returned for the report.
+Fidelity comes first (issue 34): no edge goes further from where it was drawn than the
+tolerance, nor than an eighth of the narrowest element, gap between two elements of one
+label, or visible part of an element it bounds (``tiling.move_limits``; ``bounds_of``),
+so nothing is lost, shrunk away or fused. Within those bounds every equality is first
+asked for softly (weighted by kind, ``WEIGHTS``: elements, then strips, runs and
+line-ups); those the soft QP meets are then made exact together, and the rest stay as
+drawn (the report counts them). What moved is returned for the report.
 """
 
 from __future__ import annotations
@@ -30,12 +35,14 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from facadecli.grammar.deadline import Deadline
-from facadecli.grammar.tiling import LabelledLayout, Rect, Tiling, snap, tile
+from facadecli.grammar.tiling import LabelledLayout, Rect, Tiling, move_limits, snap, tile
 
 DEFAULT_TOLERANCE = 0.01  # of the façade's extent along the axis
 RELATIVE = 0.1  # and never sizes more than this fraction apart
-LINED = 1e-3  # of the extent: line-ups the soft QP brings this near are then made exact
-SOFT = 100.0  # weight of a line-up against moving edges (both squared)
+MET = 1e-4  # of the extent: equal sizes and line-ups the soft QP brings this near are made exact
+EQUAL = 1e-6  # of the extent: sizes this near are equal
+# weights of equal sizes against moving edges (both squared), the weightiest kept first
+WEIGHTS = {"element": 1e4, "strip": 3e3, "run": 1e3, "line-up": 1e2}
 PITCH = 2.0  # pitches of a run may differ by this many tolerances (hand drawing jitters)
 
 
@@ -191,10 +198,10 @@ def _line_ups(rects: list[Rect], axis: str, extent: float, tolerance: float) -> 
     return groups
 
 
-def _centre_gap(line_up: list[Span], at: dict[float, float]) -> float:
-    """How far apart the centres of a line-up's two elements are (twice, in fact), with
-    the edges where ``at`` puts them."""
-    (a0, b0), (a, b) = line_up
+def _size_gap(pair: list[Span], at: dict[float, float]) -> float:
+    """How far apart the sizes of a pair's two spans are, with the edges where ``at`` puts
+    them (a line-up is such a pair: see ``_line_ups``)."""
+    (a0, b0), (a, b) = pair
     return abs(at[b] - at[a] - at[b0] + at[a0])
 
 
@@ -216,11 +223,12 @@ def _solve_axis(
     extent: float,
     groups: list[list[tuple[float, float]]],
     elements: list[tuple[float, float]],
-    soft: list[list[tuple[float, float]]],
+    soft: list[tuple[float, list[list[tuple[float, float]]]]],
+    bounds: tuple[np.ndarray, np.ndarray],
 ) -> list[float] | None:
-    """Edges as near as they can be to where they were, with the spans of each group
-    equal, and those of each ``soft`` group as near to equal as they can be (weighted by
-    ``SOFT``)."""
+    """Edges as near as they can be to where they were and within their ``bounds`` (low,
+    high), with the spans of each group equal, and those of each ``soft`` group as near to
+    equal as they can be (its weight times the square of the difference)."""
     import cvxpy as cp  # imported here: it takes half a second
 
     index = {value: i for i, value in enumerate(edges)}
@@ -232,16 +240,18 @@ def _solve_axis(
     v = cp.Variable(len(edges))
     # constraints as a few vector expressions: building one per pair is slow in cvxpy
     constraints = [v[0] == 0.0, v[len(edges) - 1] == extent, cp.diff(v) >= 0]
+    constraints += [v >= bounds[0], v <= bounds[1]]
     objective = cp.sum_squares(v - np.array(edges))
     if kept:  # every element keeps at least half its size
         constraints.append(v[stops] - v[starts] >= drawn / 2)
         objective += cp.sum_squares(v[stops] - v[starts] - drawn)
     if len(equal):
         constraints.append(v[equal[:, 3]] - v[equal[:, 2]] == v[equal[:, 1]] - v[equal[:, 0]])
-    near = _pairs(soft, index)
+    near = _pairs([group for _, groups in soft for group in groups], index)
     if len(near):
-        objective += SOFT * cp.sum_squares(
-            v[near[:, 3]] - v[near[:, 2]] - v[near[:, 1]] + v[near[:, 0]]
+        weights = np.sqrt(np.array([w for w, g in soft for _ in g]))
+        objective += cp.sum_squares(
+            cp.multiply(weights, v[near[:, 3]] - v[near[:, 2]] - v[near[:, 1]] + v[near[:, 0]])
         )
     problem = cp.Problem(cp.Minimize(objective), constraints)
     try:
@@ -253,15 +263,64 @@ def _solve_axis(
     return [float(x) for x in v.value]
 
 
+def bounds_of(
+    layout: LabelledLayout,
+    drawn: LabelledLayout,
+    axis: str,
+    edges: list[float],
+    tolerance: float,
+    background: str,
+) -> tuple[np.ndarray, np.ndarray]:
+    """How far each edge of ``layout`` (snapped from ``drawn``: the same rectangles in the
+    same order) may go: within ``move_limits`` (the tolerance, and a share of the narrowest
+    element, gap or visible part it bounds as drawn) of every drawn coordinate snapped to
+    it, and never further from where it is now than to there. The façade's edges stay."""
+    extent = layout.width if axis == "x" else layout.height
+
+    def span(r: Rect) -> tuple[float, float]:  # clipped to the façade, as snapped
+        a, b = (r.x0, r.x1) if axis == "x" else (r.y0, r.y1)
+        return min(max(a, 0.0), extent), min(max(b, 0.0), extent)
+
+    pairs = [
+        (r, q)
+        for r, q in zip(drawn.rects, layout.rects, strict=True)
+        if r.label != background and span(r)[0] < span(r)[1]
+    ]
+    limits = move_limits(
+        [r for r, _ in pairs],
+        [span(r) for r, _ in pairs],
+        [(r.y0, r.y1) if axis == "x" else (r.x0, r.x1) for r, _ in pairs],
+        tolerance * extent,
+    )
+    index = {value: i for i, value in enumerate(edges)}
+    low = np.array(edges) - tolerance * extent
+    high = np.array(edges) + tolerance * extent
+    for r, q in pairs:
+        for was, now in zip(span(r), span(q), strict=True):
+            k = index.get(now)
+            if k is not None:
+                reach = limits.get(was, tolerance * extent)
+                low[k] = max(low[k], was - reach)
+                high[k] = min(high[k], was + reach)
+    current = np.array(edges)
+    low, high = np.minimum(low, current), np.maximum(high, current)
+    low[0] = high[0] = 0.0
+    low[-1] = high[-1] = extent
+    return low, high
+
+
 def regularize(
     layout: LabelledLayout,
     tolerance: float = DEFAULT_TOLERANCE,
     background: str = "facade",
     deadline: Deadline | None = None,
+    drawn: LabelledLayout | None = None,
 ) -> tuple[LabelledLayout, Regularization]:
     """The layout with repeated elements made equal (see the module); its edges must be
-    snapped already (``tile`` snaps, ``snap_layout`` gives the snapped layout). The
-    deadline is checked before each QP (a QP itself cannot be stopped)."""
+    snapped already (``tile`` snaps, ``snap_layout`` gives the snapped layout), from
+    ``drawn`` (the same rectangles as drawn; the layout itself when not given): no edge
+    goes further from where it was drawn than ``bounds_of`` allows. The deadline is
+    checked before each QP (a QP itself cannot be stopped)."""
     result = Regularization(tolerance)
     if tolerance <= 0:
         return layout, result
@@ -271,40 +330,40 @@ def regularize(
     mapping: dict[str, dict[float, float]] = {}
     for axis, extent in (("x", layout.width), ("y", layout.height)):
         edges = list(tiling.xs if axis == "x" else tiling.ys)
+        bounds = bounds_of(layout, drawn or layout, axis, edges, tolerance, background)
         elements, strips = _pairs_of(rects, tiling, axis, extent, tolerance)
-        element_groups = [g for groups in elements.values() for g in groups]
-        strip_groups = [g for groups in strips.values() for g in groups]
         runs = _runs(rects, axis, extent, tolerance)
-        run_groups = [g for groups in runs.values() for g in groups]
         line_ups = _line_ups(rects, axis, extent, tolerance)
         spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
         cuts = set(edges)
         spans = [(a, b) for a, b in spans if a in cuts and b in cuts]
-        solved = None
-        attempts = (  # each one without what the one before could not hold
-            (element_groups + strip_groups + run_groups, "runs", "equal pitches of runs"),
-            (element_groups + strip_groups, "strips", "equal sizes of strips"),
-            (element_groups, "elements", "equal sizes of elements"),
-        )
-        used = ""
         movable_line_ups = [g for g in line_ups if _movable(g, cuts)]
-        for kept, dropped, what in attempts:
-            deadline.check("regularising")
-            movable = [g for g in kept if _movable(g, cuts)]
-            solved = _solve_axis(edges, extent, movable, spans, movable_line_ups)
-            if solved is not None:
-                used = dropped
-                # the line-ups the soft QP nearly met are made exact where they all can be
-                at = dict(zip(edges, solved, strict=True))
-                met = [g for g in movable_line_ups if _centre_gap(g, at) <= LINED * extent]
-                if met:
-                    exact = _solve_axis(edges, extent, movable + met, spans, [])
-                    solved = exact or solved
-                break
-            result.warnings.append(f"{axis}: {what} do not all fit; left out")
+        wanted = [  # (weight, kind, label, group): the equal sizes the QP is asked for
+            (weight, kind, label, group)
+            for weight, kind, named in (
+                (WEIGHTS["element"], "element", elements),
+                (WEIGHTS["strip"], "strip", strips),
+                (WEIGHTS["run"], "run", runs),
+            )
+            for label, groups in named.items()
+            for group in groups
+            if _movable(group, cuts)
+        ]
+        soft = [(w, [[g[0], member]]) for w, _, _, g in wanted for member in g[1:]]
+        soft += [(WEIGHTS["line-up"], [g]) for g in movable_line_ups]
+        deadline.check("regularising")
+        solved = _solve_axis(edges, extent, [], spans, soft, bounds)
         if solved is None:
+            result.warnings.append(f"{axis}: the edges could not be regularised; left as drawn")
             mapping[axis] = {e: e for e in edges}
             continue
+        # what the soft QP met is made exact, all at once where it can be
+        at = dict(zip(edges, solved, strict=True))
+        met = [pair for _, (pair,) in soft if _size_gap(pair, at) <= MET * extent]
+        if met:
+            deadline.check("regularising")
+            exact = _solve_axis(edges, extent, met, spans, [], bounds)
+            solved = exact or solved
         solved[0], solved[-1] = 0.0, extent
         merged = snap(solved, 1e-7 * extent, (0.0, extent))  # edges the QP joined are one
         solved = [merged[value] for value in solved]
@@ -312,20 +371,24 @@ def regularize(
         for before, after in zip(edges, solved, strict=True):
             if abs(after - before) > 1e-6 * extent:
                 result.moves.append(Move(axis, before, after))
-        strips_kept = used in ("strips", "runs")
-        runs_kept = used == "runs"
-        for kind, named in (
-            ("element", elements),
-            ("strip", strips if strips_kept else {}),
-            ("run", runs if runs_kept else {}),
-        ):
-            for label, groups in named.items():
-                for group in groups:
-                    a, b = group[0]
-                    size = mapping[axis][b] - mapping[axis][a]
-                    count = len(group) + (kind == "run")  # a run of n pitches has n + 1
-                    result.groups.append(SizeGroup(axis, kind, label, count, size))
-        lined = sum(_centre_gap(g, mapping[axis]) <= 1e-6 * extent for g in movable_line_ups)
+        apart = 0
+        for _, kind, label, group in wanted:
+            kept = [
+                m for m in group[1:] if _size_gap([group[0], m], mapping[axis]) <= EQUAL * extent
+            ]
+            apart += len(group) - 1 - len(kept)
+            if kept:
+                a, b = group[0]
+                size = mapping[axis][b] - mapping[axis][a]
+                count = len(kept) + 1 + (kind == "run")  # a run of n pitches has n + 1
+                result.groups.append(SizeGroup(axis, kind, label, count, size))
+        if apart:
+            result.warnings.append(
+                f"{axis}: {apart} of {len(soft) - len(movable_line_ups)} nearly equal sizes "
+                "left apart (making them equal would move edges further than the drawing "
+                "allows)"
+            )
+        lined = sum(_size_gap(g, mapping[axis]) <= EQUAL * extent for g in movable_line_ups)
         if movable_line_ups:
             result.groups.append(SizeGroup(axis, "line-up", "*", lined, 0.0))
             if lined < len(movable_line_ups):

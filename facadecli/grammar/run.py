@@ -213,7 +213,7 @@ def tidy_layout(
     snapped, snapping = snap_and_count(layout, snap, deadline)
     check_cells(path, snapped, snap)
     progress("regularising")
-    regular, regularization = regularize(snapped, tolerance, deadline=deadline)
+    regular, regularization = regularize(snapped, tolerance, deadline=deadline, drawn=layout)
     return Tidied(regular, snapping, regularization, snapped, layout)
 
 

@@ -59,6 +59,7 @@ class Tiling:
         return self.labels[row][column]
 
 
+MOVE_SHARE = 0.125  # an edge moves at most this share of the narrowest element or gap it bounds
 WIDE = 24  # candidate starts of a cluster above which numpy weighs them, not a loop
 
 
@@ -186,18 +187,21 @@ def _snap_axis(
     anchors: tuple[float, ...] = (),
     apart: Iterable[tuple[float, float]] = (),
     deadline: Deadline | None = None,
+    limits: dict[float, float] | None = None,
 ) -> tuple[dict[float, float], set[tuple[float, float]]]:
     """``snap``, and the pairs of ``apart`` (the two edges of one element) that the
     clustering would have joined and that were kept in different clusters instead.
 
     An anchor weighs as much as every value together (a cluster's median is its anchor,
-    and moving it costs most); two anchors are never joined."""
+    and moving it costs most); two anchors are never joined. A value of ``limits`` moves
+    at most its limit (``_limited``)."""
     deadline = deadline or Deadline()
     weights = Counter(values)
     ordered = sorted(set(values) | set(anchors))
     index = {value: i for i, value in enumerate(ordered)}
     heavy = len(values) + 1
-    mass = [weights[v] + (heavy if v in anchors else 0) for v in ordered]
+    limits = {v: limit for v, limit in (limits or {}).items() if limit < tolerance}
+    mass = [weights[v] + (heavy if v in anchors or v in limits else 0) for v in ordered]
     held = sorted({index[a] for a in anchors})
     pinned = list(itertools.pairwise(held))
     starts = _starts(ordered, mass, tolerance, pinned, deadline)
@@ -205,8 +209,9 @@ def _snap_axis(
     cluster = list(itertools.accumulate(int(k in firsts) for k in range(len(ordered))))
     pairs = sorted({(index[a], index[b]) for a, b in apart if index[a] < index[b]})
     joined = [(i, j) for i, j in pairs if cluster[i] == cluster[j]]
-    if joined:  # cluster again, keeping every pair apart
-        starts = _starts(ordered, mass, tolerance, pinned + pairs, deadline)
+    limited = _limited(ordered, limits, anchors, tolerance)
+    if joined or limited:  # cluster again, keeping every pair apart and within the limits
+        starts = _starts(ordered, mass, tolerance, pinned + pairs + limited, deadline)
     kept = {(ordered[i], ordered[j]) for i, j in joined}
     mapping = {}
     for lo, hi in itertools.pairwise([*starts, len(ordered)]):
@@ -216,6 +221,29 @@ def _snap_axis(
         for value in members:
             mapping[value] = target
     return mapping, kept
+
+
+def _limited(
+    ordered: list[float], limits: dict[float, float], anchors: tuple[float, ...], tolerance: float
+) -> list[tuple[int, int]]:
+    """Index pairs kept in different clusters so that a value with a limit shares its
+    cluster with no other limited value, nor anchor, further from it than its limit: for
+    each, the nearest such one beyond its limit on either side (a cluster holding both
+    would hold every value between). Limited values weigh as much as anchors, so a
+    cluster's representative lies among them (``_snap_axis``) and none moves further
+    than its limit. Values further apart than the tolerance never share a cluster."""
+    held = {v: limit for v, limit in limits.items() if limit < tolerance}
+    heavy = sorted({*held, *anchors})
+    index = {value: i for i, value in enumerate(ordered)}
+    pairs = []
+    for value, limit in held.items():
+        below = bisect.bisect_left(heavy, value - limit) - 1
+        above = bisect.bisect_right(heavy, value + limit)
+        if below >= 0 and value - heavy[below] <= tolerance:
+            pairs.append((index[heavy[below]], index[value]))
+        if above < len(heavy) and heavy[above] - value <= tolerance:
+            pairs.append((index[value], index[heavy[above]]))
+    return sorted(pairs)
 
 
 def snap(
@@ -268,6 +296,62 @@ class Snapping:
         )
 
 
+def move_limits(
+    rects: list[Rect],
+    spans: list[tuple[float, float]],
+    across: list[tuple[float, float]],
+    tolerance: float,
+    share: float = MOVE_SHARE,
+) -> dict[float, float]:
+    """How far each edge coordinate along an axis may move, where that is less than the
+    ``tolerance``: ``share`` of the narrowest span it bounds of
+
+    - an element (``spans``, of ``rects``; ``across``: the other axis);
+    - the gap between two elements of one label that face each other (overlapping
+      across): the wall between two windows never closes, they stay two;
+    - the part of an element left visible beside one in front of it that covers most
+      of it across (a blind's strip beside its window): it never goes behind.
+
+    So tidying keeps what was drawn: every element most of its size and what shows of
+    it. Only spans shorter than ``tolerance / share`` limit anything; each element
+    is looked up against the elements starting or ending within that of its edges."""
+    limits: dict[float, float] = {}
+    reach = tolerance / share
+
+    def limit(a: float, b: float) -> None:
+        for value in (a, b):
+            if share * (b - a) < min(tolerance, limits.get(value, tolerance)):
+                limits[value] = share * (b - a)
+
+    by_start = sorted(range(len(spans)), key=lambda i: spans[i][0])
+    starts = [spans[i][0] for i in by_start]
+    by_end = sorted(range(len(spans)), key=lambda i: spans[i][1])
+    ends = [spans[i][1] for i in by_end]
+
+    def covers(front: int, back: int) -> bool:  # front hides most of back across
+        (a, b), (c, d) = across[front], across[back]
+        in_front = (rects[front].z, front) > (rects[back].z, back)
+        return in_front and min(b, d) - max(a, c) >= (d - c) / 2
+
+    for i, (a, b) in enumerate(spans):
+        limit(a, b)
+        lo, hi = across[i]
+        # elements starting just past this one's end (a gap), or just inside its start
+        for j in by_start[bisect.bisect_left(starts, a) : bisect.bisect_right(starts, b + reach)]:
+            start = spans[j][0]
+            if start >= b and rects[j].label == rects[i].label:
+                if across[j][0] < hi and lo < across[j][1] and start > b:
+                    limit(b, start)
+            elif a < start < min(b, a + reach) and covers(j, i):
+                limit(a, start)
+        # elements ending just inside this one's end
+        for j in by_end[bisect.bisect_left(ends, b - reach) : bisect.bisect_left(ends, b)]:
+            end = spans[j][1]
+            if max(a, b - reach) < end and covers(j, i):
+                limit(end, b)
+    return limits
+
+
 NO_SNAPPING = Snapping(0.0, 0, 0, 0, 0.0, 0.0)  # before anything was snapped
 
 
@@ -294,7 +378,13 @@ def snap_and_count(
         clipped = [(clip(a), clip(b)) for a, b in (spans[axis][i] for i in on)]
         thin = {(a, b) for a, b in clipped if b - a <= tolerance * extent}
         values = [v for span in clipped for v in span]
-        mapping, joined = _snap_axis(values, tolerance * extent, (0.0, extent), thin, deadline)
+        across = "y" if axis == "x" else "x"
+        limits = move_limits(
+            [rects[i] for i in on], clipped, [spans[across][i] for i in on], tolerance * extent
+        )
+        mapping, joined = _snap_axis(
+            values, tolerance * extent, (0.0, extent), thin, deadline, limits
+        )
         for i, (a, b) in zip(on, clipped, strict=True):
             if (a, b) in joined:
                 kept.add(i)
