@@ -241,7 +241,10 @@ def _solve_axis(
     # constraints as a few vector expressions: building one per pair is slow in cvxpy
     constraints = [v[0] == 0.0, v[len(edges) - 1] == extent, cp.diff(v) >= 0]
     constraints += [v >= bounds[0], v <= bounds[1]]
-    objective = cp.sum_squares(v - np.array(edges))
+    # moving an edge costs more the less it may move (the edge of a sill more than of a
+    # wall): the same share of its bound costs the same, so small elements move least
+    reach = np.maximum((bounds[1] - bounds[0]) / 2, 1e-9 * extent)
+    objective = cp.sum_squares(cp.multiply(reach.max() / reach, v - np.array(edges)))
     if kept:  # every element keeps at least half its size
         constraints.append(v[stops] - v[starts] >= drawn / 2)
         objective += cp.sum_squares(v[stops] - v[starts] - drawn)

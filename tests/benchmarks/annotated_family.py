@@ -1,0 +1,87 @@
+"""A family of hand-drawn-looking annotations with known structure, for measuring the
+tidy-up against what was drawn (issue 34), seed by seed: nothing in it comes from a CMP
+sample.
+
+Each seed draws a façade on CMP's unit square: a grid of bays and floors (pitches
+jittered a little, as a hand draws them), a window in every cell with its sill under it
+and, on some façades, a blind beside it (CMP's z-order puts the window in front), a
+cornice across the façade over some floors, one door in a ground-floor bay (unique), and,
+on some façades, mirrored halves (the left half drawn, then mirrored, then each edge
+jittered on its own). Every edge is then moved by a drawing jitter of a few thousandths
+of the façade. ``known(seed)`` says what is there: windows, bays, floors.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+
+Box = tuple[str, float, float, float, float]  # label, x0, y0, x1, y1 on the unit square, y up
+
+
+@dataclass(frozen=True)
+class Known:
+    bays: int
+    floors: int
+    windows: int
+    doors: int
+    mirrored: bool
+    blinds: bool
+
+
+def family(seed: int) -> tuple[list[Box], Known]:
+    """The annotation of seed ``seed`` (background first, then by label) and its structure."""
+    rng = random.Random(seed)
+    bays, floors = rng.randint(3, 9), rng.randint(2, 7)
+    mirrored, blinds = rng.random() < 0.5, rng.random() < 0.5
+    jitter = rng.uniform(0.001, 0.004)  # a hand's error, of the façade
+    margin = rng.uniform(0.02, 0.06)
+    pitch_x = (1 - 2 * margin) / bays
+    pitch_y = 0.9 / (floors + 0.5)
+    width = rng.uniform(0.35, 0.6) * pitch_x
+    height = rng.uniform(0.4, 0.6) * pitch_y
+    door_bay = bays // 2 if mirrored else rng.randrange(bays)
+
+    def bay_x(k: int) -> float:  # the centre of bay k, its pitch jittered
+        return margin + (k + 0.5) * pitch_x + rng.uniform(-0.1, 0.1) * pitch_x * 0.1
+
+    centres = [bay_x(k) for k in range(bays)]
+    if mirrored:  # the left half drawn, mirrored
+        half = [centres[k] for k in range(bays // 2)]
+        middle = [0.5] if bays % 2 else []
+        centres = [*half, *middle, *(1 - c for c in reversed(half))]
+    boxes: list[Box] = [("facade", 0.0, 0.0, 1.0, 1.0)]
+    windows, sills, side, cornices, doors = [], [], [], [], []
+    for f in range(floors):
+        base = 0.05 + (f + 0.25) * pitch_y
+        for k, c in enumerate(centres):
+            if f == 0 and k == door_bay:
+                w = width * 1.2
+                doors.append(("door", c - w / 2, 0.0, c + w / 2, base + height))
+                continue
+            windows.append(("window", c - width / 2, base, c + width / 2, base + height))
+            sills.append(("sill", c - width * 0.55, base - 0.012, c + width * 0.55, base))
+            if blinds:
+                side.append(("blind", c + width / 2 - 0.01, base, c + width * 0.8, base + height))
+        if f and rng.random() < 0.4:
+            top = base + height + 0.15 * pitch_y
+            cornices.append(("cornice", margin / 2, top, 1 - margin / 2, top + 0.012))
+
+    def drawn(box: Box) -> Box:
+        label, *edges = box
+        x0, y0, x1, y1 = (min(max(v + rng.gauss(0.0, jitter / 2), 0.0), 1.0) for v in edges)
+        return (label, x0, y0, x1, y1)
+
+    boxes += [drawn(b) for b in (*windows, *cornices, *doors, *sills, *side)]
+    known = Known(bays, floors, len(windows), len(doors), mirrored, blinds)
+    return boxes, known
+
+
+def cmp_xml(boxes: list[Box]) -> str:
+    """CMP XML of the boxes (CMP's rows count down from the top)."""
+    return "\n".join(
+        f"<object><points><x>{1 - y1:.6f}</x><x>{1 - y0:.6f}</x><y>{x0:.6f}</y>"
+        f"<y>{x1:.6f}</y></points><label>3</label><labelname>{label}</labelname>"
+        "<flag>1</flag></object>"
+        for label, x0, y0, x1, y1 in boxes
+    )
