@@ -30,7 +30,7 @@ import math
 import sys
 import time
 from collections import Counter
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
@@ -258,6 +258,16 @@ class _Group:
     ends: tuple[int, ...]
 
 
+class _Combining(NamedTuple):
+    """What :meth:`_Search.combine` builds the columns out of a state from."""
+
+    group: _Group
+    memory: tuple[int, ...]
+    order: list[int]  # the rows, those with the fewest options first
+    chosen: list[Move | None]  # the column being built, an entry per row
+    choices: Callable[[int, tuple[int, Move, np.ndarray] | None], list[Option]]
+
+
 @dataclass(frozen=True)
 class _Node:
     """A state of the search: where each row stands in its group, the attached rule's
@@ -402,7 +412,6 @@ class _Search:
         # rows with the fewest options first: the first entry of known length is the one
         # the others are checked against
         order = sorted(range(len(sized)), key=lambda r: (len(sized[r][0]), r))
-        chosen: list[Move | None] = [None] * len(sized)
 
         def choices(r: int, first: tuple[int, Move, np.ndarray] | None) -> list[Option]:
             options, known, lengths = sized[r]
@@ -418,31 +427,35 @@ class _Search:
                 ]
             return kept
 
-        last = len(order) - 1
+        combining = _Combining(group, memory, order, [None] * len(sized), choices)
+        yield from self.combine(combining, 0, None, False)
 
-        def extend(
-            i: int, first: tuple[int, Move, np.ndarray] | None, solid: bool
-        ) -> Iterator[tuple[Move | None, ...]]:
-            self.combinations += 1
-            if self.combinations % COMBINATION_WORK == 0:
-                self.budget.spend()
-            if i == len(order):
-                if self.valid(group, chosen, memory):
-                    yield tuple(chosen)
-                return
-            r = order[i]
-            for move, length in choices(r, first):
-                if i == last and not solid and move is not None and move.plain and move.letters > 1:
-                    continue  # a stretch of several letters: searched a letter at a time
-                chosen[r] = move
-                held = solid or not _stands_aside(move)
-                if first is None and length is not None and move is not None:
-                    yield from extend(i + 1, (r, move, length), held)
-                else:
-                    yield from extend(i + 1, first, held)
-            chosen[r] = None
-
-        yield from extend(0, None, False)
+    def combine(
+        self, c: _Combining, i: int, first: tuple[int, Move, np.ndarray] | None, solid: bool
+    ) -> Iterator[tuple[Move | None, ...]]:
+        """The valid columns that complete ``c.chosen`` from its ``i``-th row in
+        ``c.order`` on (a method: a closure calling itself would be a cycle holding the
+        search, its caches megabytes for a long row, until the garbage collector ran)."""
+        self.combinations += 1
+        if self.combinations % COMBINATION_WORK == 0:
+            self.budget.spend()
+        chosen = c.chosen
+        if i == len(c.order):
+            if self.valid(c.group, chosen, c.memory):
+                yield tuple(chosen)
+            return
+        r = c.order[i]
+        last = i == len(c.order) - 1
+        for move, length in c.choices(r, first):
+            if last and not solid and move is not None and move.plain and move.letters > 1:
+                continue  # a stretch of several letters: searched a letter at a time
+            chosen[r] = move
+            held = solid or not _stands_aside(move)
+            if first is None and length is not None and move is not None:
+                yield from self.combine(c, i + 1, (r, move, length), held)
+            else:
+                yield from self.combine(c, i + 1, first, held)
+        chosen[r] = None
 
     def options(self, g: int, r: int, position: int, node: _Node) -> Options:
         """The entries of a row out of ``position`` (None: a gap) with their lengths when
