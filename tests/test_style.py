@@ -15,7 +15,15 @@ import pytest
 from facadecli.grammar.inputs import BACKGROUND
 from facadecli.grammar.regularize import regularize
 from facadecli.grammar.run import Options, extract_grammar
-from facadecli.grammar.style import Box, check, facade_of, find_style, holds
+from facadecli.grammar.style import (
+    Box,
+    check,
+    facade_of,
+    find_style,
+    holds,
+    shown_tiles,
+    style_of_drawing,
+)
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.grammar.variation import Piece, align, derive_at, derive_variations
 
@@ -49,7 +57,14 @@ def test_the_style_of_a_symmetric_facade() -> None:
         ("axis", "door"),
         ("centre", "door"),
         ("centre", "window"),
+        ("sizes", "window"),
+        ("sizes", "door"),
+        ("pitch", "window"),
     }
+    sizes = next(c for c in style if c.kind == "sizes" and c.label == "window")
+    assert sizes.text == "window 1.2 m wide, 1.6 m tall"
+    pitch = next(c for c in style if c.kind == "pitch")
+    assert pitch.text == "rows of window 2.5 m apart"
     columns = next(c for c in style if c.kind == "columns")
     assert columns.text == "3 of 3 rows of window on the same 3 columns"
     spacing = next(c for c in style if c.kind == "spacing")
@@ -284,3 +299,80 @@ def test_a_layout_derived_at_its_own_size_is_the_input(tmp_path: Path) -> None:
     assert sorted(found[0].pieces, key=str) == sorted(source, key=str)
     door = next(p for p in found[0].pieces if p.label == "door")
     assert (door.x0, door.x1) == pytest.approx((5.2, 6.4))
+
+
+def _broken(style: list, boxes: list[Box], width: float, height: float) -> set[tuple[str, str]]:  # type: ignore[type-arg]
+    return _kinds(list(check(style, facade_of(boxes, width, height, BACKGROUND)).broken))
+
+
+def test_squeezed_windows_break_their_sizes_dropped_bays_do_not() -> None:
+    """The style measures sizes: a narrower façade whose windows shrink by a fifth breaks
+    ``sizes``; one that drops a bay and keeps its windows keeps it."""
+    style = find_style(facade_of(_palazzo(), 11.4, 10.0, BACKGROUND))
+    squeezed = [
+        Box(b.label, b.x0 * 0.8, b.y0, b.x0 * 0.8 + (b.x1 - b.x0) * 0.8, b.y1)
+        if b.label == "window"
+        else b
+        for b in _palazzo()
+    ]
+    assert ("sizes", "window") in _broken(style, squeezed, 9.1, 10.0)
+    dropped = [b for b in _palazzo() if b.label != "window" or b.x0 < 8.0]
+    assert ("sizes", "window") not in _broken(style, dropped, 8.4, 10.0)
+    assert ("sizes", "door") not in _broken(style, dropped, 8.4, 10.0)
+
+
+def test_stretched_floors_break_the_pitch_a_whole_floor_more_does_not() -> None:
+    style = find_style(facade_of(_palazzo(), 11.4, 10.0, BACKGROUND))
+    stretched = [
+        Box(b.label, b.x0, 3.5 + (b.y0 - 3.5) * 1.4, b.x1, 3.5 + (b.y0 - 3.5) * 1.4 + 1.6)
+        if b.label == "window"
+        else b
+        for b in _palazzo()
+    ]
+    assert ("pitch", "window") in _broken(style, stretched, 11.4, 12.0)
+    taller = _palazzo() + [Box("window", x, 11.0, x + 1.2, 12.6) for x in (2.1, 5.1, 8.1)]
+    assert ("pitch", "window") not in _broken(style, taller, 11.4, 12.5)
+
+
+def test_the_style_is_found_on_what_the_drawing_shows() -> None:
+    """A blind drawn whole behind a window shows as two strips beside it, as derived
+    layouts show it; a window drawn over by a pillar is the pillar there."""
+    rects = (
+        Rect("blind", 1.0, 3.0, 3.0, 4.0, z=1),
+        Rect("window", 1.5, 3.0, 2.5, 4.0, z=2),
+        Rect("pillar", 5.0, 0.0, 5.5, 10.0, z=3),
+        Rect("window", 4.5, 3.0, 6.0, 4.0, z=2),
+    )
+    tiles = shown_tiles(rects, 10.0, 10.0)
+    assert sorted(t for t in tiles if t.label == "blind") == [
+        Box("blind", 1.0, 3.0, 1.5, 4.0),
+        Box("blind", 2.5, 3.0, 3.0, 4.0),
+    ]
+    assert sorted(t for t in tiles if t.label == "window") == [
+        Box("window", 1.5, 3.0, 2.5, 4.0),
+        Box("window", 4.5, 3.0, 5.0, 4.0),
+        Box("window", 5.5, 3.0, 6.0, 4.0),
+    ]
+    assert sum((t.x1 - t.x0) * (t.y1 - t.y0) for t in tiles if t.label == "pillar") == 5.0
+    style = style_of_drawing(LabelledLayout(10.0, 10.0, rects))
+    sizes = next(c for c in style if c.kind == "sizes" and c.label == "window")
+    assert sizes.sizes == ((0.5, 1.0), (1.0, 1.0))  # what shows, not what was drawn
+
+
+def test_the_grammar_finds_its_style_on_the_annotation_not_its_tidied_tiling(
+    tmp_path: Path,
+) -> None:
+    """Two windows drawn 3 cm apart: the style found has both, at their drawn sizes."""
+    layout = {
+        "canvas": {"width": 10.0, "height": 6.0},
+        "rects": [
+            {"label": "window", "x0": 1.0, "y0": 2.0, "x1": 2.2, "y1": 3.6},
+            {"label": "window", "x0": 2.23, "y0": 2.0, "x1": 3.43, "y1": 3.6},
+            {"label": "window", "x0": 6.0, "y0": 2.0, "x1": 7.2, "y1": 3.6},
+        ],
+    }
+    path = tmp_path / "two.json"
+    path.write_text(json.dumps(layout))
+    extraction = extract_grammar(path, Options(iterations=20))
+    sizes = next(c for c in extraction.style if c.kind == "sizes" and c.label == "window")
+    assert sizes.sizes == ((1.2, 1.6),)

@@ -27,7 +27,7 @@ from facadecli.grammar.json_layouts import read_plain, read_report
 from facadecli.grammar.regularize import Regularization, regularize
 from facadecli.grammar.search import SearchResult, extract
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar, derive
-from facadecli.grammar.style import Constraint, Kept, style_of
+from facadecli.grammar.style import Constraint, Kept, style_of, style_of_drawing
 from facadecli.grammar.tiling import NO_SNAPPING, Snapping, Tiling, snap_and_count, tile
 from facadecli.limits import LAYOUT_CELLS_MAX
 
@@ -72,12 +72,13 @@ class Extraction:
     problems: list[str] = field(default_factory=list)
     snapping: Snapping = NO_SNAPPING  # what snapping changed
     fidelity: Fidelity | None = None  # the derivation at the input's size vs the annotation
+    raw: LabelledLayout | None = None  # the annotation as read (stretched to the size)
 
     @cached_property
     def style(self) -> list[Constraint]:
-        """Bao's constraints the input holds (found on its tiling, as derivations are
-        checked on their terminals)."""
-        return style_of(self.tiling)
+        """Bao's constraints the input holds: found on what the annotation shows (its
+        rectangles in their z-order), or on the tiling when there is no annotation."""
+        return style_of(self.tiling) if self.raw is None else style_of_drawing(self.raw)
 
     @property
     def grammar(self) -> Grammar:
@@ -246,6 +247,7 @@ def extract_grammar(
     progress("checking the grammar derives the layout")
     extraction.problems = rederivation_problems(found.grammar, tiling)
     extraction.snapping = snapping
+    extraction.raw = tidied.raw
     progress("measuring the derivation against the annotation")
     terminals = [Rect(*box) for box in derive(found.grammar, tiling.xs[-1], tiling.ys[-1])]
     extraction.fidelity = fidelity(tidied.raw, regular, terminals)

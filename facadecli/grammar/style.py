@@ -16,7 +16,17 @@ Found on the (regularised) input, over its elements (the background is not one):
   ``SKIPPED`` places of the pitch empty between two (the windows each side of a
   staircase's, which sit half a floor lower);
 - ``ends`` and ``centre``: a label at both ends of the façade, or on its centre line
-  (pilasters at the corners and in the middle: a frequency pattern).
+  (pilasters at the corners and in the middle: a frequency pattern);
+- ``sizes``: a label's elements (bands aside) keep their sizes: at least ``SIZE_SHARE`` of
+  a derived layout's are within ``SIZE_TOLERANCE`` of an input element's width and height
+  (a narrower façade that squeezes its windows breaks it; one that drops bays does not);
+- ``pitch``: the rows of a label on the same columns keep their vertical pitch (each
+  pitch of a derived layout within ``SIZE_TOLERANCE`` of one of the input's: a taller
+  façade gains whole floors, it does not stretch them).
+
+The style is found on what the drawing shows (:func:`style_of_drawing`: the annotation's
+rectangles in their z-order, as :mod:`facadecli.grammar.fidelity` paints them), never on
+the tool's own tidied tiling, so a tidy-up that moved or merged elements cannot hide it.
 
 A derived layout keeps a constraint when it holds there too (for ``columns`` and
 ``spacing``, in as large a share of the label's rows, or in as many rows: a taller façade
@@ -29,11 +39,14 @@ from __future__ import annotations
 import bisect
 import itertools
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
+import numpy as np
+
 from facadecli.grammar import retarget
+from facadecli.grammar.inputs import LabelledLayout, Rect
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 
 SKIPPED = 1  # places of a row's pitch that may be empty between two elements
@@ -41,6 +54,8 @@ TOLERANCE = 0.01  # of the façade's extent along the axis compared
 MIRRORED = 0.9  # share of the elements with a mirror partner for a symmetric façade
 BAND = retarget.BAND  # of the input's width: a wider element is a band, on no column
 CHECKED_BAND = 0.5  # ... of a derived layout's (an element stretched there is still checked)
+SIZE_TOLERANCE = 0.15  # of a size or pitch: a derived element keeps its size within it
+SIZE_SHARE = 0.9  # of a label's derived elements that must keep an input element's size
 
 
 class Box(NamedTuple):
@@ -61,6 +76,9 @@ class Constraint:
     share: float = 1.0  # for ``columns`` and ``spacing``: the share of the label's rows
     other: str = ""  # for ``axis``: the label whose columns it is centred on
     rows: int = 0  # for ``columns`` and ``spacing``: how many of the label's rows
+    # for ``sizes``: the input elements' (width, height); for ``pitch``: the input's pitches
+    sizes: tuple[tuple[float, float], ...] = ()
+    pitches: tuple[float, ...] = ()
 
     def summary(self) -> dict[str, object]:
         return {"kind": self.kind, "label": self.label, "text": self.text}
@@ -182,6 +200,47 @@ def style_of(tiling: Tiling, background: str = BACKGROUND) -> list[Constraint]:
     return find_style(facade)
 
 
+def style_of_drawing(drawing: LabelledLayout, background: str = BACKGROUND) -> list[Constraint]:
+    """The constraints a drawing holds: found on what it shows (:func:`shown_tiles`)."""
+    tiles = shown_tiles(drawing.rects, drawing.width, drawing.height)
+    return find_style(facade_of(tiles, drawing.width, drawing.height, background))
+
+
+def shown_tiles(rects: Sequence[Rect], width: float, height: float) -> list[Box]:
+    """What a drawing shows, as tiles: the plane cut at every edge of every rectangle
+    (within the façade), each cell the label of the front-most rectangle over it (by
+    ``z``, a later one over an earlier among equals, as fidelity paints), cells of one
+    label side by side in a row joined; cells no rectangle covers are left out (the
+    background)."""
+    near = 1e-6 * max(width, height, 1.0)
+    xs = _distinct([min(max(v, 0.0), width) for r in rects for v in (r.x0, r.x1)], near)
+    ys = _distinct([min(max(v, 0.0), height) for r in rects for v in (r.y0, r.y1)], near)
+    if len(xs) < 2 or len(ys) < 2:
+        return []
+    owner = np.full((len(ys) - 1, len(xs) - 1), -1, dtype=np.int64)
+    for i in sorted(range(len(rects)), key=lambda k: rects[k].z):  # stable: later wins
+        r = rects[i]
+        c0, c1 = bisect.bisect_left(xs, r.x0 - near), bisect.bisect_left(xs, r.x1 - near)
+        r0, r1 = bisect.bisect_left(ys, r.y0 - near), bisect.bisect_left(ys, r.y1 - near)
+        owner[r0:r1, c0:c1] = i
+    labels = [r.label for r in rects]
+    tiles = []
+    for row, (y0, y1) in enumerate(itertools.pairwise(ys)):
+        start = 0
+        cells = owner[row].tolist()
+        for column in range(1, len(cells) + 1):
+            if column < len(cells) and _same_label(labels, cells[column], cells[start]):
+                continue
+            if cells[start] >= 0:
+                tiles.append(Box(labels[cells[start]], xs[start], y0, xs[column], y1))
+            start = column
+    return tiles
+
+
+def _same_label(labels: Sequence[str], a: int, b: int) -> bool:
+    return (a < 0 and b < 0) or (a >= 0 and b >= 0 and labels[a] == labels[b])
+
+
 def tiles_of(tiling: Tiling) -> list[Box]:
     """A tiling's cells as tiles."""
     return [
@@ -295,7 +354,16 @@ def find_style(facade: Facade) -> list[Constraint]:
         if even:
             text = f"{even} of {rows} rows of three or more {label} evenly spaced"
             found.append(Constraint("spacing", label, text, even / rows, rows=even))
+        if len(best) >= 2:
+            pitches = _pitches(best)
+            text = f"rows of {label} {_listed(pitches)} m apart"
+            found.append(Constraint("pitch", label, text, pitches=pitches))
         boxes = [b for b in facade.boxes if b.label == label]
+        sizes = _sizes(boxes, BAND * facade.width)
+        if sizes:
+            wide, tall = _listed(w for w, _ in sizes), _listed(h for _, h in sizes)
+            text = f"{label} {wide} m wide, {tall} m tall"
+            found.append(Constraint("sizes", label, text, sizes=sizes))
         if any(b.x0 <= near for b in boxes) and any(b.x1 >= facade.width - near for b in boxes):
             found.append(Constraint("ends", label, f"{label} at both ends"))
         if any(abs(_cx(b) - facade.width / 2) <= near for b in boxes):
@@ -328,12 +396,49 @@ def holds(constraint: Constraint, facade: Facade) -> bool:
         return any(b.x0 <= near for b in boxes) and any(b.x1 >= facade.width - near for b in boxes)
     if kind == "centre":
         return any(abs(_cx(b) - facade.width / 2) <= near for b in boxes)
+    if kind == "sizes":
+        derived = [b for b in boxes if b.x1 - b.x0 < CHECKED_BAND * facade.width]
+        alike = sum(_near_size(b, constraint.sizes) for b in derived)
+        return alike >= SIZE_SHARE * len(derived) - 1e-9
+    if kind == "pitch":
+        best, _ = _shared_columns(facade, label)
+        return all(
+            any(abs(p - q) <= SIZE_TOLERANCE * q for q in constraint.pitches)
+            for p in _pitches(best)
+        )
     if kind == "axis":
         best, _ = _shared_columns(facade, constraint.other)
         centres = _centres(best[0]) if best else []
         narrow = [b for b in boxes if b.x1 - b.x0 < CHECKED_BAND * facade.width]
         return bool(narrow) and all(any(abs(_cx(b) - c) <= near for c in centres) for b in narrow)
     raise ValueError(f"unknown constraint kind {kind!r}")
+
+
+def _sizes(boxes: Sequence[Box], band: float) -> tuple[tuple[float, float], ...]:
+    """The distinct sizes of elements narrower than ``band`` (to the centimetre)."""
+    found = {(round(b.x1 - b.x0, 2), round(b.y1 - b.y0, 2)) for b in boxes if b.x1 - b.x0 < band}
+    return tuple(sorted(found))
+
+
+def _near_size(box: Box, sizes: Sequence[tuple[float, float]]) -> bool:
+    width, height = box.x1 - box.x0, box.y1 - box.y0
+    return any(
+        abs(width - w) <= SIZE_TOLERANCE * w and abs(height - h) <= SIZE_TOLERANCE * h
+        for w, h in sizes
+    )
+
+
+def _pitches(rows: Sequence[Sequence[Box]]) -> tuple[float, ...]:
+    """The distinct vertical distances between rows one above the other (bottom up), to
+    the centimetre."""
+    bottoms = sorted(row[0].y0 for row in rows)
+    return tuple(sorted({round(b - a, 2) for a, b in itertools.pairwise(bottoms)}))
+
+
+def _listed(values: Iterable[float]) -> str:
+    found = sorted(set(values))
+    shown = ", ".join(f"{v:g}" for v in found[:4])
+    return shown + (f" (and {len(found) - 4} more)" if len(found) > 4 else "")
 
 
 def _as_many(constraint: Constraint, holding: int, rows: int) -> bool:
