@@ -64,18 +64,26 @@ FACING = 0.5  # a saltbox's long slope: the sides facing its direction within 60
 HALF_HIP = 2 / 3  # a half hip's gable end goes up to this part of its height
 BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
 CURVED = ("dome", "round", "onion")
-GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox")
+GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox", "side_hip")
+FIXABLE = ("hip", "pyramidal", "mansard", *GABLED)  # roofs that keep still at party walls
+ON_WALL = 0.05  # metres: an edge whose middle is this near a fixed segment, along it, is one
 
 
 # ---------------------------------------------------------------------------------------
 # the public interface
 
 
+Segment = tuple[tuple[float, float], tuple[float, float]]
+
+
 def roof_meshes(
-    part: Polygon, height: float, roof: Roof
+    part: Polygon, height: float, roof: Roof, fixed: tuple[Segment, ...] = ()
 ) -> tuple[trimesh.Trimesh, list[trimesh.Trimesh]]:
-    """(the roof, walls filling the space between the eaves and the roof: gable ends)."""
-    shape = _shape(part.wkb, *_key(roof))
+    """(the roof, walls filling the space between the eaves and the roof: gable ends).
+    ``fixed``: the walls the roof must not slope down to (party walls, a taller part
+    standing on this one), as segments: edges along them stand still (weight 0), so the
+    roof runs on to them with a gable end, or on into the neighbour's."""
+    shape = _shape(part.wkb, *_key(roof), fixed if roof.type in FIXABLE else ())
     if shape.kind == "flat":
         return _slab(part, height), []
     return _mesh(shape, height, _rise(shape, roof))
@@ -131,30 +139,44 @@ FLAT = _Shape("flat", np.zeros((0, 2)), np.zeros(0), (), (), 0.0)
 
 
 @lru_cache(maxsize=512)
-def _shape(wkb: bytes, kind: str, direction: float | None, orientation: str) -> _Shape:
+def _shape(
+    wkb: bytes,
+    kind: str,
+    direction: float | None,
+    orientation: str,
+    fixed: tuple[Segment, ...] = (),
+) -> _Shape:
     """The shape built for a footprint (as WKB, so it can be a cache key), falling back
-    to a hip roof, then to a flat one, rather than raising."""
+    to the shape without its fixed walls, to a hip roof, then to a flat one, rather than
+    raising."""
     import shapely
 
     part = shapely.from_wkb(wkb)
     if kind == "flat" or not isinstance(part, Polygon) or part.is_empty or part.area <= 0:
         return FLAT
-    tries = [kind] if kind == "hip" else [kind, "hip"]
+    tries = [(kind, fixed)] + [(kind, ())] * bool(fixed)
+    tries += [] if kind == "hip" else [("hip", fixed)] * bool(fixed) + [("hip", ())]
     with np.errstate(all="ignore"):
-        for attempt in tries:
+        for attempt, still in tries:
             try:
-                return _build(part, attempt, direction, orientation)
+                return _build(part, attempt, direction, orientation, still)
             except Exception:  # a degenerate skeleton, or worse: the simpler shape
                 continue
     return FLAT
 
 
-def _build(part: Polygon, kind: str, direction: float | None, orientation: str) -> _Shape:
-    outline = _Outline(part)
+def _build(
+    part: Polygon,
+    kind: str,
+    direction: float | None,
+    orientation: str,
+    fixed: tuple[Segment, ...] = (),
+) -> _Shape:
+    outline = _Outline(part, fixed)
     if kind == "shed":
         return outline.shed(direction)
     if kind == "pyramidal":
-        return outline.pyramid()
+        return outline.hipped("hip") if outline.still else outline.pyramid()
     if kind in GABLED:
         return outline.gabled(kind, direction, orientation)
     if kind in ("hip", "mansard", "dome", "onion"):
@@ -178,7 +200,7 @@ class _Outline:
     """A footprint's rings, cleaned, relative to an origin (for precision), with its
     sides and main direction."""
 
-    def __init__(self, part: Polygon) -> None:
+    def __init__(self, part: Polygon, fixed: tuple[Segment, ...] = ()) -> None:
         part = orient(part, sign=1.0)  # exterior counter-clockwise, holes clockwise
         minx, miny, maxx, maxy = part.bounds
         self.origin = np.array([minx, miny])
@@ -214,6 +236,9 @@ class _Outline:
         )
         centre, main, normal = _axes(part)
         self.centre, self.main, self.normal = centre - self.origin, main, normal
+        self.still = _still(self.exact, self.direction, self.next, fixed)
+        if len(self.still) == self.count:
+            raise Degenerate("every wall fixed: nothing to slope")
 
     # -- shapes -----------------------------------------------------------------------
 
@@ -270,7 +295,8 @@ class _Outline:
         return self._finish("pyramidal", xy, t, faces, [], top)
 
     def hipped(self, kind: str) -> _Shape:
-        skeleton = Skeleton(self, [1.0] * self.count, {})
+        weights = [0.0 if e in self.still else 1.0 for e in range(self.count)]
+        skeleton = Skeleton(self, weights, {})
         return self._from_skeleton(kind, skeleton, {})
 
     def gabled(self, kind: str, direction: float | None, orientation: str) -> _Shape:
@@ -303,6 +329,9 @@ class _Outline:
                 if float(outward @ facing) > FACING:
                     for e in side.edges:
                         weights[e] = 2.0
+        if kind == "side_hip":  # one gable end: at a fixed wall if one is, else the first
+            fixed = any(e in self.still for side in chosen for e in side.edges)
+            chosen = [] if fixed else chosen[:1]
         switches: dict[int, float] = {}
         for side in chosen:
             for e in side.edges:
@@ -312,6 +341,9 @@ class _Outline:
                 if apex is not None:
                     for e in side.edges:
                         switches[e] = HALF_HIP * apex
+        for e in self.still:  # party walls: gable ends too
+            weights[e] = 0.0
+            switches.pop(e, None)
         if plain is not None and all(w == 1.0 for w in weights):  # no gable ends after all
             return self._from_skeleton(kind, plain, {})
         skeleton = Skeleton(self, weights, switches)
@@ -787,6 +819,28 @@ def _wall(
 
 # ---------------------------------------------------------------------------------------
 # small geometry
+
+
+def _still(
+    points: np.ndarray, direction: np.ndarray, following: np.ndarray, fixed: tuple[Segment, ...]
+) -> frozenset[int]:
+    """The edges (from ``points[e]`` to ``points[following[e]]``) lying along a fixed
+    segment: parallel, their middle within ON_WALL of it."""
+    found: set[int] = set()
+    for a, b in fixed:
+        start, end = np.array(a, dtype=float), np.array(b, dtype=float)
+        span = end - start
+        size = float(np.hypot(*span))
+        if size <= 0:
+            continue
+        along = span / size
+        middle = (points + points[following]) / 2 - start
+        u = middle @ along
+        off = np.abs(_cross(np.broadcast_to(along, middle.shape), middle))
+        parallel = np.abs(_cross(direction, np.broadcast_to(along, direction.shape))) < 0.05
+        near = (u >= -ON_WALL) & (u <= size + ON_WALL) & (off <= ON_WALL) & parallel
+        found.update(int(e) for e in np.flatnonzero(near))
+    return frozenset(found)
 
 
 def _clean(points: np.ndarray, eps: float) -> np.ndarray:
