@@ -93,6 +93,12 @@ BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [
         box(60, 30, 8, 8),
         {"building": "yes", "building:colour": "blurple", "roof:shape": "banana"},
     ),
+    # a factory under a sawtooth roof (not built yet: a shed, warned)
+    (
+        800,
+        box(60, 60, 30, 20),
+        {"building": "industrial", "height": "10", "roof:shape": "sawtooth", "roof:height": "3"},
+    ),
     # every roof shape S3DB lists, one house each
     *(
         (
@@ -122,7 +128,7 @@ def write_district(path: Path, buildings: list[Building] = BUILDINGS) -> Path:
     for (x, y), nid in sorted(nodes.items(), key=lambda item: item[1]):
         lon, lat = ORIGIN[0] + x * METRE_LON, ORIGIN[1] + y * METRE_LAT
         lines.append(f'  <node id="{nid}" version="1" lat="{lat:.9f}" lon="{lon:.9f}"/>')
-    for oid, refs, tags in ways:
+    for oid, refs, tags in sorted(ways, key=lambda way: way[0]):  # sorted, as OSM files are
         lines.append(f'  <way id="{oid}" version="1">')
         lines.extend(f'    <nd ref="{ref}"/>' for ref in refs)
         lines.extend(f"    <tag k={quoteattr(k)} v={quoteattr(v)}/>" for k, v in tags.items())

@@ -19,7 +19,8 @@ from facadecli.city.manifest import load_city
 from facadecli.city.run import run_city, safe_name
 from facadecli.city.s3db import COLOURS, colour, tag_problems
 from facadecli.city.straight import merged_ring
-from tests.osm_district import ROOF_SHAPES, write_district
+from tests.osm_district import ROOF_SHAPES, box, write_district
+from tests.running import facade
 from tests.test_s3db import SPEC
 
 MANIFEST = """\
@@ -178,6 +179,12 @@ def test_every_roof_shape_builds(district: tuple[Path, dict[str, Any]]) -> None:
     assert min(west, east) < 0.05 and max(west, east) > 3.0
     west, east = _ridge_reach(_mesh(folder, 700 + ROOF_SHAPES.index("hipped"), "roof"))
     assert min(west, east) > 3.0
+    # crosspitched: two gables crossing, their ridges reaching all four walls
+    roof = _mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "roof")
+    flat, up = roof.vertices[:, [0, 2]], roof.vertices[:, 1]
+    ridges = flat[up > up.max() - 0.01]
+    assert np.ptp(ridges, axis=0) == pytest.approx(np.ptp(flat, axis=0), abs=0.5)  # grid turn
+    assert len(_mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "wall").faces) == 4
 
 
 def test_what_is_not_understood_is_warned_and_counted(
@@ -186,12 +193,12 @@ def test_what_is_not_understood_is_warned_and_counted(
     _, report = district
     warned = {(w["id"], w["warning"].split(" ", 1)[0]) for w in report["warnings"]}
     assert ("way/600", "roof:shape") in warned and ("way/600", "building:colour") in warned
-    unbuilt = {"sawtooth", "zakomar", "crosspitched"} & set(ROOF_SHAPES)
+    unbuilt = {"sawtooth", "zakomar"}  # built as a shed and a dome, warned
     for shape in unbuilt:
         oid = 700 + ROOF_SHAPES.index(shape)
         assert (f"way/{oid}", "roof:shape") in warned
     counts = report["summary"]["warnings_by_tag"]
-    assert counts == {"building:colour": 1, "roof:shape": 1 + len(unbuilt)}
+    assert counts == {"building:colour": 1, "roof:shape": 1 + len(unbuilt) + 1}  # + the factory
     assert report["summary"]["warnings"] == len(report["warnings"]) == sum(counts.values())
     # every other shape S3DB lists is understood: no warning
     for shape in set(ROOF_SHAPES) - unbuilt:
@@ -234,3 +241,18 @@ def test_the_same_district_gives_the_same_bytes_on_one_or_two_workers(
         return json.dumps(found, sort_keys=True)
 
     assert steady(again) == steady(report)
+
+
+def test_a_value_not_understood_is_warned_once(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    junk = {"building": "yes", "roof:shape": "banana"}
+    write_district(tmp_path / "d.osm", [(k, box(12 * k, 0, 10, 10), junk) for k in range(1, 4)])
+    (tmp_path / "plain.yaml").write_text(SPEC)
+    (tmp_path / "d.yaml").write_text(MANIFEST.format(extra=""))
+    code, _, err = facade(capsys, "city", tmp_path / "d.yaml", "-o", tmp_path / "out", "-j", "1")
+    lines = [line for line in err.splitlines() if "banana" in line]
+    assert code == 0 and len(lines) == 1, err
+    assert lines[0].startswith(f"{tmp_path / 'd.osm'}:") and "(and 2 more features" in lines[0]
+    report = json.loads((tmp_path / "out" / "d.report.json").read_text())
+    assert report["summary"]["warnings_by_tag"] == {"roof:shape": 3}

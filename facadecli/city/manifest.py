@@ -30,6 +30,7 @@ RoofType = Literal[
     "pyramidal",
     "half_hip",
     "side_hip",
+    "crosspitched",
     "gambrel",
     "mansard",
     "saltbox",
@@ -215,6 +216,7 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "gambrel": "gambrel",
     "mansard": "mansard",
     "saltbox": "saltbox",
+    "crosspitched": "crosspitched",
     "dome": "dome",
     "round": "round",
     "onion": "onion",
@@ -224,7 +226,6 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
 UNBUILT: dict[str, RoofType] = {  # roof:shape S3DB lists -> the roof built instead (warned)
     "sawtooth": "shed",
     "zakomar": "dome",
-    "crosspitched": "hip",
 }
 
 

@@ -1,6 +1,6 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
-(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, gambrel, mansard, saltbox, dome,
-round, onion.
+(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, mansard,
+saltbox, crosspitched, dome, round, onion.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
 
@@ -19,12 +19,16 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
 - shed: one plane, its low side facing ``direction`` (else across the main direction);
 - gable: the skeleton with weight 0 on the gable ends; half_hip: the same, the ends
   turning to weight 1 at two thirds of their height (hipped over the top third);
+  side_hip: one gable end (at a party wall if one is there), the other hipped;
 - hip: the plain skeleton; pyramidal: every edge slopes to one apex (hip on concave
   outlines and courtyards);
 - saltbox: a gable whose side facing ``direction`` moves twice as fast: its slope runs
   twice as far, at half the pitch;
 - gambrel and mansard: gable and hip with two slopes (steep to a third of the way in and
   two thirds of the height, then shallow);
+- crosspitched: on a convex outline, a gable over every side, the ridges meeting in the
+  middle (two gables crossing, on a rectangle); on any other, the gable roof, whose
+  wings' gables cross;
 - dome, onion and round: hip, hip and gable roofs whose height is a curve of the
   skeleton time: a quarter circle (round: a barrel with a half-circle section), an onion
   (a bulb that narrows to a point), in flat bands.
@@ -33,8 +37,11 @@ Heights: ``pitch`` is the slope of a plane moving at weight 1, unless ``height``
 top; domes and barrels rise by their half width, onions by twice that. ``roof_height``
 gives the rise of what ``roof_meshes`` builds. A shape that cannot be built on some
 outline (a degenerate skeleton; more than MAX_SKELETON vertices) falls back to hip, then
-flat; nothing raises. Results are cached per (outline, roof shape), so asking for the
-height and then the mesh builds the skeleton once.
+flat; nothing raises. Walls given as ``fixed`` (party walls, a taller part standing on
+the roof) stand still in the skeleton: the roof runs on to them at full height instead
+of sloping down (a terrace of hipped houses has one ridge, no valleys between them).
+Results are cached per (outline, roof shape, fixed walls), so asking for the height and
+then the mesh builds the skeleton once.
 """
 
 from __future__ import annotations
@@ -42,7 +49,7 @@ from __future__ import annotations
 import math
 from collections import defaultdict
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -177,6 +184,10 @@ def _build(
         return outline.shed(direction)
     if kind == "pyramidal":
         return outline.hipped("hip") if outline.still else outline.pyramid()
+    if kind == "crosspitched":  # on wings: their gables cross already
+        if outline.convex:
+            return outline.crossed()
+        return replace(outline.gabled("gable", direction, orientation), kind=kind)
     if kind in GABLED:
         return outline.gabled(kind, direction, orientation)
     if kind in ("hip", "mansard", "dome", "onion"):
@@ -271,6 +282,29 @@ class _Outline:
             loop = [i, j] + [lifted[j]] * int(t[j] > 0) + [lifted[i]] * int(t[i] > 0)
             walls.append((tuple(loop), (float(self.direction[i, 0]), float(self.direction[i, 1]))))
         return self._finish("shed", np.array(xy), np.array(ts), (rings,), walls, top)
+
+    def crossed(self) -> _Shape:
+        """Crosspitched: a gable over every side of a convex outline, their ridges
+        running in from the top of each gable end to the middle, valleys down to the
+        corners (on a rectangle: two gable roofs crossing)."""
+        if not self.convex:
+            raise Degenerate("crosspitched needs a convex outline")
+        centre = np.array(Polygon(self.points).centroid.coords[0])
+        reach = _cross(self.direction, centre - self.points)  # distance in from each edge
+        top = float(reach.min())
+        if top <= self.eps:
+            raise Degenerate("crosspitched: no room")
+        middles = (self.points + self.points[self.next]) / 2
+        xy = np.vstack([self.points, middles, centre])
+        t = np.concatenate([np.zeros(self.count), np.full(self.count + 1, top)])
+        apex = 2 * self.count
+        cover = []
+        walls = []
+        for e in range(self.count):
+            m, f = self.count + e, int(self.next[e])
+            cover.extend([((e, m, apex),), ((m, f, apex),)])
+            walls.append(((e, f, m), (float(self.direction[e, 0]), float(self.direction[e, 1]))))
+        return self._finish("crosspitched", xy, t, cover, walls, top)
 
     def pyramid(self) -> _Shape:
         """Every edge slopes up to one apex, which must see the whole outline."""
