@@ -580,9 +580,7 @@ def shared_edges(
             beyond = other.difference(shape.buffer(tolerance / 2, join_style="mitre"))
             if beyond.is_empty:
                 continue
-            touching = shape.boundary.intersection(
-                beyond.buffer(1.5 * tolerance, join_style="mitre")
-            )
+            touching = shape.boundary.intersection(beyond.buffer(tolerance, join_style="mitre"))
             if touching.is_empty or touching.length < tolerance:
                 continue
             before = shared.get(owner[index])
