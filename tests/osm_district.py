@@ -93,7 +93,7 @@ BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [
         box(60, 30, 8, 8),
         {"building": "yes", "building:colour": "blurple", "roof:shape": "banana"},
     ),
-    # a factory under a sawtooth roof (not built yet: a shed, warned)
+    # a factory under a sawtooth roof, its glazing facing north
     (
         800,
         box(60, 60, 30, 20),

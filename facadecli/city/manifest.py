@@ -31,6 +31,7 @@ RoofType = Literal[
     "half_hip",
     "side_hip",
     "crosspitched",
+    "sawtooth",
     "gambrel",
     "mansard",
     "saltbox",
@@ -217,6 +218,7 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "mansard": "mansard",
     "saltbox": "saltbox",
     "crosspitched": "crosspitched",
+    "sawtooth": "sawtooth",
     "dome": "dome",
     "round": "round",
     "onion": "onion",
@@ -224,7 +226,6 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
 
 
 UNBUILT: dict[str, RoofType] = {  # roof:shape S3DB lists -> the roof built instead (warned)
-    "sawtooth": "shed",
     "zakomar": "dome",
 }
 

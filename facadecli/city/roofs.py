@@ -1,6 +1,6 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
 (SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, mansard,
-saltbox, crosspitched, dome, round, onion.
+saltbox, crosspitched, sawtooth, dome, round, onion.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
 
@@ -26,6 +26,8 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
   twice as far, at half the pitch;
 - gambrel and mansard: gable and hip with two slopes (steep to a third of the way in and
   two thirds of the height, then shallow);
+- sawtooth: sheds side by side on strips about TOOTH wide, their low sides facing
+  ``direction`` (else the long side's southern face), a vertical wall at each high side;
 - crosspitched: on a convex outline, a gable over every side, the ridges meeting in the
   middle (two gables crossing, on a rectangle); on any other, the gable roof, whose
   wings' gables cross;
@@ -54,7 +56,7 @@ from functools import lru_cache
 
 import numpy as np
 import trimesh
-from shapely.geometry import Polygon
+from shapely.geometry import Point, Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.manifest import Roof
@@ -69,6 +71,7 @@ ACROSS = 0.7072  # a gable end lies across the ridge: |cos| of their angle at mo
 PYRAMID_HULL = 0.9  # a pyramid's outline fills this much of its convex hull at least
 FACING = 0.5  # a saltbox's long slope: the sides facing its direction within 60°
 HALF_HIP = 2 / 3  # a half hip's gable end goes up to this part of its height
+TOOTH = 6.0  # metres: a sawtooth roof's teeth are about this wide
 BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
 CURVED = ("dome", "round", "onion")
 GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox", "side_hip")
@@ -105,7 +108,7 @@ def roof_height(part: Polygon, roof: Roof) -> float:
 
 def _key(roof: Roof) -> tuple[str, float | None, str]:
     """What the shape depends on (not the pitch or height: they scale it)."""
-    if roof.type == "shed":
+    if roof.type in ("shed", "sawtooth"):
         return roof.type, roof.direction, "along"
     if roof.type in GABLED:
         return roof.type, roof.direction, roof.orientation
@@ -182,6 +185,8 @@ def _build(
     outline = _Outline(part, fixed)
     if kind == "shed":
         return outline.shed(direction)
+    if kind == "sawtooth":
+        return outline.sawtooth(direction)
     if kind == "pyramidal":
         return outline.hipped("hip") if outline.still else outline.pyramid()
     if kind == "crosspitched":  # on wings: their gables cross already
@@ -252,6 +257,82 @@ class _Outline:
             raise Degenerate("every wall fixed: nothing to slope")
 
     # -- shapes -----------------------------------------------------------------------
+
+    def sawtooth(self, direction: float | None) -> _Shape:
+        """Sheds side by side on strips about TOOTH wide across ``direction`` (the way
+        their slopes face, downhill; else the long side's southern face), each rising
+        from its low side at the eaves to its high side, where a vertical wall (a
+        factory's glazing) drops to the next strip's low side."""
+        down = _compass(direction) if direction is not None else -_north(self.normal)
+        across = _perpendicular(down)
+        reach = self.points @ down
+        low, high = float(reach.min()), float(reach.max())
+        count = max(1, round((high - low) / TOOTH))
+        width = (high - low) / count
+        if width <= self.eps:
+            raise Degenerate("sawtooth: no room")
+        polygon = Polygon(self.local[0], self.local[1:])
+        span = float(np.abs(self.points @ across).max()) * 2 + 1.0
+        nodes: dict[tuple[float, float, float], int] = {}
+        xy: list[np.ndarray] = []
+        ts: list[float] = []
+
+        def node(point: np.ndarray, t: float) -> int:
+            key = (round(float(point[0]), 7), round(float(point[1]), 7), round(t, 7))
+            if key not in nodes:
+                nodes[key] = len(xy)
+                xy.append(np.asarray(point, dtype=float))
+                ts.append(t)
+            return nodes[key]
+
+        for point in self.points:  # the eave nodes first, in order, as _finish wants them
+            node(point, 0.0)
+        snap = 1e3 * self.eps
+        cover: list[tuple[tuple[int, ...], ...]] = []
+        walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
+        outline = polygon.boundary.buffer(snap)
+        for k in range(count):
+            a, b = low + k * width, low + (k + 1) * width
+            band = Polygon(
+                [
+                    down * a - across * span,
+                    down * b - across * span,
+                    down * b + across * span,
+                    down * a + across * span,
+                ]
+            )
+            piece = polygon.intersection(band)
+            teeth = [piece] if isinstance(piece, Polygon) else list(getattr(piece, "geoms", []))
+            for tooth in teeth:
+                if not isinstance(tooth, Polygon) or tooth.area <= snap * self.scale:
+                    continue
+                tooth = orient(tooth, sign=1.0)
+                rings = []
+                for ring in (tooth.exterior, *tooth.interiors):
+                    points = _clean(np.array(ring.coords)[:-1, :2], self.eps * 10)
+                    heights = [min(width, max(0.0, b - float(p @ down))) for p in points]
+                    heights = [
+                        0.0 if h <= snap else width if h >= width - snap else h for h in heights
+                    ]
+                    roof = [node(p, h) for p, h in zip(points, heights, strict=True)]
+                    rings.append(tuple(roof))
+                    for i in range(len(points)):
+                        j = (i + 1) % len(points)
+                        p, q = points[i], points[j]
+                        edge = q - p
+                        size = float(np.hypot(*edge))
+                        if size <= self.eps:
+                            continue
+                        d = (float(edge[0] / size), float(edge[1] / size))
+                        on_outline = outline.contains(Point(*((p + q) / 2)))
+                        riser = heights[i] >= width and heights[j] >= width and not on_outline
+                        if not (on_outline or riser) or heights[i] + heights[j] <= 0:
+                            continue
+                        loop = [node(p, 0.0), node(q, 0.0)]
+                        loop += [roof[j]] * (heights[j] > 0) + [roof[i]] * (heights[i] > 0)
+                        walls.append((tuple(loop), d))
+                cover.append(tuple(rings))
+        return self._finish("sawtooth", np.array(xy), np.array(ts), cover, walls, width)
 
     def shed(self, direction: float | None) -> _Shape:
         """One plane rising away from ``direction`` (its low side faces it)."""
