@@ -12,6 +12,7 @@ import math
 import sys
 import time
 import traceback
+from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -517,11 +518,15 @@ def city(
         if entry["line"] is None:
             where = f"{loaded.footprints}: features[{entry['feature']}]"
         _warn(f"{where}: rejected: feature '{entry['id']}': {entry['error']}")
-    for entry in report["warnings"]:  # tags ignored: the building is built without them
+    alike = Counter(entry["warning"] for entry in report["warnings"])
+    for entry in report["warnings"]:  # tags ignored: each warned once, all in the report
         where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
         if entry["line"] is None:
             where = f"{loaded.footprints}: features[{entry['feature']}]"
-        _warn(f"{where}: warning: feature '{entry['id']}': {entry['warning']}")
+        more = alike.pop(entry["warning"], 0) - 1
+        if more >= 0:
+            also = f" (and {more} more features: see the report)" if more else ""
+            _warn(f"{where}: warning: feature '{entry['id']}': {entry['warning']}{also}")
     for entry in report["buildings"]:
         if entry["status"] != "ok":
             typer.echo(f"{source}: building {entry['id']}: {entry['error']}", err=True)

@@ -234,6 +234,8 @@ def test_walls_close_even_when_every_edge_is_shorter_than_a_sliver(tmp_path: Pat
     manifest = town(
         tmp_path, [json.dumps({"type": "Feature", "id": "round", "geometry": geometry})]
     )
+    text = manifest.read_text().replace("defaults: {", "defaults: {collinear_angle: 0, ")
+    manifest.write_text(text)  # every node a corner, as drawn
     report = run_city(load_city(manifest), tmp_path / "out", jobs=1)
     (building,) = report["buildings"]
     assert "simplified" not in building and building["plain_walls"] > 300

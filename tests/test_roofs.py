@@ -71,13 +71,25 @@ def _surface(cover: trimesh.Trimesh, points: np.ndarray) -> np.ndarray:
 
 
 def _closed(part: Polygon, cover: trimesh.Trimesh, infill: list) -> trimesh.Trimesh:
-    """The building: walls from the ground to the eaves, the infill, the roof, a floor."""
+    """The building: walls from the ground to the eaves, the infill, the roof, a floor.
+    A wall's top meets the roof's vertices at the eaves along it (a sawtooth's valleys
+    come down to the eaves in the middle of a wall), as a façade's top would."""
     pieces = [cover, *infill]
+    eaves = np.vstack([cover.vertices, *(wall.vertices for wall in infill)])
+    eaves = eaves[np.abs(eaves[:, 2] - EAVES) < 1e-9, :2]
     for ring in (part.exterior, *part.interiors):
         points = np.array(ring.coords)[:-1]
         for a, b in zip(points, np.roll(points, -1, axis=0), strict=True):
-            quad = np.array([[*a, 0], [*b, 0], [*b, EAVES], [*a, EAVES]])
-            pieces.append(trimesh.Trimesh(quad, [[0, 1, 2], [0, 2, 3]], process=False))
+            v = b - a
+            u = (eaves - a) @ v / (v @ v)
+            off = np.abs((eaves[:, 0] - a[0]) * v[1] - (eaves[:, 1] - a[1]) * v[0])
+            on = np.unique(u[(u > 1e-9) & (u < 1 - 1e-9) & (off < 1e-7 * np.hypot(*v))])
+            top = [a, *(a + k * v for k in on), b]  # the wall's top, along the eaves
+            ground = np.array([[*a, 0], [*b, 0]])
+            rim = np.array([[*p, EAVES] for p in top[::-1]])
+            vertices = np.vstack([ground, rim])  # a, b on the ground; b ... a at the eaves
+            fan = [[0, 1, 2]] + [[0, k, k + 1] for k in range(2, len(vertices) - 1)]
+            pieces.append(trimesh.Trimesh(vertices, fan, process=False))
     vertices, faces = trimesh.creation.triangulate_polygon(part)
     floor = np.column_stack([vertices, np.zeros(len(vertices))])
     pieces.append(trimesh.Trimesh(floor, np.asarray(faces)[:, ::-1], process=False))

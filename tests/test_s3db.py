@@ -243,10 +243,12 @@ def test_party_walls_of_a_terrace_are_blind(district: tuple[Path, dict[str, Any]
     _, report = district
     assert [_entry(report, t)["party_walls"] for t in ("t1", "t2", "t3")] == [1, 2, 1]
     assert _entry(report, "t2")["facades"] == 2  # street and garden only
-    # the tower and the low part share a wall too: inside one building, blind
+    # the tower and the low part share a wall too: the low part's is blind; the tower
+    # (15 m) stands free above the low part (6 m, under half its height): a façade
     assert _entry(report, "low")["party_walls"] == 1
+    assert _entry(report, "tower")["party_walls"] == 0
     # and the hall and the rest of the station's outline
-    assert report["summary"]["party_walls"] == 1 + 2 + 1 + 1 + 1 + 1 + 1
+    assert report["summary"]["party_walls"] == 1 + 2 + 1 + 1 + 1 + 1
 
 
 def test_heights_from_any_property_with_a_scale(district: tuple[Path, dict[str, Any]]) -> None:

@@ -23,13 +23,14 @@ from typing import Any
 
 import numpy as np
 import trimesh
-from shapely.geometry import Polygon
+from shapely.geometry import Point, Polygon
+from shapely.geometry.polygon import orient
 from trimesh.visual.material import PBRMaterial
 
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
-from facadecli.city.roofs import roof_meshes
-from facadecli.city.s3db import Heights, Volume, along, party_zone, volume
+from facadecli.city.roofs import Segment, roof_meshes
+from facadecli.city.s3db import Heights, Volume, along, party_zone, roof_only, volume
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import facade_scene, pbr
@@ -101,6 +102,10 @@ class AxisCache:
         found = self._layouts(key, spec, axis, length, variants)
         return found[pick % len(found)] if found else None
 
+    def fits(self, key: str, spec: Spec, axis: str, length: float, variants: int = 1) -> bool:
+        """Does some layout of the axis fit at the rung of ``length``?"""
+        return bool(self._layouts(key, spec, axis, length, variants))
+
     def _layouts(
         self, key: str, spec: Spec, axis: str, length: float, variants: int
     ) -> tuple[AxisLayout, ...]:
@@ -154,6 +159,7 @@ class BuildingResult:
     party_walls: int  # walls along a neighbour: blind
     top: float  # metres: the highest roof
     volumes: tuple[Volume, ...] = ()  # the parts as built: walls and roofs
+    plain: dict[str, int] = field(default_factory=dict)  # plain walls by reason (PLAIN_REASONS)
 
 
 def _to_world(origin: tuple[float, float], direction: tuple[float, float]) -> np.ndarray:
@@ -212,6 +218,7 @@ def build_building(
     walls: Sequence[tuple[WallRule, Facade]] = (),
     variants: int = 1,
     pick: int = 0,
+    above: Any = None,
 ) -> BuildingResult:
     """The building's scene: a volume a part of its footprint, as the heights say (walls
     from ``base`` to the eaves, the roof on them); façades on every wall but the party
@@ -219,18 +226,27 @@ def build_building(
     ground under the parts that stand on it. A wall gets the façade of the first of
     ``walls`` that matches it (its side, the way it faces, its length), else ``spec``'s.
     ``base_dir`` is the spec's folder, where its mesh and texture files are. Each axis is
-    the ``pick``-th of up to ``variants`` layouts, the same for all the building's walls."""
+    the ``pick``-th of up to ``variants`` layouts, the same for all the building's walls.
+    Roofs stand still at party walls (a gable end, not a hip down to the neighbour), and
+    leave out ``above``, the taller parts standing on this one, running on into their
+    walls."""
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
     facades = plain = party = 0
+    reasons: dict[str, int] = {}
     volumes = [volume(part, heights, roof) for part in footprint.parts]
+    posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
     for block in volumes:
         wall_height = _wall_height(block)
         lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
         proud: dict[tuple[float, float], tuple[tuple[float, float], float, str]] = {}
         ends: list[tuple[tuple[float, float], tuple[float, float], float]] = []
-        for a, b, length, party_wall, chosen in _walls(block, shared, tolerance, main, walls):
+        fixed: list[Segment] = []
+        laid = () if posts_only else _walls(block, shared, tolerance, main, walls)
+        for a, b, length, party_wall, chosen in laid:
+            if party_wall:
+                fixed.append((a, b))
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
             meshes = (
@@ -247,6 +263,11 @@ def build_building(
                 parts.setdefault(WALL_NAME, []).append(wall)
                 plain += 1
                 party += party_wall
+                reason = _plain_reason(party_wall, length, min_facade_width)
+                if reason is None:  # the façade did not fit: its height, or its length
+                    fits = cache.fits(chosen.key, chosen.spec, "y", wall_height, variants)
+                    reason = "no_layout" if fits else "too_low"
+                reasons[reason] = reasons.get(reason, 0) + 1
                 continue
             facades += 1
             out = max(float(mesh.vertices[:, 2].max(initial=0.0)) for _, mesh in meshes)
@@ -257,12 +278,15 @@ def build_building(
                 parts.setdefault(name, []).append(mesh)
         for name, post in _corner_posts(proud, ends, block.base, wall_height):
             parts.setdefault(name, []).append(post)
-        cover, infill = roof_meshes(block.part, block.eaves, block.roof)
-        cover.apply_transform(MAP_TO_WORLD)
-        parts.setdefault(ROOF_NAME, []).append(cover)
-        for piece in infill:
-            piece.apply_transform(MAP_TO_WORLD)
-            parts.setdefault(WALL_NAME, []).append(piece)
+        if posts_only:
+            parts.setdefault(WALL_NAME, []).extend(_posts(block))
+        for shape, still in roof_outlines(block.part, fixed, above):
+            cover, infill = roof_meshes(shape, block.eaves, block.roof, still)
+            cover.apply_transform(MAP_TO_WORLD)
+            parts.setdefault(ROOF_NAME, []).append(cover)
+            for piece in [] if posts_only else infill:  # a roof on posts has open gables
+                piece.apply_transform(MAP_TO_WORLD)
+                parts.setdefault(WALL_NAME, []).append(piece)
         bottom = trimesh.creation.extrude_polygon(block.part, 0.01)
         bottom.apply_translation((0, 0, block.base - 0.01))
         bottom.apply_transform(MAP_TO_WORLD)
@@ -280,7 +304,75 @@ def build_building(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"
         )
     top = max(block.top for block in volumes)
-    return BuildingResult(scene, facades, plain, party, round(top, 3), tuple(volumes))
+    return BuildingResult(
+        scene, facades, plain, party, round(top, 3), tuple(volumes), dict(sorted(reasons.items()))
+    )
+
+
+PLAIN_REASONS = ("party", "too_short", "too_low", "no_layout")
+
+
+def _plain_reason(party: bool, length: float, min_facade_width: float) -> str | None:
+    """Why a wall is plain before any layout is tried: a party wall, or shorter than
+    ``min_facade_width``; None: a layout was tried (``too_low``: none fits its height,
+    ``no_layout``: none fits its length)."""
+    if party:
+        return "party"
+    if length < min_facade_width:
+        return "too_short"
+    return None
+
+
+POST = 0.25  # metres: the side of a square post under a roof on posts
+POST_SPACING = 6.0  # metres: posts along a side at most this far apart
+
+
+def _posts(block: Volume) -> list[trimesh.Trimesh]:
+    """Posts from the base to the eaves under a roof with no walls: at each corner of
+    its outline, and along the sides at most POST_SPACING apart, each inside the
+    outline."""
+    inset = block.part.buffer(-POST / 2, join_style="mitre")
+    if not isinstance(inset, Polygon) or inset.is_empty:
+        inset = block.part
+    ring = _corners(list(inset.exterior.coords))
+    height = max(_wall_height(block), POST)
+    posts = []
+    for a, b in itertools.pairwise(ring):
+        steps = max(1, math.ceil(math.dist(a, b) / POST_SPACING))
+        for k in range(steps):  # the corner a, then evenly along to b (b: the next side's)
+            x = a[0] + (b[0] - a[0]) * k / steps
+            y = a[1] + (b[1] - a[1]) * k / steps
+            post = trimesh.creation.box(extents=(POST, POST, height))
+            post.apply_translation((x, y, block.base + height / 2))
+            post.apply_transform(MAP_TO_WORLD)
+            posts.append(post)
+    return posts
+
+
+def roof_outlines(
+    part: Polygon, party: Sequence[Segment], above: Any
+) -> list[tuple[Polygon, tuple[Segment, ...]]]:
+    """Where a volume's roof goes, and the walls it stands still at: the part less the
+    taller parts standing on it (``above``: a tower on a podium), whose walls join the
+    party walls; the part whole when that leaves too little."""
+    if above is None or above.is_empty:
+        return [(part, tuple(party))]
+    rest = part.difference(above)
+    pieces = [rest] if isinstance(rest, Polygon) else list(getattr(rest, "geoms", []))
+    pieces = [orient(p, sign=1.0) for p in pieces if isinstance(p, Polygon) and p.area >= 1.0]
+    if not pieces:
+        return [(part, tuple(party))]
+    edge = part.boundary
+    found = []
+    for piece in pieces:
+        cut = [
+            (a, b)
+            for ring in (piece.exterior, *piece.interiors)
+            for a, b in itertools.pairwise((p[0], p[1]) for p in ring.coords)
+            if edge.distance(Point((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)) > MIN_EDGE
+        ]
+        found.append((piece, (*party, *cut)))
+    return found
 
 
 @dataclass(frozen=True)
@@ -332,6 +424,8 @@ def facade_axes(
     """The axes a building's façades need, as cache slots: what a run can solve ahead, in
     parallel, before the buildings (see :meth:`AxisCache.get`)."""
     needed: set[Slot] = set()
+    if roof_only(footprint.properties):
+        return needed  # no walls: no façades
     for block in (volume(part, heights, roof) for part in footprint.parts):
         height = rung(_wall_height(block))
         for _, _, length, party, chosen in _walls(block, shared, tolerance, main, rules):

@@ -432,7 +432,9 @@ def checked_properties(
         shown = printable(str(value))
         shown = shown if len(shown) <= 40 else shown[:37] + "..."
         warnings.append(f"{name} '{shown}' {problem}: ignored")
-    return kept, warnings
+    from facadecli.city.s3db import tag_problems  # here: s3db reads footprints
+
+    return kept, warnings + tag_problems(kept)
 
 
 def building_height(properties: dict[str, Any], default: float, floor_height: float) -> float:

@@ -29,6 +29,9 @@ RoofType = Literal[
     "hip",
     "pyramidal",
     "half_hip",
+    "side_hip",
+    "crosspitched",
+    "sawtooth",
     "gambrel",
     "mansard",
     "saltbox",
@@ -106,6 +109,8 @@ class Defaults(Model):
         default_factory=list
     )  # wall colours a building may take (when its tags give none)
     party_wall_tolerance: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] = 0.3
+    # degrees: footprint edges this close to straight are one wall (0: every node a corner)
+    collinear_angle: Annotated[float, Field(ge=0, le=20, allow_inf_nan=False)] = 3.0
 
 
 class Rule(Model):
@@ -203,7 +208,7 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "lean_to": "shed",
     "gabled": "gable",
     "hipped": "hip",
-    "side_hipped": "hip",
+    "side_hipped": "side_hip",
     "pyramidal": "pyramidal",
     "cone": "pyramidal",
     "half-hipped": "half_hip",
@@ -212,14 +217,22 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "gambrel": "gambrel",
     "mansard": "mansard",
     "saltbox": "saltbox",
+    "crosspitched": "crosspitched",
+    "sawtooth": "sawtooth",
     "dome": "dome",
     "round": "round",
     "onion": "onion",
 }
 
 
+UNBUILT: dict[str, RoofType] = {  # roof:shape S3DB lists -> the roof built instead (warned)
+    "zakomar": "dome",
+}
+
+
 def _tagged_roof(properties: dict[str, Any]) -> Roof | None:
-    kind = OSM_ROOFS.get(str(properties.get("roof:shape", "")).strip().lower())
+    name = str(properties.get("roof:shape", "")).strip().lower()
+    kind = OSM_ROOFS.get(name) or UNBUILT.get(name)
     if kind is None:
         return None
     angle = number(properties.get("roof:angle"))

@@ -1,6 +1,6 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
-(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, gambrel, mansard, saltbox, dome,
-round, onion.
+(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, mansard,
+saltbox, crosspitched, sawtooth, dome, round, onion.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
 
@@ -19,12 +19,18 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
 - shed: one plane, its low side facing ``direction`` (else across the main direction);
 - gable: the skeleton with weight 0 on the gable ends; half_hip: the same, the ends
   turning to weight 1 at two thirds of their height (hipped over the top third);
+  side_hip: one gable end (at a party wall if one is there), the other hipped;
 - hip: the plain skeleton; pyramidal: every edge slopes to one apex (hip on concave
   outlines and courtyards);
 - saltbox: a gable whose side facing ``direction`` moves twice as fast: its slope runs
   twice as far, at half the pitch;
 - gambrel and mansard: gable and hip with two slopes (steep to a third of the way in and
   two thirds of the height, then shallow);
+- sawtooth: sheds side by side on strips about TOOTH wide, their low sides facing
+  ``direction`` (else the long side's southern face), a vertical wall at each high side;
+- crosspitched: on a convex outline, a gable over every side, the ridges meeting in the
+  middle (two gables crossing, on a rectangle); on any other, the gable roof, whose
+  wings' gables cross;
 - dome, onion and round: hip, hip and gable roofs whose height is a curve of the
   skeleton time: a quarter circle (round: a barrel with a half-circle section), an onion
   (a bulb that narrows to a point), in flat bands.
@@ -33,8 +39,11 @@ Heights: ``pitch`` is the slope of a plane moving at weight 1, unless ``height``
 top; domes and barrels rise by their half width, onions by twice that. ``roof_height``
 gives the rise of what ``roof_meshes`` builds. A shape that cannot be built on some
 outline (a degenerate skeleton; more than MAX_SKELETON vertices) falls back to hip, then
-flat; nothing raises. Results are cached per (outline, roof shape), so asking for the
-height and then the mesh builds the skeleton once.
+flat; nothing raises. Walls given as ``fixed`` (party walls, a taller part standing on
+the roof) stand still in the skeleton: the roof runs on to them at full height instead
+of sloping down (a terrace of hipped houses has one ridge, no valleys between them).
+Results are cached per (outline, roof shape, fixed walls), so asking for the height and
+then the mesh builds the skeleton once.
 """
 
 from __future__ import annotations
@@ -42,12 +51,12 @@ from __future__ import annotations
 import math
 from collections import defaultdict
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
 import trimesh
-from shapely.geometry import Polygon
+from shapely.geometry import Point, Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.manifest import Roof
@@ -62,20 +71,29 @@ ACROSS = 0.7072  # a gable end lies across the ridge: |cos| of their angle at mo
 PYRAMID_HULL = 0.9  # a pyramid's outline fills this much of its convex hull at least
 FACING = 0.5  # a saltbox's long slope: the sides facing its direction within 60°
 HALF_HIP = 2 / 3  # a half hip's gable end goes up to this part of its height
+TOOTH = 6.0  # metres: a sawtooth roof's teeth are about this wide
 BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
 CURVED = ("dome", "round", "onion")
-GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox")
+GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox", "side_hip")
+FIXABLE = ("hip", "pyramidal", "mansard", *GABLED)  # roofs that keep still at party walls
+ON_WALL = 0.05  # metres: an edge whose middle is this near a fixed segment, along it, is one
 
 
 # ---------------------------------------------------------------------------------------
 # the public interface
 
 
+Segment = tuple[tuple[float, float], tuple[float, float]]
+
+
 def roof_meshes(
-    part: Polygon, height: float, roof: Roof
+    part: Polygon, height: float, roof: Roof, fixed: tuple[Segment, ...] = ()
 ) -> tuple[trimesh.Trimesh, list[trimesh.Trimesh]]:
-    """(the roof, walls filling the space between the eaves and the roof: gable ends)."""
-    shape = _shape(part.wkb, *_key(roof))
+    """(the roof, walls filling the space between the eaves and the roof: gable ends).
+    ``fixed``: the walls the roof must not slope down to (party walls, a taller part
+    standing on this one), as segments: edges along them stand still (weight 0), so the
+    roof runs on to them with a gable end, or on into the neighbour's."""
+    shape = _shape(part.wkb, *_key(roof), fixed if roof.type in FIXABLE else ())
     if shape.kind == "flat":
         return _slab(part, height), []
     return _mesh(shape, height, _rise(shape, roof))
@@ -90,7 +108,7 @@ def roof_height(part: Polygon, roof: Roof) -> float:
 
 def _key(roof: Roof) -> tuple[str, float | None, str]:
     """What the shape depends on (not the pitch or height: they scale it)."""
-    if roof.type == "shed":
+    if roof.type in ("shed", "sawtooth"):
         return roof.type, roof.direction, "along"
     if roof.type in GABLED:
         return roof.type, roof.direction, roof.orientation
@@ -131,30 +149,50 @@ FLAT = _Shape("flat", np.zeros((0, 2)), np.zeros(0), (), (), 0.0)
 
 
 @lru_cache(maxsize=512)
-def _shape(wkb: bytes, kind: str, direction: float | None, orientation: str) -> _Shape:
+def _shape(
+    wkb: bytes,
+    kind: str,
+    direction: float | None,
+    orientation: str,
+    fixed: tuple[Segment, ...] = (),
+) -> _Shape:
     """The shape built for a footprint (as WKB, so it can be a cache key), falling back
-    to a hip roof, then to a flat one, rather than raising."""
+    to the shape without its fixed walls, to a hip roof, then to a flat one, rather than
+    raising."""
     import shapely
 
     part = shapely.from_wkb(wkb)
     if kind == "flat" or not isinstance(part, Polygon) or part.is_empty or part.area <= 0:
         return FLAT
-    tries = [kind] if kind == "hip" else [kind, "hip"]
+    tries = [(kind, fixed)] + [(kind, ())] * bool(fixed)
+    tries += [] if kind == "hip" else [("hip", fixed)] * bool(fixed) + [("hip", ())]
     with np.errstate(all="ignore"):
-        for attempt in tries:
+        for attempt, still in tries:
             try:
-                return _build(part, attempt, direction, orientation)
+                return _build(part, attempt, direction, orientation, still)
             except Exception:  # a degenerate skeleton, or worse: the simpler shape
                 continue
     return FLAT
 
 
-def _build(part: Polygon, kind: str, direction: float | None, orientation: str) -> _Shape:
-    outline = _Outline(part)
+def _build(
+    part: Polygon,
+    kind: str,
+    direction: float | None,
+    orientation: str,
+    fixed: tuple[Segment, ...] = (),
+) -> _Shape:
+    outline = _Outline(part, fixed)
     if kind == "shed":
         return outline.shed(direction)
+    if kind == "sawtooth":
+        return outline.sawtooth(direction)
     if kind == "pyramidal":
-        return outline.pyramid()
+        return outline.hipped("hip") if outline.still else outline.pyramid()
+    if kind == "crosspitched":  # on wings: their gables cross already
+        if outline.convex:
+            return outline.crossed()
+        return replace(outline.gabled("gable", direction, orientation), kind=kind)
     if kind in GABLED:
         return outline.gabled(kind, direction, orientation)
     if kind in ("hip", "mansard", "dome", "onion"):
@@ -178,7 +216,7 @@ class _Outline:
     """A footprint's rings, cleaned, relative to an origin (for precision), with its
     sides and main direction."""
 
-    def __init__(self, part: Polygon) -> None:
+    def __init__(self, part: Polygon, fixed: tuple[Segment, ...] = ()) -> None:
         part = orient(part, sign=1.0)  # exterior counter-clockwise, holes clockwise
         minx, miny, maxx, maxy = part.bounds
         self.origin = np.array([minx, miny])
@@ -214,8 +252,87 @@ class _Outline:
         )
         centre, main, normal = _axes(part)
         self.centre, self.main, self.normal = centre - self.origin, main, normal
+        self.still = _still(self.exact, self.direction, self.next, fixed)
+        if len(self.still) == self.count:
+            raise Degenerate("every wall fixed: nothing to slope")
 
     # -- shapes -----------------------------------------------------------------------
+
+    def sawtooth(self, direction: float | None) -> _Shape:
+        """Sheds side by side on strips about TOOTH wide across ``direction`` (the way
+        their slopes face, downhill; else the long side's southern face), each rising
+        from its low side at the eaves to its high side, where a vertical wall (a
+        factory's glazing) drops to the next strip's low side."""
+        down = _compass(direction) if direction is not None else -_north(self.normal)
+        across = _perpendicular(down)
+        reach = self.points @ down
+        low, high = float(reach.min()), float(reach.max())
+        count = max(1, round((high - low) / TOOTH))
+        width = (high - low) / count
+        if width <= self.eps:
+            raise Degenerate("sawtooth: no room")
+        polygon = Polygon(self.local[0], self.local[1:])
+        span = float(np.abs(self.points @ across).max()) * 2 + 1.0
+        nodes: dict[tuple[float, float, float], int] = {}
+        xy: list[np.ndarray] = []
+        ts: list[float] = []
+
+        def node(point: np.ndarray, t: float) -> int:
+            key = (round(float(point[0]), 7), round(float(point[1]), 7), round(t, 7))
+            if key not in nodes:
+                nodes[key] = len(xy)
+                xy.append(np.asarray(point, dtype=float))
+                ts.append(t)
+            return nodes[key]
+
+        for point in self.points:  # the eave nodes first, in order, as _finish wants them
+            node(point, 0.0)
+        snap = 1e3 * self.eps
+        cover: list[tuple[tuple[int, ...], ...]] = []
+        walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
+        outline = polygon.boundary.buffer(snap)
+        for k in range(count):
+            a, b = low + k * width, low + (k + 1) * width
+            band = Polygon(
+                [
+                    down * a - across * span,
+                    down * b - across * span,
+                    down * b + across * span,
+                    down * a + across * span,
+                ]
+            )
+            piece = polygon.intersection(band)
+            teeth = [piece] if isinstance(piece, Polygon) else list(getattr(piece, "geoms", []))
+            for tooth in teeth:
+                if not isinstance(tooth, Polygon) or tooth.area <= snap * self.scale:
+                    continue
+                tooth = orient(tooth, sign=1.0)
+                rings = []
+                for ring in (tooth.exterior, *tooth.interiors):
+                    points = _clean(np.array(ring.coords)[:-1, :2], self.eps * 10)
+                    heights = [min(width, max(0.0, b - float(p @ down))) for p in points]
+                    heights = [
+                        0.0 if h <= snap else width if h >= width - snap else h for h in heights
+                    ]
+                    roof = [node(p, h) for p, h in zip(points, heights, strict=True)]
+                    rings.append(tuple(roof))
+                    for i in range(len(points)):
+                        j = (i + 1) % len(points)
+                        p, q = points[i], points[j]
+                        edge = q - p
+                        size = float(np.hypot(*edge))
+                        if size <= self.eps:
+                            continue
+                        d = (float(edge[0] / size), float(edge[1] / size))
+                        on_outline = outline.contains(Point(*((p + q) / 2)))
+                        riser = heights[i] >= width and heights[j] >= width and not on_outline
+                        if not (on_outline or riser) or heights[i] + heights[j] <= 0:
+                            continue
+                        loop = [node(p, 0.0), node(q, 0.0)]
+                        loop += [roof[j]] * (heights[j] > 0) + [roof[i]] * (heights[i] > 0)
+                        walls.append((tuple(loop), d))
+                cover.append(tuple(rings))
+        return self._finish("sawtooth", np.array(xy), np.array(ts), cover, walls, width)
 
     def shed(self, direction: float | None) -> _Shape:
         """One plane rising away from ``direction`` (its low side faces it)."""
@@ -247,6 +364,29 @@ class _Outline:
             walls.append((tuple(loop), (float(self.direction[i, 0]), float(self.direction[i, 1]))))
         return self._finish("shed", np.array(xy), np.array(ts), (rings,), walls, top)
 
+    def crossed(self) -> _Shape:
+        """Crosspitched: a gable over every side of a convex outline, their ridges
+        running in from the top of each gable end to the middle, valleys down to the
+        corners (on a rectangle: two gable roofs crossing)."""
+        if not self.convex:
+            raise Degenerate("crosspitched needs a convex outline")
+        centre = np.array(Polygon(self.points).centroid.coords[0])
+        reach = _cross(self.direction, centre - self.points)  # distance in from each edge
+        top = float(reach.min())
+        if top <= self.eps:
+            raise Degenerate("crosspitched: no room")
+        middles = (self.points + self.points[self.next]) / 2
+        xy = np.vstack([self.points, middles, centre])
+        t = np.concatenate([np.zeros(self.count), np.full(self.count + 1, top)])
+        apex = 2 * self.count
+        cover = []
+        walls = []
+        for e in range(self.count):
+            m, f = self.count + e, int(self.next[e])
+            cover.extend([((e, m, apex),), ((m, f, apex),)])
+            walls.append(((e, f, m), (float(self.direction[e, 0]), float(self.direction[e, 1]))))
+        return self._finish("crosspitched", xy, t, cover, walls, top)
+
     def pyramid(self) -> _Shape:
         """Every edge slopes up to one apex, which must see the whole outline."""
         polygon = Polygon(self.points)
@@ -270,7 +410,8 @@ class _Outline:
         return self._finish("pyramidal", xy, t, faces, [], top)
 
     def hipped(self, kind: str) -> _Shape:
-        skeleton = Skeleton(self, [1.0] * self.count, {})
+        weights = [0.0 if e in self.still else 1.0 for e in range(self.count)]
+        skeleton = Skeleton(self, weights, {})
         return self._from_skeleton(kind, skeleton, {})
 
     def gabled(self, kind: str, direction: float | None, orientation: str) -> _Shape:
@@ -303,6 +444,9 @@ class _Outline:
                 if float(outward @ facing) > FACING:
                     for e in side.edges:
                         weights[e] = 2.0
+        if kind == "side_hip":  # one gable end: at a fixed wall if one is, else the first
+            fixed = any(e in self.still for side in chosen for e in side.edges)
+            chosen = [] if fixed else chosen[:1]
         switches: dict[int, float] = {}
         for side in chosen:
             for e in side.edges:
@@ -312,6 +456,9 @@ class _Outline:
                 if apex is not None:
                     for e in side.edges:
                         switches[e] = HALF_HIP * apex
+        for e in self.still:  # party walls: gable ends too
+            weights[e] = 0.0
+            switches.pop(e, None)
         if plain is not None and all(w == 1.0 for w in weights):  # no gable ends after all
             return self._from_skeleton(kind, plain, {})
         skeleton = Skeleton(self, weights, switches)
@@ -787,6 +934,28 @@ def _wall(
 
 # ---------------------------------------------------------------------------------------
 # small geometry
+
+
+def _still(
+    points: np.ndarray, direction: np.ndarray, following: np.ndarray, fixed: tuple[Segment, ...]
+) -> frozenset[int]:
+    """The edges (from ``points[e]`` to ``points[following[e]]``) lying along a fixed
+    segment: parallel, their middle within ON_WALL of it."""
+    found: set[int] = set()
+    for a, b in fixed:
+        start, end = np.array(a, dtype=float), np.array(b, dtype=float)
+        span = end - start
+        size = float(np.hypot(*span))
+        if size <= 0:
+            continue
+        along = span / size
+        middle = (points + points[following]) / 2 - start
+        u = middle @ along
+        off = np.abs(_cross(np.broadcast_to(along, middle.shape), middle))
+        parallel = np.abs(_cross(direction, np.broadcast_to(along, direction.shape))) < 0.05
+        near = (u >= -ON_WALL) & (u <= size + ON_WALL) & (off <= ON_WALL) & parallel
+        found.update(int(e) for e in np.flatnonzero(near))
+    return frozenset(found)
 
 
 def _clean(points: np.ndarray, eps: float) -> np.ndarray:

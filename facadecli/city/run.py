@@ -19,7 +19,7 @@ import json
 import os
 import re
 import time
-from collections import deque
+from collections import Counter, deque
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from facadecli.city.building import (
+    PLAIN_REASONS,
     AxisCache,
     Facade,
     Looks,
@@ -54,16 +55,20 @@ from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
+    inherited,
     outline_rest,
     replaced_outlines,
     roof_colour,
+    screens,
     shared_edges,
     side_by_side,
+    standing_on,
     tagged_heights,
     tagged_roof,
     volume,
     wall_colour,
 )
+from facadecli.city.straight import Straightened, straighten
 from facadecli.city.tiles import merge_city
 from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
@@ -97,6 +102,7 @@ class Task:
     variants: int = 1  # layouts each axis may take
     pick: int = 0  # which of them this building takes (from the seed and its id)
     usd: bool = False  # a USD stage beside the glb (``--usd``)
+    above: Any = None  # the taller parts standing on this one: its roof leaves them out
 
 
 PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
@@ -184,6 +190,7 @@ def build(task: Task) -> dict[str, Any]:
             task.walls,
             task.variants,
             task.pick,
+            task.above,
         )
         solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
         write_cityjson(_feature_file(task.target), building_object(solids))
@@ -206,6 +213,7 @@ def build(task: Task) -> dict[str, Any]:
         "facades": result.facades,
         "plain_walls": result.plain_walls,
         "party_walls": result.party_walls,
+        "plain": result.plain,
         "height": result.top,
         "repaired": task.footprint.repaired,
         **_simplified(task.footprint.simplified),
@@ -274,6 +282,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
     shapes = {footprint.id: _shape(city, footprint.properties) for footprint in footprints}
     beside = _beside(footprints, shapes)
     shared = shared_edges(footprints, tolerance, beside) if tolerance > 0 else {}
+    above = standing_on(footprints, {key: shape[1] for key, shape in shapes.items()})
     tasks = []
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
@@ -329,6 +338,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 choice.variants,
                 pick,
                 usd,
+                above.get(footprint.id),
             )
         )
     return tasks
@@ -361,6 +371,8 @@ def _beside(
         return min(block.base for block in blocks), max(block.eaves for block in blocks)
 
     def beside(one: str, other: str) -> bool:
+        if not screens(shapes[one][1], shapes[other][1]):
+            return False  # a lower neighbour: the wall stands free above it
         if shapes[one][1].base <= 0 and shapes[other][1].base <= 0:
             return True  # walls from the ground up meet for MIN_WALL at least
         return side_by_side(span(one), span(other))
@@ -503,8 +515,10 @@ def run_city(
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
     found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
     replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
-    footprints, kept = standing(city, found.footprints, replaced)
-    footprints = footprints[: limit if limit is not None else None]
+    footprints, kept = standing(city, inherited(found.footprints, replaced), replaced)
+    defaults = city.manifest.defaults
+    straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
+    footprints = list(straight.footprints[: limit if limit is not None else None])
     tasks = plan(city, footprints, outdir, usd)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
@@ -520,6 +534,7 @@ def run_city(
             scheduler,
             usd,
             started,
+            straight,
         )
 
 
@@ -536,6 +551,7 @@ def _build(
     scheduler: str | None,
     usd: bool,
     started: float,
+    straight: Straightened | None = None,
 ) -> dict[str, Any]:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report."""
@@ -613,6 +629,7 @@ def _build(
             "buildings built are kept: run again with --resume"
         ) from None
     failed = [r for r in results if r["status"] != "ok"]
+    warned = [w for w in found.warnings if w.id in by_id]
     report = {
         "version": 1,
         "name": city.manifest.name,
@@ -621,7 +638,7 @@ def _build(
         "georeference": georeference(georef),
         "buildings": results,
         "rejected": [_rejected(r) for r in found.rejected],
-        "warnings": [_warning(w) for w in found.warnings if w.id in by_id],
+        "warnings": [_warning(w) for w in warned],
         "replaced": [
             {"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())
         ],
@@ -631,11 +648,19 @@ def _build(
             "ok": len(results) - len(failed),
             "failed": len(failed),
             "rejected": len(found.rejected),
-            "warnings": sum(1 for w in found.warnings if w.id in by_id),
+            "warnings": len(warned),
             "outside_bbox": found.outside,
             "replaced": sum(1 for area in kept.values() if area == 0),
             "trimmed": sum(1 for area in kept.values() if area > 0),
             "party_walls": sum(r.get("party_walls", 0) for r in results),
+            "plain_walls": {
+                reason: sum(r.get("plain", {}).get(reason, 0) for r in results)
+                for reason in PLAIN_REASONS
+            },
+            "collinear_nodes_merged": straight.nodes if straight else 0,
+            "warnings_by_tag": dict(
+                sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())
+            ),
             "seconds": round(time.perf_counter() - started, 2),
         },
     }

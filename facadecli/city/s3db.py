@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import shapely
@@ -29,7 +29,7 @@ from shapely.geometry import LineString, Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.footprints import MAX_HEIGHT, MIN_AREA, Footprint, length, number
-from facadecli.city.manifest import Roof
+from facadecli.city.manifest import OSM_ROOFS, UNBUILT, Roof
 from facadecli.city.roofs import roof_height
 
 MIN_WALL = 0.5  # metres: a roof taller than its building leaves at least this much wall
@@ -135,6 +135,8 @@ def tagged_heights(
     roof = length(properties.get("roof:height"))
     if roof is None or roof <= 0:
         roof = storeys(number(properties.get("roof:levels")))
+    if top is None and eaves is None and roof_only(properties):
+        eaves = floor_height  # a roof on posts one storey high, not the default building
     if top is not None and eaves is not None and roof is None:
         roof = max(0.0, top - eaves)  # both known: the roof is what lies between
     return Heights(top, eaves, base, roof, default)
@@ -168,47 +170,159 @@ def compass(value: Any) -> float | None:
     return None if found is None else found % 360.0
 
 
-# CSS colour names OSM mappers use most (osm wiki: Key:colour), and the colours of the
-# materials S3DB lists, as a renderer would show them
+# the 148 colour names of CSS (CSS Color Module Level 4, as OSM's Key:colour takes them)
 COLOURS = {
-    "white": "#ffffff",
-    "black": "#000000",
-    "grey": "#808080",
-    "gray": "#808080",
-    "lightgrey": "#d3d3d3",
-    "lightgray": "#d3d3d3",
-    "darkgrey": "#a9a9a9",
-    "darkgray": "#a9a9a9",
-    "silver": "#c0c0c0",
-    "red": "#ff0000",
-    "darkred": "#8b0000",
-    "maroon": "#800000",
-    "brown": "#a52a2a",
-    "sienna": "#a0522d",
-    "tan": "#d2b48c",
+    "aliceblue": "#f0f8ff",
+    "antiquewhite": "#faebd7",
+    "aqua": "#00ffff",
+    "aquamarine": "#7fffd4",
+    "azure": "#f0ffff",
     "beige": "#f5f5dc",
-    "ivory": "#fffff0",
-    "cream": "#fffdd0",
-    "wheat": "#f5deb3",
-    "orange": "#ffa500",
-    "yellow": "#ffff00",
-    "gold": "#ffd700",
-    "khaki": "#f0e68c",
-    "olive": "#808000",
-    "green": "#008000",
-    "darkgreen": "#006400",
-    "lightgreen": "#90ee90",
-    "teal": "#008080",
+    "bisque": "#ffe4c4",
+    "black": "#000000",
+    "blanchedalmond": "#ffebcd",
     "blue": "#0000ff",
-    "navy": "#000080",
-    "lightblue": "#add8e6",
-    "skyblue": "#87ceeb",
-    "purple": "#800080",
-    "pink": "#ffc0cb",
-    "salmon": "#fa8072",
+    "blueviolet": "#8a2be2",
+    "brown": "#a52a2a",
+    "burlywood": "#deb887",
+    "cadetblue": "#5f9ea0",
+    "chartreuse": "#7fff00",
+    "chocolate": "#d2691e",
     "coral": "#ff7f50",
-    "terracotta": "#e2725b",
+    "cornflowerblue": "#6495ed",
+    "cornsilk": "#fff8dc",
+    "crimson": "#dc143c",
+    "cyan": "#00ffff",
+    "darkblue": "#00008b",
+    "darkcyan": "#008b8b",
+    "darkgoldenrod": "#b8860b",
+    "darkgray": "#a9a9a9",
+    "darkgreen": "#006400",
+    "darkgrey": "#a9a9a9",
+    "darkkhaki": "#bdb76b",
+    "darkmagenta": "#8b008b",
+    "darkolivegreen": "#556b2f",
+    "darkorange": "#ff8c00",
+    "darkorchid": "#9932cc",
+    "darkred": "#8b0000",
+    "darksalmon": "#e9967a",
+    "darkseagreen": "#8fbc8f",
+    "darkslateblue": "#483d8b",
+    "darkslategray": "#2f4f4f",
+    "darkslategrey": "#2f4f4f",
+    "darkturquoise": "#00ced1",
+    "darkviolet": "#9400d3",
+    "deeppink": "#ff1493",
+    "deepskyblue": "#00bfff",
+    "dimgray": "#696969",
+    "dimgrey": "#696969",
+    "dodgerblue": "#1e90ff",
+    "firebrick": "#b22222",
+    "floralwhite": "#fffaf0",
+    "forestgreen": "#228b22",
+    "fuchsia": "#ff00ff",
+    "gainsboro": "#dcdcdc",
+    "ghostwhite": "#f8f8ff",
+    "gold": "#ffd700",
+    "goldenrod": "#daa520",
+    "gray": "#808080",
+    "green": "#008000",
+    "greenyellow": "#adff2f",
+    "grey": "#808080",
+    "honeydew": "#f0fff0",
+    "hotpink": "#ff69b4",
+    "indianred": "#cd5c5c",
+    "indigo": "#4b0082",
+    "ivory": "#fffff0",
+    "khaki": "#f0e68c",
+    "lavender": "#e6e6fa",
+    "lavenderblush": "#fff0f5",
+    "lawngreen": "#7cfc00",
+    "lemonchiffon": "#fffacd",
+    "lightblue": "#add8e6",
+    "lightcoral": "#f08080",
+    "lightcyan": "#e0ffff",
+    "lightgoldenrodyellow": "#fafad2",
+    "lightgray": "#d3d3d3",
+    "lightgreen": "#90ee90",
+    "lightgrey": "#d3d3d3",
+    "lightpink": "#ffb6c1",
+    "lightsalmon": "#ffa07a",
+    "lightseagreen": "#20b2aa",
+    "lightskyblue": "#87cefa",
+    "lightslategray": "#778899",
+    "lightslategrey": "#778899",
+    "lightsteelblue": "#b0c4de",
+    "lightyellow": "#ffffe0",
+    "lime": "#00ff00",
+    "limegreen": "#32cd32",
+    "linen": "#faf0e6",
+    "magenta": "#ff00ff",
+    "maroon": "#800000",
+    "mediumaquamarine": "#66cdaa",
+    "mediumblue": "#0000cd",
+    "mediumorchid": "#ba55d3",
+    "mediumpurple": "#9370db",
+    "mediumseagreen": "#3cb371",
+    "mediumslateblue": "#7b68ee",
+    "mediumspringgreen": "#00fa9a",
+    "mediumturquoise": "#48d1cc",
+    "mediumvioletred": "#c71585",
+    "midnightblue": "#191970",
+    "mintcream": "#f5fffa",
+    "mistyrose": "#ffe4e1",
+    "moccasin": "#ffe4b5",
+    "navajowhite": "#ffdead",
+    "navy": "#000080",
+    "oldlace": "#fdf5e6",
+    "olive": "#808000",
+    "olivedrab": "#6b8e23",
+    "orange": "#ffa500",
+    "orangered": "#ff4500",
+    "orchid": "#da70d6",
+    "palegoldenrod": "#eee8aa",
+    "palegreen": "#98fb98",
+    "paleturquoise": "#afeeee",
+    "palevioletred": "#db7093",
+    "papayawhip": "#ffefd5",
+    "peachpuff": "#ffdab9",
+    "peru": "#cd853f",
+    "pink": "#ffc0cb",
+    "plum": "#dda0dd",
+    "powderblue": "#b0e0e6",
+    "purple": "#800080",
+    "rebeccapurple": "#663399",
+    "red": "#ff0000",
+    "rosybrown": "#bc8f8f",
+    "royalblue": "#4169e1",
+    "saddlebrown": "#8b4513",
+    "salmon": "#fa8072",
+    "sandybrown": "#f4a460",
+    "seagreen": "#2e8b57",
+    "seashell": "#fff5ee",
+    "sienna": "#a0522d",
+    "silver": "#c0c0c0",
+    "skyblue": "#87ceeb",
+    "slateblue": "#6a5acd",
+    "slategray": "#708090",
+    "slategrey": "#708090",
+    "snow": "#fffafa",
+    "springgreen": "#00ff7f",
+    "steelblue": "#4682b4",
+    "tan": "#d2b48c",
+    "teal": "#008080",
+    "thistle": "#d8bfd8",
+    "tomato": "#ff6347",
+    "turquoise": "#40e0d0",
+    "violet": "#ee82ee",
+    "wheat": "#f5deb3",
+    "white": "#ffffff",
+    "whitesmoke": "#f5f5f5",
+    "yellow": "#ffff00",
+    "yellowgreen": "#9acd32",
 }
+COLOURS |= {"cream": "#fffdd0", "terracotta": "#e2725b"}  # names mappers use beside them
+# the colours of the materials S3DB lists, as a renderer would show them
 BUILDING_MATERIALS = {
     "brick": "#9c4a32",
     "plaster": "#e8e0d0",
@@ -280,6 +394,110 @@ def roof_colour(properties: dict[str, Any]) -> str | None:
     return found or ROOF_MATERIALS.get(material)
 
 
+def roof_only(properties: dict[str, Any]) -> bool:
+    """``building=roof`` (or ``building:part=roof``): a roof on posts, no walls (a
+    carport, a petrol station's canopy, a platform roof)."""
+    return any(
+        str(properties.get(key, "")).strip().lower() == "roof"
+        for key in ("building", "building:part")
+    )
+
+
+def tag_problems(properties: dict[str, Any]) -> list[str]:
+    """What of a feature's S3DB tags is not understood, a sentence each (the building is
+    built without it): roof shapes S3DB does not list or that are not built here,
+    colours that are neither #rgb, #rrggbb nor a CSS name, unknown materials, roof
+    directions, orientations and angles that are not one."""
+    problems = []
+
+    def shown(key: str) -> str:
+        text = str(properties[key])
+        return f"{key} '{text if len(text) <= 40 else text[:37] + '...'}'"
+
+    shape = properties.get("roof:shape")
+    if shape is not None and str(shape).strip():
+        name = str(shape).strip().lower()
+        if name not in OSM_ROOFS and name not in UNBUILT:
+            problems.append(
+                f"{shown('roof:shape')} is not a roof shape of Simple 3D Buildings: "
+                "the manifest's roof instead"
+            )
+        elif name in UNBUILT:
+            problems.append(
+                f"{shown('roof:shape')} is not built here yet: a {UNBUILT[name]} roof instead"
+            )
+    for key in ("building:colour", "roof:colour"):
+        if properties.get(key) is not None and colour(properties[key]) is None:
+            problems.append(
+                f"{shown(key)} is not a colour (#rrggbb, #rgb or one of the 148 CSS names): ignored"
+            )
+    for key, known in (
+        ("building:material", BUILDING_MATERIALS),
+        ("roof:material", ROOF_MATERIALS),
+    ):
+        value = properties.get(key)
+        if value is not None and str(value).strip().lower() not in known:
+            problems.append(f"{shown(key)} is not a material known here: ignored")
+    if (
+        properties.get("roof:direction") is not None
+        and compass(properties["roof:direction"]) is None
+    ):
+        problems.append(f"{shown('roof:direction')} is not degrees or a compass point: ignored")
+    orientation = properties.get("roof:orientation")
+    if orientation is not None and str(orientation).strip().lower() not in ("along", "across"):
+        problems.append(f"{shown('roof:orientation')} is not 'along' or 'across': ignored")
+    angle = properties.get("roof:angle")
+    if angle is not None and not (0 < (number(angle) or 0) < 90):
+        problems.append(f"{shown('roof:angle')} is not an angle between 0 and 90°: 30° instead")
+    return problems
+
+
+# tags a part without them takes from its outline, as OSM2World does: each on its own,
+# but the heights only together (a part with levels of its own keeps them, and does not
+# take the outline's height)
+INHERITED = (
+    "building:colour",
+    "building:material",
+    "roof:colour",
+    "roof:material",
+    "roof:shape",
+    "roof:height",
+    "roof:angle",
+    "roof:levels",
+    "roof:direction",
+    "roof:orientation",
+)
+INHERITED_HEIGHTS = ("height", "building:levels", "levels")
+
+
+def inherited(footprints: Iterable[Footprint], replaced: dict[str, list[str]]) -> list[Footprint]:
+    """The footprints with every part given the tags of its outline (``replaced``:
+    outline id -> its parts' ids, from :func:`replaced_outlines`) that it lacks; a part
+    in several outlines takes from the first by id."""
+    footprints = list(footprints)
+    by_id = {footprint.id: footprint for footprint in footprints}
+    parent: dict[str, str] = {}
+    for key in sorted(replaced):
+        for part in replaced[key]:
+            parent.setdefault(part, key)
+    found = []
+    for footprint in footprints:
+        outline = by_id.get(parent.get(footprint.id, ""))
+        if outline is None:
+            found.append(footprint)
+            continue
+        own, theirs = footprint.properties, outline.properties
+        keys = [key for key in INHERITED if key not in own and key in theirs]
+        if not any(key in own for key in INHERITED_HEIGHTS):
+            keys += [key for key in INHERITED_HEIGHTS if key in theirs]
+        if not keys:
+            found.append(footprint)
+            continue
+        properties = {**own, **{key: theirs[key] for key in keys}}
+        found.append(replace(footprint, properties=properties))
+    return found
+
+
 def is_part(properties: dict[str, Any]) -> bool:
     """A ``building:part`` feature (a volume of a building, not its outline)."""
     value = properties.get("building:part")
@@ -338,10 +556,12 @@ def shared_edges(
     beside: Callable[[str, str], bool] | None = None,
 ) -> dict[str, Any]:
     """For each footprint, the lines of its outline that lie along another footprint's
-    (within ``tolerance`` metres): party walls of terraces and city blocks, and the walls
-    between the parts of one building. ``beside(id, other)`` says whether two footprints'
-    walls stand side by side at all (see :func:`side_by_side`; None: all do): upper
-    storeys drawn as a part over a podium have walls of their own, not party walls.
+    (within ``tolerance`` metres) standing outside it: party walls of terraces and city
+    blocks, and the walls between the parts of one building (a part inside another, or
+    flush with its outline, has no neighbour outside those walls). ``beside(id, other)``
+    says whether two footprints' walls stand side by side at all (see :func:`side_by_side`
+    and :func:`screens`; None: all do): upper storeys drawn as a part over a podium have
+    walls of their own, not party walls.
     Footprint id -> a shapely geometry (absent: none)."""
     shapes = [shape for f in footprints for shape in f.parts]
     owner = [f.id for f in footprints for _ in f.parts]
@@ -356,13 +576,59 @@ def shared_edges(
         ]
         if not others:
             continue
-        for other in others:
-            touching = shape.boundary.intersection(other.buffer(tolerance))
+        for other in others:  # the neighbour outside the wall, not under or over it
+            beyond = other.difference(shape.buffer(tolerance / 2, join_style="mitre"))
+            if beyond.is_empty:
+                continue
+            touching = shape.boundary.intersection(beyond.buffer(tolerance, join_style="mitre"))
             if touching.is_empty or touching.length < tolerance:
                 continue
             before = shared.get(owner[index])
             shared[owner[index]] = touching if before is None else before.union(touching)
     return shared
+
+
+SCREEN = 0.5  # of a wall's height: a neighbour this high, at least, makes it a party wall
+
+
+def reach(heights: Heights) -> float:
+    """How high a building stands, from its tags alone (no roof geometry): its top, else
+    its eaves and tagged roof, else the default."""
+    if heights.top is not None:
+        return heights.top
+    if heights.eaves is not None:
+        return heights.eaves + (heights.roof or 0.0)
+    return max(heights.default, heights.base + MIN_WALL)
+
+
+def screens(one: Heights, other: Heights) -> bool:
+    """Does ``other``, standing along a wall of ``one``, make it a party wall? When it
+    stands SCREEN of the wall's height at least: a podium only hides the foot of a
+    tower's walls, which keep their façades; a neighbour one storey lower keeps the
+    fire wall blind."""
+    return reach(other) - one.base >= SCREEN * (reach(one) - one.base)
+
+
+def standing_on(footprints: list[Footprint], heights: dict[str, Heights]) -> dict[str, Any]:
+    """For each footprint, the taller footprints standing on it (most of their area in
+    its outline, their base below its top, their top above it): a tower part on a
+    podium part, whose roof must leave the tower out. Footprint id -> a shapely geometry
+    (absent: none)."""
+    shapes = [shape for f in footprints for shape in f.parts]
+    owner = [f.id for f in footprints for _ in f.parts]
+    tree = STRtree(shapes)
+    found: dict[str, list[Polygon]] = {}
+    for index, shape in enumerate(shapes):
+        me = heights[owner[index]]
+        for i in sorted(int(i) for i in tree.query(shape)):
+            other = heights[owner[i]]
+            if owner[i] == owner[index] or reach(other) <= reach(me) + MIN_WALL:
+                continue
+            if other.base >= reach(me) or shapes[i].area >= shape.area:
+                continue
+            if shapes[i].intersection(shape).area >= 0.5 * shapes[i].area:
+                found.setdefault(owner[index], []).append(shapes[i])
+    return {key: shapely.union_all(parts) for key, parts in found.items()}
 
 
 def side_by_side(one: tuple[float, float], other: tuple[float, float]) -> bool:

@@ -1,0 +1,147 @@
+"""Near-collinear footprint nodes merged, so that one straight wall is one façade.
+
+Mappers often draw a straight wall with extra nodes on it (where a neighbour's wall
+meets it, where an address point or an entrance was, or from tracing). Left as they are,
+each node starts a new façade and its bay rhythm restarts there. Before the façades are
+laid, a run of edges becomes one edge (its first node to its last) when no two of its
+edges differ in direction by ``angle`` degrees or more: measuring every pair, not each
+edge against the next, keeps a gentle curve (a round tower's many short edges) a curve.
+
+A node is kept, whatever its angle, where another footprint has a vertex within
+``near`` metres: the end of a party wall, a neighbour's corner, a part's corner on its
+outline. So a wall that is blind along a neighbour and free past it keeps the node
+between. A ring is kept as it was if merging would leave it invalid or under three
+nodes. Pure functions of the footprints.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+
+from shapely import STRtree
+from shapely.geometry import MultiPoint, Polygon
+from shapely.geometry.polygon import orient
+
+from facadecli.city.footprints import Footprint
+
+ANGLE = 3.0  # degrees: edges this close to their run's chord are one wall (the default)
+
+Point = tuple[float, float]
+Kept = Callable[[Point], bool]
+
+
+@dataclass(frozen=True)
+class Straightened:
+    """What merging did: the footprints, and how many nodes it took out of how many."""
+
+    footprints: tuple[Footprint, ...]
+    nodes: int  # nodes taken out
+    footprints_changed: int  # footprints with at least one node taken out
+
+
+def straighten(footprints: Sequence[Footprint], angle: float, near: float) -> Straightened:
+    """Every footprint with its near-collinear nodes merged (see the module); ``angle``
+    0 leaves them all as they are."""
+    if angle <= 0 or not footprints:
+        return Straightened(tuple(footprints), 0, 0)
+    corners = [
+        (point, footprint.id)
+        for footprint in footprints
+        for part in footprint.parts
+        for ring in (part.exterior, *part.interiors)
+        for point in ring.coords[:-1]
+    ]
+    tree = STRtree(MultiPoint([p for p, _ in corners]).geoms)
+    owners = [owner for _, owner in corners]
+    points = [p for p, _ in corners]
+    done: list[Footprint] = []
+    taken = changed = 0
+    for footprint in footprints:
+
+        def shared(point: Point, me: str = footprint.id) -> bool:
+            """Another footprint has a vertex within ``near`` of the point."""
+            box = (point[0] - near, point[1] - near, point[0] + near, point[1] + near)
+            return any(
+                owners[i] != me and math.dist(points[i][:2], point) <= near
+                for i in tree.query(_box(box))
+            )
+
+        parts = []
+        before = taken
+        for part in footprint.parts:
+            merged, count = _part(part, angle, shared)
+            parts.append(merged)
+            taken += count
+        if taken > before:
+            changed += 1
+            done.append(replace(footprint, parts=tuple(parts)))
+        else:
+            done.append(footprint)
+    return Straightened(tuple(done), taken, changed)
+
+
+def _box(bounds: tuple[float, float, float, float]) -> Polygon:
+    x0, y0, x1, y1 = bounds
+    return Polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+
+
+def _part(part: Polygon, angle: float, shared: Kept) -> tuple[Polygon, int]:
+    rings = [list(ring.coords)[:-1] for ring in (part.exterior, *part.interiors)]
+    kept = [merged_ring([(p[0], p[1]) for p in ring], angle, shared) for ring in rings]
+    count = sum(len(a) - len(b) for a, b in zip(rings, kept, strict=True))
+    if count == 0:
+        return part, 0
+    merged = Polygon(kept[0], kept[1:])
+    if not merged.is_valid or merged.is_empty:
+        return part, 0
+    return orient(merged, sign=1.0), count
+
+
+def merged_ring(ring: list[Point], angle: float, shared: Kept | None = None) -> list[Point]:
+    """A closed ring's nodes (without the closing repeat) less those inside runs of edges
+    within ``angle`` degrees of their chord; ``shared(point)`` says a node must stay."""
+    size = len(ring)
+    if size <= 3:
+        return ring
+    must = [shared is not None and shared(p) for p in ring]
+    limit = math.radians(angle)
+    # start at a node that surely stays: a kept one, else the sharpest corner
+    starts = [i for i in range(size) if must[i]]
+    start = starts[0] if starts else max(range(size), key=lambda i: (_turn(ring, i), -i))
+    order = [ring[(start + k) % size] for k in range(size)] + [ring[start]]
+    keep = [must[(start + k) % size] for k in range(size)] + [True]
+    result = [order[0]]
+    i = 0
+    while i < size:
+        j = i + 1  # the run i..j is one wall while every edge lies along its chord
+        while j < size and not keep[j] and _straight(order, i, j + 1, limit):
+            j += 1
+        result.append(order[j])
+        i = j
+    result.pop()  # the closing repeat of the start
+    return result if len(result) >= 3 else ring
+
+
+def _turn(ring: list[Point], i: int) -> float:
+    a, b, c = ring[i - 1], ring[i], ring[(i + 1) % len(ring)]
+    return abs(_apart(_bearing(a, b), _bearing(b, c)))
+
+
+def _bearing(a: Point, b: Point) -> float:
+    return math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def _apart(one: float, other: float) -> float:
+    return (one - other + math.pi) % (2 * math.pi) - math.pi
+
+
+def _straight(points: list[Point], i: int, j: int, limit: float) -> bool:
+    """Do the edges from node i to node j all run within ``limit`` of each other?"""
+    turns = [
+        _apart(_bearing(points[k], points[k + 1]), _bearing(points[i], points[i + 1]))
+        for k in range(i, j)
+        if math.dist(points[k], points[k + 1]) > 1e-9
+    ]
+    return bool(turns) and max(turns) - min(turns) < limit
