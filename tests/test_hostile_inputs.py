@@ -468,6 +468,36 @@ def test_staging_of_runs_that_are_gone_is_removed_and_no_other(
     assert all((out / name / "half.glb").exists() for name in kept)
 
 
+def test_staging_of_an_older_version_is_kept_and_told_once(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """facadecli 0.1.0 named its staging ``.facade-XXXXXXXX``: no owner to prove it is gone,
+    so such folders stay, and a run (two specs into the folder: two stagings) says so once."""
+    out = tmp_path / "out"
+    out.mkdir()
+    older = [".facade-abcd1234", ".facade-x_9z0qwe"]
+    for name in older:
+        (out / name).mkdir()
+        (out / name / "half.glb").write_bytes(b"glTF\x02")
+    (out / ".facade-file0001").write_text("a file, not a staging folder")
+    spec = _asset_spec(tmp_path, instanced_glb(triangles=5, instances=2))
+    other = tmp_path / "other.yaml"
+    other.write_text(spec.read_text().replace("name: assets", "name: other"))
+    code, _, err = facade(capsys, "solve", spec, other, "-o", out, "-f", "json")
+    assert code == 0, err
+    told = [line for line in err.splitlines() if "staging folder" in line]
+    assert told == [
+        f"{out}: warning: 2 staging folders of facadecli 0.1.0 left as they are "
+        f"({', '.join(older)}): they name no owner, so they may be a run's still writing "
+        "here; remove them when no facade run writes into this folder"
+    ], err
+    assert all((out / name / "half.glb").exists() for name in older)
+    assert (out / ".facade-file0001").is_file()
+    assert {"assets.layout.json", "other.layout.json"} <= {p.name for p in out.iterdir()}
+    code, _, err = facade(capsys, "-q", "solve", spec, "-o", out, "-f", "json")
+    assert code == 0 and err == "", err  # --quiet: errors only
+
+
 def test_a_run_killed_while_staging_is_cleaned_up_by_the_next(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
