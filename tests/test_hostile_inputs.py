@@ -365,6 +365,45 @@ def test_the_plain_tags_of_lists_and_mappings_are_kept(
     assert code == 0, err
 
 
+@pytest.mark.parametrize(
+    ("line", "col", "tag"),
+    [
+        ("name: !!binary aGVsbG8=", 7, "!!binary"),
+        ("name: !!python/name:os.system", 7, "!!python/name:os.system"),
+        ("name: &n !custom hint", 7, "!custom"),
+        ("name: !!timestamp 'x'", 7, "!!timestamp"),  # a bare date is one, tag or not
+        ('name: !!binary "aGVsbG8="', 7, "!!binary"),
+        ("canvas: {width: !!python/object:x 4.0, height: 3.0}", 17, "!!python/object:x"),
+        ("canvas: {!!binary d2lkdGg=: 4.0, height: 3.0}", 10, "!!binary"),
+    ],
+)
+def test_tags_on_values_and_keys_are_refused_with_their_place(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, line: str, col: int, tag: str
+) -> None:
+    """A tag on a scalar built bytes or dates (!!binary, !!timestamp) or was "invalid
+    YAML" (!custom); now each is refused by name, at its key or value."""
+    spec = tmp_path / "tagged.yaml"
+    key = line.split(":")[0]
+    text = HINT_SPEC.format(name="A")
+    spec.write_text(
+        "\n".join(line if row.startswith(f"{key}:") else row for row in text.split("\n"))
+    )
+    code, _, err = facade(capsys, "validate", spec)
+    row = 2 if key == "name" else 3
+    assert code == 2 and f"tagged.yaml:{row}:{col}: error:" in err, err
+    assert f"has the tag '{tag}'" in err and "remove the '!' tag" in err
+
+
+def test_the_core_tags_of_values_are_kept(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    spec = tmp_path / "plain.yaml"
+    text = HINT_SPEC.format(name="A").replace("name: hint", "name: !!str 3")
+    spec.write_text(text.replace("{width: 4.0, height: 3.0}", "{width: !!float 4, height: ! 3}"))
+    code, out, err = facade(capsys, "validate", spec)
+    assert code == 0 and "plain.yaml: ok (3: 1 layers)" in out, err
+
+
 def test_a_spec_past_the_size_limit_is_refused_at_the_byte_past_it(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
