@@ -46,6 +46,7 @@ GALLERY_BYTES_MAX = 256 * 1024 * 1024  # bytes of the models a ``facade view`` p
 WATCH_CONNECTIONS_MAX = 32  # connections ``facade watch`` serves at once (more: closed)
 WATCH_STREAMS_MAX = 8  # of those, open event streams (pages following the spec; more: 503)
 WATCH_IDLE_SECONDS = 10.0  # a connection that sends or takes nothing this long is closed
+WATCH_REQUEST_SECONDS = 10.0  # a request's line and headers arrive within this, in all
 
 #: bytes of a city's single merged glb (a glb's lengths are 32-bit); beyond, tiles only
 MERGED_GLB_MAX = 2**31
