@@ -12,6 +12,7 @@ import math
 import sys
 import time
 import traceback
+import warnings
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import replace
@@ -21,7 +22,13 @@ from typing import TYPE_CHECKING, Annotated, NoReturn
 import typer
 
 from facadecli import __version__
-from facadecli.errors import FacadeError, InfeasibleError, SearchLimitError, SpecError
+from facadecli.errors import (
+    FacadeError,
+    FacadeWarning,
+    InfeasibleError,
+    SearchLimitError,
+    SpecError,
+)
 from facadecli.export import (
     DEFAULT_FORMATS,
     SINGLE_FILE_FORMATS,
@@ -1004,7 +1011,10 @@ def main() -> None:
     try:
         args = _hoisted(sys.argv[1:])
         _state["debug"] = "--debug" in args  # for an error before the options are read
-        app(args=args, prog_name="facade")  # typer reports usage errors itself (exit 2)
+        with warnings.catch_warnings():  # a stage's FacadeWarning: a warning line, once
+            warnings.simplefilter("always", FacadeWarning)  # told once by ``_shown_warning``
+            warnings.showwarning = _shown_warning(warnings.showwarning)
+            app(args=args, prog_name="facade")  # typer reports usage errors itself (exit 2)
     except FacadeError as error:
         _report(error)
         sys.exit(error.exit_code)
@@ -1021,6 +1031,21 @@ def main() -> None:
             sys.exit(2)
     except Exception as error:  # the last line of defence: no traceback for users
         _internal(error)
+
+
+def _shown_warning(other: Callable[..., None]) -> Callable[..., None]:
+    """``warnings.showwarning`` for a run: each FacadeWarning a warning line, once."""
+    told: set[str] = set()
+
+    def show(message: Warning | str, category: type[Warning], *rest: object) -> None:
+        if issubclass(category, FacadeWarning):
+            if str(message) not in told:
+                told.add(str(message))
+                _warn(str(message))
+        else:
+            other(message, category, *rest)
+
+    return show
 
 
 COMMANDS = {  # the commands' names, for messages (a command is named after its function)

@@ -93,3 +93,8 @@ class MissingExtraError(FacadeError):
     extra and the command that installs it."""
 
     exit_code = 2
+
+
+class FacadeWarning(UserWarning):
+    """Something a user should know that stops nothing (``warnings.warn`` from a stage;
+    the command line prints it as a warning line, each once a run)."""

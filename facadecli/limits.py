@@ -38,7 +38,7 @@ LAYOUT_BYTES_MAX = 32_000_000  # bytes of one layout file read by ``facade gramm
 LAYOUT_RECTS_MAX = 20_000  # rectangles of one layout
 LAYOUT_EXTENT_MAX = 1e6  # a layout's size and any coordinate, in the file's own units
 LAYOUT_CELLS_MAX = 1_000_000  # cells of a snapped tiling (1000 x 1000)
-GRAMMAR_CELLS_MAX = 30_000_000  # cells the grammar search reads into its regions' contents
+GRAMMAR_WORK_MAX = 30_000_000  # work units of one grammar search (a cell read into a content: 1)
 GRAMMAR_DEPTH_MAX = 400  # rules nested in a grammar (each derived, written, varied in turn)
 LABEL_CHARS_MAX = 100  # characters of a label
 HINT_NAME_CHARS_MAX = 200  # characters of an unknown name that gets a "did you mean" hint
@@ -46,6 +46,7 @@ GALLERY_BYTES_MAX = 256 * 1024 * 1024  # bytes of the models a ``facade view`` p
 WATCH_CONNECTIONS_MAX = 32  # connections ``facade watch`` serves at once (more: closed)
 WATCH_STREAMS_MAX = 8  # of those, open event streams (pages following the spec; more: 503)
 WATCH_IDLE_SECONDS = 10.0  # a connection that sends or takes nothing this long is closed
+WATCH_REQUEST_SECONDS = 10.0  # a request's line and headers arrive within this, in all
 
 #: bytes of a city's single merged glb (a glb's lengths are 32-bit); beyond, tiles only
 MERGED_GLB_MAX = 2**31

@@ -399,4 +399,4 @@ def test_the_search_for_repeats_stops_at_its_share_of_the_time_and_says_so() -> 
     stopped = find_repeats(Grid(tiling), deadline=Deadline(0.0))
     assert not stopped.complete and stopped.kinds >= 1  # the seeds are kept
     found = extract(tiling, "adp", 50, deadline=Deadline(0.0))
-    assert not found.repeats_complete and found.iterations == 1
+    assert found.repeats_stopped == "time" and found.iterations == 1

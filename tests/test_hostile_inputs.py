@@ -133,16 +133,107 @@ def test_staggered_squares_are_refused_by_the_search_budget(
     real one are refused the same way, by the limit's name."""
     from facadecli.grammar import regions
 
-    monkeypatch.setattr(regions, "CELLS_READ_MAX", 300_000)
+    monkeypatch.setattr(regions, "WORK_MAX", 300_000)
     rects = staggered_rects(40)
     layout = tmp_path / f"slant.{form}"
     layout.write_text(layout_json(rects) if form == "json" else layout_cmp(rects))
     out = tmp_path / "out"
     code, _, err = facade(capsys, "grammar", layout, "-o", out)
     assert code == 2, err
-    assert f"slant.{form}: error:" in err and "limit of cells a grammar search reads" in err
+    assert f"slant.{form}: error:" in err and "limit of work a grammar search does" in err
     assert "--snap" in err
     assert files(out) == []
+
+
+def _tiling_of(tmp_path: Path, rects: list[tuple[float, float, float, float]]):  # type: ignore[no-untyped-def]
+    from facadecli.grammar import run
+    from facadecli.grammar.deadline import Deadline
+    from facadecli.grammar.tiling import tile
+
+    layout = tmp_path / "slant.json"
+    layout.write_text(layout_json(rects))
+    deadline = Deadline()
+    return tile(run.tidy_layout(layout, run.Options(), deadline).layout, tolerance=0.0)
+
+
+@pytest.mark.parametrize("count", [6, 20])
+def test_the_search_for_repeats_stops_at_its_share_of_the_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, count: int
+) -> None:
+    """600 squares on a slant spent 5 s of CPU growing repeated regions that the budget did
+    not count: every step of that search now counts, and it stops before passing its share
+    (at most one region's growing past it), the same on every machine."""
+    from facadecli.grammar import regions, symmetry
+    from facadecli.grammar.regions import Grid
+
+    monkeypatch.setattr(regions, "WORK_MAX", 40_000)
+    tiling = _tiling_of(tmp_path, staggered_rects(count))
+    grid = Grid(tiling)
+    found = symmetry.find_repeats(grid)
+    share = symmetry.WORK_SHARE * regions.WORK_MAX
+    one_growing = regions.STEP_UNITS * max(grid.rows, grid.columns) + grid.rows * grid.columns
+    assert found.stopped == "work" and not found.complete
+    assert share - one_growing < grid.work <= share + one_growing
+    again = Grid(tiling)
+    repeated = symmetry.find_repeats(again)  # the same work, the same repeats
+    assert again.work == grid.work and repeated.kinds == found.kinds
+    assert [a.tolist() for a in (repeated.r0, repeated.c0, repeated.r1, repeated.c1)] == [
+        a.tolist() for a in (found.r0, found.c0, found.r1, found.c1)
+    ]
+
+
+def test_a_search_whose_repeats_ran_out_of_work_says_so(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from facadecli.grammar import regions
+
+    monkeypatch.setattr(regions, "WORK_MAX", 200_000)
+    layout = tmp_path / "slant.json"
+    layout.write_text(layout_json(staggered_rects(6)))
+    out = tmp_path / "out"
+    code, _, err = facade(capsys, "grammar", layout, "-o", out)
+    assert code == 0, err
+    assert "the search for repeated regions did the most work it may (100,000 of" in err
+    assert len(files(out)) == 5
+
+
+def test_seeds_are_the_rectangles_of_one_label_in_the_order_met() -> None:
+    """The seeds (labelled compiled) against a flood fill, on random grids of 1-3 labels."""
+    import numpy as np
+
+    from facadecli.grammar import symmetry
+
+    rng = np.random.default_rng(7)
+    for _ in range(60):
+        rows, cols = rng.integers(1, 12, size=2)
+        labels = rng.integers(0, rng.integers(1, 4), size=(rows, cols))
+        grid = type("G", (), {"labels": labels, "rows": int(rows), "columns": int(cols)})()
+        assert symmetry._seeds(grid) == _flooded(labels)  # type: ignore[arg-type]
+
+
+def _flooded(labels) -> list[tuple[int, int, int, int]]:  # type: ignore[no-untyped-def]
+    rows, cols = labels.shape
+    seen: set[tuple[int, int]] = set()
+    found = []
+    for r in range(rows):
+        for c in range(cols):
+            if (r, c) in seen:
+                continue
+            stack, cells = [(r, c)], []
+            seen.add((r, c))
+            while stack:
+                i, j = stack.pop()
+                cells.append((i, j))
+                for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
+                    inside = 0 <= a < rows and 0 <= b < cols
+                    if inside and (a, b) not in seen and labels[a, b] == labels[r, c]:
+                        seen.add((a, b))
+                        stack.append((a, b))
+            r0, r1 = min(i for i, _ in cells), max(i for i, _ in cells) + 1
+            c0, c1 = min(j for _, j in cells), max(j for _, j in cells) + 1
+            if len(cells) == (r1 - r0) * (c1 - c0):
+                found.append((r0, r1, c0, c1))
+    return found
 
 
 def test_the_budget_stops_adp_with_the_best_grammar_so_far(
@@ -150,13 +241,13 @@ def test_the_budget_stops_adp_with_the_best_grammar_so_far(
 ) -> None:
     from facadecli.grammar import regions
 
-    monkeypatch.setattr(regions, "CELLS_READ_MAX", 300_000)  # the greedy grammar reads 140,033
+    monkeypatch.setattr(regions, "WORK_MAX", 300_000)  # the greedy grammar reads 140,033
     layout = tmp_path / "slant.json"
     layout.write_text(layout_json(staggered_rects(12)))
     out = tmp_path / "out"
     code, _, err = facade(capsys, "grammar", layout, "-o", out)
     assert code == 0, err
-    assert "the search read the most cells of regions it may (300,000)" in err
+    assert "the search did the most work it may (300,000 units)" in err
     assert len(files(out)) == 5
 
 
@@ -186,16 +277,16 @@ def test_the_compiled_search_and_python_read_the_same_cells(
     layout.write_text(layout_json(staggered_rects(8)))
     deadline = Deadline()
     tiling = tile(run.tidy_layout(layout, run.Options(), deadline).layout, tolerance=0.0)
-    monkeypatch.setattr(regions, "CELLS_READ_MAX", 100_000)
+    monkeypatch.setattr(regions, "WORK_MAX", 100_000)
     found = []
     for compiled in (True, False):
         search = Search(tiling, deadline=deadline, compiled=compiled)
         search.greedy()
-        greedy = search.grid.cells_read
+        greedy = search.grid.work
         _, best_at, done = search.adp(200, seed=1)
-        found.append((greedy, search.grid.cells_read, search.grid.spent, best_at, done))
-    assert found[0] == found[1]
-    assert found[0][0] == 85_116 and found[0][2] and found[0][4] < 200  # ADP stopped
+        found.append((greedy, search.grid.work, search.grid.spent, best_at, done))
+    assert found[0] == found[1], found
+    assert found[0][0] == 58_785 and found[0][2] and found[0][4] < 200  # ADP stopped
 
 
 # -- "did you mean": bounded work ---------------------------------------------------------------
@@ -272,6 +363,45 @@ def test_the_plain_tags_of_lists_and_mappings_are_kept(
     spec.write_text(HINT_SPEC.format(name="A").replace("canvas: {", "canvas: !!map {"))
     code, _, err = facade(capsys, "validate", spec)
     assert code == 0, err
+
+
+@pytest.mark.parametrize(
+    ("line", "col", "tag"),
+    [
+        ("name: !!binary aGVsbG8=", 7, "!!binary"),
+        ("name: !!python/name:os.system", 7, "!!python/name:os.system"),
+        ("name: &n !custom hint", 7, "!custom"),
+        ("name: !!timestamp 'x'", 7, "!!timestamp"),  # a bare date is one, tag or not
+        ('name: !!binary "aGVsbG8="', 7, "!!binary"),
+        ("canvas: {width: !!python/object:x 4.0, height: 3.0}", 17, "!!python/object:x"),
+        ("canvas: {!!binary d2lkdGg=: 4.0, height: 3.0}", 10, "!!binary"),
+    ],
+)
+def test_tags_on_values_and_keys_are_refused_with_their_place(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, line: str, col: int, tag: str
+) -> None:
+    """A tag on a scalar built bytes or dates (!!binary, !!timestamp) or was "invalid
+    YAML" (!custom); now each is refused by name, at its key or value."""
+    spec = tmp_path / "tagged.yaml"
+    key = line.split(":")[0]
+    text = HINT_SPEC.format(name="A")
+    spec.write_text(
+        "\n".join(line if row.startswith(f"{key}:") else row for row in text.split("\n"))
+    )
+    code, _, err = facade(capsys, "validate", spec)
+    row = 2 if key == "name" else 3
+    assert code == 2 and f"tagged.yaml:{row}:{col}: error:" in err, err
+    assert f"has the tag '{tag}'" in err and "remove the '!' tag" in err
+
+
+def test_the_core_tags_of_values_are_kept(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    spec = tmp_path / "plain.yaml"
+    text = HINT_SPEC.format(name="A").replace("name: hint", "name: !!str 3")
+    spec.write_text(text.replace("{width: 4.0, height: 3.0}", "{width: !!float 4, height: ! 3}"))
+    code, out, err = facade(capsys, "validate", spec)
+    assert code == 0 and "plain.yaml: ok (3: 1 layers)" in out, err
 
 
 def test_a_spec_past_the_size_limit_is_refused_at_the_byte_past_it(
@@ -375,6 +505,36 @@ def test_staging_of_runs_that_are_gone_is_removed_and_no_other(
     assert f".facade-{host}-{dead}-1-file" in names and "mine.txt" in names
     assert "assets.glb" in names and "assets.layout.json" in names
     assert all((out / name / "half.glb").exists() for name in kept)
+
+
+def test_staging_of_an_older_version_is_kept_and_told_once(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """facadecli 0.1.0 named its staging ``.facade-XXXXXXXX``: no owner to prove it is gone,
+    so such folders stay, and a run (two specs into the folder: two stagings) says so once."""
+    out = tmp_path / "out"
+    out.mkdir()
+    older = [".facade-abcd1234", ".facade-x_9z0qwe"]
+    for name in older:
+        (out / name).mkdir()
+        (out / name / "half.glb").write_bytes(b"glTF\x02")
+    (out / ".facade-file0001").write_text("a file, not a staging folder")
+    spec = _asset_spec(tmp_path, instanced_glb(triangles=5, instances=2))
+    other = tmp_path / "other.yaml"
+    other.write_text(spec.read_text().replace("name: assets", "name: other"))
+    code, _, err = facade(capsys, "solve", spec, other, "-o", out, "-f", "json")
+    assert code == 0, err
+    told = [line for line in err.splitlines() if "staging folder" in line]
+    assert told == [
+        f"{out}: warning: 2 staging folders of facadecli 0.1.0 left as they are "
+        f"({', '.join(older)}): they name no owner, so they may be a run's still writing "
+        "here; remove them when no facade run writes into this folder"
+    ], err
+    assert all((out / name / "half.glb").exists() for name in older)
+    assert (out / ".facade-file0001").is_file()
+    assert {"assets.layout.json", "other.layout.json"} <= {p.name for p in out.iterdir()}
+    code, _, err = facade(capsys, "-q", "solve", spec, "-o", out, "-f", "json")
+    assert code == 0 and err == "", err  # --quiet: errors only
 
 
 def test_a_run_killed_while_staging_is_cleaned_up_by_the_next(

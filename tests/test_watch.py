@@ -7,6 +7,7 @@ import asyncio
 import json
 import os
 import re
+import select
 import shutil
 import socket
 import subprocess
@@ -284,6 +285,48 @@ def test_idle_connections_are_closed(monkeypatch: pytest.MonkeyPatch, tmp_path: 
             idle.close()
     finally:
         served.close()
+
+
+def test_a_request_sent_a_byte_at_a_time_is_cut_off(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """A client that sends its request a byte now and then, each within the idle timeout,
+    held a connection (of 32) for as long as it liked: the request's line and headers
+    must now all arrive within their own limit (here 0.3 s, the idle timeout 60 s). The
+    trickle would take 30 s: the server closes first, with nothing answered."""
+    monkeypatch.setattr(watch, "WATCH_IDLE_SECONDS", 60.0)
+    monkeypatch.setattr(watch, "WATCH_REQUEST_SECONDS", 0.3)
+    spec = tmp_path / "house.yaml"
+    spec.write_text("version: 1\n")
+    served = Running(spec)
+    request = f"GET /state HTTP/1.1\r\nHost: 127.0.0.1:{served.port}\r\n\r\n".encode()
+    try:
+        for head in (b"", b"GET /state HTTP/1.1\r\n"):  # the request line; the headers
+            slow = socket.create_connection(("127.0.0.1", served.port), timeout=60)
+            slow.sendall(head)
+            rest, answer = request[len(head) :], None
+            for i in range(len(rest)):
+                try:
+                    slow.sendall(rest[i : i + 1])
+                except OSError:  # reset: the server has closed it
+                    answer = b""
+                    break
+                if select.select([slow], [], [], 0.5)[0]:  # a byte every 0.5 s at most
+                    answer = _received(slow)
+                    break
+            slow.close()
+            assert answer == b"", answer  # closed before the request was whole
+        assert served.reports == []
+        assert _get(served.url + "state")  # and the server serves on
+    finally:
+        served.close()
+
+
+def _received(client: socket.socket) -> bytes:
+    try:
+        return client.recv(100)
+    except OSError:
+        return b""
 
 
 def test_connections_and_event_streams_are_bounded(small: Running) -> None:

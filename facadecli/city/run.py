@@ -73,15 +73,11 @@ from facadecli.city.tiles import merge_city
 from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.gltf import glb_bytes
+from facadecli.export.lock import locked
 from facadecli.export.usd import city_usda, usda_text
 from facadecli.geometry.facade import transmissions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
-
-try:
-    import fcntl
-except ImportError:  # Windows: runs are not locked
-    fcntl = None  # type: ignore[assignment]
 
 
 @dataclass(frozen=True)
@@ -465,33 +461,14 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
 
 @contextlib.contextmanager
 def claimed(outdir: Path, name: str) -> Iterator[None]:
-    """The output folder, made and locked for this run (``flock``: another run into it
-    is exit 2), with what a killed run left in it removed (:func:`leftovers`)."""
-    try:
-        outdir.mkdir(parents=True, exist_ok=True)
-        folder = os.open(outdir, os.O_RDONLY)
-    except OSError as error:
-        raise OutputError(f"{outdir}: cannot write the outputs: {error.strerror}") from None
-    try:
-        if fcntl is not None:
-            try:
-                fcntl.flock(folder, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                raise SpecError.at(
-                    "--output",
-                    None,
-                    None,
-                    f"another facade city run is writing in '{outdir}'",
-                    "wait for it to end, or give another folder",
-                ) from None
-            except OSError:  # a file system without locks: run unlocked
-                pass
+    """The output folder, made and locked for this run (:mod:`facadecli.export.lock`:
+    another run into it is exit 2), with what a killed run left in it removed
+    (:func:`leftovers`)."""
+    with locked(outdir, "facade city"):
         for path in leftovers(outdir, name):
             with contextlib.suppress(FileNotFoundError):
                 path.unlink()
         yield
-    finally:
-        os.close(folder)  # and with it the lock
 
 
 def run_city(

@@ -5,7 +5,9 @@ A run stages its outputs in a folder of its own inside the output folder
 later run can tell whether its owner is still running). A run killed outright (``kill -9``,
 a power cut) leaves its staging folder behind; the next run into the same folder removes
 such folders of processes that are gone, and only those: folders of runs still going, of
-other hosts, or named any other way are never touched.
+other hosts, or named any other way are never touched. Staging folders of facadecli 0.1.0
+(``.facade-XXXXXXXX``) name no owner, so they are never removed either: a run that finds
+them says so once (a :class:`~facadecli.errors.FacadeWarning`).
 """
 
 from __future__ import annotations
@@ -16,11 +18,12 @@ import re
 import shutil
 import socket
 import tempfile
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-from facadecli.errors import OutputError, SpecError
+from facadecli.errors import FacadeWarning, OutputError, SpecError
 
 
 @contextlib.contextmanager
@@ -88,6 +91,10 @@ _STAGING = re.compile(
 )
 
 
+#: what facadecli 0.1.0 named its staging folders (``tempfile.mkdtemp``'s 8 letters)
+_OWNERLESS_STAGING = re.compile(r"\.facade-[a-z0-9_]{8}")
+
+
 def _host() -> str:
     """This machine's name, in the characters a staging folder's name allows."""
     return re.sub(r"[^A-Za-z0-9.]", "", socket.gethostname())[:64] or "localhost"
@@ -127,8 +134,11 @@ def remove_stale_staging(folder: Path) -> list[Path]:
         entries = list(folder.iterdir())
     except OSError:
         return removed
+    ownerless = []
     for entry in entries:
         found = _STAGING.fullmatch(entry.name)
+        if found is None and _OWNERLESS_STAGING.fullmatch(entry.name) and entry.is_dir():
+            ownerless.append(entry.name)
         if found is None or found["host"] != host:
             continue
         started, recorded = _started(int(found["pid"])), int(found["start"])
@@ -138,7 +148,21 @@ def remove_stale_staging(folder: Path) -> list[Path]:
             continue
         shutil.rmtree(entry, ignore_errors=True)
         removed.append(entry)
+    if ownerless:
+        _warn_ownerless(folder, sorted(ownerless))
     return removed
+
+
+def _warn_ownerless(folder: Path, names: list[str]) -> None:
+    shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+    warnings.warn(
+        FacadeWarning(
+            f"{folder}: warning: {len(names)} staging folder{'s' * (len(names) > 1)} of "
+            f"facadecli 0.1.0 left as they are ({shown}): they name no owner, so they may be "
+            "a run's still writing here; remove them when no facade run writes into this folder"
+        ),
+        stacklevel=2,
+    )
 
 
 @contextlib.contextmanager

@@ -196,7 +196,7 @@ typedef struct {
     SeqSet forms;      /* (op, axis, count, centre, sizes...) -> form */
     int *buffer;       /* scratch for keys */
     Py_ssize_t buffer_cap;
-    long long cells_read, cells_max; /* the contents' budget (``regions.CELLS_READ_MAX``) */
+    long long cells_read, cells_max; /* the contents' budget (``regions.WORK_MAX``, less ``Grid.charge``) */
     int spent;         /* a content was refused: the budget ran out */
 } Grid;
 

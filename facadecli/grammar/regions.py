@@ -14,16 +14,20 @@ from __future__ import annotations
 import numpy as np
 
 from facadecli.grammar.tiling import BACKGROUND, Tiling
-from facadecli.limits import GRAMMAR_CELLS_MAX
+from facadecli.limits import GRAMMAR_WORK_MAX
 from facadecli.native import GRAMMAR_COMPILED, _adp
 
 Region = tuple[int, int, int, int]
 SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's extent)
-CELLS_READ_MAX = GRAMMAR_CELLS_MAX  # cells the contents of one search read (see ``content``)
+WORK_MAX = GRAMMAR_WORK_MAX  # work units of one search: cells its contents read, and ``charge``
+# units a step of Python work counts (growing a region a line, checking one for overlap):
+# such a step costs what reading 100-200 cells costs compiled; at 50, the 12 CMP samples'
+# searches for repeats use 0.1-15 % of their share, and 600 squares on a slant stop there
+STEP_UNITS = 50
 
 
 class BudgetError(Exception):
-    """The regions' contents would read more than ``CELLS_READ_MAX`` cells."""
+    """The search's work would pass ``WORK_MAX`` units."""
 
 
 #: what a spent budget raises, here or in the compiled table
@@ -75,7 +79,8 @@ class Grid:
                 self.quantum_y,
                 bg,
             )
-            self.table.limit(CELLS_READ_MAX)
+            self.table.limit(WORK_MAX)
+        self._charged = 0  # work other than the contents' (``charge``)
 
     def content(self, region: Region) -> int:
         """The region's content number: equal for regions with the same labels at the same
@@ -86,8 +91,8 @@ class Grid:
 
         A region's key holds a label per merged cell, so a layout whose regions all differ
         (squares on a slant) makes keys of a size that grows with the square of the region's
-        side: the keys read, over the whole run, are bounded by ``CELLS_READ_MAX`` cells
-        (counted before each is made), past which :class:`BudgetError` is raised."""
+        side: the keys read, over the whole run, are counted as work (a unit a cell, before
+        each is made), past ``WORK_MAX`` units :class:`BudgetError` is raised."""
         cid = self._content_of.get(region)
         if cid is None:
             cid, label = (
@@ -108,7 +113,7 @@ class Grid:
         starts_c = np.concatenate(([0], np.nonzero(changes_x)[0] + 1))
         starts_r = np.concatenate(([0], np.nonzero(changes_y)[0] + 1))
         cost = 2 + len(starts_r) * len(starts_c) + len(starts_r) + len(starts_c)
-        if self._spent or self._cells_read + cost > CELLS_READ_MAX:
+        if self._spent or self._cells_read + cost > WORK_MAX - self._charged:
             self._spent = True
             raise BudgetError("the contents' budget has run out")
         self._cells_read += cost
@@ -127,12 +132,25 @@ class Grid:
 
     @property
     def cells_read(self) -> int:
-        """Cells the contents have read so far (counted against ``CELLS_READ_MAX``)."""
+        """Cells the contents have read so far (a unit of work each)."""
         return self._cells_read if self.table is None else self.table.cells_read()
 
     @property
+    def work(self) -> int:
+        """Units of work done so far, counted against ``WORK_MAX``: the contents' cells and
+        what ``charge`` counted."""
+        return self.cells_read + self._charged
+
+    def charge(self, units: int) -> None:
+        """Count work other than the contents' against the same budget (it leaves the
+        contents, and the search after it, that much less)."""
+        self._charged += units
+        if self.table is not None:
+            self.table.limit(WORK_MAX - self._charged)
+
+    @property
     def spent(self) -> bool:
-        """Whether a content was refused because ``CELLS_READ_MAX`` was reached."""
+        """Whether a content was refused because ``WORK_MAX`` was reached."""
         return self._spent if self.table is None else self.table.spent()
 
     def contents_of(self, regions: list[Region]) -> list[int]:

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from facadecli.errors import Problem, SpecError
-from facadecli.grammar import regions
+from facadecli.grammar import regions, symmetry
 from facadecli.grammar.cmp_xml import read_cmp
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.fidelity import Fidelity, fidelity
@@ -102,15 +102,21 @@ class Extraction:
             )
         if self.found.budget_spent:
             found.append(
-                f"the search read the most cells of regions it may ({regions.CELLS_READ_MAX:,}) "
+                f"the search did the most work it may ({regions.WORK_MAX:,} units) "
                 f"after {self.found.iterations} of {self.options.iterations} iterations: the "
                 "best grammar so far is kept"
             )
-        if not self.found.repeats_complete:
+        if self.found.repeats_stopped == "time":
             found.append(
                 f"time limit of {self.options.time_limit:g} s: the search for repeated regions "
                 f"stopped at {self.found.repeats} kinds; the grammar depends on the machine's "
                 "speed"
+            )
+        if self.found.repeats_stopped == "work":
+            found.append(
+                "the search for repeated regions did the most work it may "
+                f"({symmetry.WORK_SHARE * regions.WORK_MAX:,.0f} of the search's "
+                f"{regions.WORK_MAX:,} units) and stopped at {self.found.repeats} kinds"
             )
         return found
 

@@ -93,8 +93,8 @@ class SearchResult:
     greedy_cost: float
     regions: int  # distinct regions given actions
     repeats: int  # repeated regions found by hashing (kinds)
-    repeats_complete: bool = True  # False when the time limit stopped their search
-    budget_spent: bool = False  # True when ``CELLS_READ_MAX`` stopped ADP
+    repeats_stopped: str = ""  # what stopped their search early: "", "time" or "work"
+    budget_spent: bool = False  # True when ``WORK_MAX`` stopped ADP
 
 
 class Search:
@@ -708,9 +708,9 @@ def extract(
             deadline.source,
             None,
             None,
-            f"the grammar search would read more than {regions.CELLS_READ_MAX:,} cells of regions "
-            "before its first grammar (the limit of cells a grammar search reads): the "
-            "layout's regions all differ, e.g. elements on a slant",
+            f"the grammar search would do more than {regions.WORK_MAX:,} units of work before "
+            "its first grammar (the limit of work a grammar search does): the layout's regions "
+            "all differ, e.g. elements on a slant",
             "join nearby edges with a larger --snap, or give fewer rectangles",
         ) from None
     grammar, best_at, done = greedy, 0, 1
@@ -728,7 +728,7 @@ def extract(
         greedy.cost,
         search.regions_explored,
         search.repeats.kinds,
-        search.repeats.complete,
+        search.repeats.stopped,
         search.grid.spent,
     )
 

@@ -3,7 +3,8 @@
 PyYAML composes the document into nodes (which carry marks); we build plain Python data
 from them ourselves, recording where each key and value was. Hostile input is refused
 early: oversized files, alias bombs (the expanded document is bounded, however small the
-text), recursive aliases, deep nesting, duplicate keys, and tags that build objects.
+text), recursive aliases, deep nesting, duplicate keys, and tags (on a scalar, all but
+the core schema's ``!!str``, ``!!int``, ``!!float``, ``!!bool`` and ``!!null``).
 """
 
 from __future__ import annotations
@@ -34,6 +35,11 @@ _PLAIN_TAGS: dict[type[yaml.Node], str] = {
     yaml.MappingNode: "tag:yaml.org,2002:map",
 }
 _SCALAR_CONSTRUCTOR = yaml.constructor.SafeConstructor()
+_RESOLVER = yaml.resolver.Resolver()  # the tag a scalar has when none is given
+# the tags a scalar may be given: YAML's core schema (plain values, as when untagged)
+_SCALAR_TAGS = frozenset(
+    f"tag:yaml.org,2002:{name}" for name in ("str", "int", "float", "bool", "null")
+)
 
 Path = tuple[str | int, ...]
 
@@ -197,6 +203,17 @@ def _yaml_problem(error: yaml.MarkedYAMLError, file: str, text: str = "") -> Spe
     return SpecError.at(file, line, col, f"invalid YAML: {what}", hint)
 
 
+def _untagged(node: yaml.ScalarNode) -> str:
+    """The tag the scalar would have without one (a date's stays as YAML reads it)."""
+    plain = not node.style  # None (PyYAML) or "" (libyaml)
+    tag = _RESOLVER.resolve(yaml.ScalarNode, node.value, (plain, not plain))  # type: ignore[no-untyped-call]
+    return str(tag)
+
+
+def _shown_tag(tag: str) -> str:
+    return tag.replace("tag:yaml.org,2002:", "!!")
+
+
 class _Builder:
     """Builds plain data from nodes, recording positions, within a node budget."""
 
@@ -221,6 +238,13 @@ class _Builder:
             raise self.fail(node, "the document is nested too deeply", f"nest at most {MAX_DEPTH}")
         self.source.values.setdefault(path, node)
         if isinstance(node, yaml.ScalarNode):
+            if node.tag not in _SCALAR_TAGS and node.tag != _untagged(node):
+                raise self.fail(
+                    node,
+                    f"the value has the tag '{_shown_tag(node.tag)}': specs hold plain values "
+                    "only (of the tags, !!str, !!int, !!float, !!bool and !!null)",
+                    "remove the '!' tag",
+                )
             try:
                 return _SCALAR_CONSTRUCTOR.construct_object(node, deep=True)
             except yaml.MarkedYAMLError as error:
@@ -229,11 +253,10 @@ class _Builder:
                 raise self.fail(node, f"invalid value: {error}", "check the value") from None
         plain = _PLAIN_TAGS.get(type(node))
         if plain is not None and node.tag != plain:
-            tag = node.tag.replace("tag:yaml.org,2002:", "!!")
             kind = "list" if isinstance(node, yaml.SequenceNode) else "mapping"
             raise self.fail(
                 node,
-                f"the {kind} has the tag '{tag}': specs hold plain values only",
+                f"the {kind} has the tag '{_shown_tag(node.tag)}': specs hold plain values only",
                 "remove the '!' tag",
             )
         if id(node) in self.active:
@@ -287,5 +310,11 @@ class _Builder:
     def key(self, node: yaml.Node) -> str:
         if not isinstance(node, yaml.ScalarNode):
             raise self.fail(node, "a mapping key must be a plain name", "use a name as the key")
+        if node.tag not in _SCALAR_TAGS and node.tag != _untagged(node):
+            raise self.fail(
+                node,
+                f"the key has the tag '{_shown_tag(node.tag)}': a key is a plain name",
+                "remove the '!' tag",
+            )
         # keys are names: keep their text, so 'on', 'no' or '1' stay names, not booleans
         return str(node.value)

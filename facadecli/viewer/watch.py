@@ -15,15 +15,18 @@ Only this machine can reach the server (127.0.0.1), and only pages it served can
 a request whose ``Host`` is not ``127.0.0.1:PORT`` or ``localhost:PORT`` is refused (403),
 so a web page that rebinds its own name to 127.0.0.1 gets nothing. Connections are
 bounded (:data:`~facadecli.limits.WATCH_CONNECTIONS_MAX`, of them
-:data:`~facadecli.limits.WATCH_STREAMS_MAX` event streams) and an idle one is closed after
-:data:`~facadecli.limits.WATCH_IDLE_SECONDS`; a client that goes away early is nothing
-to report. Solving runs in the serving process, warm, one save at a time.
+:data:`~facadecli.limits.WATCH_STREAMS_MAX` event streams); an idle one is closed after
+:data:`~facadecli.limits.WATCH_IDLE_SECONDS`, and one whose request's line and headers
+have not all arrived :data:`~facadecli.limits.WATCH_REQUEST_SECONDS` after it began (a
+byte now and then, to hold a connection forever) too. A client that goes away early is
+nothing to report. Solving runs in the serving process, warm, one save at a time.
 """
 
 from __future__ import annotations
 
 import base64
 import hashlib
+import io
 import json
 import select
 import socket
@@ -44,6 +47,7 @@ from facadecli.limits import (
     SPEC_BYTES_MAX,
     WATCH_CONNECTIONS_MAX,
     WATCH_IDLE_SECONDS,
+    WATCH_REQUEST_SECONDS,
     WATCH_STREAMS_MAX,
 )
 from facadecli.viewer.saves import Saves, watch_saves
@@ -289,14 +293,51 @@ class _Server(ThreadingHTTPServer):
         self.report(f"facade watch: a request failed: {type(error).__name__}: {error}")
 
 
+class _Connection(io.RawIOBase):
+    """What a client sends, read with a deadline for the whole of a request's line and
+    headers (``until``, while they arrive), else with the idle timeout for each read: the
+    socket's timeout is set to what is left before every read."""
+
+    def __init__(self, connection: socket.socket, idle: float):
+        self.connection, self.idle = connection, idle
+        self.until: float | None = None  # monotonic seconds: the request's head is due
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        timeout = self.idle
+        if self.until is not None:
+            timeout = min(timeout, self.until - time.monotonic())
+            if timeout <= 0:
+                raise TimeoutError("the request's line and headers took too long")
+        self.connection.settimeout(timeout)
+        return self.connection.recv_into(buffer)
+
+
 def _handler(preview: Preview) -> type[BaseHTTPRequestHandler]:
+    head_seconds = WATCH_REQUEST_SECONDS
+
     class Handler(BaseHTTPRequestHandler):
         timeout = WATCH_IDLE_SECONDS  # every read and write on the connection
         default_request_version = "HTTP/1.0"  # a refusal has a status line, always
         server: _Server
 
+        def setup(self) -> None:
+            super().setup()
+            self.rfile.close()  # the socket's own reader: the connection is read through
+            self.reader = _Connection(self.connection, self.timeout)
+            self.rfile = io.BufferedReader(self.reader)
+
+        def handle_one_request(self) -> None:
+            # a timeout while the head arrives closes the connection (BaseHTTPRequestHandler)
+            self.reader.until = time.monotonic() + head_seconds
+            super().handle_one_request()
+
         def parse_request(self) -> bool:
-            if not super().parse_request():
+            read = super().parse_request()
+            self.reader.until = None  # the head is in: the idle timeout from here
+            if not read:
                 return False
             major = self.request_version.partition("/")[2].partition(".")[0]
             if len(self.requestline.split()) < 3 or int(major) < 1:
