@@ -32,6 +32,7 @@ def _finish(extensions: Extensions | None) -> Callable[[dict[str, Any]], None]:
 
     def finish(tree: dict[str, Any]) -> None:
         _share_images(tree)
+        _tangent_space(tree)
         used: set[str] = set()
         for material in tree.get("materials", []):
             for extension, value in (extensions or {}).get(material.get("name", ""), {}).items():
@@ -74,6 +75,18 @@ def _share_images(tree: dict[str, Any]) -> None:
     tree["images"], tree["textures"] = kept_images, kept_textures
     for material in tree.get("materials", []):
         _renumber(material, texture_map)
+
+
+def _tangent_space(tree: dict[str, Any]) -> None:
+    """trimesh writes a mesh's own vertex attributes with a leading underscore (custom
+    attributes); the normals and tangents a normal-mapped mesh carries are glTF's
+    ``NORMAL`` and ``TANGENT``."""
+    for mesh in tree.get("meshes", []):
+        for primitive in mesh.get("primitives", []):
+            attributes = primitive.get("attributes", {})
+            for name in ("NORMAL", "TANGENT"):
+                if f"_{name}" in attributes:
+                    attributes[name] = attributes.pop(f"_{name}")
 
 
 def _renumber(value: Any, texture_map: list[int]) -> None:

@@ -144,6 +144,40 @@ def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
     return flat
 
 
+def tangent_space(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """Give a mesh whose faces have their own vertices (as :func:`metric_uv` leaves them)
+    the normals and tangents a normal map is read in: each face's normal, and its
+    tangent along increasing u with the handedness of v (glTF 3.7.2.1's ``TANGENT``), so
+    that every viewer reads the normal map the same way. They go out as ``NORMAL`` and
+    ``TANGENT`` (see :mod:`facadecli.export.gltf`)."""
+    corners = mesh.vertices[mesh.faces]  # (faces, 3, 3)
+    uv = np.asarray(mesh.visual.uv)[mesh.faces]  # (faces, 3, 2)
+    edge1, edge2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    du1, dv1 = uv[:, 1, 0] - uv[:, 0, 0], uv[:, 1, 1] - uv[:, 0, 1]
+    du2, dv2 = uv[:, 2, 0] - uv[:, 0, 0], uv[:, 2, 1] - uv[:, 0, 1]
+    det = du1 * dv2 - du2 * dv1
+    det = np.where(np.abs(det) < 1e-12, 1.0, det)[:, None]
+    tangent = (edge1 * dv2[:, None] - edge2 * dv1[:, None]) / det
+    bitangent = (edge2 * du1[:, None] - edge1 * du2[:, None]) / det
+    normal = np.asarray(mesh.face_normals, dtype=float)
+    tangent -= normal * np.einsum("ij,ij->i", tangent, normal)[:, None]  # in the face's plane
+    length = np.linalg.norm(tangent, axis=1)
+    fallback = np.cross(normal, [0.0, 1.0, 0.0])  # a face with no u direction: any tangent
+    fallback[np.linalg.norm(fallback, axis=1) < 1e-6] = (1.0, 0.0, 0.0)
+    tangent = np.where(length[:, None] > 1e-9, tangent, fallback)
+    tangent /= np.linalg.norm(tangent, axis=1)[:, None]
+    handed = np.where(np.einsum("ij,ij->i", np.cross(normal, tangent), bitangent) < 0, -1.0, 1.0)
+    normals = np.zeros((len(mesh.vertices), 3))
+    tangents = np.zeros((len(mesh.vertices), 4))
+    for corner in range(3):
+        normals[mesh.faces[:, corner]] = normal
+        tangents[mesh.faces[:, corner], :3] = tangent
+        tangents[mesh.faces[:, corner], 3] = handed
+    mesh.vertex_attributes["NORMAL"] = normals.astype(np.float32)
+    mesh.vertex_attributes["TANGENT"] = tangents.astype(np.float32)
+    return mesh
+
+
 def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
     """Mirror a mesh within its cell on the axes whose letters are reflected."""
     if not (x or y):
@@ -179,6 +213,8 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
         metres = texture_metres(finished)
         if metres is not None:
             mesh = metric_uv(mesh, metres)
+            if finished.library is not None:  # a normal map: normals and tangents with it
+                mesh = tangent_space(mesh)
             mesh.visual.material = appearance
         else:
             mesh.visual = trimesh.visual.TextureVisuals(material=appearance)
