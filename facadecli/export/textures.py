@@ -38,11 +38,12 @@ class TextureFiles:
 
 
 def texture_files(materials: Iterable[tuple[str, object]], stem: str) -> TextureFiles:
-    """The PNG files of the drawn ones among ``(name, material)`` pairs, in order."""
+    """The PNG files of the drawn ones among ``(name, material)`` pairs, taken in the
+    order of their names (so every format names a shared picture alike)."""
     names: dict[tuple[str, str], str] = {}
     files: dict[str, bytes] = {}
     by_bytes: dict[bytes, str] = {}
-    for name, material in materials:
+    for name, material in sorted(materials, key=lambda pair: pair[0]):
         if not drawn(material):
             continue
         for slot, (attribute, suffix) in SLOTS.items():

@@ -260,7 +260,8 @@ def _roof_tiles(n: int, tile: float, rng: np.random.Generator) -> Surface:
     profile = np.sin(np.pi * units.u) ** 0.7  # a rounded tile across its width
     shade = 1.0 + per_unit(rng, units.ident, 0.09) + 0.04 * noise(rng, n, 0.02, tile)
     colour = np.stack([shade, shade, shade], axis=-1) * (0.75 + 0.25 * profile[..., None])
-    height = 0.02 * profile + 0.015 * (1 - units.v)  # each course laps over the one below
+    lift = per_unit(rng, units.ident, 0.002)  # no two tiles lie quite alike
+    height = 0.02 * profile + 0.015 * (1 - units.v) + lift  # each course laps the one below
     return Surface(height, colour, 0.06 * noise(rng, n, 0.01, tile), np.zeros((n, n)))
 
 
