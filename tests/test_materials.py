@@ -99,7 +99,7 @@ def test_every_material_of_the_examples_has_a_base_colour_and_a_normal_texture(
     path: Path,
 ) -> None:
     spec = load_spec(path)
-    document, binary = read_glb(glb_bytes(facade_scene(solve(spec), path.parent)))
+    document, _ = read_glb(glb_bytes(facade_scene(solve(spec), path.parent)))
     assert document["materials"]
     for material in document["materials"]:
         assert "baseColorTexture" in material["pbrMetallicRoughness"], material["name"]
