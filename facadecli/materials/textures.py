@@ -212,7 +212,7 @@ def _render(n: int, tile: float, rng: np.random.Generator) -> Surface:
     coarse, fine = noise(rng, n, 0.25, tile), noise(rng, n, 0.004, tile)
     shade = 1.0 + 0.03 * coarse + 0.02 * fine
     colour = np.repeat(shade[..., None], 3, axis=-1)
-    return Surface(0.0006 * fine + 0.0004 * coarse, colour, 0.05 * fine, np.zeros((n, n)))
+    return Surface(0.0003 * fine + 0.0004 * coarse, colour, 0.05 * fine, np.zeros((n, n)))
 
 
 def _concrete(n: int, tile: float, rng: np.random.Generator) -> Surface:
