@@ -27,6 +27,7 @@ PICTURES: dict[str, tuple[str, str, str]] = {
     "shop-front": ("shop-front", "model", "35,10,1.3,0.5,0.5"),
     "terraced-house": ("terraced-house", "model", "35,10,1.3,0.5,0.5"),
     "townhouse": ("townhouse", "model", "35,10,1.3,0.5,0.5"),
+    "townhouse-street": ("townhouse", "model", "25,3,2.2,0.5,0.3"),
     "parts": ("parts", "model", "35,10,1.5,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
     "part-door": ("parts", "model", "25,5,5,0.17,0.25"),
