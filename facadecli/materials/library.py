@@ -96,7 +96,7 @@ def images(material: Material) -> Images:
     return _images(material)
 
 
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=32)  # at most 32 x 9 MB of pictures at 1024 px
 def _images(material: Material) -> Images:
     from PIL import Image
 

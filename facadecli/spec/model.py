@@ -248,7 +248,7 @@ class Material(Model):
     texture: str | None = None  # a PNG or JPEG next to the spec, tinted by color
     texture_size: PositiveLength = 1.0  # metres of façade one copy of the texture covers
     scale: PositiveLength = 1.0  # library: its texture's size in metres, times this
-    resolution: Literal[64, 128, 256, 512, 1024, 2048, 4096] = 512  # library: pixels a side
+    resolution: Literal[64, 128, 256, 512, 1024] = 512  # library: pixels a side
     seed: Annotated[int, Field(ge=0, le=2**32 - 1)] = 0  # library: its texture's random choices
     ior: Annotated[float, Field(ge=1, le=3, allow_inf_nan=False)] | None = None  # glass: 1.5
 
