@@ -27,6 +27,7 @@ PICTURES: dict[str, tuple[str, str, str]] = {
     "shop-front": ("shop-front", "model", "35,10,1.3,0.5,0.5"),
     "terraced-house": ("terraced-house", "model", "35,10,1.3,0.5,0.5"),
     "townhouse": ("townhouse", "model", "35,10,1.3,0.5,0.5"),
+    "townhouse-street": ("townhouse", "model", "25,3,2.2,0.5,0.3"),
     "parts": ("parts", "model", "35,10,1.5,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
     "part-door": ("parts", "model", "25,5,5,0.17,0.25"),
@@ -78,7 +79,47 @@ def svg_size(svg: Path) -> str:
     return f"{round(float(width))},{round(float(height))}"
 
 
+SWATCH = 192  # pixels a side of one material on the library's contact sheet
+
+
+def material_sheet(target: Path) -> None:
+    """The material library's contact sheet: each material's pictures at 256 px, two by
+    two copies (so a seam would show), lit from the upper left through its normal map
+    and occlusion: colour x (0.3 + 0.7 n.l) x occlusion. No browser needed."""
+    import numpy as np
+    from PIL import Image, ImageDraw
+
+    from facadecli.materials import LIBRARY, TILES, images
+
+    light = np.array([-0.5, 0.5, 0.7]) / np.linalg.norm([-0.5, 0.5, 0.7])
+    columns, label = 4, 18
+    rows = -(-len(LIBRARY) // columns)
+    sheet = Image.new("RGB", (columns * SWATCH, rows * (SWATCH + label)), "white")
+    draw = ImageDraw.Draw(sheet)
+    for index, (name, material) in enumerate(LIBRARY.items()):
+        drawn = images(material.model_copy(update={"resolution": 256}))
+        colour = np.asarray(drawn.base_colour, dtype=float) / 255.0
+        normal = np.asarray(drawn.normal, dtype=float) / 127.5 - 1.0
+        occlusion = np.asarray(drawn.orm, dtype=float)[..., 0] / 255.0
+        lit = colour * ((0.3 + 0.7 * np.clip(normal @ light, 0, 1)) * occlusion)[..., None]
+        four = np.tile(lit, (2, 2, 1))
+        swatch = Image.fromarray(np.round(np.clip(four, 0, 1) * 255).astype(np.uint8))
+        swatch = swatch.resize((SWATCH, SWATCH), Image.Resampling.LANCZOS)
+        x, y = (index % columns) * SWATCH, (index // columns) * (SWATCH + label)
+        sheet.paste(swatch, (x, y + label))
+        draw.text((x + 4, y + 3), f"{name}: 2 x 2 tiles of {TILES[name]} m", fill="black")
+    sheet.save(target, optimize=True)
+
+
 def main(names: list[str]) -> None:
+    if not names or "materials" in names:
+        target = TARGET / "materials.png"
+        material_sheet(target)
+        print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
+        if names:
+            names = [name for name in names if name != "materials"]
+            if not names:
+                return
     chrome = browser()
     facade = Path(sys.executable).parent / "facade"
     chosen = names or list(PICTURES)

@@ -11,10 +11,10 @@ import pytest
 
 from facadecli import load_spec, parse_spec, solve
 from facadecli.export.glb_merge import merge_glb, read_glb
-from facadecli.export.gltf import TRANSMISSION, glb_bytes
+from facadecli.export.gltf import glb_bytes
 from facadecli.export.svg import svg_text
 from facadecli.geometry.cell import Cell, railing_plan, shutter_plan
-from facadecli.geometry.facade import facade_scene, transmissions
+from facadecli.geometry.facade import IOR, TRANSMISSION, facade_scene, material_extensions
 from facadecli.geometry.primitives import PANES, PRIMITIVES
 from facadecli.geometry.runs import built
 from tests.rays import directions, missing, nearest, reach
@@ -184,25 +184,29 @@ def test_a_string_course_closes_the_free_ends_of_its_facade(path: Path | None) -
 
 def test_glass_lets_light_through_in_the_glb(tmp_path: Path) -> None:
     spec = load_spec(ROOT / "specs" / "centred-bay.yaml")
-    assert transmissions(spec) == {"glass": 0.8}
+    # the example's glass is the library's float glass: it lets light through, and bends it
+    glass_light = {TRANSMISSION: {"transmissionFactor": 0.9}, IOR: {"ior": 1.52}}
+    assert material_extensions(spec) == {"glass": glass_light}
     layout = solve(spec)
-    document, _ = read_glb(glb_bytes(facade_scene(layout), transmissions(spec)))
+    document, _ = read_glb(glb_bytes(facade_scene(layout), material_extensions(spec)))
     glass = [m for m in document["materials"] if m["name"] == "glass"]
-    assert glass and glass[0]["extensions"][TRANSMISSION] == {"transmissionFactor": 0.8}
-    assert TRANSMISSION in document["extensionsUsed"]
+    assert glass and glass[0]["extensions"] == glass_light
+    assert {TRANSMISSION, IOR} <= set(document["extensionsUsed"])
     others = [m for m in document["materials"] if m["name"] != "glass"]
     assert all("extensions" not in m for m in others)
     # a city merges building files: the extension stays declared
     for name in ("a", "b"):
-        (tmp_path / f"{name}.glb").write_bytes(glb_bytes(facade_scene(layout), {"glass": 0.8}))
+        (tmp_path / f"{name}.glb").write_bytes(
+            glb_bytes(facade_scene(layout), {"glass": glass_light})
+        )
     merge_glb([(n, tmp_path / f"{n}.glb") for n in ("a", "b")], tmp_path / "city.glb")
     merged, _ = read_glb((tmp_path / "city.glb").read_bytes())
-    assert merged["extensionsUsed"] == [TRANSMISSION]
+    assert merged["extensionsUsed"] == [IOR, TRANSMISSION]
 
 
 def test_without_transmission_no_extension_is_declared() -> None:
     layout = solve(parse_spec(LEDGES))
-    document, _ = read_glb(glb_bytes(facade_scene(layout), transmissions(layout.spec)))
+    document, _ = read_glb(glb_bytes(facade_scene(layout), material_extensions(layout.spec)))
     assert "extensionsUsed" not in document
 
 

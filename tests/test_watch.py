@@ -525,8 +525,9 @@ def test_a_browser_page_follows_the_saves(running: tuple[Path, Running], tmp_pat
         _save(spec, _wider(spec.read_text().replace("layers: [\n", ""), 9.5))
         _until(lambda: evaluate("document.documentElement.dataset.version") == "3", "layout 3")
         assert evaluate(f"{banner}.style.display") == "none"
-        status = evaluate("document.getElementById('status').textContent")
-        assert status == "drag to orbit, scroll to zoom"
+        status = "document.getElementById('status').textContent"
+        # the model's pictures take a moment to decode: then the page says how to move
+        _until(lambda: evaluate(status) == "drag to orbit, scroll to zoom", "the model shown")
 
     _in_browser(served.url, tmp_path / "profile", steps)
 

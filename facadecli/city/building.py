@@ -25,7 +25,6 @@ import numpy as np
 import trimesh
 from shapely.geometry import Point, Polygon
 from shapely.geometry.polygon import orient
-from trimesh.visual.material import PBRMaterial
 
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
@@ -33,7 +32,15 @@ from facadecli.city.roofs import Segment, roof_meshes
 from facadecli.city.s3db import Heights, Volume, along, party_zone, roof_only, volume
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
-from facadecli.geometry.facade import facade_scene, pbr
+from facadecli.geometry.facade import (
+    facade_scene,
+    look,
+    material_names,
+    metric_uv,
+    pbr,
+    tangent_space,
+    texture_metres,
+)
 from facadecli.layout import (
     BUILTIN_INTERIOR,
     DEFAULT_MATERIAL,
@@ -291,15 +298,17 @@ def build_building(
         bottom.apply_translation((0, 0, block.base - 0.01))
         bottom.apply_transform(MAP_TO_WORLD)
         parts.setdefault(GROUND_NAME if block.base <= 0 else WALL_NAME, []).append(bottom)
-    materials = {}
+    materials: dict[str, tuple[Material, Path | None]] = {}
     for _, other in walls:  # the building's own spec wins where two name one material
         materials.update(_materials(other.spec, other.base_dir, looks))
     materials.update(_materials(spec, base_dir, looks))
     for name in sorted(parts):
-        merged = trimesh.util.concatenate(parts[name])
         fallback = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
-        material = materials.get(name) or pbr(name, fallback)  # the recesses stay dark
-        merged.visual = trimesh.visual.TextureVisuals(material=material)
+        finished, folder = materials.get(name) or (fallback, None)  # the recesses stay dark
+        merged = _merged(parts[name], texture_metres(finished))
+        if finished.library is not None:  # a normal map: normals and tangents with it
+            merged = tangent_space(merged)
+        merged.visual.material = pbr(name, finished, folder)
         scene.add_geometry(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"
         )
@@ -496,10 +505,14 @@ def _facade(spec: Spec, horizontal: AxisLayout, vertical: AxisLayout) -> Layout:
     )
 
 
-def _materials(spec: Spec, base_dir: Path | None, looks: Looks) -> dict[str, PBRMaterial]:
-    """The materials by name: the spec's, the building's own (a spec material of that
-    name wins over the built-in one), and the tags' colours over both."""
-    declared = dict(spec.materials)
+def _materials(
+    spec: Spec, base_dir: Path | None, looks: Looks
+) -> dict[str, tuple[Material, Path | None]]:
+    """The materials by name (with the folder their texture files are in): the spec's
+    and the library's it names, the building's own (a spec material of that name wins
+    over the built-in one), and the tags' colours over both."""
+    declared = {name: look(spec, name) for name in material_names(spec)}
+    declared = {name: m for name, m in declared.items() if name in spec.materials or m.library}
     for name, builtin in ((WALL_NAME, WALL), (ROOF_NAME, ROOF), (GROUND_NAME, GROUND)):
         declared.setdefault(name, builtin)
     if looks.wall is not None:
@@ -512,7 +525,28 @@ def _materials(spec: Spec, base_dir: Path | None, looks: Looks) -> dict[str, PBR
         declared[ROOF_NAME] = declared[ROOF_NAME].model_copy(
             update={"color": looks.roof, "texture": None}
         )
-    return {name: pbr(name, m, base_dir) for name, m in declared.items()}
+    return {name: (m, base_dir) for name, m in declared.items()}
+
+
+def _merged(meshes: list[trimesh.Trimesh], metres: float | None) -> trimesh.Trimesh:
+    """The meshes of one material as one; for a textured material, with the texture
+    coordinates they have (a façade's, in its own frame), and metric ones for those
+    without (roofs, plain walls)."""
+    if metres is None:
+        merged = trimesh.util.concatenate(meshes)
+        merged.visual = trimesh.visual.TextureVisuals()
+        return merged
+    mapped = [
+        m if getattr(m.visual, "uv", None) is not None else metric_uv(m, metres) for m in meshes
+    ]
+    offsets = np.cumsum([0] + [len(m.vertices) for m in mapped[:-1]])
+    merged = trimesh.Trimesh(  # stacked by hand: trimesh would pack the pictures in an atlas
+        np.vstack([m.vertices for m in mapped]),
+        np.vstack([m.faces + offset for m, offset in zip(mapped, offsets, strict=True)]),
+        process=False,
+    )
+    merged.visual = trimesh.visual.TextureVisuals(uv=np.vstack([m.visual.uv for m in mapped]))
+    return merged
 
 
 def _placed(scene: trimesh.Scene) -> list[trimesh.Trimesh]:

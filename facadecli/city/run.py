@@ -75,7 +75,7 @@ from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
 from facadecli.export.usd import city_usda, usda_text
-from facadecli.geometry.facade import transmissions
+from facadecli.geometry.facade import material_extensions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
 
@@ -190,7 +190,7 @@ def build(task: Task) -> dict[str, Any]:
         )
         solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
         write_cityjson(_feature_file(task.target), building_object(solids))
-        write_atomic(task.target, glb_bytes(result.scene, transmissions(task.spec)))
+        write_atomic(task.target, glb_bytes(result.scene, material_extensions(task.spec)))
         if task.usd:
             write_atomic(
                 task.target.with_suffix(".usda"), usda_text(result.scene, task.target.stem)

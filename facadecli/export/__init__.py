@@ -59,18 +59,18 @@ def _scene(layout: Layout, options: OutputOptions) -> trimesh.Scene:
 
 def _write_glb(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.gltf import write_glb
-    from facadecli.geometry.facade import transmissions
+    from facadecli.geometry.facade import material_extensions
 
     path = outdir / f"{layout.spec.name}.glb"
-    return write_glb(_scene(layout, options), path, transmissions(layout.spec))
+    return write_glb(_scene(layout, options), path, material_extensions(layout.spec))
 
 
 def _write_gltf(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.gltf import write_gltf
-    from facadecli.geometry.facade import transmissions
+    from facadecli.geometry.facade import material_extensions
 
     path = outdir / f"{layout.spec.name}.gltf"
-    return write_gltf(_scene(layout, options), path, transmissions(layout.spec))
+    return write_gltf(_scene(layout, options), path, material_extensions(layout.spec))
 
 
 def _write_obj(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
@@ -88,11 +88,11 @@ def _write_usd(layout: Layout, outdir: Path, options: OutputOptions) -> list[Pat
 def _write_html(layout: Layout, outdir: Path, options: OutputOptions) -> list[Path]:
     from facadecli.export.gltf import glb_bytes
     from facadecli.export.svg import svg_text
-    from facadecli.geometry.facade import transmissions
+    from facadecli.geometry.facade import material_extensions
     from facadecli.viewer import page
 
     path = outdir / f"{layout.spec.name}.html"
-    glb = glb_bytes(_scene(layout, options), transmissions(layout.spec))
+    glb = glb_bytes(_scene(layout, options), material_extensions(layout.spec))
     write_atomic(path, page(layout.spec.name, glb, svg_text(layout, labels=options.labels)))
     return [path]
 
@@ -130,7 +130,18 @@ def write_stream(layout: Layout, name: str, options: OutputOptions, stream: Bina
     if name not in SINGLE_FILE_FORMATS:
         raise ValueError(f"{name} is not one file: use one of {', '.join(SINGLE_FILE_FORMATS)}")
     with tempfile.TemporaryDirectory(prefix="facade-") as folder:
-        (path,) = WRITERS[name](layout, Path(folder), options)
+        path, *pictures = WRITERS[name](layout, Path(folder), options)
+        if pictures:  # a USD stage with its library materials' pictures beside it
+            from facadecli.errors import SpecError
+
+            raise SpecError.at(
+                layout.spec.name,
+                None,
+                None,
+                f"the {name} output of this spec is {1 + len(pictures)} files: the model and "
+                "the texture pictures of its library materials",
+                "write it to a folder (-o DIR), or use glb, which embeds the pictures",
+            )
         stream.write(path.read_bytes())
 
 

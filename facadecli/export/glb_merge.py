@@ -8,6 +8,7 @@ assembled at the end and renamed into place, so a city of any size merges in fla
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 import shutil
@@ -73,8 +74,10 @@ def merge_glb(
     fd, binary_path = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".bin", dir=target.parent)
     try:
         with os.fdopen(fd, "wb") as binary:
+            known: dict[bytes, int] = {}  # a picture's digest -> its merged image
             for name, path in parts:
                 document, chunk = read_glb(path.read_bytes())
+                document, chunk = _known_images(document, chunk, known, len(merged["images"]))
                 _append(merged, document, name, binary.tell())
                 binary.write(chunk)
                 binary.write(b"\0" * (-len(chunk) % 4))
@@ -83,6 +86,64 @@ def merge_glb(
     finally:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(binary_path)
+
+
+def _known_images(
+    document: dict[str, Any], chunk: bytes, known: dict[bytes, int], first: int
+) -> tuple[dict[str, Any], bytes]:
+    """The document and its binary chunk without the pictures an earlier part already
+    brought (every building of a city built from one spec carries the same library
+    textures): its textures point at the merged images instead (``first`` is where this
+    part's images will start), and the chunk keeps only the other buffer views."""
+    images = document.get("images", [])
+    views = document.get("bufferViews", [])
+    dropped: set[int] = set()
+    sources: list[int] = []  # this part's image -> its merged image, less ``first``
+    kept: list[dict[str, Any]] = []
+    for image in images:
+        view = views[image["bufferView"]] if "bufferView" in image else None
+        if view is None:
+            sources.append(len(kept))
+            kept.append(image)
+            continue
+        start = view.get("byteOffset", 0)
+        digest = hashlib.sha256(chunk[start : start + view["byteLength"]]).digest()
+        if digest in known:
+            sources.append(known[digest] - first)
+            dropped.add(image["bufferView"])
+        else:
+            known[digest] = first + len(kept)
+            sources.append(len(kept))
+            kept.append(image)
+    if not dropped:
+        return document, chunk
+    order = [i for i in range(len(views)) if i not in dropped]
+    renumbered = {old: new for new, old in enumerate(order)}
+    pieces: list[bytes] = []
+    offset = 0
+    new_views = []
+    for old in order:
+        view = dict(views[old])
+        start = view.get("byteOffset", 0)
+        pieces.append(chunk[start : start + view["byteLength"]] + b"\0" * (-view["byteLength"] % 4))
+        view["byteOffset"] = offset
+        offset += len(pieces[-1])
+        new_views.append(view)
+    document = dict(document)
+    document["bufferViews"] = new_views
+    document["accessors"] = [
+        {**a, "bufferView": renumbered[a["bufferView"]]} if "bufferView" in a else a
+        for a in document.get("accessors", [])
+    ]
+    document["images"] = [
+        {**image, "bufferView": renumbered[image["bufferView"]]} if "bufferView" in image else image
+        for image in kept
+    ]
+    document["textures"] = [
+        {**texture, "source": sources[texture["source"]]} if "source" in texture else texture
+        for texture in document.get("textures", [])
+    ]
+    return document, b"".join(pieces)
 
 
 def _append(merged: dict[str, Any], document: dict[str, Any], name: str, offset: int) -> None:

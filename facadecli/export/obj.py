@@ -8,6 +8,7 @@ import trimesh
 from trimesh.exchange.obj import export_obj
 
 from facadecli.export.atomic import write_atomic
+from facadecli.export.textures import TextureFiles, texture_files
 
 
 def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, dict[str, bytes]]:
@@ -34,7 +35,62 @@ def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, dict[str, bytes]]:
         return_texture=True,
         mtl_name=f"{name}.mtl",
     )
+    materials = {m.name: m for m in (g.visual.material for g in flat.geometry.values())}
+    pictures = texture_files(sorted(materials.items()), name)
+    if pictures.files:
+        textures = _pbr_library(textures, f"{name}.mtl", materials, pictures)
     return text, dict(sorted(textures.items()))
+
+
+def _pbr_library(
+    textures: dict[str, bytes],
+    mtl_name: str,
+    materials: dict[str, object],
+    pictures: TextureFiles,
+) -> dict[str, bytes]:
+    """trimesh's MTL and pictures with each drawn material's entry written again with
+    every map (trimesh keeps only the base colour): ``map_Kd``, ``norm`` and
+    ``map_Bump`` (normal map), ``map_Pr``/``map_Pm`` (roughness and metallic, from the
+    green and blue of glTF's packed picture), ``map_ao`` (its red: occlusion)."""
+    blocks = textures[mtl_name].decode("utf-8").split("\nnewmtl ")
+    kept: dict[str, bytes] = {}
+    out = [blocks[0]]
+    for block in blocks[1:]:
+        name = block.split("\n", 1)[0].strip()
+        material = materials.get(name)
+        if material is None or (name, "normal") not in pictures.names:
+            out.append(block)
+            kept.update({f: textures[f] for f in _maps(block) if f in textures})
+            continue
+        out.append(_entry(name, material, pictures))
+    kept.update(pictures.files)
+    kept[mtl_name] = "\nnewmtl ".join(out).encode("utf-8")
+    return kept
+
+
+def _maps(block: str) -> list[str]:
+    """The picture files an MTL entry names."""
+    return [line.split()[-1] for line in block.splitlines() if line.startswith("map_")]
+
+
+def _entry(name: str, material: object, pictures: TextureFiles) -> str:
+    colour = getattr(material, "baseColorFactor", None)
+    opacity = 1.0 if colour is None else float(colour[3]) / 255.0
+    base, normal, orm = (pictures.names[(name, slot)] for slot in ("base_colour", "normal", "orm"))
+    return "\n".join(
+        [
+            name,
+            "Kd 1.00000000 1.00000000 1.00000000",
+            f"d {opacity:.8f}",
+            f"map_Kd {base}",
+            f"norm {normal}",
+            f"map_Bump -bm 1.0 {normal}",
+            f"map_Pr -imfchan g {orm}",
+            f"map_Pm -imfchan b {orm}",
+            f"map_ao -imfchan r {orm}",
+            "",
+        ]
+    )
 
 
 def ordered_nodes(scene: trimesh.Scene) -> list[str]:

@@ -91,7 +91,9 @@ def svg_text(layout: Layout, labels: bool = False) -> str:
 
 
 def _colour(spec: Spec, name: str) -> tuple[str, float]:
-    material = spec.materials.get(name)
+    from facadecli.materials import resolve
+
+    material = resolve(spec.materials, name)  # a library material: its colour
     if material is not None:
         return material.color[:7], material.opacity
     if name == PANE_MATERIAL:

@@ -8,7 +8,9 @@ and the rest of the USD world, written without USD's own library.
   where it has them, its extent), and every part that uses it is an instanceable Xform
   referencing it, with its own transform.
 - Materials are UsdPreviewSurface shaders under ``/<name>/Materials`` with the glTF's base
-  colour, metallic, roughness and opacity; every prototype is bound to its material.
+  colour, metallic, roughness and opacity; every prototype is bound to its material. A
+  library material's inputs read UsdUVTextures of its PNG pictures, written beside the
+  stage.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import trimesh
 
 from facadecli.export.atomic import write_atomic
 from facadecli.export.obj import ordered_nodes
+from facadecli.export.textures import SLOTS, TextureFiles, texture_files
 
 
 def usd_name(text: str) -> str:
@@ -38,31 +41,89 @@ def _tuples(rows: np.ndarray) -> str:
     return "[" + ", ".join(f"({_floats(row)})" for row in rows) + "]"
 
 
-def _material(name: str, material: object, root: str) -> list[str]:
+def _material(
+    name: str, material: object, root: str, pictures: dict[str, str] | None = None
+) -> list[str]:
+    """A UsdPreviewSurface; with ``pictures`` (slot -> file beside the stage, for a
+    drawn material), its inputs read from UsdUVTextures over the mesh's ``st``."""
     colour = getattr(material, "baseColorFactor", None)
     rgba = (
         np.array(colour, dtype=float) / (255.0 if np.max(colour) > 1.0 else 1.0)
         if colour is not None
         else np.array([0.75, 0.75, 0.75, 1.0])
     )
-    metallic = getattr(material, "metallicFactor", None)
+    metallic = getattr(material, "metallicFactor", None) or 0.0
     roughness = getattr(material, "roughnessFactor", None)
+    roughness = 1.0 if roughness is None else roughness
     path = f"{root}/Materials/{name}"
-    return [
+    reads = f"{path}/base_colour.outputs:rgb"
+    if pictures:
+        inputs = [
+            f"                color3f inputs:diffuseColor.connect = <{reads}>",
+            f"                normal3f inputs:normal.connect = <{path}/normal.outputs:rgb>",
+            f"                float inputs:metallic.connect = <{path}/orm.outputs:b>",
+            f"                float inputs:roughness.connect = <{path}/orm.outputs:g>",
+            f"                float inputs:occlusion.connect = <{path}/orm.outputs:r>",
+        ]
+    else:
+        inputs = [
+            f"                color3f inputs:diffuseColor = ({_floats(rgba[:3])})",
+            f"                float inputs:metallic = {metallic:.6g}",
+            f"                float inputs:roughness = {roughness:.6g}",
+        ]
+    lines = [
         f'        def Material "{name}"',
         "        {",
         f"            token outputs:surface.connect = <{path}/Surface.outputs:surface>",
         '            def Shader "Surface"',
         "            {",
         '                uniform token info:id = "UsdPreviewSurface"',
-        f"                color3f inputs:diffuseColor = ({_floats(rgba[:3])})",
-        f"                float inputs:metallic = {0.0 if metallic is None else metallic:.6g}",
-        f"                float inputs:roughness = {1.0 if roughness is None else roughness:.6g}",
+        *inputs,
         f"                float inputs:opacity = {rgba[3]:.6g}",
         "                token outputs:surface",
         "            }",
-        "        }",
     ]
+    if pictures:
+        lines += _texture_network(path, pictures)
+    return [*lines, "        }"]
+
+
+def _texture_network(path: str, pictures: dict[str, str]) -> list[str]:
+    """The ``st`` reader and a UsdUVTexture per picture (normals from 0..1 to -1..1, raw:
+    only the base colour is sRGB)."""
+    lines = [
+        '            def Shader "st"',
+        "            {",
+        '                uniform token info:id = "UsdPrimvarReader_float2"',
+        '                string inputs:varname = "st"',
+        "                float2 outputs:result",
+        "            }",
+    ]
+    for slot, file in pictures.items():
+        space = "sRGB" if slot == "base_colour" else "raw"
+        lines += [
+            f'            def Shader "{slot}"',
+            "            {",
+            '                uniform token info:id = "UsdUVTexture"',
+            f"                asset inputs:file = @./{file}@",
+            f"                float2 inputs:st.connect = <{path}/st.outputs:result>",
+            f'                token inputs:sourceColorSpace = "{space}"',
+            '                token inputs:wrapS = "repeat"',
+            '                token inputs:wrapT = "repeat"',
+        ]
+        if slot == "normal":
+            lines += [
+                "                float4 inputs:scale = (2, 2, 2, 1)",
+                "                float4 inputs:bias = (-1, -1, -1, 0)",
+            ]
+        lines += [
+            "                float3 outputs:rgb",
+            "                float outputs:r",
+            "                float outputs:g",
+            "                float outputs:b",
+            "            }",
+        ]
+    return lines
 
 
 def _mesh(name: str, mesh: trimesh.Trimesh, material: str, root: str) -> list[str]:
@@ -100,8 +161,9 @@ def _mesh(name: str, mesh: trimesh.Trimesh, material: str, root: str) -> list[st
     return lines
 
 
-def usda_text(scene: trimesh.Scene, name: str) -> str:
-    """The scene as a USD stage (see the module)."""
+def usda_text(scene: trimesh.Scene, name: str, pictures: TextureFiles | None = None) -> str:
+    """The scene as a USD stage (see the module); ``pictures`` names the files of the drawn
+    materials' textures, by the materials' own names."""
     root = f"/{usd_name(name)}"
     prototypes: dict[str, str] = {}  # geometry key -> prototype prim name
     materials: dict[str, object] = {}
@@ -132,8 +194,11 @@ def usda_text(scene: trimesh.Scene, name: str) -> str:
             ]
         )
     out = [*_head(name, "component"), '    def Scope "Materials"', "    {"]
+    names = pictures.names if pictures else {}
     for material_name, material in materials.items():
-        out += _material(material_name, material, root)
+        own = getattr(material, "name", None) or "default"
+        files = {slot: names[(own, slot)] for slot in SLOTS if (own, slot) in names}
+        out += _material(material_name, material, root, files)
     out += ["    }", '    class Scope "Prototypes"', "    {", *meshes, "    }"]
     for layer, prims in layers.items():
         out += [f'    def Xform "{layer}"', "    {", *prims, "    }"]
@@ -159,8 +224,23 @@ def _head(name: str, kind: str) -> list[str]:
 
 
 def write_usd(scene: trimesh.Scene, path: Path) -> list[Path]:
-    write_atomic(path, usda_text(scene, path.stem))
-    return [path]
+    """The stage, and beside it the PNG pictures of its drawn materials."""
+    pictures = texture_files(_materials(scene), path.stem)
+    written = []
+    for file, data in pictures.files.items():
+        write_atomic(path.parent / file, data)
+        written.append(path.parent / file)
+    write_atomic(path, usda_text(scene, path.stem, pictures))
+    return [path, *written]
+
+
+def _materials(scene: trimesh.Scene) -> list[tuple[str, object]]:
+    """The scene's materials by name, in the order of its meshes' names."""
+    found: dict[str, object] = {}
+    for key in sorted(scene.geometry):
+        material = getattr(scene.geometry[key].visual, "material", None)
+        found.setdefault(getattr(material, "name", None) or "default", material)
+    return list(found.items())
 
 
 def city_usda(name: str, buildings: list[Path], folder: Path) -> str:

@@ -28,20 +28,40 @@ from facadecli.layout import (
     Shape,
 )
 from facadecli.limits import SCENE_FACES_MAX
+from facadecli.materials import images, resolve
 from facadecli.spec.assets import load_mesh
 from facadecli.spec.model import Material, Spec
 
 FALLBACK_MATERIAL = Material(color="#bfbfbf", roughness=0.8)
+TRANSMISSION = "KHR_materials_transmission"
+IOR = "KHR_materials_ior"
 
 
 @lru_cache(maxsize=256)
 def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMaterial:
     """A glTF metallic-roughness material; see-through ones blend; a texture is tinted by
-    the colour. Cached: a city builds the same materials for every wall, and reads each
-    texture image once."""
+    the colour. A library material carries its drawn texture set instead (base colour,
+    normal, and one image for occlusion, roughness and metallic), with factors of 1.
+    Cached: a city builds the same materials for every wall, and reads each texture
+    image once."""
     colour = material.color.lstrip("#")
     rgb = [int(colour[i : i + 2], 16) for i in (0, 2, 4)]
     alpha = round(255 * material.opacity)
+    blend = "BLEND" if material.opacity < 1.0 else "OPAQUE"
+    if material.library is not None:
+        drawn = images(material)
+        return PBRMaterial(
+            name=name,
+            baseColorFactor=[255, 255, 255, alpha],
+            baseColorTexture=drawn.base_colour,
+            normalTexture=drawn.normal,
+            metallicRoughnessTexture=drawn.orm,
+            occlusionTexture=drawn.orm,
+            metallicFactor=1.0,
+            roughnessFactor=1.0,
+            alphaMode=blend,
+            doubleSided=False,
+        )
     texture = None
     if material.texture is not None:
         from PIL import Image
@@ -54,17 +74,55 @@ def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMater
         baseColorTexture=texture,
         metallicFactor=material.metallic,
         roughnessFactor=material.roughness,
-        alphaMode="BLEND" if material.opacity < 1.0 else "OPAQUE",
+        alphaMode=blend,
         doubleSided=False,
     )
 
 
-def transmissions(spec: Spec) -> dict[str, float]:
-    """The materials of a spec's model that let light through, by name (the built-in glass
-    when the spec defines none of that name)."""
-    found = {name: m.transmission for name, m in spec.materials.items() if m.transmission > 0}
-    if PANE_MATERIAL not in spec.materials and BUILTIN_GLASS.transmission > 0:
-        found[PANE_MATERIAL] = BUILTIN_GLASS.transmission
+def texture_metres(material: Material) -> float | None:
+    """Metres of surface one copy of a material's texture covers (None: no texture)."""
+    if material.library is not None:
+        return images(material).size
+    return material.texture_size if material.texture is not None else None
+
+
+def look(spec: Spec, name: str) -> Material:
+    """The material a name stands for in a spec: its own (over the library entry it
+    starts from), a library material, or a built-in (:func:`_builtin`)."""
+    return resolve(spec.materials, name) or _builtin(name)
+
+
+def material_names(spec: Spec) -> list[str]:
+    """Every material name a spec's model may use: its own, those its rules name, and
+    the built-in glass and interior."""
+    rules = [*spec.shapes, *(rule for layer in spec.layers for rule in layer.shapes)]
+    named = (
+        spec.defaults.material,
+        *(rule.material for rule in rules),
+        *(rule.pane_material for rule in rules),
+        PANE_MATERIAL,
+        INTERIOR_MATERIAL,
+    )
+    names = dict.fromkeys(spec.materials)
+    for name in named:
+        if name is not None:
+            names.setdefault(name)
+    return list(names)
+
+
+def material_extensions(spec: Spec) -> dict[str, dict[str, dict[str, float]]]:
+    """glTF material extensions by material name: light passing through glass
+    (``KHR_materials_transmission``) and its index of refraction (``KHR_materials_ior``)."""
+    found: dict[str, dict[str, dict[str, float]]] = {}
+    for name in material_names(spec):
+        material = look(spec, name)
+        extensions: dict[str, dict[str, float]] = {}
+        if material.transmission > 0:
+            extensions[TRANSMISSION] = {"transmissionFactor": material.transmission}
+        if material.ior is not None:
+            extensions[IOR] = {"ior": material.ior}
+        if extensions:
+            found[name] = extensions
     return found
 
 
@@ -84,6 +142,40 @@ def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
         uv[vertex, 1] = flat.vertices[vertex, planes[rows, 1]]
     flat.visual = trimesh.visual.TextureVisuals(uv=uv / size)
     return flat
+
+
+def tangent_space(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """Give a mesh whose faces have their own vertices (as :func:`metric_uv` leaves them)
+    the normals and tangents a normal map is read in: each face's normal, and its
+    tangent along increasing u with the handedness of v (glTF 3.7.2.1's ``TANGENT``), so
+    that every viewer reads the normal map the same way. They go out as ``NORMAL`` and
+    ``TANGENT`` (see :mod:`facadecli.export.gltf`)."""
+    corners = mesh.vertices[mesh.faces]  # (faces, 3, 3)
+    uv = np.asarray(mesh.visual.uv)[mesh.faces]  # (faces, 3, 2)
+    edge1, edge2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    du1, dv1 = uv[:, 1, 0] - uv[:, 0, 0], uv[:, 1, 1] - uv[:, 0, 1]
+    du2, dv2 = uv[:, 2, 0] - uv[:, 0, 0], uv[:, 2, 1] - uv[:, 0, 1]
+    det = du1 * dv2 - du2 * dv1
+    det = np.where(np.abs(det) < 1e-12, 1.0, det)[:, None]
+    tangent = (edge1 * dv2[:, None] - edge2 * dv1[:, None]) / det
+    bitangent = (edge2 * du1[:, None] - edge1 * du2[:, None]) / det
+    normal = np.asarray(mesh.face_normals, dtype=float)
+    tangent -= normal * np.einsum("ij,ij->i", tangent, normal)[:, None]  # in the face's plane
+    length = np.linalg.norm(tangent, axis=1)
+    fallback = np.cross(normal, [0.0, 1.0, 0.0])  # a face with no u direction: any tangent
+    fallback[np.linalg.norm(fallback, axis=1) < 1e-6] = (1.0, 0.0, 0.0)
+    tangent = np.where(length[:, None] > 1e-9, tangent, fallback)
+    tangent /= np.linalg.norm(tangent, axis=1)[:, None]
+    handed = np.where(np.einsum("ij,ij->i", np.cross(normal, tangent), bitangent) < 0, -1.0, 1.0)
+    normals = np.zeros((len(mesh.vertices), 3))
+    tangents = np.zeros((len(mesh.vertices), 4))
+    for corner in range(3):
+        normals[mesh.faces[:, corner]] = normal
+        tangents[mesh.faces[:, corner], :3] = tangent
+        tangents[mesh.faces[:, corner], 3] = handed
+    mesh.vertex_attributes["NORMAL"] = normals.astype(np.float32)
+    mesh.vertex_attributes["TANGENT"] = tangents.astype(np.float32)
+    return mesh
 
 
 def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
@@ -107,7 +199,6 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     or panel of a see-through material, a closed dark recess (:func:`.recess`) in the
     ``interior`` material, so that no view through a window passes through the model."""
     spec = layout.spec
-    materials = {name: pbr(name, m, base_dir) for name, m in spec.materials.items()}
     assets: dict[str, trimesh.Trimesh] = {}
     scene = trimesh.Scene()
     world = scene.graph.base_frame
@@ -117,13 +208,16 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
 
     def dress(mesh: trimesh.Trimesh, material: str) -> trimesh.Trimesh:
         """The mesh in a material (with texture coordinates in metres if it has a texture)."""
-        declared = spec.materials.get(material)
-        look = materials.get(material) or pbr(material, _builtin(material))
-        if declared is not None and declared.texture is not None:
-            mesh = metric_uv(mesh, declared.texture_size)
-            mesh.visual.material = look
+        finished = look(spec, material)
+        appearance = pbr(material, finished, base_dir)
+        metres = texture_metres(finished)
+        if metres is not None:
+            mesh = metric_uv(mesh, metres)
+            if finished.library is not None:  # a normal map: normals and tangents with it
+                mesh = tangent_space(mesh)
+            mesh.visual.material = appearance
         else:
-            mesh.visual = trimesh.visual.TextureVisuals(material=look)
+            mesh.visual = trimesh.visual.TextureVisuals(material=appearance)
         return mesh
 
     def place(
@@ -207,7 +301,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
 
 def _see_through(spec: Spec, name: str) -> bool:
     """Whether a material lets the view through (blended or transmitting): glass."""
-    material = spec.materials.get(name) or _builtin(name)
+    material = look(spec, name)
     return material.opacity < 1.0 or material.transmission > 0.0
 
 

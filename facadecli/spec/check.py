@@ -247,9 +247,18 @@ class Checker:
 
     # -- appearance -------------------------------------------------------------------
     def check_appearance(self) -> None:
+        from facadecli.materials.library import LIBRARY  # it builds on the spec's model
+
         for index, rule in enumerate(self.spec.shapes):
             self.check_rule(("shapes", index), rule)
         for name, material in self.spec.materials.items():
+            if material.library is not None and material.library not in LIBRARY:
+                self.report(
+                    ("materials", name, "library"),
+                    f"unknown library material '{material.library}'",
+                    did_you_mean(material.library, LIBRARY)
+                    + f"the library has {', '.join(LIBRARY)}",
+                )
             if material.texture is not None:
                 self.check_file(
                     ("materials", name, "texture"), material.texture, TEXTURE_SUFFIXES, "texture"
@@ -276,13 +285,16 @@ class Checker:
             self.check_mesh((*path, "mesh"), rule.mesh)
 
     def check_material(self, path: Path, name: str) -> None:
-        if name in self.spec.materials:
+        from facadecli.materials.library import LIBRARY
+
+        if name in self.spec.materials or name in LIBRARY:
             return
-        hint = did_you_mean(name, self.spec.materials)
+        hint = did_you_mean(name, [*self.spec.materials, *LIBRARY])
         self.report(
             path,
             f"unknown material '{name}'",
-            hint + f"define it under materials, e.g. '{name}: {{color: \"#c9a27e\"}}'",
+            hint + f"define it under materials, e.g. '{name}: {{color: \"#c9a27e\"}}', "
+            f"or name a library material ({', '.join(LIBRARY)})",
         )
 
     def check_mesh(self, path: Path, mesh: str) -> None:

@@ -205,14 +205,14 @@ class ShapeRule(Model):
     """Appearance of the shapes a rule matches; later rules win, field by field."""
 
     match: ShapeMatch = ShapeMatch()
-    material: Ident | None = None
+    material: MaterialName | None = None  # a name under materials, or a library material
     mesh: str | None = None
     depth: Length | None = None
     thickness: NonNegativeLength | None = None
     frame_width: PositiveLength | None = None  # frame and arch: width of the frame's bars
     pane_depth: NonNegativeLength | None = None  # pane recess
     segments: Annotated[int, Field(ge=3, le=128)] | None = None  # arch and column smoothness
-    pane_material: Ident | None = None  # frame, arch, door: the pane's (default: glass)
+    pane_material: MaterialName | None = None  # frame, arch, door: the pane's (default: glass)
     sill: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None  # frame, arch
     panels: Annotated[int, Field(ge=0, le=12)] | None = None  # door: rows of raised panels
     glazing: Annotated[float, Field(ge=0, le=0.9, allow_inf_nan=False)] | None = None  # door
@@ -232,9 +232,14 @@ class Layer(Model):
     shapes: list[ShapeRule] = []
 
 
-class Material(Model):
-    """A PBR material (glTF metallic-roughness)."""
+MaterialName = Annotated[str, StringConstraints(pattern=r"^[A-Za-z_][A-Za-z0-9_-]*$")]
 
+
+class Material(Model):
+    """A PBR material (glTF metallic-roughness); with ``library``, a material of the
+    library whose fields set here replace the library's."""
+
+    library: MaterialName | None = None  # a library material to start from (brick-flemish)
     color: Annotated[str, StringConstraints(pattern=COLOR_RE)] = "#bfbfbf"
     metallic: Unit = 0.0
     roughness: Unit = 0.8
@@ -242,13 +247,28 @@ class Material(Model):
     transmission: Unit = 0.0  # light passing through (glass): KHR_materials_transmission
     texture: str | None = None  # a PNG or JPEG next to the spec, tinted by color
     texture_size: PositiveLength = 1.0  # metres of façade one copy of the texture covers
+    scale: PositiveLength = 1.0  # library: its texture's size in metres, times this
+    resolution: Literal[64, 128, 256, 512, 1024] = 512  # library: pixels a side
+    seed: Annotated[int, Field(ge=0, le=2**32 - 1)] = 0  # library: its texture's random choices
+    ior: Annotated[float, Field(ge=1, le=3, allow_inf_nan=False)] | None = None  # glass: 1.5
+
+    @model_validator(mode="after")
+    def _library_fields(self) -> Material:
+        if self.library is not None and self.texture is not None:
+            raise ValueError("a library material draws its own texture: drop 'texture'")
+        if self.library is None:
+            library_only = {"scale", "resolution", "seed"} & self.model_fields_set
+            if library_only:
+                field = sorted(library_only)[0]
+                raise ValueError(f"'{field}' applies to a library material: add 'library:'")
+        return self
 
 
 class Defaults(Model):
     """Appearance of shapes no rule sets (SPEC 2.8)."""
 
     mesh: str = "box"
-    material: Ident | None = None
+    material: MaterialName | None = None
     thickness: NonNegativeLength = 0.2
     depth: Length = 0.0
 

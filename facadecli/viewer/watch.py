@@ -224,14 +224,14 @@ def _page(path: Path, raw: bytes, version: int) -> tuple[str, str, str]:
     the model (base64) and the elevation (inline SVG) it swaps in."""
     from facadecli.export.gltf import glb_bytes
     from facadecli.export.svg import svg_text
-    from facadecli.geometry.facade import facade_scene, transmissions
+    from facadecli.geometry.facade import facade_scene, material_extensions
     from facadecli.solve import solve
     from facadecli.spec import parse_spec
     from facadecli.viewer import page
 
     spec = parse_spec(raw, str(path), base_dir=path.parent)
     layout = solve(spec)
-    glb = glb_bytes(facade_scene(layout, path.parent), transmissions(spec))
+    glb = glb_bytes(facade_scene(layout, path.parent), material_extensions(spec))
     svg = svg_text(layout)
     html = page(spec.name, glb, svg).replace("</body>", live_script(version) + "</body>", 1)
     return html, base64.b64encode(glb).decode(), svg.split("?>", 1)[-1]

@@ -1,0 +1,364 @@
+"""Procedural PBR texture sets: a height field, a colour field and a roughness field over
+one square tile of a surface (brick in its bonds, ashlar, render, ...), made with numpy
+from a seed, and turned into the three images glTF wants.
+
+Every field is periodic over the tile: units (bricks, blocks, boards, slates) are laid
+modulo the tile's width and height, and noise is white noise filtered in the frequency
+domain, which wraps by construction. So the left edge of an image continues its right
+edge, and the top its bottom: a wall textured in metres shows no seam where one copy of
+the tile meets the next.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+Field = np.ndarray  # (n, n) float64, row 0 at the top of the tile (image order)
+
+
+@dataclass(frozen=True)
+class Surface:
+    """What a generator draws: height in metres of relief, colour as linear-ish RGB in
+    0..1 (before the material's own colour is applied), roughness 0..1 as an offset
+    around the material's roughness, metal 0..1."""
+
+    height: Field
+    colour: np.ndarray  # (n, n, 3)
+    roughness: Field
+    metal: Field
+    tinted: Field | None = None  # 0..1: how much the material's colour applies (1: all)
+
+
+@dataclass(frozen=True)
+class TextureSet:
+    """The images of a material, as uint8 arrays: base colour (sRGB), tangent-space
+    normal, and glTF's packed occlusion (R), roughness (G), metallic (B)."""
+
+    base_colour: np.ndarray
+    normal: np.ndarray
+    orm: np.ndarray
+
+
+def noise(
+    rng: np.random.Generator,
+    n: int,
+    scale: float,
+    tile: float,
+    aniso: tuple[float, float] = (1.0, 1.0),
+) -> Field:
+    """Periodic smooth noise with features about ``scale`` metres across (``aniso``
+    stretches them along x and y), zero mean, unit deviation. Features are at least
+    three pixels across: finer noise would alias, and no PNG can compress it."""
+    scale = max(scale, 3 * tile / n)
+    white = rng.standard_normal((n, n))
+    freq = np.fft.fftfreq(n, d=tile / n)  # cycles per metre
+    fy, fx = np.meshgrid(freq, freq, indexing="ij")
+    radius = np.hypot(fx * scale * aniso[0], fy * scale * aniso[1])
+    filtered = np.fft.ifft2(np.fft.fft2(white) * np.exp(-((radius * 2.0) ** 2))).real
+    deviation = filtered.std()
+    normalised: Field = (filtered - filtered.mean()) / (deviation if deviation > 0 else 1.0)
+    return normalised
+
+
+def blur(field: Field, radius_px: float) -> Field:
+    """A periodic Gaussian blur (through the frequency domain, so it wraps too)."""
+    n = field.shape[0]
+    freq = np.fft.fftfreq(n)
+    fy, fx = np.meshgrid(freq, freq, indexing="ij")
+    kernel = np.exp(-2.0 * (np.pi * radius_px) ** 2 * (fx**2 + fy**2))
+    return np.fft.ifft2(np.fft.fft2(field) * kernel).real
+
+
+def grid(n: int, tile: float) -> tuple[Field, Field]:
+    """Metric coordinates of the pixel centres: x to the right, y up from the tile's
+    bottom (row 0 is the top of the image)."""
+    step = tile / n
+    centres = (np.arange(n) + 0.5) * step
+    x, y = np.meshgrid(centres, centres[::-1])
+    return x, y
+
+
+@dataclass(frozen=True)
+class Units:
+    """Each pixel's unit (brick, block, slate) in a coursed layout: an id unique within
+    the tile, the distance to the unit's nearest joint, and the position inside it."""
+
+    ident: np.ndarray  # int
+    edge: Field  # metres to the nearest joint line
+    u: Field  # 0..1 across the unit
+    v: Field  # 0..1 up the unit
+
+
+def coursed(
+    x: Field, y: Field, tile: float, courses: list[tuple[float, list[float], float]]
+) -> Units:
+    """Units laid in courses from the bottom: each course is (height, lengths of its
+    units repeating along it, offset of the first unit). Every course's repeat must
+    divide the tile, and the heights must sum to it, so the layout wraps."""
+    ident = np.zeros(x.shape, dtype=np.int64)
+    edge = np.zeros(x.shape)
+    u = np.zeros(x.shape)
+    v = np.zeros(x.shape)
+    bottom = 0.0
+    first = 0
+    for height, lengths, offset in courses:
+        inside = (y >= bottom) & (y < bottom + height)
+        period = float(sum(lengths))
+        starts = np.concatenate([[0.0], np.cumsum(lengths)])
+        along = np.mod(x[inside] + offset, period)
+        index = np.searchsorted(starts, along, side="right") - 1
+        start, length = starts[index], np.asarray(lengths)[index]
+        repeat = np.floor((x[inside] + offset) / period)
+        repeats = max(1, round(tile / period))
+        ident[inside] = first + np.mod(repeat, repeats).astype(np.int64) * len(lengths) + index
+        dx = along - start
+        dy = y[inside] - bottom
+        edge[inside] = np.minimum.reduce([dx, length - dx, dy, height - dy])
+        u[inside] = dx / length
+        v[inside] = dy / height
+        first += repeats * len(lengths)
+        bottom += height
+    return Units(ident, edge, u, v)
+
+
+def per_unit(rng: np.random.Generator, ident: np.ndarray, spread: float) -> Field:
+    """A random value per unit, normal with the given spread."""
+    values = rng.standard_normal(int(ident.max()) + 1) * spread
+    picked: Field = values[ident]
+    return picked
+
+
+def smoothstep(a: float, b: float, t: Field) -> Field:
+    s = np.clip((t - a) / (b - a), 0.0, 1.0)
+    return s * s * (3 - 2 * s)
+
+
+def jointed(
+    units: Units,
+    rng: np.random.Generator,
+    noise_field: Field,
+    joint: float,
+    recess: float,
+    colour_spread: float,
+    mortar: tuple[float, float, float],
+    bevel: float,
+) -> Surface:
+    """Units with recessed joints of ``joint`` metres: the unit colour varies per unit
+    and with noise, the mortar is its own colour, rougher and lower."""
+    face = smoothstep(joint / 2, joint / 2 + bevel, units.edge)  # 0 in the joint, 1 on the face
+    shade = 1.0 + per_unit(rng, units.ident, colour_spread) + 0.04 * noise_field
+    hue = per_unit(rng, units.ident, colour_spread * 0.5)
+    body = np.stack([shade + hue, shade, shade - hue], axis=-1)
+    colour = body * face[..., None] + np.asarray(mortar) * (1 - face[..., None])
+    height = recess * face + 0.0015 * noise_field * face
+    roughness = 0.08 * noise_field + 0.08 * (1 - face)
+    return Surface(height, colour, roughness, np.zeros_like(height), face)
+
+
+# --- the kinds of surface ---------------------------------------------------------------
+
+BRICK, HEADER, JOINT = 0.215, 0.1025, 0.01  # metres: a UK brick, its header face, a joint
+COURSE = 0.065 + JOINT
+
+
+def _bricks(bond: str) -> Callable[[int, float, np.random.Generator], Surface]:
+    stretcher, header = BRICK + JOINT, HEADER + JOINT
+
+    def make(n: int, tile: float, rng: np.random.Generator) -> Surface:
+        x, y = grid(n, tile)
+        count = round(tile / COURSE)
+        courses = []
+        for k in range(count):
+            if bond == "stretcher":
+                courses.append((COURSE, [stretcher], (k % 2) * stretcher / 2))
+            elif bond == "english":
+                courses.append(
+                    (COURSE, [stretcher], 0.0) if k % 2 == 0 else (COURSE, [header], header / 2)
+                )
+            else:  # flemish: stretcher and header alternate, headers centred on stretchers
+                courses.append((COURSE, [stretcher, header], (k % 2) * (stretcher + header) / 2))
+        units = coursed(x, y, tile, courses)
+        grain = noise(rng, n, 0.01, tile)
+        return jointed(units, rng, grain, JOINT, 0.006, 0.08, (0.78, 0.75, 0.70), 0.003)
+
+    return make
+
+
+def _ashlar(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    x, y = grid(n, tile)
+    heights = [0.3, 0.4, 0.3, 0.35, 0.45, 0.3, 0.3]
+    heights = [h * tile / sum(heights) for h in heights]
+    courses = []
+    for height in heights:
+        parts = rng.uniform(0.5, 1.0, size=max(2, round(tile / 0.7)))
+        lengths = list(parts * tile / parts.sum())
+        courses.append((height, lengths, float(rng.uniform(0, tile))))
+    units = coursed(x, y, tile, courses)
+    tooled = noise(rng, n, 0.03, tile)
+    surface = jointed(units, rng, tooled, 0.006, 0.004, 0.05, (0.80, 0.78, 0.74), 0.004)
+    return Surface(
+        surface.height + 0.0008 * noise(rng, n, 0.005, tile),
+        surface.colour,
+        surface.roughness,
+        surface.metal,
+        surface.tinted,
+    )
+
+
+def _render(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    coarse, fine = noise(rng, n, 0.25, tile), noise(rng, n, 0.004, tile)
+    shade = 1.0 + 0.03 * coarse + 0.02 * fine
+    colour = np.repeat(shade[..., None], 3, axis=-1)
+    return Surface(0.0003 * fine + 0.0004 * coarse, colour, 0.05 * fine, np.zeros((n, n)))
+
+
+def _concrete(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    x, y = grid(n, tile)
+    units = coursed(x, y, tile, [(tile / 2, [tile / 2], 0.0)] * 2)  # formwork panels
+    coarse, fine = noise(rng, n, 0.3, tile), noise(rng, n, 0.003, tile)
+    line = smoothstep(0.0, 0.004, units.edge)
+    ties = np.hypot(units.u - 0.5, units.v - 0.5) * tile / 2 > 0.012  # the tie holes
+    shade = 1.0 + 0.05 * coarse + 0.025 * fine + per_unit(rng, units.ident, 0.02)
+    colour = np.repeat((shade * (0.9 + 0.1 * line))[..., None], 3, axis=-1)
+    height = 0.0005 * fine + 0.002 * line + 0.004 * ties - 0.004
+    return Surface(height, colour, 0.05 * coarse, np.zeros((n, n)))
+
+
+def _timber(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    x, y = grid(n, tile)
+    board = tile / round(tile / 0.15)
+    units = coursed(
+        x, y, tile, [(board, [tile], float(rng.uniform(0, tile)))] * round(tile / board)
+    )
+    grain = noise(rng, n, 0.004, tile, aniso=(0.05, 1.0))
+    rings = np.sin(40 * units.v + 3 * noise(rng, n, 0.05, tile, aniso=(0.2, 1.0)))
+    shade = 1.0 + 0.10 * grain + 0.05 * rings + per_unit(rng, units.ident, 0.08)
+    colour = np.stack([shade * 1.02, shade, shade * 0.96], axis=-1)
+    lap = units.v * 0.006 + 0.0008 * grain  # each board laps over the one below
+    face = smoothstep(0.0, 0.003, units.edge)
+    return Surface(lap * face, colour * (0.55 + 0.45 * face[..., None]), 0.06 * grain, 0 * lap)
+
+
+def _metal(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    x, y = grid(n, tile)
+    seams = coursed(x, y, tile, [(tile, [tile / 2], 0.0)])  # standing seams 0.5 m apart
+    brushed = noise(rng, n, 0.002, tile, aniso=(1.0, 0.02))
+    seam = np.exp(-((np.minimum(seams.u, 1 - seams.u) * tile / 2 / 0.01) ** 2))
+    colour = np.repeat((1.0 + 0.03 * brushed)[..., None], 3, axis=-1)
+    height = 0.02 * seam + 0.0002 * brushed
+    return Surface(height, colour, 0.06 * brushed, np.ones((n, n)))
+
+
+def _roof_tiles(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    x, y = grid(n, tile)
+    width, rows = tile / round(tile / 0.2), round(tile / 0.3)
+    courses = [(tile / rows, [width], (k % 2) * width / 2) for k in range(rows)]
+    units = coursed(x, y, tile, courses)
+    profile = np.sin(np.pi * units.u) ** 0.7  # a rounded tile across its width
+    shade = 1.0 + per_unit(rng, units.ident, 0.09) + 0.04 * noise(rng, n, 0.02, tile)
+    colour = np.stack([shade, shade, shade], axis=-1) * (0.75 + 0.25 * profile[..., None])
+    lift = per_unit(rng, units.ident, 0.002)  # no two tiles lie quite alike
+    height = 0.02 * profile + 0.015 * (1 - units.v) + lift  # each course laps the one below
+    return Surface(height, colour, 0.06 * noise(rng, n, 0.01, tile), np.zeros((n, n)))
+
+
+def _slate(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    x, y = grid(n, tile)
+    width, rows = tile / round(tile / 0.25), round(tile / 0.2)
+    courses = [(tile / rows, [width], (k % 2) * width / 2) for k in range(rows)]
+    units = coursed(x, y, tile, courses)
+    cleft = noise(rng, n, 0.01, tile, aniso=(1.0, 0.3))
+    face = smoothstep(0.0, 0.002, units.edge)
+    shade = 1.0 + per_unit(rng, units.ident, 0.08) + 0.04 * cleft
+    colour = np.repeat(shade[..., None], 3, axis=-1) * (0.6 + 0.4 * face[..., None])
+    height = 0.006 * (1 - units.v) * face + 0.0006 * cleft  # each slate's tail is thicker
+    return Surface(height, colour, 0.07 * cleft, np.zeros((n, n)))
+
+
+def _glass(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    wave = noise(rng, n, 0.4, tile)  # float glass is not quite flat: a faint ripple
+    colour = np.ones((n, n, 3))
+    return Surface(0.00015 * wave, colour, 0.0 * wave, np.zeros((n, n)))
+
+
+#: kind -> generator(resolution, tile metres, rng)
+GENERATORS: dict[str, Callable[[int, float, np.random.Generator], Surface]] = {
+    "brick-stretcher": _bricks("stretcher"),
+    "brick-flemish": _bricks("flemish"),
+    "brick-english": _bricks("english"),
+    "ashlar": _ashlar,
+    "render": _render,
+    "concrete": _concrete,
+    "timber": _timber,
+    "metal": _metal,
+    "roof-tiles": _roof_tiles,
+    "slate": _slate,
+    "glass": _glass,
+}
+
+
+def normal_map(height: Field, tile: float) -> np.ndarray:
+    """The tangent-space normals of a height field (metres over a tile of ``tile``
+    metres), with central differences that wrap: +x right, +y up (glTF's convention)."""
+    n = height.shape[0]
+    step = tile / n
+    dx = (np.roll(height, -1, axis=1) - np.roll(height, 1, axis=1)) / (2 * step)
+    dy = (np.roll(height, 1, axis=0) - np.roll(height, -1, axis=0)) / (2 * step)  # row 0 top
+    normal = np.stack([-dx, -dy, np.ones_like(height)], axis=-1)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    return normal
+
+
+def occlusion(height: Field, tile: float) -> Field:
+    """Ambient occlusion from the cavities of a height field: how far a pixel lies below
+    its neighbourhood's mean (a periodic blur of some 2 cm), 1 = open."""
+    n = height.shape[0]
+    radius = 0.02 / (tile / n)
+    depth = np.maximum(0.0, blur(height, radius) - height)
+    open_sky: Field = np.clip(1.0 - depth / 0.004, 0.3, 1.0)
+    return open_sky
+
+
+def srgb(linear: np.ndarray) -> np.ndarray:
+    linear = np.clip(linear, 0.0, 1.0)
+    encoded: np.ndarray = np.where(
+        linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055
+    )
+    return encoded
+
+
+def to_bytes(values: np.ndarray) -> np.ndarray:
+    quantised: np.ndarray = np.round(np.clip(values, 0.0, 1.0) * 255.0).astype(np.uint8)
+    return quantised
+
+
+def texture_set(
+    kind: str,
+    resolution: int,
+    tile: float,
+    seed: int,
+    colour: tuple[float, float, float],
+    roughness: float,
+    metallic: float,
+) -> TextureSet:
+    """The images of a surface kind over one tile: ``colour`` (linear RGB 0..1) is the
+    material's main colour (the bricks', the stone's; joints keep their own), and
+    ``roughness``/``metallic`` the means its maps vary around."""
+    rng = np.random.default_rng([seed, sorted(GENERATORS).index(kind)])
+    surface = GENERATORS[kind](resolution, tile, rng)
+    tinted = np.ones(surface.height.shape) if surface.tinted is None else surface.tinted
+    main = np.asarray(colour)
+    base = surface.colour * (tinted[..., None] * main + (1 - tinted[..., None]))
+    rough = np.clip(roughness + surface.roughness, 0.02, 1.0)
+    metal = np.clip(metallic * surface.metal, 0.0, 1.0) if metallic > 0 else surface.metal * 0
+    # occlusion and roughness in steps of 1/32 and 1/64: finer steps cannot be seen, and
+    # would double the image's size
+    orm = np.stack(
+        [np.round(occlusion(surface.height, tile) * 32) / 32, np.round(rough * 64) / 64, metal],
+        axis=-1,
+    )
+    normal = normal_map(surface.height, tile) * 0.5 + 0.5
+    return TextureSet(to_bytes(srgb(base)), to_bytes(normal), to_bytes(orm))

@@ -1,0 +1,266 @@
+"""The material library: procedural PBR texture sets named by specs, in glb, OBJ and USD."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from PIL import Image
+
+from facadecli import load_spec, solve
+from facadecli.export.glb_merge import merge_glb, read_glb
+from facadecli.export.gltf import glb_bytes
+from facadecli.export.textures import png
+from facadecli.geometry.facade import facade_scene, material_extensions
+from facadecli.materials import LIBRARY, TILES, Images, images
+from facadecli.materials.library import _images
+from facadecli.spec import parse_spec
+from tests.running import facade, files
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = sorted((ROOT / "specs").glob("*.yaml"))
+
+WALL = """
+version: 1
+name: wall
+canvas: {width: 6, height: 3}
+symbol_defaults: {opaque: true}
+symbols: {A: 1.0, B: 1.0}
+counters: {k: {min: 1}}
+patterns: {x: "A (B A)^k", y: "A"}
+layers: [{name: base, x: x, y: y}]
+shapes:
+  - {match: {x: B}, material: %s}
+materials: %s
+defaults: {mesh: box, material: wall, thickness: 0.2}
+"""
+
+
+def _wall(rule: str, materials: str) -> bytes:
+    spec = parse_spec(WALL % (rule, materials))
+    return glb_bytes(facade_scene(solve(spec)), material_extensions(spec))
+
+
+def _small(name: str, **fields: object) -> Images:
+    """A library material's pictures at 64 px, drawn afresh (not from the cache)."""
+    material = LIBRARY[name].model_copy(update={"resolution": 64, **fields})
+    drawn: Images = _images.__wrapped__(material)
+    return drawn
+
+
+@pytest.mark.parametrize("name", sorted(LIBRARY))
+def test_the_same_material_and_seed_draw_the_same_bytes(name: str) -> None:
+    first = _small(name)
+    again = _small(name, seed=0, scale=1.0)
+    assert first.normal is not again.normal  # drawn twice
+    other = _small(name, seed=7)
+    for slot in ("base_colour", "normal", "orm"):
+        assert png(getattr(first, slot)) == png(getattr(again, slot))
+    if name != "float-glass":  # glass is a flat colour: only its ripple moves with the seed
+        assert png(first.base_colour) != png(other.base_colour)
+    assert png(first.normal) != png(other.normal)
+
+
+def _jump(image: np.ndarray) -> tuple[float, float]:
+    """The mean colour step across the wrap (last column to first) and the largest mean
+    step between two neighbouring columns inside the image."""
+    values = image.astype(float)
+    inside = np.abs(np.diff(values, axis=1)).mean(axis=(0, 2))
+    wrap = np.abs(values[:, 0] - values[:, -1]).mean()
+    return float(wrap), float(inside.max())
+
+
+@pytest.mark.parametrize("name", sorted(LIBRARY))
+def test_every_texture_tiles_across_both_edges(name: str) -> None:
+    drawn = images(LIBRARY[name].model_copy(update={"resolution": 128}))
+    for slot in ("base_colour", "normal", "orm"):
+        image = np.asarray(getattr(drawn, slot))
+        for turned in (image, image.transpose(1, 0, 2)):  # left-right, then top-bottom
+            wrap, inside = _jump(turned)
+            assert wrap <= 1.5 * inside + 1.0, (slot, wrap, inside)
+
+
+def test_two_runs_write_the_same_files(tmp_path: Path) -> None:
+    """Two processes (no cache shared) solving one spec write byte-identical glb, OBJ,
+    MTL, USD and pictures."""
+    spec = ROOT / "specs" / "residential-house.yaml"
+    for run in ("a", "b"):
+        command = [sys.executable, "-m", "facadecli", "solve", str(spec), "-o", str(tmp_path / run)]
+        subprocess.run([*command, "-f", "glb,obj,usd"], check=True, capture_output=True)
+    first = {p.name: p.read_bytes() for p in (tmp_path / "a").iterdir()}
+    assert len([n for n in first if n.endswith(".png")]) >= 9
+    assert first == {p.name: p.read_bytes() for p in (tmp_path / "b").iterdir()}
+
+
+def test_the_tiling_check_sees_a_seam() -> None:
+    """The check above fails on a picture that does not wrap (a ramp)."""
+    ramp = np.tile(np.linspace(0, 255, 128)[None, :, None], (128, 1, 3)).astype(np.uint8)
+    wrap, inside = _jump(ramp)
+    assert not wrap <= 1.5 * inside + 1.0
+
+
+def test_a_brick_tile_holds_whole_courses_and_bricks() -> None:
+    """The library's tiles are whole numbers of courses (75 mm) and of their bond's repeat,
+    so that the bond runs on across copies."""
+    for name, repeat in (("brick-stretcher", 0.225), ("brick-english", 0.225)):
+        assert TILES[name] / 0.075 == pytest.approx(round(TILES[name] / 0.075))
+        assert TILES[name] / repeat == pytest.approx(round(TILES[name] / repeat))
+    assert TILES["brick-flemish"] / 0.3375 == pytest.approx(4)
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_every_material_of_the_examples_has_a_base_colour_and_a_normal_texture(
+    path: Path,
+) -> None:
+    spec = load_spec(path)
+    document, _ = read_glb(glb_bytes(facade_scene(solve(spec), path.parent)))
+    assert document["materials"]
+    for material in document["materials"]:
+        assert "baseColorTexture" in material["pbrMetallicRoughness"], material["name"]
+        assert "normalTexture" in material, material["name"]
+    sources = [texture["source"] for texture in document["textures"]]
+    assert len(sources) == len(set(sources))  # one texture per picture
+    views = [image["bufferView"] for image in document["images"]]
+    assert len(views) == len(set(views))  # one image per picture
+    for mesh in document["meshes"]:
+        for primitive in mesh["primitives"]:
+            assert {"TEXCOORD_0", "NORMAL", "TANGENT"} <= set(primitive["attributes"])
+
+
+def test_materials_sharing_a_picture_share_one_image() -> None:
+    """Two spec materials from one library entry with the same colour draw the same
+    pictures: the glb holds them once, and both materials point at them."""
+    data = _wall("trim", "{wall: {library: render}, trim: {library: render, roughness: 0.9}}")
+    document, _ = read_glb(data)
+    assert len(document["materials"]) == 2
+    assert len(document["images"]) == 3  # base colour, normal, occlusion-roughness-metallic
+    first, second = document["materials"]
+    assert first["normalTexture"] == second["normalTexture"]
+    packed = first["pbrMetallicRoughness"]["metallicRoughnessTexture"]
+    assert first["occlusionTexture"] == packed  # occlusion rides in the same picture's red
+
+
+def test_overrides_change_the_pictures_and_their_size() -> None:
+    plain = LIBRARY["brick-flemish"].model_copy(update={"resolution": 64})
+    tinted = images(plain.model_copy(update={"color": "#404040"}))
+    assert png(tinted.base_colour) != png(images(plain).base_colour)
+    assert png(tinted.normal) == png(images(plain).normal)  # the colour does not move bricks
+    assert images(plain.model_copy(update={"scale": 2.0})).size == 2 * TILES["brick-flemish"]
+    data = _wall("brick-flemish", "{wall: {library: brick-flemish, color: '#503020'}}")
+    # two colours of one brick: two base colours, one normal and one packed picture shared
+    assert len(read_glb(data)[0]["images"]) == 4
+
+
+def test_glass_reflects_and_bends_light() -> None:
+    document, _ = read_glb(_wall("float-glass", "{wall: {library: render}}"))
+    (glass,) = [m for m in document["materials"] if m["name"] == "float-glass"]
+    assert glass["pbrMetallicRoughness"]["metallicFactor"] == 1.0  # the picture's blue: 0
+    assert glass["extensions"]["KHR_materials_ior"] == {"ior": 1.52}
+    assert "KHR_materials_transmission" in glass["extensions"]
+    assert LIBRARY["float-glass"].roughness < 0.1 and LIBRARY["float-glass"].metallic == 0
+
+
+def test_wall_texture_coordinates_are_metres_over_the_tile() -> None:
+    """A wall's texture runs on across its cells: every front corner's coordinates are
+    its position over the tile's size, whichever cell it belongs to."""
+    spec = parse_spec(WALL % ("wall", "{wall: {library: brick-english}}"))
+    scene = facade_scene(solve(spec))
+    walls = [scene.geometry[scene.graph[n][1]] for n in scene.graph.nodes_geometry]
+    assert walls
+    for mesh in walls:
+        front = mesh.face_normals[:, 2] > 0.99
+        corners = np.unique(mesh.faces[front])
+        uv = mesh.visual.uv[corners]
+        expected = mesh.vertices[corners][:, :2] / TILES["brick-english"]
+        assert uv == pytest.approx(expected, abs=1e-9)
+
+
+def test_a_spec_without_library_materials_has_no_pictures() -> None:
+    data = _wall("wall", "{wall: {color: '#c9a27e'}}")
+    assert "images" not in read_glb(data)[0]
+
+
+def test_obj_and_usd_name_the_pictures_written_beside_them(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    spec = ROOT / "specs" / "townhouse.yaml"
+    code, _, err = facade(capsys, "solve", str(spec), "-o", str(tmp_path), "-f", "obj,usd")
+    assert code == 0, err
+    mtl = (tmp_path / "townhouse.mtl").read_text()
+    entries = mtl.split("newmtl ")[1:]
+    assert len(entries) >= 5  # brick, sandstone, granite, glass, frames, ...
+    for entry in entries:
+        for key in ("map_Kd", "norm", "map_Pr", "map_Pm"):
+            (line,) = [x for x in entry.splitlines() if x.startswith(key + " ")]
+            assert (tmp_path / line.split()[-1]).is_file(), line
+    stage = (tmp_path / "townhouse.usda").read_text()
+    named = re.findall(r"asset inputs:file = @\./([^@]+)@", stage)
+    assert len(named) == 3 * len(entries)
+    assert all((tmp_path / name).is_file() for name in named)
+    for name in set(named):
+        with Image.open(tmp_path / name) as image:
+            assert image.format == "PNG"
+    mesh = trimesh.load(tmp_path / "townhouse.obj", force="mesh")
+    assert len(mesh.faces) > 0
+    pictures = {p.name for p in tmp_path.glob("*.png")}
+    assert pictures == set(named)  # OBJ and USD name the same files, and nothing else is left
+
+
+def test_a_city_stores_each_picture_once(tmp_path: Path) -> None:
+    data = _wall("brick-flemish", "{wall: {library: render}}")
+    for name in ("a", "b"):
+        (tmp_path / f"{name}.glb").write_bytes(data)
+    merge_glb([(n, tmp_path / f"{n}.glb") for n in ("a", "b")], tmp_path / "city.glb")
+    merged, binary = read_glb((tmp_path / "city.glb").read_bytes())
+    alone, alone_binary = read_glb(data)
+    assert len(merged["images"]) == len(alone["images"])
+    pictures = sum(alone["bufferViews"][i["bufferView"]]["byteLength"] for i in alone["images"])
+    assert len(binary) <= 2 * len(alone_binary) - pictures + 16
+    for material in merged["materials"]:
+        index = material["normalTexture"]["index"]
+        assert merged["textures"][index]["source"] < len(merged["images"])
+
+
+@pytest.mark.parametrize(
+    ("where", "text", "said"),
+    [
+        ("rule", "brick-flemsh", "did you mean 'brick-flemish'"),
+        ("library", "slat", "did you mean 'slate'"),
+    ],
+)
+def test_unknown_library_names_are_refused_with_their_place(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, where: str, text: str, said: str
+) -> None:
+    rule, materials = (
+        (text, "{wall: {color: '#ffffff'}}")
+        if where == "rule"
+        else ("wall", f"{{wall: {{library: {text}}}}}")
+    )
+    path = tmp_path / "bad.yaml"
+    path.write_text(WALL % (rule, materials))
+    code, _, err = facade(capsys, "solve", str(path), "-o", str(tmp_path / "out"))
+    assert code == 2, err
+    text_lines = path.read_text().splitlines()
+    line = (
+        1 + next(i for i, row in enumerate(text_lines) if text in row and "match" in row)
+        if (where == "rule")
+        else 1 + next(i for i, row in enumerate(text_lines) if f"library: {text}" in row)
+    )
+    assert re.search(rf"bad\.yaml:{line}:\d+:", err), err
+    assert said in err and "Traceback" not in err
+    assert files(tmp_path / "out") == []
+
+
+def test_library_fields_without_a_library_are_refused(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    path = tmp_path / "bad.yaml"
+    path.write_text(WALL % ("wall", "{wall: {color: '#ffffff', scale: 2}}"))
+    code, _, err = facade(capsys, "solve", str(path), "-o", str(tmp_path / "out"))
+    line = 1 + next(i for i, row in enumerate(path.read_text().splitlines()) if "scale" in row)
+    assert code == 2 and f"bad.yaml:{line}:" in err and "library" in err, err
