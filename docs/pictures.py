@@ -29,10 +29,10 @@ PICTURES: dict[str, tuple[str, str, str]] = {
     "townhouse": ("townhouse", "model", "35,10,1,0.5,0.5"),
     "parts": ("parts", "model", "35,10,1.1,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
-    "part-door": ("parts", "model", "25,5,4,0.17,0.25"),
-    "part-arch-shutters": ("parts", "model", "-30,5,3.6,0.45,0.27"),
-    "part-balcony": ("parts", "model", "45,20,3.6,0.82,0.5"),
-    "part-sill": ("parts", "model", "50,25,4,0.25,0.65"),
+    "part-door": ("parts", "model", "25,5,2.6,0.17,0.25"),
+    "part-arch-shutters": ("parts", "model", "-30,5,2.5,0.45,0.27"),
+    "part-balcony": ("parts", "model", "45,20,2.4,0.82,0.5"),
+    "part-sill": ("parts", "model", "50,25,2.6,0.25,0.65"),
     "part-ledge": ("parts", "model", "-60,-15,3.2,0.15,0.9"),
 }
 
