@@ -210,7 +210,7 @@ function castsShadows(model) {  // everything opaque casts and takes shadows; gl
   model.traverse(part => {
     if (!part.isMesh) return;
     const materials = Array.isArray(part.material) ? part.material : [part.material];
-    part.castShadow = materials.every(material => !material.transparent);
+    part.castShadow = materials.every(m => !m.transparent && !(m.transmission > 0));
     part.receiveShadow = true;
   });
 }
