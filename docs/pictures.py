@@ -21,20 +21,20 @@ WINDOW = "900,560"
 
 # picture name -> (spec, what: "model" or "elevation", camera: around, up, zoom, x, y)
 PICTURES: dict[str, tuple[str, str, str]] = {
-    "centred-bay": ("centred-bay", "model", "35,10,1.3,0.5,0.5"),
-    "qualifiers": ("qualifiers", "model", "35,10,1.3,0.5,0.5"),
-    "residential-house": ("residential-house", "model", "35,10,1.3,0.5,0.5"),
-    "shop-front": ("shop-front", "model", "35,10,1.3,0.5,0.5"),
-    "terraced-house": ("terraced-house", "model", "35,10,1.3,0.5,0.5"),
-    "townhouse": ("townhouse", "model", "35,10,1.3,0.5,0.5"),
-    "townhouse-street": ("townhouse", "model", "25,3,2.2,0.5,0.3"),
-    "parts": ("parts", "model", "35,10,1.5,0.5,0.5"),
+    "centred-bay": ("centred-bay", "model", "35,10,1,0.5,0.5"),
+    "qualifiers": ("qualifiers", "model", "35,10,1,0.5,0.5"),
+    "residential-house": ("residential-house", "model", "35,10,1,0.5,0.5"),
+    "shop-front": ("shop-front", "model", "35,10,1,0.5,0.5"),
+    "terraced-house": ("terraced-house", "model", "35,10,1,0.5,0.5"),
+    "townhouse": ("townhouse", "model", "35,10,1,0.5,0.5"),
+    "townhouse-street": ("townhouse", "model", "25,3,1.7,0.5,0.3"),
+    "parts": ("parts", "model", "35,10,1.1,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
-    "part-door": ("parts", "model", "25,5,5,0.17,0.25"),
-    "part-arch-shutters": ("parts", "model", "-30,5,4.5,0.45,0.27"),
-    "part-balcony": ("parts", "model", "45,20,4.5,0.82,0.5"),
-    "part-sill": ("parts", "model", "50,25,5,0.25,0.65"),
-    "part-ledge": ("parts", "model", "-60,-15,4,0.15,0.9"),
+    "part-door": ("parts", "model", "25,5,2.6,0.17,0.25"),
+    "part-arch-shutters": ("parts", "model", "-30,5,2.5,0.45,0.27"),
+    "part-balcony": ("parts", "model", "45,20,2.4,0.82,0.5"),
+    "part-sill": ("parts", "model", "50,25,2.6,0.25,0.65"),
+    "part-ledge": ("parts", "model", "-60,-15,3.2,0.15,0.9"),
 }
 
 

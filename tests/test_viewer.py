@@ -35,6 +35,7 @@ def test_the_page_holds_everything_it_shows(tmp_path: Path) -> None:
     assert '<script type="importmap">' in text and "data:text/javascript;base64," in text
     assert '<script id="glb" type="application/octet-stream">Z2xURg' in text  # "glTF"
     assert "<svg" in text and "MIT licence" in text
+    assert "three/addons/postprocessing/GTAOPass.js" in text  # ambient occlusion, bundled
     assert not re.search(r"(src|href)=[\"']https?://", text)  # nothing fetched at view time
 
 
@@ -68,6 +69,43 @@ def test_a_browser_shows_the_model(tmp_path: Path) -> None:
     shot, dom = _browse(tmp_path, _page(tmp_path).as_uri())
     assert "<title>townhouse</title>" in dom  # the model loaded ("loading: " is gone)
     assert _drawn(shot, 0, 3 / 5)
+
+
+def _lit(shot: Path) -> tuple[float, int]:
+    """In a screenshot of a model alone (``?bare``) standing on the ground: the spread of
+    brightness across the model's columns, and how many pixels of the ground right of the
+    model are darker than the haze behind it by more than a tenth (its shadow, the sun
+    being on the left)."""
+    from PIL import Image, ImageStat
+
+    with Image.open(shot) as image:
+        grey = image.convert("L")
+    haze = grey.getpixel((2, 2))
+    assert isinstance(haze, int)
+    band = grey.crop((0, 0, grey.width, grey.height // 4))  # above the ground: model or haze
+    darkest = [min(band.crop((x, 0, x + 1, band.height)).tobytes()) for x in range(band.width)]
+    columns = [x for x, value in enumerate(darkest) if value < haze - 12]
+    assert columns, "no model drawn"
+    model = grey.crop((min(columns), 0, max(columns) + 1, grey.height))
+    beside = grey.crop((max(columns) + 8, grey.height // 2, grey.width, grey.height))
+    shaded = sum(1 for value in beside.tobytes() if value < haze - 25)
+    return ImageStat.Stat(model).stddev[0], shaded
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+@pytest.mark.parametrize("example", ["townhouse", "shop-front"])
+def test_the_model_is_lit_and_shades_the_ground(tmp_path: Path, example: str) -> None:
+    """A sun from the front left: the walls, reveals and glass read in light and shade, and
+    the building's shadow darkens the ground beside it (the old viewer's flat light on a
+    plain backdrop had neither)."""
+    layout = solve(load_spec(ROOT / "specs" / f"{example}.yaml"))
+    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
+    shot, dom = _browse(tmp_path, path.as_uri() + "?bare&view=0,10,1,0.5,0.5")
+    assert f"<title>{example}</title>" in dom
+    spread, shaded = _lit(shot)
+    assert spread > 10
+    assert shaded > 2000  # of 1000 x 600; the old viewer's backdrop: none
 
 
 # ``facade view``: a gallery of a folder's models

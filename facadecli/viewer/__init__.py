@@ -18,14 +18,33 @@ from html import escape
 from importlib import resources
 
 THREE_VERSION = "0.160.0"
-# specifier -> bundled file; relative imports between the files are made bare specifiers
+# specifier -> bundled file
 MODULES = {
     "three": "three.module.min.js",
     "three/addons/utils/BufferGeometryUtils.js": "BufferGeometryUtils.js",
     "three/addons/loaders/GLTFLoader.js": "GLTFLoader.js",
     "three/addons/controls/OrbitControls.js": "OrbitControls.js",
+    "three/addons/math/SimplexNoise.js": "SimplexNoise.js",
+    "three/addons/shaders/CopyShader.js": "CopyShader.js",
+    "three/addons/shaders/OutputShader.js": "OutputShader.js",
+    "three/addons/shaders/GTAOShader.js": "GTAOShader.js",
+    "three/addons/shaders/PoissonDenoiseShader.js": "PoissonDenoiseShader.js",
+    "three/addons/postprocessing/Pass.js": "Pass.js",
+    "three/addons/postprocessing/MaskPass.js": "MaskPass.js",
+    "three/addons/postprocessing/ShaderPass.js": "ShaderPass.js",
+    "three/addons/postprocessing/EffectComposer.js": "EffectComposer.js",
+    "three/addons/postprocessing/RenderPass.js": "RenderPass.js",
+    "three/addons/postprocessing/GTAOPass.js": "GTAOPass.js",
+    "three/addons/postprocessing/OutputPass.js": "OutputPass.js",
 }
-RELATIVE = {"'../utils/BufferGeometryUtils.js'": "'three/addons/utils/BufferGeometryUtils.js'"}
+# how the bundled modules import each other ('../shaders/X.js', './X.js'): the files lie
+# side by side here, so each relative import is made the bare specifier of its file
+RELATIVE = {
+    f"'{relative}'": f"'{spec}'"
+    for spec in MODULES
+    if spec.startswith("three/addons/")
+    for relative in (spec.replace("three/addons/", "../"), "./" + spec.rsplit("/", 1)[1])
+}
 
 
 def _module(name: str) -> str:
@@ -47,22 +66,125 @@ VIEWER = """
 import * as THREE from 'three';
 import {GLTFLoader} from 'three/addons/loaders/GLTFLoader.js';
 import {OrbitControls} from 'three/addons/controls/OrbitControls.js';
+import {EffectComposer} from 'three/addons/postprocessing/EffectComposer.js';
+import {RenderPass} from 'three/addons/postprocessing/RenderPass.js';
+import {GTAOPass} from 'three/addons/postprocessing/GTAOPass.js';
+import {OutputPass} from 'three/addons/postprocessing/OutputPass.js';
+import {SimplexNoise} from 'three/addons/math/SimplexNoise.js';
 const view = document.getElementById('model');
 const status = document.getElementById('status');
 const renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
 renderer.setPixelRatio(window.devicePixelRatio);
+renderer.toneMapping = THREE.ACESFilmicToneMapping;  // filmic: highlights roll off, no clipping
+renderer.toneMappingExposure = 0.8;  // three's ACES brightens by 1/0.6: pale walls kept from white
+renderer.outputColorSpace = THREE.SRGBColorSpace;
+renderer.shadowMap.enabled = true;
+renderer.shadowMap.type = THREE.PCFSoftShadowMap;
+renderer.shadowMap.autoUpdate = false;  // the scene holds still: drawn again when a model comes
 view.appendChild(renderer.domElement);
+// The light of an overcast-bright day: a sky dome (blue overhead, pale at the horizon, a warm
+// glow round the sun, grey-brown ground below), prefiltered (PMREM) into the environment
+// every material is lit and reflects by, and a sun casting soft shadows.
+const SKY = 0xe9edf2;  // the backdrop and the haze the ground fades into
+const sunDirection = new THREE.Vector3(-0.45, 0.72, 0.53).normalize();  // front left, 46 degrees up
+function skyEnvironment() {
+  const dome = new THREE.SphereGeometry(1, 96, 48);
+  const zenith = new THREE.Color(0x86a9d6), horizon = new THREE.Color(0xf1f4f7);
+  const ground = new THREE.Color(0x7a7266), glow = new THREE.Color(0xfff1dc);
+  const colours = [], normal = new THREE.Vector3(), colour = new THREE.Color();
+  const points = dome.attributes.position;
+  for (let i = 0; i < points.count; i++) {
+    normal.fromBufferAttribute(points, i);
+    if (normal.y >= 0) colour.copy(horizon).lerp(zenith, Math.pow(normal.y, 0.6));
+    else colour.copy(horizon).lerp(ground, Math.min(1, -normal.y * 5));
+    colour.multiplyScalar(0.6).add(glow.clone().multiplyScalar(
+      3 * Math.pow(Math.max(0, normal.dot(sunDirection)), 24)));
+    colours.push(colour.r, colour.g, colour.b);
+  }
+  dome.setAttribute('color', new THREE.Float32BufferAttribute(colours, 3));
+  const sky = new THREE.Scene();
+  const material = new THREE.MeshBasicMaterial({vertexColors: true, side: THREE.BackSide});
+  sky.add(new THREE.Mesh(dome, material));
+  const prefilter = new THREE.PMREMGenerator(renderer);
+  const environment = prefilter.fromScene(sky, 0.02).texture;
+  prefilter.dispose(); dome.dispose(); material.dispose();
+  return environment;
+}
 const scene = new THREE.Scene();
-scene.background = new THREE.Color(0xdddddd);
-scene.add(new THREE.HemisphereLight(0xffffff, 0x666666, 2.0));
-const sun = new THREE.DirectionalLight(0xffffff, 2.0);
-sun.position.set(5, 10, 8);
-scene.add(sun);
+scene.background = new THREE.Color(SKY);
+scene.environment = skyEnvironment();
+scene.fog = new THREE.Fog(SKY, 1, 2);  // placed by frame(): the model clear, the ground fading out
+const sun = new THREE.DirectionalLight(0xfff3e0, 3.4);
+sun.castShadow = true;
+sun.shadow.bias = -0.0002;
+scene.add(sun, sun.target);
+const ground = new THREE.Mesh(  // takes the shadows; large enough to reach the haze
+  new THREE.CircleGeometry(1, 64).rotateX(-Math.PI / 2),
+  new THREE.MeshStandardMaterial({color: 0xc9c4b9, roughness: 0.95}));
+ground.receiveShadow = true;
+ground.visible = false;
+scene.add(ground);
 const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 5000);
 const controls = new OrbitControls(camera, renderer.domElement);
+// Ambient occlusion (GTAO) between the scene's render and the output pass (tone mapping and
+// sRGB); WebGL 1 draws without it. Its noise is seeded, so a picture is the same each time.
+class SteadyGTAOPass extends GTAOPass {
+  generateNoise(size = 64) {
+    let seed = 1;  // mulberry32
+    const random = () => {
+      seed = (seed + 0x6D2B79F5) | 0;
+      let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
+      t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
+      return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+    };
+    const simplex = new SimplexNoise({random});
+    const data = new Uint8Array(size * size * 4);
+    for (let i = 0; i < size; i++) for (let j = 0; j < size; j++) {
+      const at = (i * size + j) * 4;
+      data[at] = (simplex.noise(i, j) * 0.5 + 0.5) * 255;
+      data[at + 1] = (simplex.noise(i + size, j) * 0.5 + 0.5) * 255;
+      data[at + 2] = (simplex.noise(i, j + size) * 0.5 + 0.5) * 255;
+      data[at + 3] = (simplex.noise(i + size, j + size) * 0.5 + 0.5) * 255;
+    }
+    const noise = new THREE.DataTexture(data, size, size);
+    noise.wrapS = noise.wrapT = THREE.RepeatWrapping;
+    noise.needsUpdate = true;
+    return noise;
+  }
+}
+let composer = null, occlusion = null;
+if (renderer.capabilities.isWebGL2) {
+  const target = new THREE.WebGLRenderTarget(1, 1, {type: THREE.HalfFloatType, samples: 4});
+  composer = new EffectComposer(renderer, target);
+  composer.addPass(new RenderPass(scene, camera));
+  occlusion = new SteadyGTAOPass(scene, camera, 1, 1);
+  occlusion.updateGtaoMaterial({samples: 16, distanceExponent: 1, thickness: 1, scale: 1});
+  occlusion.updatePdMaterial(
+    {lumaPhi: 10, depthPhi: 2, normalPhi: 3, radius: 6, rings: 2, samples: 16});
+  occlusion.blendIntensity = 0.85;
+  // normals from the depth buffer: glTF without normals (drawn flat) has none to give
+  for (const material of [occlusion.gtaoMaterial, occlusion.pdMaterial]) {
+    material.defines.NORMAL_VECTOR_TYPE = 0;
+  }
+  composer.addPass(occlusion);
+  composer.addPass(new OutputPass());
+}
+let drawing = false;  // one drawing per frame, only when something changed
+function redraw() {
+  if (drawing) return;
+  drawing = true;
+  requestAnimationFrame(() => {
+    drawing = false;
+    controls.update();
+    if (composer) composer.render(); else renderer.render(scene, camera);
+  });
+}
+controls.addEventListener('change', redraw);
 function resize() {
   const w = view.clientWidth, h = view.clientHeight;
   renderer.setSize(w, h); camera.aspect = w / h; camera.updateProjectionMatrix();
+  if (composer) { composer.setPixelRatio(window.devicePixelRatio); composer.setSize(w, h); }
+  redraw();
 }
 let shown = null, asked = 0, moved = false;  // moved: turned by the user since framed
 controls.addEventListener('start', () => { moved = true; });
@@ -84,32 +206,114 @@ function dispose(object) {
     }
   });
 }
+function castsShadows(model) {  // everything opaque casts and takes shadows; glass lets light by
+  model.traverse(part => {
+    if (!part.isMesh) return;
+    const materials = Array.isArray(part.material) ? part.material : [part.material];
+    part.castShadow = materials.every(m => !m.transparent && !(m.transmission > 0));
+    part.receiveShadow = true;
+  });
+}
 // ?view=ANGLE,ELEVATION,ZOOM,X,Y: seen from ANGLE degrees around and ELEVATION up, ZOOM
 // times closer, looking at the point X, Y (0..1 across the model); ?bare: the model alone
 const query = new URLSearchParams(location.search);
 const [around, up, zoom, atX, atY] = (query.get('view') || '').split(',').map(parseFloat);
 const or = (value, fallback) => Number.isFinite(value) ? value : fallback;
 if (query.has('bare')) document.body.classList.add('bare');
-function frame(model) {  // the model's bounding sphere fills the view, seen from 35 degrees
-  resize();
-  const box = new THREE.Box3().setFromObject(model);
-  const centre = box.isEmpty() ? new THREE.Vector3() : box.getCenter(new THREE.Vector3());
-  const size = box.isEmpty() ? 10 : Math.max(box.getSize(new THREE.Vector3()).length(), 0.01);
-  if (!box.isEmpty()) {
-    centre.x = box.min.x + or(atX, 0.5) * (box.max.x - box.min.x);
-    centre.y = box.min.y + or(atY, 0.5) * (box.max.y - box.min.y);
-  }
+function corners(box) {
+  const {min, max} = box;
+  return [0, 1, 2, 3, 4, 5, 6, 7].map(i => new THREE.Vector3(
+    i & 1 ? max.x : min.x, i & 2 ? max.y : min.y, i & 4 ? max.z : min.z));
+}
+// The camera's distance at which the box's eight corners fit the view (a margin of 8%):
+// a facade fills the picture, a district is seen whole.
+function fitDistance(box, centre, direction) {
   const vertical = camera.fov * Math.PI / 180;
-  const horizontal = 2 * Math.atan(Math.tan(vertical / 2) * camera.aspect);
-  const distance = 1.1 * (size / 2) / Math.sin(Math.min(vertical, horizontal) / 2) / or(zoom, 1);
-  const angle = or(around, 35) * Math.PI / 180, rise = or(up, 8.5) * Math.PI / 180;
-  const direction = new THREE.Vector3(
-    Math.sin(angle) * Math.cos(rise), Math.sin(rise), Math.cos(angle) * Math.cos(rise));
-  camera.position.copy(centre).addScaledVector(direction, distance);
-  camera.near = distance / 1000; camera.far = distance * 20; controls.maxDistance = distance * 10;
+  const tanV = Math.tan(vertical / 2) / 1.08, tanH = tanV * camera.aspect;
+  const right = new THREE.Vector3(0, 1, 0).cross(direction).normalize();
+  const upward = direction.clone().cross(right);
+  let distance = 0;
+  for (const corner of corners(box)) {
+    const offset = corner.sub(centre);
+    const depth = offset.dot(direction);
+    distance = Math.max(distance,
+      depth + Math.abs(offset.dot(right)) / tanH, depth + Math.abs(offset.dot(upward)) / tanV);
+  }
+  return distance;
+}
+// The sun's shadow camera fitted round the model's box, seen from the sun, so a facade and a
+// district both get shadows as sharp as the map allows.
+function fitSun(box, centre, radius) {
+  sun.position.copy(centre).addScaledVector(sunDirection, 2 * radius);
+  sun.target.position.copy(centre);
+  const right = new THREE.Vector3(0, 1, 0).cross(sunDirection).normalize();
+  const upward = sunDirection.clone().cross(right);
+  const shadow = sun.shadow.camera;
+  shadow.left = shadow.bottom = Infinity; shadow.right = shadow.top = -Infinity;
+  for (const corner of corners(box)) {
+    const offset = corner.sub(centre);
+    const x = offset.dot(right), y = offset.dot(upward);
+    shadow.left = Math.min(shadow.left, x); shadow.right = Math.max(shadow.right, x);
+    shadow.bottom = Math.min(shadow.bottom, y); shadow.top = Math.max(shadow.top, y);
+  }
+  const extent = Math.max(shadow.right - shadow.left, shadow.top - shadow.bottom);
+  const size = extent > 60 ? 4096 : 2048;
+  shadow.left -= extent / 50; shadow.right += extent / 50;
+  shadow.bottom -= extent / 50; shadow.top += extent / 50;
+  shadow.near = radius / 2;
+  shadow.far = 3 * radius + (box.max.y - box.min.y) / sunDirection.y;
+  shadow.updateProjectionMatrix();
+  if (sun.shadow.mapSize.x !== size) {
+    sun.shadow.mapSize.set(size, size);
+    if (sun.shadow.map) { sun.shadow.map.dispose(); sun.shadow.map = null; }
+  }
+  sun.shadow.normalBias = 1.5 * extent / size;
+  renderer.shadowMap.needsUpdate = true;
+}
+const SEEN_FROM = 35;  // degrees round from the front, unless ?view says otherwise
+function bounds(model) {
+  const box = new THREE.Box3().setFromObject(model);
+  if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(10, 10, 10));
+  const size = box.getSize(new THREE.Vector3());
+  const district = Math.min(size.x, size.z) > 2 * size.y;  // wider and deeper than tall
+  return {box, size, centre: box.getCenter(new THREE.Vector3()),
+          radius: Math.max(size.length() / 2, 0.01), rise: district ? 30 : 8.5};
+}
+function direction(angle, rise) {
+  const a = angle * Math.PI / 180, r = rise * Math.PI / 180;
+  return new THREE.Vector3(Math.sin(a) * Math.cos(r), Math.sin(r), Math.cos(a) * Math.cos(r));
+}
+// The ground, the haze, the sun's shadows and the ambient occlusion's reach, fitted to the
+// model as first framed (not to where the camera is turned: a picture is the same each time)
+function light(model) {
+  const {box, centre, radius, rise} = bounds(model);
+  const fit = fitDistance(box, centre, direction(SEEN_FROM, rise));
+  const haze = fit + 2 * radius;
+  scene.fog.near = haze; scene.fog.far = 4 * haze;
+  ground.position.set(centre.x, box.min.y - radius * 1e-4, centre.z);
+  ground.scale.setScalar(4 * haze);
+  ground.visible = true;
+  fitSun(box, centre, radius);
+  // AO reaches about as far as a window's reveal on a facade, a yard in a district
+  if (occlusion) occlusion.updateGtaoMaterial({radius: Math.max(0.3, fit / 60)});
+  redraw();
+}
+function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a district from 30
+  resize();
+  const {box, size, centre, radius, rise} = bounds(model);
+  const seen = direction(or(around, SEEN_FROM), or(up, rise));
+  const fit = fitDistance(box, centre, seen);
+  const target = centre.clone();
+  target.x = box.min.x + or(atX, 0.5) * size.x;
+  target.y = box.min.y + or(atY, 0.5) * size.y;
+  const distance = fit / or(zoom, 1);
+  camera.position.copy(target).addScaledVector(seen, distance);
+  camera.near = distance / 1000; camera.far = distance * 20 + 8 * radius;
+  controls.maxDistance = distance * 10;
   camera.updateProjectionMatrix();
-  controls.target.copy(centre); controls.update();
+  controls.target.copy(target); controls.update();
   moved = false;
+  redraw();
 }
 function show(id, keep = false) {  // keep: the camera where the user turned it, if they did
   const mine = ++asked;
@@ -122,7 +326,9 @@ function show(id, keep = false) {  // keep: the camera where the user turned it,
     if (mine !== asked) { dispose(gltf.scene); return; }
     if (shown) { scene.remove(shown); dispose(shown); }
     shown = gltf.scene;
+    castsShadows(shown);
     scene.add(shown);
+    light(shown);
     if (!(keep && moved)) frame(shown);
     status.textContent = 'drag to orbit, scroll to zoom';
     document.title = document.title.replace('loading: ', '');
@@ -131,7 +337,6 @@ function show(id, keep = false) {  // keep: the camera where the user turned it,
   });
 }
 resize();
-renderer.setAnimationLoop(() => { controls.update(); renderer.render(scene, camera); });
 window.facadeShow = show;  // for a page's own scripts (facade watch swaps the model)
 """
 
