@@ -1,10 +1,10 @@
-"""The compiled inner loop of the grammar search, and the example specs and samples
-shipped inside the package; everything else is in pyproject.toml.
+"""The compiled inner loops (the grammar search, the exact alignment search), and the
+example specs and samples shipped inside the package; everything else is in
+pyproject.toml.
 
-The extension is optional: where it cannot be built (no C compiler, no Python headers)
-the install goes on without it, and facadecli runs the same search in pure Python
-(``facadecli.native`` says which is in use: ``facadecli.native.describe()``). The solver
-is pure Python and needs no compiler.
+Both extensions are optional: where they cannot be built (no C compiler, no Python
+headers) the install goes on without them, and facadecli runs the same searches in pure
+Python (``facadecli.native`` says which is in use: ``facadecli.native.describe()``).
 
 The examples live once in git, at the root (``specs/``, ``samples/``), where the docs and
 tests use them; ``build_py`` copies them into the built package as
@@ -20,7 +20,7 @@ from setuptools.command.build_ext import build_ext
 from setuptools.command.build_py import build_py
 from setuptools.errors import CCompilerError, ExecError, PlatformError
 
-NOTE = "facadecli: C compiler not available, using the pure-Python grammar search (slower)"
+NOTE = "facadecli: C compiler not available, using the pure-Python search (slower)"
 FAILURES = (CCompilerError, ExecError, PlatformError, OSError, ValueError)
 
 
@@ -31,7 +31,7 @@ class OptionalBuildExt(build_ext):
         try:
             super().run()
         except FAILURES as error:  # no compiler at all (PlatformError) or no headers
-            self._skip("the C extension", error)
+            self._skip("the C extensions", error)
 
     def build_extension(self, ext: Extension) -> None:
         try:
@@ -69,6 +69,12 @@ setup(
             "facadecli.grammar._adp",
             ["facadecli/grammar/_adp.c"],
             extra_compile_args=["-O2", "-Wall", "-Wextra", "-Wno-unused-parameter"],
+            optional=True,
+        ),
+        Extension(
+            "facadecli.solver._exact",
+            ["facadecli/solver/_exact.c"],
+            extra_compile_args=["-O3", "-Wall", "-Wextra", "-Wno-unused-parameter"],
             optional=True,
         ),
     ],

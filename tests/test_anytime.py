@@ -62,7 +62,6 @@ def test_a_perfect_layout_of_three_distinct_layers_is_found_and_proven() -> None
 FIG_4C = """
 version: 1
 name: fig-4c
-solver: {time_limit: 120}  # the work budget decides; no safety net on a loaded CI
 canvas: {width: 93.4, height: 3.0}
 symbol_defaults: {opaque: true}
 symbols:

@@ -159,6 +159,23 @@ class _Row:
         pairs = zip(self.row.word, self.row.traits, strict=True)
         return {letter.symbol: traits.size for letter, traits in pairs}
 
+    @functools.cached_property
+    def letters(self) -> list[tuple[str, float | None, bool, bool, bool, bool, int]]:
+        """Its letters as the compiled search reads them: symbol, preferred size (None for
+        a placeholder), transparent, opaque, attached, unoccludable, segment."""
+        return [
+            (
+                letter.symbol,
+                traits.size,
+                traits.transparent,
+                traits.opaque,
+                traits.attached,
+                traits.unoccludable,
+                traits.segment,
+            )
+            for letter, traits in zip(self.row.word, self.row.traits, strict=True)
+        ]
+
     def remaining(self, position: int, left: float, sizes: Sizes) -> float:
         """Least length the row still has to lay out from ``position`` on."""
         k, inside = divmod(position, 2)

@@ -19,9 +19,9 @@ is optimal and "none" is a proof.
 All work is counted in *work units* (columns bounded, layouts sized), never in seconds, so
 the same input gives the same answer on any machine.
 
-The search is :class:`_Search`, in Python, its one implementation (most façades are laid
-out by construction, :mod:`facadecli.solver.construct`, before it runs: a compiled twin
-saved too little to keep; docs/explanation/solver.md).
+The search runs compiled (``_exact.c``, driven by :class:`_Compiled`; complete layouts are
+still sized here). :class:`_Search` is the same search in Python: the reference the tests
+compare it with, column for column (the same layouts, reasons and work units).
 """
 
 from __future__ import annotations
@@ -36,6 +36,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from facadecli.native import EXACT_COMPILED, _exact
 from facadecli.patterns import Word
 from facadecli.solver import columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row, prepared_row
@@ -49,11 +50,13 @@ from facadecli.solver.rows import LetterTraits, Row
 from facadecli.spec.model import Spec
 
 FREE, AFTER_EMPTY, AFTER_ATTACHED = 0, 1, 2
-# the rules a column may break
+# the rules a column may break (numbered as in _exact.c)
 NO_OPAQUE, ATTACHED_GAP, NO_COVER, GAP_BEFORE_ATTACHED, COVERED = 1, 2, 3, 4, 5
 Column = tuple[Move | None, ...]
 Option = tuple[Move | None, np.ndarray | None]  # an entry (None: a gap), its length if known
 Options = tuple[list[Option], list[int], np.ndarray]  # see _Search.options()
+COMPILED = EXACT_COMPILED  # search with _exact.c where built (False: the Python reference)
+_EXHAUSTED, _STOPPED = 2, 3  # what _exact.Search.run() returns besides 0 (done)
 
 
 class BudgetExhausted(Exception):
@@ -784,6 +787,86 @@ class _Search:
             # only a layout was asked for
 
 
+class _Compiled:
+    """The search of ``_exact.c`` over a :class:`_Search`'s groups: it walks the network
+    as :meth:`_Search.run` does, and hands every complete alignment to
+    :meth:`_Search.settle` by its cuts; the budget, the incumbent and the rejections end
+    up where the Python search keeps them."""
+
+    def __init__(self, search: _Search):
+        self.search = search
+        groups = [
+            [(row.letters, group.above[r], group.covering[r]) for r, row in enumerate(group.rows)]
+            for group in search.groups
+        ]
+        budget = search.budget
+        self.table: _exact.Search | None = _exact.Search(
+            groups,
+            search.variables,
+            search.target.tolist(),
+            search.canvas,
+            search.incumbent,
+            budget.limit,
+            budget.used,
+            budget.deadline,
+            search.first_only,
+            self.leaf,
+        )
+
+    def close(self) -> None:
+        """Let the compiled search go: it holds leaf(), which holds it (a cycle that only
+        the garbage collector would find), and its moves and options."""
+        self.table = None
+
+    def run(self) -> None:
+        search = self.search
+        assert self.table is not None, "a closed search"
+        status = self.table.run(search.gaps)
+        search.budget.used = self.table.used
+        search.budget.timed_out = self.table.timed_out
+        search.incumbent = self.table.incumbent
+        if search.best is None:  # the reasons are read only when nothing was found
+            self.reasons()
+        if status == _EXHAUSTED:
+            raise BudgetExhausted
+        if status == _STOPPED:
+            raise _Perfect
+
+    def reasons(self) -> None:
+        """The compiled search's rejections, worded, into the search's (as it counts them)."""
+        search = self.search
+        search.rejections.clear()
+        assert self.table is not None, "a closed search"
+        for rule, g, r, above, start, end, progress, count in self.table.rejections():
+            group = search.groups[g]
+            move = None if start < 0 else group.rows[r].spanning(start, end)
+            why = search.why(rule, group, r, move, above)
+            before, times = search.rejections.get(why, (0, 0))
+            search.rejections[why] = (max(before, progress), times + count)
+
+    def leaf(self, cuts: list[list[tuple[tuple[int, int] | None, ...]]]) -> tuple[float, bool]:
+        """Size a complete alignment given by its cuts: the incumbent after it, and whether
+        the search should stop."""
+        search = self.search
+        if search.existence:
+            return search.incumbent, True
+        paths = [
+            [
+                tuple(
+                    None if cut is None else group.rows[r].spanning(*cut)
+                    for r, cut in enumerate(column)
+                )
+                for column in columns
+            ]
+            for group, columns in zip(search.groups, cuts, strict=True)
+        ]
+        try:
+            search.settle(paths)
+        except _Perfect:
+            return search.incumbent, True
+        return search.incumbent, False
+
+
 def _has_opaque(row: Row) -> bool:
     """Only an opaque letter makes a row behind give way (SPEC 2.4)."""
     return any(traits.opaque for traits in row.traits)
@@ -878,12 +961,15 @@ def align_exactly(
     incumbent: float = INF,
     prepared_rows: dict[Row, _Row] | None = None,
     first_only: bool = False,
+    compiled: bool | None = None,
 ) -> Outcome:
     """The best layout of a candidate's groups (one set of rows per group), searched
-    exactly; only layouts with an objective at most ``incumbent`` are looked for."""
+    exactly; only layouts with an objective at most ``incumbent`` are looked for.
+    ``compiled``: run the search of ``_exact.c`` (the default, :data:`COMPILED`) or the
+    Python reference, :class:`_Search`."""
     search = _search_of(spec, groups, canvas, budget, incumbent, prepared_rows, first_only)
     try:
-        _run(search)
+        _run(search, compiled)
     except _Perfect:
         best = search.best
         if best is not None and best.sizing.objective > SAME:  # the first layout, asked for
@@ -909,6 +995,7 @@ def reaches(
     budget: Budget,
     incumbent: float,
     prepared_rows: dict[Row, _Row] | None = None,
+    compiled: bool | None = None,
 ) -> bool:
     """Whether the search reaches a complete alignment of the groups within ``incumbent``,
     unsized: its equalities allow that objective, the sizing's bounds unchecked. A quick,
@@ -917,7 +1004,7 @@ def reaches(
     search = _search_of(spec, groups, canvas, budget, incumbent, prepared_rows, True)
     search.existence = True
     try:
-        _run(search)
+        _run(search, compiled)
     except (_Perfect, BudgetExhausted):
         return True
     return False
@@ -959,23 +1046,27 @@ def _search_of(
     )
 
 
-def _run(search: _Search) -> None:
-    """Run a search: first without gaps (most layouts have none, and gaps multiply the
-    columns out of every state), then with them, looking only for better layouts than
-    that one."""
+def _run(search: _Search, compiled: bool | None) -> None:
+    """Run a search, compiled (the default, :data:`COMPILED`) or in Python: first without
+    gaps (most layouts have none, and gaps multiply the columns out of every state), then
+    with them, looking only for better layouts than that one."""
     # the search recurses a column at a time through every group in turn: room for the
     # longest path (a column per half-step of every row, at most), whatever the groups
     depth = sum(max(group.ends, default=0) for group in search.groups) + RECURSION_MARGIN
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(max(limit, depth))
+    table = _Compiled(search) if (COMPILED if compiled is None else compiled) else None
+    run = search.run if table is None else table.run
     try:
         if any(any(group.covering) for group in search.groups):
             search.gaps = False
-            search.run()
+            run()
             search.gaps = True
-        search.run()
+        run()
     finally:
         sys.setrecursionlimit(limit)
+        if table is not None:
+            table.close()
 
 
 Counts = dict[str, tuple[int, float]]  # symbol -> (letters, preferred size)

@@ -25,6 +25,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from facadecli.native import EXACT_COMPILED, _exact
 from facadecli.solver.alignment import Alignment, Move
 from facadecli.spec.model import Spec
 
@@ -257,7 +258,27 @@ def _parametrized(
     rows: Sequence[tuple[Mapping[int, float], float]], n: int
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """Every solution of the sparse equalities ``rows`` over ``n`` variables as
-    ``z0 + N y`` (``y`` the free variables), or None when they contradict each other.
+    ``z0 + N y`` (``y`` the free variables), or None when they contradict each other:
+    :func:`_parametrized_in_python`, compiled (``_exact.eliminate``) where it was built."""
+    if not EXACT_COMPILED:
+        return _parametrized_in_python(rows, n)
+    scale = max((abs(rhs) for _, rhs in rows), default=0.0)
+    found = _exact.eliminate(rows, n, ZERO, 1e-9 * max(1.0, scale))
+    if found is None:
+        return None
+    constants, free, entries = found
+    basis = np.zeros((n, len(free)))
+    basis[free, np.arange(len(free))] = 1.0
+    if entries:
+        v, j, c = zip(*entries, strict=True)
+        basis[list(v), list(j)] = c
+    return np.array(constants), basis
+
+
+def _parametrized_in_python(
+    rows: Sequence[tuple[Mapping[int, float], float]], n: int
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`_parametrized` in Python, the reference the tests compare it with.
 
     Gaussian elimination, a row at a time, shortest rows first: the row is written over
     the variables still free, and one of them (the largest coefficient; the latest
