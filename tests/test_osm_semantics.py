@@ -19,6 +19,7 @@ from facadecli.city.manifest import load_city
 from facadecli.city.run import run_city, safe_name
 from facadecli.city.s3db import COLOURS, colour, tag_problems
 from facadecli.city.straight import merged_ring
+from facadecli.geometry.facade import linear_rgb
 from tests.osm_district import ROOF_SHAPES, box, write_district
 from tests.running import facade
 from tests.test_s3db import SPEC
@@ -155,7 +156,7 @@ def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, An
     assert _entry(report, 502)["height"] == 10.0  # its own
     scene = trimesh.load(folder / "out" / "buildings" / f"{safe_name('way/501')}.glb")
     roof = scene.geometry["way/501/roof"].visual.material.baseColorFactor[:3]
-    assert list(roof) == [0xFF, 0xEF, 0xD5]  # papayawhip, a CSS name
+    assert list(roof) == linear_rgb("#ffefd5")  # papayawhip, a CSS name (linear in glTF)
     ridge = scene.geometry["way/501/roof"].vertices[:, 1]
     assert ridge.max() - ridge.min() == pytest.approx(2.0, abs=1e-3)  # roof:height 2
 

@@ -27,6 +27,7 @@ from facadecli.city.s3db import (
     tagged_heights,
     volume,
 )
+from facadecli.geometry.facade import linear_rgb
 
 SPEC = """
 version: 1
@@ -282,7 +283,7 @@ def test_a_spec_material_named_wall_is_used_for_plain_walls(tmp_path: Path) -> N
     run_city(load_city(tmp_path / "tags.yaml"), tmp_path / "out")
     document = json.loads(_json_chunk(tmp_path / "out" / "buildings" / "a.glb"))
     wall = next(m for m in document["materials"] if m["name"] == "wall")
-    expected = [0x12 / 255, 0x34 / 255, 0x56 / 255]
+    expected = [c / 255 for c in linear_rgb("#123456")]  # glTF's factor is linear light
     assert wall["pbrMetallicRoughness"]["baseColorFactor"][:3] == pytest.approx(expected, abs=0.01)
 
 

@@ -38,14 +38,26 @@ IOR = "KHR_materials_ior"
 
 
 @lru_cache(maxsize=256)
+def linear_rgb(colour: str) -> list[int]:
+    """A ``#rrggbb`` colour (sRGB, as people write colours) as glTF's ``baseColorFactor``
+    wants it: linear light, 0-255 (a renderer that reads the factor as linear, as the
+    glTF specification says, would otherwise show every colour pale)."""
+    digits = colour.lstrip("#")
+    found = []
+    for i in (0, 2, 4):
+        c = int(digits[i : i + 2], 16) / 255.0
+        linear = c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+        found.append(round(255 * linear))
+    return found
+
+
 def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMaterial:
     """A glTF metallic-roughness material; see-through ones blend; a texture is tinted by
     the colour. A library material carries its drawn texture set instead (base colour,
     normal, and one image for occlusion, roughness and metallic), with factors of 1.
     Cached: a city builds the same materials for every wall, and reads each texture
     image once."""
-    colour = material.color.lstrip("#")
-    rgb = [int(colour[i : i + 2], 16) for i in (0, 2, 4)]
+    rgb = linear_rgb(material.color)
     alpha = round(255 * material.opacity)
     blend = "BLEND" if material.opacity < 1.0 else "OPAQUE"
     if material.library is not None:
