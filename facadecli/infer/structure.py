@@ -25,8 +25,8 @@ them. Each axis on its own, for every element that is not a band across the faç
 
 An element whose edge would move further than ``SHARE`` of the narrowest element,
 same-label gap or visible part it bounds (``tiling.move_limits``, as the tidy-up's)
-stays as drawn along that axis, and so does an element hidden behind one in front of it
-that would peek out, or one that would overlap another of its label; nothing is dropped,
+stays as drawn along that axis, and so do an element hidden behind others and those
+hiding it, and one that would overlap or touch another of its label; nothing is dropped,
 and no two elements of a label are put on one line unless they overlapped along the axis
 by half their size.
 """
@@ -37,7 +37,7 @@ import statistics
 from collections import defaultdict
 from collections.abc import Callable
 
-from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
+from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
 from facadecli.grammar.tiling import MOVE_SHARE, move_limits
 from facadecli.infer.layers import BAND
 
@@ -46,6 +46,7 @@ JITTER = 0.005  # of the façade: or within this (a hand's error, for small elem
 NEAR = 0.01  # of the façade: centres this close are one column (row)
 PITCH = 0.03  # spacings within this share of one another are one pitch
 SHARE = MOVE_SHARE  # of the narrowest element, gap or visible part an edge bounds
+SAMPLES = 4  # points along each side at which an element is looked at for being hidden
 DIGITS = 9  # of a metre: lines and sizes equal to that are equal (one gap symbol)
 STRUCTURE = "window"  # of labels with as many elements, the one that sets the structure
 
@@ -62,7 +63,7 @@ def structured(layout: LabelledLayout) -> LabelledLayout:
         Rect(r.label, x0, y0, x1, y1, r.z)
         for r, (x0, x1), (y0, y1) in zip(rects, x, y, strict=True)
     ]
-    for k in _colliding(rects, placed) | _peeking(rects, placed):
+    for k in _colliding(rects, placed) | _hiding(rects):
         placed[k] = rects[k]
     return LabelledLayout(layout.width, layout.height, tuple(placed))
 
@@ -100,23 +101,37 @@ def _colliding(before: list[Rect], after: list[Rect]) -> set[int]:
     return found
 
 
-def _peeking(before: list[Rect], after: list[Rect]) -> set[int]:
-    """The elements inside one in front of them before structuring but not after."""
-    order = sorted(range(len(before)), key=lambda k: before[k].z)
+def _hiding(before: list[Rect]) -> set[int]:
+    """The elements hidden behind those in front of them (CMP's order, then ``z``, as
+    ``layers`` stacks them; looked at in ``SAMPLES`` x ``SAMPLES`` points), and those
+    hiding them: moved, they would show slivers of what the annotation hides."""
+    order = sorted(
+        range(len(before)), key=lambda k: (CMP_Z_ORDER.get(before[k].label, 99), before[k].z)
+    )
     found: set[int] = set()
     for n, k in enumerate(order):
         if before[k].label == BACKGROUND:
             continue
         fronts = [j for j in order[n + 1 :] if before[j].label != BACKGROUND]
-        if any(_inside(before[k], before[j]) for j in fronts) and not any(
-            _inside(after[k], after[j]) for j in fronts
-        ):
+        if _hidden(before[k], [before[j] for j in fronts]):  # it, and what hides it
             found.add(k)
+            found.update(j for j in fronts if _meet(before[j], before[k]))
     return found
 
 
-def _inside(a: Rect, b: Rect) -> bool:
-    return b.x0 <= a.x0 and a.x1 <= b.x1 and b.y0 <= a.y0 and a.y1 <= b.y1
+def _hidden(rect: Rect, fronts: list[Rect]) -> bool:
+    near = [
+        f for f in fronts if f.x0 < rect.x1 and rect.x0 < f.x1 and f.y0 < rect.y1 and rect.y0 < f.y1
+    ]
+    if not near:
+        return False
+    for i in range(SAMPLES):
+        x = rect.x0 + (i + 0.5) / SAMPLES * (rect.x1 - rect.x0)
+        for j in range(SAMPLES):
+            y = rect.y0 + (j + 0.5) / SAMPLES * (rect.y1 - rect.y0)
+            if not any(f.x0 <= x <= f.x1 and f.y0 <= y <= f.y1 for f in near):
+                return False
+    return True
 
 
 def _meet(a: Rect, b: Rect) -> bool:
