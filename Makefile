@@ -51,7 +51,7 @@ format: $(STAMP) ## Reformat the code with ruff
 	$(BIN)/ruff check --fix facadecli tests
 	$(BIN)/ruff format facadecli tests
 
-bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extraction on CMP, cities, infer on CMP (and its fidelity to the annotation), and watch from save to page
+bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extraction on CMP, cities, infer on CMP (its fidelity to the annotation, its spec at other sizes), and watch from save to page
 	$(BIN)/python tests/benchmarks/bench.py
 	$(BIN)/python tests/benchmarks/solver_bench.py
 	$(BIN)/python tests/benchmarks/grammar_bench.py
@@ -59,6 +59,7 @@ bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extrac
 	$(BIN)/python tests/benchmarks/walls_bench.py
 	$(BIN)/python tests/benchmarks/infer_bench.py
 	$(BIN)/python tests/benchmarks/fidelity_bench.py
+	$(BIN)/python tests/benchmarks/retarget_bench.py
 	$(BIN)/python tests/benchmarks/watch_bench.py
 
 bench-large: $(STAMP) ## Time facade grammar on three large generated layouts (minutes)

@@ -1,5 +1,6 @@
 """``facade infer``'s pipeline, without the writing: read a labelled layout, snap and
-regularise it (as ``facade grammar`` does), find its grids, write them as a layered spec,
+regularise it (as ``facade grammar`` does), put it on one structure (``structure``: sizes,
+columns, rows and pitches shared), find its grids, write them as a layered spec,
 and check the spec: solved at the input's size it is compared with the raw annotation
 (``grammar.fidelity``: IoU per label, elements lost or fused) and with the tidied layout it
 was written from (``iou``), and it must solve at other widths.
@@ -18,6 +19,7 @@ from facadecli.grammar.run import Options, Progress, no_progress, tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
 from facadecli.infer.layers import BAND, Grid, grids, to_edges
 from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
+from facadecli.infer.structure import structured
 from facadecli.layout import Layout
 from facadecli.spec.model import Spec
 
@@ -27,7 +29,7 @@ WIDTHS = (0.7, 1.5)  # other widths the spec must solve at, as shares of the inp
 @dataclass
 class Inference:
     source: str
-    layout: LabelledLayout  # snapped and regularised
+    layout: LabelledLayout  # snapped, regularised and structured (``infer.structure``)
     tiling: Tiling
     grids: list[Grid]
     text: str  # the spec
@@ -54,7 +56,7 @@ def infer(
     ``progress`` is told each stage as it starts."""
     options = options or Options()
     tidied = tidy_layout(path, options, Deadline(options.time_limit, str(path)), progress)
-    regular = tidied.layout
+    regular = structured(tidied.layout)
     if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
     progress("finding the grids of each label")

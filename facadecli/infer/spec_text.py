@@ -37,6 +37,8 @@ from facadecli.infer.layers import Grid, Span, uncovered
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
 RUNS = {1: 3, 2: 2}  # copies of a unit of one letter, or of two, that make a repeat
+PITCH_SHARED = 0.02  # runs of one count whose pitches are this close share a counter
+UNIQUE = ("door",)  # labels whose elements are never repeated (a portal stays one)
 MIRRORED = 5  # letters a word needs (two elements and more) to be written as mirrored
 MESHES = {  # CMP labels; anything else is a box
     "window": ("frame", 0.1),
@@ -78,11 +80,17 @@ class _Counters:
     names: dict[tuple[str, float, int], str] = field(default_factory=dict)
 
     def of(self, axis: str, pitch: float, count: int) -> str:
-        key = (axis, round(pitch, 4), count)
-        name = self.names.get(key)
-        if name is None:
-            name = self.names[key] = f"n{len(self.names) + 1}"
+        """The counter of runs along ``axis`` of ``count`` copies at ``pitch`` (within
+        ``PITCH_SHARED``: a sill's run and its window's, measured apart)."""
+        for (along, known, copies), name in self.names.items():
+            if along == axis and copies == count and abs(known - pitch) <= PITCH_SHARED * known:
+                return name
+        name = self.names[(axis, round(pitch, 4), count)] = f"n{len(self.names) + 1}"
         return name
+
+
+def _names(table: _Symbols) -> frozenset[str]:
+    return frozenset(table.sizes.values())
 
 
 def ident(label: str) -> str:
@@ -96,46 +104,60 @@ Spread = dict[tuple[str, str, float], tuple[float, float]]  # (axis, label, size
 
 
 def _tokens(
-    spans: tuple[Span, ...], extent: float, element: _Symbols, gap: _Symbols
+    spans: tuple[Span, ...], extent: float, element: _Symbols, gap: _Symbols, margin: _Symbols
 ) -> list[Token]:
-    """(symbol, size) of the elements and the gaps between them, from 0 to ``extent``."""
+    """(symbol, size) of the elements and the gaps between them, from 0 to ``extent``; the
+    gaps before the first element and after the last are margins (symbols of their own)."""
     tokens: list[Token] = []
     cursor = 0.0
     for a, b in spans:
         if a - cursor > 1e-9 * extent:
-            tokens.append((gap.of(a - cursor), a - cursor))
+            table = margin if cursor == 0.0 else gap
+            tokens.append((table.of(a - cursor), a - cursor))
         tokens.append((element.of(b - a), b - a))
         cursor = b
     if extent - cursor > 1e-9 * extent:
-        tokens.append((gap.of(extent - cursor), extent - cursor))
+        tokens.append((margin.of(extent - cursor), extent - cursor))
     return tokens
 
 
-def _word(tokens: list[Token], axis: str, counters: _Counters, repeated: set[str]) -> str:
+def _word(
+    tokens: list[Token],
+    axis: str,
+    counters: _Counters,
+    repeated: set[str],
+    repeat: bool = True,
+    margins: frozenset[str] = frozenset(),
+) -> str:
     """The tokens as a word (see ``_with_run``). A mirrored word (the same read backwards,
     two elements or more) is written as its first half, the middle letter, and the first
     half reflected, ``... (...)^-1`` (SPEC 2.2), when that loses no repeat: each half then
     keeps its run with one counter, and the meshes of the right half are mirrored."""
     symbols = [symbol for symbol, _ in tokens]
+    if not repeat:
+        return " ".join(symbols)
     half = len(tokens) // 2
     if len(tokens) >= MIRRORED and symbols == symbols[::-1]:
         left = tokens[:half]
-        if 2 * _covered(_longest_run(left)) >= _covered(_longest_run(tokens)):
-            text = _with_run(left, axis, counters, repeated)
+        if 2 * _covered(_longest_run(left, margins)) >= _covered(_longest_run(tokens, margins)):
+            text = _with_run(left, axis, counters, repeated, margins)
             middle = [symbols[half]] if len(tokens) % 2 else []
             return " ".join([text, *middle, f"({text})^-1"])
-    return _with_run(tokens, axis, counters, repeated)
+    return _with_run(tokens, axis, counters, repeated, margins)
 
 
 Run = tuple[int, int, int, int]  # letters covered, start, unit, copies
 
 
-def _longest_run(tokens: list[Token]) -> Run | None:
-    """The longest run of a repeated unit (one or two letters, at least ``RUNS`` copies)."""
+def _longest_run(tokens: list[Token], margins: frozenset[str] = frozenset()) -> Run | None:
+    """The longest run of a repeated unit (one or two letters, at least ``RUNS`` copies;
+    never a margin: it takes the slack)."""
     symbols = [symbol for symbol, _ in tokens]
     best = None
     for unit in (1, 2):
         for start in range(len(tokens) - unit):
+            if margins & set(symbols[start : start + unit]):
+                continue
             copies = 1
             while (
                 symbols[start + copies * unit : start + (copies + 1) * unit]
@@ -151,11 +173,17 @@ def _covered(run: Run | None) -> int:
     return 0 if run is None else run[0]
 
 
-def _with_run(tokens: list[Token], axis: str, counters: _Counters, repeated: set[str]) -> str:
+def _with_run(
+    tokens: list[Token],
+    axis: str,
+    counters: _Counters,
+    repeated: set[str],
+    margins: frozenset[str] = frozenset(),
+) -> str:
     """The tokens as a word, the longest run written with a counter; the run's symbols go
     into ``repeated``."""
     symbols = [symbol for symbol, _ in tokens]
-    best = _longest_run(tokens)
+    best = _longest_run(tokens, margins)
     if best is None:
         return " ".join(symbols)
     _, start, unit, copies = best
@@ -182,29 +210,46 @@ def spec_text(
     elements: dict[str, tuple[_Symbols, _Symbols]] = {}
     # a layer's gaps are its own, but layers with the same columns (or rows) share them:
     # their words are then alike and stay aligned at any size
-    gaps_x: dict[tuple[Span, ...], _Symbols] = {}
-    gaps_y: dict[tuple[Span, ...], _Symbols] = {}
-    owned: list[list[_Symbols]] = []  # the gap symbols each layer introduces
+    gaps_x: dict[tuple[Span, ...], tuple[_Symbols, _Symbols]] = {}
+    gaps_y: dict[tuple[Span, ...], tuple[_Symbols, _Symbols]] = {}
+    owned: list[list[_Symbols]] = []  # the gap and margin symbols each layer introduces
     repeated: set[str] = set()  # symbols of runs (written with a counter)
     stretched: set[str] = set()  # elements of words without gaps: they fill the façade
+    margined: set[str] = set()  # gaps of words with a margin: the margins take the slack
+    loose: set[str] = set()  # symbols of words without a margin: they take the slack
+    held: set[str] = set()  # gaps of words with a run and a margin: they keep their size
     layers: list[tuple[str, Grid, str, str]] = []
     for layer, grid in zip(layer_names(found), found, strict=True):
         base = ident(grid.label)
         symbols = elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
         introduced = [
-            table.setdefault(spans, _Symbols(f"{layer}_g{axis}"))
+            symbols
             for table, spans, axis in ((gaps_x, grid.columns, "x"), (gaps_y, grid.rows, "y"))
             if spans not in table
+            for symbols in table.setdefault(
+                spans, (_Symbols(f"{layer}_g{axis}"), _Symbols(f"{layer}_m{axis}"))
+            )
         ]
         owned.append(introduced)
-        x_tokens = _tokens(grid.columns, width, symbols[0], gaps_x[grid.columns])
-        y_tokens = _tokens(grid.rows, height, symbols[1], gaps_y[grid.rows])
-        for tokens, spans in ((x_tokens, grid.columns), (y_tokens, grid.rows)):
+        x_tokens = _tokens(grid.columns, width, symbols[0], *gaps_x[grid.columns])
+        y_tokens = _tokens(grid.rows, height, symbols[1], *gaps_y[grid.rows])
+        words = []
+        for axis, tokens, spans, (gaps, margins) in (
+            ("x", x_tokens, grid.columns, gaps_x[grid.columns]),
+            ("y", y_tokens, grid.rows, gaps_y[grid.rows]),
+        ):
             if len(tokens) == len(spans):  # no gap: nothing else takes a longer façade
                 stretched.update(symbol for symbol, _ in tokens)
-        x = _word(x_tokens, "x", counters, repeated)
-        y = _word(y_tokens, "y", counters, repeated)
-        layers.append((layer, grid, x, y))
+            ends = _names(margins)
+            word = _word(tokens, axis, counters, repeated, grid.label not in UNIQUE, ends)
+            if not {tokens[0][0], tokens[-1][0]} & ends:  # no margin: its letters stay free
+                loose.update(symbol for symbol, _ in tokens)
+            elif "^n" in word:  # a run: the counter and the margins take the slack
+                held.update(gaps.sizes.values())
+            else:
+                margined.update(gaps.sizes.values())
+            words.append(word)
+        layers.append((layer, grid, words[0], words[1]))
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
         "# a label's elements on a grid (its columns x its rows), back to front, with the",
@@ -220,6 +265,8 @@ def spec_text(
     ]
     spread = spread or {}
     clear = uncovered(found)
+    fixed = repeated - loose  # a run's letters keep their size where margins take the slack
+    held -= loose
     sizes = [
         [
             (
@@ -227,7 +274,7 @@ def spec_text(
                 _size(
                     size,
                     None if symbol in stretched else spread.get((axis, label, size)),
-                    symbol in repeated,
+                    symbol in fixed,
                     label in clear,
                 ),
             )
@@ -237,7 +284,11 @@ def spec_text(
         for label, pair in elements.items()
     ]
     sizes += [
-        [(symbol, _number(size)) for gaps in mine for size, symbol in gaps.sizes.items()]
+        [
+            (symbol, _gap(size, symbol in fixed | held, symbol in margined))
+            for gaps in mine
+            for size, symbol in gaps.sizes.items()
+        ]
         for mine in owned
     ]
     out += [
@@ -250,7 +301,7 @@ def spec_text(
     if counters.names:
         out.append("counters:")
         out += [
-            f"  {n}: {{min: 1}}  # {count} along {axis} at a pitch of {_number(pitch)} m"
+            f"  {n}: {{min: 0}}  # {count} along {axis} at a pitch of {_number(pitch)} m"
             for (axis, pitch, count), n in counters.names.items()
         ]
     out.append("patterns: {wall_x: wall_w, wall_y: wall_h}")
@@ -277,6 +328,23 @@ def spec_text(
     return "\n".join(out) + "\n"
 
 
+def _gap(size: float, repeated: bool, margined: bool) -> str:
+    """A gap's size: the gaps of a word with a run and a margin keep it (``min`` and
+    ``max``: the bays keep their pitch and the counter and the margins take the slack, so
+    layers whose runs share a counter keep their columns together at any size); other
+    gaps of a word with a margin do not grow (the margins take what the façade gains, so
+    every such layer moves alike, yet a narrower façade may close them up); margins, and
+    gaps of words without one, are free, and so is a gap under the solver's tolerance (a
+    sliver between elements drawn touching: bounded, it leaves the solver no layout)."""
+    if size < TOLERANCE:
+        return _number(size)
+    if repeated:
+        return f"{{size: {_number(size)}, min: {_number(size)}, max: {_number(size)}}}"
+    if margined:
+        return f"{{size: {_number(size)}, max: {_number(size)}}}"
+    return _number(size)
+
+
 def _size(
     size: float,
     spread: tuple[float, float] | None,
@@ -286,18 +354,18 @@ def _size(
     """A symbol's size, with the bounds the input shows (``spread``: the least and
     greatest size its elements had before regularising; None for bands, which stretch
     with the façade). An element never grows beyond the greatest (``max``): a wider
-    façade widens the gaps around a door, not the door. A run's elements also keep the
-    least (``min``), where the spread is wider than the sizes are written (a tenth of a
-    millimetre): a narrower façade loses a bay of them before they shrink further; an
-    element that does not repeat may shrink to fit. ``unoccludable`` for openings
-    nothing covers in the input: each layer is its own alignment group, so it steers
-    nothing until layers are grouped (SPEC 2.6), and then keeps what was clear clear."""
+    façade widens the gaps around a door, not the door; one that does not repeat may
+    shrink to fit. A run's elements keep their size (``min`` and ``max``), as its gaps
+    do (``_gap``): a façade of another size gains or loses bays and floors at the input's
+    pitch, and the layers sharing the run's counter keep their columns together.
+    ``unoccludable`` for openings nothing covers in the input: each layer is its own
+    alignment group, so it steers nothing until layers are grouped (SPEC 2.6), and then
+    keeps what was clear clear."""
     extra = []
-    if spread is not None:
-        low, high = min(spread[0], size), max(spread[1], size)
-        if repeated and high - low >= 2 * 10.0**-DECIMALS:
-            extra.append(f"min: {_number(low)}")
-        extra.append(f"max: {_number(high)}")
+    if spread is not None and repeated:
+        extra += [f"min: {_number(size)}", f"max: {_number(size)}"]
+    elif spread is not None:
+        extra.append(f"max: {_number(max(spread[1], size))}")
     if unoccludable:
         extra.append("unoccludable: true")
     if not extra:

@@ -1,0 +1,251 @@
+"""One structure per façade: the tidied layout's elements put on shared columns and rows
+before ``facade infer`` writes them as layers (issue 34).
+
+The tidy-up keeps what was drawn, within a hand's jitter; a spec needs what the façade
+means: windows of one size, in columns and floors at one pitch, with their sills under
+them. Each axis on its own, for every element that is not a band across the façade
+(``layers.BAND``):
+
+1. **Sizes**: a label's sizes each within ``SIZE`` of the next smaller, or within
+   ``JITTER`` of the façade (and a quarter of the size), are one, up to twice that from
+   the smallest: the cluster's median, one symbol in the spec.
+2. **Columns** (rows along y): a label's element centres within ``NEAR`` of the façade
+   (and half the elements' size, so only elements that already overlap along the axis
+   merge) are one line, their mean.
+3. **Pitch**: consecutive lines of a label whose spacings are within ``PITCH`` of the
+   first of a run are spaced evenly between the run's ends (which stay): the run becomes
+   a repeat with one counter.
+4. **Mirror**: a label's lines that, reflected about the façade's middle, each fall
+   within ``NEAR`` of another are made exactly symmetric, so the spec's words read the
+   same backwards and are written mirrored.
+5. **Shared structure**: the label with the most elements (windows on a tie) sets the
+   structure; another
+   label's line within ``NEAR`` of a structure line is put on it (a sill under its
+   window, a balcony, a blind over it), so their layers align at any size.
+
+An element whose edge would move further than ``SHARE`` of the narrowest element,
+same-label gap or visible part it bounds (``tiling.move_limits``, as the tidy-up's)
+stays as drawn along that axis, and so do an element hidden behind others and those
+hiding it, and one that would overlap or touch another of its label; nothing is dropped,
+and no two elements of a label are put on one line unless they overlapped along the axis
+by half their size.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections import defaultdict
+from collections.abc import Callable
+
+from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
+from facadecli.grammar.tiling import MOVE_SHARE, move_limits
+from facadecli.infer.layers import BAND
+
+SIZE = 0.03  # sizes of a label within this share of one another are one
+JITTER = 0.005  # of the façade: or within this (a hand's error, for small elements)
+NEAR = 0.01  # of the façade: centres this close are one column (row)
+PITCH = 0.03  # spacings within this share of one another are one pitch
+SHARE = MOVE_SHARE  # of the narrowest element, gap or visible part an edge bounds
+SAMPLES = 4  # points along each side at which an element is looked at for being hidden
+DIGITS = 9  # of a metre: lines and sizes equal to that are equal (one gap symbol)
+STRUCTURE = "window"  # of labels with as many elements, the one that sets the structure
+
+
+def structured(layout: LabelledLayout) -> LabelledLayout:
+    """The layout with its elements on shared sizes, lines and pitches (see the module);
+    the rectangles in the same order."""
+    rects = list(layout.rects)
+    x = _axis([(r.label, r.x0, r.x1) for r in rects], layout.width)
+    y = _axis([(r.label, r.y0, r.y1) for r in rects], layout.height)
+    x = _within_limits(rects, x, "x", layout.width)
+    y = _within_limits(rects, y, "y", layout.height)
+    placed = [
+        Rect(r.label, x0, y0, x1, y1, r.z)
+        for r, (x0, x1), (y0, y1) in zip(rects, x, y, strict=True)
+    ]
+    for k in _colliding(rects, placed) | _hiding(rects):
+        placed[k] = rects[k]
+    return LabelledLayout(layout.width, layout.height, tuple(placed))
+
+
+def _within_limits(
+    rects: list[Rect], moved: list[tuple[float, float]], axis: str, extent: float
+) -> list[tuple[float, float]]:
+    """The moved spans, each kept as it was where an edge of it moved further than the
+    structure lets an edge move (``tiling.move_limits`` with ``NEAR`` and ``SHARE``: an
+    eighth of the narrowest element, same-label gap or visible part it bounds, as in the
+    tidy-up): what was drawn shows."""
+    spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
+    across = [(r.y0, r.y1) if axis == "x" else (r.x0, r.x1) for r in rects]
+    limits = move_limits(rects, spans, across, NEAR * extent, SHARE)
+    out = []
+    for (a, b), (c, d) in zip(spans, moved, strict=True):
+        far = abs(c - a) > limits.get(a, NEAR * extent) or abs(d - b) > limits.get(b, NEAR * extent)
+        out.append((a, b) if far else (c, d))
+    return out
+
+
+def _colliding(before: list[Rect], after: list[Rect]) -> set[int]:
+    """The elements that overlap or touch one of their label after structuring but did not
+    before (grown a few per cent into a neighbour): they stay as drawn, never fused."""
+    by_label: dict[str, list[int]] = defaultdict(list)
+    for k, rect in enumerate(after):
+        if rect.label != BACKGROUND:
+            by_label[rect.label].append(k)
+    found: set[int] = set()
+    for members in by_label.values():
+        for n, a in enumerate(members):
+            for b in members[n + 1 :]:
+                if _meet(after[a], after[b]) and not _meet(before[a], before[b]):
+                    found |= {a, b}
+    return found
+
+
+def _hiding(before: list[Rect]) -> set[int]:
+    """The elements hidden behind those in front of them (CMP's order, then ``z``, as
+    ``layers`` stacks them; looked at in ``SAMPLES`` x ``SAMPLES`` points), and those
+    hiding them: moved, they would show slivers of what the annotation hides."""
+    order = sorted(
+        range(len(before)), key=lambda k: (CMP_Z_ORDER.get(before[k].label, 99), before[k].z)
+    )
+    found: set[int] = set()
+    for n, k in enumerate(order):
+        if before[k].label == BACKGROUND:
+            continue
+        fronts = [j for j in order[n + 1 :] if before[j].label != BACKGROUND]
+        if _hidden(before[k], [before[j] for j in fronts]):  # it, and what hides it
+            found.add(k)
+            found.update(j for j in fronts if _meet(before[j], before[k]))
+    return found
+
+
+def _hidden(rect: Rect, fronts: list[Rect]) -> bool:
+    near = [
+        f for f in fronts if f.x0 < rect.x1 and rect.x0 < f.x1 and f.y0 < rect.y1 and rect.y0 < f.y1
+    ]
+    if not near:
+        return False
+    for i in range(SAMPLES):
+        x = rect.x0 + (i + 0.5) / SAMPLES * (rect.x1 - rect.x0)
+        for j in range(SAMPLES):
+            y = rect.y0 + (j + 0.5) / SAMPLES * (rect.y1 - rect.y0)
+            if not any(f.x0 <= x <= f.x1 and f.y0 <= y <= f.y1 for f in near):
+                return False
+    return True
+
+
+def _meet(a: Rect, b: Rect) -> bool:
+    """Overlapping, or touching along one axis while overlapping along the other."""
+    x = min(a.x1, b.x1) - max(a.x0, b.x0)
+    y = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return x > -1e-9 and y > -1e-9 and max(x, y) > 1e-9
+
+
+def _axis(spans: list[tuple[str, float, float]], extent: float) -> list[tuple[float, float]]:
+    """Each span, structured along one axis (see the module)."""
+    size = {k: b - a for k, (_, a, b) in enumerate(spans)}
+    centre = {k: (a + b) / 2 for k, (_, a, b) in enumerate(spans)}
+    by_label: dict[str, list[int]] = defaultdict(list)
+    for k, (label, a, b) in enumerate(spans):
+        if label != BACKGROUND and 0 < b - a <= BAND * extent:
+            by_label[label].append(k)
+    for members in by_label.values():
+
+        def similar(first: float, b: float) -> bool:  # within twice the step of the first
+            return b - first <= 2 * max(SIZE * first, min(JITTER * extent, 0.25 * first))
+
+        def step(a: int, b: int) -> bool:
+            return size[b] - size[a] <= max(SIZE * size[a], min(JITTER * extent, 0.25 * size[a]))
+
+        for cluster in _chains(sorted(members, key=size.__getitem__), size, similar, step):
+            median = statistics.median(size[k] for k in cluster)
+            for k in cluster:
+                size[k] = median
+    reference: list[float] = []
+    near = NEAR * extent
+    for label in sorted(by_label, key=lambda name: (-len(by_label[name]), name != STRUCTURE, name)):
+        members = sorted(by_label[label], key=centre.__getitem__)
+
+        def close(a: int, b: int) -> bool:
+            return centre[b] - centre[a] <= min(near, 0.5 * size[a], 0.5 * size[b])
+
+        lines = _chains(members, centre, lambda _v, _w: True, close)
+        lines_at = _even([statistics.fmean(centre[k] for k in line) for line in lines])
+        means = _mirrored(lines_at, extent, near)
+        if reference:
+            means = _onto(means, reference, near)
+        else:
+            reference = means
+        for line, mean in zip(lines, means, strict=True):
+            for k in line:
+                centre[k] = mean
+    out = []
+    for k, (label, a, b) in enumerate(spans):
+        if k not in size or label == BACKGROUND or not 0 < b - a <= BAND * extent:
+            out.append((a, b))
+            continue
+        low = round(max(0.0, centre[k] - size[k] / 2), DIGITS)
+        out.append((low, round(min(extent, low + size[k]), DIGITS)))
+    return out
+
+
+def _mirrored(lines: list[float], extent: float, near: float) -> list[float]:
+    """The lines made exactly symmetric about the façade's middle where, reflected, each
+    is within ``near`` of another (mirrored halves, drawn by hand)."""
+    reflected = [extent - m for m in reversed(lines)]
+    if all(abs(a - b) <= near for a, b in zip(lines, reflected, strict=True)):
+        return [(a + b) / 2 for a, b in zip(lines, reflected, strict=True)]
+    return lines
+
+
+def _onto(lines: list[float], reference: list[float], near: float) -> list[float]:
+    """Each line on the nearest reference line within ``near``, unless another line of
+    the same label would go there too (then both stay)."""
+    nearest = [min(reference, key=lambda r: abs(r - m)) for m in lines]
+    taken: dict[float, int] = defaultdict(int)
+    for line, target in zip(lines, nearest, strict=True):
+        taken[target] += abs(target - line) <= near
+    return [
+        target if abs(target - line) <= near and taken[target] == 1 else line
+        for line, target in zip(lines, nearest, strict=True)
+    ]
+
+
+def _chains(
+    members: list[int],
+    value: dict[int, float],
+    with_first: Callable[[float, float], bool],
+    with_last: Callable[[int, int], bool] | None = None,
+) -> list[list[int]]:
+    """Sorted members cut into runs: each joins the run when ``with_first`` holds for the
+    run's first value and its own, and ``with_last`` (when given) for the run's last
+    member and itself."""
+    runs: list[list[int]] = []
+    for k in members:
+        if (
+            runs
+            and with_first(value[runs[-1][0]], value[k])
+            and (with_last is None or with_last(runs[-1][-1], k))
+        ):
+            runs[-1].append(k)
+        else:
+            runs.append([k])
+    return runs
+
+
+def _even(lines: list[float]) -> list[float]:
+    """The lines with each run of near-equal spacings (within ``PITCH`` of the run's
+    first, two spacings or more) spaced evenly between the run's ends."""
+    out = list(lines)
+    start = 0
+    while start < len(out) - 1:
+        first = out[start + 1] - out[start]
+        end = start + 1
+        while end < len(out) - 1 and abs((out[end + 1] - out[end]) - first) <= PITCH * first:
+            end += 1
+        if end - start >= 2:
+            pitch = (out[end] - out[start]) / (end - start)
+            for j in range(start + 1, end):
+                out[j] = out[start] + (j - start) * pitch
+        start = end
+    return out

@@ -1,0 +1,247 @@
+"""``make bench``: ``facade infer``'s spec solved at other sizes (issue 34, items 2 and 3).
+
+On the CMP sample annotations beside the project (``../shared/data/cmp-sample/xml``; never
+copied into it; skipped, saying so, when absent) and on the generated family
+(``annotated_family``, seeds 1-24), each inferred at 15 x 15 m and its spec solved at 1x,
+0.7x, 1.5x and 2x the width and 1.5x the height. Per size, over the façades:
+
+- ``solve``: façades whose spec solves there (exit 0 of ``facade solve``);
+- ``size``: façades with 90% or more of their windows within +-15% (width and height) of a
+  window of the annotation as read; ``size%``: the windows so, of all windows;
+- ``dens``: façades whose windows per square metre are 0.85-1.15 of the annotation's
+  (bays and floors gained or dropped, not windows squeezed or stretched);
+- ``cols``: façades whose windows keep their columns: the share of windows with a window
+  of another floor whose centre is within 0.15 m (1% of the input) along x is at least
+  the annotation's less 0.05;
+- ``ovl``: façades with more windows and doors overlapping one another (by more than
+  1 cm x 1 cm) than the annotation has;
+- ``sym``: of the façades whose annotation is mirrored (90% of windows have a mirror image
+  within 0.15 m and 10% in size), those that stay so.
+
+Then the spec's size: layers, symbols, counters (mean and most), façades with no counter;
+and CPU per façade (``time.process_time``: inferring, the check at 1x, and the five
+solves). The figures go into docs/benchmarks.md with this file's name.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from facadecli import parse_spec  # noqa: E402
+from facadecli.errors import FacadeError  # noqa: E402
+from facadecli.grammar.inputs import Rect  # noqa: E402
+from facadecli.grammar.run import Options  # noqa: E402
+from facadecli.infer.run import Inference, infer, solved_layout  # noqa: E402
+from facadecli.solve import retarget, solve  # noqa: E402
+from tests.benchmarks.annotated_family import cmp_xml, family  # noqa: E402
+
+DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
+SEEDS = range(1, 25)
+SIZE = 15.0
+SIZES = {
+    "1x": (1.0, 1.0),
+    "0.7w": (0.7, 1.0),
+    "1.5w": (1.5, 1.0),
+    "2w": (2.0, 1.0),
+    "1.5h": (1.0, 1.5),
+}
+NEAR = 0.15  # m: centres this close line up (1% of the input)
+KEEP = 0.15  # a window keeps its size within this share
+OPENINGS = ("window", "door")
+
+
+@dataclass
+class Tally:
+    facades: int = 0
+    solve: int = 0
+    size: int = 0
+    windows: int = 0
+    windows_ok: int = 0
+    density: int = 0
+    columns: int = 0
+    overlaps: int = 0
+    mirrored: int = 0
+    symmetric: int = 0
+    worst: list[str] = field(default_factory=list)
+
+
+def windows(rects: tuple[Rect, ...] | list[Rect]) -> list[Rect]:
+    return [r for r in rects if r.label == "window" and r.x1 - r.x0 > 1e-6 and r.y1 - r.y0 > 1e-6]
+
+
+def _sized(r: Rect, reference: list[Rect]) -> bool:
+    w, h = r.x1 - r.x0, r.y1 - r.y0
+    return any(
+        abs(w / (q.x1 - q.x0) - 1) <= KEEP and abs(h / (q.y1 - q.y0) - 1) <= KEEP for q in reference
+    )
+
+
+def _centre(r: Rect) -> tuple[float, float]:
+    return (r.x0 + r.x1) / 2, (r.y0 + r.y1) / 2
+
+
+def aligned(found: list[Rect]) -> float:
+    """The share of windows with a window of another floor (not overlapping it along y)
+    whose centre is within ``NEAR`` along x."""
+    if len(found) < 2:
+        return 1.0
+    hits = 0
+    for r in found:
+        cx = _centre(r)[0]
+        hits += any(
+            abs(_centre(q)[0] - cx) <= NEAR and (q.y0 >= r.y1 - 1e-6 or q.y1 <= r.y0 + 1e-6)
+            for q in found
+            if q is not r
+        )
+    return hits / len(found)
+
+
+def overlaps(rects: list[Rect]) -> int:
+    shown = [r for r in rects if r.label in OPENINGS]
+    count = 0
+    for k, a in enumerate(shown):
+        for b in shown[k + 1 :]:
+            if (
+                min(a.x1, b.x1) - max(a.x0, b.x0) > 0.01
+                and min(a.y1, b.y1) - max(a.y0, b.y0) > 0.01
+            ):
+                count += 1
+    return count
+
+
+def symmetric(found: list[Rect], width: float) -> bool:
+    """90% of the windows have a mirror image (about the façade's middle)."""
+    if len(found) < 2:
+        return False
+    hits = 0
+    for r in found:
+        cx, cy = _centre(r)
+        w, h = r.x1 - r.x0, r.y1 - r.y0
+        hits += any(
+            abs(_centre(q)[0] - (width - cx)) <= NEAR
+            and abs(_centre(q)[1] - cy) <= NEAR
+            and abs((q.x1 - q.x0) / w - 1) <= 0.1
+            and abs((q.y1 - q.y0) / h - 1) <= 0.1
+            for q in found
+        )
+    return hits >= 0.9 * len(found)
+
+
+def spec_size(text: str, name: str) -> tuple[int, int, int]:
+    spec = parse_spec(text, name)
+    return len(spec.layers), len(spec.symbols), len(spec.counters)
+
+
+def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
+    spec = parse_spec(inference.text, name)
+    raw = inference.raw or inference.layout
+    reference = windows(raw.rects)
+    area = raw.width * raw.height
+    density = len(reference) / area
+    in_aligned = aligned(reference)
+    in_overlaps = overlaps(list(raw.rects))
+    mirrored = symmetric(reference, raw.width)
+    for size, (sx, sy) in SIZES.items():
+        tally = tallies[size]
+        tally.facades += 1
+        width, height = round(raw.width * sx, 4), round(raw.height * sy, 4)
+        try:
+            layout = solve(retarget(spec, width, height))
+        except FacadeError as error:
+            tally.worst.append(f"{name}: does not solve ({str(error)[:60]})")
+            continue
+        tally.solve += 1
+        rects = list(solved_layout(layout, spec, inference).rects)
+        found = windows(rects)
+        ok = sum(_sized(r, reference) for r in found)
+        tally.windows += len(found)
+        tally.windows_ok += ok
+        share = ok / len(found) if found else 1.0
+        tally.size += share >= 0.9
+        ratio = (len(found) / (width * height)) / density if density else 1.0
+        tally.density += 0.85 <= ratio <= 1.15
+        kept = aligned(found) >= in_aligned - 0.05
+        tally.columns += kept
+        extra = overlaps(rects) > in_overlaps
+        tally.overlaps += extra
+        if mirrored:
+            tally.mirrored += 1
+            tally.symmetric += symmetric(found, width)
+        if share < 0.9 or not 0.85 <= ratio <= 1.15 or not kept or extra:
+            tally.worst.append(
+                f"{name}: {share:.0%} sized, density {ratio:.2f}, aligned "
+                f"{aligned(found):.2f} (input {in_aligned:.2f}), overlaps {overlaps(rects)}"
+            )
+
+
+def report(
+    title: str,
+    tallies: dict[str, Tally],
+    sizes: list[tuple[int, int, int]],
+    cpu: float,
+    verbose: bool,
+) -> None:
+    n = len(sizes)
+    print(f"\n{title}: {n} façades at 15 x 15 m, the spec solved at other sizes")
+    print(
+        f"{'size':5} {'solve':>6} {'size':>6} {'size%':>6} {'dens':>6} {'cols':>6} "
+        f"{'ovl':>6} {'sym':>7}"
+    )
+    for name, t in tallies.items():
+        share = t.windows_ok / t.windows if t.windows else 1.0
+        print(
+            f"{name:5} {t.solve:3d}/{t.facades:<2d} {t.size:3d}/{t.solve:<2d} {share:6.0%} "
+            f"{t.density:3d}/{t.solve:<2d} {t.columns:3d}/{t.solve:<2d} "
+            f"{t.overlaps:3d}/{t.solve:<2d} "
+            f"{t.symmetric:3d}/{t.mirrored:<3d}"
+        )
+        if verbose:
+            for line in t.worst:
+                print(f"      {line}")
+    layers, symbols, counters = zip(*sizes, strict=True)
+    print(
+        f"spec: layers mean {sum(layers) / n:.1f} most {max(layers)}; symbols mean "
+        f"{sum(symbols) / n:.1f} most {max(symbols)}; counters mean {sum(counters) / n:.1f} "
+        f"most {max(counters)}, none on {sum(c == 0 for c in counters)}; "
+        f"CPU {cpu / n:.2f} s a façade"
+    )
+
+
+def run(paths: list[Path], title: str, verbose: bool) -> None:
+    tallies = {size: Tally() for size in SIZES}
+    sizes = []
+    cpu = 0.0
+    for path in paths:
+        started = time.process_time()
+        inference = infer(path, path.stem, Options(size=(SIZE, SIZE)))
+        measure(inference, path.stem, tallies)
+        cpu += time.process_time() - started
+        sizes.append(spec_size(inference.text, path.stem))
+    report(title, tallies, sizes, cpu, verbose)
+
+
+def main() -> None:
+    verbose = "-v" in sys.argv
+    files = sorted(DATA.glob("*.xml")) if DATA.is_dir() else []
+    if files:
+        run(files, "CMP samples", verbose)
+    else:
+        print(f"retargeting on CMP skipped: no CMP annotations in {DATA}")
+    with tempfile.TemporaryDirectory() as folder:
+        paths = []
+        for seed in SEEDS:
+            path = Path(folder) / f"family-{seed}.xml"
+            path.write_text(cmp_xml(family(seed)[0]))
+            paths.append(path)
+        run(paths, f"generated family (seeds {SEEDS[0]}-{SEEDS[-1]})", verbose)
+
+
+if __name__ == "__main__":
+    main()
