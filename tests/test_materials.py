@@ -264,3 +264,29 @@ def test_library_fields_without_a_library_are_refused(
     code, _, err = facade(capsys, "solve", str(path), "-o", str(tmp_path / "out"))
     line = 1 + next(i for i, row in enumerate(path.read_text().splitlines()) if "scale" in row)
     assert code == 2 and f"bad.yaml:{line}:" in err and "library" in err, err
+
+
+def test_a_drawn_picture_encodes_once_to_the_same_bytes() -> None:
+    """A city exports the same pictures for every building: they keep their PNG bytes,
+    which are PIL's own encoding (the glb is byte for byte what it was)."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from facadecli.materials.pictures import Picture, picture
+
+    pixels = np.random.default_rng(3).integers(0, 256, (64, 64, 3), dtype=np.uint8)
+    plain = io.BytesIO()
+    Image.fromarray(pixels, "RGB").save(plain, format="png")
+    drawn = picture(Image.fromarray(pixels, "RGB"))
+    assert isinstance(drawn, Picture)
+    first, second = io.BytesIO(), io.BytesIO()
+    drawn.save(first, format="PNG")
+    encoded = drawn._png
+    drawn.save(second, format="png")
+    assert first.getvalue() == second.getvalue() == plain.getvalue()
+    assert drawn._png is encoded  # not encoded again
+    other = io.BytesIO()
+    drawn.save(other, format="bmp")  # anything else is PIL's own
+    assert other.getvalue()[:2] == b"BM"

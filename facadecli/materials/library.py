@@ -100,6 +100,7 @@ def images(material: Material) -> Images:
 def _images(material: Material) -> Images:
     from PIL import Image
 
+    from facadecli.materials.pictures import picture
     from facadecli.materials.textures import texture_set
 
     assert material.library is not None
@@ -115,9 +116,9 @@ def _images(material: Material) -> Images:
         material.roughness,
         material.metallic,
     )
-    return Images(
-        Image.fromarray(made.base_colour, "RGB"),
-        Image.fromarray(made.normal, "RGB"),
-        Image.fromarray(made.orm, "RGB"),
+    return Images(  # pictures that keep their PNG bytes: a city exports them per building
+        picture(Image.fromarray(made.base_colour, "RGB")),
+        picture(Image.fromarray(made.normal, "RGB")),
+        picture(Image.fromarray(made.orm, "RGB")),
         tile * material.scale,
     )
