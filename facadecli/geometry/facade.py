@@ -29,6 +29,7 @@ from facadecli.layout import (
 )
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.materials import images, resolve
+from facadecli.materials.textures import linear
 from facadecli.spec.assets import load_mesh
 from facadecli.spec.model import Material, Spec
 
@@ -37,7 +38,6 @@ TRANSMISSION = "KHR_materials_transmission"
 IOR = "KHR_materials_ior"
 
 
-@lru_cache(maxsize=256)
 def linear_rgb(colour: str) -> list[int]:
     """A ``#rrggbb`` colour (sRGB, as people write colours) as glTF's ``baseColorFactor``
     wants it: linear light, 0-255 (a renderer that reads the factor as linear, as the
@@ -45,12 +45,11 @@ def linear_rgb(colour: str) -> list[int]:
     digits = colour.lstrip("#")
     found = []
     for i in (0, 2, 4):
-        c = int(digits[i : i + 2], 16) / 255.0
-        linear = c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
-        found.append(round(255 * linear))
+        found.append(round(255 * linear(int(digits[i : i + 2], 16) / 255.0)))
     return found
 
 
+@lru_cache(maxsize=256)
 def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMaterial:
     """A glTF metallic-roughness material; see-through ones blend; a texture is tinted by
     the colour. A library material carries its drawn texture set instead (base colour,

@@ -101,12 +101,12 @@ def _images(material: Material) -> Images:
     from PIL import Image
 
     from facadecli.materials.pictures import picture
-    from facadecli.materials.textures import texture_set
+    from facadecli.materials.textures import linear, texture_set
 
     assert material.library is not None
     tile = TILES[material.library]
     hexa = material.color.lstrip("#")
-    rgb = tuple((int(hexa[i : i + 2], 16) / 255.0) ** 2.2 for i in (0, 2, 4))
+    rgb = tuple(linear(int(hexa[i : i + 2], 16) / 255.0) for i in (0, 2, 4))
     made = texture_set(
         KINDS[material.library],
         material.resolution,
