@@ -72,13 +72,15 @@ class Extraction:
     problems: list[str] = field(default_factory=list)
     snapping: Snapping = NO_SNAPPING  # what snapping changed
     fidelity: Fidelity | None = None  # the derivation at the input's size vs the annotation
-    raw: LabelledLayout | None = None  # the annotation as read (stretched to the size)
+    # the annotation as drawn, only its edges within the snap tolerance joined (its tiling
+    # is within the cell limit checked before the work, unlike the raw drawing's)
+    drawn: LabelledLayout | None = None
 
     @cached_property
     def style(self) -> list[Constraint]:
         """Bao's constraints the input holds: found on what the annotation shows (its
         rectangles in their z-order), or on the tiling when there is no annotation."""
-        return style_of(self.tiling) if self.raw is None else style_of_drawing(self.raw)
+        return style_of(self.tiling) if self.drawn is None else style_of_drawing(self.drawn)
 
     @property
     def grammar(self) -> Grammar:
@@ -253,7 +255,7 @@ def extract_grammar(
     progress("checking the grammar derives the layout")
     extraction.problems = rederivation_problems(found.grammar, tiling)
     extraction.snapping = snapping
-    extraction.raw = tidied.raw
+    extraction.drawn = tidied.snapped
     progress("measuring the derivation against the annotation")
     terminals = [Rect(*box) for box in derive(found.grammar, tiling.xs[-1], tiling.ys[-1])]
     extraction.fidelity = fidelity(tidied.raw, regular, terminals)

@@ -25,8 +25,9 @@ Found on the (regularised) input, over its elements (the background is not one):
   façade gains whole floors, it does not stretch them).
 
 The style is found on what the drawing shows (:func:`style_of_drawing`: the annotation's
-rectangles in their z-order, as :mod:`facadecli.grammar.fidelity` paints them), never on
-the tool's own tidied tiling, so a tidy-up that moved or merged elements cannot hide it.
+rectangles in their z-order, its edges only joined within the snap tolerance), never on
+the tool's own regularised tiling, so a tidy-up that moved or merged elements cannot hide
+it.
 
 A derived layout keeps a constraint when it holds there too (for ``columns`` and
 ``spacing``, in as large a share of the label's rows, or in as many rows: a taller façade
@@ -43,11 +44,9 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
-import numpy as np
-
 from facadecli.grammar import retarget
 from facadecli.grammar.inputs import LabelledLayout, Rect
-from facadecli.grammar.tiling import BACKGROUND, Tiling
+from facadecli.grammar.tiling import BACKGROUND, Tiling, tile
 
 SKIPPED = 1  # places of a row's pitch that may be empty between two elements
 TOLERANCE = 0.01  # of the façade's extent along the axis compared
@@ -207,38 +206,11 @@ def style_of_drawing(drawing: LabelledLayout, background: str = BACKGROUND) -> l
 
 
 def shown_tiles(rects: Sequence[Rect], width: float, height: float) -> list[Box]:
-    """What a drawing shows, as tiles: the plane cut at every edge of every rectangle
-    (within the façade), each cell the label of the front-most rectangle over it (by
-    ``z``, a later one over an earlier among equals, as fidelity paints), cells of one
-    label side by side in a row joined; cells no rectangle covers are left out (the
-    background)."""
-    near = 1e-6 * max(width, height, 1.0)
-    xs = _distinct([min(max(v, 0.0), width) for r in rects for v in (r.x0, r.x1)], near)
-    ys = _distinct([min(max(v, 0.0), height) for r in rects for v in (r.y0, r.y1)], near)
-    if len(xs) < 2 or len(ys) < 2:
-        return []
-    owner = np.full((len(ys) - 1, len(xs) - 1), -1, dtype=np.int64)
-    for i in sorted(range(len(rects)), key=lambda k: rects[k].z):  # stable: later wins
-        r = rects[i]
-        c0, c1 = bisect.bisect_left(xs, r.x0 - near), bisect.bisect_left(xs, r.x1 - near)
-        r0, r1 = bisect.bisect_left(ys, r.y0 - near), bisect.bisect_left(ys, r.y1 - near)
-        owner[r0:r1, c0:c1] = i
-    labels = [r.label for r in rects]
-    tiles = []
-    for row, (y0, y1) in enumerate(itertools.pairwise(ys)):
-        start = 0
-        cells = owner[row].tolist()
-        for column in range(1, len(cells) + 1):
-            if column < len(cells) and _same_label(labels, cells[column], cells[start]):
-                continue
-            if cells[start] >= 0:
-                tiles.append(Box(labels[cells[start]], xs[start], y0, xs[column], y1))
-            start = column
-    return tiles
-
-
-def _same_label(labels: Sequence[str], a: int, b: int) -> bool:
-    return (a < 0 and b < 0) or (a >= 0 and b >= 0 and labels[a] == labels[b])
+    """What a drawing shows, as tiles: its tiling with no edge moved (:func:`tile`: cuts at
+    every edge, each cell the label of the front-most rectangle), the background left
+    out."""
+    drawing = tile(LabelledLayout(width, height, tuple(rects)), tolerance=0.0)
+    return [box for box in tiles_of(drawing) if box.label != BACKGROUND]
 
 
 def tiles_of(tiling: Tiling) -> list[Box]:
