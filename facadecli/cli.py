@@ -520,16 +520,17 @@ def city(
 
         report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box, usd)
     summary = report["summary"]
-    for entry in report["rejected"]:  # rejected by design: reported, not a failure
-        where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
+
+    def place(entry: dict[str, object]) -> str:  # a feature's place in the footprints
         if entry["line"] is None:
-            where = f"{loaded.footprints}: features[{entry['feature']}]"
-        _warn(f"{where}: rejected: feature '{entry['id']}': {entry['error']}")
+            return f"{loaded.footprints}: features[{entry['feature']}]"
+        return f"{loaded.footprints}:{entry['line']}:{entry['column']}"
+
+    for entry in report["rejected"]:  # rejected by design: reported, not a failure
+        _warn(f"{place(entry)}: rejected: feature '{entry['id']}': {entry['error']}")
     alike = Counter(entry["warning"] for entry in report["warnings"])
     for entry in report["warnings"]:  # tags ignored: each warned once, all in the report
-        where = f"{loaded.footprints}:{entry['line']}:{entry['column']}"
-        if entry["line"] is None:
-            where = f"{loaded.footprints}: features[{entry['feature']}]"
+        where = place(entry)
         more = alike.pop(entry["warning"], 0) - 1
         if more >= 0:
             also = f" (and {more} more features: see the report)" if more else ""
