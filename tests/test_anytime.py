@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 import random
+import time
 
 import pytest
 
@@ -15,6 +16,7 @@ from facadecli import make_word, parse_spec, solve
 from facadecli.export.report import report
 from facadecli.solver import columns, construct
 from facadecli.solver.alignment import _Row
+from facadecli.solver.axis import _AxisProblem
 from facadecli.solver.rows import Row, make_rows
 from facadecli.spec.resolve import layer_pattern
 from tests.benchmarks.distinct import GRAND_HALL_PERIODS, distinct_palace, grand_hall
@@ -415,3 +417,122 @@ def test_letters_that_touch_within_rounding_leave_their_boundary_free() -> None:
     points = construct.boundaries(base, sizes)
     among = construct.laid_for(row, [(base, sizes), (over, {**sizes, "u": 0.3, "w": 0.4})])
     assert construct.fit(row, sizes, points, 1.0, among) == pytest.approx({"g": 0.3, "h": 0.4})
+
+
+def _floors_with_alternatives(seed: int, layers: int = 12) -> tuple[str, int]:
+    """Floors (ground, storey^f, top) under ``layers`` layers that share the floors'
+    counter and each end in an alternative: two short letters (the first, and wrong: they
+    end inside the top floor) or one the top floor's height. Every layer's words fit the
+    canvas for any count (a placeholder takes the rest), so there are 2^layers options per
+    count: joined in the order they are enumerated, the cap on a cluster's options keeps
+    only the first count's."""
+    rng = random.Random(seed)
+    q = 0.05
+    ground, storey, top = (rng.randint(a, b) * q for a, b in ((60, 90), (56, 80), (16, 40)))
+    floors = rng.randint(3, 9)
+    lines = [
+        "version: 1",
+        f"name: alternatives-{seed}",
+        f"canvas: {{width: 6.0, height: {round(ground + floors * storey + top, 6)}}}",
+        "symbol_defaults: {opaque: true}",
+        "symbols:",
+        f"  G: {ground}",
+        f"  S: {storey}",
+        f"  T: {top}",
+        "  X: 6.0",
+    ]
+    for i in range(layers):
+        short = round(top * rng.choice([0.55, 0.6, 0.65, 0.7]), 6)
+        lines += [
+            f"  A{i}: {{size: {short}, opaque: false}}",
+            f"  B{i}: {{size: {top}, opaque: false}}",
+        ]
+    lines += ["counters: {f: {min: 1}}", "patterns:", "  floors: G (S)^f T"]
+    lines += [
+        f"  p{i}: {{control: h{i} (S)^f v{i}, where: {{v{i}: A{i} A{i} | B{i}}}}}"
+        for i in range(layers)
+    ]
+    lines += ["layers:", "  - {name: base, x: X, y: floors}"]
+    lines += [
+        f"  - {{name: l{i}, x: X, y: p{i}, offset: {0.01 * (i + 1):.2f}}}" for i in range(layers)
+    ]
+    return "\n".join(lines) + "\n", floors
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_options_of_least_tolerance_are_made_before_any_cap(seed: int) -> None:
+    """The planted count is found, exactly, by construction: each layer's right branch
+    chosen given the floors' count (before: the first count only, a layout 14-52 m² off
+    and unproven)."""
+    text, floors = _floors_with_alternatives(seed)
+    spec = parse_spec(text, "alternatives.yaml")
+    layout = solve(spec)
+    assert layout.counters["f"] == floors
+    assert layout.y.objective == pytest.approx(0.0, abs=1e-9)
+    assert layout.y.proven
+    problem = _AxisProblem(spec, "y", spec.canvas.height, time.perf_counter() + 60, 1)
+    assert problem.perfect_built  # no search needed
+
+
+CONFLICT = """
+version: 1
+name: cluster-conflict
+canvas: {width: 22.65, height: 3.5}
+symbol_defaults: {opaque: true}
+symbols:
+  {symbols}
+  E: 1.1
+  P: 1.15
+  W: 1.55
+  S: 3.5
+  V2: {size: 1.55, opaque: false}
+  V49: {size: 1.55, opaque: false}
+  V50: {size: 2.7, opaque: false}
+counters: {k: {min: 1}}
+patterns:
+  base: E (W P)^k W E
+  window: {control: g1 (W P)^k s4 g5, where: {s4: V2}}
+  # the first branch fits the base alone, not with the window: V50 V50 would cross the
+  # window's boundary between its spacer P and its V2
+  pair: {control: g47 (g48)^k s51 E, where: {s51: V50 V50 | V49}}
+  {patterns}
+layers:
+  - {name: base, x: base, y: S}
+  - {name: window, x: window, y: S, offset: 0.1}
+  - {name: pair, x: pair, y: S, offset: 0.2}
+  {layers}
+"""
+
+
+def test_words_of_one_cluster_are_fitted_to_each_other_too() -> None:
+    """Five layers of two equal alternatives after the pair keep its wrong branch in the
+    first 32 options; the fit to the base must see that it crosses the window's row
+    (before: exit 4, no layout within the search budget)."""
+    extra = range(5)
+    text = (
+        CONFLICT.replace(
+            "{symbols}",
+            "\n  ".join(
+                f"C{i}: {{size: 1.1, opaque: false}}\n  D{i}: {{size: 1.1, opaque: false}}"
+                for i in extra
+            ),
+        )
+        .replace(
+            "{patterns}",
+            "\n  ".join(
+                f"m{i}: {{control: q{i} (W P)^k W r{i}, where: {{r{i}: C{i} | D{i}}}}}"
+                for i in extra
+            ),
+        )
+        .replace(
+            "{layers}",
+            "\n  ".join(
+                f"- {{name: m{i}, x: m{i}, y: S, offset: {0.3 + 0.01 * i:.2f}}}" for i in extra
+            ),
+        )
+    )
+    spec = parse_spec(text, "conflict.yaml")
+    layout = solve(spec)
+    assert layout.counters["k"] == 7
+    assert layout.x.objective == pytest.approx(0.0, abs=1e-9) and layout.x.proven
+    assert [p.symbol for p in letters(layout, "pair", "x") if p.symbol.startswith("V")] == ["V49"]

@@ -41,6 +41,7 @@ from facadecli.solver.budgets import (
     TIER,
     TRIED,
     VARIANTS,
+    WORDS_FITTED,
 )
 from facadecli.solver.candidates import (
     Candidate,
@@ -775,11 +776,16 @@ def _fitted_to_backs(
         ]
 
     def fitted(
-        variant: Candidate, keys: set[str], apart: bool
+        variant: Candidate,
+        keys: set[str],
+        apart: bool,
+        more: Mapping[str, list[tuple[Row, Mapping[str, float]]]] | None = None,
     ) -> list[tuple[str, Row, dict[str, float]]] | None:
+        """The rows of the patterns ``keys`` in ``variant`` fitted to the backs' points,
+        and (``apart``) to the rows placed and ``more``; None when one does not fit."""
         own = own_rows(variant, keys)
         known = {**_sized(spec, [row for _, row in own]), **sizes}
-        found = []
+        found: list[tuple[str, Row, dict[str, float]]] = []
         for group, row in own:
             if group not in points:
                 return None
@@ -787,7 +793,15 @@ def _fitted_to_backs(
                 continue  # laid
             if any(layer in backs[group].layers for layer in row.layers):
                 return None  # another word at the back: the backs are laid
-            laid = construct.laid_for(row, placed[group]) if apart else construct.NOTHING_LAID
+            # apart from the rows placed and from this option's own rows fitted so far
+            # (one cluster's words must fit each other as well as the others')
+            mine = [(other, lengths) for g, other, lengths in found if g == group]
+            extra = [] if more is None else more.get(group, [])
+            laid = (
+                construct.laid_for(row, [*placed[group], *extra, *mine])
+                if apart
+                else construct.NOTHING_LAID
+            )
             fit = construct.fit(row, known, points[group], canvas, laid)
             if fit is None:
                 return None
@@ -819,10 +833,46 @@ def _fitted_to_backs(
             if any(option[key] is not candidate.words[key] for key in keys)
         ]
 
+    def piecewise(
+        candidate: Candidate, cluster: int
+    ) -> tuple[Candidate, list[tuple[str, Row, dict[str, float]]]] | None:
+        """The cluster's words chosen a pattern at a time, given the counters set so far
+        (the back's first): a pattern's alternatives are independent of the others' once
+        the counters they share agree, so each takes its first word (least tolerance
+        first) whose rows fit the backs and the rows placed, its own cluster's included.
+        None when a pattern has no such word among WORDS_FITTED."""
+        members = space.clusters[cluster]
+        chosen = {u.key: candidate.words[u.key] for u in members if u.key in at_back}
+        counters: dict[str, int] = {}
+        for item in chosen.values():
+            counters.update(item.choice.counters)
+        mine: dict[str, list[tuple[Row, Mapping[str, float]]]] = {}
+        found: list[tuple[str, Row, dict[str, float]]] = []
+        for use in members:
+            if use.key in chosen:
+                continue
+            for item in space.words[use.key][:WORDS_FITTED]:
+                values = item.choice.counters
+                if any(counters.get(name, value) != value for name, value in values.items()):
+                    continue
+                variant = space.candidate([dict(candidate.words), {**chosen, use.key: item}])
+                fits = fitted(variant, {use.key}, True, mine)
+                if fits is not None:
+                    chosen[use.key] = item
+                    counters.update(values)
+                    for group, row, lengths in fits:
+                        mine.setdefault(group, []).append((row, lengths))
+                    found.extend(fits)
+                    break
+            else:
+                return None
+        return space.candidate([dict(candidate.words), chosen]), found
+
     def laid_in(order: Sequence[int], candidate: Candidate) -> tuple[Candidate, list[int]]:
         """One pass over the clusters in ``order``: each takes its first option whose rows
-        fit the backs and the rows placed so far (or, failing that, the backs alone: it is
-        in conflict)."""
+        fit the backs and the rows placed so far (or its words chosen a pattern at a time,
+        :func:`piecewise`; or, failing that, an option that fits the backs alone: it is in
+        conflict)."""
         for group, row in backs.items():
             placed[group] = [(row, laid)]
         conflicted = []
@@ -833,6 +883,8 @@ def _fitted_to_backs(
                 chosen = next(
                     ((v, f) for v in tried if (f := fitted(v, keys, apart)) is not None), None
                 )
+                if chosen is None and apart and len(space.clusters[cluster]) > 1:
+                    chosen = piecewise(candidate, cluster)
                 if chosen is not None:
                     candidate = chosen[0]
                     for group, row, lengths in chosen[1]:

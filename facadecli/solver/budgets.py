@@ -26,6 +26,9 @@ TIE = 1e-11  # objectives this close, relative to the canvas squared (and never 
 CONSTRUCTIONS = 16  # candidates laid out by construction, least bound first, until one fits
 VARIANTS = 48  # options of a cluster of patterns tried in place of the best layout's
 FITTED = 2000  # options of a cluster tried for a fit to the rows at the back (cheap tests)
+WORDS_FITTED = (
+    200  # words of one pattern tried for that fit when its cluster is chosen a pattern at a time
+)
 SWEEPS = 2  # passes over the clusters while a variant improves the best layout
 TRIED = 3  # of a cluster's options that fit, those laid out (least covering first)
 NEAR_CANVAS = 1e-9  # a word this close to the canvas (relative) fits it at preferred sizes

@@ -118,6 +118,8 @@ class CandidateSpace:
     # a lower bound on the objective of every candidate with a word longer than twice the
     # canvas (never made; see of())
     beyond: float = math.inf
+    # per pattern, its words, those that need least tolerance (Eq. 7) first
+    words: dict[str, list[Enumerated]] = field(default_factory=dict)
     made: int = 0  # candidates made so far (their order)
 
     @classmethod
@@ -167,12 +169,20 @@ class CandidateSpace:
             for item in found
         }
         clusters = _clusters(uses)
-        options = [_cluster_options(cluster, words) for cluster in clusters]
+        room = {use.key: _max_room_above(use, uses, words, opaque) for use in uses}
+        needs = {
+            id(item): word_need(item.length, item.elastic, canvas, room[key])
+            for key, found in words.items()
+            for item in found
+        }
+        options = []
+        for cluster in clusters:
+            cluster_options, cut = _options_by_need(cluster, words, needs)
+            options.append(cluster_options)
+            truncated = truncated or cut
         if any(not cluster_options for cluster_options in options):
             return None
-        truncated = truncated or any(len(o) >= OPTIONS_PER_CLUSTER for o in options)
         # rank each cluster's options by a context-free estimate
-        room = {use.key: _max_room_above(use, uses, words, opaque) for use in uses}
         ranked = []
         for cluster_options in options:
             scored = [
@@ -181,7 +191,12 @@ class CandidateSpace:
             ]
             scored.sort(key=lambda item: (item[0], item[1]))
             ranked.append([option for _, _, option in scored])
-        return cls(canvas, clusters, ranked, _layers_above(uses), opaque, truncated, beyond)
+        by_need = {
+            key: sorted(found, key=lambda item: needs[id(item)]) for key, found in words.items()
+        }
+        return cls(
+            canvas, clusters, ranked, _layers_above(uses), opaque, truncated, beyond, by_need
+        )
 
     def candidate(self, choice: Sequence[dict[str, Enumerated]]) -> Candidate:
         """The candidate of one option per cluster (numbered in the order made)."""
@@ -296,10 +311,49 @@ def _clusters(uses: Sequence[PatternUse]) -> list[list[PatternUse]]:
     return list(clusters.values())
 
 
+def _options_by_need(
+    cluster: list[PatternUse], words: Mapping[str, list[Enumerated]], needs: Mapping[int, float]
+) -> tuple[list[dict[str, Enumerated]], bool]:
+    """A cluster's joint word choices, those whose words need least tolerance (Eq. 7)
+    first: every option whose words all need at most some tolerance, for the largest
+    tolerance whose options stay within OPTIONS_PER_CLUSTER, then options of the next
+    tolerance up to that cap. With it, whether the cap left some out (then the candidate
+    space is truncated: what is not made is not proven absent). Joining the words in the
+    order they are enumerated, as a capped join would, keeps the first counts and loses
+    a façade of many floors whose layers have alternatives."""
+    tiers = sorted({needs[id(item)] for use in cluster for item in words[use.key]})
+
+    def within(tier: int) -> list[dict[str, Enumerated]]:
+        limit = tiers[tier] + 1e-12
+        return _cluster_options(
+            cluster,
+            {use.key: [i for i in words[use.key] if needs[id(i)] <= limit] for use in cluster},
+        )
+
+    every = _cluster_options(cluster, words)
+    if len(every) < OPTIONS_PER_CLUSTER:  # all of them, as a rule
+        return every, False
+    # the largest tier whose options all fit under the cap (their count grows with it)
+    low, high = -1, len(tiers) - 2
+    complete: list[dict[str, Enumerated]] = []
+    while low < high:
+        middle = (low + high + 1) // 2
+        found = within(middle)
+        if len(found) < OPTIONS_PER_CLUSTER:
+            low, complete = middle, found
+        else:
+            high = middle - 1
+    # and the next tier's first options, up to the cap
+    seen = {tuple(id(item) for item in option.values()) for option in complete}
+    more = [o for o in within(low + 1) if tuple(id(i) for i in o.values()) not in seen]
+    return complete + more[: OPTIONS_PER_CLUSTER - len(complete)], True
+
+
 def _cluster_options(
     cluster: list[PatternUse], words: Mapping[str, list[Enumerated]]
 ) -> list[dict[str, Enumerated]]:
-    """Joint word choices of a cluster whose shared counters agree."""
+    """Joint word choices of a cluster whose shared counters agree (OPTIONS_PER_CLUSTER
+    at most, in the order the words are given)."""
     options: list[dict[str, Enumerated]] = []
     # each pattern's words with their counters, and filed by the values of the counters
     # that every one of them sets and a pattern before it names (the join's usual keys)
