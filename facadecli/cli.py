@@ -16,6 +16,7 @@ import warnings
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import replace
+from importlib.machinery import EXTENSION_SUFFIXES
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, NoReturn
 
@@ -73,7 +74,22 @@ SpecPaths = Annotated[
 def _version(value: bool) -> None:
     if value:
         typer.echo(f"facade {__version__}")
+        missing = _not_built()
+        if missing:  # pip hides the build's own note
+            searches = ", ".join(missing)
+            typer.echo(f"pure-Python searches ({searches}): slower; no C compiler at install")
         raise typer.Exit(0)
+
+
+def _not_built() -> list[str]:
+    """The compiled searches this install lacks, from its files (``facadecli.native``
+    would import them, and the solver with them)."""
+    here = Path(__file__).parent
+    return [
+        what
+        for what, stem in (("grammar", "grammar/_adp"), ("alignment", "solver/_exact"))
+        if not any((here / f"{stem}{suffix}").exists() for suffix in EXTENSION_SUFFIXES)
+    ]
 
 
 GLOBAL_FLAGS = {  # accepted before and after the command: main() moves them before it
