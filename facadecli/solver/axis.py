@@ -34,6 +34,7 @@ from facadecli.solver.budgets import (
     MAX_NODES,
     NEAR_CANVAS,
     NEAR_EQUAL,
+    PERFECT_REACH,
     REPAIRS,
     SWEEPS,
     TIE,
@@ -313,20 +314,24 @@ class _AxisProblem:
         self.spec, self.axis, self.canvas = spec, axis, canvas
         self.deadline, self.alternatives = deadline, alternatives
         self.uses = pattern_uses(spec, axis_words(spec, axis))
-        space = CandidateSpace.of(spec, self.uses, canvas)
-        leading = [] if space is None else space.best(CONSTRUCTIONS)
-        if space is None or not leading:  # within the caps on words: not a proof
-            raise SearchLimitError(_no_candidate_reason(axis, canvas))
-        self.space = space
         self.tie = tie_window(canvas)
-        self.memory = _SearchMemory(full_layers(spec, axis))
-        self.evaluated: list[_Evaluated] = []
         # a perfect layout of the first candidates, by construction, is optimal: then no
-        # other candidate is made (nor searched)
+        # other candidate is made (nor searched). Only words that fit the canvas can make
+        # one, so it is looked for among those alone first (a quarter of the letters of
+        # the words up to twice the canvas that a search needs)
         self.perfect_built: list[_Evaluated] = []
+        space = None
         if alternatives == 1:
-            built = _constructions(spec, self.uses, space, leading, canvas, self.memory, self.tie)
-            self.perfect_built = [e for e in built if e.estimate.objective <= self.tie]
+            space, self.memory, self.perfect_built = _perfect(spec, axis, self.uses, canvas)
+        if not self.perfect_built:
+            space = CandidateSpace.of(spec, self.uses, canvas)
+            leading = [] if space is None else space.best(CONSTRUCTIONS)
+            if space is None or not leading:  # within the caps on words: not a proof
+                raise SearchLimitError(_no_candidate_reason(axis, canvas))
+            self.memory = _SearchMemory(full_layers(spec, axis))
+        assert space is not None
+        self.space = space
+        self.evaluated: list[_Evaluated] = []
         self.candidates = [] if self.perfect_built else space.best(CANDIDATE_LIMIT)
         self.generated = time.perf_counter()
         self.shared = _relaxations(spec, self.uses, self.candidates, self.memory.full)
@@ -574,6 +579,23 @@ class _AxisProblem:
         return [replace(layout, timings=timings, candidates_tried=self.tried) for layout in layouts]
 
 
+def _perfect(
+    spec: Spec, axis: Axis, uses: Sequence[PatternUse], canvas: float
+) -> tuple[CandidateSpace | None, _SearchMemory, list[_Evaluated]]:
+    """The layouts at objective 0 the constructions find among words no longer than the
+    canvas (every word that needs no tolerance, Eq. 7, is one of them), with their space
+    and its search memory; none when they find none. Ties among perfect layouts are
+    broken within that space, which holds every word that can make one."""
+    memory = _SearchMemory(full_layers(spec, axis))
+    space = CandidateSpace.of(spec, uses, canvas, reach=PERFECT_REACH)
+    leading = [] if space is None else space.best(CONSTRUCTIONS)
+    if space is None or not leading:
+        return None, memory, []
+    tie = tie_window(canvas)
+    built = _constructions(spec, uses, space, leading, canvas, memory, tie)
+    return space, memory, [e for e in built if e.estimate.objective <= tie]
+
+
 def tie_window(canvas: float) -> float:
     """How close two objectives (m^2) on an axis of this length are equally good: numerical
     noise, relative to the canvas squared (SPEC 2.7)."""
@@ -676,6 +698,7 @@ def _constructions(
     if best is None:
         return made
     pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
+    laid: tuple[_Evaluated, LaidRows] | None = None  # the best layout's rows, laid once
     for _ in range(SWEEPS):
         improved = False
         if best.estimate.objective <= tie:  # every cluster's tie-break at once
@@ -685,7 +708,9 @@ def _constructions(
                 best, improved = found, True
         for cluster in range(len(space.clusters)):
             keys = {use.key for use in space.clusters[cluster]}
-            points = _points_without(best, keys, pattern_of)
+            if laid is None or laid[0] is not best:
+                laid = (best, _laid_rows(best))
+            points = _points_without(laid[1], keys, pattern_of)
             # the options whose rows fit the layout's other boundaries, least covering
             # first (SPEC 2.7's last tie-break; those covering as little as the
             # layout's own do not beat it): built until one improves it
@@ -923,9 +948,10 @@ def _least_covering_together(
     pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
     words = layout.candidate.words
     chosen: dict[str, Enumerated] = {}
+    laid = _laid_rows(layout)
     for cluster, members in enumerate(space.clusters):
         keys = {use.key for use in members}
-        points = _points_without(layout, keys, pattern_of)
+        points = _points_without(laid, keys, pattern_of)
         own = _covering({key: words[key] for key in keys}, canvas)
         others = {key: word for key, word in words.items() if key not in keys}
         options = space.options[cluster][:VARIANTS]
@@ -977,21 +1003,35 @@ def _covering(option: Mapping[str, Enumerated], canvas: float) -> float:
     return total
 
 
-def _points_without(
-    layout: _Evaluated, keys: set[str], pattern_of: Mapping[int, str]
-) -> dict[str, list[float]]:
-    """Per group, the boundaries of a sized layout's rows, but those of the patterns
-    ``keys`` (the rows another option of theirs must meet)."""
+LaidRows = dict[str, list[tuple[Row, list[float]]]]
+
+
+def _laid_rows(layout: _Evaluated) -> LaidRows:
+    """Per group, a sized layout's rows with their boundaries."""
     program, solved = layout.program, layout.estimate
     lengths = {name: solved.of(index) for name, index in program.symbols.items()}
-    points: dict[str, list[float]] = {}
-    for group, alignment in layout.groups.items():
-        found: set[float] = set()
-        for row in alignment.rows:
-            if not any(pattern_of[layer] in keys for layer in row.layers):
-                found.update(construct.boundaries(row, lengths))
-        points[group] = sorted(found)
-    return points
+    return {
+        group: [(row, construct.boundaries(row, lengths)) for row in alignment.rows]
+        for group, alignment in layout.groups.items()
+    }
+
+
+def _points_without(
+    laid: LaidRows, keys: set[str], pattern_of: Mapping[int, str]
+) -> dict[str, list[float]]:
+    """Per group, the boundaries of a sized layout's rows (:func:`_laid_rows`), but those
+    of the patterns ``keys`` (the rows another option of theirs must meet)."""
+    return {
+        group: sorted(
+            {
+                point
+                for row, x in rows
+                if not any(pattern_of[layer] in keys for layer in row.layers)
+                for point in x
+            }
+        )
+        for group, rows in laid.items()
+    }
 
 
 def _fits_among(

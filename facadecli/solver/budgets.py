@@ -23,6 +23,7 @@ EFFORT_FACTOR = 4  # ... or this many times what the first that aligned needed
 TIE = 1e-11  # objectives this close, relative to the canvas squared (and never less than
 # TIE m^2), are equally good: numerical noise (SPEC 2.7: 4.5e-8 m^2 on a 67 m façade, where
 # an element 0.2 mm off its size already counts); its tie-breaks decide among them
+PERFECT_REACH = 1.0 + 1e-9  # words looked at for a perfect layout: those the canvas holds
 CONSTRUCTIONS = 16  # candidates laid out by construction, least bound first, until one fits
 VARIANTS = 48  # options of a cluster of patterns tried in place of the best layout's
 FITTED = 2000  # options of a cluster tried for a fit to the rows at the back (cheap tests)

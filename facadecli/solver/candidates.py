@@ -123,8 +123,12 @@ class CandidateSpace:
     made: int = 0  # candidates made so far (their order)
 
     @classmethod
-    def of(cls, spec: Spec, uses: Sequence[PatternUse], canvas: float) -> CandidateSpace | None:
-        """The space of an axis; None when some pattern makes no word."""
+    def of(
+        cls, spec: Spec, uses: Sequence[PatternUse], canvas: float, reach: float = 2.0
+    ) -> CandidateSpace | None:
+        """The space of an axis, of words up to ``reach`` times the canvas (a space of
+        reach 2 bounds every longer word by ``beyond``; one of less holds the words of
+        layouts at objective 0 only); None when some pattern makes no word."""
         sizes = {name: symbol.size for name, symbol in spec.symbols.items()}
         transparent = frozenset(n for n in spec.symbols if spec.qualifiers(n).transparent)
         bounds = {name: counter.bounds for name, counter in spec.counters.items()}
@@ -148,7 +152,7 @@ class CandidateSpace:
                     (size for size in (sizes.get(n) for n in _names(use)) if size), default=0.0
                 )
                 beyond = min(beyond, smallest * smallest / 4.0)
-                found = _words(use, sizes, transparent, bounds, 2.0 * canvas)
+                found = _words(use, sizes, transparent, bounds, reach * canvas)
             if not found:  # not one word that short: the shortest there are
                 found = _words(use, sizes, transparent, bounds, math.inf)
             if len(found) > WORDS_PER_PATTERN:

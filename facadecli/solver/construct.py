@@ -322,10 +322,8 @@ def coverage(
 
 
 def boundaries(row: Row, lengths: Mapping[str, float]) -> list[float]:
-    x = [0.0]
-    for letter in row.word:
-        x.append(x[-1] + lengths[letter.symbol])
-    return x
+    """Where a row laid from 0 at ``lengths`` has its letters' boundaries."""
+    return list(itertools.accumulate((lengths[letter.symbol] for letter in row.word), initial=0.0))
 
 
 def _changes(row: Row, k: int) -> bool:
