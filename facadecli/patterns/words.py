@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import NamedTuple
 
 from facadecli.patterns.ast import Alt, Anonymous, Fixed, Named, Node, Repeat, Seq, Sym, walk
@@ -79,13 +80,17 @@ class CompiledPattern:
                     keys[id(node)] = f"{prefix}rep#{index}"
         return keys
 
-    def counter_names(self) -> set[str]:
-        names: set[str] = set()
-        for root in (self.root, *self.contents.values()):
-            for node in walk(root):
-                if isinstance(node, Repeat) and isinstance(node.count, Named):
-                    names.add(node.count.name)
-        return names
+    def counter_names(self) -> frozenset[str]:
+        return self._counter_names
+
+    @cached_property
+    def _counter_names(self) -> frozenset[str]:  # a pattern's words ask for them often
+        return frozenset(
+            node.count.name
+            for root in (self.root, *self.contents.values())
+            for node in walk(root)
+            if isinstance(node, Repeat) and isinstance(node.count, Named)
+        )
 
 
 class PatternSourceError(PatternSyntaxError):
