@@ -697,7 +697,7 @@ def _constructions(
             break
     if best is None:
         return made
-    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
+    pattern_of = _pattern_of(uses)
     laid: tuple[_Evaluated, LaidRows] | None = None  # the best layout's rows, laid once
     for _ in range(SWEEPS):
         improved = False
@@ -741,6 +741,10 @@ def _constructions(
     return made
 
 
+Fits = list[tuple[str, Row, dict[str, float]]]  # (group, row, every letter's size) per row
+Placed = dict[str, list[tuple[Row, Mapping[str, float]]]]  # per group, rows laid and sizes
+
+
 def _fitted_to_backs(
     spec: Spec,
     uses: Sequence[PatternUse],
@@ -756,12 +760,39 @@ def _fitted_to_backs(
     one of those boundaries and fill the canvas (:func:`construct.fit`). Layers that meet
     only through the base's columns align independently given them. With it, the sizes
     the fits found (every symbol's, when each row was laid; else None)."""
-    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
-    # first the backs: each cluster holding a group's back row takes the option whose back
-    # rows fit the canvas best on their own
+    candidate, tied = _backs_chosen(spec, uses, space, candidate, canvas, memory, tie)
+    fitting = _BackFitting.of(spec, uses, space, candidate, canvas, memory, tied)
+    if fitting is None:
+        return candidate, None
+    # the clusters with fewest placeholders first: their rows have least choice; passes
+    # again with the clusters in conflict first (their rows are the rigid ones)
+    order = sorted(
+        range(len(space.clusters)), key=lambda c: (fitting.open_letters(candidate, c), c)
+    )
+    for _ in range(REPAIRS):
+        candidate, conflicted = fitting.laid_in(order, candidate)
+        if not conflicted:
+            break
+        order = conflicted + [cluster for cluster in order if cluster not in conflicted]
+    return candidate, fitting.sizes_found()
+
+
+def _backs_chosen(
+    spec: Spec,
+    uses: Sequence[PatternUse],
+    space: CandidateSpace,
+    candidate: Candidate,
+    canvas: float,
+    memory: _SearchMemory,
+    tie: float,
+) -> tuple[Candidate, dict[int, list[dict[str, Enumerated]]]]:
+    """The candidate with each cluster holding a group's back row at the option whose
+    back rows fit the canvas best on their own; with, per such cluster, its options as
+    good (VARIANTS at most)."""
+    pattern_of = _pattern_of(uses)
     rows = _candidate_rows(spec, uses, candidate, memory)
     at_back = {pattern_of[layer] for members in rows.values() for layer in members[0].layers}
-    tied: dict[int, list[dict[str, Enumerated]]] = {}  # per back cluster, its best options
+    tied: dict[int, list[dict[str, Enumerated]]] = {}
     for cluster, members in enumerate(space.clusters):
         keys = {use.key for use in members}
         if not keys & at_back:
@@ -775,104 +806,141 @@ def _fitted_to_backs(
             if bound <= least + tie
         ]
         candidate = options[bounds.index(least)]
-    # the backs laid at their own relaxation's sizes: their boundaries are what the
-    # other rows must meet
-    rows = _candidate_rows(spec, uses, candidate, memory)
-    backs = {group: members[0] for group, members in rows.items() if members}
-    relaxed = construct.relax(spec, {group: [row] for group, row in backs.items()}, canvas)
-    if relaxed is None:
-        return candidate, None
-    laid = construct.placeholders_laid(
-        {group: [row] for group, row in backs.items()}, relaxed, canvas
-    ) or dict(relaxed.lengths)
-    points = {group: construct.boundaries(row, laid) for group, row in backs.items()}
-    sizes = {name: size for name, size in relaxed.lengths.items() if spec.size(name) is not None}
-    # rows chosen so far, with their sizes: a row chosen later keeps its turns between
-    # transparent and visible out of their visible letters, and theirs out of its own
-    placed = {group: [(row, laid)] for group, row in backs.items()}
+    return candidate, tied
 
-    def own_rows(variant: Candidate, keys: set[str]) -> list[tuple[str, Row]]:
-        grouped = _candidate_rows(spec, uses, variant, memory)
+
+def _pattern_of(uses: Sequence[PatternUse]) -> dict[int, str]:
+    """The pattern of every layer (by index) on the axis."""
+    return {layer: use.key for use in uses for layer, _ in use.layers}
+
+
+@dataclass
+class _BackFitting:
+    """The other clusters' words fitted to the backs laid at their relaxation's sizes
+    (:func:`_fitted_to_backs`): the backs' boundaries, the sizes known, and the rows
+    placed so far (a row chosen later keeps its turns between transparent and visible
+    out of their visible letters, and theirs out of its own)."""
+
+    spec: Spec
+    uses: Sequence[PatternUse]
+    space: CandidateSpace
+    canvas: float
+    memory: _SearchMemory
+    tied: dict[int, list[dict[str, Enumerated]]]  # per back cluster, its options as good
+    pattern_of: dict[int, str]
+    at_back: set[str]  # patterns with a row at the back of a group
+    backs: dict[str, Row]  # per group
+    laid: dict[str, float]  # the backs' sizes
+    points: dict[str, list[float]]  # per group, the backs' boundaries
+    sizes: dict[str, float]  # sized symbols, at the relaxation's sizes
+    placed: Placed = field(default_factory=dict)
+
+    @classmethod
+    def of(
+        cls,
+        spec: Spec,
+        uses: Sequence[PatternUse],
+        space: CandidateSpace,
+        candidate: Candidate,
+        canvas: float,
+        memory: _SearchMemory,
+        tied: dict[int, list[dict[str, Enumerated]]],
+    ) -> _BackFitting | None:
+        """The backs of the candidate laid; None when their relaxation has no solution."""
+        pattern_of = _pattern_of(uses)
+        rows = _candidate_rows(spec, uses, candidate, memory)
+        at_back = {pattern_of[layer] for members in rows.values() for layer in members[0].layers}
+        backs = {group: members[0] for group, members in rows.items() if members}
+        alone = {group: [row] for group, row in backs.items()}
+        relaxed = construct.relax(spec, alone, canvas)
+        if relaxed is None:
+            return None
+        laid = construct.placeholders_laid(alone, relaxed, canvas) or dict(relaxed.lengths)
+        return cls(
+            spec,
+            uses,
+            space,
+            canvas,
+            memory,
+            tied,
+            pattern_of,
+            at_back,
+            backs,
+            laid,
+            {group: construct.boundaries(row, laid) for group, row in backs.items()},
+            {name: size for name, size in relaxed.lengths.items() if spec.size(name) is not None},
+        )
+
+    def own_rows(self, variant: Candidate, keys: set[str]) -> list[tuple[str, Row]]:
+        """The rows of the patterns ``keys`` in ``variant``, with their groups."""
+        grouped = _candidate_rows(self.spec, self.uses, variant, self.memory)
         return [
             (group, row)
             for group, members in grouped.items()
             for row in members
-            if any(pattern_of[layer] in keys for layer in row.layers)
+            if any(self.pattern_of[layer] in keys for layer in row.layers)
         ]
 
+    def open_letters(self, candidate: Candidate, cluster: int) -> int:
+        """How many placeholders the cluster's rows have in the candidate."""
+        keys = {use.key for use in self.space.clusters[cluster]}
+        rows = self.own_rows(candidate, keys)
+        return sum(traits.size is None for _, row in rows for traits in row.traits)
+
     def fitted(
-        variant: Candidate,
-        keys: set[str],
-        apart: bool,
-        more: Mapping[str, list[tuple[Row, Mapping[str, float]]]] | None = None,
-    ) -> list[tuple[str, Row, dict[str, float]]] | None:
+        self, variant: Candidate, keys: set[str], apart: bool, more: Placed | None = None
+    ) -> Fits | None:
         """The rows of the patterns ``keys`` in ``variant`` fitted to the backs' points,
-        and (``apart``) to the rows placed and ``more``; None when one does not fit."""
-        own = own_rows(variant, keys)
-        known = {**_sized(spec, [row for _, row in own]), **sizes}
-        found: list[tuple[str, Row, dict[str, float]]] = []
+        and (``apart``) to the rows placed, ``more`` and each other; None when one does
+        not fit."""
+        own = self.own_rows(variant, keys)
+        known = {**_sized(self.spec, [row for _, row in own]), **self.sizes}
+        found: Fits = []
         for group, row in own:
-            if group not in points:
+            if group not in self.points:
                 return None
-            if row == backs[group]:
+            back = self.backs[group]
+            if row == back:
                 continue  # laid
-            if any(layer in backs[group].layers for layer in row.layers):
+            if any(layer in back.layers for layer in row.layers):
                 return None  # another word at the back: the backs are laid
-            # apart from the rows placed and from this option's own rows fitted so far
-            # (one cluster's words must fit each other as well as the others')
-            mine = [(other, lengths) for g, other, lengths in found if g == group]
-            extra = [] if more is None else more.get(group, [])
-            laid = (
-                construct.laid_for(row, [*placed[group], *extra, *mine])
-                if apart
-                else construct.NOTHING_LAID
-            )
-            fit = construct.fit(row, known, points[group], canvas, laid)
+            laid = construct.NOTHING_LAID
+            if apart:  # one cluster's words must fit each other as well as the others'
+                mine = [(other, lengths) for g, other, lengths in found if g == group]
+                extra = [] if more is None else more.get(group, [])
+                laid = construct.laid_for(row, [*self.placed[group], *extra, *mine])
+            fit = construct.fit(row, known, self.points[group], self.canvas, laid)
             if fit is None:
                 return None
             found.append((group, row, {**known, **fit}))
         return found
 
-    # the clusters with fewest placeholders first: their rows have least choice
-    order = sorted(
-        range(len(space.clusters)),
-        key=lambda cluster: (
-            sum(
-                traits.size is None
-                for _, row in own_rows(candidate, {u.key for u in space.clusters[cluster]})
-                for traits in row.traits
-            ),
-            cluster,
-        ),
-    )
-
-    def options_of(candidate: Candidate, cluster: int, keys: set[str]) -> Iterable[Candidate]:
+    def options_of(self, candidate: Candidate, cluster: int, keys: set[str]) -> Iterable[Candidate]:
         """The candidate, then with the cluster's other options to try, in order."""
-        if cluster not in tied:
-            return _least_covering_first(space, candidate, cluster, FITTED)
+        if cluster not in self.tied:
+            return _least_covering_first(self.space, candidate, cluster, FITTED)
         # the backs' words are chosen: only their options as good
         others = {key: word for key, word in candidate.words.items() if key not in keys}
         return [candidate] + [
-            space.candidate([others, option])
-            for option in tied[cluster]
+            self.space.candidate([others, option])
+            for option in self.tied[cluster]
             if any(option[key] is not candidate.words[key] for key in keys)
         ]
 
-    def piecewise(
-        candidate: Candidate, cluster: int
-    ) -> tuple[Candidate, list[tuple[str, Row, dict[str, float]]]] | None:
+    def piecewise(self, candidate: Candidate, cluster: int) -> tuple[Candidate, Fits] | None:
         """The cluster's words chosen a pattern at a time, given the counters set so far
         (the back's first): a pattern's alternatives are independent of the others' once
         the counters they share agree, so each takes its first word (least tolerance
         first) whose rows fit the backs and the rows placed, its own cluster's included.
         None when a pattern has no such word among WORDS_FITTED."""
+        space = self.space
         members = space.clusters[cluster]
-        chosen = {u.key: candidate.words[u.key] for u in members if u.key in at_back}
+        chosen = {u.key: candidate.words[u.key] for u in members if u.key in self.at_back}
         counters: dict[str, int] = {}
         for item in chosen.values():
             counters.update(item.choice.counters)
-        mine: dict[str, list[tuple[Row, Mapping[str, float]]]] = {}
-        found: list[tuple[str, Row, dict[str, float]]] = []
+        mine: Placed = {}
+        found: Fits = []
         for use in members:
             if use.key in chosen:
                 continue
@@ -881,7 +949,7 @@ def _fitted_to_backs(
                 if any(counters.get(name, value) != value for name, value in values.items()):
                     continue
                 variant = space.candidate([dict(candidate.words), {**chosen, use.key: item}])
-                fits = fitted(variant, {use.key}, True, mine)
+                fits = self.fitted(variant, {use.key}, True, mine)
                 if fits is not None:
                     chosen[use.key] = item
                     counters.update(values)
@@ -893,43 +961,39 @@ def _fitted_to_backs(
                 return None
         return space.candidate([dict(candidate.words), chosen]), found
 
-    def laid_in(order: Sequence[int], candidate: Candidate) -> tuple[Candidate, list[int]]:
+    def laid_in(self, order: Sequence[int], candidate: Candidate) -> tuple[Candidate, list[int]]:
         """One pass over the clusters in ``order``: each takes its first option whose rows
         fit the backs and the rows placed so far (or its words chosen a pattern at a time,
-        :func:`piecewise`; or, failing that, an option that fits the backs alone: it is in
+        :meth:`piecewise`; or, failing that, an option that fits the backs alone: it is in
         conflict)."""
-        for group, row in backs.items():
-            placed[group] = [(row, laid)]
+        self.placed = {group: [(row, self.laid)] for group, row in self.backs.items()}
         conflicted = []
         for cluster in order:
-            keys = {use.key for use in space.clusters[cluster]}
+            keys = {use.key for use in self.space.clusters[cluster]}
             for apart in (True, False):
-                tried = options_of(candidate, cluster, keys)
+                tried = self.options_of(candidate, cluster, keys)
                 chosen = next(
-                    ((v, f) for v in tried if (f := fitted(v, keys, apart)) is not None), None
+                    ((v, f) for v in tried if (f := self.fitted(v, keys, apart)) is not None),
+                    None,
                 )
-                if chosen is None and apart and len(space.clusters[cluster]) > 1:
-                    chosen = piecewise(candidate, cluster)
+                if chosen is None and apart and len(self.space.clusters[cluster]) > 1:
+                    chosen = self.piecewise(candidate, cluster)
                 if chosen is not None:
                     candidate = chosen[0]
                     for group, row, lengths in chosen[1]:
-                        placed[group].append((row, lengths))
+                        self.placed[group].append((row, lengths))
                     if not apart:
                         conflicted.append(cluster)
                     break
         return candidate, conflicted
 
-    # passes again with the clusters in conflict first (their rows are the rigid ones)
-    for _ in range(REPAIRS):
-        candidate, conflicted = laid_in(order, candidate)
-        if not conflicted:
-            break
-        order = conflicted + [cluster for cluster in order if cluster not in conflicted]
-    found: dict[str, float] = {}
-    for laid_rows in placed.values():
-        for _, lengths in laid_rows:
-            found.update(lengths)
-    return candidate, found
+    def sizes_found(self) -> dict[str, float]:
+        """Every size the rows placed were laid at."""
+        found: dict[str, float] = {}
+        for rows in self.placed.values():
+            for _, lengths in rows:
+                found.update(lengths)
+        return found
 
 
 def _least_covering_together(
@@ -945,7 +1009,7 @@ def _least_covering_together(
     covering less than its own and fitting the layout's other boundaries
     (:func:`_fits_among`), all at once: one layout to build where a sweep builds one per
     cluster. None when no cluster has such an option."""
-    pattern_of = {layer: use.key for use in uses for layer, _ in use.layers}
+    pattern_of = _pattern_of(uses)
     words = layout.candidate.words
     chosen: dict[str, Enumerated] = {}
     laid = _laid_rows(layout)
