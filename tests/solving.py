@@ -9,7 +9,16 @@ from facadecli.solver.axis import PlacedLetter
 
 
 def solve_text(text: str) -> Layout:
-    return solve(parse_spec(textwrap.dedent(text), "test.yaml"))
+    """The layout of a spec's text, with its wall-clock safety net (``solver.time_limit``)
+    out of reach unless the text sets it: the work budgets decide, so the answer does not
+    depend on the machine's load (a search-heavy spec takes seconds where the searches
+    run in pure Python, on a machine with no C compiler)."""
+    spec = parse_spec(textwrap.dedent(text), "test.yaml")
+    if "time_limit" not in text:
+        spec = spec.model_copy(
+            update={"solver": spec.solver.model_copy(update={"time_limit": 3600.0})}
+        )
+    return solve(spec)
 
 
 def letters(layout: Layout, layer: str, axis: str) -> list[PlacedLetter]:
