@@ -20,7 +20,7 @@ from facadecli.city.run import run_city, safe_name
 from facadecli.city.s3db import COLOURS, colour, tag_problems
 from facadecli.city.straight import merged_ring
 from facadecli.geometry.facade import linear_rgb
-from tests.osm_district import ROOF_SHAPES, box, write_district
+from tests.osm_district import ROOF_SHAPES, UNBUILT_SHAPES, box, write_district
 from tests.running import facade
 from tests.test_s3db import SPEC
 
@@ -68,6 +68,23 @@ def _ridge_reach(roof: trimesh.Trimesh) -> tuple[float, float]:
     return float(on_ridge.min() - along.min()), float(along.max() - on_ridge.max())
 
 
+def _pieces(mesh: trimesh.Trimesh) -> list[trimesh.Trimesh]:
+    """The mesh's pieces whose triangles share edges (pieces touching at a point apart)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    keys = np.round(mesh.vertices, 4)
+    _, ids = np.unique(keys, axis=0, return_inverse=True)
+    faces = ids.reshape(-1)[mesh.faces]
+    edges = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    _, edge_ids = np.unique(edges, axis=0, return_inverse=True)
+    owner = np.repeat(np.arange(len(faces)), 3)
+    graph = coo_matrix((np.ones(len(owner)), (owner, edge_ids.reshape(-1))))
+    both = graph @ graph.T  # faces sharing an edge
+    count, label = connected_components(both, directed=False)
+    return [mesh.submesh([np.flatnonzero(label == k)], append=True) for k in range(count)]
+
+
 def test_a_terrace_of_hipped_houses_has_no_valleys(district: tuple[Path, dict[str, Any]]) -> None:
     folder, report = district
     # the end houses are hipped at their free ends and run on to their party walls; the
@@ -103,8 +120,11 @@ def test_the_podium_roof_runs_into_the_tower_not_through_it(
         & (middles[:, 2] < z1 - 0.2)
     )
     assert not inside.any()  # no piece of the podium's roof inside the tower
-    # the tower, 30 m on a 10 m podium, keeps its façades all round
+    # the tower, 30 m on a 10 m podium, keeps its façades all round, from the podium's
+    # eaves (10 m less its 2 m hipped roof) up: none inside the podium
     assert _entry(report, 503)["facades"] == 4 and _entry(report, 503)["party_walls"] == 0
+    assert tower.bounds[0][1] == pytest.approx(8.0, abs=1e-3)
+    assert tower.bounds[1][1] == pytest.approx(30.0, abs=0.3)
 
 
 def test_a_wall_drawn_with_nodes_on_a_line_is_one_facade(
@@ -188,6 +208,29 @@ def test_every_roof_shape_builds(district: tuple[Path, dict[str, Any]]) -> None:
     assert len(_mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "wall").faces) == 4
 
 
+def test_a_zakomar_roof_is_arches_along_the_walls(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, _ = district
+    oid = 700 + ROOF_SHAPES.index("zakomar")
+    roof = _mesh(folder, oid, "roof")
+    up = roof.vertices[:, 1]
+    # 12 x 8 m: two arches on each long wall, one on each short one; their crests and
+    # the point the roof runs in to are the top, 3 m (roof:height) above the eaves
+    assert int((up > up.max() - 1e-3).sum()) == 6 + 1
+    assert up.max() - up.min() == pytest.approx(3.0, abs=1e-3)
+    # under each arch a vertical gable, a half circle of ARCH_SEGMENTS pieces
+    gables = _mesh(folder, oid, "wall")
+    assert np.abs(gables.face_normals[gables.area_faces > 1e-9, 1]).max() < 1e-4  # float32
+    pieces = _pieces(gables)
+    assert len(pieces) == 6
+    widths = sorted(float(np.ptp(p.vertices[:, [0, 2]], axis=0).max()) for p in pieces)
+    assert widths == pytest.approx([6, 6, 6, 6, 8, 8], abs=0.05)  # 12 m walls: 2 arches each
+    for piece in pieces:  # half circles 6 m wide, 3 m high; over 8 m, half ellipses
+        width = float(np.ptp(piece.vertices[:, [0, 2]], axis=0).max())
+        assert piece.area == pytest.approx(math.pi * width / 2 * 3.0 / 2, rel=0.03)
+
+
 def test_a_sawtooth_roof_is_sheds_side_by_side(district: tuple[Path, dict[str, Any]]) -> None:
     folder, _ = district
     roof = _mesh(folder, 800, "roof")
@@ -209,15 +252,15 @@ def test_what_is_not_understood_is_warned_and_counted(
     _, report = district
     warned = {(w["id"], w["warning"].split(" ", 1)[0]) for w in report["warnings"]}
     assert ("way/600", "roof:shape") in warned and ("way/600", "building:colour") in warned
-    unbuilt = {"zakomar"}  # built as a dome, warned
+    unbuilt = set(UNBUILT_SHAPES)  # built as another shape, warned
     for shape in unbuilt:
-        oid = 700 + ROOF_SHAPES.index(shape)
+        oid = 700 + (ROOF_SHAPES + UNBUILT_SHAPES).index(shape)
         assert (f"way/{oid}", "roof:shape") in warned
     counts = report["summary"]["warnings_by_tag"]
     assert counts == {"building:colour": 1, "roof:shape": 1 + len(unbuilt)}
     assert report["summary"]["warnings"] == len(report["warnings"]) == sum(counts.values())
-    # every other shape S3DB lists is understood: no warning
-    for shape in set(ROOF_SHAPES) - unbuilt:
+    # every shape S3DB lists is understood: no warning
+    for shape in ROOF_SHAPES:
         assert tag_problems({"roof:shape": shape}) == []
 
 

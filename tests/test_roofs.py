@@ -4,6 +4,7 @@ close the building with its walls, and keep its gable walls under it."""
 
 from __future__ import annotations
 
+import itertools
 import math
 import random
 from typing import get_args
@@ -356,7 +357,22 @@ def test_no_shape_falls_back_on_the_hand_made_footprints(name: str) -> None:
     for kind in SLOPED:
         built = roofs._shape(part.wkb, *roofs._key(Roof(type=kind))).kind  # type: ignore[arg-type]
         concave = name != "rectangle"
-        assert built == ("hip" if kind == "pyramidal" and concave else kind), (name, kind)
+        expected = "hip" if kind == "pyramidal" and concave else kind
+        if kind == "zakomar" and (part.interiors or _kernel(part).area < 1e-3):  # none sees it
+            expected = "dome"
+        assert built == expected, (name, kind)
+
+
+def _kernel(part: Polygon) -> Polygon:
+    """The points inside a (single ring, counter-clockwise) outline that see all of it:
+    the left half-planes of its edges, together."""
+    ring = np.array(part.exterior.coords)
+    kernel = part
+    for a, b in itertools.pairwise(ring):
+        v = (b - a) / np.hypot(*(b - a)) * 1e3
+        left = np.array([-v[1], v[0]])
+        kernel = kernel.intersection(Polygon([a - v, b + v, b + v + left, a - v + left]))
+    return kernel
 
 
 def _random_outline(rng: random.Random) -> Polygon:

@@ -38,6 +38,7 @@ RoofType = Literal[
     "dome",
     "round",
     "onion",
+    "zakomar",
 ]
 
 
@@ -222,11 +223,15 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "dome": "dome",
     "round": "round",
     "onion": "onion",
+    "zakomar": "zakomar",
 }
 
 
-UNBUILT: dict[str, RoofType] = {  # roof:shape S3DB lists -> the roof built instead (warned)
-    "zakomar": "dome",
+UNBUILT: dict[str, RoofType] = {  # roof:shape OSM documents -> the roof built instead (warned)
+    "gabled_height_moved": "gable",  # a gable whose ridge is off the middle
+    "bellcast_gable": "gable",  # a gable whose slopes flare out at the eaves
+    "hipped-and-gabled": "hip",  # a hip with a small gable at the top of each end
+    "butterfly": "flat",  # two slopes down to a valley in the middle
 }
 
 

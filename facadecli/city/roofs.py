@@ -1,6 +1,6 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
 (SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, mansard,
-saltbox, crosspitched, sawtooth, dome, round, onion.
+saltbox, crosspitched, sawtooth, dome, round, onion, zakomar.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
 
@@ -33,7 +33,10 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
   wings' gables cross;
 - dome, onion and round: hip, hip and gable roofs whose height is a curve of the
   skeleton time: a quarter circle (round: a barrel with a half-circle section), an onion
-  (a bulb that narrows to a point), in flat bands.
+  (a bulb that narrows to a point), in flat bands;
+- zakomar: half-circle arches (ARCH_SEGMENTS straight pieces each) about ZAKOMARA wide
+  along every wall, vertical gables under them, the roof running in from the arches to a
+  point that sees the whole outline (a dome where there is none).
 
 Heights: ``pitch`` is the slope of a plane moving at weight 1, unless ``height`` sets the
 top; domes and barrels rise by their half width, onions by twice that. ``roof_height``
@@ -48,6 +51,7 @@ then the mesh builds the skeleton once.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import defaultdict
 from collections.abc import Sequence
@@ -72,8 +76,11 @@ PYRAMID_HULL = 0.9  # a pyramid's outline fills this much of its convex hull at 
 FACING = 0.5  # a saltbox's long slope: the sides facing its direction within 60°
 HALF_HIP = 2 / 3  # a half hip's gable end goes up to this part of its height
 TOOTH = 6.0  # metres: a sawtooth roof's teeth are about this wide
+ZAKOMARA = 6.0  # metres: a zakomar roof's arches are about this wide
+ARCH_MIN = 3.0  # metres: walls shorter than this carry no arch
+ARCH_SEGMENTS = 8  # straight pieces of a zakomar arch (a half circle)
 BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
-CURVED = ("dome", "round", "onion")
+CURVED = ("dome", "round", "onion")  # profiles in bands (zakomar: curved in plan)
 GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox", "side_hip")
 FIXABLE = ("hip", "pyramidal", "mansard", *GABLED)  # roofs that keep still at party walls
 ON_WALL = 0.05  # metres: an edge whose middle is this near a fixed segment, along it, is one
@@ -120,7 +127,7 @@ def _rise(shape: _Shape, roof: Roof) -> float:
         return 0.0
     if roof.height is not None:
         return float(roof.height)
-    if shape.kind in ("dome", "round"):
+    if shape.kind in ("dome", "round", "zakomar"):
         return shape.top
     if shape.kind == "onion":
         return 2 * shape.top
@@ -165,6 +172,7 @@ def _shape(
     if kind == "flat" or not isinstance(part, Polygon) or part.is_empty or part.area <= 0:
         return FLAT
     tries = [(kind, fixed)] + [(kind, ())] * bool(fixed)
+    tries += [("dome", ())] * (kind == "zakomar")  # an outline no point sees whole
     tries += [] if kind == "hip" else [("hip", fixed)] * bool(fixed) + [("hip", ())]
     with np.errstate(all="ignore"):
         for attempt, still in tries:
@@ -189,6 +197,8 @@ def _build(
         return outline.sawtooth(direction)
     if kind == "pyramidal":
         return outline.hipped("hip") if outline.still else outline.pyramid()
+    if kind == "zakomar":
+        return outline.zakomar()
     if kind == "crosspitched":  # on wings: their gables cross already
         if outline.convex:
             return outline.crossed()
@@ -387,22 +397,83 @@ class _Outline:
             walls.append(((e, f, m), (float(self.direction[e, 0]), float(self.direction[e, 1]))))
         return self._finish("crosspitched", xy, t, cover, walls, top)
 
+    def zakomar(self) -> _Shape:
+        """Zakomar: the roof of a Russian church, a half-circle arch (a zakomara) about
+        ZAKOMARA wide over each stretch of every wall at least ARCH_MIN long, its gable
+        a vertical wall, and the roof running in from the arches to a point inside that
+        sees the whole outline: over an arch's crest level at the arches' height, down to
+        the eaves between two arches. The height over a point a share u of the way from
+        the wall to the centre is u x the top + (1 - u) x the arch's over the wall, so
+        each triangle from the centre to a piece of arch is one plane and the arches of
+        two walls meet at the corner between them. The arches' height is half the width
+        of the narrowest (flatter half-ellipses on wider ones)."""
+        if len(self.local) != 1:
+            raise Degenerate("zakomar: a courtyard")
+        centre = self._kernel_point()
+        lengths = np.hypot(*(self.points[self.next] - self.points).T)
+        arches = [
+            0 if size < ARCH_MIN else max(1, round(float(size) / ZAKOMARA)) for size in lengths
+        ]
+        widths = [size / n for size, n in zip(lengths.tolist(), arches, strict=True) if n]
+        if not widths:
+            raise Degenerate("zakomar: no wall long enough for an arch")
+        top = min(widths) / 2
+        xy: list[np.ndarray] = list(self.points)
+        ts: list[float] = [0.0] * self.count
+        apex = len(xy)
+        xy.append(centre)
+        ts.append(top)
+        cover: list[tuple[tuple[int, ...], ...]] = []
+        walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
+        for e in range(self.count):
+            a, f = self.points[e], int(self.next[e])
+            b = self.points[f]
+            d = (float(self.direction[e, 0]), float(self.direction[e, 1]))
+            crest: list[int] = [e]  # the top of the wall, from a to b: eaves and arches
+            for k in range(arches[e]):
+                for step in range(1, ARCH_SEGMENTS + 1):
+                    angle = math.pi * step / ARCH_SEGMENTS
+                    share = (k + (1 - math.cos(angle)) / 2) / arches[e]
+                    rise = top * math.sin(angle)
+                    if step == ARCH_SEGMENTS and k == arches[e] - 1:
+                        crest.append(f)
+                        continue
+                    xy.append(a + share * (b - a))
+                    ts.append(rise if step < ARCH_SEGMENTS else 0.0)
+                    crest.append(len(xy) - 1)
+                start = crest[-1 - ARCH_SEGMENTS]
+                lifted = crest[-ARCH_SEGMENTS:-1]
+                walls.append(((start, crest[-1], *lifted[::-1]), d))
+            if not arches[e]:
+                crest.append(f)
+            cover.extend(((p, q, apex),) for p, q in itertools.pairwise(crest))
+        return self._finish("zakomar", np.array(xy), np.array(ts), cover, walls, top)
+
+    def _kernel_point(self) -> np.ndarray:
+        """A point inside that sees the whole (single-ring) outline, a share of its size
+        in from every wall's line: its centroid, else the pole of inaccessibility."""
+        import shapely.ops
+
+        polygon = Polygon(self.points)
+        for point in (
+            np.array(polygon.centroid.coords[0]),
+            np.array(shapely.ops.polylabel(polygon, self.scale * 1e-3).coords[0]),
+        ):
+            reach = _cross(self.direction, point - self.points)  # distance in from each edge
+            if (reach > self.scale * 1e-3).all():
+                return point
+        raise Degenerate("no point sees the whole outline")
+
     def pyramid(self) -> _Shape:
         """Every edge slopes up to one apex, which must see the whole outline."""
         polygon = Polygon(self.points)
         if len(self.local) != 1 or polygon.area < PYRAMID_HULL * polygon.convex_hull.area:
             return self.hipped("hip")  # a courtyard or a concave outline
-        import shapely.ops
-
-        for apex in (
-            np.array(polygon.centroid.coords[0]),
-            np.array(shapely.ops.polylabel(polygon, self.scale * 1e-3).coords[0]),
-        ):
-            reach = _cross(self.direction, apex - self.points)  # distance in from each edge
-            if (reach > self.scale * 1e-3).all():
-                break
-        else:
+        try:
+            apex = self._kernel_point()
+        except Degenerate:
             return self.hipped("hip")
+        reach = _cross(self.direction, apex - self.points)  # distance in from each edge
         top = float(reach.min())
         xy = np.vstack([self.points, apex])
         t = np.concatenate([np.zeros(self.count), [top]])

@@ -56,6 +56,7 @@ from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
     inherited,
+    lifted,
     outline_rest,
     replaced_outlines,
     roof_colour,
@@ -276,9 +277,13 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
     shapes = {footprint.id: _shape(city, footprint.properties) for footprint in footprints}
+    above = standing_on(footprints, {key: shape[1] for key, shape in shapes.items()})
+    raised = lifted(
+        footprints, {k: s[1] for k, s in shapes.items()}, {k: s[2] for k, s in shapes.items()}
+    )
+    shapes |= {key: (shapes[key][0], heights, shapes[key][2]) for key, heights in raised.items()}
     beside = _beside(footprints, shapes)
     shared = shared_edges(footprints, tolerance, beside) if tolerance > 0 else {}
-    above = standing_on(footprints, {key: shape[1] for key, shape in shapes.items()})
     tasks = []
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
