@@ -64,6 +64,8 @@ BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [
     ),
     # a carport: a roof on posts, 2.5 m high
     (200, box(40, 0, 6, 5), {"building": "roof", "height": "2.5"}),
+    # a carport under a gabled roof, one storey high as nothing says otherwise
+    (210, box(48, 0, 6, 5), {"building": "carport", "roof:shape": "gabled", "roof:height": "1"}),
     # a 30 m wall drawn with three extra nodes on a line (a few cm off it)
     (
         300,

@@ -168,6 +168,23 @@ def test_a_carport_is_a_roof_on_posts(district: tuple[Path, dict[str, Any]]) -> 
     assert len(walls.split(only_watertight=False)) >= 4
     roof = _mesh(folder, 200, "roof")
     assert roof.bounds[1][1] == pytest.approx(2.5, abs=1e-3)
+    # building=carport too, its gable ends open; one storey (3 m) and its roof high
+    entry = _entry(report, 210)
+    assert entry["facades"] == 0 and entry["plain_walls"] == 0 and entry["height"] == 4.0
+    gabled = _mesh(folder, 210, "wall")  # posts only: no gable ends
+    assert all(np.ptp(p.vertices[:, [0, 2]], axis=0).max() < 0.3 for p in _pieces(gabled))
+    # in CityJSON each is one closed solid, the roof on a slab whose underside is a
+    # ceiling, at the top of the posts: no walls down to the ground
+    document = json.loads((folder / "out" / "d.city.json").read_text())
+    scale = document["transform"]["scale"][2]
+    for oid, eaves in ((200, 2.5), (210, 3.0)):
+        (geometry,) = document["CityObjects"][f"way/{oid}"]["geometry"]
+        assert geometry["type"] == "Solid"
+        kinds = {s["type"] for s in geometry["semantics"]["surfaces"]}
+        assert kinds == {"OuterCeilingSurface", "WallSurface", "RoofSurface"}
+        used = {i for surface in geometry["boundaries"][0] for ring in surface for i in ring}
+        low = min(document["vertices"][i][2] for i in used) * scale
+        assert low == pytest.approx(eaves - 0.2, abs=1e-3)
 
 
 def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, Any]]) -> None:

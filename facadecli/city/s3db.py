@@ -394,13 +394,22 @@ def roof_colour(properties: dict[str, Any]) -> str | None:
     return found or ROOF_MATERIALS.get(material)
 
 
+ON_POSTS = ("roof", "carport")  # building values for a roof on posts
+
+
 def roof_only(properties: dict[str, Any]) -> bool:
-    """``building=roof`` (or ``building:part=roof``): a roof on posts, no walls (a
-    carport, a petrol station's canopy, a platform roof)."""
+    """``building=roof`` or ``building=carport`` (or such a ``building:part``): a roof on
+    posts, no walls (a carport, a petrol station's canopy, a platform roof)."""
     return any(
-        str(properties.get(key, "")).strip().lower() == "roof"
+        str(properties.get(key, "")).strip().lower() in ON_POSTS
         for key in ("building", "building:part")
     )
+
+
+def roof_solid(block: Volume, thickness: float) -> Volume:
+    """The solid of a roof on posts: the roof on a slab ``thickness`` thick under its
+    eaves (its underside a ceiling open to the air), not walls down to the ground."""
+    return replace(block, base=max(block.base, block.eaves - thickness))
 
 
 def tag_problems(properties: dict[str, Any]) -> list[str]:
