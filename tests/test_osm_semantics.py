@@ -22,6 +22,7 @@ from facadecli.city.straight import merged_ring
 from facadecli.geometry.facade import linear_rgb
 from tests.osm_district import ROOF_SHAPES, UNBUILT_SHAPES, box, write_district
 from tests.running import facade
+from tests.test_cityjson import _check_valid
 from tests.test_s3db import SPEC
 
 MANIFEST = """\
@@ -196,6 +197,40 @@ def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, An
     assert list(roof) == linear_rgb("#ffefd5")  # papayawhip, a CSS name (linear in glTF)
     ridge = scene.geometry["way/501/roof"].vertices[:, 1]
     assert ridge.max() - ridge.min() == pytest.approx(2.0, abs=1e-3)  # roof:height 2
+
+
+def test_the_cityjson_keeps_the_buildings_structure(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, _ = district
+    document = json.loads((folder / "out" / "d.city.json").read_text())
+    _check_valid(document, apart=False)  # the 2.0.2 schemas, parents and children, vertices
+    objects = document["CityObjects"]
+    # the outline is the Building, with its tags; its parts are its BuildingParts
+    outline = objects["way/500"]
+    assert outline["type"] == "Building" and "geometry" not in outline
+    assert outline["children"] == ["way/501", "way/502", "way/503"]
+    assert outline["attributes"]["building:colour"] == "rebeccapurple"
+    assert outline["attributes"]["measuredHeight"] == 30.0  # its tallest part
+    for key in outline["children"]:
+        assert objects[key]["type"] == "BuildingPart" and objects[key]["parents"] == ["way/500"]
+    assert [k for k, o in objects.items() if o["type"] == "Building" and "parents" in o] == []
+    # numbers as numbers: heights in metres (feet read), levels as counts
+    assert (
+        outline["attributes"]["height"] == 12.0
+        and objects["way/501"]["attributes"]["height"] == 12.0
+    )
+    assert objects["way/400"]["attributes"]["height"] == pytest.approx(12.192)
+    assert objects["way/100"]["attributes"]["building:levels"] == 2
+    assert objects["way/100"]["attributes"]["roof:height"] == 3.0
+    # every volume a closed solid; the tower part starts on the podium's eaves
+    scale = document["transform"]["scale"][2]
+    for key, item in objects.items():
+        for geometry in item.get("geometry", []):
+            assert geometry["type"] == "Solid", key
+    (tower,) = objects["way/503"]["geometry"]
+    used = {i for surface in tower["boundaries"][0] for ring in surface for i in ring}
+    assert min(document["vertices"][i][2] for i in used) * scale == pytest.approx(8.0)
 
 
 def test_heights_in_feet(district: tuple[Path, dict[str, Any]]) -> None:

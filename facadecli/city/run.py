@@ -41,6 +41,8 @@ from facadecli.city.cityjson import (
     BuildingSolids,
     CityJSONWriter,
     building_object,
+    grouped,
+    outlines,
     write_cityjson,
 )
 from facadecli.city.footprints import (
@@ -50,6 +52,7 @@ from facadecli.city.footprints import (
     Rejected,
     Simplified,
     read_footprints,
+    typed,
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
@@ -240,7 +243,7 @@ def _feature_file(target: Path) -> Path:
 def _attributes(task: Task, top: float) -> dict[str, Any]:
     """A building's CityJSON attributes: its tags, how tall it is, its roof and spec."""
     return {
-        **task.footprint.properties,
+        **typed(task.footprint.properties),
         "measuredHeight": top,
         "roofType": task.roof.type,
         "facade": task.spec_key,
@@ -602,9 +605,10 @@ def _build(
     cityjson = outdir / f"{city.manifest.name}.city.json"
     try:
         with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:
-            for result in results:
-                if result["status"] == "ok":
-                    writer.add(_feature(by_id[result["id"]]))
+            ok = [r["id"] for r in results if r["status"] == "ok"]
+            features = (_feature(by_id[key]) for key in ok)
+            for feature in grouped(features, outlines(found.footprints, replaced, ok)):
+                writer.add(feature)
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the CityJSON: {error.strerror or error}; the "

@@ -479,16 +479,23 @@ INHERITED = (
 INHERITED_HEIGHTS = ("height", "building:levels", "levels")
 
 
+def outline_of(replaced: dict[str, list[str]]) -> dict[str, str]:
+    """Part id -> the id of its outline (``replaced``: outline id -> its parts' ids, from
+    :func:`replaced_outlines`); a part in several outlines is the first's by id."""
+    parent: dict[str, str] = {}
+    for key in sorted(replaced):
+        for part in replaced[key]:
+            parent.setdefault(part, key)
+    return parent
+
+
 def inherited(footprints: Iterable[Footprint], replaced: dict[str, list[str]]) -> list[Footprint]:
     """The footprints with every part given the tags of its outline (``replaced``:
     outline id -> its parts' ids, from :func:`replaced_outlines`) that it lacks; a part
     in several outlines takes from the first by id."""
     footprints = list(footprints)
     by_id = {footprint.id: footprint for footprint in footprints}
-    parent: dict[str, str] = {}
-    for key in sorted(replaced):
-        for part in replaced[key]:
-            parent.setdefault(part, key)
+    parent = outline_of(replaced)
     found = []
     for footprint in footprints:
         outline = by_id.get(parent.get(footprint.id, ""))
