@@ -484,12 +484,21 @@ class _Vertices:
 
 
 def _geometry(volume: Volume, vertices: _Vertices) -> dict[str, Any]:
-    """The volume's Solid (or MultiSurface when its surfaces do not close)."""
+    """The volume's Solid (or MultiSurface when its surfaces do not close, with the
+    roof's slivers or without them)."""
     if not volume.eaves > volume.base:
         raise ValueError(f"eaves at {volume.eaves} m are not above the base at {volume.base} m")
-    kinds, surfaces = zip(*_surfaces(volume, vertices), strict=True)
-    split = _split_edges(list(surfaces), vertices.points)
-    oriented = _orient(split, vertices.points)
+    before = len(vertices.points)
+    for slivers in (True, False):  # a roof's slivers may fold the shell at a ridge
+        if not slivers:  # the first try's points are not written
+            for point in vertices.points[before:]:
+                del vertices.index[point]
+            del vertices.points[before:]
+        kinds, surfaces = zip(*_surfaces(volume, vertices, slivers), strict=True)
+        split = _split_edges(list(surfaces), vertices.points)
+        oriented = _orient(split, vertices.points)
+        if oriented is not None:
+            break
     types = [t for t in SURFACE_TYPES if t in kinds]
     values = [types.index(kind) for kind in kinds]
     semantics = {"surfaces": [{"type": t} for t in types], "values": values}
@@ -499,8 +508,11 @@ def _geometry(volume: Volume, vertices: _Vertices) -> dict[str, Any]:
     return {"type": "Solid", "lod": LOD, "boundaries": [oriented], "semantics": semantics}
 
 
-def _surfaces(volume: Volume, vertices: _Vertices) -> Iterator[tuple[str, Surface]]:
-    """Ground, walls and roof: rings of vertex indices, facing outwards as built."""
+def _surfaces(
+    volume: Volume, vertices: _Vertices, slivers: bool = True
+) -> Iterator[tuple[str, Surface]]:
+    """Ground, walls and roof: rings of vertex indices, facing outwards as built (the
+    roof's slivers left out without ``slivers``: see :func:`_polygons`)."""
     base, eaves = round(volume.base * UNITS), round(volume.eaves * UNITS)
     exterior = _plan_ring(volume.part.exterior)
     if not exterior:
@@ -527,10 +539,10 @@ def _surfaces(volume: Volume, vertices: _Vertices) -> Iterator[tuple[str, Surfac
     if flat:
         yield "RoofSurface", [at(ring, eaves) for ring in rings]
         return
-    for surface in _polygons(cover, vertices):
+    for surface in _polygons(cover, vertices, slivers):
         yield "RoofSurface", surface
     for piece in infill:
-        for surface in _polygons(piece, vertices):
+        for surface in _polygons(piece, vertices, slivers):
             yield "WallSurface", surface
 
 
@@ -545,10 +557,11 @@ def _plan_ring(ring: Any) -> list[tuple[int, int]]:
     return kept if len(kept) >= 3 else []
 
 
-def _polygons(mesh: trimesh.Trimesh, vertices: _Vertices) -> list[Surface]:
+def _polygons(mesh: trimesh.Trimesh, vertices: _Vertices, slivers: bool = True) -> list[Surface]:
     """A mesh's triangles as polygons: each set of edge-adjacent triangles with the same
     normal becomes one polygon when its outline is one simple ring, else stays triangles.
-    Triangles degenerate at millimetre precision are left out."""
+    Triangles degenerate at millimetre precision are left out, and without ``slivers``
+    those less than a unit high too."""
     if len(mesh.faces) == 0:
         return []
     points = np.asarray(mesh.vertices, dtype=float)
@@ -561,6 +574,9 @@ def _polygons(mesh: trimesh.Trimesh, vertices: _Vertices) -> list[Surface]:
     normal = np.cross(spans[:, 1] - spans[:, 0], spans[:, 2] - spans[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
     keep = twice >= 1.0  # at least half a square unit (three distinct points, not in line)
+    if not slivers:  # nor a corner within NEAR of the opposite edge (_split_edges puts it in)
+        longest = np.max(np.linalg.norm(units - np.roll(units, 1, axis=1), axis=2), axis=1)
+        keep &= twice > math.sqrt(NEAR) * longest
     triangles = [(a, b, c) for a, b, c in corners[keep].tolist()]
     normals = normal[keep]
     parent = list(range(len(triangles)))
