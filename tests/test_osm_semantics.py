@@ -128,6 +128,30 @@ def test_the_podium_roof_runs_into_the_tower_not_through_it(
     assert tower.bounds[1][1] == pytest.approx(30.0, abs=0.3)
 
 
+def test_a_tower_part_on_a_flat_podium_part_starts_on_its_roof(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, report = district
+    # 12 levels of 3 m on a podium of 3: façades from 9 m to 36 m, none inside the podium
+    facades = _mesh(folder, 902, "render")
+    assert facades.bounds[0][1] == pytest.approx(9.0, abs=1e-3)
+    assert _entry(report, 902)["facades"] == 4
+    # its pyramid 13'6" high
+    roof = _mesh(folder, 902, "roof").vertices[:, 1]
+    assert roof.max() - roof.min() == pytest.approx(13.5 * 0.3048, abs=1e-3)
+    assert _entry(report, 902)["height"] == pytest.approx(36 + 13.5 * 0.3048, abs=1e-3)
+    # the podium's flat roof is left out under the tower
+    podium = _mesh(folder, 901, "roof")
+    (x0, _, z0), (x1, _, z1) = facades.bounds
+    middles = podium.triangles_center
+    inside = (middles[:, 0] > x0 + 0.5) & (middles[:, 0] < x1 - 0.5)
+    inside &= (middles[:, 2] > z0 + 0.5) & (middles[:, 2] < z1 - 0.5)
+    assert not inside.any()
+    document = json.loads((folder / "out" / "d.city.json").read_text())
+    tower = document["CityObjects"]["way/900"]
+    assert tower["attributes"]["name"] == "Tower" and tower["children"] == ["way/901", "way/902"]
+
+
 def test_a_wall_drawn_with_nodes_on_a_line_is_one_facade(
     district: tuple[Path, dict[str, Any]], tmp_path: Path
 ) -> None:
