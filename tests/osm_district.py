@@ -34,6 +34,7 @@ ROOF_SHAPES = [
     "side_half-hipped",
     "pyramidal",
     "gambrel",
+    "bellcast_gable",
     "mansard",
     "saltbox",
     "dome",
@@ -45,7 +46,7 @@ ROOF_SHAPES = [
     "crosspitched",
 ]
 # shapes OSM documents that are not built here: each warned, built as another
-UNBUILT_SHAPES = ["gabled_height_moved", "bellcast_gable", "hipped-and-gabled", "butterfly"]
+UNBUILT_SHAPES = ["gabled_height_moved", "hipped-and-gabled", "butterfly"]
 
 # (id, outer ring, tags); ways only (the readers' multipolygons are tested elsewhere)
 BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [

@@ -269,6 +269,17 @@ def test_mansard_and_gambrel_break_their_slopes() -> None:
         assert at_break[0] - EAVES == pytest.approx(2 * rise / 3)
 
 
+def test_a_bellcast_gable_flares_out_at_the_eaves() -> None:
+    _, cover, walls = _roof("rectangle", "bellcast")  # 10 x 6 m: the ridge 3 m in
+    rise = cover.bounds[1][2] - EAVES
+    assert rise == pytest.approx(math.tan(math.radians(30)) * 3)
+    flare = _surface(cover, np.array([[5.0, 0.75], [5.0, 5.25]]))  # a quarter of the way in
+    assert flare - EAVES == pytest.approx([rise / 10, rise / 10])
+    slopes = np.degrees(np.arccos(np.abs(cover.face_normals[:, 2])))
+    assert slopes.min() < 15 and slopes.max() > 33  # 13° at the eaves, 35° above (30° plain)
+    assert len(walls) == 1 and set(np.round(walls[0].vertices[:, 0], 6)) == {0.0, 10.0}
+
+
 def test_heights_come_from_the_pitch_or_are_given() -> None:
     part = orient(FOOTPRINTS["rectangle"], sign=1.0)  # 10 x 6 m
     rise = math.tan(math.radians(40)) * 3

@@ -33,6 +33,7 @@ RoofType = Literal[
     "crosspitched",
     "sawtooth",
     "gambrel",
+    "bellcast",
     "mansard",
     "saltbox",
     "dome",
@@ -216,6 +217,7 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "half_hipped": "half_hip",
     "side_half-hipped": "half_hip",
     "gambrel": "gambrel",
+    "bellcast_gable": "bellcast",
     "mansard": "mansard",
     "saltbox": "saltbox",
     "crosspitched": "crosspitched",
@@ -229,7 +231,6 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
 
 UNBUILT: dict[str, RoofType] = {  # roof:shape OSM documents -> the roof built instead (warned)
     "gabled_height_moved": "gable",  # a gable whose ridge is off the middle
-    "bellcast_gable": "gable",  # a gable whose slopes flare out at the eaves
     "hipped-and-gabled": "hip",  # a hip with a small gable at the top of each end
     "butterfly": "flat",  # two slopes down to a valley in the middle
 }

@@ -1,5 +1,5 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
-(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, mansard,
+(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, bellcast, mansard,
 saltbox, crosspitched, sawtooth, dome, round, onion, zakomar.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
@@ -25,7 +25,8 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
 - saltbox: a gable whose side facing ``direction`` moves twice as fast: its slope runs
   twice as far, at half the pitch;
 - gambrel and mansard: gable and hip with two slopes (steep to a third of the way in and
-  two thirds of the height, then shallow);
+  two thirds of the height, then shallow); bellcast: a gable flaring out at the eaves
+  (shallow for a quarter of the way in, a tenth of the height, then steep);
 - sawtooth: sheds side by side on strips about TOOTH wide, their low sides facing
   ``direction`` (else the long side's southern face), a vertical wall at each high side;
 - crosspitched: on a convex outline, a gable over every side, the ridges meeting in the
@@ -80,8 +81,9 @@ ZAKOMARA = 6.0  # metres: a zakomar roof's arches are about this wide
 ARCH_MIN = 3.0  # metres: walls shorter than this carry no arch
 ARCH_SEGMENTS = 8  # straight pieces of a zakomar arch (a half circle)
 BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
+FLARE = (1 / 4, 1 / 10)  # bellcast: the eaves' flare, this far in rising this much
 CURVED = ("dome", "round", "onion")  # profiles in bands (zakomar: curved in plan)
-GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox", "side_hip")
+GABLED = ("gable", "half_hip", "gambrel", "bellcast", "round", "saltbox", "side_hip")
 FIXABLE = ("hip", "pyramidal", "mansard", *GABLED)  # roofs that keep still at party walls
 ON_WALL = 0.05  # metres: an edge whose middle is this near a fixed segment, along it, is one
 
@@ -759,6 +761,8 @@ def _profile(kind: str, bands: int) -> tuple[np.ndarray, np.ndarray]:
     """The roof's section, from the eaves (0, 0) to the top (1, 1): (in, up) fractions."""
     if kind in ("gambrel", "mansard"):
         return np.array([0.0, BREAK[0], 1.0]), np.array([0.0, BREAK[1], 1.0])
+    if kind == "bellcast":  # shallow at the eaves, then steep
+        return np.array([0.0, FLARE[0], 1.0]), np.array([0.0, FLARE[1], 1.0])
     if kind in ("dome", "round"):
         angle = np.linspace(0, math.pi / 2, bands + 1)
         return 1 - np.cos(angle), np.sin(angle)
