@@ -42,11 +42,12 @@ ROOF_SHAPES = [
     "onion",
     "cone",
     "sawtooth",
+    "butterfly",
     "zakomar",
     "crosspitched",
 ]
 # shapes OSM documents that are not built here: each warned, built as another
-UNBUILT_SHAPES = ["gabled_height_moved", "hipped-and-gabled", "butterfly"]
+UNBUILT_SHAPES = ["gabled_height_moved", "hipped-and-gabled"]
 
 # (id, outer ring, tags); ways only (the readers' multipolygons are tested elsewhere)
 BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [

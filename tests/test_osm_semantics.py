@@ -284,6 +284,26 @@ def test_every_roof_shape_builds(district: tuple[Path, dict[str, Any]]) -> None:
     assert len(_mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "wall").faces) == 4
 
 
+def test_a_butterfly_roof_is_a_valley_between_two_high_walls(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, _ = district
+    oid = 700 + ROOF_SHAPES.index("butterfly")
+    roof = _mesh(folder, oid, "roof")
+    up, flat = roof.vertices[:, 1], roof.vertices[:, [0, 2]]
+    assert up.max() - up.min() == pytest.approx(3.0, abs=1e-3)  # roof:height
+    # 12 x 8 m: the valley at the eaves, along the middle; high along the two long
+    # walls, 4 m either side of it
+    valley = flat[up < up.min() + 1e-3]
+    (a, b) = valley[np.argsort(valley[:, 0])[[0, -1]]]
+    assert np.linalg.norm(b - a) == pytest.approx(12.0, abs=0.05)
+    along = (b - a) / np.linalg.norm(b - a)
+    off = (flat[up > up.max() - 1e-3] - a) @ np.array([-along[1], along[0]])
+    assert np.abs(off) == pytest.approx(4.0, abs=0.01) and off.min() < 0 < off.max()
+    ends = _mesh(folder, oid, "wall")  # the walls above the eaves: vertical
+    assert np.abs(ends.face_normals[ends.area_faces > 1e-9, 1]).max() < 1e-4
+
+
 def test_a_zakomar_roof_is_arches_along_the_walls(
     district: tuple[Path, dict[str, Any]],
 ) -> None:

@@ -32,6 +32,7 @@ RoofType = Literal[
     "side_hip",
     "crosspitched",
     "sawtooth",
+    "butterfly",
     "gambrel",
     "bellcast",
     "mansard",
@@ -222,6 +223,7 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "saltbox": "saltbox",
     "crosspitched": "crosspitched",
     "sawtooth": "sawtooth",
+    "butterfly": "butterfly",
     "dome": "dome",
     "round": "round",
     "onion": "onion",
@@ -232,7 +234,6 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
 UNBUILT: dict[str, RoofType] = {  # roof:shape OSM documents -> the roof built instead (warned)
     "gabled_height_moved": "gable",  # a gable whose ridge is off the middle
     "hipped-and-gabled": "hip",  # a hip with a small gable at the top of each end
-    "butterfly": "flat",  # two slopes down to a valley in the middle
 }
 
 

@@ -1,6 +1,6 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
 (SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, bellcast, mansard,
-saltbox, crosspitched, sawtooth, dome, round, onion, zakomar.
+saltbox, crosspitched, sawtooth, butterfly, dome, round, onion, zakomar.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
 
@@ -27,6 +27,7 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
 - gambrel and mansard: gable and hip with two slopes (steep to a third of the way in and
   two thirds of the height, then shallow); bellcast: a gable flaring out at the eaves
   (shallow for a quarter of the way in, a tenth of the height, then steep);
+- butterfly: two sheds sloping down to a valley along the middle, their sides walls;
 - sawtooth: sheds side by side on strips about TOOTH wide, their low sides facing
   ``direction`` (else the long side's southern face), a vertical wall at each high side;
 - crosspitched: on a convex outline, a gable over every side, the ridges meeting in the
@@ -121,6 +122,8 @@ def _key(roof: Roof) -> tuple[str, float | None, str]:
         return roof.type, roof.direction, "along"
     if roof.type in GABLED:
         return roof.type, roof.direction, roof.orientation
+    if roof.type == "butterfly":
+        return roof.type, None, roof.orientation
     return roof.type, None, "along"
 
 
@@ -197,6 +200,8 @@ def _build(
         return outline.shed(direction)
     if kind == "sawtooth":
         return outline.sawtooth(direction)
+    if kind == "butterfly":
+        return outline.butterfly(orientation)
     if kind == "pyramidal":
         return outline.hipped("hip") if outline.still else outline.pyramid()
     if kind == "zakomar":
@@ -276,13 +281,34 @@ class _Outline:
         from its low side at the eaves to its high side, where a vertical wall (a
         factory's glazing) drops to the next strip's low side."""
         down = _compass(direction) if direction is not None else -_north(self.normal)
-        across = _perpendicular(down)
         reach = self.points @ down
         low, high = float(reach.min()), float(reach.max())
         count = max(1, round((high - low) / TOOTH))
         width = (high - low) / count
+        return self._strips(
+            "sawtooth", down, [(low + k * width, False) for k in range(count)], width
+        )
+
+    def butterfly(self, orientation: str) -> _Shape:
+        """Two sheds sloping down to a valley along the middle of the footprint (along
+        its long side, or across it with ``orientation: across``), high at the walls,
+        their sides vertical walls up to the roof."""
+        down = self.normal if orientation != "across" else self.main
+        reach = self.points @ down
+        low, high = float(reach.min()), float(reach.max())
+        width = (high - low) / 2
+        return self._strips("butterfly", down, [(low, False), (low + width, True)], width)
+
+    def _strips(
+        self, kind: str, down: np.ndarray, strips: list[tuple[float, bool]], width: float
+    ) -> _Shape:
+        """Sheds on strips ``width`` wide across ``down``, each starting where given
+        (along ``down``), rising from 0 at its far side to ``width`` at its near side
+        (flipped: the other way); vertical walls where a strip is higher than its
+        neighbour or the eaves."""
         if width <= self.eps:
-            raise Degenerate("sawtooth: no room")
+            raise Degenerate(f"{kind}: no room")
+        across = _perpendicular(down)
         polygon = Polygon(self.local[0], self.local[1:])
         span = float(np.abs(self.points @ across).max()) * 2 + 1.0
         nodes: dict[tuple[float, float, float], int] = {}
@@ -303,8 +329,8 @@ class _Outline:
         cover: list[tuple[tuple[int, ...], ...]] = []
         walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
         outline = polygon.boundary.buffer(snap)
-        for k in range(count):
-            a, b = low + k * width, low + (k + 1) * width
+        for a, flipped in strips:
+            b = a + width
             band = Polygon(
                 [
                     down * a - across * span,
@@ -322,7 +348,12 @@ class _Outline:
                 rings = []
                 for ring in (tooth.exterior, *tooth.interiors):
                     points = _clean(np.array(ring.coords)[:-1, :2], self.eps * 10)
-                    heights = [min(width, max(0.0, b - float(p @ down))) for p in points]
+                    heights = [
+                        min(
+                            width, max(0.0, float(p @ down) - a if flipped else b - float(p @ down))
+                        )
+                        for p in points
+                    ]
                     heights = [
                         0.0 if h <= snap else width if h >= width - snap else h for h in heights
                     ]
@@ -344,7 +375,7 @@ class _Outline:
                         loop += [roof[j]] * (heights[j] > 0) + [roof[i]] * (heights[i] > 0)
                         walls.append((tuple(loop), d))
                 cover.append(tuple(rings))
-        return self._finish("sawtooth", np.array(xy), np.array(ts), cover, walls, width)
+        return self._finish(kind, np.array(xy), np.array(ts), cover, walls, width)
 
     def shed(self, direction: float | None) -> _Shape:
         """One plane rising away from ``direction`` (its low side faces it)."""
