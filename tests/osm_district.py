@@ -32,6 +32,7 @@ ROOF_SHAPES = [
     "side_hipped",
     "half-hipped",
     "side_half-hipped",
+    "hipped-and-gabled",
     "pyramidal",
     "gambrel",
     "bellcast_gable",
@@ -47,7 +48,7 @@ ROOF_SHAPES = [
     "crosspitched",
 ]
 # shapes OSM documents that are not built here: each warned, built as another
-UNBUILT_SHAPES = ["gabled_height_moved", "hipped-and-gabled"]
+UNBUILT_SHAPES = ["gabled_height_moved"]
 
 # (id, outer ring, tags); ways only (the readers' multipolygons are tested elsewhere)
 BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [

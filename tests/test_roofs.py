@@ -123,7 +123,10 @@ def test_the_top_is_the_roof_height_above_the_eaves(kind: str, name: str) -> Non
         assert rise > 0.5
         assert cover.bounds[0][2] == pytest.approx(EAVES, abs=1e-9)  # down to the eaves
     for wall in infill:
-        assert wall.bounds[0][2] == pytest.approx(EAVES, abs=1e-9)
+        if kind == "dutch_gable":  # its gables stand on its hips
+            assert EAVES < wall.bounds[0][2] < EAVES + rise
+        else:
+            assert wall.bounds[0][2] == pytest.approx(EAVES, abs=1e-9)
         assert wall.bounds[1][2] <= EAVES + rise + 1e-6
 
 
@@ -267,6 +270,21 @@ def test_mansard_and_gambrel_break_their_slopes() -> None:
         rise = cover.bounds[1][2] - EAVES
         at_break = _surface(cover, np.array([[5.0, 1.0]]))  # a third of the way in
         assert at_break[0] - EAVES == pytest.approx(2 * rise / 3)
+
+
+def test_a_hipped_and_gabled_roof_is_hipped_below_and_gabled_above() -> None:
+    _, cover, walls = _roof("rectangle", "dutch_gable")  # 10 x 6 m: the ridge 3 m in
+    rise = cover.bounds[1][2] - EAVES
+    assert rise == pytest.approx(math.tan(math.radians(30)) * 3)
+    # each end hipped up to half the height (1.5 m in), then a small gable end
+    (gables,) = walls
+    assert gables.bounds[0][2] == pytest.approx(EAVES + rise / 2)
+    assert gables.bounds[1][2] == pytest.approx(EAVES + rise)
+    assert set(np.round(gables.vertices[:, 0], 6)) == {1.5, 8.5}
+    assert np.abs(gables.face_normals[:, 2]).max() < 1e-9  # vertical
+    ridge = _top_edges(cover)
+    assert np.ptp(ridge[:, :, 0]) == pytest.approx(10 - 2 * 1.5)  # to the gables' tops
+    assert _surface(cover, np.array([[0.75, 3.0]]))[0] - EAVES == pytest.approx(rise / 4)
 
 
 def test_a_bellcast_gable_flares_out_at_the_eaves() -> None:

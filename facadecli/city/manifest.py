@@ -30,6 +30,7 @@ RoofType = Literal[
     "pyramidal",
     "half_hip",
     "side_hip",
+    "dutch_gable",
     "crosspitched",
     "sawtooth",
     "butterfly",
@@ -212,6 +213,7 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "gabled": "gable",
     "hipped": "hip",
     "side_hipped": "side_hip",
+    "hipped-and-gabled": "dutch_gable",
     "pyramidal": "pyramidal",
     "cone": "pyramidal",
     "half-hipped": "half_hip",
@@ -233,7 +235,6 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
 
 UNBUILT: dict[str, RoofType] = {  # roof:shape OSM documents -> the roof built instead (warned)
     "gabled_height_moved": "gable",  # a gable whose ridge is off the middle
-    "hipped-and-gabled": "hip",  # a hip with a small gable at the top of each end
 }
 
 

@@ -1,6 +1,6 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
-(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, bellcast, mansard,
-saltbox, crosspitched, sawtooth, butterfly, dome, round, onion, zakomar.
+(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, dutch_gable, gambrel,
+bellcast, mansard, saltbox, crosspitched, sawtooth, butterfly, dome, round, onion, zakomar.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
 
@@ -20,6 +20,8 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
 - gable: the skeleton with weight 0 on the gable ends; half_hip: the same, the ends
   turning to weight 1 at two thirds of their height (hipped over the top third);
   side_hip: one gable end (at a party wall if one is there), the other hipped;
+  dutch_gable (OSM's hipped-and-gabled): the ends hipped up to DUTCH of their gable's
+  height, a small gable end above (the edges stop moving there);
 - hip: the plain skeleton; pyramidal: every edge slopes to one apex (hip on concave
   outlines and courtyards);
 - saltbox: a gable whose side facing ``direction`` moves twice as fast: its slope runs
@@ -77,6 +79,7 @@ ACROSS = 0.7072  # a gable end lies across the ridge: |cos| of their angle at mo
 PYRAMID_HULL = 0.9  # a pyramid's outline fills this much of its convex hull at least
 FACING = 0.5  # a saltbox's long slope: the sides facing its direction within 60°
 HALF_HIP = 2 / 3  # a half hip's gable end goes up to this part of its height
+DUTCH = 1 / 2  # a hipped-and-gabled roof's ends are hipped up to this part of its height
 TOOTH = 6.0  # metres: a sawtooth roof's teeth are about this wide
 ZAKOMARA = 6.0  # metres: a zakomar roof's arches are about this wide
 ARCH_MIN = 3.0  # metres: walls shorter than this carry no arch
@@ -84,7 +87,7 @@ ARCH_SEGMENTS = 8  # straight pieces of a zakomar arch (a half circle)
 BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
 FLARE = (1 / 4, 1 / 10)  # bellcast: the eaves' flare, this far in rising this much
 CURVED = ("dome", "round", "onion")  # profiles in bands (zakomar: curved in plan)
-GABLED = ("gable", "half_hip", "gambrel", "bellcast", "round", "saltbox", "side_hip")
+GABLED = ("gable", "half_hip", "dutch_gable", "gambrel", "bellcast", "round", "saltbox", "side_hip")
 FIXABLE = ("hip", "pyramidal", "mansard", *GABLED)  # roofs that keep still at party walls
 ON_WALL = 0.05  # metres: an edge whose middle is this near a fixed segment, along it, is one
 
@@ -552,7 +555,14 @@ class _Outline:
             fixed = any(e in self.still for side in chosen for e in side.edges)
             chosen = [] if fixed else chosen[:1]
         switches: dict[int, float] = {}
+        stops: dict[int, float] = {}
         for side in chosen:
+            if kind == "dutch_gable":  # hipped up to DUTCH of the way, then a gable end
+                apex = self._gable_apex(side)
+                if apex is not None:
+                    for e in side.edges:
+                        stops[e] = DUTCH * apex
+                continue
             for e in side.edges:
                 weights[e] = 0.0
             if kind == "half_hip":
@@ -563,10 +573,11 @@ class _Outline:
         for e in self.still:  # party walls: gable ends too
             weights[e] = 0.0
             switches.pop(e, None)
-        if plain is not None and all(w == 1.0 for w in weights):  # no gable ends after all
-            return self._from_skeleton(kind, plain, {})
-        skeleton = Skeleton(self, weights, switches)
-        return self._from_skeleton(kind, skeleton, switches)
+            stops.pop(e, None)
+        if plain is not None and all(w == 1.0 for w in weights) and not stops:
+            return self._from_skeleton(kind, plain, {})  # no gable ends after all
+        skeleton = Skeleton(self, weights, switches, stops)
+        return self._from_skeleton(kind, skeleton, switches, stops)
 
     # -- sides and gable ends ---------------------------------------------------------
 
@@ -639,20 +650,31 @@ class _Outline:
 
     # -- from a skeleton to a shape ----------------------------------------------------
 
-    def _from_skeleton(self, kind: str, skeleton: Skeleton, switches: dict[int, float]) -> _Shape:
-        """The skeleton's faces as roof faces, and as walls where edges stood still;
-        each roof face must lie in its edge's plane: t = its start + distance / weight."""
+    def _from_skeleton(
+        self,
+        kind: str,
+        skeleton: Skeleton,
+        switches: dict[int, float],
+        stops: dict[int, float] | None = None,
+    ) -> _Shape:
+        """The skeleton's faces as roof faces, and as walls where edges stood still
+        (``switches``: still until then; ``stops``: still from then); each roof face must
+        lie in its edge's plane: t = its start + distance / weight."""
+        stops = stops or {}
         cover: list[tuple[tuple[int, ...], ...]] = []
         walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
         xy, t = skeleton.xy, skeleton.t
         for e in range(self.count):
             d = (float(self.direction[e, 0]), float(self.direction[e, 1]))
-            slopes = skeleton.weights[e] > 0 and e not in switches
+            slopes = skeleton.weights[e] > 0 and e not in switches and e not in stops
             start, weight = switches.get(e, 0.0), skeleton.weights[e] if slopes else 1.0
             for face in skeleton.faces[e]:
-                wall, roofs = (
-                    (None, [face]) if slopes else self._split_face(e, face, xy, t, switches.get(e))
-                )
+                if slopes:
+                    wall, roofs = None, [face]
+                elif e in stops:
+                    wall, roofs = self._split_face(e, face, xy, t, stops[e], above=True)
+                else:
+                    wall, roofs = self._split_face(e, face, xy, t, switches.get(e))
                 if wall is not None:
                     walls.append((wall, d))
                 for roof in roofs:
@@ -666,19 +688,33 @@ class _Outline:
         return self._finish(kind, xy, t, cover, walls, top)
 
     def _split_face(
-        self, e: int, loop: tuple[int, ...], xy: np.ndarray, t: np.ndarray, switch: float | None
+        self,
+        e: int,
+        loop: tuple[int, ...],
+        xy: np.ndarray,
+        t: np.ndarray,
+        switch: float | None,
+        above: bool = False,
     ) -> tuple[tuple[int, ...] | None, list[tuple[int, ...]]]:
         """A face of an edge that first stood still: (its vertical part, its sloped
         parts). The wall is the face's nodes reached before the edge began to move (on
         its line), in order; each run of later nodes, with the nodes on either side, is a
-        sloped part (a half hip's top; two, if the roof came down to the wall between)."""
+        sloped part (a half hip's top; two, if the roof came down to the wall between).
+        ``above``: an edge that moved, then stopped at ``switch``: the wall is the nodes
+        reached after, the sloped part those before (a hipped-and-gabled roof's end)."""
         if e not in loop:
             return None, [loop] if abs(_area(xy[list(loop)])) > self.eps * self.scale else []
         start = loop.index(e)
         loop = loop[start:] + loop[:start]
         if switch is None:
             return loop, []
-        on = t[list(loop)] <= switch + self.eps
+        if above:
+            on_wall = t[list(loop)] >= switch - self.eps
+            if not on_wall.any():  # the edge was gone before it stopped: all slope
+                return None, [loop]
+            first = int(np.argmax(on_wall))  # the loop from a wall node: runs of slope
+            loop = loop[first:] + loop[:first]
+        on = t[list(loop)] >= switch - self.eps if above else t[list(loop)] <= switch + self.eps
         wall = tuple(n for n, kept in zip(loop, on.tolist(), strict=True) if kept)
         slopes: list[tuple[int, ...]] = []
         size, i = len(loop), 1
