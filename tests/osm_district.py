@@ -1,8 +1,9 @@
 """A small OpenStreetMap district of our own, written as OSM XML by the tests, with one
 case of each thing S3DB says of buildings: a terrace of hipped houses sharing their
-nodes, a tower part standing in a podium part, a carport (``building=roof``), heights in
-feet, a long wall drawn with extra nodes on a line, parts inheriting their outline's
-tags, every roof shape, CSS colour names and junk values.
+nodes, tower parts standing in podium parts (one hipped, one flat), carports
+(``building=roof``, ``building=carport``), heights in feet and inches, a long wall drawn
+with extra nodes on a line, parts inheriting their outline's tags, every roof shape
+(and those OSM documents that are not built), CSS colour names and junk values.
 
 Plans are in metres east and north of ORIGIN; nodes shared by two ways are one node."""
 
@@ -31,8 +32,10 @@ ROOF_SHAPES = [
     "side_hipped",
     "half-hipped",
     "side_half-hipped",
+    "hipped-and-gabled",
     "pyramidal",
     "gambrel",
+    "bellcast_gable",
     "mansard",
     "saltbox",
     "dome",
@@ -40,9 +43,12 @@ ROOF_SHAPES = [
     "onion",
     "cone",
     "sawtooth",
+    "butterfly",
     "zakomar",
     "crosspitched",
 ]
+# shapes OSM documents that are not built here: each warned, built as another
+UNBUILT_SHAPES = ["gabled_height_moved"]
 
 # (id, outer ring, tags); ways only (the readers' multipolygons are tested elsewhere)
 BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [
@@ -62,6 +68,8 @@ BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [
     ),
     # a carport: a roof on posts, 2.5 m high
     (200, box(40, 0, 6, 5), {"building": "roof", "height": "2.5"}),
+    # a carport under a gabled roof, one storey high as nothing says otherwise
+    (210, box(48, 0, 6, 5), {"building": "carport", "roof:shape": "gabled", "roof:height": "1"}),
     # a 30 m wall drawn with three extra nodes on a line (a few cm off it)
     (
         300,
@@ -87,6 +95,21 @@ BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [
     (501, box(0, 60, 10, 20), {"building:part": "yes"}),
     (502, box(10, 60, 30, 20), {"building:part": "yes", "height": "10"}),
     (503, box(20, 66, 8, 8), {"building:part": "yes", "height": "30", "roof:shape": "flat"}),
+    # a podium of three levels under a flat roof, drawn as a part of its outline, and a
+    # tower part of twelve levels from the ground in it, its roof's height in feet and
+    # inches (13'6" is 4.115 m)
+    (900, box(100, 0, 30, 20), {"building": "commercial", "name": "Tower"}),
+    (901, box(100, 0, 30, 20), {"building:part": "yes", "building:levels": "3"}),
+    (
+        902,
+        box(108, 5, 10, 10),
+        {
+            "building:part": "yes",
+            "building:levels": "12",
+            "roof:shape": "pyramidal",
+            "roof:height": "13'6\"",
+        },
+    ),
     # junk: a colour and a roof shape no one knows
     (
         600,
@@ -106,7 +129,7 @@ BUILDINGS: list[tuple[int, Ring, dict[str, str]]] = [
             box(14 * k, 100, 12, 8),
             {"building": "house", "building:levels": "1", "roof:shape": shape, "roof:height": "3"},
         )
-        for k, shape in enumerate(ROOF_SHAPES)
+        for k, shape in enumerate(ROOF_SHAPES + UNBUILT_SHAPES)
     ),
 ]
 

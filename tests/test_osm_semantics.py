@@ -20,8 +20,9 @@ from facadecli.city.run import run_city, safe_name
 from facadecli.city.s3db import COLOURS, colour, tag_problems
 from facadecli.city.straight import merged_ring
 from facadecli.geometry.facade import linear_rgb
-from tests.osm_district import ROOF_SHAPES, box, write_district
+from tests.osm_district import ROOF_SHAPES, UNBUILT_SHAPES, box, write_district
 from tests.running import facade
+from tests.test_cityjson import _check_valid
 from tests.test_s3db import SPEC
 
 MANIFEST = """\
@@ -68,6 +69,23 @@ def _ridge_reach(roof: trimesh.Trimesh) -> tuple[float, float]:
     return float(on_ridge.min() - along.min()), float(along.max() - on_ridge.max())
 
 
+def _pieces(mesh: trimesh.Trimesh) -> list[trimesh.Trimesh]:
+    """The mesh's pieces whose triangles share edges (pieces touching at a point apart)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    keys = np.round(mesh.vertices, 4)
+    _, ids = np.unique(keys, axis=0, return_inverse=True)
+    faces = ids.reshape(-1)[mesh.faces]
+    edges = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    _, edge_ids = np.unique(edges, axis=0, return_inverse=True)
+    owner = np.repeat(np.arange(len(faces)), 3)
+    graph = coo_matrix((np.ones(len(owner)), (owner, edge_ids.reshape(-1))))
+    both = graph @ graph.T  # faces sharing an edge
+    count, label = connected_components(both, directed=False)
+    return [mesh.submesh([np.flatnonzero(label == k)], append=True) for k in range(count)]
+
+
 def test_a_terrace_of_hipped_houses_has_no_valleys(district: tuple[Path, dict[str, Any]]) -> None:
     folder, report = district
     # the end houses are hipped at their free ends and run on to their party walls; the
@@ -103,8 +121,35 @@ def test_the_podium_roof_runs_into_the_tower_not_through_it(
         & (middles[:, 2] < z1 - 0.2)
     )
     assert not inside.any()  # no piece of the podium's roof inside the tower
-    # the tower, 30 m on a 10 m podium, keeps its façades all round
+    # the tower, 30 m on a 10 m podium, keeps its façades all round, from the podium's
+    # eaves (10 m less its 2 m hipped roof) up: none inside the podium
     assert _entry(report, 503)["facades"] == 4 and _entry(report, 503)["party_walls"] == 0
+    assert tower.bounds[0][1] == pytest.approx(8.0, abs=1e-3)
+    assert tower.bounds[1][1] == pytest.approx(30.0, abs=0.3)
+
+
+def test_a_tower_part_on_a_flat_podium_part_starts_on_its_roof(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, report = district
+    # 12 levels of 3 m on a podium of 3: façades from 9 m to 36 m, none inside the podium
+    facades = _mesh(folder, 902, "render")
+    assert facades.bounds[0][1] == pytest.approx(9.0, abs=1e-3)
+    assert _entry(report, 902)["facades"] == 4
+    # its pyramid 13'6" high
+    roof = _mesh(folder, 902, "roof").vertices[:, 1]
+    assert roof.max() - roof.min() == pytest.approx(13.5 * 0.3048, abs=1e-3)
+    assert _entry(report, 902)["height"] == pytest.approx(36 + 13.5 * 0.3048, abs=1e-3)
+    # the podium's flat roof is left out under the tower
+    podium = _mesh(folder, 901, "roof")
+    (x0, _, z0), (x1, _, z1) = facades.bounds
+    middles = podium.triangles_center
+    inside = (middles[:, 0] > x0 + 0.5) & (middles[:, 0] < x1 - 0.5)
+    inside &= (middles[:, 2] > z0 + 0.5) & (middles[:, 2] < z1 - 0.5)
+    assert not inside.any()
+    document = json.loads((folder / "out" / "d.city.json").read_text())
+    tower = document["CityObjects"]["way/900"]
+    assert tower["attributes"]["name"] == "Tower" and tower["children"] == ["way/901", "way/902"]
 
 
 def test_a_wall_drawn_with_nodes_on_a_line_is_one_facade(
@@ -148,6 +193,23 @@ def test_a_carport_is_a_roof_on_posts(district: tuple[Path, dict[str, Any]]) -> 
     assert len(walls.split(only_watertight=False)) >= 4
     roof = _mesh(folder, 200, "roof")
     assert roof.bounds[1][1] == pytest.approx(2.5, abs=1e-3)
+    # building=carport too, its gable ends open; one storey (3 m) and its roof high
+    entry = _entry(report, 210)
+    assert entry["facades"] == 0 and entry["plain_walls"] == 0 and entry["height"] == 4.0
+    gabled = _mesh(folder, 210, "wall")  # posts only: no gable ends
+    assert all(np.ptp(p.vertices[:, [0, 2]], axis=0).max() < 0.3 for p in _pieces(gabled))
+    # in CityJSON each is one closed solid, the roof on a slab whose underside is a
+    # ceiling, at the top of the posts: no walls down to the ground
+    document = json.loads((folder / "out" / "d.city.json").read_text())
+    scale = document["transform"]["scale"][2]
+    for oid, eaves in ((200, 2.5), (210, 3.0)):
+        (geometry,) = document["CityObjects"][f"way/{oid}"]["geometry"]
+        assert geometry["type"] == "Solid"
+        kinds = {s["type"] for s in geometry["semantics"]["surfaces"]}
+        assert kinds == {"OuterCeilingSurface", "WallSurface", "RoofSurface"}
+        used = {i for surface in geometry["boundaries"][0] for ring in surface for i in ring}
+        low = min(document["vertices"][i][2] for i in used) * scale
+        assert low == pytest.approx(eaves - 0.2, abs=1e-3)
 
 
 def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, Any]]) -> None:
@@ -159,6 +221,40 @@ def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, An
     assert list(roof) == linear_rgb("#ffefd5")  # papayawhip, a CSS name (linear in glTF)
     ridge = scene.geometry["way/501/roof"].vertices[:, 1]
     assert ridge.max() - ridge.min() == pytest.approx(2.0, abs=1e-3)  # roof:height 2
+
+
+def test_the_cityjson_keeps_the_buildings_structure(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, _ = district
+    document = json.loads((folder / "out" / "d.city.json").read_text())
+    _check_valid(document, apart=False)  # the 2.0.2 schemas, parents and children, vertices
+    objects = document["CityObjects"]
+    # the outline is the Building, with its tags; its parts are its BuildingParts
+    outline = objects["way/500"]
+    assert outline["type"] == "Building" and "geometry" not in outline
+    assert outline["children"] == ["way/501", "way/502", "way/503"]
+    assert outline["attributes"]["building:colour"] == "rebeccapurple"
+    assert outline["attributes"]["measuredHeight"] == 30.0  # its tallest part
+    for key in outline["children"]:
+        assert objects[key]["type"] == "BuildingPart" and objects[key]["parents"] == ["way/500"]
+    assert [k for k, o in objects.items() if o["type"] == "Building" and "parents" in o] == []
+    # numbers as numbers: heights in metres (feet read), levels as counts
+    assert (
+        outline["attributes"]["height"] == 12.0
+        and objects["way/501"]["attributes"]["height"] == 12.0
+    )
+    assert objects["way/400"]["attributes"]["height"] == pytest.approx(12.192)
+    assert objects["way/100"]["attributes"]["building:levels"] == 2
+    assert objects["way/100"]["attributes"]["roof:height"] == 3.0
+    # every volume a closed solid; the tower part starts on the podium's eaves
+    scale = document["transform"]["scale"][2]
+    for key, item in objects.items():
+        for geometry in item.get("geometry", []):
+            assert geometry["type"] == "Solid", key
+    (tower,) = objects["way/503"]["geometry"]
+    used = {i for surface in tower["boundaries"][0] for ring in surface for i in ring}
+    assert min(document["vertices"][i][2] for i in used) * scale == pytest.approx(8.0)
 
 
 def test_heights_in_feet(district: tuple[Path, dict[str, Any]]) -> None:
@@ -188,6 +284,49 @@ def test_every_roof_shape_builds(district: tuple[Path, dict[str, Any]]) -> None:
     assert len(_mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "wall").faces) == 4
 
 
+def test_a_butterfly_roof_is_a_valley_between_two_high_walls(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, _ = district
+    oid = 700 + ROOF_SHAPES.index("butterfly")
+    roof = _mesh(folder, oid, "roof")
+    up, flat = roof.vertices[:, 1], roof.vertices[:, [0, 2]]
+    assert up.max() - up.min() == pytest.approx(3.0, abs=1e-3)  # roof:height
+    # 12 x 8 m: the valley at the eaves, along the middle; high along the two long
+    # walls, 4 m either side of it
+    valley = flat[up < up.min() + 1e-3]
+    (a, b) = valley[np.argsort(valley[:, 0])[[0, -1]]]
+    assert np.linalg.norm(b - a) == pytest.approx(12.0, abs=0.05)
+    along = (b - a) / np.linalg.norm(b - a)
+    off = (flat[up > up.max() - 1e-3] - a) @ np.array([-along[1], along[0]])
+    assert np.abs(off) == pytest.approx(4.0, abs=0.01) and off.min() < 0 < off.max()
+    ends = _mesh(folder, oid, "wall")  # the walls above the eaves: vertical
+    assert np.abs(ends.face_normals[ends.area_faces > 1e-9, 1]).max() < 1e-4
+
+
+def test_a_zakomar_roof_is_arches_along_the_walls(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    folder, _ = district
+    oid = 700 + ROOF_SHAPES.index("zakomar")
+    roof = _mesh(folder, oid, "roof")
+    up = roof.vertices[:, 1]
+    # 12 x 8 m: two arches on each long wall, one on each short one; their crests and
+    # the point the roof runs in to are the top, 3 m (roof:height) above the eaves
+    assert int((up > up.max() - 1e-3).sum()) == 6 + 1
+    assert up.max() - up.min() == pytest.approx(3.0, abs=1e-3)
+    # under each arch a vertical gable, a half circle of ARCH_SEGMENTS pieces
+    gables = _mesh(folder, oid, "wall")
+    assert np.abs(gables.face_normals[gables.area_faces > 1e-9, 1]).max() < 1e-4  # float32
+    pieces = _pieces(gables)
+    assert len(pieces) == 6
+    widths = sorted(float(np.ptp(p.vertices[:, [0, 2]], axis=0).max()) for p in pieces)
+    assert widths == pytest.approx([6, 6, 6, 6, 8, 8], abs=0.05)  # 12 m walls: 2 arches each
+    for piece in pieces:  # half circles 6 m wide, 3 m high; over 8 m, half ellipses
+        width = float(np.ptp(piece.vertices[:, [0, 2]], axis=0).max())
+        assert piece.area == pytest.approx(math.pi * width / 2 * 3.0 / 2, rel=0.03)
+
+
 def test_a_sawtooth_roof_is_sheds_side_by_side(district: tuple[Path, dict[str, Any]]) -> None:
     folder, _ = district
     roof = _mesh(folder, 800, "roof")
@@ -209,15 +348,15 @@ def test_what_is_not_understood_is_warned_and_counted(
     _, report = district
     warned = {(w["id"], w["warning"].split(" ", 1)[0]) for w in report["warnings"]}
     assert ("way/600", "roof:shape") in warned and ("way/600", "building:colour") in warned
-    unbuilt = {"zakomar"}  # built as a dome, warned
+    unbuilt = set(UNBUILT_SHAPES)  # built as another shape, warned
     for shape in unbuilt:
-        oid = 700 + ROOF_SHAPES.index(shape)
+        oid = 700 + (ROOF_SHAPES + UNBUILT_SHAPES).index(shape)
         assert (f"way/{oid}", "roof:shape") in warned
     counts = report["summary"]["warnings_by_tag"]
     assert counts == {"building:colour": 1, "roof:shape": 1 + len(unbuilt)}
     assert report["summary"]["warnings"] == len(report["warnings"]) == sum(counts.values())
-    # every other shape S3DB lists is understood: no warning
-    for shape in set(ROOF_SHAPES) - unbuilt:
+    # every shape S3DB lists is understood: no warning
+    for shape in ROOF_SHAPES:
         assert tag_problems({"roof:shape": shape}) == []
 
 

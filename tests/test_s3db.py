@@ -21,6 +21,7 @@ from facadecli.city.s3db import (
     blind,
     colour,
     compass,
+    lifted,
     outline_rest,
     replaced_outlines,
     shared_edges,
@@ -341,6 +342,40 @@ def test_shared_edges_and_replaced_outlines_are_found() -> None:
     other = footprint("q", _box(30, 30, 3, 3), **{"building:part": "yes"})
     assert replaced_outlines([outline, part, other]) == {"o": ["p"]}
     assert blind((5.1, 5), (5.1, 0), shared["b"], 0.3)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_part_standing_in_a_lower_one_starts_at_its_eaves(seed: int) -> None:
+    """Any part over any other, by their heights: the taller, most of it inside, starts
+    where the lower one's walls stop; one beside it, one lifted above that already, and
+    one no taller, stay as they are."""
+    rng = np.random.default_rng(seed)
+    x, y = rng.uniform(0, 50, 2)
+    w, d = rng.uniform(20, 40, 2)
+    podium_top, roof = float(rng.uniform(6, 15)), float(rng.choice([0.0, 2.0]))
+    tower_top = podium_top + float(rng.uniform(3, 40))
+    tags = {"height": str(podium_top), "roof:height": str(roof)}
+    shape = Roof(type="hip" if roof else "flat")
+    found = [
+        Footprint("podium", (Polygon(_box(x, y, w, d)),), tags),
+        Footprint("tower", (Polygon(_box(x + 2, y + 2, w / 3, d / 3)),), {}),
+        Footprint("half", (Polygon(_box(x + w - 2, y + 2, 6, 6)),), {}),  # mostly beside
+        Footprint("high", (Polygon(_box(x + w / 2, y + d / 2, 4, 4)),), {}),
+        Footprint("low", (Polygon(_box(x + 2, y + d - 6, 4, 4)),), {}),
+    ]
+    heights = {
+        "podium": tagged_heights(tags, 3.0, 9.0),
+        "tower": tagged_heights({"height": str(tower_top)}, 3.0, 9.0),
+        "half": tagged_heights({"height": str(tower_top)}, 3.0, 9.0),
+        "high": tagged_heights({"height": str(tower_top), "min_height": "20"}, 3.0, 9.0),
+        "low": tagged_heights({"height": str(podium_top - 1)}, 3.0, 9.0),
+    }
+    roofs = {key: shape if key == "podium" else Roof() for key in heights}
+    raised = lifted(found, heights, roofs)
+    eaves = volume(found[0].parts[0], heights["podium"], shape).eaves
+    assert eaves == pytest.approx(podium_top - roof)
+    assert {key: h.base for key, h in raised.items()} == pytest.approx({"tower": eaves})
+    assert raised["tower"].top == heights["tower"].top  # the top stays where it was
 
 
 def test_walls_are_front_back_and_sides() -> None:

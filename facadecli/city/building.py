@@ -29,7 +29,15 @@ from shapely.geometry.polygon import orient
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import Segment, roof_meshes
-from facadecli.city.s3db import Heights, Volume, along, party_zone, roof_only, volume
+from facadecli.city.s3db import (
+    Heights,
+    Volume,
+    along,
+    party_zone,
+    roof_only,
+    roof_solid,
+    volume,
+)
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.geometry.facade import (
@@ -165,7 +173,7 @@ class BuildingResult:
     plain_walls: int  # walls without one (too short, no layout, or party walls)
     party_walls: int  # walls along a neighbour: blind
     top: float  # metres: the highest roof
-    volumes: tuple[Volume, ...] = ()  # the parts as built: walls and roofs
+    volumes: tuple[Volume, ...] = ()  # the solids: walls and roofs (on posts: the roof alone)
     plain: dict[str, int] = field(default_factory=dict)  # plain walls by reason (PLAIN_REASONS)
 
 
@@ -313,6 +321,8 @@ def build_building(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"
         )
     top = max(block.top for block in volumes)
+    if posts_only:  # the solids are the roofs: the posts stand in the air under them
+        volumes = [roof_solid(block, SLAB) for block in volumes]
     return BuildingResult(
         scene, facades, plain, party, round(top, 3), tuple(volumes), dict(sorted(reasons.items()))
     )

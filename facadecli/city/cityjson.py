@@ -1,7 +1,9 @@
 """CityJSON 2.0 of a city's buildings: LOD2.2 solids with semantic surfaces.
 
 Each building becomes a ``Building`` CityObject (with ``BuildingPart`` children when it has
-several volumes), each volume one closed ``Solid`` whose surfaces face outwards: a
+several volumes; an outline drawn with ``building:part`` features is one ``Building`` with
+its tags, its parts its ``BuildingPart`` children: :func:`grouped`), each volume one
+closed ``Solid`` whose surfaces face outwards: a
 GroundSurface at its base (an OuterCeilingSurface when the base is above the ground, as
 under a part lifted by ``min_height``), a WallSurface per footprint edge (base to eaves),
 WallSurfaces for the roof's infill (gable ends), and RoofSurfaces (the roof's coplanar
@@ -36,9 +38,10 @@ from typing import Any, BinaryIO
 import numpy as np
 import trimesh
 
+from facadecli.city.footprints import Footprint, typed
 from facadecli.city.georef import reference_system
 from facadecli.city.roofs import roof_meshes
-from facadecli.city.s3db import Volume
+from facadecli.city.s3db import Volume, outline_of
 from facadecli.export.atomic import atomic_output, write_atomic
 
 VERSION = "2.0"
@@ -97,6 +100,136 @@ def building_object(building: BuildingSolids) -> dict[str, Any]:
         "CityObjects": objects,
         "vertices": [list(p) for p in vertices.points],
     }
+
+
+@dataclass(frozen=True)
+class Outline:
+    """A building drawn as an outline with ``building:part`` features inside: its id, its
+    attributes (its tags: name, address, ...) and the ids of the features written for
+    it, in the order they come (what is built of the outline itself, under its own id,
+    and its parts)."""
+
+    id: str
+    attributes: dict[str, Any]
+    members: tuple[str, ...]
+
+
+def building_with_parts(outline: Outline, features: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """One CityJSONFeature for an outline and the features (:func:`building_object`) of
+    its members: a ``Building`` with the outline's id and attributes (``measuredHeight``
+    the top of its tallest member), whose ``children`` are
+    each part's building, now a ``BuildingPart`` with the outline as its parent (a
+    part's own parts stay its children). What is built of the outline itself (its
+    feature has the outline's id) stays the Building's geometry. Vertices shared by
+    two members are written once."""
+    vertices = _Vertices()
+    moved: list[dict[str, dict[str, Any]]] = []
+    for feature in features:
+        table = [vertices.add((int(x), int(y), int(z))) for x, y, z in feature["vertices"]]
+        moved.append(
+            {key: _renumbered(value, table) for key, value in feature["CityObjects"].items()}
+        )
+    own = next((m for f, m in zip(features, moved, strict=True) if f["id"] == outline.id), None)
+    head: dict[str, Any] = dict(own[outline.id]) if own is not None else {"type": "Building"}
+    attributes = dict(head.get("attributes", {}))
+    if own is None:
+        attributes = dict(sorted(_json_safe(dict(outline.attributes)).items()))
+    children = list(head.get("children", []))
+    objects: dict[str, Any] = {}
+    parts: dict[str, Any] = {}
+    for feature, objects_of in zip(features, moved, strict=True):
+        for key, value in objects_of.items():
+            if key == outline.id:
+                continue
+            if key == feature["id"]:  # a part's building: a part of the outline's
+                value = {**value, "type": "BuildingPart", "parents": [outline.id]}
+                children.append(key)
+            parts[key] = _ordered(value)
+    tops = [
+        parts[key]["attributes"]["measuredHeight"]
+        for key in children
+        if isinstance(parts.get(key, {}).get("attributes", {}).get("measuredHeight"), (int, float))
+    ]
+    own_top = attributes.get("measuredHeight")
+    if isinstance(own_top, (int, float)) and not isinstance(own_top, bool):
+        tops.append(own_top)
+    if tops:
+        attributes = dict(sorted({**attributes, "measuredHeight": max(tops)}.items()))
+    objects[outline.id] = _ordered({**head, "attributes": attributes, "children": children})
+    objects.update(parts)
+    return {
+        "type": "CityJSONFeature",
+        "id": outline.id,
+        "CityObjects": objects,
+        "vertices": [list(p) for p in vertices.points],
+    }
+
+
+def outlines(
+    footprints: Iterable[Footprint], replaced: dict[str, list[str]], written: Sequence[str]
+) -> list[Outline]:
+    """The outlines with parts (``replaced``: outline id -> its parts' ids, a part in
+    several outlines belonging to the first by id) of which a part is among the
+    features ``written`` (ids, in their order): their typed tags, and their members in
+    that order."""
+    parent = outline_of(replaced)
+    order = {key: index for index, key in enumerate(written)}
+    by_id = {footprint.id: footprint for footprint in footprints}
+    found = []
+    for key in sorted(replaced):
+        parts = [p for p in replaced[key] if p in order and parent[p] == key]
+        if not parts or key not in by_id:
+            continue
+        members = sorted([key, *parts] if key in order else parts, key=order.__getitem__)
+        found.append(Outline(key, typed(by_id[key].properties), tuple(members)))
+    return found
+
+
+def grouped(
+    features: Iterable[dict[str, Any]], outlines: Sequence[Outline]
+) -> Iterator[dict[str, Any]]:
+    """The features, those of an outline's members merged into one
+    (:func:`building_with_parts`), which comes where its last member came; the others as
+    they are. Only the members of outlines not yet complete are held."""
+    owner = {member: outline for outline in outlines for member in outline.members}
+    held: dict[str, list[dict[str, Any]]] = {}
+    for feature in features:
+        outline = owner.get(feature["id"])
+        if outline is None:
+            yield feature
+            continue
+        members = held.setdefault(outline.id, [])
+        members.append(feature)
+        if len(members) == len(outline.members):
+            yield building_with_parts(outline, members)
+            del held[outline.id]
+    for key, members in held.items():  # members that never came: what there is
+        outline = next(o for o in outlines if o.id == key)
+        yield building_with_parts(outline, members)
+
+
+def _renumbered(value: dict[str, Any], table: list[int]) -> dict[str, Any]:
+    """A CityObject with its geometries' vertex indices looked up in ``table``."""
+    if "geometry" not in value:
+        return value
+    return {
+        **value,
+        "geometry": [
+            {**g, "boundaries": _lookup(g["boundaries"], table)} for g in value["geometry"]
+        ],
+    }
+
+
+def _lookup(boundaries: Any, table: list[int]) -> Any:
+    if isinstance(boundaries, list):
+        return [_lookup(item, table) for item in boundaries]
+    return table[boundaries]
+
+
+def _ordered(value: dict[str, Any]) -> dict[str, Any]:
+    """A CityObject's members in the order :func:`_object` writes them."""
+    order = ("type", "attributes", "children", "geometry", "parents")
+    return {key: value[key] for key in order if key in value and value[key] not in ([], {})}
 
 
 def cityjson_header(crs: str, origin: tuple[float, float], name: str) -> dict[str, Any]:
@@ -351,12 +484,21 @@ class _Vertices:
 
 
 def _geometry(volume: Volume, vertices: _Vertices) -> dict[str, Any]:
-    """The volume's Solid (or MultiSurface when its surfaces do not close)."""
+    """The volume's Solid (or MultiSurface when its surfaces do not close, with the
+    roof's slivers or without them)."""
     if not volume.eaves > volume.base:
         raise ValueError(f"eaves at {volume.eaves} m are not above the base at {volume.base} m")
-    kinds, surfaces = zip(*_surfaces(volume, vertices), strict=True)
-    split = _split_edges(list(surfaces), vertices.points)
-    oriented = _orient(split, vertices.points)
+    before = len(vertices.points)
+    for slivers in (True, False):  # a roof's slivers may fold the shell at a ridge
+        if not slivers:  # the first try's points are not written
+            for point in vertices.points[before:]:
+                del vertices.index[point]
+            del vertices.points[before:]
+        kinds, surfaces = zip(*_surfaces(volume, vertices, slivers), strict=True)
+        split = _split_edges(list(surfaces), vertices.points)
+        oriented = _orient(split, vertices.points)
+        if oriented is not None:
+            break
     types = [t for t in SURFACE_TYPES if t in kinds]
     values = [types.index(kind) for kind in kinds]
     semantics = {"surfaces": [{"type": t} for t in types], "values": values}
@@ -366,8 +508,11 @@ def _geometry(volume: Volume, vertices: _Vertices) -> dict[str, Any]:
     return {"type": "Solid", "lod": LOD, "boundaries": [oriented], "semantics": semantics}
 
 
-def _surfaces(volume: Volume, vertices: _Vertices) -> Iterator[tuple[str, Surface]]:
-    """Ground, walls and roof: rings of vertex indices, facing outwards as built."""
+def _surfaces(
+    volume: Volume, vertices: _Vertices, slivers: bool = True
+) -> Iterator[tuple[str, Surface]]:
+    """Ground, walls and roof: rings of vertex indices, facing outwards as built (the
+    roof's slivers left out without ``slivers``: see :func:`_polygons`)."""
     base, eaves = round(volume.base * UNITS), round(volume.eaves * UNITS)
     exterior = _plan_ring(volume.part.exterior)
     if not exterior:
@@ -394,10 +539,10 @@ def _surfaces(volume: Volume, vertices: _Vertices) -> Iterator[tuple[str, Surfac
     if flat:
         yield "RoofSurface", [at(ring, eaves) for ring in rings]
         return
-    for surface in _polygons(cover, vertices):
+    for surface in _polygons(cover, vertices, slivers):
         yield "RoofSurface", surface
     for piece in infill:
-        for surface in _polygons(piece, vertices):
+        for surface in _polygons(piece, vertices, slivers):
             yield "WallSurface", surface
 
 
@@ -412,10 +557,11 @@ def _plan_ring(ring: Any) -> list[tuple[int, int]]:
     return kept if len(kept) >= 3 else []
 
 
-def _polygons(mesh: trimesh.Trimesh, vertices: _Vertices) -> list[Surface]:
+def _polygons(mesh: trimesh.Trimesh, vertices: _Vertices, slivers: bool = True) -> list[Surface]:
     """A mesh's triangles as polygons: each set of edge-adjacent triangles with the same
     normal becomes one polygon when its outline is one simple ring, else stays triangles.
-    Triangles degenerate at millimetre precision are left out."""
+    Triangles degenerate at millimetre precision are left out, and without ``slivers``
+    those less than a unit high too."""
     if len(mesh.faces) == 0:
         return []
     points = np.asarray(mesh.vertices, dtype=float)
@@ -428,6 +574,9 @@ def _polygons(mesh: trimesh.Trimesh, vertices: _Vertices) -> list[Surface]:
     normal = np.cross(spans[:, 1] - spans[:, 0], spans[:, 2] - spans[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
     keep = twice >= 1.0  # at least half a square unit (three distinct points, not in line)
+    if not slivers:  # nor a corner within NEAR of the opposite edge (_split_edges puts it in)
+        longest = np.max(np.linalg.norm(units - np.roll(units, 1, axis=1), axis=2), axis=1)
+        keep &= twice > math.sqrt(NEAR) * longest
     triangles = [(a, b, c) for a, b, c in corners[keep].tolist()]
     normals = normal[keep]
     parent = list(range(len(triangles)))

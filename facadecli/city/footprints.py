@@ -402,6 +402,38 @@ COUNTS = ("levels", "building:levels", "building:min_level", "roof:levels")  # l
 Names = dict[str, tuple[str, float]]  # height, eaves, levels, min_height -> (property, scale)
 
 
+ANGLES = ("roof:angle", "roof:direction")  # degrees (a compass point stays a word)
+
+
+def _quantities(names: Names | None) -> dict[str, tuple[float, bool]]:
+    """Property name -> (the manifest's scale, whether it is a length) for the heights
+    and levels read as numbers: OSM's tags and the properties a manifest names."""
+    quantities = {key: (1.0, True) for key in LENGTHS} | {key: (1.0, False) for key in COUNTS}
+    for key, (name, scale) in (names or {}).items():
+        quantities[name] = (scale, key != "levels")
+    return quantities
+
+
+def typed(properties: dict[str, Any], names: Names | None = None) -> dict[str, Any]:
+    """The properties with the numbers they mean as JSON numbers: lengths in metres,
+    their unit read (``height=40'`` is 12.192), level counts, and ``roof:angle`` and
+    ``roof:direction`` in degrees, the properties a manifest names for heights as they
+    are (before its scale); whole counts as integers. Any other value, and one that
+    is not a number, as it is (a house number or a postcode stays text)."""
+    found = dict(properties)
+    kinds = {key: metres for key, (_, metres) in _quantities(names).items()}
+    kinds |= {key: False for key in ANGLES}
+    for key, metres in kinds.items():
+        value = properties.get(key)
+        if not isinstance(value, str):
+            continue
+        number_ = length(value) if metres else number(value)
+        if number_ is None:
+            continue
+        found[key] = int(number_) if not metres and number_.is_integer() else number_
+    return found
+
+
 def checked_properties(
     properties: dict[str, Any], names: Names | None = None
 ) -> tuple[dict[str, Any], list[str]]:
@@ -409,9 +441,7 @@ def checked_properties(
     number, below 0, above BUILDING_HEIGHT_MAX metres or BUILDING_LEVELS_MAX levels, the
     manifest's scale applied), and a warning for each value left out: the building is
     then built from its other tags, or the manifest's defaults."""
-    quantities = {key: (1.0, True) for key in LENGTHS} | {key: (1.0, False) for key in COUNTS}
-    for key, (name, scale) in (names or {}).items():
-        quantities[name] = (scale, key != "levels")
+    quantities = _quantities(names)
     kept = dict(properties)
     warnings = []
     for name, (scale, metres) in quantities.items():

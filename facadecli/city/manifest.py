@@ -30,14 +30,18 @@ RoofType = Literal[
     "pyramidal",
     "half_hip",
     "side_hip",
+    "dutch_gable",
     "crosspitched",
     "sawtooth",
+    "butterfly",
     "gambrel",
+    "bellcast",
     "mansard",
     "saltbox",
     "dome",
     "round",
     "onion",
+    "zakomar",
 ]
 
 
@@ -209,24 +213,28 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "gabled": "gable",
     "hipped": "hip",
     "side_hipped": "side_hip",
+    "hipped-and-gabled": "dutch_gable",
     "pyramidal": "pyramidal",
     "cone": "pyramidal",
     "half-hipped": "half_hip",
     "half_hipped": "half_hip",
     "side_half-hipped": "half_hip",
     "gambrel": "gambrel",
+    "bellcast_gable": "bellcast",
     "mansard": "mansard",
     "saltbox": "saltbox",
     "crosspitched": "crosspitched",
     "sawtooth": "sawtooth",
+    "butterfly": "butterfly",
     "dome": "dome",
     "round": "round",
     "onion": "onion",
+    "zakomar": "zakomar",
 }
 
 
-UNBUILT: dict[str, RoofType] = {  # roof:shape S3DB lists -> the roof built instead (warned)
-    "zakomar": "dome",
+UNBUILT: dict[str, RoofType] = {  # roof:shape OSM documents -> the roof built instead (warned)
+    "gabled_height_moved": "gable",  # a gable whose ridge is off the middle
 }
 
 

@@ -1,6 +1,6 @@
 """Roofs on any footprint polygon, holes included, as OSM's Simple 3D Buildings draws them
-(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, gambrel, mansard,
-saltbox, crosspitched, sawtooth, dome, round, onion.
+(SPEC 5): flat, shed, gable, hip, pyramidal, half_hip, side_hip, dutch_gable, gambrel,
+bellcast, mansard, saltbox, crosspitched, sawtooth, butterfly, dome, round, onion, zakomar.
 
 Meshes are in map coordinates (x east, y north, z up), from the eaves at ``height``.
 
@@ -20,12 +20,16 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
 - gable: the skeleton with weight 0 on the gable ends; half_hip: the same, the ends
   turning to weight 1 at two thirds of their height (hipped over the top third);
   side_hip: one gable end (at a party wall if one is there), the other hipped;
+  dutch_gable (OSM's hipped-and-gabled): the ends hipped up to DUTCH of their gable's
+  height, a small gable end above (the edges stop moving there);
 - hip: the plain skeleton; pyramidal: every edge slopes to one apex (hip on concave
   outlines and courtyards);
 - saltbox: a gable whose side facing ``direction`` moves twice as fast: its slope runs
   twice as far, at half the pitch;
 - gambrel and mansard: gable and hip with two slopes (steep to a third of the way in and
-  two thirds of the height, then shallow);
+  two thirds of the height, then shallow); bellcast: a gable flaring out at the eaves
+  (shallow for a quarter of the way in, a tenth of the height, then steep);
+- butterfly: two sheds sloping down to a valley along the middle, their sides walls;
 - sawtooth: sheds side by side on strips about TOOTH wide, their low sides facing
   ``direction`` (else the long side's southern face), a vertical wall at each high side;
 - crosspitched: on a convex outline, a gable over every side, the ridges meeting in the
@@ -33,7 +37,10 @@ cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all ro
   wings' gables cross;
 - dome, onion and round: hip, hip and gable roofs whose height is a curve of the
   skeleton time: a quarter circle (round: a barrel with a half-circle section), an onion
-  (a bulb that narrows to a point), in flat bands.
+  (a bulb that narrows to a point), in flat bands;
+- zakomar: half-circle arches (ARCH_SEGMENTS straight pieces each) about ZAKOMARA wide
+  along every wall, vertical gables under them, the roof running in from the arches to a
+  point that sees the whole outline (a dome where there is none).
 
 Heights: ``pitch`` is the slope of a plane moving at weight 1, unless ``height`` sets the
 top; domes and barrels rise by their half width, onions by twice that. ``roof_height``
@@ -48,6 +55,7 @@ then the mesh builds the skeleton once.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import defaultdict
 from collections.abc import Sequence
@@ -71,10 +79,15 @@ ACROSS = 0.7072  # a gable end lies across the ridge: |cos| of their angle at mo
 PYRAMID_HULL = 0.9  # a pyramid's outline fills this much of its convex hull at least
 FACING = 0.5  # a saltbox's long slope: the sides facing its direction within 60°
 HALF_HIP = 2 / 3  # a half hip's gable end goes up to this part of its height
+DUTCH = 1 / 2  # a hipped-and-gabled roof's ends are hipped up to this part of its height
 TOOTH = 6.0  # metres: a sawtooth roof's teeth are about this wide
+ZAKOMARA = 6.0  # metres: a zakomar roof's arches are about this wide
+ARCH_MIN = 3.0  # metres: walls shorter than this carry no arch
+ARCH_SEGMENTS = 8  # straight pieces of a zakomar arch (a half circle)
 BREAK = (1 / 3, 2 / 3)  # gambrel and mansard: where the slope changes (in, up)
-CURVED = ("dome", "round", "onion")
-GABLED = ("gable", "half_hip", "gambrel", "round", "saltbox", "side_hip")
+FLARE = (1 / 4, 1 / 10)  # bellcast: the eaves' flare, this far in rising this much
+CURVED = ("dome", "round", "onion")  # profiles in bands (zakomar: curved in plan)
+GABLED = ("gable", "half_hip", "dutch_gable", "gambrel", "bellcast", "round", "saltbox", "side_hip")
 FIXABLE = ("hip", "pyramidal", "mansard", *GABLED)  # roofs that keep still at party walls
 ON_WALL = 0.05  # metres: an edge whose middle is this near a fixed segment, along it, is one
 
@@ -112,6 +125,8 @@ def _key(roof: Roof) -> tuple[str, float | None, str]:
         return roof.type, roof.direction, "along"
     if roof.type in GABLED:
         return roof.type, roof.direction, roof.orientation
+    if roof.type == "butterfly":
+        return roof.type, None, roof.orientation
     return roof.type, None, "along"
 
 
@@ -120,7 +135,7 @@ def _rise(shape: _Shape, roof: Roof) -> float:
         return 0.0
     if roof.height is not None:
         return float(roof.height)
-    if shape.kind in ("dome", "round"):
+    if shape.kind in ("dome", "round", "zakomar"):
         return shape.top
     if shape.kind == "onion":
         return 2 * shape.top
@@ -165,6 +180,7 @@ def _shape(
     if kind == "flat" or not isinstance(part, Polygon) or part.is_empty or part.area <= 0:
         return FLAT
     tries = [(kind, fixed)] + [(kind, ())] * bool(fixed)
+    tries += [("dome", ())] * (kind == "zakomar")  # an outline no point sees whole
     tries += [] if kind == "hip" else [("hip", fixed)] * bool(fixed) + [("hip", ())]
     with np.errstate(all="ignore"):
         for attempt, still in tries:
@@ -187,8 +203,12 @@ def _build(
         return outline.shed(direction)
     if kind == "sawtooth":
         return outline.sawtooth(direction)
+    if kind == "butterfly":
+        return outline.butterfly(orientation)
     if kind == "pyramidal":
         return outline.hipped("hip") if outline.still else outline.pyramid()
+    if kind == "zakomar":
+        return outline.zakomar()
     if kind == "crosspitched":  # on wings: their gables cross already
         if outline.convex:
             return outline.crossed()
@@ -264,13 +284,34 @@ class _Outline:
         from its low side at the eaves to its high side, where a vertical wall (a
         factory's glazing) drops to the next strip's low side."""
         down = _compass(direction) if direction is not None else -_north(self.normal)
-        across = _perpendicular(down)
         reach = self.points @ down
         low, high = float(reach.min()), float(reach.max())
         count = max(1, round((high - low) / TOOTH))
         width = (high - low) / count
+        return self._strips(
+            "sawtooth", down, [(low + k * width, False) for k in range(count)], width
+        )
+
+    def butterfly(self, orientation: str) -> _Shape:
+        """Two sheds sloping down to a valley along the middle of the footprint (along
+        its long side, or across it with ``orientation: across``), high at the walls,
+        their sides vertical walls up to the roof."""
+        down = self.normal if orientation != "across" else self.main
+        reach = self.points @ down
+        low, high = float(reach.min()), float(reach.max())
+        width = (high - low) / 2
+        return self._strips("butterfly", down, [(low, False), (low + width, True)], width)
+
+    def _strips(
+        self, kind: str, down: np.ndarray, strips: list[tuple[float, bool]], width: float
+    ) -> _Shape:
+        """Sheds on strips ``width`` wide across ``down``, each starting where given
+        (along ``down``), rising from 0 at its far side to ``width`` at its near side
+        (flipped: the other way); vertical walls where a strip is higher than its
+        neighbour or the eaves."""
         if width <= self.eps:
-            raise Degenerate("sawtooth: no room")
+            raise Degenerate(f"{kind}: no room")
+        across = _perpendicular(down)
         polygon = Polygon(self.local[0], self.local[1:])
         span = float(np.abs(self.points @ across).max()) * 2 + 1.0
         nodes: dict[tuple[float, float, float], int] = {}
@@ -291,8 +332,8 @@ class _Outline:
         cover: list[tuple[tuple[int, ...], ...]] = []
         walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
         outline = polygon.boundary.buffer(snap)
-        for k in range(count):
-            a, b = low + k * width, low + (k + 1) * width
+        for a, flipped in strips:
+            b = a + width
             band = Polygon(
                 [
                     down * a - across * span,
@@ -310,7 +351,12 @@ class _Outline:
                 rings = []
                 for ring in (tooth.exterior, *tooth.interiors):
                     points = _clean(np.array(ring.coords)[:-1, :2], self.eps * 10)
-                    heights = [min(width, max(0.0, b - float(p @ down))) for p in points]
+                    heights = [
+                        min(
+                            width, max(0.0, float(p @ down) - a if flipped else b - float(p @ down))
+                        )
+                        for p in points
+                    ]
                     heights = [
                         0.0 if h <= snap else width if h >= width - snap else h for h in heights
                     ]
@@ -332,7 +378,7 @@ class _Outline:
                         loop += [roof[j]] * (heights[j] > 0) + [roof[i]] * (heights[i] > 0)
                         walls.append((tuple(loop), d))
                 cover.append(tuple(rings))
-        return self._finish("sawtooth", np.array(xy), np.array(ts), cover, walls, width)
+        return self._finish(kind, np.array(xy), np.array(ts), cover, walls, width)
 
     def shed(self, direction: float | None) -> _Shape:
         """One plane rising away from ``direction`` (its low side faces it)."""
@@ -387,22 +433,83 @@ class _Outline:
             walls.append(((e, f, m), (float(self.direction[e, 0]), float(self.direction[e, 1]))))
         return self._finish("crosspitched", xy, t, cover, walls, top)
 
+    def zakomar(self) -> _Shape:
+        """Zakomar: the roof of a Russian church, a half-circle arch (a zakomara) about
+        ZAKOMARA wide over each stretch of every wall at least ARCH_MIN long, its gable
+        a vertical wall, and the roof running in from the arches to a point inside that
+        sees the whole outline: over an arch's crest level at the arches' height, down to
+        the eaves between two arches. The height over a point a share u of the way from
+        the wall to the centre is u x the top + (1 - u) x the arch's over the wall, so
+        each triangle from the centre to a piece of arch is one plane and the arches of
+        two walls meet at the corner between them. The arches' height is half the width
+        of the narrowest (flatter half-ellipses on wider ones)."""
+        if len(self.local) != 1:
+            raise Degenerate("zakomar: a courtyard")
+        centre = self._kernel_point()
+        lengths = np.hypot(*(self.points[self.next] - self.points).T)
+        arches = [
+            0 if size < ARCH_MIN else max(1, round(float(size) / ZAKOMARA)) for size in lengths
+        ]
+        widths = [size / n for size, n in zip(lengths.tolist(), arches, strict=True) if n]
+        if not widths:
+            raise Degenerate("zakomar: no wall long enough for an arch")
+        top = min(widths) / 2
+        xy: list[np.ndarray] = list(self.points)
+        ts: list[float] = [0.0] * self.count
+        apex = len(xy)
+        xy.append(centre)
+        ts.append(top)
+        cover: list[tuple[tuple[int, ...], ...]] = []
+        walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
+        for e in range(self.count):
+            a, f = self.points[e], int(self.next[e])
+            b = self.points[f]
+            d = (float(self.direction[e, 0]), float(self.direction[e, 1]))
+            crest: list[int] = [e]  # the top of the wall, from a to b: eaves and arches
+            for k in range(arches[e]):
+                for step in range(1, ARCH_SEGMENTS + 1):
+                    angle = math.pi * step / ARCH_SEGMENTS
+                    share = (k + (1 - math.cos(angle)) / 2) / arches[e]
+                    rise = top * math.sin(angle)
+                    if step == ARCH_SEGMENTS and k == arches[e] - 1:
+                        crest.append(f)
+                        continue
+                    xy.append(a + share * (b - a))
+                    ts.append(rise if step < ARCH_SEGMENTS else 0.0)
+                    crest.append(len(xy) - 1)
+                start = crest[-1 - ARCH_SEGMENTS]
+                lifted = crest[-ARCH_SEGMENTS:-1]
+                walls.append(((start, crest[-1], *lifted[::-1]), d))
+            if not arches[e]:
+                crest.append(f)
+            cover.extend(((p, q, apex),) for p, q in itertools.pairwise(crest))
+        return self._finish("zakomar", np.array(xy), np.array(ts), cover, walls, top)
+
+    def _kernel_point(self) -> np.ndarray:
+        """A point inside that sees the whole (single-ring) outline, a share of its size
+        in from every wall's line: its centroid, else the pole of inaccessibility."""
+        import shapely.ops
+
+        polygon = Polygon(self.points)
+        for point in (
+            np.array(polygon.centroid.coords[0]),
+            np.array(shapely.ops.polylabel(polygon, self.scale * 1e-3).coords[0]),
+        ):
+            reach = _cross(self.direction, point - self.points)  # distance in from each edge
+            if (reach > self.scale * 1e-3).all():
+                return point
+        raise Degenerate("no point sees the whole outline")
+
     def pyramid(self) -> _Shape:
         """Every edge slopes up to one apex, which must see the whole outline."""
         polygon = Polygon(self.points)
         if len(self.local) != 1 or polygon.area < PYRAMID_HULL * polygon.convex_hull.area:
             return self.hipped("hip")  # a courtyard or a concave outline
-        import shapely.ops
-
-        for apex in (
-            np.array(polygon.centroid.coords[0]),
-            np.array(shapely.ops.polylabel(polygon, self.scale * 1e-3).coords[0]),
-        ):
-            reach = _cross(self.direction, apex - self.points)  # distance in from each edge
-            if (reach > self.scale * 1e-3).all():
-                break
-        else:
+        try:
+            apex = self._kernel_point()
+        except Degenerate:
             return self.hipped("hip")
+        reach = _cross(self.direction, apex - self.points)  # distance in from each edge
         top = float(reach.min())
         xy = np.vstack([self.points, apex])
         t = np.concatenate([np.zeros(self.count), [top]])
@@ -448,7 +555,14 @@ class _Outline:
             fixed = any(e in self.still for side in chosen for e in side.edges)
             chosen = [] if fixed else chosen[:1]
         switches: dict[int, float] = {}
+        stops: dict[int, float] = {}
         for side in chosen:
+            if kind == "dutch_gable":  # hipped up to DUTCH of the way, then a gable end
+                apex = self._gable_apex(side)
+                if apex is not None:
+                    for e in side.edges:
+                        stops[e] = DUTCH * apex
+                continue
             for e in side.edges:
                 weights[e] = 0.0
             if kind == "half_hip":
@@ -459,10 +573,11 @@ class _Outline:
         for e in self.still:  # party walls: gable ends too
             weights[e] = 0.0
             switches.pop(e, None)
-        if plain is not None and all(w == 1.0 for w in weights):  # no gable ends after all
-            return self._from_skeleton(kind, plain, {})
-        skeleton = Skeleton(self, weights, switches)
-        return self._from_skeleton(kind, skeleton, switches)
+            stops.pop(e, None)
+        if plain is not None and all(w == 1.0 for w in weights) and not stops:
+            return self._from_skeleton(kind, plain, {})  # no gable ends after all
+        skeleton = Skeleton(self, weights, switches, stops)
+        return self._from_skeleton(kind, skeleton, switches, stops)
 
     # -- sides and gable ends ---------------------------------------------------------
 
@@ -535,20 +650,31 @@ class _Outline:
 
     # -- from a skeleton to a shape ----------------------------------------------------
 
-    def _from_skeleton(self, kind: str, skeleton: Skeleton, switches: dict[int, float]) -> _Shape:
-        """The skeleton's faces as roof faces, and as walls where edges stood still;
-        each roof face must lie in its edge's plane: t = its start + distance / weight."""
+    def _from_skeleton(
+        self,
+        kind: str,
+        skeleton: Skeleton,
+        switches: dict[int, float],
+        stops: dict[int, float] | None = None,
+    ) -> _Shape:
+        """The skeleton's faces as roof faces, and as walls where edges stood still
+        (``switches``: still until then; ``stops``: still from then); each roof face must
+        lie in its edge's plane: t = its start + distance / weight."""
+        stops = stops or {}
         cover: list[tuple[tuple[int, ...], ...]] = []
         walls: list[tuple[tuple[int, ...], tuple[float, float]]] = []
         xy, t = skeleton.xy, skeleton.t
         for e in range(self.count):
             d = (float(self.direction[e, 0]), float(self.direction[e, 1]))
-            slopes = skeleton.weights[e] > 0 and e not in switches
+            slopes = skeleton.weights[e] > 0 and e not in switches and e not in stops
             start, weight = switches.get(e, 0.0), skeleton.weights[e] if slopes else 1.0
             for face in skeleton.faces[e]:
-                wall, roofs = (
-                    (None, [face]) if slopes else self._split_face(e, face, xy, t, switches.get(e))
-                )
+                if slopes:
+                    wall, roofs = None, [face]
+                elif e in stops:
+                    wall, roofs = self._split_face(e, face, xy, t, stops[e], above=True)
+                else:
+                    wall, roofs = self._split_face(e, face, xy, t, switches.get(e))
                 if wall is not None:
                     walls.append((wall, d))
                 for roof in roofs:
@@ -562,19 +688,33 @@ class _Outline:
         return self._finish(kind, xy, t, cover, walls, top)
 
     def _split_face(
-        self, e: int, loop: tuple[int, ...], xy: np.ndarray, t: np.ndarray, switch: float | None
+        self,
+        e: int,
+        loop: tuple[int, ...],
+        xy: np.ndarray,
+        t: np.ndarray,
+        switch: float | None,
+        above: bool = False,
     ) -> tuple[tuple[int, ...] | None, list[tuple[int, ...]]]:
         """A face of an edge that first stood still: (its vertical part, its sloped
         parts). The wall is the face's nodes reached before the edge began to move (on
         its line), in order; each run of later nodes, with the nodes on either side, is a
-        sloped part (a half hip's top; two, if the roof came down to the wall between)."""
+        sloped part (a half hip's top; two, if the roof came down to the wall between).
+        ``above``: an edge that moved, then stopped at ``switch``: the wall is the nodes
+        reached after, the sloped part those before (a hipped-and-gabled roof's end)."""
         if e not in loop:
             return None, [loop] if abs(_area(xy[list(loop)])) > self.eps * self.scale else []
         start = loop.index(e)
         loop = loop[start:] + loop[:start]
         if switch is None:
             return loop, []
-        on = t[list(loop)] <= switch + self.eps
+        if above:
+            on_wall = t[list(loop)] >= switch - self.eps
+            if not on_wall.any():  # the edge was gone before it stopped: all slope
+                return None, [loop]
+            first = int(np.argmax(on_wall))  # the loop from a wall node: runs of slope
+            loop = loop[first:] + loop[:first]
+        on = t[list(loop)] >= switch - self.eps if above else t[list(loop)] <= switch + self.eps
         wall = tuple(n for n, kept in zip(loop, on.tolist(), strict=True) if kept)
         slopes: list[tuple[int, ...]] = []
         size, i = len(loop), 1
@@ -688,6 +828,8 @@ def _profile(kind: str, bands: int) -> tuple[np.ndarray, np.ndarray]:
     """The roof's section, from the eaves (0, 0) to the top (1, 1): (in, up) fractions."""
     if kind in ("gambrel", "mansard"):
         return np.array([0.0, BREAK[0], 1.0]), np.array([0.0, BREAK[1], 1.0])
+    if kind == "bellcast":  # shallow at the eaves, then steep
+        return np.array([0.0, FLARE[0], 1.0]), np.array([0.0, FLARE[1], 1.0])
     if kind in ("dome", "round"):
         angle = np.linspace(0, math.pi / 2, bands + 1)
         return 1 - np.cos(angle), np.sin(angle)

@@ -41,6 +41,8 @@ from facadecli.city.cityjson import (
     BuildingSolids,
     CityJSONWriter,
     building_object,
+    grouped,
+    outlines,
     write_cityjson,
 )
 from facadecli.city.footprints import (
@@ -50,12 +52,14 @@ from facadecli.city.footprints import (
     Rejected,
     Simplified,
     read_footprints,
+    typed,
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.s3db import (
     Heights,
     inherited,
+    lifted,
     outline_rest,
     replaced_outlines,
     roof_colour,
@@ -239,7 +243,7 @@ def _feature_file(target: Path) -> Path:
 def _attributes(task: Task, top: float) -> dict[str, Any]:
     """A building's CityJSON attributes: its tags, how tall it is, its roof and spec."""
     return {
-        **task.footprint.properties,
+        **typed(task.footprint.properties),
         "measuredHeight": top,
         "roofType": task.roof.type,
         "facade": task.spec_key,
@@ -276,9 +280,13 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
     shapes = {footprint.id: _shape(city, footprint.properties) for footprint in footprints}
+    above = standing_on(footprints, {key: shape[1] for key, shape in shapes.items()})
+    raised = lifted(
+        footprints, {k: s[1] for k, s in shapes.items()}, {k: s[2] for k, s in shapes.items()}
+    )
+    shapes |= {key: (shapes[key][0], heights, shapes[key][2]) for key, heights in raised.items()}
     beside = _beside(footprints, shapes)
     shared = shared_edges(footprints, tolerance, beside) if tolerance > 0 else {}
-    above = standing_on(footprints, {key: shape[1] for key, shape in shapes.items()})
     tasks = []
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
@@ -597,9 +605,10 @@ def _build(
     cityjson = outdir / f"{city.manifest.name}.city.json"
     try:
         with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:
-            for result in results:
-                if result["status"] == "ok":
-                    writer.add(_feature(by_id[result["id"]]))
+            ok = [r["id"] for r in results if r["status"] == "ok"]
+            features = (_feature(by_id[key]) for key in ok)
+            for feature in grouped(features, outlines(found.footprints, replaced, ok)):
+                writer.add(feature)
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the CityJSON: {error.strerror or error}; the "

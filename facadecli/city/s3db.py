@@ -394,13 +394,22 @@ def roof_colour(properties: dict[str, Any]) -> str | None:
     return found or ROOF_MATERIALS.get(material)
 
 
+ON_POSTS = ("roof", "carport")  # building values for a roof on posts
+
+
 def roof_only(properties: dict[str, Any]) -> bool:
-    """``building=roof`` (or ``building:part=roof``): a roof on posts, no walls (a
-    carport, a petrol station's canopy, a platform roof)."""
+    """``building=roof`` or ``building=carport`` (or such a ``building:part``): a roof on
+    posts, no walls (a carport, a petrol station's canopy, a platform roof)."""
     return any(
-        str(properties.get(key, "")).strip().lower() == "roof"
+        str(properties.get(key, "")).strip().lower() in ON_POSTS
         for key in ("building", "building:part")
     )
+
+
+def roof_solid(block: Volume, thickness: float) -> Volume:
+    """The solid of a roof on posts: the roof on a slab ``thickness`` thick under its
+    eaves (its underside a ceiling open to the air), not walls down to the ground."""
+    return replace(block, base=max(block.base, block.eaves - thickness))
 
 
 def tag_problems(properties: dict[str, Any]) -> list[str]:
@@ -470,16 +479,23 @@ INHERITED = (
 INHERITED_HEIGHTS = ("height", "building:levels", "levels")
 
 
+def outline_of(replaced: dict[str, list[str]]) -> dict[str, str]:
+    """Part id -> the id of its outline (``replaced``: outline id -> its parts' ids, from
+    :func:`replaced_outlines`); a part in several outlines is the first's by id."""
+    parent: dict[str, str] = {}
+    for key in sorted(replaced):
+        for part in replaced[key]:
+            parent.setdefault(part, key)
+    return parent
+
+
 def inherited(footprints: Iterable[Footprint], replaced: dict[str, list[str]]) -> list[Footprint]:
     """The footprints with every part given the tags of its outline (``replaced``:
     outline id -> its parts' ids, from :func:`replaced_outlines`) that it lacks; a part
     in several outlines takes from the first by id."""
     footprints = list(footprints)
     by_id = {footprint.id: footprint for footprint in footprints}
-    parent: dict[str, str] = {}
-    for key in sorted(replaced):
-        for part in replaced[key]:
-            parent.setdefault(part, key)
+    parent = outline_of(replaced)
     found = []
     for footprint in footprints:
         outline = by_id.get(parent.get(footprint.id, ""))
@@ -609,15 +625,18 @@ def screens(one: Heights, other: Heights) -> bool:
     return reach(other) - one.base >= SCREEN * (reach(one) - one.base)
 
 
-def standing_on(footprints: list[Footprint], heights: dict[str, Heights]) -> dict[str, Any]:
-    """For each footprint, the taller footprints standing on it (most of their area in
-    its outline, their base below its top, their top above it): a tower part on a
-    podium part, whose roof must leave the tower out. Footprint id -> a shapely geometry
-    (absent: none)."""
+Podiums = tuple[list[tuple[int, int]], list[Polygon], list[str]]
+
+
+def podiums(footprints: list[Footprint], heights: dict[str, Heights]) -> Podiums:
+    """Which footprints stand on which: (pairs (lower, taller) of indices into the
+    footprints' parts, the parts, their footprints' ids), the taller with most of its
+    area in the lower's outline, its base below the lower's top and its top above it: a
+    tower part on a podium part, whatever their tags call them."""
     shapes = [shape for f in footprints for shape in f.parts]
     owner = [f.id for f in footprints for _ in f.parts]
     tree = STRtree(shapes)
-    found: dict[str, list[Polygon]] = {}
+    pairs = []
     for index, shape in enumerate(shapes):
         me = heights[owner[index]]
         for i in sorted(int(i) for i in tree.query(shape)):
@@ -627,8 +646,42 @@ def standing_on(footprints: list[Footprint], heights: dict[str, Heights]) -> dic
             if other.base >= reach(me) or shapes[i].area >= shape.area:
                 continue
             if shapes[i].intersection(shape).area >= 0.5 * shapes[i].area:
-                found.setdefault(owner[index], []).append(shapes[i])
+                pairs.append((index, i))
+    return pairs, shapes, owner
+
+
+def standing_on(footprints: list[Footprint], heights: dict[str, Heights]) -> dict[str, Any]:
+    """For each footprint, the taller footprints standing on it (:func:`podiums`), whose
+    walls its roof must leave out. Footprint id -> a shapely geometry (absent: none)."""
+    found: dict[str, list[Polygon]] = {}
+    pairs, shapes, owner = podiums(footprints, heights)
+    for low, high in pairs:
+        found.setdefault(owner[low], []).append(shapes[high])
     return {key: shapely.union_all(parts) for key, parts in found.items()}
+
+
+def lifted(
+    footprints: list[Footprint], heights: dict[str, Heights], roofs: dict[str, Roof]
+) -> dict[str, Heights]:
+    """The heights of the footprints standing on a lower one (:func:`podiums`), their
+    base lifted to the lower one's eaves (its walls' top, the top of a flat roof): a
+    tower part drawn from the ground inside a podium part has walls and façades only
+    above the podium, none inside it. A part with a ``min_height`` above that keeps it;
+    one standing on several takes the highest. Footprint id -> its new heights (only
+    those that change)."""
+    parts = {f.id: f.parts for f in footprints}
+    bases: dict[str, float] = {}
+    pairs, shapes, owner = podiums(footprints, heights)
+    for low, high in pairs:
+        under = volume(shapes[low], heights[owner[low]], roofs[owner[low]]).eaves
+        bases[owner[high]] = max(bases.get(owner[high], heights[owner[high]].base), under)
+    found = {}
+    for key, base in sorted(bases.items()):
+        lifted_heights = replace(heights[key], base=base)
+        walls = [volume(part, lifted_heights, roofs[key]) for part in parts[key]]
+        if base > heights[key].base and all(w.eaves - w.base >= MIN_WALL for w in walls):
+            found[key] = lifted_heights
+    return found
 
 
 def side_by_side(one: tuple[float, float], other: tuple[float, float]) -> bool:

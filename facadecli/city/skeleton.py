@@ -52,7 +52,11 @@ class Skeleton:
     together, which copes with the many simultaneous events of rectilinear outlines."""
 
     def __init__(
-        self, outline: _Outline, weights: Sequence[float], switches: dict[int, float]
+        self,
+        outline: _Outline,
+        weights: Sequence[float],
+        switches: dict[int, float],
+        stops: dict[int, float] | None = None,
     ) -> None:
         if outline.count > MAX_SKELETON:
             raise Degenerate("too many vertices for a skeleton here")
@@ -63,7 +67,11 @@ class Skeleton:
         self.unit = [(float(x), float(y)) for x, y in outline.direction]
         self.weights = list(weights)
         self.weight = np.array(weights, dtype=float)
-        self.pending = sorted((time, e) for e, time in switches.items())
+        # (time, edge, its weight from then): switches start still edges, stops stop them
+        self.pending = sorted(
+            [(time, e, 1.0) for e, time in switches.items()]
+            + [(time, e, 0.0) for e, time in (stops or {}).items()]
+        )
         self.x: list[float] = []
         self.y: list[float] = []
         self.times: list[float] = []
@@ -122,8 +130,8 @@ class Skeleton:
                 v.x, v.y = x, y
             self.time += step
             while self.pending and self.pending[0][0] <= self.time + self.eps:
-                _, e = self.pending.pop(0)
-                self.weight[e] = 1.0
+                _, e, speed = self.pending.pop(0)
+                self.weight[e] = speed
                 for v in vertices:
                     if e in (v.a, v.b):
                         self._close(v)
