@@ -40,6 +40,7 @@ from facadecli.geometry.facade import (
     pbr,
     tangent_space,
     texture_metres,
+    weld,
 )
 from facadecli.layout import (
     BUILTIN_INTERIOR,
@@ -308,6 +309,7 @@ def build_building(
         merged = _merged(parts[name], texture_metres(finished))
         if finished.library is not None:  # a normal map: normals and tangents with it
             merged = tangent_space(merged)
+        merged = weld(merged)
         merged.visual.material = pbr(name, finished, folder)
         scene.add_geometry(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"

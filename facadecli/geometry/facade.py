@@ -189,6 +189,35 @@ def tangent_space(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     return mesh
 
 
+def weld(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """The mesh with each vertex stored once: corners that agree in every attribute the
+    file will carry (position, texture coordinates, normal and tangent, as float32) become
+    one, in the order they first appear. :func:`metric_uv` gives every face its own
+    corners; welding them back is about a third fewer vertices (a box's face: 4, not 6)."""
+    uv = getattr(mesh.visual, "uv", None)
+    attributes = {name: mesh.vertex_attributes.get(name) for name in ("NORMAL", "TANGENT")}
+    attributes = {name: value for name, value in attributes.items() if value is not None}
+    columns = [mesh.vertices, *([] if uv is None else [uv]), *attributes.values()]
+    rows = np.hstack(
+        [np.asarray(c, dtype=np.float32).reshape(len(mesh.vertices), -1) for c in columns]
+    )
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # the welded vertices in order of appearance
+    renumber = np.empty(len(order), dtype=np.int64)
+    renumber[order] = np.arange(len(order))
+    keep = first[order]
+    welded = trimesh.Trimesh(
+        mesh.vertices[keep], renumber[inverse.reshape(-1)][mesh.faces], process=False
+    )
+    material = getattr(mesh.visual, "material", None)
+    welded.visual = trimesh.visual.TextureVisuals(
+        uv=None if uv is None else np.asarray(uv)[keep], material=material
+    )
+    for name, value in attributes.items():
+        welded.vertex_attributes[name] = np.asarray(value)[keep]
+    return welded
+
+
 def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
     """Mirror a mesh within its cell on the axes whose letters are reflected."""
     if not (x or y):
