@@ -48,29 +48,44 @@ def browser() -> str:
 
 
 def screenshot(chrome: str, url: str, target: Path, window: str, profile: Path) -> None:
-    subprocess.run(
-        [
-            chrome,
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--use-gl=swiftshader",
-            "--enable-unsafe-swiftshader",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--no-first-run",
-            "--hide-scrollbars",
-            f"--user-data-dir={profile}",
-            f"--window-size={window}",
-            "--virtual-time-budget=15000",
-            f"--screenshot={target}",
-            url,
-        ],
-        check=True,
-        capture_output=True,
-        timeout=180,
-    )
+    """Chromium's screenshot of the page. Decoding a textured model's pictures runs
+    outside Chromium's virtual time, so a blank picture (the page still loading when the
+    budget ended) is taken again with a larger budget."""
+    for budget in (15_000, 60_000, 180_000):
+        subprocess.run(
+            [
+                chrome,
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--use-gl=swiftshader",
+                "--enable-unsafe-swiftshader",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+                "--no-first-run",
+                "--hide-scrollbars",
+                f"--user-data-dir={profile}",
+                f"--window-size={window}",
+                f"--virtual-time-budget={budget}",
+                f"--screenshot={target}",
+                url,
+            ],
+            check=True,
+            capture_output=True,
+            timeout=600,
+        )
+        if not _blank(target):
+            return
+    sys.exit(f"{target}: the page drew nothing in {budget // 1000} s of virtual time")
+
+
+def _blank(picture: Path) -> bool:
+    """Whether a screenshot is one flat colour (the page's backdrop, nothing drawn)."""
+    from PIL import Image, ImageStat
+
+    with Image.open(picture) as image:
+        return bool(ImageStat.Stat(image.convert("L")).stddev[0] < 2.0)
 
 
 def svg_size(svg: Path) -> str:
