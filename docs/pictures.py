@@ -98,9 +98,9 @@ def svg_size(svg: Path) -> str:
 # the 50-building city block: camera (around, up, zoom, x, y) of each picture
 CITY_BLOCK = 50
 CITY_VIEWS: dict[str, str] = {
-    "front": "0,12,1,0.5,0.5",
-    "oblique": "35,35,1,0.5,0.5",
-    "street": "25,2,3,0.45,0.15",
+    "front": "0,12,1.5,0.5,0.5",
+    "oblique": "35,35,1.6,0.5,0.5",
+    "street": "0,3,2.5,0.5,0.2",
 }
 
 

@@ -18,11 +18,13 @@ import trimesh
 from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
+from facadecli.city.building import MAP_TO_WORLD
 from facadecli.city.demo import write_demo
-from facadecli.city.manifest import load_city
+from facadecli.city.manifest import Roof, load_city
+from facadecli.city.roofs import roof_meshes
 from facadecli.city.run import run_city
 from facadecli.export.glb_merge import merge_glb, read_glb
-from facadecli.geometry.facade import weld
+from facadecli.geometry.facade import plane_uv, weld
 from tests.rays import reach
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -168,3 +170,40 @@ def test_rays_at_35_degrees_from_eight_directions_meet_every_building(city: Path
             if len(through):
                 leaks.append((name, direction.round(2).tolist(), through[:3].round(2).tolist()))
     assert not leaks, leaks[:5]
+
+
+@pytest.mark.parametrize("kind", ["gable", "hip", "shed", "dome"])
+def test_roof_textures_lie_in_their_slopes_in_metres(kind: str) -> None:
+    """Each roof face's texture coordinates are its own plane's, in metres: an edge is as
+    long in the texture as on the roof (no stretch on a steep slope or a dome's facets),
+    and u runs level, along the eaves (tile courses stay horizontal)."""
+    part = Polygon([(0, 0), (12, 0), (12, 8), (7, 8), (7, 5), (0, 5)])  # an L: hips, valleys
+    cover, _ = roof_meshes(part, 6.0, Roof(type=kind, pitch=40))  # type: ignore[arg-type]
+    cover.apply_transform(MAP_TO_WORLD)
+    mapped = plane_uv(cover, 1.0)
+    corners = mapped.vertices[mapped.faces]
+    uv = np.asarray(mapped.visual.uv)[mapped.faces]
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        assert np.allclose(
+            np.linalg.norm(corners[:, b] - corners[:, a], axis=1),
+            np.linalg.norm(uv[:, b] - uv[:, a], axis=1),
+            atol=1e-6,
+        )
+    # the 3D direction of increasing u in each face: level
+    edge1, edge2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    du1, dv1 = uv[:, 1, 0] - uv[:, 0, 0], uv[:, 1, 1] - uv[:, 0, 1]
+    du2, dv2 = uv[:, 2, 0] - uv[:, 0, 0], uv[:, 2, 1] - uv[:, 0, 1]
+    det = du1 * dv2 - du2 * dv1
+    usable = np.abs(det) > 1e-9
+    along = (edge1 * dv2[:, None] - edge2 * dv1[:, None])[usable] / det[usable, None]
+    assert np.abs(along[:, 1]).max() < 1e-6
+    assert (det[usable] > 0).all()  # seen from outside the texture is not mirrored
+
+
+def test_roofs_wear_a_library_material(city: Path) -> None:
+    document, _ = read_glb((city / "demo-district.glb").read_bytes())
+    roofs = [m for m in document["materials"] if m["name"] in ("roof", "flat_roof")]
+    assert {m["name"] for m in roofs} == {"roof", "flat_roof"}  # pitched and flat, in the demo
+    for material in roofs:
+        assert "baseColorTexture" in material["pbrMetallicRoughness"]
+        assert "normalTexture" in material

@@ -19,7 +19,6 @@ from facadecli.city.manifest import load_city
 from facadecli.city.run import run_city, safe_name
 from facadecli.city.s3db import COLOURS, colour, tag_problems
 from facadecli.city.straight import merged_ring
-from facadecli.geometry.facade import linear_rgb
 from tests.osm_district import ROOF_SHAPES, box, write_district
 from tests.running import facade
 from tests.test_s3db import SPEC
@@ -141,12 +140,12 @@ def test_a_carport_is_a_roof_on_posts(district: tuple[Path, dict[str, Any]]) -> 
     folder, report = district
     entry = _entry(report, 200)
     assert entry["facades"] == 0 and entry["plain_walls"] == 0 and entry["height"] == 2.5
-    walls = _mesh(folder, 200, "wall")
+    walls = _mesh(folder, 200, "render")  # the spec's wall material: nothing but posts
     for post in walls.split(only_watertight=False):
         (x0, _, z0), (x1, _, z1) = post.bounds
         assert x1 - x0 < 0.3 and z1 - z0 < 0.3  # posts, no wall
     assert len(walls.split(only_watertight=False)) >= 4
-    roof = _mesh(folder, 200, "roof")
+    roof = _mesh(folder, 200, "flat_roof")  # the manifest's roof: flat
     assert roof.bounds[1][1] == pytest.approx(2.5, abs=1e-3)
 
 
@@ -155,8 +154,10 @@ def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, An
     assert _entry(report, 501)["height"] == 12.0  # the outline's height, roof and colours
     assert _entry(report, 502)["height"] == 10.0  # its own
     scene = trimesh.load(folder / "out" / "buildings" / f"{safe_name('way/501')}.glb")
-    roof = scene.geometry["way/501/roof"].visual.material.baseColorFactor[:3]
-    assert list(roof) == linear_rgb("#ffefd5")  # papayawhip, a CSS name (linear in glTF)
+    roof = scene.geometry["way/501/roof"].visual.material  # tiles drawn in papayawhip
+    assert list(roof.baseColorFactor[:3]) == [255, 255, 255]  # the colour is in the picture
+    drawn = np.asarray(roof.baseColorTexture.convert("RGB"), dtype=float).reshape(-1, 3)
+    assert drawn.mean(axis=0) == pytest.approx([255, 239, 213], abs=16)  # #ffefd5, a CSS name
     ridge = scene.geometry["way/501/roof"].vertices[:, 1]
     assert ridge.max() - ridge.min() == pytest.approx(2.0, abs=1e-3)  # roof:height 2
 
@@ -185,7 +186,10 @@ def test_every_roof_shape_builds(district: tuple[Path, dict[str, Any]]) -> None:
     flat, up = roof.vertices[:, [0, 2]], roof.vertices[:, 1]
     ridges = flat[up > up.max() - 0.01]
     assert np.ptp(ridges, axis=0) == pytest.approx(np.ptp(flat, axis=0), abs=0.5)  # grid turn
-    assert len(_mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "wall").faces) == 4
+    walls = _mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "render")  # as the façades
+    heights = walls.vertices[walls.faces][:, :, 1]
+    gables = (heights.min(axis=1) >= up.min() - 1e-3) & (heights.max(axis=1) > up.min() + 1e-3)
+    assert gables.sum() == 4  # the four gable ends, above the eaves
 
 
 def test_a_sawtooth_roof_is_sheds_side_by_side(district: tuple[Path, dict[str, Any]]) -> None:
@@ -197,7 +201,9 @@ def test_a_sawtooth_roof_is_sheds_side_by_side(district: tuple[Path, dict[str, A
     north = -roof.vertices[:, 2]  # the world's z runs south
     highs = np.sort(north[up > 9.99])  # (the UTM grid turns them a little off east)
     assert 1 + int((np.diff(highs) > 2.0).sum()) == 3
-    risers = _mesh(folder, 800, "wall")  # the glazed risers and the sides: vertical
+    walls = _mesh(folder, 800, "render")  # the façades' wall material, as the gables'
+    risers = walls.submesh([walls.vertices[walls.faces][:, :, 1].max(axis=1) > 7.0 + 1e-3])[0]
+    # the glazed risers and the sides above the eaves: vertical
     assert np.abs(risers.face_normals[risers.area_faces > 1e-9, 1]).max() < 1e-6
     facing = risers.face_normals[risers.area_faces > 1e-9]
     assert (facing[:, 2] < -0.99).sum() > 0  # some face north (-z): the glazing

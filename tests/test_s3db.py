@@ -229,7 +229,13 @@ def test_colour_tags_colour_walls_and_roof(district: tuple[Path, dict[str, Any]]
     colours = {
         m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
     }
-    assert colours["roof"][:3] == pytest.approx([0.0, 1.0, 0.0])
+    assert colours["flat_roof"][:3] == pytest.approx([1.0, 1.0, 1.0])  # a drawn deck:
+    scene = trimesh.load(folder / "out" / "buildings" / "tower.glb", force="scene")
+    deck = next(
+        g.visual.material for name, g in scene.geometry.items() if name.endswith("/flat_roof")
+    )
+    drawn = np.asarray(deck.baseColorTexture.convert("RGB"), dtype=float).reshape(-1, 3)
+    assert drawn.mean(axis=0) == pytest.approx([0, 255, 0], abs=24)  # the colour is in it
     assert colours["render"][:3] == pytest.approx([1.0, 0.0, 0.0])  # the façade's wall too
     assert colours["glass"][:3] != pytest.approx([1.0, 0.0, 0.0])  # not the windows
 

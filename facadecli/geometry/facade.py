@@ -155,6 +155,32 @@ def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
     return flat
 
 
+def plane_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
+    """Texture coordinates in metres (one texture copy per ``size`` metres) in each face's
+    own plane: u level along it, v up its slope. A roof's tiles run along its eaves and
+    keep their size however steep it is (a projection on a dominant plane would stretch
+    them by 1 / cos(pitch) and turn their courses on a hip); a wall reads as
+    :func:`metric_uv` does, seen from outside; a level face takes x and north."""
+    flat = mesh.copy()
+    flat.unmerge_vertices()
+    normal = np.asarray(flat.face_normals, dtype=float)
+    along = np.stack([normal[:, 2], np.zeros(len(normal)), -normal[:, 0]], axis=1)  # up x n
+    length = np.linalg.norm(along, axis=1)
+    level = length < 1e-6
+    along[level] = (1.0, 0.0, 0.0)
+    along[~level] /= length[~level, None]
+    up = np.cross(normal, along)
+    up[level] = (0.0, 0.0, -1.0)
+    corners = flat.vertices[flat.faces]  # (faces, 3, 3)
+    uv = np.zeros((len(flat.vertices), 2))
+    for corner in range(3):
+        vertex = flat.faces[:, corner]
+        uv[vertex, 0] = np.einsum("ij,ij->i", corners[:, corner], along)
+        uv[vertex, 1] = np.einsum("ij,ij->i", corners[:, corner], up)
+    flat.visual = trimesh.visual.TextureVisuals(uv=uv / size)
+    return flat
+
+
 def tangent_space(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     """Give a mesh whose faces have their own vertices (as :func:`metric_uv` leaves them)
     the normals and tangents a normal map is read in: each face's normal, and its
