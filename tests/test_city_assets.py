@@ -9,7 +9,7 @@ import math
 import shutil
 import subprocess
 import sys
-from collections import defaultdict
+from collections import Counter, defaultdict
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +19,7 @@ from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
 from facadecli.city.building import MAP_TO_WORLD
+from facadecli.city.default import default_city, tones
 from facadecli.city.demo import write_demo
 from facadecli.city.manifest import Roof, load_city
 from facadecli.city.roofs import roof_meshes
@@ -46,8 +47,10 @@ def test_buildings_share_one_material_of_each_kind_and_each_picture(city: Path) 
     document, binary = read_glb((city / "demo-district.glb").read_bytes())
     materials = document["materials"]
     names = [m["name"] for m in materials]
-    # the demo's specs give every kind one look: one material each for the whole city
-    assert len(names) == len(set(names)), names
+    # one material of each kind for the whole city, but the walls' four tones (the demo's
+    # palettes) and a name two specs give different looks (stone: the church's, the shop's)
+    assert max(Counter(names).values()) <= 4, Counter(names)
+    assert len(names) <= len(set(names)) + 2 * 3 + 1
     canonical = [json.dumps(m, sort_keys=True) for m in materials]
     assert len(set(canonical)) == len(canonical)
     assert len({json.dumps(t, sort_keys=True) for t in document["textures"]}) == len(
@@ -126,7 +129,7 @@ def _buildings(scene: trimesh.Scene, see_through: set[str]) -> dict[str, list[np
 
 def test_rays_at_35_degrees_from_eight_directions_meet_every_building(city: Path) -> None:
     """From eight directions 35° above the horizon, rays aimed at points inside each
-    building (half a metre in from its footprint, 1 m up and at 40% of its height) meet
+    building (a metre in from its footprint, 1 m up and at 40% of its height) meet
     the building's own opaque surface before they get there: no building of the city
     lets a view through (a missing wall, a window with nothing behind it)."""
     glb = city / "demo-district.glb"
@@ -151,7 +154,7 @@ def test_rays_at_35_degrees_from_eight_directions_meet_every_building(city: Path
         low, high = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
         ground = [t for t in triangles if np.ptp(t[:, 1]) < 1e-6 and t[0, 1] <= low[1] + 0.02]
         plan = unary_union([Polygon(t[:, [0, 2]]) for t in ground if Polygon(t[:, [0, 2]]).area])
-        inner = plan.buffer(-0.5)
+        inner = plan.buffer(-1.0)  # deeper than any window recess reaches
         assert not inner.is_empty, name
         x0, z0, x1, z1 = inner.bounds
         points = [
@@ -207,3 +210,61 @@ def test_roofs_wear_a_library_material(city: Path) -> None:
     for material in roofs:
         assert "baseColorTexture" in material["pbrMetallicRoughness"]
         assert "normalTexture" in material
+
+
+def test_the_default_city_dresses_buildings_by_their_tags() -> None:
+    city = default_city(ROOT / "samples" / "town.osm")
+    name = lambda path: Path(path).stem  # noqa: E731
+    for kind in ("church", "cathedral", "chapel", "tower"):
+        assert name(city.choose({"building": kind}).facade) == "church"
+    assert name(city.choose({"building": "yes", "man_made": "tower"}).facade) == "church"
+    shop = city.choose({"building": "yes", "shop": "bakery"})  # a house with a shop
+    assert name(shop.facade) == "townhouse"
+    assert [(w.side, name(w.facade)) for w in shop.walls] == [("front", "shop-front")]
+    flats = city.choose({"building": "apartments", "shop": "books"})
+    assert name(flats.facade) == "terraced-house" and name(flats.walls[0].facade) == "shop-front"
+    assert city.choose({"building": "yes", "shop": "no"}).walls == ()
+    assert city.choose({"building": "yes"}).walls == ()
+    # every style varies its own wall colour: four tones, the spec's own first
+    brick = city.choose({"building": "yes"}).palette
+    assert len(set(brick)) == 4 and brick[0] == "#9c4a32"  # the townhouse's brick
+    assert city.choose({"building": "church"}).palette != brick
+
+
+def test_tones_keep_the_hue_and_stay_within_white() -> None:
+    for colour in ("#9c4a32", "#e8e4dc", "#ffffff", "#000000", "#abc"):
+        found = tones(colour)
+        assert len(found) == 4
+        for tone in found:
+            rgb = np.array([int(tone[i : i + 2], 16) for i in (1, 3, 5)], dtype=float)
+            first = np.array([int(found[0][i : i + 2], 16) for i in (1, 3, 5)], dtype=float)
+            if first.max() > 0:  # the same proportions: the hue kept
+                assert rgb / max(rgb.max(), 1) == pytest.approx(first / first.max(), abs=0.02)
+
+
+def test_the_seed_varies_the_walls_and_the_same_seed_gives_the_same_bytes(
+    tmp_path: Path,
+) -> None:
+    manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
+    text = manifest.read_text()
+    looks = []
+    for run, seed in enumerate((0, 0, 1, 2)):
+        manifest.write_text(f"{text}seed: {seed}\n")
+        out = tmp_path / f"out{run}"
+        run_city(load_city(manifest), out, jobs=1, limit=6)
+        document, _ = read_glb((out / "demo-district.glb").read_bytes())
+        walls = {}
+        for node in document["nodes"]:
+            for child in node.get("children", []):
+                mesh = document["nodes"][child].get("mesh")
+                if mesh is None:
+                    continue
+                for primitive in document["meshes"][mesh]["primitives"]:
+                    material = document["materials"][primitive["material"]]
+                    if material["name"] in ("brick", "render"):
+                        texture = material["pbrMetallicRoughness"]["baseColorTexture"]
+                        walls[node["name"]] = document["textures"][texture["index"]]["source"]
+        looks.append((out / "demo-district.glb").read_bytes())
+        looks[-1] = (looks[-1], tuple(sorted(walls.items())))
+    assert looks[0][0] == looks[1][0]  # the same city and seed: the same bytes
+    assert len({walls for _, walls in looks}) > 1  # another seed: other tones somewhere
