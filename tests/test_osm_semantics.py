@@ -19,7 +19,6 @@ from facadecli.city.manifest import load_city
 from facadecli.city.run import run_city, safe_name
 from facadecli.city.s3db import COLOURS, colour, tag_problems
 from facadecli.city.straight import merged_ring
-from facadecli.geometry.facade import linear_rgb
 from tests.osm_district import ROOF_SHAPES, UNBUILT_SHAPES, box, write_district
 from tests.running import facade
 from tests.test_cityjson import _check_valid
@@ -67,6 +66,14 @@ def _ridge_reach(roof: trimesh.Trimesh) -> tuple[float, float]:
     axis = (ends[1] - ends[0]) / np.linalg.norm(ends[1] - ends[0])
     along, on_ridge = flat @ axis, ridge @ axis
     return float(on_ridge.min() - along.min()), float(along.max() - on_ridge.max())
+
+
+def _above(mesh: trimesh.Trimesh, height: float) -> trimesh.Trimesh:
+    """The triangles of a mesh that rise above ``height`` from it (the walls over the
+    eaves, where the façades' wall material also dresses the façades below them)."""
+    heights = mesh.vertices[mesh.faces][:, :, 1]
+    keep = (heights.min(axis=1) >= height - 1e-3) & (heights.max(axis=1) > height + 1e-3)
+    return mesh.submesh([np.flatnonzero(keep)], append=True)
 
 
 def _pieces(mesh: trimesh.Trimesh) -> list[trimesh.Trimesh]:
@@ -124,7 +131,8 @@ def test_the_podium_roof_runs_into_the_tower_not_through_it(
     # the tower, 30 m on a 10 m podium, keeps its façades all round, from the podium's
     # eaves (10 m less its 2 m hipped roof) up: none inside the podium
     assert _entry(report, 503)["facades"] == 4 and _entry(report, 503)["party_walls"] == 0
-    assert tower.bounds[0][1] == pytest.approx(8.0, abs=1e-3)
+    # (less the centimetre of its underside, which wears the wall material too)
+    assert tower.bounds[0][1] == pytest.approx(8.0 - 0.01, abs=1e-3)
     assert tower.bounds[1][1] == pytest.approx(30.0, abs=0.3)
 
 
@@ -134,14 +142,14 @@ def test_a_tower_part_on_a_flat_podium_part_starts_on_its_roof(
     folder, report = district
     # 12 levels of 3 m on a podium of 3: façades from 9 m to 36 m, none inside the podium
     facades = _mesh(folder, 902, "render")
-    assert facades.bounds[0][1] == pytest.approx(9.0, abs=1e-3)
+    assert facades.bounds[0][1] == pytest.approx(9.0 - 0.01, abs=1e-3)  # and its underside
     assert _entry(report, 902)["facades"] == 4
     # its pyramid 13'6" high
     roof = _mesh(folder, 902, "roof").vertices[:, 1]
     assert roof.max() - roof.min() == pytest.approx(13.5 * 0.3048, abs=1e-3)
     assert _entry(report, 902)["height"] == pytest.approx(36 + 13.5 * 0.3048, abs=1e-3)
     # the podium's flat roof is left out under the tower
-    podium = _mesh(folder, 901, "roof")
+    podium = _mesh(folder, 901, "flat_roof")
     (x0, _, z0), (x1, _, z1) = facades.bounds
     middles = podium.triangles_center
     inside = (middles[:, 0] > x0 + 0.5) & (middles[:, 0] < x1 - 0.5)
@@ -186,17 +194,17 @@ def test_a_carport_is_a_roof_on_posts(district: tuple[Path, dict[str, Any]]) -> 
     folder, report = district
     entry = _entry(report, 200)
     assert entry["facades"] == 0 and entry["plain_walls"] == 0 and entry["height"] == 2.5
-    walls = _mesh(folder, 200, "wall")
+    walls = _mesh(folder, 200, "render")  # the spec's wall material: nothing but posts
     for post in walls.split(only_watertight=False):
         (x0, _, z0), (x1, _, z1) = post.bounds
         assert x1 - x0 < 0.3 and z1 - z0 < 0.3  # posts, no wall
     assert len(walls.split(only_watertight=False)) >= 4
-    roof = _mesh(folder, 200, "roof")
+    roof = _mesh(folder, 200, "flat_roof")  # the manifest's roof: flat
     assert roof.bounds[1][1] == pytest.approx(2.5, abs=1e-3)
     # building=carport too, its gable ends open; one storey (3 m) and its roof high
     entry = _entry(report, 210)
     assert entry["facades"] == 0 and entry["plain_walls"] == 0 and entry["height"] == 4.0
-    gabled = _mesh(folder, 210, "wall")  # posts only: no gable ends
+    gabled = _mesh(folder, 210, "render")  # posts only: no gable ends
     assert all(np.ptp(p.vertices[:, [0, 2]], axis=0).max() < 0.3 for p in _pieces(gabled))
     # in CityJSON each is one closed solid, the roof on a slab whose underside is a
     # ceiling, at the top of the posts: no walls down to the ground
@@ -217,8 +225,10 @@ def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, An
     assert _entry(report, 501)["height"] == 12.0  # the outline's height, roof and colours
     assert _entry(report, 502)["height"] == 10.0  # its own
     scene = trimesh.load(folder / "out" / "buildings" / f"{safe_name('way/501')}.glb")
-    roof = scene.geometry["way/501/roof"].visual.material.baseColorFactor[:3]
-    assert list(roof) == linear_rgb("#ffefd5")  # papayawhip, a CSS name (linear in glTF)
+    roof = scene.geometry["way/501/roof"].visual.material  # tiles drawn in papayawhip
+    assert list(roof.baseColorFactor[:3]) == [255, 255, 255]  # the colour is in the picture
+    drawn = np.asarray(roof.baseColorTexture.convert("RGB"), dtype=float).reshape(-1, 3)
+    assert drawn.mean(axis=0) == pytest.approx([255, 239, 213], abs=16)  # #ffefd5, a CSS name
     ridge = scene.geometry["way/501/roof"].vertices[:, 1]
     assert ridge.max() - ridge.min() == pytest.approx(2.0, abs=1e-3)  # roof:height 2
 
@@ -281,7 +291,10 @@ def test_every_roof_shape_builds(district: tuple[Path, dict[str, Any]]) -> None:
     flat, up = roof.vertices[:, [0, 2]], roof.vertices[:, 1]
     ridges = flat[up > up.max() - 0.01]
     assert np.ptp(ridges, axis=0) == pytest.approx(np.ptp(flat, axis=0), abs=0.5)  # grid turn
-    assert len(_mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "wall").faces) == 4
+    walls = _mesh(folder, 700 + ROOF_SHAPES.index("crosspitched"), "render")  # as the façades
+    heights = walls.vertices[walls.faces][:, :, 1]
+    gables = (heights.min(axis=1) >= up.min() - 1e-3) & (heights.max(axis=1) > up.min() + 1e-3)
+    assert gables.sum() == 4  # the four gable ends, above the eaves
 
 
 def test_a_butterfly_roof_is_a_valley_between_two_high_walls(
@@ -300,7 +313,7 @@ def test_a_butterfly_roof_is_a_valley_between_two_high_walls(
     along = (b - a) / np.linalg.norm(b - a)
     off = (flat[up > up.max() - 1e-3] - a) @ np.array([-along[1], along[0]])
     assert np.abs(off) == pytest.approx(4.0, abs=0.01) and off.min() < 0 < off.max()
-    ends = _mesh(folder, oid, "wall")  # the walls above the eaves: vertical
+    ends = _above(_mesh(folder, oid, "render"), up.min())  # the walls over the eaves
     assert np.abs(ends.face_normals[ends.area_faces > 1e-9, 1]).max() < 1e-4
 
 
@@ -313,10 +326,11 @@ def test_a_zakomar_roof_is_arches_along_the_walls(
     up = roof.vertices[:, 1]
     # 12 x 8 m: two arches on each long wall, one on each short one; their crests and
     # the point the roof runs in to are the top, 3 m (roof:height) above the eaves
-    assert int((up > up.max() - 1e-3).sum()) == 6 + 1
+    crests = np.unique(np.round(roof.vertices[up > up.max() - 1e-3], 4), axis=0)
+    assert len(crests) == 6 + 1
     assert up.max() - up.min() == pytest.approx(3.0, abs=1e-3)
     # under each arch a vertical gable, a half circle of ARCH_SEGMENTS pieces
-    gables = _mesh(folder, oid, "wall")
+    gables = _above(_mesh(folder, oid, "render"), up.min())  # the façades' wall material
     assert np.abs(gables.face_normals[gables.area_faces > 1e-9, 1]).max() < 1e-4  # float32
     pieces = _pieces(gables)
     assert len(pieces) == 6
@@ -336,7 +350,9 @@ def test_a_sawtooth_roof_is_sheds_side_by_side(district: tuple[Path, dict[str, A
     north = -roof.vertices[:, 2]  # the world's z runs south
     highs = np.sort(north[up > 9.99])  # (the UTM grid turns them a little off east)
     assert 1 + int((np.diff(highs) > 2.0).sum()) == 3
-    risers = _mesh(folder, 800, "wall")  # the glazed risers and the sides: vertical
+    walls = _mesh(folder, 800, "render")  # the façades' wall material, as the gables'
+    risers = walls.submesh([walls.vertices[walls.faces][:, :, 1].max(axis=1) > 7.0 + 1e-3])[0]
+    # the glazed risers and the sides above the eaves: vertical
     assert np.abs(risers.face_normals[risers.area_faces > 1e-9, 1]).max() < 1e-6
     facing = risers.face_normals[risers.area_faces > 1e-9]
     assert (facing[:, 2] < -0.99).sum() > 0  # some face north (-z): the glazing

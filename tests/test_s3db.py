@@ -158,8 +158,13 @@ def test_height_is_the_top_of_the_roof(district: tuple[Path, dict[str, Any]]) ->
     folder, report = district
     scene = _model(folder, "gabled")
     assert scene.bounds[1][1] == pytest.approx(12.0, abs=1e-3)  # y is up
-    walls = scene.geometry["gabled/render"].bounds  # the façades' wall material
-    assert walls[1][1] == pytest.approx(8.0, abs=0.05)  # 12 m less the 4 m roof
+    walls = scene.geometry["gabled/render"]  # the façades' wall material, gable ends too
+    heights = walls.vertices[walls.faces][:, :, 1]
+    over = heights.max(axis=1) > 8.0 + 0.05  # above the eaves, 12 m less the 4 m roof
+    assert over.any() and walls.bounds[1][1] == pytest.approx(12.0, abs=1e-3)
+    # only the gable ends: vertical, standing on the eaves (no façade reaches past them)
+    assert heights[over].min() == pytest.approx(8.0, abs=0.05)
+    assert np.abs(walls.face_normals[over][:, 1]).max() < 1e-4
     assert _entry(report, "gabled")["height"] == pytest.approx(12.0)
 
 
@@ -230,7 +235,13 @@ def test_colour_tags_colour_walls_and_roof(district: tuple[Path, dict[str, Any]]
     colours = {
         m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
     }
-    assert colours["roof"][:3] == pytest.approx([0.0, 1.0, 0.0])
+    assert colours["flat_roof"][:3] == pytest.approx([1.0, 1.0, 1.0])  # a drawn deck:
+    scene = trimesh.load(folder / "out" / "buildings" / "tower.glb", force="scene")
+    deck = next(
+        g.visual.material for name, g in scene.geometry.items() if name.endswith("/flat_roof")
+    )
+    drawn = np.asarray(deck.baseColorTexture.convert("RGB"), dtype=float).reshape(-1, 3)
+    assert drawn.mean(axis=0) == pytest.approx([0, 255, 0], abs=24)  # the colour is in it
     assert colours["render"][:3] == pytest.approx([1.0, 0.0, 0.0])  # the façade's wall too
     assert colours["glass"][:3] != pytest.approx([1.0, 0.0, 0.0])  # not the windows
 

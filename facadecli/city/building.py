@@ -16,7 +16,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,8 +46,10 @@ from facadecli.geometry.facade import (
     material_names,
     metric_uv,
     pbr,
+    plane_uv,
     tangent_space,
     texture_metres,
+    weld,
 )
 from facadecli.layout import (
     BUILTIN_INTERIOR,
@@ -56,13 +58,17 @@ from facadecli.layout import (
     Layout,
     build_shapes,
 )
+from facadecli.materials import LIBRARY
 from facadecli.solver.axis import AxisLayout, solve_axis_alternatives
 from facadecli.spec.model import Material, Spec
 
 WALL = Material(color="#cfc6b8", roughness=0.9)
-ROOF = Material(color="#6b4f43", roughness=0.8)
+ROOF = LIBRARY["roof-tiles"]  # pitched roofs: clay tiles, courses along the eaves
+FLAT_ROOF = LIBRARY["concrete"].model_copy(update={"color": "#77736c"})  # a flat roof's deck
 GROUND = Material(color="#808080", roughness=1.0)
 WALL_NAME, ROOF_NAME, GROUND_NAME = "wall", "roof", "ground"  # a spec may define them
+FLAT_ROOF_NAME = "flat_roof"
+ROOFS = (ROOF_NAME, FLAT_ROOF_NAME)  # their textures lie in their slopes (plane_uv)
 SLAB = 0.2  # metres: thickness of flat roofs and plain walls
 MIN_EDGE = 0.05  # metres: shorter edges are slivers, merged into the next wall
 
@@ -275,7 +281,7 @@ def build_building(
                 wall = trimesh.creation.box(extents=(length, wall_height, SLAB))
                 wall.apply_translation((length / 2, wall_height / 2, -SLAB / 2))
                 wall.apply_transform(placement)
-                parts.setdefault(WALL_NAME, []).append(wall)
+                parts.setdefault(_plain_material(chosen.spec), []).append(wall)
                 plain += 1
                 party += party_wall
                 reason = _plain_reason(party_wall, length, min_facade_width)
@@ -294,18 +300,21 @@ def build_building(
         for name, post in _corner_posts(proud, ends, block.base, wall_height):
             parts.setdefault(name, []).append(post)
         if posts_only:
-            parts.setdefault(WALL_NAME, []).extend(_posts(block))
+            parts.setdefault(_plain_material(spec), []).extend(_posts(block))
         for shape, still in roof_outlines(block.part, fixed, above):
             cover, infill = roof_meshes(shape, block.eaves, block.roof, still)
             cover.apply_transform(MAP_TO_WORLD)
-            parts.setdefault(ROOF_NAME, []).append(cover)
+            flat = block.roof.type == "flat" and ROOF_NAME not in spec.materials
+            kind = FLAT_ROOF_NAME if flat else ROOF_NAME  # a spec's own roof covers both
+            parts.setdefault(kind, []).append(cover)
             for piece in [] if posts_only else infill:  # a roof on posts has open gables
                 piece.apply_transform(MAP_TO_WORLD)
-                parts.setdefault(WALL_NAME, []).append(piece)
+                parts.setdefault(_plain_material(spec), []).append(piece)
         bottom = trimesh.creation.extrude_polygon(block.part, 0.01)
         bottom.apply_translation((0, 0, block.base - 0.01))
         bottom.apply_transform(MAP_TO_WORLD)
-        parts.setdefault(GROUND_NAME if block.base <= 0 else WALL_NAME, []).append(bottom)
+        below = GROUND_NAME if block.base <= 0 else _plain_material(spec)
+        parts.setdefault(below, []).append(bottom)
     materials: dict[str, tuple[Material, Path | None]] = {}
     for _, other in walls:  # the building's own spec wins where two name one material
         materials.update(_materials(other.spec, other.base_dir, looks))
@@ -313,9 +322,11 @@ def build_building(
     for name in sorted(parts):
         fallback = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
         finished, folder = materials.get(name) or (fallback, None)  # the recesses stay dark
-        merged = _merged(parts[name], texture_metres(finished))
+        project = plane_uv if name in ROOFS else metric_uv
+        merged = _merged(parts[name], texture_metres(finished), project)
         if finished.library is not None:  # a normal map: normals and tangents with it
             merged = tangent_space(merged)
+        merged = weld(merged)
         merged.visual.material = pbr(name, finished, folder)
         scene.add_geometry(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"
@@ -461,6 +472,16 @@ def _wall_material(spec: Spec) -> str:
     return spec.defaults.material or DEFAULT_MATERIAL
 
 
+def _plain_material(spec: Spec) -> str:
+    """The material of the walls without a façade (plain and party walls, gable ends,
+    posts) beside a façade of ``spec``: its own wall material, so that a brick terrace
+    does not end in a grey blind wall; a spec's own ``wall`` material wins, and the
+    built-in ``wall`` stands in when it names neither."""
+    if WALL_NAME in spec.materials:
+        return WALL_NAME
+    return spec.defaults.material or WALL_NAME
+
+
 def _corner_posts(
     starts: dict[tuple[float, float], tuple[tuple[float, float], float, str]],
     ends: list[tuple[tuple[float, float], tuple[float, float], float]],
@@ -523,7 +544,8 @@ def _materials(
     over the built-in one), and the tags' colours over both."""
     declared = {name: look(spec, name) for name in material_names(spec)}
     declared = {name: m for name, m in declared.items() if name in spec.materials or m.library}
-    for name, builtin in ((WALL_NAME, WALL), (ROOF_NAME, ROOF), (GROUND_NAME, GROUND)):
+    builtins = ((WALL_NAME, WALL), (ROOF_NAME, ROOF), (FLAT_ROOF_NAME, FLAT_ROOF))
+    for name, builtin in (*builtins, (GROUND_NAME, GROUND)):
         declared.setdefault(name, builtin)
     if looks.wall is not None:
         walls = [WALL_NAME] + ([spec.defaults.material] if spec.defaults.material else [])
@@ -532,22 +554,27 @@ def _materials(
                 update={"color": looks.wall, "texture": None}
             )
     if looks.roof is not None:
-        declared[ROOF_NAME] = declared[ROOF_NAME].model_copy(
-            update={"color": looks.roof, "texture": None}
-        )
+        for name in ROOFS:
+            declared[name] = declared[name].model_copy(
+                update={"color": looks.roof, "texture": None}
+            )
     return {name: (m, base_dir) for name, m in declared.items()}
 
 
-def _merged(meshes: list[trimesh.Trimesh], metres: float | None) -> trimesh.Trimesh:
+def _merged(
+    meshes: list[trimesh.Trimesh],
+    metres: float | None,
+    project: Callable[[trimesh.Trimesh, float], trimesh.Trimesh] = metric_uv,
+) -> trimesh.Trimesh:
     """The meshes of one material as one; for a textured material, with the texture
-    coordinates they have (a façade's, in its own frame), and metric ones for those
-    without (roofs, plain walls)."""
+    coordinates they have, and for those without, ``project``'s in metres
+    (:func:`.metric_uv`, or :func:`.plane_uv` for roofs)."""
     if metres is None:
         merged = trimesh.util.concatenate(meshes)
         merged.visual = trimesh.visual.TextureVisuals()
         return merged
     mapped = [
-        m if getattr(m.visual, "uv", None) is not None else metric_uv(m, metres) for m in meshes
+        m if getattr(m.visual, "uv", None) is not None else project(m, metres) for m in meshes
     ]
     offsets = np.cumsum([0] + [len(m.vertices) for m in mapped[:-1]])
     merged = trimesh.Trimesh(  # stacked by hand: trimesh would pack the pictures in an atlas

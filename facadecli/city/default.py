@@ -3,8 +3,11 @@ the manifest a user would write first, built in code.
 
 Every building gets the façade spec given (``--spec``); without one, the shipped examples
 dress it by its OSM ``building`` tag: apartments get the terraced house, shops and offices
-the shop front, every other building the townhouse. Roofs are hipped (30°) unless the
-data tags a shape; a building without a height or levels is 9 m tall, 3 m a level; walls
+the shop front, churches, chapels and towers the church, every other building the
+townhouse; a building with a ``shop`` tag keeps its own and gets the shop front on its
+front walls. Each building's walls take one of four tones of its spec's wall colour
+(:func:`tones`), picked by the seed and its id. Roofs are hipped (30°) unless the data
+tags a shape; a building without a height or levels is 9 m tall, 3 m a level; walls
 shorter than 3 m are plain.
 """
 
@@ -12,18 +15,25 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Any
 
-from facadecli.city.manifest import City, Defaults, Manifest, Roof, Rule
+from facadecli.city.manifest import ANY, City, Defaults, Manifest, Roof, Rule, WallRule
 from facadecli.errors import SpecError
 from facadecli.examples import example_spec
 from facadecli.spec import Spec, load_spec
 
 SUFFIXES: tuple[str, ...] = (".osm.pbf", ".osm.bz2", ".osm.gz", ".pbf", ".osm", ".geojson")
 SUFFIXES += (".json", ".gpkg", ".shp", ".fgb")  # stripped from the file's name
+CHURCHES = (  # walls with tall windows, not storeys of flats
+    *("church", "cathedral", "chapel", "temple", "mosque", "synagogue", "shrine"),
+    *("bell_tower", "tower"),
+)
 RULES = (  # building tag -> the example that dresses it, when no --spec is given
     (("apartments", "residential", "dormitory"), "terraced-house"),
     (("retail", "commercial", "office", "supermarket", "kiosk"), "shop-front"),
+    (CHURCHES, "church"),
 )
+TONES = (1.0, 0.86, 1.12, 0.94)  # the lightness of a wall colour's four tones, as factors
 
 
 def city_name(footprints: Path) -> str:
@@ -42,14 +52,23 @@ def default_city(footprints: Path, spec: Path | None = None) -> City:
     if not footprints.is_file():
         what = "is a folder" if footprints.is_dir() else "no such file"
         raise SpecError.at(str(footprints), None, None, what, "give a footprints file")
-    rules: list[Rule] = []
+    plan: list[tuple[dict[str, Any], str, list[WallRule] | None]] = []  # when, façade, walls
     if spec is None:
         default = str(example_spec("townhouse"))
-        for kinds, example in RULES:
-            for kind in kinds:
-                rules.append(Rule(when={"building": kind}, facade=str(example_spec(example))))
+        front = [WallRule(side="front", facade=str(example_spec("shop-front")))]
+        dressed = [(kind, str(example_spec(e))) for kinds, e in RULES for kind in kinds]
+        for kind, facade in [*dressed, (None, default)]:  # a shop tag: a shop front too
+            when = {"shop": ANY} if kind is None else {"building": kind, "shop": ANY}
+            plan.append((when, facade, front))
+        plan += [({"building": kind}, facade, None) for kind, facade in dressed]
+        plan.append(({"man_made": "tower"}, str(example_spec("church")), None))
     else:
         default = str(spec)
+    specs: dict[str, Spec] = {}
+    walls = [wall.facade for _, _, chosen in plan for wall in chosen or []]
+    for facade in [default, *(facade for _, facade, _ in plan), *walls]:
+        if facade not in specs:  # a spec's own errors name its file, line and column
+            specs[facade] = load_spec(facade)
     manifest = Manifest(
         version=1,
         name=city_name(footprints),
@@ -60,11 +79,28 @@ def default_city(footprints: Path, spec: Path | None = None) -> City:
             floor_height=3.0,
             roof=Roof(type="hip", pitch=30.0),
             min_facade_width=3.0,
+            palette=tones(wall_colour(specs[default])),
         ),
-        rules=rules,
+        rules=[
+            Rule(when=when, facade=facade, walls=chosen, palette=tones(wall_colour(specs[facade])))
+            for when, facade, chosen in plan
+        ],
     )
-    specs: dict[str, Spec] = {}
-    for facade in [default, *(rule.facade for rule in rules if rule.facade is not None)]:
-        if facade not in specs:  # a spec's own errors name its file, line and column
-            specs[facade] = load_spec(facade)
     return City(manifest, footprints.parent, footprints, specs)
+
+
+def wall_colour(spec: Spec) -> str:
+    """The colour of a spec's wall material (its ``defaults.material``)."""
+    from facadecli.geometry.facade import look
+
+    return look(spec, spec.defaults.material or "").color
+
+
+def tones(colour: str) -> list[str]:
+    """Four tones of a ``#rrggbb`` colour, lighter and darker by the :data:`TONES` factors
+    (its hue kept): the walls of one style that still differ from house to house."""
+    digits = colour.lstrip("#")
+    digits = "".join(c * 2 for c in digits) if len(digits) == 3 else digits
+    rgb = [int(digits[i : i + 2], 16) for i in (0, 2, 4)]
+    brightest = 255 / max(*rgb, 1)  # no lighter than white allows: the hue stays
+    return ["#" + "".join(f"{round(c * min(f, brightest)):02x}" for c in rgb) for f in TONES]

@@ -1,5 +1,7 @@
 """A demo district the project makes itself (``make city``): blocks of rectangular and
-L-shaped footprints along a street grid, with OSM-like properties, in a projected CRS."""
+L-shaped footprints along a street grid, with OSM-like properties, in a projected CRS:
+apartment blocks, houses, a shop in every other block (a shop front on its front wall),
+and a church now and then; the houses' walls take tones of their brick by the seed."""
 
 from __future__ import annotations
 
@@ -20,14 +22,26 @@ defaults:
   floor_height: 3.2
   roof: {{type: gable, pitch: 35}}
   min_facade_width: 3.0
+  palette: ["#9c4a32", "#86402b", "#af5338", "#93462f"]  # tones of the townhouse's brick
 rules:
+  - when: {{building: church}}
+    facade: {specs}/church.yaml
+    roof: {{type: gable, pitch: 50}}
+    palette: []
+  - when: {{shop: "*"}}
+    walls: [{{side: front, facade: {specs}/shop-front.yaml}}]
   - when: {{building: apartments, building:levels: "7"}}
     facade: {specs}/terraced-house.yaml
     roof: {{type: flat, parapet: 0.6}}
+    palette: ["#e8e4dc", "#c8c4bd", "#fffbf2", "#dad6cf"]  # tones of its render
   - when: {{building: apartments}}
     facade: {specs}/terraced-house.yaml
     roof: {{type: hip, pitch: 30}}
+    palette: ["#e8e4dc", "#c8c4bd", "#fffbf2", "#dad6cf"]
 """
+
+
+SHOPS = ("bakery", "books", "clothes", "hardware")
 
 
 def district(blocks: int = 3, seed: int = 0) -> dict[str, object]:
@@ -60,6 +74,10 @@ def district(blocks: int = 3, seed: int = 0) -> dict[str, object]:
                 else:
                     properties["building"] = "yes"
                     properties["height"] = rng.choice((9.6, 12.8))
+                if k == 1 and (bx + by) % 2 == 0:
+                    properties["shop"] = SHOPS[(bx + by * blocks) % len(SHOPS)]
+                if k == 2 and (bx * 3 + by) % 7 == 3:
+                    properties.update(building="church", height=17.0)
                 features.append(
                     {
                         "type": "Feature",

@@ -70,6 +70,7 @@ class Range(Model):
     max: float | None = None
 
 
+ANY = "*"  # a rule's ``when`` value matching any value a feature's tag has (not "no")
 Colours = Literal["tags", "spec"]  # who colours the walls and roof: the OSM tags, or the spec
 Side = Literal["front", "back", "side"]
 
@@ -251,6 +252,8 @@ def _matches(properties: dict[str, Any], key: str, want: str | float | bool | Ra
     value = properties.get(key)
     if value is None and key == "levels":
         value = properties.get("building:levels")
+    if want == ANY:  # the tag is there, with a value other than "no"
+        return value is not None and str(value).strip().lower() not in ("", "no")
     if isinstance(want, Range):
         found = number(value)
         return found is not None and _within(found, want)

@@ -75,10 +75,11 @@ def merge_glb(
     try:
         with os.fdopen(fd, "wb") as binary:
             known: dict[bytes, int] = {}  # a picture's digest -> its merged image
+            seen: dict[str, dict[str, int]] = {}  # shared kinds' entries already merged
             for name, path in parts:
                 document, chunk = read_glb(path.read_bytes())
                 document, chunk = _known_images(document, chunk, known, len(merged["images"]))
-                _append(merged, document, name, binary.tell())
+                _append(merged, document, name, binary.tell(), seen)
                 binary.write(chunk)
                 binary.write(b"\0" * (-len(chunk) % 4))
             length = binary.tell()
@@ -146,23 +147,50 @@ def _known_images(
     return document, b"".join(pieces)
 
 
-def _append(merged: dict[str, Any], document: dict[str, Any], name: str, offset: int) -> None:
+#: kinds whose equal entries (by content, once their references are renumbered) are
+#: stored once: a city's buildings share one material of each kind and its textures
+_SHARED = ("samplers", "textures", "materials")
+
+
+def _append(
+    merged: dict[str, Any],
+    document: dict[str, Any],
+    name: str,
+    offset: int,
+    seen: dict[str, dict[str, int]],
+) -> None:
+    """Add a part's entries to the merged document, renumbering their references; a
+    sampler, texture or material equal to one already merged (``seen``: its canonical
+    JSON -> its index) is not added again, and what pointed at it points at that one."""
     base = {key: len(merged[key]) for key in _REFERENCES}
+    where: dict[str, list[int]] = {}  # this part's index -> its merged index, by kind
     for key, links in _REFERENCES.items():
+        where[key] = []
         for entry in document.get(key, []):
             entry = dict(entry)
             for field, target in links:
-                if field in entry:
-                    entry[field] += base[target]
+                if field in entry and target == "images":  # may be an earlier part's
+                    entry[field] += base["images"]  # (see _known_images)
+                elif field in entry:
+                    entry[field] = where[target][entry[field]]
             if key == "bufferViews":
                 entry["buffer"] = 0
                 entry["byteOffset"] = entry.get("byteOffset", 0) + offset
             if key == "nodes" and "children" in entry:
                 entry["children"] = [child + base["nodes"] for child in entry["children"]]
             if key == "materials":
-                _shift_textures(entry, base["textures"])
+                entry = _renumber_textures(entry, where["textures"])
             if key == "meshes":
-                entry["primitives"] = [_primitive(p, base) for p in entry["primitives"]]
+                entry["primitives"] = [_primitive(p, where) for p in entry["primitives"]]
+            if key in _SHARED:
+                canonical = json.dumps(entry, sort_keys=True, separators=(",", ":"))
+                known = seen.setdefault(key, {})
+                if canonical not in known:
+                    known[canonical] = len(merged[key])
+                    merged[key].append(entry)
+                where[key].append(known[canonical])
+                continue
+            where[key].append(len(merged[key]))
             merged[key].append(entry)
     for extension in document.get("extensionsUsed", []):
         if extension not in merged["extensionsUsed"]:
@@ -173,24 +201,32 @@ def _append(merged: dict[str, Any], document: dict[str, Any], name: str, offset:
     merged["scenes"][0]["nodes"].append(len(merged["nodes"]) - 1)
 
 
-def _primitive(primitive: dict[str, Any], base: dict[str, int]) -> dict[str, Any]:
+def _primitive(primitive: dict[str, Any], where: dict[str, list[int]]) -> dict[str, Any]:
     shifted = dict(primitive)
-    shifted["attributes"] = {k: v + base["accessors"] for k, v in primitive["attributes"].items()}
+    accessors = where["accessors"]
+    shifted["attributes"] = {k: accessors[v] for k, v in primitive["attributes"].items()}
     if "indices" in primitive:
-        shifted["indices"] = primitive["indices"] + base["accessors"]
+        shifted["indices"] = accessors[primitive["indices"]]
     if "material" in primitive:
-        shifted["material"] = primitive["material"] + base["materials"]
+        shifted["material"] = where["materials"][primitive["material"]]
     return shifted
 
 
-def _shift_textures(value: Any, base: int) -> None:
-    """Texture references sit in nested ``{"index": i}`` objects of a material."""
+def _renumber_textures(value: Any, textures: list[int]) -> Any:
+    """A copy of a material with its texture references (nested ``{"index": i}`` objects)
+    pointing at the merged textures."""
     if isinstance(value, dict):
-        for key, item in value.items():
-            if key.endswith("Texture") and isinstance(item, dict) and "index" in item:
-                item["index"] += base
-            else:
-                _shift_textures(item, base)
+        return {
+            key: (
+                {**item, "index": textures[item["index"]]}
+                if key.endswith("Texture") and isinstance(item, dict) and "index" in item
+                else _renumber_textures(item, textures)
+            )
+            for key, item in value.items()
+        }
+    if isinstance(value, list):
+        return [_renumber_textures(item, textures) for item in value]
+    return value
 
 
 def _write(merged: dict[str, Any], binary_path: str, length: int, target: Path) -> None:

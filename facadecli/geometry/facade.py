@@ -155,6 +155,32 @@ def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
     return flat
 
 
+def plane_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
+    """Texture coordinates in metres (one texture copy per ``size`` metres) in each face's
+    own plane: u level along it, v up its slope. A roof's tiles run along its eaves and
+    keep their size however steep it is (a projection on a dominant plane would stretch
+    them by 1 / cos(pitch) and turn their courses on a hip); a wall reads as
+    :func:`metric_uv` does, seen from outside; a level face takes x and north."""
+    flat = mesh.copy()
+    flat.unmerge_vertices()
+    normal = np.asarray(flat.face_normals, dtype=float)
+    along = np.stack([normal[:, 2], np.zeros(len(normal)), -normal[:, 0]], axis=1)  # up x n
+    length = np.linalg.norm(along, axis=1)
+    level = length < 1e-6
+    along[level] = (1.0, 0.0, 0.0)
+    along[~level] /= length[~level, None]
+    up = np.cross(normal, along)
+    up[level] = (0.0, 0.0, -1.0)
+    corners = flat.vertices[flat.faces]  # (faces, 3, 3)
+    uv = np.zeros((len(flat.vertices), 2))
+    for corner in range(3):
+        vertex = flat.faces[:, corner]
+        uv[vertex, 0] = np.einsum("ij,ij->i", corners[:, corner], along)
+        uv[vertex, 1] = np.einsum("ij,ij->i", corners[:, corner], up)
+    flat.visual = trimesh.visual.TextureVisuals(uv=uv / size)
+    return flat
+
+
 def tangent_space(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     """Give a mesh whose faces have their own vertices (as :func:`metric_uv` leaves them)
     the normals and tangents a normal map is read in: each face's normal, and its
@@ -187,6 +213,35 @@ def tangent_space(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     mesh.vertex_attributes["NORMAL"] = normals.astype(np.float32)
     mesh.vertex_attributes["TANGENT"] = tangents.astype(np.float32)
     return mesh
+
+
+def weld(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """The mesh with each vertex stored once: corners that agree in every attribute the
+    file will carry (position, texture coordinates, normal and tangent, as float32) become
+    one, in the order they first appear. :func:`metric_uv` gives every face its own
+    corners; welding them back is about a third fewer vertices (a box's face: 4, not 6)."""
+    uv = getattr(mesh.visual, "uv", None)
+    attributes = {name: mesh.vertex_attributes.get(name) for name in ("NORMAL", "TANGENT")}
+    attributes = {name: value for name, value in attributes.items() if value is not None}
+    columns = [mesh.vertices, *([] if uv is None else [uv]), *attributes.values()]
+    rows = np.hstack(
+        [np.asarray(c, dtype=np.float32).reshape(len(mesh.vertices), -1) for c in columns]
+    )
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # the welded vertices in order of appearance
+    renumber = np.empty(len(order), dtype=np.int64)
+    renumber[order] = np.arange(len(order))
+    keep = first[order]
+    welded = trimesh.Trimesh(
+        mesh.vertices[keep], renumber[inverse.reshape(-1)][mesh.faces], process=False
+    )
+    material = getattr(mesh.visual, "material", None)
+    welded.visual = trimesh.visual.TextureVisuals(
+        uv=None if uv is None else np.asarray(uv)[keep], material=material
+    )
+    for name, value in attributes.items():
+        welded.vertex_attributes[name] = np.asarray(value)[keep]
+    return welded
 
 
 def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:

@@ -1,0 +1,277 @@
+"""A city's merged model as an engine loads it: one material of each kind, each picture
+once, vertices stored once, and no building a ray can pass through. One generated city
+of 50 buildings (the demo district's first 50), built once for the module."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import subprocess
+import sys
+from collections import Counter, defaultdict
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from shapely.geometry import Polygon
+from shapely.ops import unary_union
+
+from facadecli.city.building import MAP_TO_WORLD
+from facadecli.city.default import default_city, tones
+from facadecli.city.demo import write_demo
+from facadecli.city.manifest import Roof, load_city
+from facadecli.city.roofs import roof_meshes
+from facadecli.city.run import run_city
+from facadecli.export.glb_merge import merge_glb, read_glb
+from facadecli.geometry.facade import plane_uv, weld
+from tests.rays import reach
+
+ROOT = Path(__file__).resolve().parent.parent
+VALIDATOR = Path(sys.prefix) / "node" / "node_modules"  # make test installs it in the venv
+BUILDINGS = 50
+
+
+@pytest.fixture(scope="module")
+def city(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The folder of a 50-building city (the merged glb and ``buildings/``)."""
+    folder = tmp_path_factory.mktemp("city")
+    manifest = write_demo(folder / "demo", ROOT / "specs", 4)
+    report = run_city(load_city(manifest), folder / "out", jobs=1, limit=BUILDINGS)
+    assert report["summary"]["ok"] == BUILDINGS
+    return folder / "out"
+
+
+def test_buildings_share_one_material_of_each_kind_and_each_picture(city: Path) -> None:
+    document, binary = read_glb((city / "demo-district.glb").read_bytes())
+    materials = document["materials"]
+    names = [m["name"] for m in materials]
+    # one material of each kind for the whole city, but the walls' four tones (the demo's
+    # palettes) and a name two specs give different looks (stone: the church's, the shop's)
+    assert max(Counter(names).values()) <= 4, Counter(names)
+    assert len(names) <= len(set(names)) + 2 * 3 + 1
+    canonical = [json.dumps(m, sort_keys=True) for m in materials]
+    assert len(set(canonical)) == len(canonical)
+    assert len({json.dumps(t, sort_keys=True) for t in document["textures"]}) == len(
+        document["textures"]
+    )
+    pictures = []
+    for image in document["images"]:
+        view = document["bufferViews"][image["bufferView"]]
+        start = view.get("byteOffset", 0)
+        pictures.append(binary[start : start + view["byteLength"]])
+    assert len(set(pictures)) == len(pictures)
+    # every building still has its own node, whose meshes name the shared materials
+    assert len(document["scenes"][0]["nodes"]) == BUILDINGS
+    used = {p["material"] for m in document["meshes"] for p in m["primitives"]}
+    assert used == set(range(len(materials)))
+
+
+def test_merging_the_same_buildings_twice_gives_the_same_bytes(city: Path, tmp_path: Path) -> None:
+    parts = sorted((city / "buildings").glob("*.glb"))
+    merge_glb(((p.stem, p) for p in parts), tmp_path / "a.glb")
+    merge_glb(((p.stem, p) for p in parts), tmp_path / "b.glb")
+    assert (tmp_path / "a.glb").read_bytes() == (tmp_path / "b.glb").read_bytes()
+    document, _ = read_glb((tmp_path / "a.glb").read_bytes())
+    alone, _ = read_glb(parts[0].read_bytes())  # a building alone has its own materials
+    assert len(document["materials"]) < len(alone["materials"]) * len(parts)
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed")
+def test_the_merged_city_passes_the_khronos_validator(city: Path) -> None:
+    assert (VALIDATOR / "gltf-validator").exists(), "run 'make test' to install the validator"
+    glb = city / "demo-district.glb"
+    result = subprocess.run(
+        ["node", str(ROOT / "tests" / "gltf_validate.js"), str(VALIDATOR), str(glb)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    report = json.loads(result.stdout)
+    assert (report["errors"], report["warnings"]) == (0, 0), report
+
+
+def test_a_welded_mesh_keeps_its_triangles_and_stores_each_vertex_once() -> None:
+    box = trimesh.creation.box(extents=(2.0, 3.0, 0.5))
+    box.unmerge_vertices()  # every face its own corners, as metric_uv leaves them
+    uv = box.vertices[:, :2] / 2.0
+    box.visual = trimesh.visual.TextureVisuals(uv=uv)
+    box.vertex_attributes["NORMAL"] = np.repeat(box.face_normals, 3, axis=0)[
+        np.argsort(box.faces.reshape(-1))
+    ]
+    welded = weld(box)
+    assert len(welded.vertices) == 24  # four corners a side: each side has its own normal
+    assert np.allclose(welded.triangles, box.triangles)
+    assert np.allclose(np.asarray(welded.visual.uv)[welded.faces], uv[box.faces])
+    normals = np.asarray(welded.vertex_attributes["NORMAL"])[welded.faces]
+    assert np.allclose(normals, np.asarray(box.vertex_attributes["NORMAL"])[box.faces])
+
+
+def _buildings(scene: trimesh.Scene, see_through: set[str]) -> dict[str, list[np.ndarray]]:
+    """The opaque triangles of each building of a merged city (its root node's name):
+    glass that blends or transmits (``see_through``) is left out, as a viewer sees
+    through it."""
+    parents = scene.graph.transforms.parents
+    found: dict[str, list[np.ndarray]] = defaultdict(list)
+    for node in scene.graph.nodes_geometry:
+        transform, geometry = scene.graph[node]
+        mesh = scene.geometry[geometry]
+        material = mesh.visual.material
+        if material.alphaMode == "BLEND" or material.name in see_through:
+            continue
+        root = node
+        while parents.get(root) not in (None, scene.graph.base_frame):
+            root = parents[root]
+        found[root].append(mesh.copy().apply_transform(transform).triangles)
+    return found
+
+
+def test_rays_at_35_degrees_from_eight_directions_meet_every_building(city: Path) -> None:
+    """From eight directions 35° above the horizon, rays aimed at points inside each
+    building (a metre in from its footprint, 1 m up and at 40% of its height) meet
+    the building's own opaque surface before they get there: no building of the city
+    lets a view through (a missing wall, a window with nothing behind it)."""
+    glb = city / "demo-district.glb"
+    document, _ = read_glb(glb.read_bytes())
+    transmitting = "KHR_materials_transmission"
+    see_through = {
+        m["name"] for m in document["materials"] if transmitting in m.get("extensions", {})
+    }
+    assert see_through  # the glass of the windows: the rays pass it
+    buildings = _buildings(trimesh.load(glb, force="scene"), see_through)
+    assert len(buildings) == BUILDINGS
+    down = math.radians(35)
+    directions = np.array(
+        [
+            (math.cos(down) * math.cos(a), -math.sin(down), math.cos(down) * math.sin(a))
+            for a in np.radians(np.arange(0, 360, 45))
+        ]
+    )
+    leaks = []
+    for name, parts in sorted(buildings.items()):
+        triangles = np.concatenate(parts)
+        low, high = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
+        ground = [t for t in triangles if np.ptp(t[:, 1]) < 1e-6 and t[0, 1] <= low[1] + 0.02]
+        plan = unary_union([Polygon(t[:, [0, 2]]) for t in ground if Polygon(t[:, [0, 2]]).area])
+        inner = plan.buffer(-1.0)  # deeper than any window recess reaches
+        assert not inner.is_empty, name
+        x0, z0, x1, z1 = inner.bounds
+        points = [
+            (x, z)
+            for x in np.linspace(x0, x1, 5)
+            for z in np.linspace(z0, z1, 5)
+            if inner.contains(Polygon([(x, z), (x + 1e-3, z), (x, z + 1e-3)]))
+        ] or [inner.representative_point().coords[0]]
+        heights = (low[1] + 1.0, low[1] + 0.4 * (high[1] - low[1]))
+        targets = np.array([(x, y, z) for x, z in points for y in heights])
+        far = 2 * float(np.linalg.norm(high - low)) + 10.0
+        for direction in directions:
+            origins = targets - direction * far
+            met = reach(triangles, origins, direction)
+            through = targets[met >= far - 1e-6]
+            if len(through):
+                leaks.append((name, direction.round(2).tolist(), through[:3].round(2).tolist()))
+    assert not leaks, leaks[:5]
+
+
+@pytest.mark.parametrize("kind", ["gable", "hip", "shed", "dome"])
+def test_roof_textures_lie_in_their_slopes_in_metres(kind: str) -> None:
+    """Each roof face's texture coordinates are its own plane's, in metres: an edge is as
+    long in the texture as on the roof (no stretch on a steep slope or a dome's facets),
+    and u runs level, along the eaves (tile courses stay horizontal)."""
+    part = Polygon([(0, 0), (12, 0), (12, 8), (7, 8), (7, 5), (0, 5)])  # an L: hips, valleys
+    cover, _ = roof_meshes(part, 6.0, Roof(type=kind, pitch=40))  # type: ignore[arg-type]
+    cover.apply_transform(MAP_TO_WORLD)
+    mapped = plane_uv(cover, 1.0)
+    corners = mapped.vertices[mapped.faces]
+    uv = np.asarray(mapped.visual.uv)[mapped.faces]
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        assert np.allclose(
+            np.linalg.norm(corners[:, b] - corners[:, a], axis=1),
+            np.linalg.norm(uv[:, b] - uv[:, a], axis=1),
+            atol=1e-6,
+        )
+    # the 3D direction of increasing u in each face: level
+    edge1, edge2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    du1, dv1 = uv[:, 1, 0] - uv[:, 0, 0], uv[:, 1, 1] - uv[:, 0, 1]
+    du2, dv2 = uv[:, 2, 0] - uv[:, 0, 0], uv[:, 2, 1] - uv[:, 0, 1]
+    det = du1 * dv2 - du2 * dv1
+    usable = np.abs(det) > 1e-9
+    along = (edge1 * dv2[:, None] - edge2 * dv1[:, None])[usable] / det[usable, None]
+    assert np.abs(along[:, 1]).max() < 1e-6
+    assert (det[usable] > 0).all()  # seen from outside the texture is not mirrored
+
+
+def test_roofs_wear_a_library_material(city: Path) -> None:
+    document, _ = read_glb((city / "demo-district.glb").read_bytes())
+    roofs = [m for m in document["materials"] if m["name"] in ("roof", "flat_roof")]
+    assert {m["name"] for m in roofs} == {"roof", "flat_roof"}  # pitched and flat, in the demo
+    for material in roofs:
+        assert "baseColorTexture" in material["pbrMetallicRoughness"]
+        assert "normalTexture" in material
+
+
+def test_the_default_city_dresses_buildings_by_their_tags() -> None:
+    city = default_city(ROOT / "samples" / "town.osm")
+    name = lambda path: Path(path).stem  # noqa: E731
+    for kind in ("church", "cathedral", "chapel", "tower"):
+        assert name(city.choose({"building": kind}).facade) == "church"
+    assert name(city.choose({"building": "yes", "man_made": "tower"}).facade) == "church"
+    shop = city.choose({"building": "yes", "shop": "bakery"})  # a house with a shop
+    assert name(shop.facade) == "townhouse"
+    assert [(w.side, name(w.facade)) for w in shop.walls] == [("front", "shop-front")]
+    flats = city.choose({"building": "apartments", "shop": "books"})
+    assert name(flats.facade) == "terraced-house" and name(flats.walls[0].facade) == "shop-front"
+    assert city.choose({"building": "yes", "shop": "no"}).walls == ()
+    assert city.choose({"building": "yes"}).walls == ()
+    # every style varies its own wall colour: four tones, the spec's own first
+    brick = city.choose({"building": "yes"}).palette
+    assert len(set(brick)) == 4 and brick[0] == "#9c4a32"  # the townhouse's brick
+    assert city.choose({"building": "church"}).palette != brick
+
+
+def test_tones_keep_the_hue_and_stay_within_white() -> None:
+    for colour in ("#9c4a32", "#e8e4dc", "#ffffff", "#000000", "#abc"):
+        found = tones(colour)
+        assert len(found) == 4
+        for tone in found:
+            rgb = np.array([int(tone[i : i + 2], 16) for i in (1, 3, 5)], dtype=float)
+            first = np.array([int(found[0][i : i + 2], 16) for i in (1, 3, 5)], dtype=float)
+            if first.max() > 0:  # the same proportions: the hue kept
+                assert rgb / max(rgb.max(), 1) == pytest.approx(first / first.max(), abs=0.02)
+
+
+def _wall_pictures(glb: Path) -> dict[str, bytes]:
+    """Each building's wall picture (its brick's or render's base colour), by its name."""
+    document, binary = read_glb(glb.read_bytes())
+    found = {}
+    for node in document["nodes"]:
+        for child in node.get("children", []):
+            mesh = document["nodes"][child].get("mesh")
+            for primitive in [] if mesh is None else document["meshes"][mesh]["primitives"]:
+                material = document["materials"][primitive["material"]]
+                if material["name"] in ("brick", "render"):
+                    texture = material["pbrMetallicRoughness"]["baseColorTexture"]
+                    image = document["images"][document["textures"][texture["index"]]["source"]]
+                    view = document["bufferViews"][image["bufferView"]]
+                    start = view.get("byteOffset", 0)
+                    found[node["name"]] = binary[start : start + view["byteLength"]]
+    return found
+
+
+def test_the_seed_varies_the_walls_and_the_same_seed_gives_the_same_bytes(
+    tmp_path: Path,
+) -> None:
+    manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
+    text = manifest.read_text()
+    merged, walls = [], []
+    for run, seed in enumerate((0, 0, 1, 2)):
+        manifest.write_text(f"{text}seed: {seed}\n")
+        out = tmp_path / f"out{run}"
+        run_city(load_city(manifest), out, jobs=1, limit=6)
+        merged.append((out / "demo-district.glb").read_bytes())
+        walls.append(_wall_pictures(out / "demo-district.glb"))
+    assert merged[0] == merged[1]  # the same city and seed: the same bytes
+    assert len(walls[0]) >= 4  # the houses and flats with brick or render walls
+    assert walls[2] != walls[0] or walls[3] != walls[0]  # another seed: other tones somewhere
