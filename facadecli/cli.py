@@ -468,6 +468,15 @@ def city(
             show_default=False,
         ),
     ] = None,
+    tiles3d: Annotated[
+        bool, typer.Option("--3dtiles", help="Also OGC 3D Tiles: 3dtiles/tileset.json.")
+    ] = False,
+    lod: Annotated[
+        str,
+        typer.Option(
+            "--lod", metavar="1,2,3", help="3D Tiles' levels of detail: blocks, roofs, façades."
+        ),
+    ] = "1,2,3",
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -489,8 +498,10 @@ def city(
     from facadecli.city.default import default_city
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
+    from facadecli.city.tileset import parse_lods
 
     box = _bbox(bbox) if bbox is not None else None
+    lods = parse_lods(lod) if tiles3d else ()
     is_manifest = source.suffix.lower() in (".yaml", ".yml")
     if is_manifest and spec is not None:
         raise typer.BadParameter(
@@ -500,7 +511,7 @@ def city(
     loaded = load_city(source) if is_manifest else default_city(source, spec)
     workers = jobs or os.cpu_count() or 1
     if _state["quiet"]:
-        report = run_city(loaded, outdir, workers, limit, resume, None, scheduler, box, usd)
+        report = run_city(loaded, outdir, workers, limit, resume, None, scheduler, box, usd, lods)
     elif sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
         from rich.progress import Progress
 
@@ -510,7 +521,9 @@ def city(
             def progress(done: int, total: int) -> None:
                 bar.update(task, completed=done, total=total)
 
-            report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box, usd)
+            report = run_city(
+                loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
+            )
     else:
         step = max(1, (limit or 1000) // 20)
 
@@ -518,7 +531,9 @@ def city(
             if done == total or done % step == 0:
                 typer.echo(f"{done}/{total} buildings", err=True)
 
-        report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box, usd)
+        report = run_city(
+            loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
+        )
     summary = report["summary"]
 
     def place(entry: dict[str, object]) -> str:  # a feature's place in the footprints

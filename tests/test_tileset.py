@@ -1,0 +1,266 @@
+"""OGC 3D Tiles 1.1 of a city (issue 36 item 2, issue 35 item 5): ``facade city
+--3dtiles`` writes a tileset whose structure holds (checked here against the 3D Tiles 1.1
+rules that matter to a viewer), whose boxes hold their content, whose errors fall toward
+the leaves, which stands where its footprints are on the globe (checked with PROJ, apart
+from the code under test), byte for byte the same for the same input, with LOD1 blocks
+lighter than LOD2 roofs, lighter than LOD3 façades."""
+
+from __future__ import annotations
+
+import json
+import random
+import struct
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyproj
+import pytest
+
+import facadecli.city.tileset as tileset_module
+from facadecli.city.default import default_city
+from facadecli.city.run import run_city
+from facadecli.city.tileset import parse_lods, quadtree
+from facadecli.errors import SpecError
+from facadecli.export.glb_merge import read_glb
+from tests.osm_district import METRE_LAT, METRE_LON, ORIGIN, Building, box, write_district
+
+ROOT = Path(__file__).resolve().parent.parent
+SPEC = ROOT / "specs" / "centred-bay.yaml"
+ROOFS = ["gabled", "hipped", "flat", "pyramidal", "skillion"]
+GEODETIC = pyproj.CRS.from_epsg(4979)
+ECEF = pyproj.CRS.from_epsg(4978)
+
+
+def _houses(count: int, seed: int) -> list[Building]:
+    """``count`` detached houses of random sizes and roofs on a jittered 25 m grid."""
+    rng = random.Random(seed)
+    houses: list[Building] = []
+    for k in range(count):
+        x, y = 25.0 * (k % 4) + rng.uniform(0, 4), 25.0 * (k // 4) + rng.uniform(0, 4)
+        tags = {"building": "house", "building:levels": str(rng.randint(1, 3))}
+        tags["roof:shape"] = ROOFS[k % len(ROOFS)]
+        houses.append((1000 + k, box(x, y, rng.uniform(8, 14), rng.uniform(7, 10)), tags))
+    return houses
+
+
+def _build(folder: Path, jobs: int, lods: tuple[int, ...] = (1, 2, 3)) -> dict[str, Any]:
+    district = write_district(folder.parent / f"{folder.name}.osm", _houses(10, seed=3))
+    with pytest.MonkeyPatch.context() as patch:  # a deeper tree than 32 a leaf would give
+        patch.setattr(tileset_module, "LEAF_BUILDINGS", 3)
+        return run_city(default_city(district, SPEC), folder, jobs=jobs, lods=lods)
+
+
+@pytest.fixture(scope="module")
+def city(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("tiles") / "out"
+    report = _build(folder, jobs=1)
+    assert report["summary"]["ok"] == 10
+    return folder
+
+
+def _tiles(tile: dict[str, Any], parent: dict[str, Any] | None = None) -> Iterator[Any]:
+    yield tile, parent
+    for child in tile.get("children", []):
+        yield from _tiles(child, tile)
+
+
+def _tileset(city: Path) -> dict[str, Any]:
+    document: dict[str, Any] = json.loads((city / "3dtiles" / "tileset.json").read_text())
+    return document
+
+
+def _corners(box: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    centre, axes = np.array(box[:3]), np.array(box[3:]).reshape(3, 3)
+    assert np.allclose(axes, np.diag(np.diag(axes)))  # boxes along the tiles' axes here
+    half = np.abs(np.diag(axes))
+    return centre - half, centre + half
+
+
+def _content_bounds(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """A glb's bounds from its positions, turned z-up as 3D Tiles turns glTF content."""
+    document, _ = read_glb(path.read_bytes())
+    accessors = document["accessors"]
+    positions = [
+        accessors[p["attributes"]["POSITION"]] for m in document["meshes"] for p in m["primitives"]
+    ]
+    low = np.min([a["min"] for a in positions], axis=0)
+    high = np.max([a["max"] for a in positions], axis=0)
+    return np.array([low[0], -high[2], low[1]]), np.array([high[0], -low[2], high[1]])
+
+
+def test_the_tileset_is_3d_tiles_1_1(city: Path) -> None:
+    document = _tileset(city)
+    assert document["asset"]["version"] == "1.1"
+    root = document["root"]
+    assert document["geometricError"] == root["geometricError"]
+    assert len(root["transform"]) == 16 and root["transform"][15] == 1.0
+    uris = []
+    for tile, parent in _tiles(root):
+        assert set(tile) <= {"transform", "boundingVolume", "geometricError", "refine"} | {
+            "content",
+            "children",
+        }
+        assert len(tile["boundingVolume"]["box"]) == 12
+        assert tile["geometricError"] >= 0 and tile["refine"] in ("REPLACE", "ADD")
+        if parent is not None:
+            assert "transform" not in tile
+        if "content" in tile:
+            uri = tile["content"]["uri"]
+            uris.append(uri)
+            data = (city / "3dtiles" / uri).read_bytes()
+            magic, version, length = struct.unpack_from("<III", data)
+            assert (magic, version, length) == (0x46546C67, 2, len(data))  # glTF content
+    assert len(uris) == len(set(uris)) == 3 * len(_leaves(root))
+
+
+def _leaves(root: dict[str, Any]) -> list[dict[str, Any]]:
+    return [t for t, _ in _tiles(root) if not t.get("children")]
+
+
+def test_levels_of_detail_come_coarse_to_fine_with_falling_errors(city: Path) -> None:
+    root = _tileset(city)["root"]
+    assert "content" not in root and len(root["children"]) > 1  # a quadtree over the leaves
+    for tile, parent in _tiles(root):
+        if parent is not None:
+            assert tile["geometricError"] <= parent["geometricError"]
+            if "content" in tile and "content" in parent:  # a leaf's chain: the next LOD
+                lod = int(parent["content"]["uri"][-5])
+                assert tile["content"]["uri"][-5] == str(lod + 1)
+            if "content" not in parent:  # a square: its error beyond its children's
+                assert tile["geometricError"] < parent["geometricError"]
+    for leaf in _leaves(root):
+        assert leaf["geometricError"] == 0 and leaf["content"]["uri"].endswith(".lod3.glb")
+    chains = [t for t, p in _tiles(root) if "content" in t and (p is None or "content" not in p)]
+    for lod1 in chains:
+        lod2 = lod1["children"][0]
+        assert lod1["geometricError"] > lod2["geometricError"] >= 1.0  # a window's size
+
+
+def test_boxes_hold_their_content_and_their_children(city: Path) -> None:
+    for tile, parent in _tiles(_tileset(city)["root"]):
+        low, high = _corners(tile["boundingVolume"]["box"])
+        if "content" in tile:
+            found_low, found_high = _content_bounds(city / "3dtiles" / tile["content"]["uri"])
+            assert np.all(found_low >= low) and np.all(found_high <= high)
+            assert np.all(found_high - found_low > 0.5 * (high - low))  # and not much more
+        if parent is not None:
+            outer_low, outer_high = _corners(parent["boundingVolume"]["box"])
+            assert np.all(low >= outer_low - 1e-9) and np.all(high <= outer_high + 1e-9)
+
+
+def _on_globe(transform: list[float], point: tuple[float, float, float]) -> tuple[float, ...]:
+    """A tile-frame point through the root transform: lon, lat, height (PROJ's)."""
+    matrix = np.array(transform).reshape(4, 4).T  # column-major
+    x, y, z, _ = matrix @ np.array([*point, 1.0])
+    to = pyproj.Transformer.from_crs(ECEF, GEODETIC, always_xy=True)
+    return tuple(float(v) for v in to.transform(x, y, z))
+
+
+def test_the_root_transform_puts_the_local_frame_on_the_globe(city: Path) -> None:
+    frame = json.loads((city / f"{city.name}.georef.json").read_text())
+    transform = _tileset(city)["root"]["transform"]
+    utm = pyproj.Transformer.from_crs(frame["crs"], GEODETIC, always_xy=True)
+    geod = pyproj.Geod(ellps="WGS84")
+    for x, y, z in [(0, 0, 0), (120, 0, 0), (0, 90, 0), (80, 70, 15), (-50, 30, 40)]:
+        lon, lat, height = _on_globe(transform, (x, y, z))
+        want = utm.transform(frame["origin"][0] + x, frame["origin"][1] + y, 0.0)
+        _, _, apart = geod.inv(lon, lat, want[0], want[1])
+        assert apart < 0.01  # metres, 150 m from the origin
+        assert height == pytest.approx(z, abs=0.01)  # up is up: the Earth's curve is cm
+
+
+def test_each_house_stands_where_its_footprint_is(city: Path) -> None:
+    """A house's LOD1 block, through the y-up to z-up turn and the root transform, is
+    where the OSM nodes of its footprint are, and as tall as the block is."""
+    transform = _tileset(city)["root"]["transform"]
+    houses = {1000 + k: ring for k, (_, ring, _) in enumerate(_houses(10, seed=3))}
+    document, binary = read_glb(next((city / "3dtiles").rglob("*.lod1.glb")).read_bytes())
+    accessor = document["accessors"][
+        document["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+    ]
+    view = document["bufferViews"][accessor["bufferView"]]
+    start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+    points = np.frombuffer(binary, "<f4", accessor["count"] * 3, start).reshape(-1, 3)
+    top = points[points[:, 1] == points[:, 1].max()]  # the tallest block's lid
+    centre = (top[:, 0].mean(), -top[:, 2].mean(), float(top[0, 1]))
+    lon, lat, height = _on_globe(transform, centre)
+    nearest = min(
+        houses.values(),
+        key=lambda ring: (
+            abs(np.mean([p[0] for p in ring]) * METRE_LON + ORIGIN[0] - lon)
+            + abs(np.mean([p[1] for p in ring]) * METRE_LAT + ORIGIN[1] - lat)
+        ),
+    )
+    want_lon = ORIGIN[0] + np.mean([p[0] for p in nearest]) * METRE_LON
+    want_lat = ORIGIN[1] + np.mean([p[1] for p in nearest]) * METRE_LAT
+    _, _, apart = pyproj.Geod(ellps="WGS84").inv(lon, lat, want_lon, want_lat)
+    assert apart < 0.5  # metres: the district's own degrees-to-metres is approximate
+    assert height == pytest.approx(centre[2], abs=0.01) and height > 3.0
+
+
+def test_lod1_is_lighter_than_lod2_lighter_than_lod3(city: Path) -> None:
+    report = json.loads((city / f"{city.name}.report.json").read_text())
+    tiles = report["models"]["3dtiles"]
+    assert tiles["lods"] == [1, 2, 3]
+    triangles = tiles["triangles"]
+    assert 0 < triangles["lod1"] < triangles["lod2"] < triangles["lod3"]
+    sizes = tiles["bytes"]
+    assert sizes["lod1"] < sizes["lod2"] < sizes["lod3"]
+
+
+def test_the_same_city_gives_the_same_tiles(city: Path, tmp_path: Path) -> None:
+    _build(tmp_path / "out", jobs=2)
+    ours = sorted(p.relative_to(city) for p in (city / "3dtiles").rglob("*") if p.is_file())
+    theirs = sorted(
+        p.relative_to(tmp_path / "out") for p in (tmp_path / "out" / "3dtiles").rglob("*")
+    )
+    assert ours == [p for p in theirs if (tmp_path / "out" / p).is_file()]
+    for path in ours:
+        assert (city / path).read_bytes() == (tmp_path / "out" / path).read_bytes(), path
+
+
+def test_a_run_chooses_its_levels_of_detail(tmp_path: Path) -> None:
+    report = _build(tmp_path / "out", jobs=1, lods=(1, 3))
+    assert report["models"]["3dtiles"]["lods"] == [1, 3]
+    root = _tileset(tmp_path / "out")["root"]
+    uris = [t["content"]["uri"] for t, _ in _tiles(root) if "content" in t]
+    assert {uri[-8:] for uri in uris} == {"lod1.glb", "lod3.glb"}
+    files = {p.name[-8:] for p in (tmp_path / "out" / "3dtiles").rglob("*.glb")}
+    assert files == {"lod1.glb", "lod3.glb"}
+    # again with blocks only: the tiles the tileset no longer names are gone
+    _build(tmp_path / "out", jobs=1, lods=(1,))
+    assert {p.name[-8:] for p in (tmp_path / "out" / "3dtiles").rglob("*.glb")} == {"lod1.glb"}
+
+
+@pytest.mark.parametrize("text", ["", "0", "4", "1,x", "lod1", "1;2"])
+def test_a_bad_lod_list_is_refused(text: str) -> None:
+    with pytest.raises(SpecError, match="--lod"):
+        parse_lods(text)
+
+
+def test_lod_lists_are_read_coarse_to_fine() -> None:
+    assert parse_lods("3,1") == (1, 3)
+    assert parse_lods(" 2 , 2,1 ") == (1, 2)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) -> None:
+    rng = random.Random(seed)
+    spread = rng.choice([5.0, 300.0, 20_000.0])
+    points = [(f"b{k}", (rng.uniform(-spread, spread), rng.uniform(0, spread))) for k in range(300)]
+    points += [("twin-a", (1.0, 1.0)), ("twin-b", (1.0, 1.0))]  # one centroid for two
+    root, leaf_of = quadtree(points)
+    assert sorted(leaf_of) == sorted(bid for bid, _ in points)
+    leaves = []
+    stack = [root]
+    while stack:
+        square = stack.pop()
+        stack.extend(square.children)
+        assert len(square.children) <= 4
+        if not square.children:
+            leaves.append(square)
+            assert len(square.members) <= tileset_module.LEAF_BUILDINGS
+    assert sum(len(leaf.members) for leaf in leaves) == len(points)
+    assert leaf_of["twin-a"] is leaf_of["twin-b"]
