@@ -7,9 +7,17 @@ lighter than LOD2 roofs, lighter than LOD3 façades."""
 
 from __future__ import annotations
 
+import functools
+import http.server
 import json
+import os
 import random
+import re
+import shlex
+import shutil
 import struct
+import subprocess
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -264,3 +272,126 @@ def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) 
             assert len(square.members) <= tileset_module.LEAF_BUILDINGS
     assert sum(len(leaf.members) for leaf in leaves) == len(points)
     assert leaf_of["twin-a"] is leaf_of["twin-b"]
+
+
+# Outside tools, where they are installed: the 3D Tiles validator and CesiumJS
+
+VALIDATOR = os.environ.get("FACADE_3DTILES_VALIDATOR")  # e.g. "npx 3d-tiles-validator"
+CESIUM = os.environ.get("FACADE_CESIUM")  # a folder with Cesium.js: npm cesium's Build/Cesium
+BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.mark.skipif(not VALIDATOR, reason="set FACADE_3DTILES_VALIDATOR to a validator command")
+def test_the_3d_tiles_validator_finds_nothing(city: Path) -> None:
+    tileset = city / "3dtiles" / "tileset.json"
+    done = subprocess.run(
+        [*shlex.split(str(VALIDATOR)), "--tilesetFile", str(tileset)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    found = json.loads(done.stdout[done.stdout.index("{") :])
+    assert (found["numErrors"], found["numWarnings"]) == (0, 0), done.stdout
+
+
+PAGE = """<!doctype html>
+<html><head><meta charset="utf-8"><title>loading: tileset</title>
+<script>window.CESIUM_BASE_URL = "cesium/";</script>
+<script src="cesium/Cesium.js"></script>
+<link href="cesium/Widgets/widgets.css" rel="stylesheet">
+<style>html, body, #globe { margin: 0; width: 100%; height: 100%; overflow: hidden }</style>
+</head><body><div id="globe"></div><script>
+// No network: no Cesium ion, no imagery, a plain globe on the WGS 84 ellipsoid.
+async function main() {
+  Cesium.Ion.defaultAccessToken = "";
+  const viewer = new Cesium.Viewer("globe", {
+    baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
+    animation: false, homeButton: false, sceneModePicker: false, fullscreenButton: false,
+    navigationHelpButton: false, infoBox: false, selectionIndicator: false,
+    terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false,
+    skyAtmosphere: false, contextOptions: { webgl: { preserveDrawingBuffer: true } },
+  });
+  viewer.scene.globe.baseColor = Cesium.Color.fromCssColorString("#7d9a6a");
+  const tileset = await Cesium.Cesium3DTileset.fromUrl("tiles/tileset.json",
+                                                       { maximumScreenSpaceError: 2 });
+  viewer.scene.primitives.add(tileset);
+  const sphere = tileset.boundingSphere;
+  viewer.camera.flyToBoundingSphere(sphere, { duration: 0, offset: new Cesium.HeadingPitchRange(
+    Cesium.Math.toRadians(30), Cesium.Math.toRadians(-35), sphere.radius * 2.2) });
+  const at = Cesium.Cartographic.fromCartesian(sphere.center);
+  tileset.allTilesLoaded.addEventListener(() => {
+    const degrees = (v) => Cesium.Math.toDegrees(v).toFixed(8);
+    document.title = `loaded ${degrees(at.longitude)} ${degrees(at.latitude)} ${at.height}`;
+  });
+}
+main().catch((error) => { document.title = "error: " + error; });
+</script></body></html>
+"""
+
+
+def _served(folder: Path) -> Iterator[str]:
+    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(folder))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}/index.html"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+@pytest.mark.skipif(
+    not CESIUM or not (Path(str(CESIUM)) / "Cesium.js").is_file(),
+    reason="set FACADE_CESIUM to npm cesium's Build/Cesium",
+)
+def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: Path) -> None:
+    """CesiumJS in headless Chromium loads every tile it needs and flies to the tileset;
+    the centre of the bounding sphere it computed is where PROJ puts the root box's
+    centre, within a centimetre, and the picture shows the houses on the globe."""
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "cesium").symlink_to(Path(str(CESIUM)).resolve())
+    (site / "tiles").symlink_to(city / "3dtiles")
+    (site / "index.html").write_text(PAGE)
+    shot = tmp_path / "globe.png"
+    title = ""
+    for url in _served(site):
+        for budget in (20_000, 60_000):
+            flags = [
+                "--headless", "--no-sandbox", "--disable-gpu", "--use-gl=swiftshader",
+                "--enable-unsafe-swiftshader", "--no-first-run",
+                "--disable-background-networking", f"--user-data-dir={tmp_path / 'profile'}",
+                "--window-size=1000,600", f"--virtual-time-budget={budget}",
+            ]  # fmt: skip
+            run = [str(BROWSER), *flags]
+            subprocess.run([*run, f"--screenshot={shot}", url], timeout=300, check=False)
+            dom = subprocess.run(
+                [*run, "--dump-dom", url], timeout=300, capture_output=True, text=True
+            ).stdout
+            title = re.search(r"<title>([^<]*)</title>", dom).group(1)  # type: ignore[union-attr]
+            if title.startswith("loaded"):
+                break
+    assert title.startswith("loaded"), title
+    lon, lat, height = (float(v) for v in title.split()[1:])
+    document = _tileset(city)
+    low, high = _corners(document["root"]["boundingVolume"]["box"])
+    want = _on_globe(document["root"]["transform"], tuple((low + high) / 2))
+    _, _, apart = pyproj.Geod(ellps="WGS84").inv(lon, lat, want[0], want[1])
+    assert apart < 0.01 and height == pytest.approx(want[2], abs=0.01)
+    houses = np.array([p for _, ring, _ in _houses(10, seed=3) for p in ring])
+    middle = (houses.min(axis=0) + houses.max(axis=0)) / 2  # metres east, north of ORIGIN
+    _, _, off = pyproj.Geod(ellps="WGS84").inv(
+        lon, lat, ORIGIN[0] + middle[0] * METRE_LON, ORIGIN[1] + middle[1] * METRE_LAT
+    )
+    assert off < 1.0  # metres: the footprints' own middle, from the OSM degrees
+    from PIL import Image
+
+    with Image.open(shot) as image:
+        pixels = np.asarray(image.convert("RGB"), dtype=int)[150:450, 300:700]
+    globe = np.array([0x7D, 0x9A, 0x6A])
+    houses_drawn = int((np.abs(pixels - globe).sum(axis=2) > 40).sum())
+    assert houses_drawn > 0.2 * pixels.shape[0] * pixels.shape[1]  # a fifth of the middle
