@@ -15,16 +15,17 @@ same feature gives the same bytes.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import mapbox_earcut
 import numpy as np
 import trimesh
 
 from facadecli.city.building import MAP_TO_WORLD, ROOF_NAME, WALL_NAME
 from facadecli.city.cityjson import SCALE
+from facadecli.city.roofs import _triangulate as triangulate_face  # roofs' own, shared
 
 BOTTOMS = ("GroundSurface", "OuterCeilingSurface")
 Polygon3 = list[np.ndarray]  # a planar surface: its exterior ring, then its holes, (n, 3) metres
@@ -96,15 +97,15 @@ def triangles(polygon: Polygon3) -> np.ndarray:
     normal = normal.sum(axis=0)  # Newell's normal, twice the area
     if not np.any(normal):
         return np.zeros((0, 3, 3))
-    drop = int(np.argmax(np.abs(normal)))  # project onto the plane of the other two axes
-    keep = [axis for axis in range(3) if axis != drop]
+    drop = int(np.argmax(np.abs(normal)))  # seen along its dominant axis, in plan
     stacked = np.vstack(polygon)
-    flat = stacked[:, keep]
-    ends = np.cumsum([len(ring) for ring in polygon]).astype(np.uint32)
-    corners = np.asarray(mapbox_earcut.triangulate_float64(flat, ends), dtype=np.int64)
-    found = stacked[corners.reshape(-1, 3)]
+    flat = stacked[:, [axis for axis in range(3) if axis != drop]]
+    ends = np.cumsum([0, *(len(ring) for ring in polygon)])
+    face = tuple(tuple(range(a, b)) for a, b in itertools.pairwise(ends))
+    corners = np.asarray(triangulate_face(face, flat), dtype=np.int64).reshape(-1, 3)
+    found = stacked[corners]
     facing = np.cross(found[:, 1] - found[:, 0], found[:, 2] - found[:, 0]) @ normal
-    found[facing < 0] = found[facing < 0][:, ::-1]  # earcut's winding is its own
+    found[facing < 0] = found[facing < 0][:, ::-1]  # counter-clockwise in plan: maybe not here
     return np.asarray(found[facing != 0])
 
 
