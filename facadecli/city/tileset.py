@@ -203,7 +203,8 @@ class TilesetWriter:
                 boxes[3] = _union(finest)
                 self.triangles[3] += sum(_glb_triangles(glb) for _, glb in built)
             else:
-                scene, own = _lod_scene([m for f in features for m in [lod_meshes(f, lod)]])
+                scene, found = _lod_scene([lod_meshes(f, lod) for f in features])
+                own = [b or whole for b, whole in zip(found, finest, strict=True)]
                 data = glb_bytes(scene)
                 path.parent.mkdir(parents=True, exist_ok=True)
                 write_atomic(path, data)
@@ -292,14 +293,17 @@ def _chain(leaf: Square) -> dict[str, Any]:
     return tile
 
 
-def _lod_scene(buildings: list[dict[str, trimesh.Trimesh]]) -> tuple[trimesh.Scene, list[Box]]:
+def _lod_scene(
+    buildings: list[dict[str, trimesh.Trimesh]],
+) -> tuple[trimesh.Scene, list[Box | None]]:
     """A tile's buildings at one LOD as one mesh a material (two draw calls at most), and
-    each building's box."""
+    each building's box (None when it has no surface at this LOD)."""
     scene = trimesh.Scene()
-    boxes = []
+    boxes: list[Box | None] = []
     for meshes in buildings:
-        points = np.vstack([m.vertices for m in meshes.values() if len(m.vertices)])
-        boxes.append(_z_up(points.min(axis=0), points.max(axis=0)))
+        points = np.vstack([np.zeros((0, 3)), *(m.vertices for m in meshes.values())])
+        found = _z_up(points.min(axis=0), points.max(axis=0)) if len(points) else None
+        boxes.append(found)
     for name in sorted({name for meshes in buildings for name in meshes}):
         parts = [m[name] for m in buildings if name in m and len(m[name].faces)]
         if not parts:
