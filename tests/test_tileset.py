@@ -143,7 +143,7 @@ def test_levels_of_detail_come_coarse_to_fine_with_falling_errors(city: Path) ->
     chains = [t for t, p in _tiles(root) if "content" in t and (p is None or "content" not in p)]
     for lod1 in chains:
         lod2 = lod1["children"][0]
-        assert lod1["geometricError"] > lod2["geometricError"] >= 1.0  # a window's size
+        assert lod1["geometricError"] > lod2["geometricError"] >= 3.0  # a storey
 
 
 def test_boxes_hold_their_content_and_their_children(city: Path) -> None:

@@ -9,9 +9,10 @@ replacing its parent (``refine: REPLACE``); the squares above the leaves have no
 
 **Geometric error** is what a tile's content gets wrong, in metres: a leaf's none (0); a
 LOD2 tile the façades' relief it leaves out (how far the LOD3 model stands out of its
-box) and at least MIN_ERROR[2] (a window's size); a LOD1 tile also its roofs' depth
-and at least MIN_ERROR[1]; a square without content the diagonal of its box (all of it
-missing), and at least twice its children's. Errors fall from the root to the leaves.
+box) and at least MIN_ERROR[2] (a storey: the rhythm of windows and floors it leaves
+out); a LOD1 tile as much, at least MIN_ERROR[1], and its roofs' depth; a square
+without content the diagonal of its box (all of it missing), and at least twice its
+children's. Errors fall from the root to the leaves.
 
 **Place on the globe.** Tiles are z-up; their glTF content is y-up, as 3D Tiles wants:
 the runtime turns glTF's y-up to z-up (x, y, z) -> (x, -z, y), which makes our glTF
@@ -56,7 +57,7 @@ FOLDER = "3dtiles"
 LODS = (1, 2, 3)
 LEAF_BUILDINGS = 32  # buildings a quadtree leaf holds at most
 MAX_LEVEL = 20  # quadtree levels at most (buildings sharing a centroid stay together)
-MIN_ERROR = {1: 2.0, 2: 1.0}  # metres: what a block or a façade-less model gets wrong at least
+MIN_ERROR = {1: 4.0, 2: 3.0}  # metres: what a block or a façade-less model gets wrong at least
 COLOURS = {"wall": "#d9d2c3", "roof": "#8f5a48"}  # LOD1 and LOD2 materials
 TILE_FILE = re.compile(r"\d+\.lod[123]\.glb")
 Box = tuple[float, float, float, float, float, float]  # min x, y, z, max x, y, z (z up)
