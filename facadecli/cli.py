@@ -472,11 +472,14 @@ def city(
         bool, typer.Option("--3dtiles", help="Also OGC 3D Tiles: 3dtiles/tileset.json.")
     ] = False,
     lod: Annotated[
-        str,
+        str | None,
         typer.Option(
-            "--lod", metavar="1,2,3", help="3D Tiles' levels of detail: blocks, roofs, façades."
+            "--lod",
+            metavar="1,2,3",
+            help="3D Tiles' levels of detail: blocks, roofs, façades [default: 1,2,3].",
+            show_default=False,
         ),
-    ] = "1,2,3",
+    ] = None,
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -501,7 +504,9 @@ def city(
     from facadecli.city.tileset import parse_lods
 
     box = _bbox(bbox) if bbox is not None else None
-    lods = parse_lods(lod) if tiles3d else ()
+    if lod is not None and not tiles3d:
+        raise typer.BadParameter("chooses the levels of detail of --3dtiles", param_hint="--lod")
+    lods = parse_lods(lod or "1,2,3") if tiles3d else ()
     is_manifest = source.suffix.lower() in (".yaml", ".yml")
     if is_manifest and spec is not None:
         raise typer.BadParameter(

@@ -28,11 +28,13 @@ import pytest
 
 import facadecli.city.tileset as tileset_module
 from facadecli.city.default import default_city
+from facadecli.city.georef import Georef
 from facadecli.city.run import run_city
-from facadecli.city.tileset import parse_lods, quadtree
+from facadecli.city.tileset import TilesetWriter, parse_lods, quadtree
 from facadecli.errors import SpecError
 from facadecli.export.glb_merge import read_glb
 from tests.osm_district import METRE_LAT, METRE_LON, ORIGIN, Building, box, write_district
+from tests.running import facade
 
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "specs" / "centred-bay.yaml"
@@ -395,3 +397,54 @@ def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: P
     globe = np.array([0x7D, 0x9A, 0x6A])
     houses_drawn = int((np.abs(pixels - globe).sum(axis=2) > 40).sum())
     assert houses_drawn > 0.2 * pixels.shape[0] * pixels.shape[1]  # a fifth of the middle
+
+
+def test_the_command_line_refuses_a_bad_lod_before_any_work(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    town = ROOT / "samples" / "town.osm"
+    code, _, err = facade(capsys, "city", town, "-o", tmp_path / "out", "--3dtiles", "--lod", "4")
+    assert code == 2 and "--lod" in err and "1 (blocks)" in err
+    code, _, err = facade(capsys, "city", town, "-o", tmp_path / "out", "--lod", "1")
+    assert code == 2 and "--3dtiles" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_leaf_is_written_when_its_last_building_is_done(city: Path, tmp_path: Path) -> None:
+    """The tiles stream: a leaf's files appear with its last building, before the others
+    are done, and tileset.json only at the end."""
+    frame = json.loads((city / f"{city.name}.georef.json").read_text())
+    georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
+    glbs = sorted((city / "buildings").glob("*.glb"))
+    places = [(glb.stem, (100.0 * (k % 2), 0.0)) for k, glb in enumerate(glbs)]  # two leaves
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tileset_module, "LEAF_BUILDINGS", len(glbs) // 2)
+        writer = TilesetWriter(tmp_path, georef, (1, 2, 3), places)
+    east = [glb for k, glb in enumerate(glbs) if k % 2]
+    west = [glb for k, glb in enumerate(glbs) if not k % 2]
+    for glb in east[:-1]:
+        writer.done(glb.stem, glb)
+    assert not list((tmp_path / "3dtiles").rglob("*.glb"))
+    writer.done(east[-1].stem, east[-1])
+    assert len(list((tmp_path / "3dtiles").rglob("*.glb"))) == 3  # LOD1, 2, 3 of one leaf
+    for glb in west[:-1]:
+        writer.done(glb.stem, glb)
+    writer.done(west[-1].stem, None)  # a failed building: left out, its leaf written
+    assert len(list((tmp_path / "3dtiles").rglob("*.glb"))) == 6
+    assert not (tmp_path / "3dtiles" / "tileset.json").exists()
+    summary = writer.close("streamed")
+    assert summary["tiles"] == 6 and (tmp_path / "3dtiles" / "tileset.json").is_file()
+
+
+def test_a_resumed_run_writes_the_same_tiles(city: Path, tmp_path: Path) -> None:
+    copy = tmp_path / "out"
+    shutil.copytree(city, copy)
+    shutil.rmtree(copy / "3dtiles")
+    district = city.parent / f"{city.name}.osm"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tileset_module, "LEAF_BUILDINGS", 3)
+        report = run_city(default_city(district, SPEC), copy, resume=True, lods=(1, 2, 3))
+    assert all(b.get("resumed") for b in report["buildings"])
+    for path in sorted((city / "3dtiles").rglob("*")):
+        if path.is_file():
+            assert path.read_bytes() == (copy / path.relative_to(city)).read_bytes(), path
