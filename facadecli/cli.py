@@ -569,6 +569,7 @@ def city(
         f"{summary['ok']} of {summary['buildings']} buildings built{rejected} in "
         f"{summary['seconds']} s -> {outdir}/{report['name']}.glb, "
         f"{outdir}/{report['name']}.city.json, {outdir}/{report['name']}.report.json"
+        + (f", {outdir}/3dtiles/tileset.json" if "3dtiles" in report["models"] else "")
     )
     if summary["failed"]:  # exit 1 only when a building that should build did not
         raise typer.Exit(1)
