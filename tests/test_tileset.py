@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import http.server
+import itertools
 import json
 import os
 import random
@@ -39,6 +40,7 @@ from tests.running import facade
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "specs" / "centred-bay.yaml"
 ROOFS = ["gabled", "hipped", "flat", "pyramidal", "skillion"]
+SMALL = {1: 6, 2: 3, 3: 2}  # buildings a tile of each LOD holds: a deep tree of 10 houses
 GEODETIC = pyproj.CRS.from_epsg(4979)
 ECEF = pyproj.CRS.from_epsg(4978)
 
@@ -57,8 +59,8 @@ def _houses(count: int, seed: int) -> list[Building]:
 
 def _build(folder: Path, jobs: int, lods: tuple[int, ...] = (1, 2, 3)) -> dict[str, Any]:
     district = write_district(folder.parent / f"{folder.name}.osm", _houses(10, seed=3))
-    with pytest.MonkeyPatch.context() as patch:  # a deeper tree than 32 a leaf would give
-        patch.setattr(tileset_module, "LEAF_BUILDINGS", 3)
+    with pytest.MonkeyPatch.context() as patch:  # a deeper tree than the defaults give
+        patch.setattr(tileset_module, "CAPACITY", SMALL)
         return run_city(default_city(district, SPEC), folder, jobs=jobs, lods=lods)
 
 
@@ -122,7 +124,25 @@ def test_the_tileset_is_3d_tiles_1_1(city: Path) -> None:
             data = (city / "3dtiles" / uri).read_bytes()
             magic, version, length = struct.unpack_from("<III", data)
             assert (magic, version, length) == (0x46546C67, 2, len(data))  # glTF content
-    assert len(uris) == len(set(uris)) == 3 * len(_leaves(root))
+    assert len(uris) == len(set(uris))
+    for path in _paths(root):  # from the root to each leaf: each LOD once, coarse to fine
+        assert [int(t["content"]["uri"][-5]) for t in path if "content" in t] == [1, 2, 3]
+    lod3 = [
+        node["name"]
+        for uri in uris
+        if uri.endswith(".lod3.glb")
+        for node in read_glb((city / "3dtiles" / uri).read_bytes())[0]["nodes"]
+        if "/" in node["name"] and node["name"].count("/") == 1
+    ]
+    assert sorted(lod3) == sorted(f"way/{1000 + k}" for k in range(10))  # each house once
+
+
+def _paths(tile: dict[str, Any]) -> Iterator[list[dict[str, Any]]]:
+    if not tile.get("children"):
+        yield [tile]
+    for child in tile.get("children", []):
+        for path in _paths(child):
+            yield [tile, *path]
 
 
 def _leaves(root: dict[str, Any]) -> list[dict[str, Any]]:
@@ -131,21 +151,22 @@ def _leaves(root: dict[str, Any]) -> list[dict[str, Any]]:
 
 def test_levels_of_detail_come_coarse_to_fine_with_falling_errors(city: Path) -> None:
     root = _tileset(city)["root"]
-    assert "content" not in root and len(root["children"]) > 1  # a quadtree over the leaves
-    for tile, parent in _tiles(root):
-        if parent is not None:
-            assert tile["geometricError"] <= parent["geometricError"]
-            if "content" in tile and "content" in parent:  # a leaf's chain: the next LOD
-                lod = int(parent["content"]["uri"][-5])
-                assert tile["content"]["uri"][-5] == str(lod + 1)
-            if "content" not in parent:  # a square: its error beyond its children's
-                assert tile["geometricError"] < parent["geometricError"]
+    assert "content" not in root and len(root["children"]) > 1  # a quadtree over the tiles
+    levels = set()
+    for path in _paths(root):
+        errors = [t["geometricError"] for t in path]
+        assert errors == sorted(errors, reverse=True)  # never rising toward the leaves
+        shown = [i for i, t in enumerate(path) if "content" in t]
+        empty_above = path[: shown[0] + 1]  # no content yet: all of it missing
+        assert all(
+            a["geometricError"] > b["geometricError"] for a, b in itertools.pairwise(empty_above)
+        )
+        by_lod = {int(path[i]["content"]["uri"][-5]): errors[i] for i in shown}
+        assert by_lod[1] > by_lod[2] >= 3.0 > by_lod[3] == 0  # LOD2: at least a storey
+        levels.update(path[i]["content"]["uri"].split("/")[0] for i in shown)
+    assert len(levels) > 1  # coarse LODs in larger squares than the façades
     for leaf in _leaves(root):
         assert leaf["geometricError"] == 0 and leaf["content"]["uri"].endswith(".lod3.glb")
-    chains = [t for t, p in _tiles(root) if "content" in t and (p is None or "content" not in p)]
-    for lod1 in chains:
-        lod2 = lod1["children"][0]
-        assert lod1["geometricError"] > lod2["geometricError"] >= 3.0  # a storey
 
 
 def test_boxes_hold_their_content_and_their_children(city: Path) -> None:
@@ -261,7 +282,8 @@ def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) 
     spread = rng.choice([5.0, 300.0, 20_000.0])
     points = [(f"b{k}", (rng.uniform(-spread, spread), rng.uniform(0, spread))) for k in range(300)]
     points += [("twin-a", (1.0, 1.0)), ("twin-b", (1.0, 1.0))]  # one centroid for two
-    root, leaf_of = quadtree(points)
+    capacity = rng.choice([1, 8, 32])
+    root, leaf_of = quadtree(points, capacity)
     assert sorted(leaf_of) == sorted(bid for bid, _ in points)
     leaves = []
     stack = [root]
@@ -271,7 +293,7 @@ def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) 
         assert len(square.children) <= 4
         if not square.children:
             leaves.append(square)
-            assert len(square.members) <= tileset_module.LEAF_BUILDINGS
+            assert len(square.members) <= capacity or square.level == tileset_module.MAX_LEVEL
     assert sum(len(leaf.members) for leaf in leaves) == len(points)
     assert leaf_of["twin-a"] is leaf_of["twin-b"]
 
@@ -418,7 +440,7 @@ def test_a_leaf_is_written_when_its_last_building_is_done(city: Path, tmp_path: 
     glbs = sorted((city / "buildings").glob("*.glb"))
     places = [(glb.stem, (100.0 * (k % 2), 0.0)) for k, glb in enumerate(glbs)]  # two leaves
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(tileset_module, "LEAF_BUILDINGS", len(glbs) // 2)
+        patch.setattr(tileset_module, "CAPACITY", dict.fromkeys((1, 2, 3), len(glbs) // 2))
         writer = TilesetWriter(tmp_path, georef, (1, 2, 3), places)
     east = [glb for k, glb in enumerate(glbs) if k % 2]
     west = [glb for k, glb in enumerate(glbs) if not k % 2]
@@ -442,7 +464,7 @@ def test_a_resumed_run_writes_the_same_tiles(city: Path, tmp_path: Path) -> None
     shutil.rmtree(copy / "3dtiles")
     district = city.parent / f"{city.name}.osm"
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(tileset_module, "LEAF_BUILDINGS", 3)
+        patch.setattr(tileset_module, "CAPACITY", SMALL)
         report = run_city(default_city(district, SPEC), copy, resume=True, lods=(1, 2, 3))
     assert all(b.get("resumed") for b in report["buildings"])
     for path in sorted((city / "3dtiles").rglob("*")):

@@ -2,17 +2,20 @@
 glb content, in levels of detail, streamed as the buildings finish.
 
 **Hierarchy.** A quadtree over the buildings' centroids in the run's local frame (metres
-from its origin), split until a square holds at most LEAF_BUILDINGS buildings. Each leaf
-square becomes a chain of tiles, coarse to fine, one a level of detail chosen
-(``--lod``: LOD1 blocks, LOD2 walls and roofs, LOD3 the façades; lods.py), each
-replacing its parent (``refine: REPLACE``); the squares above the leaves have no content.
+from its origin), split until a square holds at most CAPACITY[k] buildings of the finest
+level of detail k chosen (``--lod``: LOD1 blocks, LOD2 walls and roofs, LOD3 the
+façades; lods.py). Each coarser LOD goes to the largest squares that hold at most its
+own CAPACITY, so a square may hold a chain of tiles, coarse to fine, each the only child
+of the one before; the square's children hang under the last. Every tile replaces its
+parent (``refine: REPLACE``); squares above the coarsest tiles have no content.
 
 **Geometric error** is what a tile's content gets wrong, in metres: a leaf's none (0); a
 LOD2 tile the façades' relief it leaves out (how far the LOD3 model stands out of its
 box) and at least MIN_ERROR[2] (a storey: the rhythm of windows and floors it leaves
 out); a LOD1 tile as much, at least MIN_ERROR[1], and its roofs' depth; a square
-without content the diagonal of its box (all of it missing), and at least twice its
-children's. Errors fall from the root to the leaves.
+without content under one with content the largest of its children's; above, the
+diagonal of its box (all of it missing), and at least twice its children's. Each tile's
+error is at least its children's: errors fall from the root to the leaves.
 
 **Place on the globe.** Tiles are z-up; their glTF content is y-up, as 3D Tiles wants:
 the runtime turns glTF's y-up to z-up (x, y, z) -> (x, -z, y), which makes our glTF
@@ -22,7 +25,7 @@ the run's origin on the ellipsoid (height 0: buildings stand on it), its columns
 ECEF directions of a metre east, north (the CRS's grid, so grid north and the scale
 factor are in them) and up, measured with PROJ at the origin.
 
-**Files.** ``3dtiles/<level>/<column>/<row>.lod<k>.glb``: a leaf's tiles are written,
+**Files.** ``3dtiles/<level>/<column>/<row>.lod<k>.glb``: a square's tiles are written,
 each atomically, as soon as its last building is done (or failed), and
 ``tileset.json`` last, atomically; files of an earlier run the tileset no longer names
 are removed. The same buildings give the same bytes.
@@ -55,7 +58,7 @@ from facadecli.spec.model import Material
 
 FOLDER = "3dtiles"
 LODS = (1, 2, 3)
-LEAF_BUILDINGS = 32  # buildings a quadtree leaf holds at most
+CAPACITY = {1: 256, 2: 32, 3: 8}  # buildings a tile of each level of detail holds at most
 MAX_LEVEL = 20  # quadtree levels at most (buildings sharing a centroid stay together)
 MIN_ERROR = {1: 4.0, 2: 3.0}  # metres: what a block or a façade-less model gets wrong at least
 COLOURS = {"wall": "#d9d2c3", "roof": "#8f5a48"}  # LOD1 and LOD2 materials
@@ -108,25 +111,28 @@ def _to_ecef() -> pyproj.Transformer:
 
 @dataclass
 class Square:
-    """A square of the quadtree: its place, its children, or (a leaf) its buildings."""
+    """A square of the quadtree: its place, its children, its buildings, and the levels
+    of detail whose tiles it holds (:meth:`TilesetWriter.__init__`)."""
 
     level: int
     column: int
     row: int
     children: list[Square] = field(default_factory=list)
-    members: list[str] = field(default_factory=list)  # a leaf's building ids, in run order
-    left: int = 0  # a leaf's buildings not done yet
-    tiles: list[dict[str, Any]] = field(default_factory=list)  # a leaf's chain, coarse first
-    box: Box | None = None  # of its content (a leaf) or of its children's
+    members: list[str] = field(default_factory=list)  # its building ids, in run order
+    lods: tuple[int, ...] = ()  # the levels of detail of its tiles, coarse first
+    left: int = 0  # its buildings not done yet
+    tiles: list[dict[str, Any]] = field(default_factory=list)  # its chain, coarse first
+    box: Box | None = None  # of its content and its children's
 
 
 Centroids = Sequence[tuple[str, tuple[float, float]]]  # building ids and their centroids
 
 
-def quadtree(centroids: Centroids) -> tuple[Square, dict[str, Square]]:
-    """The quadtree of the buildings (id, centroid in local metres), and each building's
-    leaf. The root square is the smallest power-of-two side (from 1 m) holding them all,
-    its south-west corner at the lowest centroid."""
+def quadtree(centroids: Centroids, capacity: int) -> tuple[Square, dict[str, Square]]:
+    """The quadtree of the buildings (id, centroid in local metres), split until a square
+    holds at most ``capacity`` buildings, and each building's leaf. The root square is the
+    smallest power-of-two side (from 1 m) holding them all, its south-west corner at the
+    lowest centroid."""
     if not centroids:
         return Square(0, 0, 0), {}
     xs = [c[0] for _, c in centroids]
@@ -139,9 +145,8 @@ def quadtree(centroids: Centroids) -> tuple[Square, dict[str, Square]]:
     leaf_of: dict[str, Square] = {}
 
     def split(square: Square, items: list[tuple[str, tuple[float, float]]]) -> None:
-        if len(items) <= LEAF_BUILDINGS or square.level >= MAX_LEVEL:
-            square.members = [bid for bid, _ in items]
-            square.left = len(items)
+        square.members = [bid for bid, _ in items]
+        if len(items) <= capacity or square.level >= MAX_LEVEL:
             leaf_of.update((bid, square) for bid, _ in items)
             return
         size = side / 2 ** (square.level + 1)
@@ -163,7 +168,9 @@ class TilesetWriter:
     """Writes the 3D Tiles of a run as its buildings finish: :meth:`done` for every
     building (its glb and CityJSON feature, or None when it failed), in any order;
     :meth:`close` writes ``tileset.json``. The quadtree is planned from every building's
-    centroid before the first is built."""
+    centroid before the first is built: it is split until a square holds CAPACITY of the
+    finest LOD chosen; each coarser LOD goes to the largest squares holding at most its
+    CAPACITY (the leaves for what is left), so far views load few, larger tiles."""
 
     def __init__(
         self,
@@ -175,30 +182,53 @@ class TilesetWriter:
         self.folder = outdir / FOLDER
         self.georef = georef
         self.lods = tuple(sorted(lods))
-        self.root, self.leaf_of = quadtree(centroids)
-        self.ready: dict[str, Path] = {}  # built buildings' glbs, until their leaf is written
+        self.root, _ = quadtree(centroids, CAPACITY[self.lods[-1]])
+        self.holders: dict[str, list[Square]] = {}  # the squares with tiles of a building
+        self._assign(self.root, ())
+        self.ready: dict[str, Path] = {}  # built buildings' glbs, until their tiles are written
+        self.boxes: dict[str, Box] = {}  # their LOD3 boxes, likewise
         self.written: set[Path] = set()
         self.triangles = dict.fromkeys(self.lods, 0)
         self.bytes = dict.fromkeys(self.lods, 0)
 
+    def _assign(self, square: Square, done: tuple[int, ...]) -> None:
+        """The LODs of the square's tiles: each not yet above it, once it holds at most
+        that LOD's CAPACITY of buildings (or it is a leaf)."""
+        leaf = not square.children
+        square.lods = tuple(
+            k for k in self.lods if k not in done and (len(square.members) <= CAPACITY[k] or leaf)
+        )
+        if square.lods:
+            square.left = len(square.members)
+            for bid in square.members:
+                self.holders.setdefault(bid, []).append(square)
+        for child in square.children:
+            self._assign(child, done + square.lods)
+
     def done(self, building_id: str, glb: Path | None) -> None:
-        leaf = self.leaf_of[building_id]
         if glb is not None:
             self.ready[building_id] = glb
-        leaf.left -= 1
-        if leaf.left == 0:
-            self._write_leaf(leaf)
+        for square in self.holders[building_id]:
+            square.left -= 1
+            if square.left == 0:
+                self._write_square(square)
 
-    def _write_leaf(self, leaf: Square) -> None:
-        built = [(bid, self.ready.pop(bid)) for bid in leaf.members if bid in self.ready]
+    def _lod3_box(self, building_id: str) -> Box:
+        if building_id not in self.boxes:
+            (self.boxes[building_id],) = _glb_boxes([self.ready[building_id]])
+        return self.boxes[building_id]
+
+    def _write_square(self, square: Square) -> None:
+        built = [(bid, self.ready[bid]) for bid in square.members if bid in self.ready]
         if not built:
             return
-        features = [_feature(glb) for _, glb in built]
+        features = [_feature(glb) for _, glb in built] if square.lods[0] < 3 else []
         boxes: dict[int, Box] = {}
         relief = {1: 0.0, 2: 0.0}  # how far each building's LOD3 stands out of the LOD's box
-        finest = _glb_boxes(glb for _, glb in built)
-        for lod in self.lods:
-            path = self.folder / f"{leaf.level}/{leaf.column}/{leaf.row}.lod{lod}.glb"
+        finest = [self._lod3_box(bid) for bid, _ in built]
+        name = f"{square.level}/{square.column}/{square.row}"
+        for lod in square.lods:
+            path = self.folder / f"{name}.lod{lod}.glb"
             if lod == 3:
                 merge_glb(built, path)
                 boxes[3] = _union(finest)
@@ -214,20 +244,23 @@ class TilesetWriter:
                 self.triangles[lod] += sum(len(g.faces) for g in scene.geometry.values())
             self.bytes[lod] += path.stat().st_size
             self.written.add(path)
-        roofs = max(roof_depth(f) for f in features)
-        error = 0.0  # the finest LOD's: a leaf's
-        for lod in reversed(self.lods):  # each at least the error of the finer one
-            if lod != self.lods[-1]:
+        roofs = max((roof_depth(f) for f in features), default=0.0)
+        for lod in square.lods:  # what each gets wrong; finer tiles below may raise it
+            missed = 0.0
+            if lod != 3:
                 missed = max(relief[lod], MIN_ERROR[lod]) + (roofs if lod == 1 else 0.0)
-                error = max(error, round(missed, 3))
-            uri = f"{leaf.level}/{leaf.column}/{leaf.row}.lod{lod}.glb"
-            leaf.tiles.insert(0, {"lod": lod, "uri": uri, "error": error})
-        leaf.box = _union(boxes.values())
+            uri = f"{name}.lod{lod}.glb"
+            square.tiles.append({"lod": lod, "uri": uri, "error": round(missed, 3)})
+        square.box = _union(boxes.values())
+        for bid, _ in built:  # a building's glb is let go with the last of its tiles
+            if all(holder.left == 0 for holder in self.holders[bid]):
+                self.ready.pop(bid)
+                self.boxes.pop(bid, None)
 
     def close(self, name: str) -> dict[str, Any]:
         """Write ``tileset.json`` (and remove tiles an earlier run left that it does not
         name); returns what the report says of the tiles."""
-        root = self._tile(self.root)
+        root = self._tile(self.root, covered=False)
         if root is None:  # no building built: an empty tileset, placed all the same
             root = {"boundingVolume": {"box": _box((0.0, 0.0, 0.0, 1.0, 1.0, 1.0))}}
             root.update(geometricError=0.0, refine="REPLACE")
@@ -249,23 +282,41 @@ class TilesetWriter:
             "bytes": {f"lod{k}": v for k, v in self.bytes.items()},
         }
 
-    def _tile(self, square: Square) -> dict[str, Any] | None:
-        """The square's tile (None when none of its buildings was built)."""
-        if not square.children:
-            return _chain(square) if square.box is not None else None
-        children = [tile for child in square.children if (tile := self._tile(child)) is not None]
-        if not children:
+    def _tile(self, square: Square, covered: bool) -> dict[str, Any] | None:
+        """The square's tile: its chain of content, coarse first, each the only child of
+        the one before, its children's tiles under the last; or, without content, a tile
+        holding its children's. None when none of its buildings was built. ``covered``:
+        a square above has content."""
+        below = covered or bool(square.tiles)
+        children = [t for child in square.children if (t := self._tile(child, below))]
+        if not children and not square.tiles:
             return None
         boxes = [_unbox(tile["boundingVolume"]["box"]) for tile in children]
-        square.box = _union(boxes)
-        lo, hi = np.array(square.box[:3]), np.array(square.box[3:])
-        error = max(float(np.linalg.norm(hi - lo)), *(2 * t["geometricError"] for t in children))
-        return {
-            "boundingVolume": {"box": _box(square.box)},
-            "geometricError": round(error, 3),
-            "refine": "REPLACE",
-            "children": children,
-        }
+        box = _union([*boxes, *([square.box] if square.box is not None else [])])
+        error = max((t["geometricError"] for t in children), default=0.0)
+        if not square.tiles:  # no content: all of it missing, unless a square above shows it
+            if not covered:
+                lo, hi = np.array(box[:3]), np.array(box[3:])
+                error = max(float(np.linalg.norm(hi - lo)), 2 * error)
+            return {
+                "boundingVolume": {"box": _box(box)},
+                "geometricError": round(error, 3),
+                "refine": "REPLACE",
+                "children": children,
+            }
+        tile: dict[str, Any] = {}
+        for entry in reversed(square.tiles):
+            error = max(error, entry["error"])  # at least what the finer tiles get wrong
+            above: dict[str, Any] = {
+                "boundingVolume": {"box": _box(box)},
+                "geometricError": round(error, 3),
+                "refine": "REPLACE",
+                "content": {"uri": entry["uri"]},
+            }
+            if children:
+                above["children"] = children
+            children, tile = [above], above
+        return tile
 
     def _remove_stale(self) -> None:
         for folder, _, files in sorted(os.walk(self.folder)):
@@ -274,24 +325,6 @@ class TilesetWriter:
                 if TILE_FILE.fullmatch(file) and path not in self.written:
                     with contextlib.suppress(FileNotFoundError):
                         path.unlink()
-
-
-def _chain(leaf: Square) -> dict[str, Any]:
-    """A leaf's tiles, the coarsest first, each the only child of the one before."""
-    assert leaf.box is not None
-    tile: dict[str, Any] | None = None
-    for entry in reversed(leaf.tiles):
-        above: dict[str, Any] = {
-            "boundingVolume": {"box": _box(leaf.box)},
-            "geometricError": entry["error"],
-            "refine": "REPLACE",
-            "content": {"uri": entry["uri"]},
-        }
-        if tile is not None:
-            above["children"] = [tile]
-        tile = above
-    assert tile is not None
-    return tile
 
 
 def _lod_scene(
