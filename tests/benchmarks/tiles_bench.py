@@ -57,7 +57,7 @@ def measure(name: str, city: City, out: Path, limit: int | None) -> None:
 
 
 def main() -> None:
-    tileset.TilesetWriter._write_leaf = _timed(tileset.TilesetWriter._write_leaf)  # type: ignore[method-assign]
+    tileset.TilesetWriter._write_square = _timed(tileset.TilesetWriter._write_square)  # type: ignore[method-assign]
     tileset.TilesetWriter.close = _timed(tileset.TilesetWriter.close)  # type: ignore[method-assign]
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
