@@ -165,6 +165,9 @@ def test_levels_of_detail_come_coarse_to_fine_with_falling_errors(city: Path) ->
         assert by_lod[1] > by_lod[2] >= 3.0 > by_lod[3] == 0  # LOD2: at least a storey
         levels.update(path[i]["content"]["uri"].split("/")[0] for i in shown)
     assert len(levels) > 1  # coarse LODs in larger squares than the façades
+    for tile, parent in _tiles(root):  # a viewer that refined a tile goes on through empty
+        if parent is not None and "content" not in tile and "content" in parent:
+            assert tile["geometricError"] == parent["geometricError"]  # ones, to content
     for leaf in _leaves(root):
         assert leaf["geometricError"] == 0 and leaf["content"]["uri"].endswith(".lod3.glb")
 
@@ -470,3 +473,32 @@ def test_a_resumed_run_writes_the_same_tiles(city: Path, tmp_path: Path) -> None
     for path in sorted((city / "3dtiles").rglob("*")):
         if path.is_file():
             assert path.read_bytes() == (copy / path.relative_to(city)).read_bytes(), path
+
+
+def test_a_viewer_goes_on_through_empty_squares_to_the_content_below(
+    city: Path, tmp_path: Path
+) -> None:
+    """Blocks and roofs for all ten houses at the root, façades a house a tile: the
+    squares between have no content, and each takes the error of the tile above with
+    content, or a viewer would stop refining at them and show nothing there."""
+    frame = json.loads((city / f"{city.name}.georef.json").read_text())
+    georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
+    glbs = sorted((city / "buildings").glob("*.glb"))
+    places = [(glb.stem, (37.0 * k % 100, 11.0 * k)) for k, glb in enumerate(glbs)]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tileset_module, "CAPACITY", {1: 10, 2: 10, 3: 1})
+        writer = TilesetWriter(tmp_path, georef, (1, 2, 3), places)
+    for glb in glbs:
+        writer.done(glb.stem, glb)
+    writer.close("deep")
+    root = _tileset(tmp_path)["root"]
+    assert root["content"]["uri"].endswith("lod1.glb")
+    lod2 = root["children"][0]
+    empty = 0
+    for path in _paths(root):
+        for above, tile in itertools.pairwise(path):
+            if "content" not in tile:
+                empty += 1
+                assert tile["geometricError"] == lod2["geometricError"] > 0
+            assert tile["geometricError"] <= above["geometricError"]
+    assert empty > 0

@@ -261,6 +261,8 @@ class TilesetWriter:
         """Write ``tileset.json`` (and remove tiles an earlier run left that it does not
         name); returns what the report says of the tiles."""
         root = self._tile(self.root, covered=False)
+        if root is not None:
+            _lift(root, None)
         if root is None:  # no building built: an empty tileset, placed all the same
             root = {"boundingVolume": {"box": _box((0.0, 0.0, 0.0, 1.0, 1.0, 1.0))}}
             root.update(geometricError=0.0, refine="REPLACE")
@@ -294,7 +296,8 @@ class TilesetWriter:
         boxes = [_unbox(tile["boundingVolume"]["box"]) for tile in children]
         box = _union([*boxes, *([square.box] if square.box is not None else [])])
         error = max((t["geometricError"] for t in children), default=0.0)
-        if not square.tiles:  # no content: all of it missing, unless a square above shows it
+        if not square.tiles:  # no content: all of it missing, unless a square above has
+            # content (then its error is raised to that one's, by _lift)
             if not covered:
                 lo, hi = np.array(box[:3]), np.array(box[3:])
                 error = max(float(np.linalg.norm(hi - lo)), 2 * error)
@@ -325,6 +328,17 @@ class TilesetWriter:
                 if TILE_FILE.fullmatch(file) and path not in self.written:
                     with contextlib.suppress(FileNotFoundError):
                         path.unlink()
+
+
+def _lift(tile: dict[str, Any], ceiling: float | None) -> None:
+    """Content-less tiles under a tile with content take that tile's error: a viewer
+    that refined it goes on through them to the content below (with a smaller error it
+    would stop at them, and draw nothing there)."""
+    if "content" not in tile and ceiling is not None:
+        tile["geometricError"] = ceiling
+    below = tile["geometricError"] if "content" in tile else ceiling
+    for child in tile.get("children", []):
+        _lift(child, below)
 
 
 def _lod_scene(
