@@ -57,6 +57,7 @@ bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extrac
 	$(BIN)/python tests/benchmarks/grammar_bench.py
 	$(BIN)/python tests/benchmarks/city_bench.py
 	$(BIN)/python tests/benchmarks/assets_bench.py
+	$(BIN)/python tests/benchmarks/tiles_bench.py
 	$(BIN)/python tests/benchmarks/walls_bench.py
 	$(BIN)/python tests/benchmarks/infer_bench.py
 	$(BIN)/python tests/benchmarks/fidelity_bench.py

@@ -484,6 +484,18 @@ def city(
             show_default=False,
         ),
     ] = None,
+    tiles3d: Annotated[
+        bool, typer.Option("--3dtiles", help="Also OGC 3D Tiles: 3dtiles/tileset.json.")
+    ] = False,
+    lod: Annotated[
+        str | None,
+        typer.Option(
+            "--lod",
+            metavar="1,2,3",
+            help="3D Tiles' levels of detail: blocks, roofs, façades [default: 1,2,3].",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -505,8 +517,12 @@ def city(
     from facadecli.city.default import default_city
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
+    from facadecli.city.tileset import parse_lods
 
     box = _bbox(bbox) if bbox is not None else None
+    if lod is not None and not tiles3d:
+        raise typer.BadParameter("chooses the levels of detail of --3dtiles", param_hint="--lod")
+    lods = parse_lods(lod or "1,2,3") if tiles3d else ()
     is_manifest = source.suffix.lower() in (".yaml", ".yml")
     if is_manifest and spec is not None:
         raise typer.BadParameter(
@@ -516,7 +532,7 @@ def city(
     loaded = load_city(source) if is_manifest else default_city(source, spec)
     workers = jobs or os.cpu_count() or 1
     if _state["quiet"]:
-        report = run_city(loaded, outdir, workers, limit, resume, None, scheduler, box, usd)
+        report = run_city(loaded, outdir, workers, limit, resume, None, scheduler, box, usd, lods)
     elif sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
         from rich.progress import Progress
 
@@ -526,7 +542,9 @@ def city(
             def progress(done: int, total: int) -> None:
                 bar.update(task, completed=done, total=total)
 
-            report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box, usd)
+            report = run_city(
+                loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
+            )
     else:
         step = max(1, (limit or 1000) // 20)
 
@@ -534,7 +552,9 @@ def city(
             if done == total or done % step == 0:
                 typer.echo(f"{done}/{total} buildings", err=True)
 
-        report = run_city(loaded, outdir, workers, limit, resume, progress, scheduler, box, usd)
+        report = run_city(
+            loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
+        )
     summary = report["summary"]
 
     def place(entry: dict[str, object]) -> str:  # a feature's place in the footprints
@@ -565,6 +585,7 @@ def city(
         f"{summary['ok']} of {summary['buildings']} buildings built{rejected} in "
         f"{summary['seconds']} s -> {outdir}/{report['name']}.glb, "
         f"{outdir}/{report['name']}.city.json, {outdir}/{report['name']}.report.json"
+        + (f", {outdir}/3dtiles/tileset.json" if "3dtiles" in report["models"] else "")
     )
     if summary["failed"]:  # exit 1 only when a building that should build did not
         raise typer.Exit(1)

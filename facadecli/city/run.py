@@ -74,6 +74,8 @@ from facadecli.city.s3db import (
 )
 from facadecli.city.straight import Straightened, straighten
 from facadecli.city.tiles import merge_city
+from facadecli.city.tileset import FOLDER as TILESET_FOLDER
+from facadecli.city.tileset import TilesetWriter
 from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
 from facadecli.export.gltf import glb_bytes
@@ -422,9 +424,10 @@ def check_output(outdir: Path, name: str) -> None:
         problem = f"'{buildings}' is a file, where the buildings' folder goes"
     elif os.path.isdir(buildings) and not os.access(buildings, os.W_OK | os.X_OK):
         problem = f"cannot write in '{buildings}' (permission denied)"
-    tiles = outdir / "tiles"
-    if os.path.lexists(tiles) and not os.path.isdir(tiles):
-        problem = f"'{tiles}' is a file, where the tiles' folder goes"
+    for folder in ("tiles", TILESET_FOLDER):
+        tiles = outdir / folder
+        if os.path.lexists(tiles) and not os.path.isdir(tiles):
+            problem = f"'{tiles}' is a file, where the tiles' folder goes"
     for output in (
         outdir / f"{name}.glb",
         outdir / f"{name}.report.json",
@@ -453,7 +456,12 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
         rf"{_RANDOM}(?:tmp|bin|objects|vertices)",
         outdir / "buildings": rf"\.[A-Za-z0-9._~-]+\.(?:glb|city\.jsonl|usda){_RANDOM}tmp",
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
+        outdir / TILESET_FOLDER: rf"\.tileset\.json{_RANDOM}tmp",
     }
+    tileset = outdir / TILESET_FOLDER  # 3D Tiles: <level>/<column>/<row>.lod<k>.glb
+    for sub, _, _ in sorted(os.walk(tileset)):
+        if Path(sub) != tileset:
+            patterns[Path(sub)] = rf"\.\d+\.lod[123]\.glb{_RANDOM}(?:tmp|bin)"
     found = []
     for folder, pattern in patterns.items():
         matcher = re.compile(pattern, re.ASCII)
@@ -489,8 +497,10 @@ def run_city(
     scheduler: str | None = None,
     bbox: BBox | None = None,
     usd: bool = False,
+    lods: tuple[int, ...] = (),
 ) -> dict[str, Any]:
     """Build a city; returns the report (also written to ``<name>.report.json``).
+    With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py).
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -520,6 +530,7 @@ def run_city(
             usd,
             started,
             straight,
+            lods,
         )
 
 
@@ -537,6 +548,7 @@ def _build(
     usd: bool,
     started: float,
     straight: Straightened | None = None,
+    lods: tuple[int, ...] = (),
 ) -> dict[str, Any]:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report."""
@@ -557,6 +569,10 @@ def _build(
         else:
             todo.append(task)
     done = len(results)
+    tileset = None
+    if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
+        centroids = [(task.footprint.id, _centroid(task.footprint)) for task in tasks]
+        tileset = TilesetWriter(outdir, georef, lods, centroids)
     local = scheduler is None
     mapped = _map_local(todo, jobs) if local else _map_dask(todo, str(scheduler))
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
@@ -565,10 +581,12 @@ def _build(
         with open(log, "w", encoding="utf-8") as lines:
             for result in results:
                 lines.write(json.dumps(result) + "\n")
+                _tiled(tileset, outdir, result)
             for result in mapped:
                 results.append(result)
                 lines.write(json.dumps(result) + "\n")
                 lines.flush()
+                _tiled(tileset, outdir, result)
                 done += 1
                 if progress is not None:
                     progress(done, len(tasks))
@@ -597,6 +615,14 @@ def _build(
             f"{outdir}: cannot write the merged model: {error.strerror or error}; the "
             "buildings built are kept: run again with --resume"
         ) from None
+    if tileset is not None:
+        try:
+            written = {**written, "3dtiles": tileset.close(city.manifest.name)}
+        except OSError as error:
+            raise OutputError(
+                f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "
+                "buildings built are kept: run again with --resume"
+            ) from None
     if usd:
         stage = outdir / f"{city.manifest.name}.usda"
         ok = [outdir / r["file"] for r in results if r["status"] == "ok"]
@@ -659,6 +685,20 @@ def _build(
             f"{outdir}: cannot write the report: {error.strerror or error}; run again with --resume"
         ) from None
     return report
+
+
+def _tiled(tileset: TilesetWriter | None, outdir: Path, result: dict[str, Any]) -> None:
+    """A building done (built, resumed or failed), for the 3D Tiles of its leaf."""
+    if tileset is None:
+        return
+    glb = outdir / result["file"] if result["status"] == "ok" else None
+    try:
+        tileset.done(result["id"], glb)
+    except OSError as error:
+        raise OutputError(
+            f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "
+            "buildings built are kept: run again with --resume"
+        ) from None
 
 
 def _rejected(rejected: Rejected) -> dict[str, Any]:

@@ -1,0 +1,434 @@
+"""OGC 3D Tiles 1.1 of a city (``facade city --3dtiles``): ``3dtiles/tileset.json`` and
+glb content, in levels of detail, streamed as the buildings finish.
+
+**Hierarchy.** A quadtree over the buildings' centroids in the run's local frame (metres
+from its origin), split until a square holds at most CAPACITY[k] buildings of the finest
+level of detail k chosen (``--lod``: LOD1 blocks, LOD2 walls and roofs, LOD3 the
+façades; lods.py). Each coarser LOD goes to the largest squares that hold at most its
+own CAPACITY, so a square may hold a chain of tiles, coarse to fine, each the only child
+of the one before; the square's children hang under the last. Every tile replaces its
+parent (``refine: REPLACE``); squares above the coarsest tiles have no content.
+
+**Geometric error** is what a tile's content gets wrong, in metres: a leaf's none (0); a
+LOD2 tile the façades' relief it leaves out (how far the LOD3 model stands out of its
+box) and at least MIN_ERROR[2] (a storey: the rhythm of windows and floors it leaves
+out); a LOD1 tile as much, at least MIN_ERROR[1], and its roofs' depth; a square
+without content under one with content the largest of its children's; above, the
+diagonal of its box (all of it missing), and at least twice its children's. Each tile's
+error is at least its children's: errors fall from the root to the leaves.
+
+**Place on the globe.** Tiles are z-up; their glTF content is y-up, as 3D Tiles wants:
+the runtime turns glTF's y-up to z-up (x, y, z) -> (x, -z, y), which makes our glTF
+frame (x east, y up, z south) x east, y north, z up. The root's ``transform`` maps that
+local frame to Earth-centred, Earth-fixed coordinates (EPSG:4978): its translation is
+the run's origin on the ellipsoid (height 0: buildings stand on it), its columns the
+ECEF directions of a metre east, north (the CRS's grid, so grid north and the scale
+factor are in them) and up, measured with PROJ at the origin.
+
+**Files.** ``3dtiles/<level>/<column>/<row>.lod<k>.glb``: a square's tiles are written,
+each atomically, as soon as its last building is done (or failed), and
+``tileset.json`` last, atomically; files of an earlier run the tileset no longer names
+are removed. The same buildings give the same bytes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyproj
+import trimesh
+
+from facadecli.city.georef import Georef, georeference
+from facadecli.city.lods import lod_meshes, roof_depth
+from facadecli.errors import SpecError
+from facadecli.export.atomic import write_atomic
+from facadecli.export.glb_merge import merge_glb, read_glb
+from facadecli.export.gltf import glb_bytes
+from facadecli.geometry.facade import pbr
+from facadecli.spec.model import Material
+
+FOLDER = "3dtiles"
+LODS = (1, 2, 3)
+CAPACITY = {1: 256, 2: 32, 3: 8}  # buildings a tile of each level of detail holds at most
+MAX_LEVEL = 20  # quadtree levels at most (buildings sharing a centroid stay together)
+MIN_ERROR = {1: 4.0, 2: 3.0}  # metres: what a block or a façade-less model gets wrong at least
+COLOURS = {"wall": "#d9d2c3", "roof": "#8f5a48"}  # LOD1 and LOD2 materials
+TILE_FILE = re.compile(r"\d+\.lod[123]\.glb")
+Box = tuple[float, float, float, float, float, float]  # min x, y, z, max x, y, z (z up)
+
+
+def parse_lods(text: str) -> tuple[int, ...]:
+    """``--lod 1,2,3`` as the levels of detail, coarse to fine; SpecError (exit 2) else."""
+    try:
+        found = sorted({int(item) for item in text.split(",") if item.strip()})
+    except ValueError:
+        found = []
+    if not found or any(lod not in LODS for lod in found):
+        raise SpecError.at(
+            "--lod",
+            None,
+            None,
+            f"'{text}' is not a list of levels of detail",
+            "give some of 1 (blocks), 2 (roofs), 3 (façades), separated by commas: --lod 1,2,3",
+        )
+    return tuple(found)
+
+
+def ecef_transform(georef: Georef) -> list[float]:
+    """The root tile's transform (column-major 4 × 4): local metres (x east, y north on
+    the CRS's grid, z up) to ECEF metres, exact at the origin (see the module)."""
+    to_ecef = _to_ecef()
+    step = 10.0
+
+    def at(x: float, y: float, z: float) -> np.ndarray:
+        lon, lat = georef.lonlat(x, y)
+        return np.array(to_ecef.transform(lon, lat, z), dtype=float)
+
+    origin = at(0.0, 0.0, 0.0)
+    columns = [
+        (at(step, 0.0, 0.0) - at(-step, 0.0, 0.0)) / (2 * step),
+        (at(0.0, step, 0.0) - at(0.0, -step, 0.0)) / (2 * step),
+        (at(0.0, 0.0, step) - at(0.0, 0.0, -step)) / (2 * step),
+    ]
+    matrix = [*(float(v) for c in columns for v in (*c, 0.0)), *(float(v) for v in origin), 1.0]
+    return [round(v, 12) if abs(v) < 2 else round(v, 4) for v in matrix]
+
+
+def _to_ecef() -> pyproj.Transformer:
+    return pyproj.Transformer.from_crs(
+        pyproj.CRS.from_epsg(4979), pyproj.CRS.from_epsg(4978), always_xy=True
+    )
+
+
+@dataclass
+class Square:
+    """A square of the quadtree: its place, its children, its buildings, and the levels
+    of detail whose tiles it holds (:meth:`TilesetWriter.__init__`)."""
+
+    level: int
+    column: int
+    row: int
+    children: list[Square] = field(default_factory=list)
+    members: list[str] = field(default_factory=list)  # its building ids, in run order
+    lods: tuple[int, ...] = ()  # the levels of detail of its tiles, coarse first
+    left: int = 0  # its buildings not done yet
+    tiles: list[dict[str, Any]] = field(default_factory=list)  # its chain, coarse first
+    box: Box | None = None  # of its content and its children's
+
+
+Centroids = Sequence[tuple[str, tuple[float, float]]]  # building ids and their centroids
+
+
+def quadtree(centroids: Centroids, capacity: int) -> tuple[Square, dict[str, Square]]:
+    """The quadtree of the buildings (id, centroid in local metres), split until a square
+    holds at most ``capacity`` buildings, and each building's leaf. The root square is the
+    smallest power-of-two side (from 1 m) holding them all, its south-west corner at the
+    lowest centroid."""
+    if not centroids:
+        return Square(0, 0, 0), {}
+    xs = [c[0] for _, c in centroids]
+    ys = [c[1] for _, c in centroids]
+    west, south = math.floor(min(xs)), math.floor(min(ys))
+    side = 1.0
+    while west + side <= max(xs) or south + side <= max(ys):
+        side *= 2
+    root = Square(0, 0, 0)
+    leaf_of: dict[str, Square] = {}
+
+    def split(square: Square, items: list[tuple[str, tuple[float, float]]]) -> None:
+        square.members = [bid for bid, _ in items]
+        if len(items) <= capacity or square.level >= MAX_LEVEL:
+            leaf_of.update((bid, square) for bid, _ in items)
+            return
+        size = side / 2 ** (square.level + 1)
+        quarters: dict[tuple[int, int], list[tuple[str, tuple[float, float]]]] = {}
+        for bid, (x, y) in items:
+            column = min(square.column * 2 + 1, max(square.column * 2, int((x - west) // size)))
+            row = min(square.row * 2 + 1, max(square.row * 2, int((y - south) // size)))
+            quarters.setdefault((column, row), []).append((bid, (x, y)))
+        for (column, row), inside in sorted(quarters.items()):
+            child = Square(square.level + 1, column, row)
+            square.children.append(child)
+            split(child, inside)
+
+    split(root, list(centroids))
+    return root, leaf_of
+
+
+class TilesetWriter:
+    """Writes the 3D Tiles of a run as its buildings finish: :meth:`done` for every
+    building (its glb and CityJSON feature, or None when it failed), in any order;
+    :meth:`close` writes ``tileset.json``. The quadtree is planned from every building's
+    centroid before the first is built: it is split until a square holds CAPACITY of the
+    finest LOD chosen; each coarser LOD goes to the largest squares holding at most its
+    CAPACITY (the leaves for what is left), so far views load few, larger tiles."""
+
+    def __init__(
+        self,
+        outdir: Path,
+        georef: Georef,
+        lods: Sequence[int],
+        centroids: Centroids,
+    ) -> None:
+        self.folder = outdir / FOLDER
+        self.georef = georef
+        self.lods = tuple(sorted(lods))
+        self.root, _ = quadtree(centroids, CAPACITY[self.lods[-1]])
+        self.holders: dict[str, list[Square]] = {}  # the squares with tiles of a building
+        self._assign(self.root, ())
+        self.ready: dict[str, Path] = {}  # built buildings' glbs, until their tiles are written
+        self.boxes: dict[str, Box] = {}  # their LOD3 boxes, likewise
+        self.written: set[Path] = set()
+        self.triangles = dict.fromkeys(self.lods, 0)
+        self.bytes = dict.fromkeys(self.lods, 0)
+
+    def _assign(self, square: Square, done: tuple[int, ...]) -> None:
+        """The LODs of the square's tiles: each not yet above it, once it holds at most
+        that LOD's CAPACITY of buildings (or it is a leaf)."""
+        leaf = not square.children
+        square.lods = tuple(
+            k for k in self.lods if k not in done and (len(square.members) <= CAPACITY[k] or leaf)
+        )
+        if square.lods:
+            square.left = len(square.members)
+            for bid in square.members:
+                self.holders.setdefault(bid, []).append(square)
+        for child in square.children:
+            self._assign(child, done + square.lods)
+
+    def done(self, building_id: str, glb: Path | None) -> None:
+        if glb is not None:
+            self.ready[building_id] = glb
+        for square in self.holders[building_id]:
+            square.left -= 1
+            if square.left == 0:
+                self._write_square(square)
+
+    def _lod3_box(self, building_id: str) -> Box:
+        if building_id not in self.boxes:
+            (self.boxes[building_id],) = _glb_boxes([self.ready[building_id]])
+        return self.boxes[building_id]
+
+    def _write_square(self, square: Square) -> None:
+        built = [(bid, self.ready[bid]) for bid in square.members if bid in self.ready]
+        if not built:
+            return
+        features = [_feature(glb) for _, glb in built] if square.lods[0] < 3 else []
+        boxes: dict[int, Box] = {}
+        relief = {1: 0.0, 2: 0.0}  # how far each building's LOD3 stands out of the LOD's box
+        finest = [self._lod3_box(bid) for bid, _ in built]
+        name = f"{square.level}/{square.column}/{square.row}"
+        for lod in square.lods:
+            path = self.folder / f"{name}.lod{lod}.glb"
+            if lod == 3:
+                merge_glb(built, path)
+                boxes[3] = _union(finest)
+                self.triangles[3] += sum(_glb_triangles(glb) for _, glb in built)
+            else:
+                scene, found = _lod_scene([lod_meshes(f, lod) for f in features])
+                own = [b or whole for b, whole in zip(found, finest, strict=True)]
+                data = glb_bytes(scene)
+                path.parent.mkdir(parents=True, exist_ok=True)
+                write_atomic(path, data)
+                boxes[lod] = _union(own)
+                relief[lod] = max(_outside(a, b) for a, b in zip(finest, own, strict=True))
+                self.triangles[lod] += sum(len(g.faces) for g in scene.geometry.values())
+            self.bytes[lod] += path.stat().st_size
+            self.written.add(path)
+        roofs = max((roof_depth(f) for f in features), default=0.0)
+        for lod in square.lods:  # what each gets wrong; finer tiles below may raise it
+            missed = 0.0
+            if lod != 3:
+                missed = max(relief[lod], MIN_ERROR[lod]) + (roofs if lod == 1 else 0.0)
+            uri = f"{name}.lod{lod}.glb"
+            square.tiles.append({"lod": lod, "uri": uri, "error": round(missed, 3)})
+        square.box = _union(boxes.values())
+        for bid, _ in built:  # a building's glb is let go with the last of its tiles
+            if all(holder.left == 0 for holder in self.holders[bid]):
+                self.ready.pop(bid)
+                self.boxes.pop(bid, None)
+
+    def close(self, name: str) -> dict[str, Any]:
+        """Write ``tileset.json`` (and remove tiles an earlier run left that it does not
+        name); returns what the report says of the tiles."""
+        root = self._tile(self.root, covered=False)
+        if root is not None:
+            _lift(root, None)
+        if root is None:  # no building built: an empty tileset, placed all the same
+            root = {"boundingVolume": {"box": _box((0.0, 0.0, 0.0, 1.0, 1.0, 1.0))}}
+            root.update(geometricError=0.0, refine="REPLACE")
+        root = {"transform": ecef_transform(self.georef), **root}
+        tileset = {
+            "asset": {"version": "1.1", "generator": "facadecli"},
+            "extras": {"name": name, "georeference": georeference(self.georef)},
+            "geometricError": root["geometricError"],
+            "root": root,
+        }
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self._remove_stale()
+        write_atomic(self.folder / "tileset.json", json.dumps(tileset, indent=1) + "\n")
+        return {
+            "tileset": f"{FOLDER}/tileset.json",
+            "lods": list(self.lods),
+            "tiles": len(self.written),
+            "triangles": {f"lod{k}": v for k, v in self.triangles.items()},
+            "bytes": {f"lod{k}": v for k, v in self.bytes.items()},
+        }
+
+    def _tile(self, square: Square, covered: bool) -> dict[str, Any] | None:
+        """The square's tile: its chain of content, coarse first, each the only child of
+        the one before, its children's tiles under the last; or, without content, a tile
+        holding its children's. None when none of its buildings was built. ``covered``:
+        a square above has content."""
+        below = covered or bool(square.tiles)
+        children = [t for child in square.children if (t := self._tile(child, below))]
+        if not children and not square.tiles:
+            return None
+        boxes = [_unbox(tile["boundingVolume"]["box"]) for tile in children]
+        box = _union([*boxes, *([square.box] if square.box is not None else [])])
+        error = max((t["geometricError"] for t in children), default=0.0)
+        if not square.tiles:  # no content: all of it missing, unless a square above has
+            # content (then its error is raised to that one's, by _lift)
+            if not covered:
+                lo, hi = np.array(box[:3]), np.array(box[3:])
+                error = max(float(np.linalg.norm(hi - lo)), 2 * error)
+            return {
+                "boundingVolume": {"box": _box(box)},
+                "geometricError": round(error, 3),
+                "refine": "REPLACE",
+                "children": children,
+            }
+        tile: dict[str, Any] = {}
+        for entry in reversed(square.tiles):
+            error = max(error, entry["error"])  # at least what the finer tiles get wrong
+            above: dict[str, Any] = {
+                "boundingVolume": {"box": _box(box)},
+                "geometricError": round(error, 3),
+                "refine": "REPLACE",
+                "content": {"uri": entry["uri"]},
+            }
+            if children:
+                above["children"] = children
+            children, tile = [above], above
+        return tile
+
+    def _remove_stale(self) -> None:
+        for folder, _, files in sorted(os.walk(self.folder)):
+            for file in files:
+                path = Path(folder) / file
+                if TILE_FILE.fullmatch(file) and path not in self.written:
+                    with contextlib.suppress(FileNotFoundError):
+                        path.unlink()
+
+
+def _lift(tile: dict[str, Any], ceiling: float | None) -> None:
+    """Content-less tiles under a tile with content take that tile's error: a viewer
+    that refined it goes on through them to the content below (with a smaller error it
+    would stop at them, and draw nothing there)."""
+    if "content" not in tile and ceiling is not None:
+        tile["geometricError"] = ceiling
+    below = tile["geometricError"] if "content" in tile else ceiling
+    for child in tile.get("children", []):
+        _lift(child, below)
+
+
+def _lod_scene(
+    buildings: list[dict[str, trimesh.Trimesh]],
+) -> tuple[trimesh.Scene, list[Box | None]]:
+    """A tile's buildings at one LOD as one mesh a material (two draw calls at most), and
+    each building's box (None when it has no surface at this LOD)."""
+    scene = trimesh.Scene()
+    boxes: list[Box | None] = []
+    for meshes in buildings:
+        points = np.vstack([np.zeros((0, 3)), *(m.vertices for m in meshes.values())])
+        found = _z_up(points.min(axis=0), points.max(axis=0)) if len(points) else None
+        boxes.append(found)
+    for name in sorted({name for meshes in buildings for name in meshes}):
+        parts = [m[name] for m in buildings if name in m and len(m[name].faces)]
+        if not parts:
+            continue
+        merged = trimesh.util.concatenate(parts)
+        merged.visual = trimesh.visual.TextureVisuals()
+        merged.visual.material = pbr(name, Material(color=COLOURS[name], roughness=0.9), None)
+        scene.add_geometry(merged, geom_name=name, node_name=name)
+    return scene, boxes
+
+
+def _feature(glb: Path) -> dict[str, Any]:
+    """A building's CityJSON feature, written beside its glb."""
+    feature: dict[str, Any] = json.loads(glb.with_suffix(".city.jsonl").read_text("utf-8"))
+    return feature
+
+
+def _glb_boxes(paths: Iterable[Path]) -> list[Box]:
+    """Each glb's box (z up) from its positions' bounds (nodes carry no transforms)."""
+    boxes = []
+    for path in paths:
+        document, _ = read_glb(path.read_bytes())
+        accessors = document.get("accessors", [])
+        lows, highs = [], []
+        for mesh in document.get("meshes", []):
+            for primitive in mesh["primitives"]:
+                accessor = accessors[primitive["attributes"]["POSITION"]]
+                lows.append(accessor["min"])
+                highs.append(accessor["max"])
+        boxes.append(_z_up(np.min(lows, axis=0), np.max(highs, axis=0)))
+    return boxes
+
+
+def _glb_triangles(path: Path) -> int:
+    document, _ = read_glb(path.read_bytes())
+    accessors = document.get("accessors", [])
+    return sum(
+        accessors[p["indices"]]["count"] // 3
+        for mesh in document.get("meshes", [])
+        for p in mesh["primitives"]
+    )
+
+
+def _z_up(low: np.ndarray, high: np.ndarray) -> Box:
+    """A glTF box (x east, y up, z south) in the tiles' frame (x east, y north, z up)."""
+    return (
+        float(low[0]),
+        -float(high[2]),
+        float(low[1]),
+        float(high[0]),
+        -float(low[2]),
+        float(high[1]),
+    )
+
+
+def _union(boxes: Iterable[Box]) -> Box:
+    found = np.array(list(boxes))
+    (x0, y0, z0), (x1, y1, z1) = found[:, :3].min(axis=0), found[:, 3:].max(axis=0)
+    return (float(x0), float(y0), float(z0), float(x1), float(y1), float(z1))
+
+
+def _outside(outer: Box, inner: Box) -> float:
+    """How far ``outer`` reaches beyond ``inner`` on any side (metres)."""
+    return max(
+        0.0, *(inner[i] - outer[i] for i in range(3)), *(outer[i] - inner[i] for i in range(3, 6))
+    )
+
+
+def _box(box: Box) -> list[float]:
+    """A 3D Tiles box: centre and half-axes, widened to the millimetre outwards."""
+    low = [math.floor(v * 1000) / 1000 for v in box[:3]]
+    high = [math.ceil(v * 1000) / 1000 for v in box[3:]]
+    centre = [round((a + b) / 2, 4) for a, b in zip(low, high, strict=True)]
+    half = [round(max((b - a) / 2, 0.001) + 0.0005, 4) for a, b in zip(low, high, strict=True)]
+    return [*centre, half[0], 0.0, 0.0, 0.0, half[1], 0.0, 0.0, 0.0, half[2]]
+
+
+def _unbox(box: list[float]) -> Box:
+    (x, y, z), (a, b, c) = box[:3], (box[3], box[7], box[11])
+    return (x - a, y - b, z - c, x + a, y + b, z + c)

@@ -1,0 +1,504 @@
+"""OGC 3D Tiles 1.1 of a city (issue 36 item 2, issue 35 item 5): ``facade city
+--3dtiles`` writes a tileset whose structure holds (checked here against the 3D Tiles 1.1
+rules that matter to a viewer), whose boxes hold their content, whose errors fall toward
+the leaves, which stands where its footprints are on the globe (checked with PROJ, apart
+from the code under test), byte for byte the same for the same input, with LOD1 blocks
+lighter than LOD2 roofs, lighter than LOD3 façades."""
+
+from __future__ import annotations
+
+import functools
+import http.server
+import itertools
+import json
+import os
+import random
+import re
+import shlex
+import shutil
+import struct
+import subprocess
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyproj
+import pytest
+
+import facadecli.city.tileset as tileset_module
+from facadecli.city.default import default_city
+from facadecli.city.georef import Georef
+from facadecli.city.run import run_city
+from facadecli.city.tileset import TilesetWriter, parse_lods, quadtree
+from facadecli.errors import SpecError
+from facadecli.export.glb_merge import read_glb
+from tests.osm_district import METRE_LAT, METRE_LON, ORIGIN, Building, box, write_district
+from tests.running import facade
+
+ROOT = Path(__file__).resolve().parent.parent
+SPEC = ROOT / "specs" / "centred-bay.yaml"
+ROOFS = ["gabled", "hipped", "flat", "pyramidal", "skillion"]
+SMALL = {1: 6, 2: 3, 3: 2}  # buildings a tile of each LOD holds: a deep tree of 10 houses
+GEODETIC = pyproj.CRS.from_epsg(4979)
+ECEF = pyproj.CRS.from_epsg(4978)
+
+
+def _houses(count: int, seed: int) -> list[Building]:
+    """``count`` detached houses of random sizes and roofs on a jittered 25 m grid."""
+    rng = random.Random(seed)
+    houses: list[Building] = []
+    for k in range(count):
+        x, y = 25.0 * (k % 4) + rng.uniform(0, 4), 25.0 * (k // 4) + rng.uniform(0, 4)
+        tags = {"building": "house", "building:levels": str(rng.randint(1, 3))}
+        tags["roof:shape"] = ROOFS[k % len(ROOFS)]
+        houses.append((1000 + k, box(x, y, rng.uniform(8, 14), rng.uniform(7, 10)), tags))
+    return houses
+
+
+def _build(folder: Path, jobs: int, lods: tuple[int, ...] = (1, 2, 3)) -> dict[str, Any]:
+    district = write_district(folder.parent / f"{folder.name}.osm", _houses(10, seed=3))
+    with pytest.MonkeyPatch.context() as patch:  # a deeper tree than the defaults give
+        patch.setattr(tileset_module, "CAPACITY", SMALL)
+        return run_city(default_city(district, SPEC), folder, jobs=jobs, lods=lods)
+
+
+@pytest.fixture(scope="module")
+def city(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("tiles") / "out"
+    report = _build(folder, jobs=1)
+    assert report["summary"]["ok"] == 10
+    return folder
+
+
+def _tiles(tile: dict[str, Any], parent: dict[str, Any] | None = None) -> Iterator[Any]:
+    yield tile, parent
+    for child in tile.get("children", []):
+        yield from _tiles(child, tile)
+
+
+def _tileset(city: Path) -> dict[str, Any]:
+    document: dict[str, Any] = json.loads((city / "3dtiles" / "tileset.json").read_text())
+    return document
+
+
+def _corners(box: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    centre, axes = np.array(box[:3]), np.array(box[3:]).reshape(3, 3)
+    assert np.allclose(axes, np.diag(np.diag(axes)))  # boxes along the tiles' axes here
+    half = np.abs(np.diag(axes))
+    return centre - half, centre + half
+
+
+def _content_bounds(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """A glb's bounds from its positions, turned z-up as 3D Tiles turns glTF content."""
+    document, _ = read_glb(path.read_bytes())
+    accessors = document["accessors"]
+    positions = [
+        accessors[p["attributes"]["POSITION"]] for m in document["meshes"] for p in m["primitives"]
+    ]
+    low = np.min([a["min"] for a in positions], axis=0)
+    high = np.max([a["max"] for a in positions], axis=0)
+    return np.array([low[0], -high[2], low[1]]), np.array([high[0], -low[2], high[1]])
+
+
+def test_the_tileset_is_3d_tiles_1_1(city: Path) -> None:
+    document = _tileset(city)
+    assert document["asset"]["version"] == "1.1"
+    root = document["root"]
+    assert document["geometricError"] == root["geometricError"]
+    assert len(root["transform"]) == 16 and root["transform"][15] == 1.0
+    uris = []
+    for tile, parent in _tiles(root):
+        assert set(tile) <= {"transform", "boundingVolume", "geometricError", "refine"} | {
+            "content",
+            "children",
+        }
+        assert len(tile["boundingVolume"]["box"]) == 12
+        assert tile["geometricError"] >= 0 and tile["refine"] in ("REPLACE", "ADD")
+        if parent is not None:
+            assert "transform" not in tile
+        if "content" in tile:
+            uri = tile["content"]["uri"]
+            uris.append(uri)
+            data = (city / "3dtiles" / uri).read_bytes()
+            magic, version, length = struct.unpack_from("<III", data)
+            assert (magic, version, length) == (0x46546C67, 2, len(data))  # glTF content
+    assert len(uris) == len(set(uris))
+    for path in _paths(root):  # from the root to each leaf: each LOD once, coarse to fine
+        assert [int(t["content"]["uri"][-5]) for t in path if "content" in t] == [1, 2, 3]
+    lod3 = [
+        node["name"]
+        for uri in uris
+        if uri.endswith(".lod3.glb")
+        for node in read_glb((city / "3dtiles" / uri).read_bytes())[0]["nodes"]
+        if "/" in node["name"] and node["name"].count("/") == 1
+    ]
+    assert sorted(lod3) == sorted(f"way/{1000 + k}" for k in range(10))  # each house once
+
+
+def _paths(tile: dict[str, Any]) -> Iterator[list[dict[str, Any]]]:
+    if not tile.get("children"):
+        yield [tile]
+    for child in tile.get("children", []):
+        for path in _paths(child):
+            yield [tile, *path]
+
+
+def _leaves(root: dict[str, Any]) -> list[dict[str, Any]]:
+    return [t for t, _ in _tiles(root) if not t.get("children")]
+
+
+def test_levels_of_detail_come_coarse_to_fine_with_falling_errors(city: Path) -> None:
+    root = _tileset(city)["root"]
+    assert "content" not in root and len(root["children"]) > 1  # a quadtree over the tiles
+    levels = set()
+    for path in _paths(root):
+        errors = [t["geometricError"] for t in path]
+        assert errors == sorted(errors, reverse=True)  # never rising toward the leaves
+        shown = [i for i, t in enumerate(path) if "content" in t]
+        empty_above = path[: shown[0] + 1]  # no content yet: all of it missing
+        assert all(
+            a["geometricError"] > b["geometricError"] for a, b in itertools.pairwise(empty_above)
+        )
+        by_lod = {int(path[i]["content"]["uri"][-5]): errors[i] for i in shown}
+        assert by_lod[1] > by_lod[2] >= 3.0 > by_lod[3] == 0  # LOD2: at least a storey
+        levels.update(path[i]["content"]["uri"].split("/")[0] for i in shown)
+    assert len(levels) > 1  # coarse LODs in larger squares than the façades
+    for tile, parent in _tiles(root):  # a viewer that refined a tile goes on through empty
+        if parent is not None and "content" not in tile and "content" in parent:
+            assert tile["geometricError"] == parent["geometricError"]  # ones, to content
+    for leaf in _leaves(root):
+        assert leaf["geometricError"] == 0 and leaf["content"]["uri"].endswith(".lod3.glb")
+
+
+def test_boxes_hold_their_content_and_their_children(city: Path) -> None:
+    for tile, parent in _tiles(_tileset(city)["root"]):
+        low, high = _corners(tile["boundingVolume"]["box"])
+        if "content" in tile:
+            found_low, found_high = _content_bounds(city / "3dtiles" / tile["content"]["uri"])
+            assert np.all(found_low >= low) and np.all(found_high <= high)
+            assert np.all(found_high - found_low > 0.5 * (high - low))  # and not much more
+        if parent is not None:
+            outer_low, outer_high = _corners(parent["boundingVolume"]["box"])
+            assert np.all(low >= outer_low - 1e-9) and np.all(high <= outer_high + 1e-9)
+
+
+def _on_globe(transform: list[float], point: tuple[float, float, float]) -> tuple[float, ...]:
+    """A tile-frame point through the root transform: lon, lat, height (PROJ's)."""
+    matrix = np.array(transform).reshape(4, 4).T  # column-major
+    x, y, z, _ = matrix @ np.array([*point, 1.0])
+    to = pyproj.Transformer.from_crs(ECEF, GEODETIC, always_xy=True)
+    return tuple(float(v) for v in to.transform(x, y, z))
+
+
+def test_the_root_transform_puts_the_local_frame_on_the_globe(city: Path) -> None:
+    frame = json.loads((city / f"{city.name}.georef.json").read_text())
+    transform = _tileset(city)["root"]["transform"]
+    utm = pyproj.Transformer.from_crs(frame["crs"], GEODETIC, always_xy=True)
+    geod = pyproj.Geod(ellps="WGS84")
+    for x, y, z in [(0, 0, 0), (120, 0, 0), (0, 90, 0), (80, 70, 15), (-50, 30, 40)]:
+        lon, lat, height = _on_globe(transform, (x, y, z))
+        want = utm.transform(frame["origin"][0] + x, frame["origin"][1] + y, 0.0)
+        _, _, apart = geod.inv(lon, lat, want[0], want[1])
+        assert apart < 0.01  # metres, 150 m from the origin
+        assert height == pytest.approx(z, abs=0.01)  # up is up: the Earth's curve is cm
+
+
+def test_each_house_stands_where_its_footprint_is(city: Path) -> None:
+    """A house's LOD1 block, through the y-up to z-up turn and the root transform, is
+    where the OSM nodes of its footprint are, and as tall as the block is."""
+    transform = _tileset(city)["root"]["transform"]
+    houses = {1000 + k: ring for k, (_, ring, _) in enumerate(_houses(10, seed=3))}
+    document, binary = read_glb(next((city / "3dtiles").rglob("*.lod1.glb")).read_bytes())
+    accessor = document["accessors"][
+        document["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+    ]
+    view = document["bufferViews"][accessor["bufferView"]]
+    start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+    points = np.frombuffer(binary, "<f4", accessor["count"] * 3, start).reshape(-1, 3)
+    top = points[points[:, 1] == points[:, 1].max()]  # the tallest block's lid
+    centre = (top[:, 0].mean(), -top[:, 2].mean(), float(top[0, 1]))
+    lon, lat, height = _on_globe(transform, centre)
+    nearest = min(
+        houses.values(),
+        key=lambda ring: (
+            abs(np.mean([p[0] for p in ring]) * METRE_LON + ORIGIN[0] - lon)
+            + abs(np.mean([p[1] for p in ring]) * METRE_LAT + ORIGIN[1] - lat)
+        ),
+    )
+    want_lon = ORIGIN[0] + np.mean([p[0] for p in nearest]) * METRE_LON
+    want_lat = ORIGIN[1] + np.mean([p[1] for p in nearest]) * METRE_LAT
+    _, _, apart = pyproj.Geod(ellps="WGS84").inv(lon, lat, want_lon, want_lat)
+    assert apart < 0.5  # metres: the district's own degrees-to-metres is approximate
+    assert height == pytest.approx(centre[2], abs=0.01) and height > 3.0
+
+
+def test_lod1_is_lighter_than_lod2_lighter_than_lod3(city: Path) -> None:
+    report = json.loads((city / f"{city.name}.report.json").read_text())
+    tiles = report["models"]["3dtiles"]
+    assert tiles["lods"] == [1, 2, 3]
+    triangles = tiles["triangles"]
+    assert 0 < triangles["lod1"] < triangles["lod2"] < triangles["lod3"]
+    sizes = tiles["bytes"]
+    assert sizes["lod1"] < sizes["lod2"] < sizes["lod3"]
+
+
+def test_the_same_city_gives_the_same_tiles(city: Path, tmp_path: Path) -> None:
+    _build(tmp_path / "out", jobs=2)
+    ours = sorted(p.relative_to(city) for p in (city / "3dtiles").rglob("*") if p.is_file())
+    theirs = sorted(
+        p.relative_to(tmp_path / "out") for p in (tmp_path / "out" / "3dtiles").rglob("*")
+    )
+    assert ours == [p for p in theirs if (tmp_path / "out" / p).is_file()]
+    for path in ours:
+        assert (city / path).read_bytes() == (tmp_path / "out" / path).read_bytes(), path
+
+
+def test_a_run_chooses_its_levels_of_detail(tmp_path: Path) -> None:
+    report = _build(tmp_path / "out", jobs=1, lods=(1, 3))
+    assert report["models"]["3dtiles"]["lods"] == [1, 3]
+    root = _tileset(tmp_path / "out")["root"]
+    uris = [t["content"]["uri"] for t, _ in _tiles(root) if "content" in t]
+    assert {uri[-8:] for uri in uris} == {"lod1.glb", "lod3.glb"}
+    files = {p.name[-8:] for p in (tmp_path / "out" / "3dtiles").rglob("*.glb")}
+    assert files == {"lod1.glb", "lod3.glb"}
+    # again with blocks only: the tiles the tileset no longer names are gone
+    _build(tmp_path / "out", jobs=1, lods=(1,))
+    assert {p.name[-8:] for p in (tmp_path / "out" / "3dtiles").rglob("*.glb")} == {"lod1.glb"}
+
+
+@pytest.mark.parametrize("text", ["", "0", "4", "1,x", "lod1", "1;2"])
+def test_a_bad_lod_list_is_refused(text: str) -> None:
+    with pytest.raises(SpecError, match="--lod"):
+        parse_lods(text)
+
+
+def test_lod_lists_are_read_coarse_to_fine() -> None:
+    assert parse_lods("3,1") == (1, 3)
+    assert parse_lods(" 2 , 2,1 ") == (1, 2)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) -> None:
+    rng = random.Random(seed)
+    spread = rng.choice([5.0, 300.0, 20_000.0])
+    points = [(f"b{k}", (rng.uniform(-spread, spread), rng.uniform(0, spread))) for k in range(300)]
+    points += [("twin-a", (1.0, 1.0)), ("twin-b", (1.0, 1.0))]  # one centroid for two
+    capacity = rng.choice([1, 8, 32])
+    root, leaf_of = quadtree(points, capacity)
+    assert sorted(leaf_of) == sorted(bid for bid, _ in points)
+    leaves = []
+    stack = [root]
+    while stack:
+        square = stack.pop()
+        stack.extend(square.children)
+        assert len(square.children) <= 4
+        if not square.children:
+            leaves.append(square)
+            assert len(square.members) <= capacity or square.level == tileset_module.MAX_LEVEL
+    assert sum(len(leaf.members) for leaf in leaves) == len(points)
+    assert leaf_of["twin-a"] is leaf_of["twin-b"]
+
+
+# Outside tools, where they are installed: the 3D Tiles validator and CesiumJS
+
+VALIDATOR = os.environ.get("FACADE_3DTILES_VALIDATOR")  # e.g. "npx 3d-tiles-validator"
+CESIUM = os.environ.get("FACADE_CESIUM")  # a folder with Cesium.js: npm cesium's Build/Cesium
+BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.mark.skipif(not VALIDATOR, reason="set FACADE_3DTILES_VALIDATOR to a validator command")
+def test_the_3d_tiles_validator_finds_nothing(city: Path) -> None:
+    tileset = city / "3dtiles" / "tileset.json"
+    done = subprocess.run(
+        [*shlex.split(str(VALIDATOR)), "--tilesetFile", str(tileset)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    found = json.loads(done.stdout[done.stdout.index("{") :])
+    assert (found["numErrors"], found["numWarnings"]) == (0, 0), done.stdout
+
+
+PAGE = """<!doctype html>
+<html><head><meta charset="utf-8"><title>loading: tileset</title>
+<script>window.CESIUM_BASE_URL = "cesium/";</script>
+<script src="cesium/Cesium.js"></script>
+<link href="cesium/Widgets/widgets.css" rel="stylesheet">
+<style>html, body, #globe { margin: 0; width: 100%; height: 100%; overflow: hidden }</style>
+</head><body><div id="globe"></div><script>
+// No network: no Cesium ion, no imagery, a plain globe on the WGS 84 ellipsoid.
+async function main() {
+  Cesium.Ion.defaultAccessToken = "";
+  const viewer = new Cesium.Viewer("globe", {
+    baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
+    animation: false, homeButton: false, sceneModePicker: false, fullscreenButton: false,
+    navigationHelpButton: false, infoBox: false, selectionIndicator: false,
+    terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false,
+    skyAtmosphere: false, contextOptions: { webgl: { preserveDrawingBuffer: true } },
+  });
+  viewer.scene.globe.baseColor = Cesium.Color.fromCssColorString("#7d9a6a");
+  const tileset = await Cesium.Cesium3DTileset.fromUrl("tiles/tileset.json",
+                                                       { maximumScreenSpaceError: 2 });
+  viewer.scene.primitives.add(tileset);
+  const sphere = tileset.boundingSphere;
+  viewer.camera.flyToBoundingSphere(sphere, { duration: 0, offset: new Cesium.HeadingPitchRange(
+    Cesium.Math.toRadians(30), Cesium.Math.toRadians(-35), sphere.radius * 2.2) });
+  const at = Cesium.Cartographic.fromCartesian(sphere.center);
+  tileset.allTilesLoaded.addEventListener(() => {
+    const degrees = (v) => Cesium.Math.toDegrees(v).toFixed(8);
+    document.title = `loaded ${degrees(at.longitude)} ${degrees(at.latitude)} ${at.height}`;
+  });
+}
+main().catch((error) => { document.title = "error: " + error; });
+</script></body></html>
+"""
+
+
+def _served(folder: Path) -> Iterator[str]:
+    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(folder))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}/index.html"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+@pytest.mark.skipif(
+    not CESIUM or not (Path(str(CESIUM)) / "Cesium.js").is_file(),
+    reason="set FACADE_CESIUM to npm cesium's Build/Cesium",
+)
+def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: Path) -> None:
+    """CesiumJS in headless Chromium loads every tile it needs and flies to the tileset;
+    the centre of the bounding sphere it computed is where PROJ puts the root box's
+    centre, within a centimetre, and the picture shows the houses on the globe."""
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "cesium").symlink_to(Path(str(CESIUM)).resolve())
+    (site / "tiles").symlink_to(city / "3dtiles")
+    (site / "index.html").write_text(PAGE)
+    shot = tmp_path / "globe.png"
+    title = ""
+    for url in _served(site):
+        for budget in (20_000, 60_000):
+            flags = [
+                "--headless", "--no-sandbox", "--disable-gpu", "--use-gl=swiftshader",
+                "--enable-unsafe-swiftshader", "--no-first-run",
+                "--disable-background-networking", f"--user-data-dir={tmp_path / 'profile'}",
+                "--window-size=1000,600", f"--virtual-time-budget={budget}",
+            ]  # fmt: skip
+            run = [str(BROWSER), *flags]
+            subprocess.run([*run, f"--screenshot={shot}", url], timeout=300, check=False)
+            dom = subprocess.run(
+                [*run, "--dump-dom", url], timeout=300, capture_output=True, text=True
+            ).stdout
+            title = re.search(r"<title>([^<]*)</title>", dom).group(1)  # type: ignore[union-attr]
+            if title.startswith("loaded"):
+                break
+    assert title.startswith("loaded"), title
+    lon, lat, height = (float(v) for v in title.split()[1:])
+    document = _tileset(city)
+    low, high = _corners(document["root"]["boundingVolume"]["box"])
+    want = _on_globe(document["root"]["transform"], tuple((low + high) / 2))
+    _, _, apart = pyproj.Geod(ellps="WGS84").inv(lon, lat, want[0], want[1])
+    assert apart < 0.01 and height == pytest.approx(want[2], abs=0.01)
+    houses = np.array([p for _, ring, _ in _houses(10, seed=3) for p in ring])
+    middle = (houses.min(axis=0) + houses.max(axis=0)) / 2  # metres east, north of ORIGIN
+    _, _, off = pyproj.Geod(ellps="WGS84").inv(
+        lon, lat, ORIGIN[0] + middle[0] * METRE_LON, ORIGIN[1] + middle[1] * METRE_LAT
+    )
+    assert off < 1.0  # metres: the footprints' own middle, from the OSM degrees
+    from PIL import Image
+
+    with Image.open(shot) as image:
+        pixels = np.asarray(image.convert("RGB"), dtype=int)[150:450, 300:700]
+    globe = np.array([0x7D, 0x9A, 0x6A])
+    houses_drawn = int((np.abs(pixels - globe).sum(axis=2) > 40).sum())
+    assert houses_drawn > 0.2 * pixels.shape[0] * pixels.shape[1]  # a fifth of the middle
+
+
+def test_the_command_line_refuses_a_bad_lod_before_any_work(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    town = ROOT / "samples" / "town.osm"
+    code, _, err = facade(capsys, "city", town, "-o", tmp_path / "out", "--3dtiles", "--lod", "4")
+    assert code == 2 and "--lod" in err and "1 (blocks)" in err
+    code, _, err = facade(capsys, "city", town, "-o", tmp_path / "out", "--lod", "1")
+    assert code == 2 and "--3dtiles" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_leaf_is_written_when_its_last_building_is_done(city: Path, tmp_path: Path) -> None:
+    """The tiles stream: a leaf's files appear with its last building, before the others
+    are done, and tileset.json only at the end."""
+    frame = json.loads((city / f"{city.name}.georef.json").read_text())
+    georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
+    glbs = sorted((city / "buildings").glob("*.glb"))
+    places = [(glb.stem, (100.0 * (k % 2), 0.0)) for k, glb in enumerate(glbs)]  # two leaves
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tileset_module, "CAPACITY", dict.fromkeys((1, 2, 3), len(glbs) // 2))
+        writer = TilesetWriter(tmp_path, georef, (1, 2, 3), places)
+    east = [glb for k, glb in enumerate(glbs) if k % 2]
+    west = [glb for k, glb in enumerate(glbs) if not k % 2]
+    for glb in east[:-1]:
+        writer.done(glb.stem, glb)
+    assert not list((tmp_path / "3dtiles").rglob("*.glb"))
+    writer.done(east[-1].stem, east[-1])
+    assert len(list((tmp_path / "3dtiles").rglob("*.glb"))) == 3  # LOD1, 2, 3 of one leaf
+    for glb in west[:-1]:
+        writer.done(glb.stem, glb)
+    writer.done(west[-1].stem, None)  # a failed building: left out, its leaf written
+    assert len(list((tmp_path / "3dtiles").rglob("*.glb"))) == 6
+    assert not (tmp_path / "3dtiles" / "tileset.json").exists()
+    summary = writer.close("streamed")
+    assert summary["tiles"] == 6 and (tmp_path / "3dtiles" / "tileset.json").is_file()
+
+
+def test_a_resumed_run_writes_the_same_tiles(city: Path, tmp_path: Path) -> None:
+    copy = tmp_path / "out"
+    shutil.copytree(city, copy)
+    shutil.rmtree(copy / "3dtiles")
+    district = city.parent / f"{city.name}.osm"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tileset_module, "CAPACITY", SMALL)
+        report = run_city(default_city(district, SPEC), copy, resume=True, lods=(1, 2, 3))
+    assert all(b.get("resumed") for b in report["buildings"])
+    for path in sorted((city / "3dtiles").rglob("*")):
+        if path.is_file():
+            assert path.read_bytes() == (copy / path.relative_to(city)).read_bytes(), path
+
+
+def test_a_viewer_goes_on_through_empty_squares_to_the_content_below(
+    city: Path, tmp_path: Path
+) -> None:
+    """Blocks and roofs for all ten houses at the root, façades a house a tile: the
+    squares between have no content, and each takes the error of the tile above with
+    content, or a viewer would stop refining at them and show nothing there."""
+    frame = json.loads((city / f"{city.name}.georef.json").read_text())
+    georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
+    glbs = sorted((city / "buildings").glob("*.glb"))
+    places = [(glb.stem, (37.0 * k % 100, 11.0 * k)) for k, glb in enumerate(glbs)]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tileset_module, "CAPACITY", {1: 10, 2: 10, 3: 1})
+        writer = TilesetWriter(tmp_path, georef, (1, 2, 3), places)
+    for glb in glbs:
+        writer.done(glb.stem, glb)
+    writer.close("deep")
+    root = _tileset(tmp_path)["root"]
+    assert root["content"]["uri"].endswith("lod1.glb")
+    lod2 = root["children"][0]
+    empty = 0
+    for path in _paths(root):
+        for above, tile in itertools.pairwise(path):
+            if "content" not in tile:
+                empty += 1
+                assert tile["geometricError"] == lod2["geometricError"] > 0
+            assert tile["geometricError"] <= above["geometricError"]
+    assert empty > 0
