@@ -19,6 +19,7 @@ import pytest
 from facadecli import parse_spec, solve
 from facadecli.grammar.inputs import LabelledLayout, Rect
 from facadecli.grammar.run import Options
+from facadecli.infer.layers import Grid, frames
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.structure import NEAR, structured
 from facadecli.solve import retarget
@@ -151,3 +152,84 @@ def test_structure_shares_sizes_and_lines_but_keeps_small_neighbours_apart() -> 
             (before.y0 + before.y1, after.y0 + after.y1),
         ):
             assert abs(a - b) / 2 <= NEAR * 10.0 + 1e-9
+
+
+def _overlapping(rects: list[Rect]) -> int:
+    shown = [r for r in rects if r.label in ("window", "door")]
+    return sum(
+        min(a.x1, b.x1) - max(a.x0, b.x0) > 0.01 and min(a.y1, b.y1) - max(a.y0, b.y0) > 0.01
+        for a, b in itertools.combinations(shown, 2)
+    )
+
+
+@pytest.mark.parametrize("seed", [2, 5, 9, 24])
+@pytest.mark.parametrize("share", [1.5, 2.0])
+def test_a_family_facade_solved_wider_gains_bays_with_no_opening_over_another(
+    tmp_path: Path, seed: int, share: float
+) -> None:
+    """A floor's windows drawn a few centimetres apart (a sill or a blind holds an edge)
+    are one row, and the door between the ground floor's windows shares their word: the
+    layers of a floor gain bays together, never over one another."""
+    path = tmp_path / f"family-{seed}.xml"
+    path.write_text(cmp_xml(family(seed)[0]))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    spec = parse_spec(inference.text, path.stem)
+    layout = solve(retarget(spec, 15.0 * share, 15.0))
+    rects = list(solved_layout(layout, spec, inference).rects)
+    assert _overlapping(rects) == 0
+    assert len(_of(rects, "door")) == 1
+    known = family(seed)[1]
+    assert len(_of(rects, "window")) / known.windows >= 0.85 * share  # bays gained
+
+
+def test_the_ground_floor_stays_on_the_ground_as_a_taller_facade_gains_floors(
+    tmp_path: Path,
+) -> None:
+    """A door between the ground floor's windows, the floors above at one pitch: 1.5 times
+    as tall, the door and the ground floor keep their height and place, and whole floors
+    are added above at the input's pitch, over nothing."""
+    rng = random.Random(7)
+    rects = []
+    for f in range(4):
+        for k in range(5):
+            cx = 2.3 + k * 2.6 + rng.uniform(-0.01, 0.01)
+            if f == 0 and k == 2:
+                rects.append(
+                    {"label": "door", "x0": cx - 0.7, "y0": 0.0, "x1": cx + 0.7, "y1": 2.6}
+                )
+                continue
+            y0 = 1.5 + f * PITCH_Y + rng.uniform(-0.01, 0.01)
+            rects.append(
+                {"label": "window", "x0": cx - 0.6, "y0": y0, "x1": cx + 0.6, "y1": y0 + 1.5}
+            )
+    path = tmp_path / "door.json"
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": HEIGHT}, "rects": rects}))
+    solved = _solved(path, WIDTH, HEIGHT * 1.5)
+    (door,) = _of(solved, "door")
+    assert door.y0 == pytest.approx(0.0, abs=1e-6)
+    assert door.y1 == pytest.approx(2.6, abs=0.03)
+    windows = _of(solved, "window")
+    floors = sorted({round(r.y0, 2) for r in windows})
+    assert floors[0] == pytest.approx(1.5, abs=0.03)
+    assert len(floors) >= 6
+    assert all(b - a == pytest.approx(PITCH_Y, abs=0.05) for a, b in itertools.pairwise(floors))
+    assert _overlapping(solved) == 0
+
+
+def test_a_door_between_windows_shares_their_word_and_two_grids_of_a_label_never_do() -> None:
+    window = Grid("window", ((1.0, 2.0), (5.0, 6.0)), ((1.5, 3.0),))
+    door = Grid("door", ((3.0, 4.0),), ((0.0, 3.0),))
+    upper = Grid("window", ((1.0, 2.0), (3.0, 4.0), (5.0, 6.0)), ((4.0, 5.5),))
+    found = frames([window, door, upper])
+    assert (
+        found[0]
+        == found[1]
+        == (
+            ((1.0, 2.0), "window"),
+            ((3.0, 4.0), "door"),
+            ((5.0, 6.0), "window"),
+        )
+    )
+    assert found[2] is None  # above the door: not beside it
+    other = Grid("window", ((7.0, 8.0),), ((1.4, 3.0),))  # a ground-floor window drawn apart
+    assert frames([window, door, other]) == [None, None, None]

@@ -266,23 +266,22 @@ def test_the_alignment_qp_makes_near_misses_of_the_style_exact() -> None:
     assert abs(plain_door.x0 + plain_door.x1 - 11.4) > 0.1  # without the style it stays off
 
 
-def test_variations_shuffle_parts_of_one_size_and_the_first_keeps_the_style(
+def test_a_shuffle_that_breaks_the_style_is_no_variation(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    """Shuffling parts of one size moves the door to where a shop was, off the centre
+    line: that breaks the style, so it is not given as a variation (issue 34: every
+    variation keeps the style as variation 0 does); the first keeps it."""
     # no drawn proportions: they keep the centre line, so they would come before shuffles
     monkeypatch.setattr("facadecli.proportions.DRAWS", 0)
     shops = [Box("shop", 2.1, 0.0, 3.3, 2.6), Box("shop", 8.1, 0.0, 9.3, 2.6)]
     extraction = _extracted(tmp_path, _palazzo() + shops, 11.4, 10.0)
-    found, _ = derive_variations(
+    found, notes = derive_variations(
         extraction.grammar, extraction.tiling, 11.4, 10.0, "p", 6, 0, extraction.style
     )
-    assert len(found) >= 2 and found[0].shuffle is None and not found[0].kept.broken
-    shuffled = [v for v in found if v.shuffle is not None]
-    assert shuffled
-    for variation in shuffled:  # the door moved to where a shop was, a shop to the middle
-        doors = [s for s in variation.layout.shapes if s.layer == "door" and s.visible]
-        assert doors and all(abs(s.x0 + s.x1 - 11.4) > 1.0 for s in doors)
-        assert len(variation.kept.broken) >= 1  # off the centre line
+    assert found[0].shuffle is None and not found[0].kept.broken
+    assert all(len(v.kept.kept) >= len(found[0].kept.kept) for v in found)
+    assert all(v.shuffle is None for v in found) and notes  # fewer than asked, said so
 
 
 def test_a_layout_derived_at_its_own_size_is_the_input(tmp_path: Path) -> None:

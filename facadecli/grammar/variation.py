@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from facadecli import proportions
-from facadecli.grammar.pieces import Piece, elements_of, likeness, score
+from facadecli.grammar.pieces import Piece, apart, elements_of, likeness, score
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
 from facadecli.grammar.style import (
@@ -72,6 +72,7 @@ CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fe
 SHUFFLES_MAX = 6  # new orders of one split rule's parts tried as variations
 STYLE_MAX = 81  # ... and for one layout, when the best fit breaks some of the style (3^4)
 TEMPERATURE = 0.1  # of the score: how strongly variations near the source's sizes are preferred
+APART = 0.01  # of the façade's smaller side: the least mean displacement between variations
 NAME_MAX = 150  # characters of the source's name in a derived layout's name
 
 
@@ -700,7 +701,11 @@ def derive_variations(
     and among those it is the nearest the source's sizes (the best fit, when it keeps as
     much as any). The others are drawn at random (``seed``) among the candidates that keep
     as much, then among the rest, favouring low scores, and ordered by what they keep and
-    their score. Named ``<name>-<W>x<H>`` when ``count`` is 1, else ``<name>-<W>x<H>-v<K>``."""
+    their score; each differs visibly from every one before it (``pieces.apart``: more
+    or fewer elements of a label, or its elements a mean ``APART`` of the façade's smaller
+    side or more from theirs) and
+    keeps as much of the style as variation 0, so fewer than ``count`` may exist. Named
+    ``<name>-<W>x<H>`` when ``count`` is 1, else ``<name>-<W>x<H>-v<K>``."""
     source = (tiling.xs[-1], tiling.ys[-1])
     stem = f"{_safe(name)}-{width:g}x{height:g}"
     grammar = _with_runs(grammar, source)
@@ -810,15 +815,24 @@ def derive_variations(
     )
     chosen: list[tuple[_Candidate, list[Piece], list[str], Kept]] = []
     aligned_seen = {_key(aligned)}
+    shown = [aligned]  # the variations so far: another differs visibly from each
+    least = APART * min(width, height)
     for other in drawn:  # aligned, two could still coincide
         if len(chosen) == count - 1:
             break
+        if not all(apart(other.pieces, p, least) for p in shown):
+            continue  # too near one as derived: not tidied (tidying moves edges a little)
         moved, moved_warnings, keeps = _tidied(
             other.pieces, other.kept, kept, width, height, style, bool(other.retarget)
         )
         key = _key(moved)
-        if key not in aligned_seen:
+        if (
+            key not in aligned_seen
+            and len(keeps.kept) >= len(found[0].kept.kept)  # the style, as variation 0 keeps it
+            and all(apart(moved, p, least) for p in shown)
+        ):
             aligned_seen.add(key)
+            shown.append(moved)
             chosen.append((other, moved, moved_warnings, keeps))
     chosen.sort(key=lambda c: (-len(c[3].kept), c[0].rank[2:]))
     for k, (other, moved, moved_warnings, keeps) in enumerate(chosen, start=1):
@@ -841,7 +855,9 @@ def derive_variations(
             f"only {len(found)} of {count} variations exist (repeat counts within 1 of the "
             f"best fit whose copies stretch by at most {STRETCH:.0%}, parts of a split "
             "that are as long as each other in a new order, and parts' proportions drawn "
-            "near the source's)"
+            "near the source's; each keeping as much of the style as the first, with more "
+            f"or fewer elements, or its elements a mean {APART:.0%} of the façade's smaller "
+            "side or more from every other's)"
         )
     return found, notes
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass
+from itertools import pairwise
 
 from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
 
@@ -130,3 +131,48 @@ def _reach(spans: tuple[Span, ...], extent: float) -> tuple[Span, ...]:
     if last[1] - last[0] > BAND * extent and 0 < extent - last[1] <= EDGE * extent:
         reached[-1] = (last[0] if len(reached) > 1 else first[0], extent)
     return tuple(reached)
+
+
+Frame = tuple[tuple[Span, str], ...]  # columns left to right, each with its label
+
+
+def frames(found: list[Grid]) -> list[Frame | None]:
+    """For each grid, the columns its layer's x word is written over: its own and those of
+    the grids of other opening labels that stand beside it on a floor (rows overlapping
+    along y, columns apart along x: a door between the ground floor's windows), so that
+    the layers of one floor share one word, each showing its own elements (its mask), and
+    solved wider they gain bays together instead of over one another. None where a grid
+    has no such neighbour, where the floor's columns would overlap, or where two grids of
+    one label would share the word (each would show the other's elements)."""
+    openings = [k for k, g in enumerate(found) if g.label in OPENINGS]
+    parent = {k: k for k in openings}
+
+    def root(k: int) -> int:
+        while parent[k] != k:
+            k = parent[k]
+        return k
+
+    for n, a in enumerate(openings):
+        for b in openings[n + 1 :]:
+            ga, gb = found[a], found[b]
+            if ga.label == gb.label:
+                continue
+            beside = any(_overlap(r, s) for r in ga.rows for s in gb.rows)
+            apart = not any(_overlap(c, d) for c in ga.columns for d in gb.columns)
+            if beside and apart:
+                parent[root(b)] = root(a)
+    members: dict[int, list[int]] = defaultdict(list)
+    for k in openings:
+        members[root(k)].append(k)
+    out: list[Frame | None] = [None] * len(found)
+    for group in members.values():
+        labels = [found[k].label for k in group]
+        if len(group) < 2 or len(set(labels)) < len(labels):
+            continue  # two grids of a label would each show the other's elements
+        columns = sorted({(c, found[k].label) for k in group for c in found[k].columns})
+        spans = [c for c, _ in columns]
+        if any(b[0] < a[1] - 1e-9 for a, b in pairwise(spans)):
+            continue  # overlapping columns (or one span of two labels): no shared word
+        for k in group:
+            out[k] = tuple(columns)
+    return out

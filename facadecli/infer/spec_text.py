@@ -32,7 +32,7 @@ import re
 from dataclasses import dataclass, field
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.layers import Grid, Span, uncovered
+from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, uncovered
 
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
@@ -104,17 +104,23 @@ Spread = dict[tuple[str, str, float], tuple[float, float]]  # (axis, label, size
 
 
 def _tokens(
-    spans: tuple[Span, ...], extent: float, element: _Symbols, gap: _Symbols, margin: _Symbols
+    spans: tuple[Span, ...],
+    extent: float,
+    element: _Symbols | list[_Symbols],
+    gap: _Symbols,
+    margin: _Symbols,
 ) -> list[Token]:
     """(symbol, size) of the elements and the gaps between them, from 0 to ``extent``; the
-    gaps before the first element and after the last are margins (symbols of their own)."""
+    gaps before the first element and after the last are margins (symbols of their own).
+    ``element``: the symbols of the elements, or of each span (a frame's, by label)."""
     tokens: list[Token] = []
     cursor = 0.0
-    for a, b in spans:
+    for k, (a, b) in enumerate(spans):
         if a - cursor > 1e-9 * extent:
             table = margin if cursor == 0.0 else gap
             tokens.append((table.of(a - cursor), a - cursor))
-        tokens.append((element.of(b - a), b - a))
+        symbols = element[k] if isinstance(element, list) else element
+        tokens.append((symbols.of(b - a), b - a))
         cursor = b
     if extent - cursor > 1e-9 * extent:
         tokens.append((margin.of(extent - cursor), extent - cursor))
@@ -218,30 +224,48 @@ def spec_text(
     margined: set[str] = set()  # gaps of words with a margin: the margins take the slack
     loose: set[str] = set()  # symbols of words without a margin: they take the slack
     held: set[str] = set()  # gaps of words with a run and a margin: they keep their size
+    grounded: set[str] = set()  # elements of words from the ground up: they do not grow
     layers: list[tuple[str, Grid, str, str]] = []
-    for layer, grid in zip(layer_names(found), found, strict=True):
+    for grid in found:
         base = ident(grid.label)
-        symbols = elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
+        elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
+    unique = {elements[label][0].prefix for label in UNIQUE if label in elements}
+    top = _floors_top(found)
+    for layer, grid, frame in zip(layer_names(found), found, frames(found), strict=True):
+        symbols = elements[grid.label]
+        columns = grid.columns if frame is None else tuple(c for c, _ in frame)
         introduced = [
             symbols
-            for table, spans, axis in ((gaps_x, grid.columns, "x"), (gaps_y, grid.rows, "y"))
+            for table, spans, axis in ((gaps_x, columns, "x"), (gaps_y, grid.rows, "y"))
             if spans not in table
             for symbols in table.setdefault(
                 spans, (_Symbols(f"{layer}_g{axis}"), _Symbols(f"{layer}_m{axis}"))
             )
         ]
         owned.append(introduced)
-        x_tokens = _tokens(grid.columns, width, symbols[0], *gaps_x[grid.columns])
+        x_tokens = _tokens(columns, width, _by_label(frame, elements, symbols[0]), *gaps_x[columns])
         y_tokens = _tokens(grid.rows, height, symbols[1], *gaps_y[grid.rows])
         words = []
         for axis, tokens, spans, (gaps, margins) in (
-            ("x", x_tokens, grid.columns, gaps_x[grid.columns]),
+            ("x", x_tokens, columns, gaps_x[columns]),
             ("y", y_tokens, grid.rows, gaps_y[grid.rows]),
         ):
             if len(tokens) == len(spans):  # no gap: nothing else takes a longer façade
                 stretched.update(symbol for symbol, _ in tokens)
             ends = _names(margins)
-            word = _word(tokens, axis, counters, repeated, grid.label not in UNIQUE, ends)
+            if axis == "x" and frame is not None:  # one word for the floor: runs of no door
+                kept = frozenset(s for s, _ in tokens if s.rstrip("0123456789") in unique)
+                word = _word(tokens, axis, counters, repeated, True, ends | kept)
+            else:
+                word = _word(tokens, axis, counters, repeated, grid.label not in UNIQUE, ends)
+            if axis == "y" and tokens[0][0] in ends and tokens[-1][0] in ends:
+                # a taller façade grows at the top of the floors: what stands on them keeps
+                # its margin to the ground, what stands above them its margin to the top
+                bottom, high = tokens[0][0], tokens[-1][0]
+                if bottom != high:
+                    margined.add(high if grid.rows[0][0] >= top else bottom)
+            elif axis == "y" and tokens[-1][0] in ends and tokens[0][0] not in ends:
+                grounded.update(symbol for symbol, _ in tokens[:-1])  # a door keeps its height
             if not {tokens[0][0], tokens[-1][0]} & ends:  # no margin: its letters stay free
                 loose.update(symbol for symbol, _ in tokens)
             elif "^n" in word:  # a run: the counter and the margins take the slack
@@ -276,6 +300,7 @@ def spec_text(
                     None if symbol in stretched else spread.get((axis, label, size)),
                     symbol in fixed,
                     label in clear,
+                    symbol in grounded,
                 ),
             )
             for axis, table in zip("xy", pair, strict=True)
@@ -328,6 +353,26 @@ def spec_text(
     return "\n".join(out) + "\n"
 
 
+def _floors_top(found: list[Grid]) -> float:
+    """Where the floors end: the top of the opening grid with the most rows (windows on a
+    tie); a grid starting there or higher stands above them (an attic, a top cornice)."""
+    openings = [g for g in found if g.label in OPENINGS]
+    if not openings:
+        return float("inf")
+    floors = max(openings, key=lambda g: (len(g.rows), g.label == "window", g.elements))
+    return floors.rows[-1][1]
+
+
+def _by_label(
+    frame: Frame | None, elements: dict[str, tuple[_Symbols, _Symbols]], own: _Symbols
+) -> _Symbols | list[_Symbols]:
+    """The element symbols of a layer's columns: its label's (``own``), or along a frame,
+    each column's label's (the other labels' hidden by the layer's mask)."""
+    if frame is None:
+        return own
+    return [elements[label][0] for _, label in frame]
+
+
 def _gap(size: float, repeated: bool, margined: bool) -> str:
     """A gap's size: the gaps of a word with a run and a margin keep it (``min`` and
     ``max``: the bays keep their pitch and the counter and the margins take the slack, so
@@ -350,6 +395,7 @@ def _size(
     spread: tuple[float, float] | None,
     repeated: bool = False,
     unoccludable: bool = False,
+    grounded: bool = False,
 ) -> str:
     """A symbol's size, with the bounds the input shows (``spread``: the least and
     greatest size its elements had before regularising; None for bands, which stretch
@@ -360,12 +406,15 @@ def _size(
     pitch, and the layers sharing the run's counter keep their columns together.
     ``unoccludable`` for openings nothing covers in the input: each layer is its own
     alignment group, so it steers nothing until layers are grouped (SPEC 2.6), and then
-    keeps what was clear clear."""
+    keeps what was clear clear. ``grounded``: an element of a word that starts at the
+    ground with no margin (a door): it never grows, the margin over it takes the slack."""
     extra = []
     if spread is not None and repeated:
         extra += [f"min: {_number(size)}", f"max: {_number(size)}"]
     elif spread is not None:
         extra.append(f"max: {_number(max(spread[1], size))}")
+    elif grounded:
+        extra.append(f"max: {_number(size)}")
     if unoccludable:
         extra.append("unoccludable: true")
     if not extra:

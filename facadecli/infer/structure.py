@@ -39,7 +39,7 @@ from collections.abc import Callable
 
 from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
 from facadecli.grammar.tiling import MOVE_SHARE, move_limits
-from facadecli.infer.layers import BAND
+from facadecli.infer.layers import BAND, OPENINGS
 
 SIZE = 0.03  # sizes of a label within this share of one another are one
 JITTER = 0.005  # of the façade: or within this (a hand's error, for small elements)
@@ -48,6 +48,8 @@ PITCH = 0.03  # spacings within this share of one another are one pitch
 SHARE = MOVE_SHARE  # of the narrowest element, gap or visible part an edge bounds
 SAMPLES = 4  # points along each side at which an element is looked at for being hidden
 DIGITS = 9  # of a metre: lines and sizes equal to that are equal (one gap symbol)
+ROW = 0.5  # elements side by side overlapping by this share of the smaller: one row
+ROW_MOVE = 0.1  # of its size: the most an edge of an element moves onto its row
 STRUCTURE = "window"  # of labels with as many elements, the one that sets the structure
 
 
@@ -63,9 +65,135 @@ def structured(layout: LabelledLayout) -> LabelledLayout:
         Rect(r.label, x0, y0, x1, y1, r.z)
         for r, (x0, x1), (y0, y1) in zip(rects, x, y, strict=True)
     ]
-    for k in _colliding(rects, placed) | _hiding(rects):
+    hiding = _hiding(rects)
+    for k in _colliding(rects, placed) | hiding:
         placed[k] = rects[k]
-    return LabelledLayout(layout.width, layout.height, tuple(placed))
+    behind = hiding | _behind(rects)
+    lined = _sizes_shared(placed, behind, "y", layout.height)
+    lined = _sizes_shared(lined, behind, "x", layout.width)
+    lined = _rows_shared(lined, behind, "y", layout.height)
+    lined = _rows_shared(lined, behind, "x", layout.width)
+    moved = {k for k, (a, b) in enumerate(zip(placed, lined, strict=True)) if a != b}
+    while back := (_colliding(placed, lined) | _closing(placed, lined)) & moved:
+        for k in back:  # as the structure had them; which may close another gap: again
+            lined[k] = placed[k]
+        moved -= back
+    return LabelledLayout(layout.width, layout.height, tuple(lined))
+
+
+def _sizes_shared(rects: list[Rect], keep: set[int], axis: str, extent: float) -> list[Rect]:
+    """A label's sizes along ``axis`` that the move limits left apart (a sill under one
+    window, a blind beside another), each within ``2 * SIZE`` of the smallest of its
+    cluster, given the cluster's median about each element's centre, where no edge moves
+    more than ``ROW_MOVE`` of the element (and ``NEAR`` of the façade): the floors of a
+    façade one height, so that its spec repeats them with a counter. Elements in ``keep``
+    stay as they are."""
+    near = NEAR * extent
+
+    def span(r: Rect) -> tuple[float, float]:
+        return (r.y0, r.y1) if axis == "y" else (r.x0, r.x1)
+
+    size = {k: span(r)[1] - span(r)[0] for k, r in enumerate(rects)}
+    by_label: dict[str, list[int]] = defaultdict(list)
+    for k, r in enumerate(rects):
+        if r.label != BACKGROUND and k not in keep and 0 < size[k] <= BAND * extent:
+            by_label[r.label].append(k)
+    out = list(rects)
+    for members in by_label.values():
+        ordered = sorted(members, key=size.__getitem__)
+        for cluster in _chains(ordered, size, lambda first, b: b - first <= 2 * SIZE * first):
+            median = statistics.median(size[k] for k in cluster)
+            if any(abs(size[k] - median) / 2 > min(near, ROW_MOVE * size[k]) for k in cluster):
+                continue
+            for k in cluster:
+                r = rects[k]
+                a, b = span(r)
+                low = round((a + b - median) / 2, DIGITS)
+                high = round(low + median, DIGITS)
+                out[k] = (
+                    Rect(r.label, r.x0, low, r.x1, high, r.z)
+                    if axis == "y"
+                    else Rect(r.label, low, r.y0, high, r.y1, r.z)
+                )
+    return out
+
+
+def _rows_shared(rects: list[Rect], keep: set[int], axis: str, extent: float) -> list[Rect]:
+    """The elements of a label that stand in one row (one floor; along x, one column):
+    side by side, each overlapping the row's first along ``axis`` by ``ROW`` of the
+    smaller, given the row's median span where no edge moves more than ``NEAR`` of the
+    façade (a hand's error, the tidy-up's tolerance). A move limit (``tiling.move_limits``)
+    can leave a floor's windows a few centimetres apart where a sill or a blind meets
+    them; a spec writes each such row as a layer of its own, and solved wider, layers
+    apart gain bays apart, over one another. Elements in ``keep`` (hidden, or hiding
+    others) stay as they are."""
+    near = NEAR * extent
+
+    def span(r: Rect) -> tuple[float, float]:
+        return (r.y0, r.y1) if axis == "y" else (r.x0, r.x1)
+
+    def across(r: Rect) -> tuple[float, float]:
+        return (r.x0, r.x1) if axis == "y" else (r.y0, r.y1)
+
+    by_label: dict[str, list[int]] = defaultdict(list)
+    for k, r in enumerate(rects):
+        a, b = span(r)
+        if r.label != BACKGROUND and k not in keep and 0 < b - a <= BAND * extent:
+            by_label[r.label].append(k)
+    out = list(rects)
+    for members in by_label.values():
+        rows: list[list[int]] = []
+        for k in sorted(members, key=lambda k: span(rects[k])):
+            a, b = span(rects[k])
+            for row in rows:
+                c, d = span(rects[row[0]])
+                apart = all(
+                    min(across(rects[k])[1], across(rects[j])[1])
+                    <= max(across(rects[k])[0], across(rects[j])[0])
+                    for j in row
+                )
+                if apart and min(b, d) - max(a, c) >= ROW * min(b - a, d - c):
+                    row.append(k)
+                    break
+            else:
+                rows.append([k])
+        for row in rows:
+            if len(row) < 2:
+                continue
+            low = statistics.median(span(rects[k])[0] for k in row)
+            high = statistics.median(span(rects[k])[1] for k in row)
+            if any(
+                max(abs(span(rects[k])[0] - low), abs(span(rects[k])[1] - high))
+                > min(near, ROW_MOVE * (span(rects[k])[1] - span(rects[k])[0]))
+                for k in row
+            ):
+                continue
+            for k in row:
+                r = rects[k]
+                out[k] = (
+                    Rect(r.label, r.x0, low, r.x1, high, r.z)
+                    if axis == "y"
+                    else Rect(r.label, low, r.y0, high, r.y1, r.z)
+                )
+        # the rows at one pitch (``_even``), where no element moves too far
+        rows.sort(key=lambda row: sum(span(out[row[0]])))
+        centres = [sum(span(out[row[0]])) / 2 for row in rows]
+        for row, was, now in zip(rows, centres, _even(centres), strict=True):
+            if any(
+                abs(now - was) > min(near, ROW_MOVE * (span(out[k])[1] - span(out[k])[0]))
+                for k in row
+            ):
+                continue
+            for k in row:
+                r = out[k]
+                a, b = span(r)
+                low, high = round(a + now - was, DIGITS), round(b + now - was, DIGITS)
+                out[k] = (
+                    Rect(r.label, r.x0, low, r.x1, high, r.z)
+                    if axis == "y"
+                    else Rect(r.label, low, r.y0, high, r.y1, r.z)
+                )
+    return out
 
 
 def _within_limits(
@@ -86,18 +214,65 @@ def _within_limits(
 
 
 def _colliding(before: list[Rect], after: list[Rect]) -> set[int]:
-    """The elements that overlap or touch one of their label after structuring but did not
-    before (grown a few per cent into a neighbour): they stay as drawn, never fused."""
+    """The elements that overlap or touch one of their label (an opening: any opening)
+    after structuring but did not before (grown a few per cent into a neighbour): they
+    stay as drawn, never fused."""
     by_label: dict[str, list[int]] = defaultdict(list)
     for k, rect in enumerate(after):
-        if rect.label != BACKGROUND:
-            by_label[rect.label].append(k)
+        if rect.label != BACKGROUND:  # openings together: a window never moves onto a door
+            by_label["" if rect.label in OPENINGS else rect.label].append(k)
     found: set[int] = set()
     for members in by_label.values():
         for n, a in enumerate(members):
             for b in members[n + 1 :]:
                 if _meet(after[a], after[b]) and not _meet(before[a], before[b]):
                     found |= {a, b}
+    return found
+
+
+def _closing(before: list[Rect], after: list[Rect]) -> set[int]:
+    """The elements whose gap to one of their label (an opening: to any opening) facing
+    them, overlapping along the other axis, is closed by more than ``SHARE`` of it: the
+    wall between two windows never narrows to a sliver (they would read as one)."""
+    by_label: dict[str, list[int]] = defaultdict(list)
+    for k, rect in enumerate(before):
+        if rect.label != BACKGROUND:
+            by_label["" if rect.label in OPENINGS else rect.label].append(k)
+    found: set[int] = set()
+    for members in by_label.values():
+        for n, i in enumerate(members):
+            for j in members[n + 1 :]:
+                for axis in ("x", "y"):
+                    was, now = _gap(before[i], before[j], axis), _gap(after[i], after[j], axis)
+                    if was > 0 and now < (1 - SHARE) * was:
+                        found |= {i, j}
+    return found
+
+
+def _gap(a: Rect, b: Rect, axis: str) -> float:
+    """The gap between two elements along ``axis`` where they overlap along the other
+    (0 where they do not face each other, or touch or overlap)."""
+    if axis == "x":
+        facing = min(a.y1, b.y1) - max(a.y0, b.y0) > 1e-9
+        gap = max(a.x0, b.x0) - min(a.x1, b.x1)
+    else:
+        facing = min(a.x1, b.x1) - max(a.x0, b.x0) > 1e-9
+        gap = max(a.y0, b.y0) - min(a.y1, b.y1)
+    return gap if facing and gap > 0 else 0.0
+
+
+def _behind(rects: list[Rect]) -> set[int]:
+    """The elements partly behind one in front of them (CMP's order, then ``z``): what
+    shows of them is what the annotation shows, so the steps that go further than the
+    move limits (``_sizes_shared``, ``_rows_shared``) leave them be."""
+    order = {k: (CMP_Z_ORDER.get(r.label, 99), r.z, k) for k, r in enumerate(rects)}
+    found: set[int] = set()
+    shown = [k for k, r in enumerate(rects) if r.label != BACKGROUND]
+    for n, i in enumerate(shown):
+        for j in shown[n + 1 :]:
+            a, b = rects[i], rects[j]
+            if a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1:
+                found.add(min(i, j, key=order.__getitem__))
     return found
 
 

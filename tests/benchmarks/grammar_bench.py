@@ -14,6 +14,7 @@ Skips, saying so, when the data is not there.
 
 from __future__ import annotations
 
+import itertools
 import statistics
 import sys
 import time
@@ -23,10 +24,16 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from facadecli.grammar.cmp_xml import read_cmp  # noqa: E402
+from facadecli.grammar.pieces import apart, displacement  # noqa: E402
 from facadecli.grammar.run import Extraction, Options, extract_grammar, resize  # noqa: E402
 from facadecli.grammar.style import Box, facade_of, tiles_of  # noqa: E402
 from facadecli.grammar.tiling import BACKGROUND, Tiling  # noqa: E402
-from facadecli.grammar.variation import Piece, derive_layout, derive_variations  # noqa: E402
+from facadecli.grammar.variation import (  # noqa: E402
+    APART,
+    Piece,
+    derive_layout,
+    derive_variations,
+)
 from facadecli.layout import Layout  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)
@@ -197,6 +204,8 @@ def variations(extractions: list[Extraction]) -> None:
     """``--variations 6`` at each width: how many distinct layouts, and how many of them
     keep as many constraints of the style as the size's first layout."""
     asked, made, full, seconds = 6, dict.fromkeys(SCALES, 0), dict.fromkeys(SCALES, 0), 0.0
+    least: dict[float, list[float]] = {s: [] for s in SCALES}  # of the façade's smaller side
+    near = dict.fromkeys(SCALES, 0)  # pairs of variations less than APART apart
     for extraction in extractions:
         for scale in SCALES:
             started = time.perf_counter()
@@ -213,6 +222,14 @@ def variations(extractions: list[Extraction]) -> None:
             seconds += time.perf_counter() - started
             made[scale] += len(drawn)
             full[scale] += sum(len(v.kept.kept) >= len(drawn[0].kept.kept) for v in drawn)
+            moved = [
+                displacement(a.pieces, b.pieces) / 15.0 for a, b in itertools.combinations(drawn, 2)
+            ]
+            least[scale] += [min(moved)] if moved else []
+            near[scale] += sum(
+                not apart(a.pieces, b.pieces, APART * 15.0)
+                for a, b in itertools.combinations(drawn, 2)
+            )
     total = asked * len(extractions)
     print(
         f"--variations {asked}: "
@@ -220,6 +237,14 @@ def variations(extractions: list[Extraction]) -> None:
         + " width; keeping as much of the style as the first: "
         + ", ".join(f"{full[s]}" for s in SCALES)
         + f" ({seconds / (len(extractions) * len(SCALES)):.1f} s a size)"
+    )
+    print(
+        "  variations apart (pieces.displacement: mean edge distance of an element to the "
+        "nearest of its label in the other, of the façade's 15 m): least pair, mean over "
+        "façades, "
+        + ", ".join(f"{statistics.fmean(least[s]) if least[s] else 0:.1%} at {s}x" for s in SCALES)
+        + f"; pairs not visibly apart (as many elements, under {APART:.0%}): "
+        + ", ".join(f"{near[s]}" for s in SCALES)
     )
 
 
