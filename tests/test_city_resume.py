@@ -133,15 +133,15 @@ def test_every_field_of_a_task_is_hashed_or_said_why_not(tmp_path: Path) -> None
 
 
 def test_results_are_taken_as_they_finish() -> None:
-    second_done = threading.Event()
+    released = threading.Event()
 
     def work(batch: list[int]) -> list[int]:
-        if batch[0] == 0:  # the first chunk waits for the second: no head-of-line block
-            assert second_done.wait(timeout=60)
-        else:
-            second_done.set()
+        if batch[0] == 0:  # the first chunk ends only once the second's results are taken
+            assert released.wait(timeout=60)
         return [item * 10 for item in batch]
 
     with ThreadPoolExecutor(max_workers=2) as pool:
-        results = list(_bounded(lambda batch: pool.submit(work, list(batch)), [0, 1, 2, 3], 2))
-    assert results == [20, 30, 0, 10]
+        stream = _bounded(lambda batch: pool.submit(work, list(batch)), [0, 1, 2, 3], 2)
+        first = [next(stream), next(stream)]  # in order, this would wait for the first
+        released.set()
+        assert first == [20, 30] and list(stream) == [0, 10]
