@@ -16,6 +16,7 @@ SLOW = {
     "test_city_inputs.py::test_a_dense_footprint_is_simplified_and_gets_its_walls",
     "test_city_resume.py::test_a_resumed_run_keeps_every_figure_and_gives_the_same_bytes",
     "test_city_resume.py::test_an_edited_spec_or_tag_rebuilds_exactly_what_it_changes",
+    "test_city_resume.py::test_kill_9_then_resume_gives_a_fresh_runs_files",
     "test_cityjson.py::test_cjio_reads_and_rewrites_the_document",
     "test_cli.py::test_gltf_is_json_and_a_buffer_that_load_back",
     "test_cli.py::test_grammar_writes_text_json_svg_and_a_report",

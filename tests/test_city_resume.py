@@ -7,7 +7,11 @@ from __future__ import annotations
 import dataclasses
 import json
 import shutil
+import signal
+import subprocess
+import sys
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -145,3 +149,23 @@ def test_results_are_taken_as_they_finish() -> None:
         first = [next(stream), next(stream)]  # in order, this would wait for the first
         released.set()
         assert first == [20, 30] and list(stream) == [0, 10]
+
+
+def test_kill_9_then_resume_gives_a_fresh_runs_files(tmp_path: Path) -> None:
+    manifest = _town(tmp_path)
+    out = tmp_path / "killed"
+    log = out / f"terraces-{HOUSES}.report.jsonl"
+    facade = Path(sys.executable).with_name("facade")
+    command = [str(facade), "city", str(manifest), "-o", str(out), "-j", "1"]
+    run = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    while run.poll() is None and not (log.is_file() and log.read_text().count("\n") >= 1):
+        time.sleep(0.02)
+    run.send_signal(signal.SIGKILL)
+    assert run.wait() == -signal.SIGKILL, "the run ended before it was killed"
+    done = subprocess.run([*command, "--resume"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    fresh = run_city(load_city(manifest), tmp_path / "fresh", jobs=1)
+    report = json.loads((out / f"terraces-{HOUSES}.report.json").read_text())
+    assert 1 <= sum(1 for b in report["buildings"] if b.get("resumed")) < HOUSES
+    assert _entries(report) == _entries(fresh)
+    assert _outputs(out) == _outputs(tmp_path / "fresh")
