@@ -64,8 +64,9 @@ bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extrac
 	$(BIN)/python tests/benchmarks/retarget_bench.py
 	$(BIN)/python tests/benchmarks/watch_bench.py
 
-bench-large: $(STAMP) ## Time facade grammar on three large generated layouts (minutes)
+bench-large: $(STAMP) ## Time facade grammar on three large generated layouts, and facade city on a generated town of FACADE_BENCH_N buildings (default 100,000: hours)
 	$(BIN)/python tests/benchmarks/grammar_large_bench.py
+	$(BIN)/python tests/benchmarks/city_large_bench.py
 
 schema: $(STAMP) ## Regenerate specs/facade.schema.json
 	$(BIN)/facade schema --output specs/facade.schema.json

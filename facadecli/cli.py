@@ -466,7 +466,14 @@ def city(
     scheduler: Annotated[
         str | None, typer.Option("--scheduler", help="A Dask scheduler, tcp://HOST:PORT.")
     ] = None,
-    resume: Annotated[bool, typer.Option("--resume", help="Skip buildings already built.")] = False,
+    resume: Annotated[
+        bool,
+        typer.Option(
+            "--resume",
+            help="Keep the buildings built before whose inputs are unchanged (their "
+            "figures too); rebuild the rest.",
+        ),
+    ] = False,
     limit: Annotated[int | None, typer.Option("--limit", min=1, help="Only the first N.")] = None,
     usd: Annotated[
         bool,

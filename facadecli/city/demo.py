@@ -1,13 +1,16 @@
 """A demo district the project makes itself (``make city``): blocks of rectangular and
 L-shaped footprints along a street grid, with OSM-like properties, in a projected CRS:
 apartment blocks, houses, a shop in every other block (a shop front on its front wall),
-and a church now and then; the houses' walls take tones of their brick by the seed."""
+and a church now and then; the houses' walls take tones of their brick by the seed. And
+a generated town of terraces of any size (:func:`terraces`, for benchmarks)."""
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import random
+from collections.abc import Iterator
 from pathlib import Path
 
 from facadecli.export.atomic import write_atomic
@@ -105,4 +108,60 @@ def write_demo(folder: Path, specs: Path, blocks: int = 3, name: str = "demo-dis
     relative = Path(os.path.relpath(specs.resolve(), folder.resolve())).as_posix()
     manifest = folder / "district.yaml"
     write_atomic(manifest, MANIFEST.format(name=name, specs=relative))
+    return manifest
+
+
+TERRACE = 8  # houses in a row of a generated block; a block is two rows back to back
+ROOFS = ("gabled", "gabled", "hipped", "flat", None)  # OSM roof:shape, None: the manifest's
+
+
+def terraces(count: int, seed: int = 0) -> Iterator[dict[str, object]]:
+    """``count`` GeoJSON features of a generated town of terraces, for benchmarks at any
+    size: blocks of two rows of TERRACE houses back to back (party walls along both
+    sides and the back), on a square grid of streets. Widths, depths, levels, heights,
+    roof shapes and building tags are drawn from ``seed``; coordinates are metres in the
+    demo's CRS, so the town needs no projection."""
+    rng = random.Random(seed)
+    side = max(1, math.ceil(math.sqrt(count / (2 * TERRACE))))  # blocks along a street
+    block, street = TERRACE * 9.0, 12.0
+    for index in range(count):
+        house, row = index % TERRACE, (index // TERRACE) % 2
+        number = index // (2 * TERRACE)
+        x0 = (number % side) * (block + street)
+        y0 = (number // side) * (2 * 12.0 + street)
+        width = block / TERRACE
+        depth = rng.choice((10.0, 11.0, 12.0))
+        ox = x0 + house * width
+        oy = y0 + (12.0 - depth if row == 0 else 12.0)
+        ring = [(ox, oy), (ox + width, oy), (ox + width, oy + depth), (ox, oy + depth)]
+        properties: dict[str, object] = {
+            "building": rng.choice(("house", "house", "apartments", "retail")),
+            "building:levels": str(rng.choice((2, 3, 3, 4))),
+        }
+        if rng.random() < 0.3:
+            properties["height"] = rng.choice((8.5, 10.0, 13.0))
+        shape = rng.choice(ROOFS)
+        if shape is not None:
+            properties["roof:shape"] = shape
+        yield {
+            "type": "Feature",
+            "id": f"t{index}",
+            "properties": properties,
+            "geometry": {
+                "type": "Polygon",
+                "coordinates": [[[x + 100000.0, y + 400000.0] for x, y in [*ring, ring[0]]]],
+            },
+        }
+
+
+def write_terraces(folder: Path, specs: Path, count: int, seed: int = 0) -> Path:
+    """Write :func:`terraces` and the demo's manifest into ``folder``; returns the manifest."""
+    folder.mkdir(parents=True, exist_ok=True)
+    crs = '{"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}}'
+    features = ",\n".join(json.dumps(feature) for feature in terraces(count, seed))
+    text = f'{{"type": "FeatureCollection", "crs": {crs}, "features": [\n{features}\n]}}\n'
+    write_atomic(folder / "footprints.geojson", text)
+    relative = Path(os.path.relpath(specs.resolve(), folder.resolve())).as_posix()
+    manifest = folder / "district.yaml"
+    write_atomic(manifest, MANIFEST.format(name=f"terraces-{count}", specs=relative))
     return manifest

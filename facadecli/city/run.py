@@ -1,8 +1,9 @@
 """``facade city``: every building of a manifest, in worker processes, written atomically.
 
 The unit of work is a building; each writes ``buildings/<id>.glb`` through a temporary
-file, so an interrupted run resumes (``--resume``) where it stopped. Results are gathered
-in the manifest's order, so the report and the merged model do not depend on scheduling.
+file, so an interrupted run resumes (``--resume``, :mod:`facadecli.city.resume`) where
+it stopped. Results are taken as they finish and put back in the manifest's order, so
+the report and the merged model do not depend on scheduling.
 Everything a user can fix (the output folder, the GeoJSON file, duplicate ids) is checked
 before the first building; then the run locks its output folder and removes the temporary
 files a killed run left there (:func:`claimed`), and only those. Features that are not
@@ -17,9 +18,10 @@ import functools
 import hashlib
 import json
 import os
+import queue
 import re
 import time
-from collections import Counter, deque
+from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
@@ -56,6 +58,7 @@ from facadecli.city.footprints import (
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
+from facadecli.city.resume import building_hashes, recorded, reusable, stamped
 from facadecli.city.s3db import (
     Heights,
     inherited,
@@ -555,26 +558,21 @@ def _build(
     georef = Georef(found.crs, found.origin, found.unit)
     results: list[dict[str, Any]] = []
     todo = []
+    hashes = building_hashes(city, tasks)
+    previous = recorded(outdir, city.manifest.name) if resume else {}
     for task in tasks:
-        built = task.target.exists() and (not usd or task.target.with_suffix(".usda").exists())
-        if resume and built:
-            results.append(
-                {
-                    "id": task.footprint.id,
-                    "status": "ok",
-                    "resumed": True,
-                    "file": f"buildings/{task.target.name}",
-                }
-            )
-        else:
+        entry = reusable(task, hashes[task.footprint.id], previous, usd)
+        if entry is None:
             todo.append(task)
+        else:
+            results.append(entry)
     done = len(results)
     tileset = None
     if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
         centroids = [(task.footprint.id, _centroid(task.footprint)) for task in tasks]
         tileset = TilesetWriter(outdir, georef, lods, centroids)
     local = scheduler is None
-    mapped = _map_local(todo, jobs) if local else _map_dask(todo, str(scheduler))
+    mapped = stamped(_map_local(todo, jobs) if local else _map_dask(todo, str(scheduler)), hashes)
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
         outdir.mkdir(parents=True, exist_ok=True)
@@ -742,11 +740,12 @@ def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, A
     needs = _bounded(lambda batch: submit(_each, _needs, batch), tasks, chunk)
     slots = sorted({slot for need in needs for slot in need})
     jobs = [(specs[slot[0]], slot) for slot in slots]
-    return dict(_bounded(lambda batch: submit(_each, _solve, batch), jobs, 1))
+    solved = _bounded(lambda batch: submit(_each, _solve, batch), jobs, 1)
+    return dict(sorted(solved, key=lambda pair: pair[0]))  # in order: they came as they ended
 
 
 def _map_dask(tasks: list[Task], scheduler: str) -> Iterator[dict[str, Any]]:
-    """The buildings on a Dask distributed cluster, results in task order: the axes are
+    """The buildings on a Dask distributed cluster, results as they finish: the axes are
     solved ahead over the cluster (:func:`_presolve`), sent to every worker once, and
     each worker's cache is seeded with them before its first building."""
     from distributed import Client
@@ -763,7 +762,7 @@ def _map_dask(tasks: list[Task], scheduler: str) -> Iterator[dict[str, Any]]:
 
 
 def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
-    """The buildings in ``jobs`` local processes, results in task order. With several
+    """The buildings in ``jobs`` local processes, results as they finish. With several
     processes, the axes every building needs are solved first (:func:`_presolve`) and
     handed to each process as it starts; one process solves them as it goes."""
     if jobs <= 1 or len(tasks) < 2:
@@ -783,16 +782,28 @@ R = TypeVar("R")
 
 def _bounded(hand: Callable[[Sequence[T]], Any], items: Sequence[T], chunk: int) -> Iterator[Any]:
     """A map as a bounded stream: ``hand`` gives a chunk of ``chunk`` items to the workers
-    (a future of their results); results come in order, with at most IN_FLIGHT chunks
-    handed out at once (``Executor.map`` would queue every item first, and a city of a
-    million buildings with it)."""
-    pending: deque[Any] = deque()
+    (a future of their results, a local pool's or Dask's); results come as their chunks
+    finish, whichever first, with at most IN_FLIGHT chunks handed out at once
+    (``Executor.map`` would queue every item first, and a city of a million buildings with
+    it; taking them in order would let one slow chunk hold up the rest). Callers put the
+    results in order themselves."""
+    finished: queue.SimpleQueue[Any] = queue.SimpleQueue()
+    pending: set[Any] = set()  # Dask cancels a future nobody holds
+
+    def take() -> list[Any]:
+        future = finished.get()
+        pending.discard(future)
+        results: list[Any] = future.result()
+        return results
+
     for start in range(0, len(items), chunk):
-        pending.append(hand(items[start : start + chunk]))
+        future = hand(items[start : start + chunk])
+        pending.add(future)
+        future.add_done_callback(finished.put)
         if len(pending) >= IN_FLIGHT:
-            yield from pending.popleft().result()
+            yield from take()
     while pending:
-        yield from pending.popleft().result()
+        yield from take()
 
 
 def _each(function: Callable[[T], R], items: Sequence[T]) -> list[R]:
