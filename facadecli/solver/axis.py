@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import heapq
 import time
+from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
@@ -1067,17 +1068,26 @@ def _covering(option: Mapping[str, Enumerated], canvas: float) -> float:
     return total
 
 
-LaidRows = dict[str, list[tuple[Row, list[float]]]]
+@dataclass(frozen=True)
+class LaidRows:
+    """A sized layout's rows laid out, per group: each row's boundaries, and how many rows
+    have a boundary at each point (so the points of all rows but a few are found by
+    taking those few away)."""
+
+    rows: dict[str, list[tuple[Row, list[float]]]]
+    counts: dict[str, Counter[float]]
 
 
 def _laid_rows(layout: _Evaluated) -> LaidRows:
     """Per group, a sized layout's rows with their boundaries."""
     program, solved = layout.program, layout.estimate
     lengths = {name: solved.of(index) for name, index in program.symbols.items()}
-    return {
+    rows = {
         group: [(row, construct.boundaries(row, lengths)) for row in alignment.rows]
         for group, alignment in layout.groups.items()
     }
+    counts = {group: Counter(p for _, x in laid for p in set(x)) for group, laid in rows.items()}
+    return LaidRows(rows, counts)
 
 
 def _points_without(
@@ -1085,17 +1095,18 @@ def _points_without(
 ) -> dict[str, list[float]]:
     """Per group, the boundaries of a sized layout's rows (:func:`_laid_rows`), but those
     of the patterns ``keys`` (the rows another option of theirs must meet)."""
-    return {
-        group: sorted(
-            {
-                point
-                for row, x in rows
-                if not any(pattern_of[layer] in keys for layer in row.layers)
-                for point in x
-            }
-        )
-        for group, rows in laid.items()
-    }
+    points: dict[str, list[float]] = {}
+    for group, rows in laid.rows.items():
+        counts = laid.counts[group]
+        left = [set(x) for row, x in rows if any(pattern_of[layer] in keys for layer in row.layers)]
+        if not left:
+            points[group] = sorted(counts)
+            continue
+        counts = counts.copy()
+        for own in left:
+            counts.subtract(own)
+        points[group] = sorted(p for p, n in counts.items() if n > 0)
+    return points
 
 
 def _fits_among(
