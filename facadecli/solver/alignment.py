@@ -141,6 +141,9 @@ class _Row:
         self.n = len(row.word)
         self.cache: dict[int, tuple[list[Move], list[float]]] = {}
         self.spans: dict[tuple[int, int], Move | None] = {}  # spanning(), cached
+        # spanning()'s entries out of each position as made so far, by their end (the first
+        # of each end), and what makes the rest (None once it is spent)
+        self.made: dict[int, tuple[dict[int, Move], list[Iterator[Move] | None]]] = {}
         self.has_attached = any(t.attached for t in row.traits)
         # from each letter on: preferred length of the sized letters, and the unsized ones
         self.fixed_after = [0.0] * (self.n + 1)
@@ -198,14 +201,27 @@ class _Row:
         return cached
 
     def spanning(self, start: int, end: int) -> Move | None:
-        """The entry from ``start`` to ``end`` (a middle piece when they are equal), if any."""
+        """The entry from ``start`` to ``end`` (a middle piece when they are equal), if any:
+        the first the row makes out of ``start`` that ends there. The entries out of a
+        position grow toward its segment's end; each is made once, however many ends
+        are asked for (a proof's reasons ask for thousands out of a few positions)."""
         key = (start, end)
         found = self.spans.get(key, self)
-        if found is self:  # made alone: the entries out of ``start`` grow toward ``end``
-            found = self.spans[key] = next(
-                (m for m in self._moves(start) if m.end == end and m.middle == (start == end)),
-                None,
-            )
+        if found is self:
+            made = self.made.get(start)
+            if made is None:
+                made = self.made[start] = ({}, [self._moves(start)])
+            ends, rest = made
+            found = ends.get(end)
+            making = rest[0]
+            while found is None and making is not None:
+                move = next(making, None)
+                if move is None:
+                    rest[0] = making = None
+                else:
+                    ends.setdefault(move.end, move)
+                    found = move if move.end == end else None
+            self.spans[key] = found
         return found  # type: ignore[return-value]
 
     def size(self, k: int) -> float:

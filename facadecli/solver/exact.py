@@ -57,6 +57,7 @@ Option = tuple[Move | None, np.ndarray | None]  # an entry (None: a gap), its le
 Options = tuple[list[Option], list[int], np.ndarray]  # see _Search.options()
 COMPILED = EXACT_COMPILED  # search with _exact.c where built (False: the Python reference)
 _EXHAUSTED, _STOPPED = 2, 3  # what _exact.Search.run() returns besides 0 (done)
+TEXT_LETTERS = 12  # an entry of more letters is named by its first and last few
 
 
 class BudgetExhausted(Exception):
@@ -304,6 +305,7 @@ class _Search:
     whole_cache: dict[tuple[int, int, int, int], np.ndarray] = field(default_factory=dict)
     counts_cache: dict[tuple[int, int], np.ndarray] = field(default_factory=dict)
     options_cache: dict[tuple[int, int, int, bool], Options] = field(default_factory=dict)
+    texts: dict[tuple[int, int, int], str] = field(default_factory=dict)  # text(), by row, ends
     gaps: bool = True  # rows may make room for the opaque letters of rows in front
     combinations: int = 0  # partial columns built (a work unit per COMBINATION_WORK)
     sizing_failure: str = ""  # why the last complete alignment could not be sized
@@ -395,11 +397,23 @@ class _Search:
         return ("layer " if len(names) == 1 else "layers ") + ", ".join(names)
 
     def text(self, group: _Group, r: int, move: Move | None) -> str:
+        """An entry in the user's words: its letters, a long one's first and last few and
+        how many (a reason names entries of a long row thousands of times)."""
         if move is None:
             return "a gap"
-        whole, parts = sizing.entry_parts(move)
-        word = group.rows[r].row.word
-        return "'" + " ".join(word[k].symbol for k in sorted({*whole, *parts})) + "'"
+        row = group.rows[r].row
+        key = (id(row), move.start, move.end)
+        found = self.texts.get(key)
+        if found is None:
+            whole, parts = sizing.entry_parts(move)
+            letters = [row.word[k].symbol for k in sorted({*whole, *parts})]
+            if len(letters) > TEXT_LETTERS:
+                shown = " ".join(letters[:3]) + " ... " + " ".join(letters[-2:])
+                found = f"'{shown}' ({len(letters)} letters)"
+            else:
+                found = "'" + " ".join(letters) + "'"
+            self.texts[key] = found
+        return found
 
     def columns(self, g: int, node: _Node) -> Iterator[tuple[Move | None, ...]]:
         """Every valid column out of a state, but not those where two entries of
