@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 import trimesh
@@ -92,18 +93,24 @@ def _distances(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray
     return np.where(inside, t, np.inf)
 
 
-def opaque_triangles(scene: trimesh.Scene, see_through: set[str] = frozenset()) -> np.ndarray:
-    """The triangles of a loaded model (a glb read back) that stop the view: those of every
-    material but the blended ones and those named in ``see_through`` (transmitting glass)."""
-    parts = []
+def opaque_parts(
+    scene: trimesh.Scene, see_through: set[str] = frozenset()
+) -> Iterator[tuple[str, np.ndarray]]:
+    """Each node of a loaded model (a glb read back) with its triangles that stop the
+    view, placed: those of every material but the blended ones and those named in
+    ``see_through`` (transmitting glass)."""
     for node in scene.graph.nodes_geometry:
         transform, geometry = scene.graph[node]
         mesh = scene.geometry[geometry]
         material = mesh.visual.material
         if material.alphaMode == "BLEND" or material.name in see_through:
             continue
-        parts.append(mesh.copy().apply_transform(transform).triangles)
-    return np.concatenate(parts)
+        yield node, mesh.copy().apply_transform(transform).triangles
+
+
+def opaque_triangles(scene: trimesh.Scene, see_through: set[str] = frozenset()) -> np.ndarray:
+    """The triangles of a loaded model that stop the view (:func:`opaque_parts`)."""
+    return np.concatenate([triangles for _, triangles in opaque_parts(scene, see_through)])
 
 
 def grid(low: np.ndarray, high: np.ndarray, step: float, margin: float) -> np.ndarray:

@@ -26,7 +26,7 @@ from facadecli.city.roofs import roof_meshes
 from facadecli.city.run import run_city
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.geometry.facade import plane_uv, weld
-from tests.rays import reach
+from tests.rays import opaque_parts, reach
 
 ROOT = Path(__file__).resolve().parent.parent
 VALIDATOR = Path(sys.prefix) / "node" / "node_modules"  # make test installs it in the venv
@@ -114,16 +114,11 @@ def _buildings(scene: trimesh.Scene, see_through: set[str]) -> dict[str, list[np
     through it."""
     parents = scene.graph.transforms.parents
     found: dict[str, list[np.ndarray]] = defaultdict(list)
-    for node in scene.graph.nodes_geometry:
-        transform, geometry = scene.graph[node]
-        mesh = scene.geometry[geometry]
-        material = mesh.visual.material
-        if material.alphaMode == "BLEND" or material.name in see_through:
-            continue
+    for node, triangles in opaque_parts(scene, see_through):
         root = node
         while parents.get(root) not in (None, scene.graph.base_frame):
             root = parents[root]
-        found[root].append(mesh.copy().apply_transform(transform).triangles)
+        found[root].append(triangles)
     return found
 
 

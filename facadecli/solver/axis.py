@@ -761,8 +761,14 @@ def _fitted_to_backs(
     one of those boundaries and fill the canvas (:func:`construct.fit`). Layers that meet
     only through the base's columns align independently given them. With it, the sizes
     the fits found (every symbol's, when each row was laid; else None)."""
-    candidate, tied = _backs_chosen(spec, uses, space, candidate, canvas, memory, tie)
-    fitting = _BackFitting.of(spec, uses, space, candidate, canvas, memory, tied)
+    pattern_of = _pattern_of(uses)
+    rows = _candidate_rows(spec, uses, candidate, memory)
+    # the patterns of the rows at the back (a layer's place in its group is the spec's)
+    at_back = {pattern_of[layer] for members in rows.values() for layer in members[0].layers}
+    candidate, tied = _backs_chosen(spec, uses, space, candidate, canvas, memory, tie, at_back)
+    fitting = _BackFitting.of(
+        spec, uses, space, candidate, canvas, memory, tied, pattern_of, at_back
+    )
     if fitting is None:
         return candidate, None
     # the clusters with fewest placeholders first: their rows have least choice; passes
@@ -786,13 +792,11 @@ def _backs_chosen(
     canvas: float,
     memory: _SearchMemory,
     tie: float,
+    at_back: set[str],
 ) -> tuple[Candidate, dict[int, list[dict[str, Enumerated]]]]:
-    """The candidate with each cluster holding a group's back row at the option whose
-    back rows fit the canvas best on their own; with, per such cluster, its options as
-    good (VARIANTS at most)."""
-    pattern_of = _pattern_of(uses)
-    rows = _candidate_rows(spec, uses, candidate, memory)
-    at_back = {pattern_of[layer] for members in rows.values() for layer in members[0].layers}
+    """The candidate with each cluster holding a group's back row (one of the patterns
+    ``at_back``) at the option whose back rows fit the canvas best on their own; with,
+    per such cluster, its options as good (VARIANTS at most)."""
     tied: dict[int, list[dict[str, Enumerated]]] = {}
     for cluster, members in enumerate(space.clusters):
         keys = {use.key for use in members}
@@ -846,11 +850,11 @@ class _BackFitting:
         canvas: float,
         memory: _SearchMemory,
         tied: dict[int, list[dict[str, Enumerated]]],
+        pattern_of: dict[int, str],
+        at_back: set[str],
     ) -> _BackFitting | None:
         """The backs of the candidate laid; None when their relaxation has no solution."""
-        pattern_of = _pattern_of(uses)
         rows = _candidate_rows(spec, uses, candidate, memory)
-        at_back = {pattern_of[layer] for members in rows.values() for layer in members[0].layers}
         backs = {group: members[0] for group, members in rows.items() if members}
         alone = {group: [row] for group, row in backs.items()}
         relaxed = construct.relax(spec, alone, canvas)
