@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import statistics
 from dataclasses import MISSING, dataclass, fields
 
 import numpy as np
@@ -279,8 +280,8 @@ class _Grid:
         # most 2 sqrt(n) cells a side)
         count = 2 * math.sqrt(len(solids))
         width, height = max(s[1] for s in solids) - self.x0, max(s[3] for s in solids) - self.y0
-        self.dx = max(float(np.median([s[1] - s[0] for s in solids])), width / count, 1e-6)
-        self.dy = max(float(np.median([s[3] - s[2] for s in solids])), height / count, 1e-6)
+        self.dx = max(statistics.median(s[1] - s[0] for s in solids), width / count, 1e-6)
+        self.dy = max(statistics.median(s[3] - s[2] for s in solids), height / count, 1e-6)
         self.cells: dict[tuple[int, int], list[_Solid]] = {}
         self.large: list[_Solid] = []
         ordered = sorted(solids, key=lambda solid: -solid[5])  # front to back
