@@ -148,3 +148,45 @@ def test_a_layout_with_two_free_lengths_is_left_to_the_qp_solver() -> None:
     assert np.linalg.matrix_rank(e) == 4
     weight = np.ones(6)
     assert sizing._on_a_line(program(e, d, weight, np.ones(6))) is sizing._MANY_FREE
+
+
+# -- bounds that contradict the equalities, shown without a QP solver --------------------
+def bounded(e: np.ndarray, d: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> sizing.Program:
+    made = program(e, d, np.ones(e.shape[1]), np.ones(e.shape[1]))
+    made.lower, made.upper = lower, upper
+    return made
+
+
+def test_two_free_lengths_that_cannot_fill_their_sum_are_infeasible() -> None:
+    """a + b = 10 with a, b at most 3 (and c free): no layout; lowering the sum to 6
+    makes it feasible, and the propagation must not claim otherwise."""
+    e = np.array([[1.0, 1.0, 0.0]])
+    inf = np.inf
+    lower, upper = np.array([0.0, 0.0, -inf]), np.array([3.0, 3.0, inf])
+    assert sizing._bounds_contradict(bounded(e, np.array([10.0]), lower, upper))
+    assert sizing.search_solve(bounded(e, np.array([10.0]), lower, upper)) is None
+    assert not sizing._bounds_contradict(bounded(e, np.array([6.0]), lower, upper))
+    assert sizing.search_solve(bounded(e, np.array([6.0]), lower, upper)) is not None
+
+
+def test_contradicting_bounds_are_only_claimed_where_the_qp_finds_no_layout() -> None:
+    """On random systems with random bounds around a solution (some kept, some pushed
+    past it), every program the propagation calls infeasible Clarabel finds infeasible
+    too. The family mixes feasible and infeasible programs, and the propagation does call
+    some infeasible (it is not a test that cannot fail)."""
+    claimed, feasible = 0, 0
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        e, d = random_system(seed, rows=8 + seed % 5, variables=12)
+        solution = np.linalg.lstsq(e, d, rcond=None)[0]
+        for trial in range(6):
+            slack = rng.uniform(-0.1, 0.6, size=(2, 12))  # below 0: the solution cut off
+            lower = np.where(rng.random(12) < 0.6, solution - slack[0], -np.inf)
+            upper = np.where(rng.random(12) < 0.6, solution + slack[1], np.inf)
+            made = bounded(e, d, lower, np.maximum(upper, lower))
+            sized = sizing._clarabel(made)
+            feasible += sized is not None
+            if sizing._bounds_contradict(made):
+                claimed += 1
+                assert sized is None, (seed, trial)
+    assert claimed >= 20 and feasible >= 40, (claimed, feasible)

@@ -401,7 +401,60 @@ def search_solve(program: Program) -> Sizing | None:
     on_line = _on_a_line(program)
     if on_line is not _MANY_FREE:
         return on_line  # type: ignore[return-value]
+    if _bounds_contradict(program):
+        return None
     return _clarabel(program)
+
+
+def _bounds_contradict(program: Program, rounds: int = 12) -> bool:
+    """Whether the bounds cannot all hold on the solutions ``z0 + N y`` of the equalities,
+    shown by propagating intervals: each bound ``lower <= z0 + N y <= upper`` narrows every
+    free length ``y_j`` to what the others' intervals leave it, round after round. A proof,
+    not a guess (an empty interval means no solution; a margin of ``1e-7`` of the program's
+    scale keeps rounding from proving anything), and cheap: most layouts the searches size
+    with several free lengths are infeasible, and this shows it without a QP solver. When
+    it shows nothing, the QP solver decides."""
+    parametrized = program.parametrized
+    if parametrized is None:
+        return True  # the equalities contradict each other
+    z0, free = parametrized
+    moving = np.abs(free) > ZERO
+    bounded = moving.any(axis=1) & (np.isfinite(program.lower) | np.isfinite(program.upper))
+    a = np.where(moving, free, 0.0)[bounded]
+    below, above = (program.lower - z0)[bounded], (program.upper - z0)[bounded]
+    low, high = np.full(free.shape[1], -np.inf), np.full(free.shape[1], np.inf)
+    margin = 1e-7 * max(1.0, float(np.abs(program.rhs).max(initial=0.0)))
+    with np.errstate(invalid="ignore"):  # 0 x inf: a length a bound does not involve
+        for _ in range(rounds):
+            ends = np.stack([a * low, a * high])
+            ends[:, ~moving[bounded]] = 0.0
+            least, most = ends.min(axis=0), ends.max(axis=0)
+            # what the other lengths of a bound's row can add, least and most
+            others_least = _sum_but_one(least, -np.inf)
+            others_most = _sum_but_one(most, np.inf)
+            span_low = (below[:, None] - others_most) / np.where(moving[bounded], a, np.nan)
+            span_high = (above[:, None] - others_least) / np.where(moving[bounded], a, np.nan)
+            flipped = a < 0
+            new_low = np.where(flipped, span_high, span_low)
+            new_high = np.where(flipped, span_low, span_high)
+            narrowed_low = np.fmax(low, np.nanmax(new_low, axis=0, initial=-np.inf))
+            narrowed_high = np.fmin(high, np.nanmin(new_high, axis=0, initial=np.inf))
+            if (narrowed_low > narrowed_high + margin).any():
+                return True
+            if np.array_equal(narrowed_low, low) and np.array_equal(narrowed_high, high):
+                return False
+            low, high = narrowed_low, narrowed_high
+    return False
+
+
+def _sum_but_one(terms: np.ndarray, infinite: float) -> np.ndarray:
+    """Per entry of each row, the sum of the row's other entries (infinite if another is)."""
+    finite = np.isfinite(terms)
+    total = np.where(finite, terms, 0.0).sum(axis=1, keepdims=True)
+    count = (~finite).sum(axis=1, keepdims=True)
+    but_one = total - np.where(finite, terms, 0.0)
+    others_infinite = count - (~finite) > 0
+    return np.where(others_infinite, infinite, but_one)
 
 
 def _clarabel(program: Program) -> Sizing | None:
