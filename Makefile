@@ -32,9 +32,10 @@ $(VALIDATOR): | $(STAMP)
 	  npm install --silent --no-audit --no-fund --prefix $(VENV)/node gltf-validator@2.0.0-dev.3.10; \
 	else echo "npm not found: the glTF validator test will be skipped"; fi
 
-# the tests on every core (pytest-xdist); TEST_JOBS=0 runs them in this one process
+# the tests on every core (pytest-xdist), a test file to a worker: a fixture a file's tests
+# share (a city built once) is built once; TEST_JOBS=0 runs them in this one process
 TEST_JOBS ?= logical
-TEST_PARALLEL := -n $(TEST_JOBS) --dist loadgroup
+TEST_PARALLEL := -n $(TEST_JOBS) --dist loadfile
 
 test: $(STAMP) $(VALIDATOR) ## Run the whole test suite
 	$(BIN)/python -m pytest $(TEST_PARALLEL)

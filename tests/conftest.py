@@ -84,25 +84,8 @@ SLOW = {
 }
 
 
-def _shares_a_fixture(item: pytest.Item) -> bool:
-    """Whether the test takes a fixture of this suite built once for more than one test
-    (module scope or wider: a city, a browser page, a solved folder)."""
-    found = getattr(item, "_fixtureinfo", None)
-    if found is None:
-        return False
-    return any(
-        definition.scope != "function" and definition.baseid  # "": pytest's own fixtures
-        for definitions in found.name2fixturedefs.values()
-        for definition in definitions
-    )
-
-
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         path, _, name = item.nodeid.partition("::")
         if f"{path.removeprefix('tests/')}::{name.partition('[')[0]}" in SLOW:
             item.add_marker(pytest.mark.slow)
-        # ``make test`` runs the suite on every core (pytest-xdist, ``--dist loadgroup``):
-        # the tests of a module that share a fixture go to one worker, which builds it once
-        if _shares_a_fixture(item):
-            item.add_marker(pytest.mark.xdist_group(path))
