@@ -32,11 +32,16 @@ $(VALIDATOR): | $(STAMP)
 	  npm install --silent --no-audit --no-fund --prefix $(VENV)/node gltf-validator@2.0.0-dev.3.10; \
 	else echo "npm not found: the glTF validator test will be skipped"; fi
 
+# the tests on every core (pytest-xdist), a test file to a worker: a fixture a file's tests
+# share (a city built once) is built once; TEST_JOBS=0 runs them in this one process
+TEST_JOBS ?= logical
+TEST_PARALLEL := -n $(TEST_JOBS) --dist loadfile
+
 test: $(STAMP) $(VALIDATOR) ## Run the whole test suite
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest $(TEST_PARALLEL)
 
 test-fast: $(STAMP) ## Run the tests not marked slow (under a minute; make test runs them all)
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest $(TEST_PARALLEL) -m "not slow"
 
 lint: $(STAMP) ## ruff (lint + format check) and mypy
 	$(BIN)/ruff check facadecli tests docs

@@ -34,6 +34,7 @@ from facadecli.city.run import run_city
 from facadecli.city.tileset import TilesetWriter, parse_lods, quadtree
 from facadecli.errors import SpecError
 from facadecli.export.glb_merge import read_glb
+from tests.browser import BROWSER, browse
 from tests.osm_district import METRE_LAT, METRE_LON, ORIGIN, Building, box, write_district
 from tests.running import facade
 
@@ -305,7 +306,6 @@ def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) 
 
 VALIDATOR = os.environ.get("FACADE_3DTILES_VALIDATOR")  # e.g. "npx 3d-tiles-validator"
 CESIUM = os.environ.get("FACADE_CESIUM")  # a folder with Cesium.js: npm cesium's Build/Cesium
-BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
 
 
 @pytest.mark.skipif(not VALIDATOR, reason="set FACADE_3DTILES_VALIDATOR to a validator command")
@@ -384,24 +384,9 @@ def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: P
     (site / "cesium").symlink_to(Path(str(CESIUM)).resolve())
     (site / "tiles").symlink_to(city / "3dtiles")
     (site / "index.html").write_text(PAGE)
-    shot = tmp_path / "globe.png"
-    title = ""
     for url in _served(site):
-        for budget in (20_000, 60_000):
-            flags = [
-                "--headless", "--no-sandbox", "--disable-gpu", "--use-gl=swiftshader",
-                "--enable-unsafe-swiftshader", "--no-first-run",
-                "--disable-background-networking", f"--user-data-dir={tmp_path / 'profile'}",
-                "--window-size=1000,600", f"--virtual-time-budget={budget}",
-            ]  # fmt: skip
-            run = [str(BROWSER), *flags]
-            subprocess.run([*run, f"--screenshot={shot}", url], timeout=300, check=False)
-            dom = subprocess.run(
-                [*run, "--dump-dom", url], timeout=300, capture_output=True, text=True
-            ).stdout
-            title = re.search(r"<title>([^<]*)</title>", dom).group(1)  # type: ignore[union-attr]
-            if title.startswith("loaded"):
-                break
+        shot, dom = browse(tmp_path, url, (20_000, 60_000), lambda dom: "<title>loaded" in dom)
+    title = re.search(r"<title>([^<]*)</title>", dom).group(1)  # type: ignore[union-attr]
     assert title.startswith("loaded"), title
     lon, lat, height = (float(v) for v in title.split()[1:])
     document = _tileset(city)

@@ -7,7 +7,6 @@ from __future__ import annotations
 import base64
 import re
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 from urllib.parse import quote
@@ -18,10 +17,10 @@ from facadecli import load_spec, solve
 from facadecli.cli import main
 from facadecli.export import OutputOptions, write_outputs
 from facadecli.viewer import gallery
+from tests.browser import BROWSER, browse
 from tests.running import facade, files
 
 ROOT = Path(__file__).resolve().parent.parent
-BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
 
 
 def _page(tmp_path: Path) -> Path:
@@ -39,31 +38,6 @@ def test_the_page_holds_everything_it_shows(tmp_path: Path) -> None:
     assert not re.search(r"(src|href)=[\"']https?://", text)  # nothing fetched at view time
 
 
-def _browse(tmp_path: Path, url: str) -> tuple[Path, str]:
-    """A screenshot (1000 x 600) of the page at ``url`` and its DOM once its scripts ran.
-    Decoding a textured model's pictures runs outside Chromium's virtual time, so a page
-    still loading when the budget ends is browsed again with a larger one (a page that
-    never loads still fails: its title keeps "loading: ")."""
-    shot = tmp_path / "shot.png"
-    dom = ""
-    for budget in (10_000, 40_000, 120_000):
-        flags = [
-            "--headless", "--no-sandbox", "--disable-gpu", "--use-gl=swiftshader",
-            "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
-            f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1000,600",
-            f"--virtual-time-budget={budget}",
-        ]  # fmt: skip
-        run = [str(BROWSER), *flags]
-        subprocess.run([*run, f"--screenshot={shot}", url], timeout=300, check=False)
-        done = subprocess.run(
-            [*run, "--dump-dom", url], timeout=300, capture_output=True, text=True
-        )
-        dom = done.stdout
-        if "<title>loading: " not in dom:
-            break
-    return shot, dom
-
-
 def _drawn(shot: Path, left: float, right: float) -> bool:
     """Whether the screenshot's columns from ``left`` to ``right`` (fractions of its width)
     hold a picture, not a blank canvas."""
@@ -76,7 +50,7 @@ def _drawn(shot: Path, left: float, right: float) -> bool:
 
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 def test_a_browser_shows_the_model(tmp_path: Path) -> None:
-    shot, dom = _browse(tmp_path, _page(tmp_path).as_uri())
+    shot, dom = browse(tmp_path, _page(tmp_path).as_uri())
     assert "<title>townhouse</title>" in dom  # the model loaded ("loading: " is gone)
     assert _drawn(shot, 0, 3 / 5)
 
@@ -111,7 +85,7 @@ def test_the_model_is_lit_and_shades_the_ground(tmp_path: Path, example: str) ->
     plain backdrop had neither)."""
     layout = solve(load_spec(ROOT / "specs" / f"{example}.yaml"))
     (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
-    shot, dom = _browse(tmp_path, path.as_uri() + "?bare&view=0,10,1,0.5,0.5")
+    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,10,1,0.5,0.5")
     assert f"<title>{example}</title>" in dom
     spread, shaded = _lit(shot)
     assert spread > 10
@@ -235,7 +209,7 @@ def test_a_browser_shows_the_gallery(
 ) -> None:
     page = tmp_path / "gallery.html"
     assert facade(capsys, "view", varied, "-o", page)[0] == 0
-    shot, dom = _browse(tmp_path, page.as_uri() + "#" + quote("residential-house-12x3-1"))
+    shot, dom = browse(tmp_path, page.as_uri() + "#" + quote("residential-house-12x3-1"))
     assert f"<title>{varied.name}</title>" in dom  # a model loaded ("loading: " is gone)
     assert '<h3 id="name">residential-house-12x3-1</h3>' in dom  # the one the address names
     assert re.findall(r'aria-pressed="true" title="([^"]+)"', dom) == ["residential-house-12x3-1"]
