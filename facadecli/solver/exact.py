@@ -27,6 +27,7 @@ answers: :mod:`facadecli.native`); every complete alignment it finds is sized he
 
 from __future__ import annotations
 
+import gc
 import sys
 import time
 from collections import Counter
@@ -425,7 +426,15 @@ def _run(search: _Search) -> None:
 
 def _walk(search: _Search, walk: network.Search, gaps: bool) -> None:
     search.gaps = gaps
-    status = walk.run(gaps)
+    # the walk makes many small objects and no reference cycles: the collector is paused
+    # while it runs (it would walk every object of the process, over and over)
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        status = walk.run(gaps)
+    finally:
+        if collecting:
+            gc.enable()
     search.budget.used = walk.used
     search.budget.timed_out = walk.timed_out
     search.incumbent = walk.incumbent

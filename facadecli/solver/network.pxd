@@ -27,7 +27,8 @@ cdef class Move:
     cdef public bint first_attached, last_attached, fixed_only
     cdef public int piece_of, tail
     cdef public double tail_size, low, high
-    cdef public object whole
+    cdef double[::1] whole
+    cdef bint has_whole
 
 
 cdef class Whole:
@@ -40,25 +41,29 @@ cdef class Whole:
 
 
 cdef class Options:
-    cdef list moves, lens
+    cdef list moves
+    cdef double[::1] lens
+    cdef int[::1] known, order
     cdef public int n
     cdef int n_whole, n_known
-    cdef object order
 
 
 cdef class Row:
     cdef public int n
     cdef int[::1] var, segment, above, covering
-    cdef double[::1] size, counts
+    cdef double[::1] size, counts, rem
+    cdef int[::1] rem_ph
+    cdef int stride
     cdef signed char[::1] transparent, opaque, attached, unoccludable
     cdef double least
     cdef bint has_attached
-    cdef list moves, cached, rem, rem_ph
+    cdef list moves, cached
     cdef int n_above, n_covering
 
     @cython.locals(n=int, positions=int, met=int, k=int, v=int, least=double, j=int,
-                   counts="double[::1]", p=int, rem="double[::1]", pairs=list, before=int,
-                   index=object, number=int, times=int)
+                   counts="double[::1]", p=int, rem="double[::1]", pairs="int[::1]",
+                   before=int, index=object, number=int, times=int, stride=int, at=int,
+                   made=object)
     cdef void read(self, letters, above, covering, dict variables, int count, int nv,
                    int sized) except *
 
@@ -95,6 +100,9 @@ cdef class System:
     cdef double value
     cdef dict probes
 
+    @cython.locals(made=object, buffer="double[::1]", at=Py_ssize_t)
+    cdef void make(self, int nv, int sized, int npiv, int nb) except *
+
 
 cdef class Cell:
     cdef public Cell prev
@@ -103,11 +111,13 @@ cdef class Cell:
 
 
 cdef class Node:
-    cdef int[::1] positions, memory, before
+    cdef int[::1] positions, memory, before, has_used
     cdef double[::1] x, used
-    cdef signed char[::1] has_used
     cdef System system
     cdef Cell path
+
+    @cython.locals(made=object, numbers="int[::1]", lengths="double[::1]")
+    cdef void make(self, int nv, int count) except *
 
 
 cdef class Child:
@@ -137,10 +147,11 @@ cdef class Search:
     cdef list groups, done
     cdef double[::1] row, known, shifted, reduced, coef, span, a, least, held, least_rhs
     cdef object diff
+    cdef double[::1] diff_view
     cdef signed char[::1] has, fixed
 
     @cython.locals(before=cython.longlong)
-    cdef void spend(self, long long units) except *
+    cdef int spend(self, long long units) except -1
 
     @cython.locals(nv=int, i=int, j=int, base=int, c=double, piv_row="double[::1]")
     cdef double reduce(self, System y, double[::1] row, double rhs) noexcept
@@ -179,26 +190,27 @@ cdef class Search:
 
     @cython.locals(nv=int, first=int, last=int, j=int, counts="double[::1]",
                    view="double[::1]", made=object)
-    cdef object whole_of(self, Row row, Move m)
+    cdef double[::1] whole_of(self, Row row, Move m)
 
-    @cython.locals(w="double[::1]", nv=int, v="double[::1]", made=object, used="double[::1]",
-                   base=int, j=int)
-    cdef object known_length(self, Row row, Move m, Node node, int r)
+    @cython.locals(w="double[::1]", nv=int, used="double[::1]", base=int, j=int)
+    cdef bint known_length(self, Row row, Move m, Node node, int r, double[::1] into,
+                           int at) except -1
 
     @cython.locals(k=int)
-    cdef bint holds_placeholder(self, double[::1] length) noexcept
+    cdef bint holds_placeholder(self, double[::1] length, int at) noexcept
 
     @cython.locals(group=Group, row=Row, position=int, inside=bint, gaps=int,
-                   cached=Options, o=Options, gap=bint, m=Move, at=int, i=int,
-                   order="int[::1]", made=object)
+                   cached=Options, o=Options, gap=bint, m=Move, at=int, i=int, nv=int,
+                   moves=list, lens="double[::1]", known="int[::1]", order="int[::1]",
+                   made=object)
     cdef Options options_of(self, int g, int r, Node node)
 
     @cython.locals(nv=int, sz=int, first="double[::1]", target="double[::1]",
                    d="double[::1]", shifted="double[::1]", reduced="double[::1]",
-                   placeholders=bint, own=bint, k=int, use_shifted=bint, alone=double,
+                   placeholders=bint, own=bint, k=int, use_shifted=bint, alone=double, fat=int,
                    norm=double, off=double, miss=double, residual=double, value=double,
                    y=System)
-    cdef (int, double) fits(self, Builder b, double[::1] length, bint pinned,
+    cdef (int, double) fits(self, Builder b, double[::1] length, int at, bint pinned,
                             double rest) except *
 
     @cython.locals(key=Py_ssize_t, nv=int, sz=int, o=Options, mask="signed char[::1]",
@@ -206,12 +218,12 @@ cdef class Search:
                    pinned=bint, rest=double, k=int, least=double, ordered=bint,
                    order="int[::1]", nw=int, nk=int, u=int, w=int, fit=int, miss=double,
                    total=double, low=int, high=int, mid=int, start=int, fo=Options,
-                   first="double[::1]", group=Group, row=Row, length=object)
+                   first="double[::1]", group=Group, row=Row, lens="double[::1]", fat=int)
     cdef object fitting(self, Builder b, int fr, int j, int r)
 
     @cython.locals(r=int, o=Options, masked=bint, mask="signed char[::1]", k=int, m=Move,
                    held=bint)
-    cdef void extend(self, Builder b, int i, int fr, int fj, bint solid) except *
+    cdef int extend(self, Builder b, int i, int fr, int fj, bint solid) except -1
 
     @cython.locals(count=int, b=Builder, order="int[::1]", i=int, v=int, k=int)
     cdef list columns_of(self, int g, Node node, list opts)
@@ -240,15 +252,15 @@ cdef class Search:
     cdef Node start_of(self, int g, System y)
 
     @cython.locals(paths=list, g=int, end=Cell, columns=list, cell=Cell, m=Move)
-    cdef void call_leaf(self, Node node) except *
+    cdef int call_leaf(self, Node node) except -1
 
     @cython.locals(closed=System)
-    cdef void finish_group(self, int g, Node node) except *
+    cdef int finish_group(self, int g, Node node) except -1
 
     @cython.locals(group=Group, count=int, at_end=bint, progress=int, r=int, opts=list,
                    children=list, entries=list, stretch=Move, c=Node, bound=double,
-                   child=Child, lows=double, highs=double, m=Move, d=double)
-    cdef void dfs(self, int g, Node node) except *
+                   child=Child, lows=double, highs=double, m=Move, d=double, columns=list)
+    cdef int dfs(self, int g, Node node) except -1
 
     @cython.locals(found=Move, r=int, m=Move)
     cdef Move stretch_of(self, list entries, int count)
@@ -268,6 +280,7 @@ cdef class Builder:
     cdef int[::1] order, base
     cdef dict fits
     cdef double[::1] first
+    cdef int first_at
     cdef double limit, margin
 
 

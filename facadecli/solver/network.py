@@ -58,15 +58,15 @@ _FLAGS = array("b", [0])
 _NO_MASK = array("b", [1])
 
 
-def _doubles(n: int) -> array[float]:
+def _doubles(n: int) -> Any:  # array[float]
     return _DOUBLES * n
 
 
-def _ints(n: int) -> array[int]:
+def _ints(n: int) -> Any:  # array[int]
     return _INTS * n
 
 
-def _flags(n: int) -> array[int]:
+def _flags(n: int) -> Any:  # array[int], of bytes
     return _FLAGS * n
 
 
@@ -106,7 +106,8 @@ class Move:
         self.tail_size = NAN
         self.low = 0.0
         self.high = 0.0
-        self.whole: array[float] | None = None  # the letters it holds whole, by symbol
+        self.whole: array[float] = _DOUBLES  # the letters it holds whole, by symbol ...
+        self.has_whole = False  # ... once whole_of() made it
 
 
 class Whole:
@@ -148,7 +149,8 @@ class Options:
 
     def __init__(self) -> None:
         self.moves: list[Any] = []  # Move, or None (a gap)
-        self.lens: list[Any] = []  # array[float], or None
+        self.lens: array[float] = _DOUBLES  # option i's length: lens[i * nv : (i + 1) * nv] ...
+        self.known: array[int] = _INTS  # ... when known[i] (not a gap, not a piece)
         self.n = 0
         self.order: array[int] = _ints(0)
         self.n_whole = 0
@@ -216,23 +218,28 @@ class Row:
             for j in range(nv):
                 counts[(k + 1) * nv + j] = counts[k * nv + j]
             counts[(k + 1) * nv + v] += 1.0
-        # what is left to lay out whole from each position: sized letters, and
-        # (placeholder, count) pairs ended by -1
-        self.rem: list[array[float]] = []
-        self.rem_ph: list[array[int]] = []
+        # what is left to lay out whole from each position (``sized`` numbers a position):
+        # sized letters, and (placeholder, count) pairs ended by -1 (``stride`` a position)
+        stride = 2 * (nv - sized) + 1
+        self.stride = stride
+        made = _doubles(positions * sized + 1)
+        rem = made
+        self.rem = made
+        made = _ints(positions * stride + 1)
+        pairs = made
+        self.rem_ph = made
         for p in range(positions):
-            rem = _doubles(sized + 1)
-            pairs: list[int] = []
             before = (p + 1) // 2
+            at = p * stride
             for v in range(sized, nv):
                 times = int(counts[n * nv + v] - counts[before * nv + v])
                 if times:
-                    pairs.extend((v, times))
-            pairs.append(-1)
+                    pairs[at] = v
+                    pairs[at + 1] = times
+                    at += 2
+            pairs[at] = -1
             for v in range(sized):
-                rem[v] = counts[n * nv + v] - counts[before * nv + v]
-            self.rem.append(rem)
-            self.rem_ph.append(array("i", pairs))
+                rem[p * sized + v] = counts[n * nv + v] - counts[before * nv + v]
         self.above = array("i", above)
         self.covering = array("i", covering)
         self.n_above = len(self.above)
@@ -354,16 +361,26 @@ class System:
     ones under them. Never changed once made: a child adds rows to a copy."""
 
     def __init__(self, nv: int, sized: int, npiv: int, nb: int) -> None:
+        self.make(nv, sized, npiv, nb)
+        self.value = 0.0
+        self.probes: dict[bytes, float] | None = None  # probe() of rows already asked about
+
+    def make(self, nv: int, sized: int, npiv: int, nb: int) -> None:
+        """Its rows, in one buffer (compiled, views of it; interpreted, copies of its parts)."""
         self.npiv = npiv
         self.nb = nb
         self.piv_var = _ints(npiv + 1)
-        self.piv_row = _doubles(npiv * nv + 1)
-        self.piv_rhs = _doubles(npiv + 1)
-        self.basis = _doubles(nb * sized + 1)
-        self.brhs = _doubles(nb + 1)
-        self.point = _doubles(sized + 1)
-        self.value = 0.0
-        self.probes: dict[bytes, float] | None = None  # probe() of rows already asked about
+        made = _doubles(npiv * nv + npiv + nb * sized + nb + sized + 1)
+        buffer = made
+        at = npiv * nv
+        self.piv_row = buffer[0:at]
+        self.piv_rhs = buffer[at : at + npiv]
+        at += npiv
+        self.basis = buffer[at : at + nb * sized]
+        at += nb * sized
+        self.brhs = buffer[at : at + nb]
+        at += nb
+        self.point = buffer[at : at + sized]
 
 
 class Cell:
@@ -381,14 +398,22 @@ class Node:
     column ends (over the symbols) and what each row has used of the letter it is inside."""
 
     def __init__(self, nv: int, count: int) -> None:
-        self.positions = _ints(count + 1)
-        self.memory = _ints(count + 1)
-        self.before = _ints(count + 1)
-        self.x = _doubles(nv + 1)
-        self.used = _doubles(count * nv + 1)
-        self.has_used = _flags(count + 1)
+        self.make(nv, count)
         self.system: Any = None  # System, once made
         self.path: Cell | None = None
+
+    def make(self, nv: int, count: int) -> None:
+        """Its numbers, in two buffers (compiled, views of them; interpreted, copies)."""
+        made = _ints(4 * count + 1)
+        numbers = made
+        self.positions = numbers[0:count]
+        self.memory = numbers[count : 2 * count]
+        self.before = numbers[2 * count : 3 * count]
+        self.has_used = numbers[3 * count : 4 * count]
+        made = _doubles(nv + count * nv + 1)
+        lengths = made
+        self.x = lengths[0:nv]
+        self.used = lengths[nv : nv + count * nv]
 
 
 class Child:
@@ -408,10 +433,6 @@ class Child:
 
 def _child_order(child: Child) -> tuple[int, int, float, int, int, int]:
     return child.order()
-
-
-class Stop(Exception):
-    """The search stops: its budget ran out, or leaf() asked it to."""
 
 
 class Search:
@@ -462,7 +483,8 @@ class Search:
         extra = nv - sized if nv > sized else 1
         self.row = _doubles(nv + 1)
         self.known = _doubles(nv + 1)
-        self.diff = _doubles(nv)
+        self.diff = _doubles(nv)  # fits()'s difference, an array (the probe's key) ...
+        self.diff_view = self.diff  # ... and a view of it
         self.shifted = _doubles(sized + 1)
         self.reduced = _doubles(nv + 1)
         self.coef = _doubles(sized + 2)
@@ -475,12 +497,15 @@ class Search:
         self.fixed = _flags(extra)
 
     # -- work ---------------------------------------------------------------------------
-    def spend(self, units: int) -> None:
+    def spend(self, units: int) -> int:
+        """Spend work units: 1 when the budget (or the deadline) says stop, else 0. The
+        walk stops by these returns, not by an exception: one raised through every level
+        of a deep path costs more than the walk itself."""
         before = self.used
         self.used += units
         if self.used > self.limit:
             self.stop = EXHAUSTED
-            raise Stop
+            return 1
         if (
             before // 256 != self.used // 256
             and isfinite(self.deadline)
@@ -488,7 +513,8 @@ class Search:
         ):
             self.timed_out = True
             self.stop = EXHAUSTED
-            raise Stop
+            return 1
+        return 0
 
     # -- the system of equalities -------------------------------------------------------
     def reduce(self, y: System, row: array[float], rhs: float) -> float:
@@ -729,7 +755,8 @@ class Search:
 
     # -- options and columns ------------------------------------------------------------
     def whole_of(self, row: Row, m: Move) -> array[float]:
-        if m.whole is None:
+        """The length of the letters an entry holds whole, over the symbols."""
+        if not m.has_whole:
             nv = self.nv
             first = (m.start + 1) // 2
             last = m.end // 2
@@ -740,30 +767,34 @@ class Search:
             counts = row.counts
             for j in range(nv):
                 view[j] = counts[last * nv + j] - counts[first * nv + j]
-            m.whole = made
+            m.whole = view
+            m.has_whole = True
         return m.whole
 
-    def known_length(self, row: Row, m: Move, node: Node, r: int) -> array[float] | None:
+    def known_length(
+        self, row: Row, m: Move, node: Node, r: int, into: array[float], at: int
+    ) -> bool:
+        """The length of an entry when it does not depend on the column's width (whole
+        letters, and what is left of a split letter it finishes), into ``into[at:]``;
+        False for pieces."""
         if m.tail >= 0 or m.start == m.end:
-            return None
+            return False
         w = self.whole_of(row, m)
-        if m.piece_of < 0:
-            return w
         nv = self.nv
-        made = _doubles(nv)
-        v = made
         for j in range(nv):
-            v[j] = w[j]
-        v[row.var[m.start // 2]] += 1.0
+            into[at + j] = w[j]
+        if m.piece_of < 0:
+            return True
+        into[at + row.var[m.start // 2]] += 1.0
         used = node.used
         base = r * nv
         for j in range(nv):
-            v[j] -= used[base + j]
-        return made
+            into[at + j] -= used[base + j]
+        return True
 
-    def holds_placeholder(self, length: array[float]) -> bool:
+    def holds_placeholder(self, length: array[float], at: int) -> bool:
         for k in range(self.sized, self.nv):  # noqa: SIM110 (a C loop once compiled)
-            if length[k] != 0.0:
+            if length[at + k] != 0.0:
                 return True
         return False
 
@@ -774,48 +805,55 @@ class Search:
         inside = position % 2 == 1
         gaps = 1 if self.gaps else 0
         if not inside:
-            cached = row.cached[gaps][position]
+            cached: Options | None = row.cached[gaps][position]
             if cached is not None:
                 return cached
         o = Options()
+        nv = self.nv
+        moves: list[Move] = []
         gap = True
         if position < group.ends[r]:
-            for m in row.moves_of(position):
-                o.moves.append(m)
-                o.lens.append(self.known_length(row, m, node, r))
+            moves = row.moves_of(position)
             gap = self.gaps and not inside and row.n_covering > 0
+        o.moves = list(moves)
         if gap:
             o.moves.append(None)
-            o.lens.append(None)
         o.n = len(o.moves)
+        made = _doubles(o.n * nv + 1)
+        lens = made
+        o.lens = lens
+        made = _ints(o.n + 1)
+        known = made
+        o.known = known
+        for i in range(len(moves)):
+            m = moves[i]
+            known[i] = 1 if self.known_length(row, m, node, r, lens, i * nv) else 0
         made = _ints(o.n + 1)
         order = made
         at = 0
         for i in range(o.n):
-            length = o.lens[i]
             m = o.moves[i]
-            if length is not None and plain(m) and not self.holds_placeholder(length):
+            if known[i] and plain(m) and not self.holds_placeholder(lens, i * nv):
                 order[at] = i
                 at += 1
         o.n_whole = at
         for i in range(o.n):
-            length = o.lens[i]
             m = o.moves[i]
-            if length is not None and not (plain(m) and not self.holds_placeholder(length)):
+            if known[i] and not (plain(m) and not self.holds_placeholder(lens, i * nv)):
                 order[at] = i
                 at += 1
         o.n_known = at - o.n_whole
         for i in range(o.n):
-            if o.lens[i] is None:
+            if not known[i]:
                 order[at] = i
                 at += 1
-        o.order = made
+        o.order = order
         if not inside:
             row.cached[gaps][position] = o
         return o
 
     def fits(
-        self, b: Builder, length: array[float], pinned: bool, rest: float
+        self, b: Builder, length: array[float], at: int, pinned: bool, rest: float
     ) -> tuple[int, float]:
         """Whether an option of known ``length`` may be as long as the builder's first
         entry: 1 it may, 0 it may not, NOT_NEAR it may not by its own least deviation
@@ -823,18 +861,19 @@ class Search:
         nv = self.nv
         sz = self.sized
         first = b.first
+        fat = b.first_at
         target = self.target
-        d = self.diff
+        d = self.diff_view
         shifted = self.shifted
         reduced = self.reduced
         placeholders = False
         own = False
         for k in range(nv):
-            d[k] = length[k] - first[k]
+            d[k] = length[at + k] - first[fat + k]
         for k in range(sz, nv):
             if d[k] != 0.0:
                 placeholders = True
-            if length[k] != 0.0:
+            if length[at + k] != 0.0:
                 own = True
         use_shifted = False
         alone = 0.0
@@ -847,7 +886,7 @@ class Search:
             alone = miss * miss / norm if norm > 0 else 0.0
         elif pinned and not own:
             for k in range(sz):
-                shifted[k] = length[k] + reduced[k]
+                shifted[k] = length[at + k] + reduced[k]
             use_shifted = True
             off = rest
             norm = dot(shifted, shifted, sz)
@@ -891,8 +930,10 @@ class Search:
         made = _flags(o.n + 1)
         mask = made
         fo = b.opts[fr]
-        first = fo.lens[j]
+        first = fo.lens
+        fat = j * nv
         b.first = first
+        b.first_at = fat
         limit = self.incumbent + SAME
         b.limit = limit
         b.margin = limit + 1e-9 * (1.0 + limit)
@@ -901,11 +942,11 @@ class Search:
         pinned = False
         rest = 0.0
         for k in range(sz, nv):
-            if first[k] != 0.0:
+            if first[fat + k] != 0.0:
                 pinned = True
         if pinned:
             for k in range(nv):
-                reduced[k] = -first[k]
+                reduced[k] = -first[fat + k]
             rest = self.reduce(y, reduced, 0.0)
             for k in range(sz, nv):
                 if fabs(reduced[k]) > 1e-9:
@@ -920,15 +961,15 @@ class Search:
         for u in range(nw + nk, o.n):
             mask[order[u]] = 1
         # with the whole entries first when they are not checked outward
+        lens = o.lens
         for w in range(0 if not ordered else nw, nw + nk):
-            length = o.lens[order[w]]
-            fit, miss = self.fits(b, length, pinned, rest)
+            fit, miss = self.fits(b, lens, order[w] * nv, pinned, rest)
             mask[order[w]] = 1 if fit == 1 else 0
         if ordered:
             # the first whole entry at least as long as the first, at preferred sizes
             total = rest if pinned else 0.0
             for k in range(sz):
-                total += (-reduced[k] if pinned else first[k]) * self.target[k]
+                total += (-reduced[k] if pinned else first[fat + k]) * self.target[k]
             low = 0
             high = nw
             while low < high:  # binary search: the whole entries are sorted by least length
@@ -939,26 +980,27 @@ class Search:
                     high = mid
             start = low
             for w in range(start, nw):  # longer, outward
-                fit, miss = self.fits(b, o.lens[order[w]], pinned, rest)
+                fit, miss = self.fits(b, lens, order[w] * nv, pinned, rest)
                 mask[order[w]] = 1 if fit == 1 else 0
                 if fit == NOT_NEAR and miss >= 0:
                     break
             for w in range(start - 1, -1, -1):  # shorter, outward
-                fit, miss = self.fits(b, o.lens[order[w]], pinned, rest)
+                fit, miss = self.fits(b, lens, order[w] * nv, pinned, rest)
                 mask[order[w]] = 1 if fit == 1 else 0
                 if fit == NOT_NEAR and miss < 0:
                     break
         b.fits[key] = made
-        return made
+        fitting: array[int] = made
+        return fitting
 
-    def extend(self, b: Builder, i: int, fr: int, fj: int, solid: bool) -> None:
+    def extend(self, b: Builder, i: int, fr: int, fj: int, solid: bool) -> int:
         self.combinations += 1
-        if self.combinations % COMBINATION_WORK == 0:
-            self.spend(1)
+        if self.combinations % COMBINATION_WORK == 0 and self.spend(1):
+            return 1
         if i == b.R:
             if self.valid(b.g, b.chosen, b.node.memory):
                 b.out.append(list(b.chosen))
-            return
+            return 0
         r = b.order[i]
         o = b.opts[r]
         masked = fr >= 0
@@ -971,13 +1013,15 @@ class Search:
                 continue  # a stretch of several letters: searched a letter at a time
             b.chosen[r] = m
             held = solid or not stands_aside(m)
-            if fr < 0 and o.lens[k] is not None and m is not None:
-                self.extend(b, i + 1, r, k, held)
-            else:
-                self.extend(b, i + 1, fr, fj, held)
+            if fr < 0 and o.known[k] and m is not None:
+                if self.extend(b, i + 1, r, k, held):
+                    return 1
+            elif self.extend(b, i + 1, fr, fj, held):
+                return 1
         b.chosen[r] = None
+        return 0
 
-    def columns_of(self, g: int, node: Node, opts: list[Options]) -> list[list[Move | None]]:
+    def columns_of(self, g: int, node: Node, opts: list[Options]) -> list[list[Move | None]] | None:
         """Every valid column out of a node, but not those where two entries of known
         length could not be as long as each other within the incumbent."""
         count = self.groups[g].n
@@ -992,7 +1036,8 @@ class Search:
                 order[k] = order[k - 1]
                 k -= 1
             order[k] = v
-        self.extend(b, 0, -1, -1, False)
+        if self.extend(b, 0, -1, -1, False):
+            return None  # stopped
         return b.out
 
     # -- nodes --------------------------------------------------------------------------
@@ -1074,11 +1119,12 @@ class Search:
             if k >= 0:
                 row = group.rows[k]
                 position = child.positions[k]
-                rem = row.rem[position]
+                rem = row.rem
+                base = position * sz
                 for j in range(sz):
-                    span[j] += rem[j]
-                pairs = row.rem_ph[position]
-                p = 0
+                    span[j] += rem[base + j]
+                pairs = row.rem_ph
+                p = position * row.stride
                 while pairs[p] >= 0:
                     v = pairs[p] - sz
                     times = pairs[p + 1]
@@ -1202,8 +1248,9 @@ class Search:
         node.system = y
         return node  # positions 0, memory FREE, x 0, nothing used, no path
 
-    def call_leaf(self, node: Node) -> None:
-        self.spend(LEAF_WORK)
+    def call_leaf(self, node: Node) -> int:
+        if self.spend(LEAF_WORK):
+            return 1
         paths: Cuts = []
         for g in range(len(self.groups)):
             end = self.done[g] if g + 1 < len(self.groups) else node.path
@@ -1220,21 +1267,23 @@ class Search:
         self.incumbent = float(incumbent)
         if stop:
             self.stop = PERFECT
-            raise Stop
+            return 1
+        return 0
 
-    def finish_group(self, g: int, node: Node) -> None:
+    def finish_group(self, g: int, node: Node) -> int:
         assert node.system is not None
         closed = self.system_add(node.system, node.x, self.canvas, self.canvas)
-        self.spend(1)
+        if self.spend(1):
+            return 1
         if closed is None or closed.value > self.incumbent + SAME:
-            return
+            return 0
         if g + 1 < len(self.groups):
             self.done[g] = node.path
-            self.dfs(g + 1, self.start_of(g + 1, closed))
-        else:
-            self.call_leaf(node)
+            return self.dfs(g + 1, self.start_of(g + 1, closed))
+        return self.call_leaf(node)
 
-    def dfs(self, g: int, node: Node) -> None:
+    def dfs(self, g: int, node: Node) -> int:
+        """Walk on from a node: 1 when the walk stops (see spend()), else 0."""
         group = self.groups[g]
         count = group.n
         at_end = True
@@ -1244,19 +1293,22 @@ class Search:
                 at_end = False
             progress += node.positions[r]
         if at_end:
-            self.finish_group(g, node)
-            return
+            return self.finish_group(g, node)
         self.progress = progress
         opts = [self.options_of(g, r, node) for r in range(count)]
         children: list[Child] = []
-        for entries in self.columns_of(g, node, opts):
+        columns = self.columns_of(g, node, opts)
+        if columns is None:
+            return 1
+        for entries in columns:
             stretch = self.stretch_of(entries, count)
             if stretch is not None:
                 if stretch.letters > 1:
                     continue
             elif node.path is not None and self.merges(g, node.path.column, entries, node.before):
                 continue  # the one column they make is searched too, and is looser
-            self.spend(1)
+            if self.spend(1):
+                return 1
             c = self.child_of(g, node, entries)
             if c is None:
                 continue
@@ -1289,7 +1341,9 @@ class Search:
         for child in children:
             if r9(child.bound) > self.incumbent + SAME:
                 break
-            self.dfs(g, child.node)
+            if self.dfs(g, child.node):
+                return 1
+        return 0
 
     def stretch_of(self, entries: list[Move | None], count: int) -> Move | None:
         found: Move | None = None
@@ -1333,10 +1387,7 @@ class Search:
         y = self.filling(empty)
         if y is None:
             return GO
-        try:  # noqa: SIM105 (plain try: no context manager in the compiled loop)
-            self.dfs(0, self.start_of(0, y))
-        except Stop:
-            pass
+        self.dfs(0, self.start_of(0, y))
         return self.stop
 
 
@@ -1358,7 +1409,8 @@ class Builder:
         self.chosen: list[Move | None] = [None] * count
         self.fits: dict[int, array[int]] = {}  # by (first row, option) and row: a fitting mask
         self.out: list[list[Move | None]] = []
-        self.first: array[float] = _DOUBLES
+        self.first: array[float] = _DOUBLES  # fitting()'s first entry: first[first_at:]
+        self.first_at = 0
         self.limit = 0.0
         self.margin = 0.0
 
