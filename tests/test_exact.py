@@ -556,8 +556,7 @@ def test_a_finished_search_is_collected_with_its_rows() -> None:
 
 def _interpreted_network() -> ModuleType:
     """network.py run as Python, beside the module the solver uses (maybe compiled)."""
-    source = Path(exact.__file__).with_name("network.py")
-    spec = importlib.util.spec_from_file_location("network_interpreted", source)
+    spec = importlib.util.spec_from_file_location("network_interpreted", _network_source())
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -709,3 +708,36 @@ def test_a_layer_that_backs_a_column_is_never_left_out_of_a_relaxation() -> None
         """
     )
     assert (layout.counters["n"], layout.counters["j"]) == (3, 1)
+
+
+def test_the_walk_runs_as_python_without_cython_installed() -> None:
+    """Cython is a build requirement only: network.py, run as Python where ``import
+    cython`` fails, eliminates and walks as it does compiled."""
+    import subprocess
+    import sys
+
+    script = textwrap.dedent(
+        f"""
+        import importlib.util, sys
+        sys.modules["cython"] = None  # as if it were not installed
+        spec = importlib.util.spec_from_file_location("walk", {str(_network_source())!r})
+        walk = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(walk)
+        assert walk.cython.compiled is False and walk.r9(0.1234567895) == 0.12345679
+        found = walk.eliminate([({{0: 1.0, 1: 1.0}}, 3.0), ({{1: 1.0}}, 1.0)], 2, 1e-12, 1e-9)
+        assert found == ([2.0, 1.0], [], []), found
+        letters = [("A", 1.0, False, True, False, False, 0)] * 3
+        cuts = []
+        search = walk.Search(
+            [[(letters, [], [])]], {{"A": 0}}, [1.0], 3.0, float("inf"), 10**6, 0,
+            float("inf"), False, lambda found: (cuts.append(found) or (0.0, True)),
+        )
+        assert search.run(True) == walk.PERFECT and cuts, cuts
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
+def _network_source() -> Path:
+    return Path(exact.__file__).with_name("network.py")
