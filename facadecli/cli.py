@@ -87,7 +87,7 @@ def _not_built() -> list[str]:
     here = Path(__file__).parent
     return [
         what
-        for what, stem in (("grammar", "grammar/_adp"), ("alignment", "solver/_exact"))
+        for what, stem in (("grammar", "grammar/_adp"), ("alignment", "solver/network"))
         if not any((here / f"{stem}{suffix}").exists() for suffix in EXTENSION_SUFFIXES)
     ]
 

@@ -31,13 +31,14 @@ def facade(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
 def test_version() -> None:
     """The version, and a line saying the searches run in pure Python where this install
     has no compiled ones (pip hides the build's note)."""
-    from facadecli.native import EXACT_COMPILED, GRAMMAR_COMPILED
+    from facadecli import native
 
     result = facade("--version")
     assert result.returncode == 0
     lines = result.stdout.splitlines()
     assert lines[0] == f"facade {__version__}"
-    assert len(lines) == (1 if EXACT_COMPILED and GRAMMAR_COMPILED else 2)
+    exact = native.compiled(native.load(native.EXACT_SEARCH))
+    assert len(lines) == (1 if exact and native.GRAMMAR_COMPILED else 2)
 
 
 def test_validate_accepts_every_example() -> None:

@@ -3,18 +3,19 @@ shapes the heuristic search got wrong (issue: "never a false no layout")."""
 
 from __future__ import annotations
 
+import importlib.util
 import itertools
 import textwrap
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from facadecli import InfeasibleError, load_spec, make_word, parse_spec, retarget, solve
+from facadecli import InfeasibleError, make_word, parse_spec, retarget, solve
 from facadecli.export.svg import svg_text
-from facadecli.native import EXACT_COMPILED
 from facadecli.solver import axis, candidates, exact, sizing
 from facadecli.solver.alignment import Alignment, Move, _Row
 from facadecli.solver.exact import Budget, align_exactly
@@ -491,97 +492,34 @@ def test_planted_layouts_the_generator_once_missed(text: str, bays: int) -> None
     assert layout.x.objective == pytest.approx(0.0, abs=1e-9)
 
 
-# -- the compiled search (_exact.c) against the Python reference ---------------------------
-needs_exact = pytest.mark.skipif(
-    not EXACT_COMPILED, reason="compares _exact.c with Python: this install has no compiled _exact"
-)
-
-
-def _both_engines(spec: object, rows: list[Row], canvas: float, incumbent: float) -> list[object]:
-    seen = []
-    for compiled in (True, False):
-        budget = Budget(10**7)
-        outcome = align_exactly(  # type: ignore[arg-type]
-            spec, {"default": rows}, canvas, budget, incumbent, compiled=compiled
-        )
-        found = outcome.found
-        seen.append(
-            (
-                outcome.complete,
-                outcome.reason,
-                budget.used,
-                None if found is None else (found.rank, found.groups),
-            )
-        )
-    return seen
-
-
-@needs_exact
+# -- the network's walk (network.py, compiled or interpreted) --------------------------
 @SETTINGS
 @given(tiny_specs(), st.sampled_from([float("inf"), 0.05, 0.0]))
-def test_the_compiled_search_takes_the_references_every_step(text: str, incumbent: float) -> None:
+def test_the_same_search_twice_takes_the_same_steps(text: str, incumbent: float) -> None:
     """The same layout, the same work units spent (every column bounded, every layout
-    sized), the same reason when there is none."""
+    sized), the same reason when there is none: budgets end at the same place on every
+    run, and a layout within the incumbent is found whenever the oracle has one."""
     spec, rows = _rows(text)
-    compiled, reference = _both_engines(spec, rows, spec.canvas.width, incumbent)  # type: ignore[attr-defined]
-    assert compiled == reference
-
-
-@needs_exact
-@settings(derandomize=True, max_examples=15, deadline=None, suppress_health_check=list(HealthCheck))
-@given(planted_specs())
-def test_the_compiled_search_solves_planted_layouts_as_the_reference(text: str) -> None:
-    """Whole solves, every candidate of both axes: the same drawing to the byte."""
-    spec = parse_spec(text, "planted.yaml")
-    drawings = []
-    default = exact.COMPILED
-    try:
-        for compiled in (True, False):
-            exact.COMPILED = compiled
-            drawings.append(svg_text(solve(spec), labels=True))
-    finally:
-        exact.COMPILED = default
-    assert drawings[0] == drawings[1]
-
-
-@needs_exact
-@pytest.mark.parametrize("source", ["townhouse", "centred-bay", "palace"])
-def test_the_compiled_search_spends_the_references_work_on_every_candidate(
-    source: str, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """Every exact search of a whole solve (both axes, every candidate and pass): the same
-    outcome after the same work units, so budgets end at the same place in both."""
-    if source == "palace":
-        spec = parse_spec(generated_spec(8, 5))
-    else:
-        spec = load_spec(ROOT / "specs" / f"{source}.yaml")
-    searched = exact.align_exactly
-    calls: list[tuple[object, ...]] = []
-
-    def recorded(*args: object, **kwargs: object) -> exact.Outcome:
-        outcome = searched(*args, **kwargs)  # type: ignore[arg-type]
+    canvas = spec.canvas.width  # type: ignore[attr-defined]
+    seen = []
+    for _ in range(2):
+        budget = Budget(10**7)
+        outcome = align_exactly(spec, {"default": rows}, canvas, budget, incumbent)  # type: ignore[arg-type]
         found = outcome.found
-        calls.append(
-            (outcome.complete, outcome.reason, args[3].used, found and found.rank)  # type: ignore[attr-defined]
-        )
-        return outcome
-
-    monkeypatch.setattr(exact, "align_exactly", recorded)
-    runs = []
-    for compiled in (True, False):
-        monkeypatch.setattr(exact, "COMPILED", compiled)
-        calls.clear()
-        solve(spec)
-        runs.append(list(calls))
-    assert runs[0]  # the constructions leave some searches (ties, proofs) to it
-    assert runs[0] == runs[1]
+        seen.append((outcome.complete, outcome.reason, budget.used, found and found.rank))
+    assert seen[0] == seen[1]
+    complete, reason, _, rank = seen[0]
+    assert complete
+    best = _oracle(spec, rows, canvas)
+    if best is not None and best <= incumbent + 1e-9:
+        assert rank is not None and rank[0] == pytest.approx(best, abs=1e-6)
+    elif rank is None:
+        assert reason  # a proof, worded
 
 
-@needs_exact
-def test_a_finished_compiled_search_is_collected() -> None:
-    """The compiled search holds its leaf(), which holds the search: the cycle must be
-    collectable, or every search keeps its moves (a city leaked megabytes a façade)."""
-    import contextlib
+def test_a_finished_search_is_collected_with_its_rows() -> None:
+    """The walk holds its leaf(), which holds the search: once it ends nothing holds the
+    walk, so it is freed at once (a city leaked megabytes a façade when it was not)."""
     import gc
     import weakref
 
@@ -596,23 +534,33 @@ def test_a_finished_compiled_search_is_collected() -> None:
           - {name: wall, x: 'A A A', y: f}
         """
     )
-    search = exact._Search(  # type: ignore[call-arg]
-        spec,
-        3.0,
-        [exact._Group("default", [_Row(r) for r in rows], [[]], [[]], (6,))],
-        Budget(10**6),
-        exact.INF,
-        {"A": 0},
-        np.array([1.0]),
-    )
-    compiled = exact._Compiled(search)
-    with contextlib.suppress(exact._Perfect):  # a layout at preferred sizes: it stops there
-        compiled.run()
-    assert search.best is not None and search.best.sizing.objective == pytest.approx(0.0)
-    alive = weakref.ref(compiled)
-    del compiled
-    gc.collect()
-    assert alive() is None
+    made: list[weakref.ref[object]] = []
+    walk = exact.network.Search
+
+    def kept(*args: object) -> object:
+        found = walk(*args)  # type: ignore[arg-type]
+        made.append(weakref.ref(found))
+        return found
+
+    gc.disable()
+    try:
+        exact.network.Search = kept  # type: ignore[misc, assignment]
+        outcome = align_exactly(spec, {"default": rows}, 3.0, Budget(10**6))  # type: ignore[arg-type]
+        assert outcome.found is not None
+        assert outcome.found.sizing.objective == pytest.approx(0.0)
+        assert made and all(ref() is None for ref in made)
+    finally:
+        exact.network.Search = walk  # type: ignore[misc]
+        gc.enable()
+
+
+def _interpreted_network() -> ModuleType:
+    """network.py run as Python, beside the module the solver uses (maybe compiled)."""
+    spec = importlib.util.spec_from_file_location("network_interpreted", _network_source())
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 @pytest.mark.parametrize(("layers", "bays"), [(24, 4), (12, 6)])
@@ -623,7 +571,8 @@ def test_a_path_with_an_empty_piece_is_left_for_the_one_without(
     empty is the same layout as the letter starting a column later: the search leaves it,
     and finds the same best layout (the same drawing) with fewer layouts sized."""
     spec = parse_spec(generated_spec(layers, bays))
-    monkeypatch.setattr(exact, "COMPILED", False)  # the reference, where the rule can be lifted
+    walk = _interpreted_network()  # where the rule can be lifted (compiled, it cannot)
+    monkeypatch.setattr(exact, "network", walk)
     settled = exact._Search.settle
     sized: list[int] = []
 
@@ -635,7 +584,7 @@ def test_a_path_with_an_empty_piece_is_left_for_the_one_without(
     drawings, counts = [], []
     for lifted in (False, True):
         if lifted:
-            monkeypatch.setattr(exact._Search, "empty_piece", lambda *args: False)
+            monkeypatch.setattr(walk.Search, "empty_piece", lambda *args: False)
         sized.clear()
         drawings.append(svg_text(solve(spec), labels=True))
         counts.append(len(sized))
@@ -735,32 +684,6 @@ def test_the_least_bound_of_a_candidate_is_never_above_its_bound() -> None:
                 assert least(c) <= exact.candidate_bound(rows, canvas) + 1e-12
 
 
-@needs_exact
-def test_a_finished_search_is_let_go_without_the_garbage_collector() -> None:
-    """Each candidate's compiled search holds its moves and options (megabytes for a long
-    row): once it ends, nothing holds it, so it is freed at once, even with the garbage
-    collector off."""
-    import gc
-    import weakref
-
-    made: list[weakref.ref[exact._Compiled]] = []
-    init = exact._Compiled.__init__
-
-    def kept(self: exact._Compiled, search: exact._Search) -> None:
-        init(self, search)
-        made.append(weakref.ref(self))
-
-    spec = parse_spec(generated_spec(8, 3))
-    gc.disable()
-    try:
-        exact._Compiled.__init__ = kept  # type: ignore[method-assign]
-        solve(spec)
-        assert made and all(ref() is None for ref in made)
-    finally:
-        exact._Compiled.__init__ = init  # type: ignore[method-assign]
-        gc.enable()
-
-
 def test_a_layer_that_backs_a_column_is_never_left_out_of_a_relaxation() -> None:
     """The front layer covers nothing (masked), but its opaque B are the only backing the
     base's non-opaque W have. Its words differ from candidate to candidate (B^n C^j); a
@@ -785,3 +708,36 @@ def test_a_layer_that_backs_a_column_is_never_left_out_of_a_relaxation() -> None
         """
     )
     assert (layout.counters["n"], layout.counters["j"]) == (3, 1)
+
+
+def test_the_walk_runs_as_python_without_cython_installed() -> None:
+    """Cython is a build requirement only: network.py, run as Python where ``import
+    cython`` fails, eliminates and walks as it does compiled."""
+    import subprocess
+    import sys
+
+    script = textwrap.dedent(
+        f"""
+        import importlib.util, sys
+        sys.modules["cython"] = None  # as if it were not installed
+        spec = importlib.util.spec_from_file_location("walk", {str(_network_source())!r})
+        walk = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(walk)
+        assert walk.cython.compiled is False and walk.r9(0.1234567895) == 0.12345679
+        found = walk.eliminate([({{0: 1.0, 1: 1.0}}, 3.0), ({{1: 1.0}}, 1.0)], 2, 1e-12, 1e-9)
+        assert found == ([2.0, 1.0], [], []), found
+        letters = [("A", 1.0, False, True, False, False, 0)] * 3
+        cuts = []
+        search = walk.Search(
+            [[(letters, [], [])]], {{"A": 0}}, [1.0], 3.0, float("inf"), 10**6, 0,
+            float("inf"), False, lambda found: (cuts.append(found) or (0.0, True)),
+        )
+        assert search.run(True) == walk.PERFECT and cuts, cuts
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
+def _network_source() -> Path:
+    return Path(exact.__file__).with_name("network.py")

@@ -21,13 +21,18 @@ import functools
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from facadecli.native import EXACT_COMPILED, _exact
+from facadecli import native
 from facadecli.solver.alignment import Alignment, Move
 from facadecli.spec.model import Spec
+
+if TYPE_CHECKING:
+    from facadecli.solver import network
+else:  # compiled where it was built from this very source, else interpreted
+    network = native.load(native.EXACT_SEARCH)
 
 TINY = 1e-8  # weight of unsized variables: breaks ties, never trades against a deviation
 MIN_SIZE = 1e-3  # every sized letter is at least a millimetre long
@@ -258,12 +263,10 @@ def _parametrized(
     rows: Sequence[tuple[Mapping[int, float], float]], n: int
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """Every solution of the sparse equalities ``rows`` over ``n`` variables as
-    ``z0 + N y`` (``y`` the free variables), or None when they contradict each other:
-    :func:`_parametrized_in_python`, compiled (``_exact.eliminate``) where it was built."""
-    if not EXACT_COMPILED:
-        return _parametrized_in_python(rows, n)
+    ``z0 + N y`` (``y`` the free variables), or None when they contradict each other
+    (the elimination is :func:`facadecli.solver.network.eliminate`)."""
     scale = max((abs(rhs) for _, rhs in rows), default=0.0)
-    found = _exact.eliminate(rows, n, ZERO, 1e-9 * max(1.0, scale))
+    found = network.eliminate(rows, n, ZERO, 1e-9 * max(1.0, scale))
     if found is None:
         return None
     constants, free, entries = found
@@ -273,67 +276,6 @@ def _parametrized(
         v, j, c = zip(*entries, strict=True)
         basis[list(v), list(j)] = c
     return np.array(constants), basis
-
-
-def _parametrized_in_python(
-    rows: Sequence[tuple[Mapping[int, float], float]], n: int
-) -> tuple[np.ndarray, np.ndarray] | None:
-    """:func:`_parametrized` in Python, the reference the tests compare it with.
-
-    Gaussian elimination, a row at a time, shortest rows first: the row is written over
-    the variables still free, and one of them (the largest coefficient; the latest
-    variable on a tie) becomes its expression in the others, which replaces it in every
-    expression that named it (``users`` says which)."""
-    solved: dict[int, tuple[dict[int, float], float]] = {}  # variable -> (expression, constant)
-    users: dict[int, set[int]] = {}  # free variable -> solved variables naming it
-    scale = max((abs(rhs) for _, rhs in rows), default=0.0)
-    for coefficients, rhs in sorted(rows, key=lambda row: len(row[0])):
-        terms: dict[int, float] = {}
-        left = rhs
-        for v, c in coefficients.items():
-            if v in solved:
-                expression, k = solved[v]
-                left -= c * k
-                for u, a in expression.items():
-                    terms[u] = terms.get(u, 0.0) + c * a
-            else:
-                terms[v] = terms.get(v, 0.0) + c
-        terms = {u: c for u, c in terms.items() if abs(c) > ZERO}
-        if not terms:
-            if abs(left) > 1e-9 * max(1.0, scale):
-                return None
-            continue
-        pivot = max(terms, key=lambda u: (abs(terms[u]), u))
-        a = terms.pop(pivot)
-        expression = {u: -c / a for u, c in terms.items()}
-        constant = left / a
-        for v in users.pop(pivot, ()):
-            named, k = solved[v]
-            c = named.pop(pivot)
-            for u, b in expression.items():
-                value = named.get(u, 0.0) + c * b
-                if abs(value) > ZERO:
-                    named[u] = value
-                    users.setdefault(u, set()).add(v)
-                elif u in named:
-                    del named[u]
-                    users[u].discard(v)
-            solved[v] = named, k + c * constant
-        solved[pivot] = expression, constant
-        for u in expression:
-            users.setdefault(u, set()).add(pivot)
-    free = [v for v in range(n) if v not in solved]
-    column = {v: j for j, v in enumerate(free)}
-    z0 = np.zeros(n)
-    basis = np.zeros((n, len(free)))
-    for v in range(n):
-        if v in column:
-            basis[v, column[v]] = 1.0
-            continue
-        expression, z0[v] = solved[v]
-        for u, c in expression.items():
-            basis[v, column[u]] = c
-    return z0, basis
 
 
 def _closed_form(program: Program) -> Sizing | np.ndarray:
