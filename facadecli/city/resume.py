@@ -158,7 +158,7 @@ def reusable(
     entry = previous.get(task.footprint.id)
     if entry is None or entry[HASH] != digest:
         return None
-    if entry.get("file") != f"buildings/{task.target.name}" or not task.target.is_file():
+    if entry.get("file") != task.file or not task.target.is_file():
         return None
     if usd and not task.target.with_suffix(".usda").is_file():
         return None

@@ -1,9 +1,11 @@
 """``facade city``: every building of a manifest, in worker processes, written atomically.
 
-The unit of work is a building; each writes ``buildings/<id>.glb`` through a temporary
-file, so an interrupted run resumes (``--resume``, :mod:`facadecli.city.resume`) where
-it stopped. Results are taken as they finish and put back in the manifest's order, so
-the report and the merged model do not depend on scheduling.
+The unit of work is a building; each writes ``buildings/<shard>/<name>.glb``
+(:mod:`facadecli.city.folders`) through a temporary file, so an interrupted run resumes
+(``--resume``, :mod:`facadecli.city.resume`) where it stopped. Results are taken as they
+finish and put back in the manifest's order, so the report and the merged model do not
+depend on scheduling; what the run ends with (merged models, CityJSON, report) is
+streamed to disk, the client holding no more a building than its task.
 Everything a user can fix (the output folder, the GeoJSON file, duplicate ids) is checked
 before the first building; then the run locks its output folder and removes the temporary
 files a killed run left there (:func:`claimed`), and only those. Features that are not
@@ -29,7 +31,6 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from facadecli.city.building import (
-    PLAIN_REASONS,
     AxisCache,
     Facade,
     Looks,
@@ -47,6 +48,7 @@ from facadecli.city.cityjson import (
     outlines,
     write_cityjson,
 )
+from facadecli.city.folders import BUILDINGS, SHARD, building_file, safe_name
 from facadecli.city.footprints import (
     BBox,
     Footprint,
@@ -58,6 +60,7 @@ from facadecli.city.footprints import (
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
+from facadecli.city.report import Entries, Tally, report_chunks
 from facadecli.city.resume import building_hashes, recorded, reusable, stamped
 from facadecli.city.s3db import (
     Heights,
@@ -80,7 +83,7 @@ from facadecli.city.tiles import merge_city
 from facadecli.city.tileset import FOLDER as TILESET_FOLDER
 from facadecli.city.tileset import TilesetWriter
 from facadecli.errors import OutputError, SpecError
-from facadecli.export.atomic import check_output_folder, write_atomic
+from facadecli.export.atomic import atomic_output, check_output_folder, write_atomic
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
 from facadecli.export.usd import city_usda, usda_text
@@ -109,21 +112,10 @@ class Task:
     usd: bool = False  # a USD stage beside the glb (``--usd``)
     above: Any = None  # the taller parts standing on this one: its roof leaves them out
 
-
-PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
-READABLE = 100  # characters of any other id kept, made safe, in front of its hash
-
-
-def safe_name(building_id: str) -> str:
-    """A file name for an id, never the same for two ids, on case-insensitive file systems
-    too. A short, lower-case, plain id is its own name; any other id (OSM ids hold '/')
-    gives its first READABLE characters with unsafe ones replaced, then '~' and a hash of
-    the whole id. No plain name holds '~', so the two kinds never meet."""
-    if PLAIN_NAME.fullmatch(building_id):
-        return building_id
-    readable = re.sub(r"[^A-Za-z0-9._-]", "_", building_id[:READABLE]).strip("._") or "building"
-    digest = hashlib.sha256(building_id.encode("utf-8", "surrogatepass")).hexdigest()[:16]
-    return f"{readable}~{digest}"
+    @property
+    def file(self) -> str:
+        """Its glb relative to the output folder (folders.py): the report's ``file``."""
+        return building_file(self.footprint.id).as_posix()
 
 
 IN_FLIGHT = 64  # chunks of tasks handed to the workers at once, at most
@@ -214,7 +206,7 @@ def build(task: Task) -> dict[str, Any]:
     return {
         "id": task.footprint.id,
         "status": "ok",
-        "file": f"buildings/{task.target.name}",
+        "file": task.file,
         "facades": result.facades,
         "plain_walls": result.plain_walls,
         "party_walls": result.party_walls,
@@ -337,7 +329,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 heights,
                 roof,
                 defaults.min_facade_width,
-                outdir / "buildings" / f"{name}.glb",
+                outdir / building_file(footprint.id),
                 (city.folder / choice.facade).parent.resolve(),
                 looks,
                 shared.get(footprint.id),
@@ -422,7 +414,7 @@ def check_output(outdir: Path, name: str) -> None:
     ``--output`` if not); nothing is created here."""
     check_output_folder(outdir)
     problem = None
-    buildings = outdir / "buildings"
+    buildings = outdir / BUILDINGS
     if os.path.lexists(buildings) and not os.path.isdir(buildings):
         problem = f"'{buildings}' is a file, where the buildings' folder goes"
     elif os.path.isdir(buildings) and not os.access(buildings, os.W_OK | os.X_OK):
@@ -448,6 +440,7 @@ def check_output(outdir: Path, name: str) -> None:
 # mkstemp's names: a prefix, 8 characters of these, a suffix (facadecli.export.atomic,
 # glb_merge, cityjson write ``.<target>.<8>.tmp``, ``.bin``, ``.objects``, ``.vertices``)
 _RANDOM = r"\.[a-z0-9_]{8}\."
+BUILT = rf"\.[A-Za-z0-9._~-]+\.(?:glb|city\.jsonl|usda){_RANDOM}tmp"  # a building's files
 
 
 def leftovers(outdir: Path, name: str) -> list[Path]:
@@ -457,10 +450,14 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
     patterns = {
         outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda)"
         rf"{_RANDOM}(?:tmp|bin|objects|vertices)",
-        outdir / "buildings": rf"\.[A-Za-z0-9._~-]+\.(?:glb|city\.jsonl|usda){_RANDOM}tmp",
+        outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
         outdir / TILESET_FOLDER: rf"\.tileset\.json{_RANDOM}tmp",
     }
+    with contextlib.suppress(OSError):  # buildings/<shard>/ (folders.py)
+        for entry in os.scandir(outdir / BUILDINGS):
+            if SHARD.fullmatch(entry.name) and entry.is_dir(follow_symlinks=False):
+                patterns[Path(entry.path)] = BUILT
     tileset = outdir / TILESET_FOLDER  # 3D Tiles: <level>/<column>/<row>.lod<k>.glb
     for sub, _, _ in sorted(os.walk(tileset)):
         if Path(sub) != tileset:
@@ -554,37 +551,50 @@ def _build(
     lods: tuple[int, ...] = (),
 ) -> dict[str, Any]:
     """The planned buildings built (those built before skipped with ``resume``), then
-    the merged models, the CityJSON and the report written; returns the report."""
+    the merged models, the CityJSON and the report written; returns the report.
+
+    The client holds no more a building than its task and its report entry as a line
+    (report.py): the merged models, the CityJSON and the report are streamed to disk."""
     georef = Georef(found.crs, found.origin, found.unit)
-    results: list[dict[str, Any]] = []
+    order = {task.footprint.id: index for index, task in enumerate(tasks)}
+    entries = Entries(len(tasks))
+    built = bytearray(len(tasks))  # 1 for a building built (or kept), in the manifest's order
+    tally = Tally()
     todo = []
+    resumed = []  # positions of the buildings kept from the last run
     hashes = building_hashes(city, tasks)
     previous = recorded(outdir, city.manifest.name) if resume else {}
-    for task in tasks:
+    for index, task in enumerate(tasks):
         entry = reusable(task, hashes[task.footprint.id], previous, usd)
         if entry is None:
             todo.append(task)
         else:
-            results.append(entry)
-    done = len(results)
+            entries.put(index, entry)
+            built[index] = entry["status"] == "ok"
+            tally.add(entry)
+            resumed.append(index)
+    del previous
+    done = len(resumed)
     tileset = None
     if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
-        centroids = [(task.footprint.id, _centroid(task.footprint)) for task in tasks]
-        tileset = TilesetWriter(outdir, georef, lods, centroids)
+        places = [(task.footprint.id, _centroid(task.footprint)) for task in tasks]
+        tileset = TilesetWriter(outdir, georef, lods, places)
     local = scheduler is None
     mapped = stamped(_map_local(todo, jobs) if local else _map_dask(todo, str(scheduler)), hashes)
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
         outdir.mkdir(parents=True, exist_ok=True)
-        with open(log, "w", encoding="utf-8") as lines:
-            for result in results:
-                lines.write(json.dumps(result) + "\n")
-                _tiled(tileset, outdir, result)
+        with open(log, "wb") as lines:
+            for index in resumed:
+                lines.write(entries.line(index) + b"\n")
+                _tiled(tileset, outdir, tasks[index], built[index])
             for result in mapped:
-                results.append(result)
-                lines.write(json.dumps(result) + "\n")
+                index = order[result["id"]]
+                lines.write(entries.put(index, result) + b"\n")
                 lines.flush()
-                _tiled(tileset, outdir, result)
+                built[index] = result["status"] == "ok"
+                tally.add(result)
+                _tiled(tileset, outdir, tasks[index], built[index])
                 done += 1
                 if progress is not None:
                     progress(done, len(tasks))
@@ -593,20 +603,25 @@ def _build(
             f"{outdir}: cannot write the report: {error.strerror or error}; the buildings "
             "built are kept: run again with --resume"
         ) from None
-    order = {task.footprint.id: i for i, task in enumerate(tasks)}
-    results.sort(key=lambda r: order[r["id"]])
-    by_id = {task.footprint.id: task for task in tasks}
+
+    def ok() -> Iterator[Task]:  # the buildings built, in the manifest's order
+        return (task for task, made in zip(tasks, built, strict=True) if made)
+
+    centroids = [_centroid(task.footprint) for task in tasks]  # for the tiles, found once
+
+    def merged() -> Iterator[tuple[str, Path, tuple[float, float]]]:
+        for task, made, centroid in zip(tasks, built, centroids, strict=True):
+            if made:
+                yield task.footprint.id, task.target, centroid
+
     try:
         written = merge_city(
-            (
-                (r["id"], outdir / r["file"], _centroid(by_id[r["id"]].footprint))
-                for r in results
-                if r["status"] == "ok"
-            ),
+            merged,
             outdir,
             city.manifest.name,
             city.manifest.tiles,
             georef,
+            streamed=bool(lods),
         )
     except OSError as error:  # a full disk: the buildings stay, for --resume
         raise OutputError(
@@ -623,30 +638,28 @@ def _build(
             ) from None
     if usd:
         stage = outdir / f"{city.manifest.name}.usda"
-        ok = [outdir / r["file"] for r in results if r["status"] == "ok"]
-        write_atomic(stage, city_usda(city.manifest.name, ok, outdir))
+        write_atomic(stage, city_usda(city.manifest.name, [t.target for t in ok()], outdir))
         written = {**written, "usd": stage.name}
     cityjson = outdir / f"{city.manifest.name}.city.json"
     try:
         with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:
-            ok = [r["id"] for r in results if r["status"] == "ok"]
-            features = (_feature(by_id[key]) for key in ok)
-            for feature in grouped(features, outlines(found.footprints, replaced, ok)):
+            ids = [task.footprint.id for task in ok()]
+            features = (_feature(task) for task in ok())
+            for feature in grouped(features, outlines(found.footprints, replaced, ids)):
                 writer.add(feature)
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the CityJSON: {error.strerror or error}; the "
             "buildings built are kept: run again with --resume"
         ) from None
-    failed = [r for r in results if r["status"] != "ok"]
-    warned = [w for w in found.warnings if w.id in by_id]
+    warned = [w for w in found.warnings if w.id in order]
     report = {
         "version": 1,
         "name": city.manifest.name,
         "crs": found.crs,
         "origin": list(found.origin),
         "georeference": georeference(georef),
-        "buildings": results,
+        "buildings": entries,
         "rejected": [_rejected(r) for r in found.rejected],
         "warnings": [_warning(w) for w in warned],
         "replaced": [
@@ -655,18 +668,15 @@ def _build(
         "models": written,
         "summary": {
             "buildings": len(tasks),
-            "ok": len(results) - len(failed),
-            "failed": len(failed),
+            "ok": tally.ok,
+            "failed": tally.failed,
             "rejected": len(found.rejected),
             "warnings": len(warned),
             "outside_bbox": found.outside,
             "replaced": sum(1 for area in kept.values() if area == 0),
             "trimmed": sum(1 for area in kept.values() if area > 0),
-            "party_walls": sum(r.get("party_walls", 0) for r in results),
-            "plain_walls": {
-                reason: sum(r.get("plain", {}).get(reason, 0) for r in results)
-                for reason in PLAIN_REASONS
-            },
+            "party_walls": tally.party_walls,
+            "plain_walls": tally.plain_by_reason(),
             "collinear_nodes_merged": straight.nodes if straight else 0,
             "warnings_by_tag": dict(
                 sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())
@@ -675,9 +685,9 @@ def _build(
         },
     }
     try:
-        write_atomic(
-            outdir / f"{city.manifest.name}.report.json", json.dumps(report, indent=2) + "\n"
-        )
+        with atomic_output(outdir / f"{city.manifest.name}.report.json") as out:
+            for chunk in report_chunks(report, "buildings", entries):
+                out.write(chunk.encode("utf-8"))
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the report: {error.strerror or error}; run again with --resume"
@@ -685,13 +695,13 @@ def _build(
     return report
 
 
-def _tiled(tileset: TilesetWriter | None, outdir: Path, result: dict[str, Any]) -> None:
-    """A building done (built, resumed or failed), for the 3D Tiles of its leaf."""
+def _tiled(tileset: TilesetWriter | None, outdir: Path, task: Task, built: int) -> None:
+    """A building done (built or resumed, or failed: ``built`` 0), for the 3D Tiles of its
+    leaf."""
     if tileset is None:
         return
-    glb = outdir / result["file"] if result["status"] == "ok" else None
     try:
-        tileset.done(result["id"], glb)
+        tileset.done(task.footprint.id, task.target if built else None)
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "
