@@ -4,6 +4,8 @@ glb and the report written without holding every building, the merged glb left o
 
 from __future__ import annotations
 
+import dataclasses
+import errno
 import json
 import tracemalloc
 from collections import Counter
@@ -14,9 +16,12 @@ import pytest
 import trimesh
 
 import facadecli.city.tiles as tiles_module
+from facadecli.city.built import BuiltCity
 from facadecli.city.folders import SHARD, SHARDS, building_file, safe_name, shard
-from facadecli.city.report import Entries, Tally, report_chunks
+from facadecli.city.manifest import load_city
+from facadecli.city.report import CityReport, Entries, Summary, Tally, report_chunks
 from facadecli.city.run import run_city
+from facadecli.export import CITY_WRITERS, CityWriter
 from facadecli.export.glb_merge import merge_glb, read_glb
 from tests.running import facade
 from tests.test_city_inputs import city, square, town
@@ -170,19 +175,57 @@ def test_merging_holds_what_one_building_needs_not_every_building(tmp_path: Path
     assert document["buffers"] == [{"byteLength": len(binary)}]
 
 
-def test_the_run_holds_a_line_a_building_not_its_entry(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """What a run returns and writes comes from the report's lines: its buildings are an
-    :class:`Entries`, and the report on disk is those entries dumped."""
+def test_the_report_is_a_typed_object_read_as_its_json_document(tmp_path: Path) -> None:
+    """What a run returns is a :class:`CityReport` (its summary a :class:`Summary`), its
+    buildings held as lines (:class:`Entries`); read as a mapping it is the document on
+    disk, key for key and in order."""
     manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(3)])
-    from facadecli.city.manifest import load_city
-
     report = run_city(load_city(manifest), tmp_path / "out")
-    assert isinstance(report["buildings"], Entries)
+    assert isinstance(report, CityReport) and isinstance(report.summary, Summary)
+    assert isinstance(report.buildings, Entries) and report.summary.ok == 3
     on_disk = json.loads((tmp_path / "out" / "town.report.json").read_text())
-    assert on_disk["buildings"] == list(report["buildings"])
-    assert on_disk["summary"]["ok"] == 3 == sum(b["status"] == "ok" for b in report["buildings"])
+    assert list(on_disk) == list(report) == [
+        "version", "name", "crs", "origin", "georeference", "buildings", "rejected",
+        "warnings", "replaced", "models", "summary",
+    ]  # fmt: skip
+    assert on_disk == {**report, "buildings": list(report["buildings"])}
+    assert on_disk["summary"] == dataclasses.asdict(report.summary)
+
+
+def test_a_city_is_ended_by_the_writers_of_the_registry(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The merged model, 3D Tiles, USD stage and CityJSON are written by CITY_WRITERS, in
+    that order; a writer the disk refuses is exit 1 naming its output, the buildings kept."""
+    manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(2)])
+    assert list(CITY_WRITERS) == ["glb", "3dtiles", "usd", "cityjson"]
+    called: list[str] = []
+    for name, writer in CITY_WRITERS.items():
+
+        def spy(built: BuiltCity, name: str = name, write: Any = writer.write) -> Any:
+            called.append(name)
+            assert [t.footprint.id for t in built.ok()] == ["h0", "h1"]
+            return write(built)
+
+        monkeypatch.setitem(CITY_WRITERS, name, dataclasses.replace(writer, write=spy))
+    code, _, err = city(capsys, manifest, "--usd", "--3dtiles")
+    assert code == 0, err
+    assert called == ["glb", "3dtiles", "usd", "cityjson"]
+    models = json.loads((tmp_path / "out" / "town.report.json").read_text())["models"]
+    assert models["usd"] == "town.usda" and models["3dtiles"]["tileset"] == "3dtiles/tileset.json"
+    called.clear()
+    assert city(capsys, manifest)[0] == 0
+    assert called == ["glb", "cityjson"]  # no --usd, no --3dtiles
+
+    def full(built: BuiltCity) -> Any:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setitem(CITY_WRITERS, "cityjson", CityWriter("CityJSON", full))
+    code, _, err = city(capsys, manifest, "--resume")
+    assert code == 1
+    assert "cannot write the CityJSON: No space left on device" in err
+    assert "run again with --resume" in err
+    assert (tmp_path / "out" / building_file("h1")).is_file()
 
 
 def test_the_command_names_the_merged_model_it_wrote(

@@ -527,8 +527,11 @@ def test_a_city_in_tiles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     monkeypatch.setattr(tiles, "MERGED_GLB_MAX", 1000)
     (tmp_path / "big").mkdir()
     report = _run(tmp_path / "big", "")
+    why = report["models"]["merged_left_out"]
+    assert why.startswith("the buildings' models hold ") and "MERGED_GLB_MAX" in why
     assert report["models"] == {
         "merged": None,
+        "merged_left_out": why,
         "tiles": "tags.tiles.json",
         "georef": "tags.georef.json",
     }

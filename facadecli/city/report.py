@@ -1,4 +1,4 @@
-"""A city's report, kept and written in flat memory.
+"""A city's report (:class:`CityReport`), kept and written in flat memory.
 
 Its per-building entries are held as the JSON lines they are logged as
 (:class:`Entries`: a few hundred bytes a building, where a parsed entry takes kilobytes),
@@ -9,9 +9,10 @@ indent=2)`` of the whole document.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections import Counter
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, overload
 
@@ -95,3 +96,60 @@ def report_chunks(report: dict[str, Any], key: str, entries: Iterable[Entry]) ->
         first = False
     yield "[]" if first else "\n  ]"
     yield after + "\n"
+
+
+@dataclass(frozen=True)
+class Summary:
+    """The report's ``summary``: the run in numbers (docs/reference/city.md#outputs)."""
+
+    buildings: int  # planned
+    ok: int
+    failed: int
+    rejected: int  # features that are not footprints
+    warnings: int  # built features with tags ignored
+    outside_bbox: int
+    replaced: int  # outlines whose parts stand in all of them
+    trimmed: int  # outlines of which a rest is built beside their parts
+    party_walls: int
+    plain_walls: dict[str, int]  # by reason (PLAIN_REASONS)
+    collinear_nodes_merged: int
+    warnings_by_tag: dict[str, int]
+    seconds: float
+
+
+@dataclass(frozen=True)
+class CityReport(Mapping[str, Any]):
+    """A city run's report, ``<name>.report.json``: a typed object, read as its JSON
+    document too (``report["summary"]["ok"]``), whose keys are its fields in order."""
+
+    name: str
+    crs: str
+    origin: list[float]
+    georeference: dict[str, Any]
+    buildings: Entries
+    rejected: list[Entry]
+    warnings: list[Entry]
+    replaced: list[Entry]
+    models: dict[str, Any]  # what the writers wrote (facadecli.export.CITY_WRITERS)
+    summary: Summary
+    version: int = 1
+
+    def document(self) -> dict[str, Any]:
+        """The report as JSON data: ``version`` first, then the fields in order (the
+        buildings left as they are: :func:`report_chunks` writes them one at a time)."""
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        fields["summary"] = dataclasses.asdict(self.summary)
+        return {"version": fields.pop("version"), **fields}
+
+    def chunks(self) -> Iterator[str]:
+        """The report's JSON text, a building at a time (:func:`report_chunks`)."""
+        return report_chunks(self.document(), "buildings", self.buildings)
+
+    def __getitem__(self, key: str) -> Any:
+        return self.document()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.document())
+
+    def __len__(self) -> int:
+        return len(dataclasses.fields(self))

@@ -18,7 +18,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
-import json
 import os
 import queue
 import re
@@ -40,12 +39,10 @@ from facadecli.city.building import (
     rung_length,
     solve_rung,
 )
+from facadecli.city.built import BuiltCity, attributes, feature_file
 from facadecli.city.cityjson import (
     BuildingSolids,
-    CityJSONWriter,
     building_object,
-    grouped,
-    outlines,
     write_cityjson,
 )
 from facadecli.city.folders import BUILDINGS, SHARD, building_file, safe_name
@@ -56,11 +53,10 @@ from facadecli.city.footprints import (
     Rejected,
     Simplified,
     read_footprints,
-    typed,
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
-from facadecli.city.report import Entries, Tally, report_chunks
+from facadecli.city.report import CityReport, Entries, Summary, Tally
 from facadecli.city.resume import building_hashes, recorded, reusable, stamped
 from facadecli.city.s3db import (
     Heights,
@@ -79,14 +75,14 @@ from facadecli.city.s3db import (
     wall_colour,
 )
 from facadecli.city.straight import Straightened, straighten
-from facadecli.city.tiles import merge_city
 from facadecli.city.tileset import FOLDER as TILESET_FOLDER
 from facadecli.city.tileset import TilesetWriter
 from facadecli.errors import OutputError, SpecError
+from facadecli.export import CITY_WRITERS, CityWriter
 from facadecli.export.atomic import atomic_output, check_output_folder, write_atomic
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
-from facadecli.export.usd import city_usda, usda_text
+from facadecli.export.usd import usda_text
 from facadecli.geometry.facade import material_extensions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
@@ -189,8 +185,8 @@ def build(task: Task) -> dict[str, Any]:
             task.pick,
             task.above,
         )
-        solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
-        write_cityjson(_feature_file(task.target), building_object(solids))
+        solids = BuildingSolids(task.footprint.id, result.volumes, attributes(task, result.top))
+        write_cityjson(feature_file(task.target), building_object(solids))
         write_atomic(task.target, glb_bytes(result.scene, material_extensions(task.spec)))
         if task.usd:
             write_atomic(
@@ -229,34 +225,6 @@ def _centroid(footprint: Footprint) -> tuple[float, float]:
     """Where a building is, for its tile: the centroid of its largest part."""
     largest = max(footprint.parts, key=lambda part: part.area)
     return largest.centroid.x, largest.centroid.y
-
-
-def _feature_file(target: Path) -> Path:
-    """Where a building's CityJSON feature goes, beside its glb (written before the glb,
-    which marks the building done for --resume)."""
-    return target.with_suffix(".city.jsonl")
-
-
-def _attributes(task: Task, top: float) -> dict[str, Any]:
-    """A building's CityJSON attributes: its tags, how tall it is, its roof and spec."""
-    return {
-        **typed(task.footprint.properties),
-        "measuredHeight": top,
-        "roofType": task.roof.type,
-        "facade": task.spec_key,
-    }
-
-
-def _feature(task: Task) -> dict[str, Any]:
-    """A building's CityJSON feature: the one its worker wrote, or (a building resumed from
-    a run before features were written) made here from its volumes."""
-    path = _feature_file(task.target)
-    if path.is_file():
-        loaded: dict[str, Any] = json.loads(path.read_bytes())
-        return loaded
-    volumes = [volume(part, task.heights, task.roof) for part in task.footprint.parts]
-    top = max(v.top for v in volumes)
-    return building_object(BuildingSolids(task.footprint.id, volumes, _attributes(task, top)))
 
 
 def _simplified(simplified: Simplified | None) -> dict[str, Any]:
@@ -498,7 +466,7 @@ def run_city(
     bbox: BBox | None = None,
     usd: bool = False,
     lods: tuple[int, ...] = (),
-) -> dict[str, Any]:
+) -> CityReport:
     """Build a city; returns the report (also written to ``<name>.report.json``).
     With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py).
 
@@ -508,30 +476,54 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
-    replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
-    footprints, kept = standing(city, inherited(found.footprints, replaced), replaced)
-    defaults = city.manifest.defaults
-    straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
-    footprints = list(straight.footprints[: limit if limit is not None else None])
-    tasks = plan(city, footprints, outdir, usd)
+    ahead = planned(city, outdir, bbox, limit, usd)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
             city,
             outdir,
-            tasks,
-            found,
-            replaced,
-            kept,
+            ahead.tasks,
+            ahead.found,
+            ahead.replaced,
+            ahead.kept,
             jobs,
             resume,
             progress,
             scheduler,
             usd,
             started,
-            straight,
+            ahead.straight,
             lods,
         )
+
+
+@dataclass(frozen=True)
+class Planned:
+    """A city read and planned, before any building: what the client holds all run."""
+
+    found: FootprintSet  # as read
+    replaced: dict[str, list[str]]  # outlines whose parts are built instead
+    kept: dict[str, float]  # of those, the area (m²) still built of each
+    straight: Straightened  # the footprints with their collinear nodes merged
+    tasks: list[Task]  # a building each, in the manifest's order
+
+
+def planned(
+    city: City,
+    outdir: Path,
+    bbox: BBox | None = None,
+    limit: int | None = None,
+    usd: bool = False,
+) -> Planned:
+    """The footprints read (those in ``bbox``), an outline's tags given to its parts, the
+    outlines with parts cut to what they leave, collinear nodes merged, the first
+    ``limit`` planned (:func:`plan`) for ``outdir``."""
+    found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
+    replaced = replaced_outlines(found.footprints)
+    footprints, kept = standing(city, inherited(found.footprints, replaced), replaced)
+    defaults = city.manifest.defaults
+    straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
+    footprints = list(straight.footprints[: limit if limit is not None else None])
+    return Planned(found, replaced, kept, straight, plan(city, footprints, outdir.resolve(), usd))
 
 
 def _build(
@@ -549,7 +541,7 @@ def _build(
     started: float,
     straight: Straightened | None = None,
     lods: tuple[int, ...] = (),
-) -> dict[str, Any]:
+) -> CityReport:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report.
 
@@ -604,95 +596,82 @@ def _build(
             "built are kept: run again with --resume"
         ) from None
 
-    def ok() -> Iterator[Task]:  # the buildings built, in the manifest's order
-        return (task for task, made in zip(tasks, built, strict=True) if made)
-
-    centroids = [_centroid(task.footprint) for task in tasks]  # for the tiles, found once
-
-    def merged() -> Iterator[tuple[str, Path, tuple[float, float]]]:
-        for task, made, centroid in zip(tasks, built, centroids, strict=True):
-            if made:
-                yield task.footprint.id, task.target, centroid
-
-    try:
-        written = merge_city(
-            merged,
-            outdir,
-            city.manifest.name,
-            city.manifest.tiles,
-            georef,
-            streamed=bool(lods),
-        )
-    except OSError as error:  # a full disk: the buildings stay, for --resume
-        raise OutputError(
-            f"{outdir}: cannot write the merged model: {error.strerror or error}; the "
-            "buildings built are kept: run again with --resume"
-        ) from None
-    if tileset is not None:
-        try:
-            written = {**written, "3dtiles": tileset.close(city.manifest.name)}
-        except OSError as error:
-            raise OutputError(
-                f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "
-                "buildings built are kept: run again with --resume"
-            ) from None
-    if usd:
-        stage = outdir / f"{city.manifest.name}.usda"
-        write_atomic(stage, city_usda(city.manifest.name, [t.target for t in ok()], outdir))
-        written = {**written, "usd": stage.name}
-    cityjson = outdir / f"{city.manifest.name}.city.json"
-    try:
-        with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:
-            ids = [task.footprint.id for task in ok()]
-            features = (_feature(task) for task in ok())
-            for feature in grouped(features, outlines(found.footprints, replaced, ids)):
-                writer.add(feature)
-    except OSError as error:
-        raise OutputError(
-            f"{outdir}: cannot write the CityJSON: {error.strerror or error}; the "
-            "buildings built are kept: run again with --resume"
-        ) from None
-    warned = [w for w in found.warnings if w.id in order]
-    report = {
-        "version": 1,
-        "name": city.manifest.name,
-        "crs": found.crs,
-        "origin": list(found.origin),
-        "georeference": georeference(georef),
-        "buildings": entries,
-        "rejected": [_rejected(r) for r in found.rejected],
-        "warnings": [_warning(w) for w in warned],
-        "replaced": [
-            {"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())
-        ],
-        "models": written,
-        "summary": {
-            "buildings": len(tasks),
-            "ok": tally.ok,
-            "failed": tally.failed,
-            "rejected": len(found.rejected),
-            "warnings": len(warned),
-            "outside_bbox": found.outside,
-            "replaced": sum(1 for area in kept.values() if area == 0),
-            "trimmed": sum(1 for area in kept.values() if area > 0),
-            "party_walls": tally.party_walls,
-            "plain_walls": tally.plain_by_reason(),
-            "collinear_nodes_merged": straight.nodes if straight else 0,
-            "warnings_by_tag": dict(
-                sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())
-            ),
-            "seconds": round(time.perf_counter() - started, 2),
-        },
-    }
+    finished = BuiltCity(
+        city.manifest.name,
+        outdir,
+        tasks,
+        bytes(built),
+        [_centroid(task.footprint) for task in tasks],
+        found,
+        replaced,
+        georef,
+        city.manifest.tiles,
+        tileset,
+    )
+    models: dict[str, Any] = {}
+    for name in ("glb", *(["3dtiles"] if tileset else []), *(["usd"] if usd else []), "cityjson"):
+        models |= _written(CITY_WRITERS[name], finished)
+    report = CityReport(
+        city.manifest.name,
+        found.crs,
+        list(found.origin),
+        georeference(georef),
+        entries,
+        [_rejected(r) for r in found.rejected],
+        [_warning(w) for w in found.warnings if w.id in order],
+        [{"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())],
+        models,
+        _summary(tally, found, kept, order, straight, time.perf_counter() - started),
+    )
     try:
         with atomic_output(outdir / f"{city.manifest.name}.report.json") as out:
-            for chunk in report_chunks(report, "buildings", entries):
+            for chunk in report.chunks():
                 out.write(chunk.encode("utf-8"))
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the report: {error.strerror or error}; run again with --resume"
         ) from None
     return report
+
+
+def _written(writer: CityWriter, finished: BuiltCity) -> dict[str, Any]:
+    """What ``writer`` wrote of the city, for the report; OutputError (exit 1) when the
+    disk refuses it: the buildings stay, for ``--resume``."""
+    try:
+        written: dict[str, Any] = writer.write(finished)
+    except OSError as error:
+        raise OutputError(
+            f"{finished.outdir}: cannot write the {writer.what}: {error.strerror or error}; "
+            "the buildings built are kept: run again with --resume"
+        ) from None
+    return written
+
+
+def _summary(
+    tally: Tally,
+    found: FootprintSet,
+    kept: dict[str, float],
+    order: dict[str, int],
+    straight: Straightened | None,
+    seconds: float,
+) -> Summary:
+    """The report's summary of a run: ``tally`` of its buildings, what was read."""
+    warned = [w for w in found.warnings if w.id in order]
+    return Summary(
+        buildings=len(order),
+        ok=tally.ok,
+        failed=tally.failed,
+        rejected=len(found.rejected),
+        warnings=len(warned),
+        outside_bbox=found.outside,
+        replaced=sum(1 for area in kept.values() if area == 0),
+        trimmed=sum(1 for area in kept.values() if area > 0),
+        party_walls=tally.party_walls,
+        plain_walls=tally.plain_by_reason(),
+        collinear_nodes_merged=straight.nodes if straight else 0,
+        warnings_by_tag=dict(sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())),
+        seconds=round(seconds, 2),
+    )
 
 
 def _tiled(tileset: TilesetWriter | None, outdir: Path, task: Task, built: int) -> None:

@@ -14,7 +14,9 @@ the client's peak resident memory (``ru_maxrss``: the workers' are not in it) an
 resident memory when the first and the last building end; the output sizes, the shard
 folders of ``buildings/`` and the tiles' sizes. With ``FACADE_BENCH_PROFILE=1`` the
 smaller size also runs in one process under cProfile, and the functions taking the most
-CPU (own and cumulative) are printed.
+CPU (own and cumulative) are printed. First, the client's memory once the town is read
+and planned (no building built) at 1,000, 10,000, 100,000 (up to ``FACADE_BENCH_N``)
+buildings, and its slope; ``FACADE_BENCH_PLAN_ONLY=1`` stops there.
 Figures depend on the machine and its load; they are for docs/benchmarks.md, never
 asserted by the tests.
 """
@@ -83,6 +85,60 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
             }
         )
     )
+
+
+def planning(manifest: Path, figures: Path) -> None:
+    """A city read and planned in this process (:func:`facadecli.city.run.planned`, and
+    the buildings' hashes for --resume), no building built: its memory and CPU to
+    ``figures``."""
+    from facadecli.city.manifest import load_city
+    from facadecli.city.resume import building_hashes
+    from facadecli.city.run import planned
+
+    city = load_city(manifest)
+    before = _resident_mib()  # the imports
+    cpu = time.process_time()
+    ahead = planned(city, manifest.parent / "out")
+    building_hashes(city, ahead.tasks)
+    figures.write_text(
+        json.dumps(
+            {
+                "buildings": len(ahead.tasks),
+                "imports_mib": before,
+                "planned_mib": _resident_mib(),
+                "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+                "cpu": time.process_time() - cpu,
+            }
+        )
+    )
+
+
+def measure_planning(counts: list[int], folder: Path) -> None:
+    """The client's memory once a town of each size is read and planned, each in a fresh
+    process: what it holds through the run, before the buildings' entries."""
+    from facadecli.city.demo import write_terraces
+
+    rows = []
+    for count in counts:
+        manifest = write_terraces(folder / f"plan-{count}", ROOT / "specs", count, SEED)
+        figures = folder / f"plan-{count}.json"
+        command = [sys.executable, __file__, "--plan", str(manifest), str(figures)]
+        subprocess.run(command, check=True)
+        rows.append(json.loads(figures.read_text()))
+        shutil.rmtree(folder / f"plan-{count}")
+    for row in rows:
+        grown = row["planned_mib"] - row["imports_mib"]
+        print(
+            f"planning {row['buildings']} buildings: {row['cpu']:.1f} CPU-s, resident "
+            f"{row['imports_mib']:.0f} MiB after the imports, {row['planned_mib']:.0f} MiB "
+            f"planned (+{grown * 1024 / row['buildings']:.1f} KiB a building), peak "
+            f"{row['peak_mib']:.0f} MiB"
+        )
+    if len(rows) > 1:
+        first, last = rows[0], rows[-1]
+        slope = (last["planned_mib"] - first["planned_mib"]) * 1024
+        slope /= last["buildings"] - first["buildings"]
+        print(f"planning's slope: {slope:.1f} KiB a building")
 
 
 def _size(path: Path) -> int:
@@ -195,6 +251,10 @@ def main() -> None:
     jobs = int(os.environ.get("FACADE_BENCH_JOBS", str(os.cpu_count() or 1)))
     with tempfile.TemporaryDirectory(prefix="city-large-") as scratch:
         folder = Path(scratch)
+        sizes = [n for n in (1_000, 10_000, 100_000) if n < count] + [count]
+        measure_planning(sizes, folder)
+        if os.environ.get("FACADE_BENCH_PLAN_ONLY"):
+            return
         small = measure(max(1, count // 4), jobs, folder)
         large = measure(count, jobs, folder)
         print(
@@ -206,7 +266,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--client"]:
+    if sys.argv[1:2] == ["--plan"]:
+        planning(Path(sys.argv[2]), Path(sys.argv[3]))
+    elif sys.argv[1:2] == ["--client"]:
         manifest, out, jobs, figures = sys.argv[2:6]
         client(Path(manifest), Path(out), int(jobs), Path(figures))
     else:
