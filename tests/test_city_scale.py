@@ -20,6 +20,7 @@ from facadecli.city.built import BuiltCity
 from facadecli.city.folders import SHARD, SHARDS, building_file, safe_name, shard
 from facadecli.city.manifest import load_city
 from facadecli.city.report import CityReport, Entries, Summary, Tally, report_chunks
+from facadecli.city.resume import recorded
 from facadecli.city.run import run_city
 from facadecli.export import CITY_WRITERS, CityWriter
 from facadecli.export.glb_merge import merge_glb, read_glb
@@ -235,3 +236,21 @@ def test_the_command_names_the_merged_model_it_wrote(
     code, said, err = facade(capsys, "city", manifest, "-o", tmp_path / "out", "-j", "1")
     assert code == 0, err
     assert f"-> {tmp_path / 'out'}/town.glb, " in said and "no merged" not in err
+
+
+def test_resume_reads_the_last_run_as_lines(tmp_path: Path) -> None:
+    """The last run's entries are kept as their lines (a city of 100,000 resumes in little
+    memory): the last line of an id wins, a line cut short or without a hash is skipped."""
+    log = tmp_path / "town.report.jsonl"
+    entries = [
+        {"id": "a", "status": "ok", "hash": "1", "height": 3.5},
+        {"id": "b", "status": "ok"},  # a run before the hashes
+        {"id": "c", "status": "failed", "hash": "2"},
+        {"id": "a", "status": "ok", "hash": "3", "height": 4.0},
+    ]
+    log.write_text("".join(json.dumps(e) + "\n" for e in entries) + '{"id": "d", "sta')
+    found = recorded(tmp_path, "town")
+    assert found == {"a": json.dumps(entries[3]).encode("utf-8")}
+    log.unlink()  # without the log, the report
+    (tmp_path / "town.report.json").write_text(json.dumps({"buildings": entries[:2]}))
+    assert recorded(tmp_path, "town") == {"a": json.dumps(entries[0]).encode("utf-8")}
