@@ -608,8 +608,10 @@ def _build(
         city.manifest.tiles,
         tileset,
     )
+    formats = ["glb", "3dtiles", "usd", "cityjson"]  # CITY_WRITERS' order: the report's too
+    asked = {"3dtiles": tileset is not None, "usd": usd}
     models: dict[str, Any] = {}
-    for name in ("glb", *(["3dtiles"] if tileset else []), *(["usd"] if usd else []), "cityjson"):
+    for name in (name for name in formats if asked.get(name, True)):
         models |= _written(CITY_WRITERS[name], finished)
     report = CityReport(
         city.manifest.name,
