@@ -8,7 +8,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
-from facadecli.export.atomic import check_output_file, check_output_folder, staged, write_atomic
+from facadecli.export.atomic import (
+    atomic_output,
+    check_output_file,
+    check_output_folder,
+    staged,
+    write_atomic,
+)
 
 if TYPE_CHECKING:  # trimesh takes half a second to import: only the mesh writers need it
     import trimesh
@@ -139,10 +145,13 @@ def _write_city_3dtiles(built: BuiltCity) -> dict[str, Any]:
 
 
 def _write_city_usd(built: BuiltCity) -> dict[str, Any]:
-    from facadecli.export.usd import city_usda
+    from facadecli.export.usd import city_usda_lines
 
     stage = built.outdir / f"{built.name}.usda"
-    write_atomic(stage, city_usda(built.name, [t.target for t in built.ok()], built.outdir))
+    with atomic_output(stage) as out:
+        buildings = (task.target for task in built.ok())
+        for line in city_usda_lines(built.name, buildings, built.outdir):
+            out.write(line.encode("utf-8"))
     return {"usd": stage.name}
 
 
