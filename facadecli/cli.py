@@ -588,11 +588,15 @@ def city(
                 f"({entry.get('time_ms')} ms)"
             )
     rejected = f", {summary['rejected']} footprints rejected" if summary["rejected"] else ""
+    models = report["models"]
+    if models.get("merged_left_out"):
+        _warn(f"{outdir}: no merged {report['name']}.glb: {models['merged_left_out']}")
+    merged = [models["merged"] or models["tiles"]] if models["merged"] or models["tiles"] else []
+    tileset = [models["3dtiles"]["tileset"]] if "3dtiles" in models else []
+    names = [*merged, f"{report['name']}.city.json", f"{report['name']}.report.json", *tileset]
     _say(
         f"{summary['ok']} of {summary['buildings']} buildings built{rejected} in "
-        f"{summary['seconds']} s -> {outdir}/{report['name']}.glb, "
-        f"{outdir}/{report['name']}.city.json, {outdir}/{report['name']}.report.json"
-        + (f", {outdir}/3dtiles/tileset.json" if "3dtiles" in report["models"] else "")
+        f"{summary['seconds']} s -> " + ", ".join(f"{outdir}/{name}" for name in names)
     )
     if summary["failed"]:  # exit 1 only when a building that should build did not
         raise typer.Exit(1)

@@ -50,3 +50,6 @@ WATCH_REQUEST_SECONDS = 10.0  # a request's line and headers arrive within this,
 
 #: bytes of a city's single merged glb (a glb's lengths are 32-bit); beyond, tiles only
 MERGED_GLB_MAX = 2**31
+#: buildings of a city's single merged glb: a bigger city is more than a viewer loads at
+#: once, so it gets tiles only (``tiles/``, and ``--3dtiles``, which a viewer streams)
+MERGED_BUILDINGS_MAX = 10_000

@@ -138,7 +138,7 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
     report = run_city(city, out, jobs=2)
     assert report["summary"] == {**report["summary"], "buildings": 4, "ok": 4, "failed": 0}
     merged = trimesh.load(out / "demo-district.glb", force="scene")
-    assert len(list((out / "buildings").glob("*.glb"))) == 4
+    assert len(list((out / "buildings").glob("*/*.glb"))) == 4  # in their shards
     low, high = merged.bounds
     assert low[1] == pytest.approx(-0.01, abs=1e-3)  # the ground
     assert high[1] >= 9.0  # the tallest building's roof
@@ -150,10 +150,10 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
     again = run_city(city, out, jobs=1, resume=True)
     assert all(b.get("resumed") for b in again["buildings"])
     serial = run_city(city, tmp_path / "serial", jobs=1)
-    for name in sorted(p.name for p in (out / "buildings").iterdir()):
-        assert (out / "buildings" / name).read_bytes() == (
-            tmp_path / "serial" / "buildings" / name
-        ).read_bytes()
+    built = sorted(p.relative_to(out) for p in (out / "buildings").rglob("*") if p.is_file())
+    assert built and all(
+        (out / path).read_bytes() == (tmp_path / "serial" / path).read_bytes() for path in built
+    )
     assert serial["summary"]["ok"] == 4
 
 

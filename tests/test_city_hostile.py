@@ -16,6 +16,7 @@ from typing import Any
 
 import pytest
 
+from facadecli.city.folders import shard
 from facadecli.city.footprints import checked_properties, length
 from facadecli.limits import OSM_INFLATION_MAX, OSM_TEXT_CHARS_MAX
 from tests.running import facade, files
@@ -322,8 +323,9 @@ def test_a_run_cleans_what_a_killed_run_left_and_nothing_else(
         (out, ".town.city.json.", ".objects"),
         (out, ".town.city.json.", ".vertices"),
         (out, ".town.report.json.", ".tmp"),
-        (out / "buildings", ".b0.glb.", ".tmp"),
-        (out / "buildings", ".b1.city.jsonl.", ".tmp"),
+        (out / "buildings", ".b0.glb.", ".tmp"),  # where runs before the shards wrote
+        (out / "buildings" / shard("b0"), ".b0.glb.", ".tmp"),
+        (out / "buildings" / shard("b1"), ".b1.city.jsonl.", ".tmp"),
         (out / "tiles", ".town_0_-1.glb.", ".bin"),
     ]:
         folder.mkdir(exist_ok=True)
@@ -337,6 +339,7 @@ def test_a_run_cleans_what_a_killed_run_left_and_nothing_else(
         out / ".other.glb.abcdefgh.tmp",
         out / "buildings" / ".b0.glb.tmp",
         out / "buildings" / "b0.glb.abcdefgh.tmp",
+        out / "buildings" / shard("b0") / "b0.glb.abcdefgh.tmp",
     ]
     for path in others:
         path.write_text("mine")

@@ -13,6 +13,7 @@ from typing import Any
 
 import pytest
 
+from facadecli.city.folders import shard
 from facadecli.city.footprints import MAX_VERTICES, read_footprints
 from facadecli.city.manifest import load_city
 from facadecli.city.run import plan, run_city, safe_name
@@ -113,8 +114,9 @@ def test_a_feature_that_cannot_be_built_is_rejected_by_id_and_line(
     assert f"{tmp_path / 'f.geojson'}:4:1: rejected: feature '{fid}': {entry['error']}" in err
     summary = report(manifest)["summary"]
     assert summary == {**summary, "buildings": 1, "ok": 1, "failed": 0, "rejected": 1}
-    built = sorted(p.name for p in (tmp_path / "out" / "buildings").iterdir())
+    built = sorted(p.name for p in (tmp_path / "out" / "buildings" / shard("good")).iterdir())
     assert built == ["good.city.jsonl", "good.glb"]
+    assert [p.name for p in (tmp_path / "out" / "buildings").iterdir()] == [shard("good")]
 
 
 NOT_GEOJSON = {
@@ -186,7 +188,7 @@ def test_long_ids_sharing_a_prefix_get_files_of_their_own(
     manifest = town(tmp_path, [square(prefix + "1"), square(prefix + "2", x=20)])
     code, _, err = city(capsys, manifest)
     assert code == 0, err
-    files = sorted((tmp_path / "out" / "buildings").glob("*.glb"))
+    files = sorted((tmp_path / "out" / "buildings").glob("*/*.glb"))
     assert len(files) == 2 and all(len(f.name) <= 125 for f in files)
     ids = ["way/1", "way_1", "way:1", "Way/1", "WAY/1", "way_1~x", "", ".", prefix, prefix + "x"]
     names = [safe_name(i) for i in ids]
@@ -297,7 +299,7 @@ def test_workers_get_absolute_paths(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     loaded = load_city(Path("m.yaml"))
     found = read_footprints(loaded.footprints)
     (task,) = plan(loaded, list(found.footprints), Path("relative/out"))
-    assert task.target == tmp_path / "relative" / "out" / "buildings" / "a.glb"
+    assert task.target == tmp_path / "relative" / "out" / "buildings" / shard("a") / "a.glb"
     assert task.spec_dir == manifest.parent and task.spec_dir.is_absolute()
 
 

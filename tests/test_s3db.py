@@ -13,9 +13,10 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon
 
+from facadecli.city.folders import building_file
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, load_city
-from facadecli.city.run import run_city, safe_name
+from facadecli.city.run import run_city
 from facadecli.city.s3db import (
     Heights,
     blind,
@@ -141,7 +142,7 @@ def _run(tmp_path: Path, extra: str = "") -> dict[str, Any]:
 
 
 def _model(tmp_path: Path, fid: str) -> trimesh.Scene:
-    return trimesh.load(tmp_path / "out" / "buildings" / f"{safe_name(fid)}.glb", force="scene")
+    return trimesh.load(tmp_path / "out" / building_file(fid), force="scene")
 
 
 @pytest.fixture(scope="module")
@@ -231,12 +232,12 @@ def test_outline_rest_keeps_what_no_part_stands_in() -> None:
 
 def test_colour_tags_colour_walls_and_roof(district: tuple[Path, dict[str, Any]]) -> None:
     folder, _ = district
-    document = json.loads(_json_chunk(folder / "out" / "buildings" / "tower.glb"))
+    document = json.loads(_json_chunk(folder / "out" / building_file("tower")))
     colours = {
         m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
     }
     assert colours["flat_roof"][:3] == pytest.approx([1.0, 1.0, 1.0])  # a drawn deck:
-    scene = trimesh.load(folder / "out" / "buildings" / "tower.glb", force="scene")
+    scene = trimesh.load(folder / "out" / building_file("tower"), force="scene")
     deck = next(
         g.visual.material for name, g in scene.geometry.items() if name.endswith("/flat_roof")
     )
@@ -272,7 +273,7 @@ def test_heights_from_any_property_with_a_scale(district: tuple[Path, dict[str, 
 
 def test_colours_spec_keeps_the_spec_materials(tmp_path: Path) -> None:
     _run(tmp_path, "rules:\n  - when: {building:part: 'yes'}\n    colours: spec\n")
-    document = json.loads(_json_chunk(tmp_path / "out" / "buildings" / "tower.glb"))
+    document = json.loads(_json_chunk(tmp_path / "out" / building_file("tower")))
     colours = {
         m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
     }
@@ -293,7 +294,7 @@ def test_a_spec_material_named_wall_is_used_for_plain_walls(tmp_path: Path) -> N
     (tmp_path / "tags.geojson").write_text(json.dumps(data))
     (tmp_path / "tags.yaml").write_text(MANIFEST.format(extra=""))
     run_city(load_city(tmp_path / "tags.yaml"), tmp_path / "out")
-    document = json.loads(_json_chunk(tmp_path / "out" / "buildings" / "a.glb"))
+    document = json.loads(_json_chunk(tmp_path / "out" / building_file("a")))
     wall = next(m for m in document["materials"] if m["name"] == "wall")
     expected = [c / 255 for c in linear_rgb("#123456")]  # glTF's factor is linear light
     assert wall["pbrMetallicRoughness"]["baseColorFactor"][:3] == pytest.approx(expected, abs=0.01)
@@ -485,7 +486,7 @@ def _varied(tmp_path: Path, seed: int) -> dict[str, Any]:
 
 
 def _looks(tmp_path: Path, fid: str) -> tuple[tuple[float, ...], bool]:
-    document = json.loads(_json_chunk(tmp_path / "out" / "buildings" / f"{fid}.glb"))
+    document = json.loads(_json_chunk(tmp_path / "out" / building_file(fid)))
     colours = {
         m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
     }
@@ -500,8 +501,8 @@ def test_a_seed_varies_layouts_and_colours_per_building(tmp_path: Path) -> None:
     assert len({shutters for _, shutters in first}) == 2  # both layouts of the alternation
     _varied(tmp_path / "b", 0)
     for i in range(8):  # the same seed: the same files
-        a = (tmp_path / "a" / "out" / "buildings" / f"h{i}.glb").read_bytes()
-        assert a == (tmp_path / "b" / "out" / "buildings" / f"h{i}.glb").read_bytes()
+        a = (tmp_path / "a" / "out" / building_file(f"h{i}")).read_bytes()
+        assert a == (tmp_path / "b" / "out" / building_file(f"h{i}")).read_bytes()
     _varied(tmp_path / "c", 1)
     assert [_looks(tmp_path / "c", f"h{i}") for i in range(8)] != first  # another seed
 
@@ -526,8 +527,11 @@ def test_a_city_in_tiles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     monkeypatch.setattr(tiles, "MERGED_GLB_MAX", 1000)
     (tmp_path / "big").mkdir()
     report = _run(tmp_path / "big", "")
+    why = report["models"]["merged_left_out"]
+    assert why.startswith("the buildings' models hold ") and "MERGED_GLB_MAX" in why
     assert report["models"] == {
         "merged": None,
+        "merged_left_out": why,
         "tiles": "tags.tiles.json",
         "georef": "tags.georef.json",
     }
@@ -552,5 +556,6 @@ def test_a_bounded_stream_of_tasks_gives_the_same_files(
     for name in ("plain.yaml", "tags.geojson", "tags.yaml"):
         (tmp_path / name).write_bytes((folder / name).read_bytes())
     run_city(load_city(tmp_path / "tags.yaml"), tmp_path / "out", jobs=2)
-    for built in sorted((folder / "out" / "buildings").glob("*.glb")):
-        assert built.read_bytes() == (tmp_path / "out" / "buildings" / built.name).read_bytes()
+    for built in sorted((folder / "out" / "buildings").glob("*/*.glb")):
+        path = built.relative_to(folder / "out")
+        assert built.read_bytes() == (tmp_path / "out" / path).read_bytes()

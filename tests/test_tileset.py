@@ -425,7 +425,7 @@ def test_a_leaf_is_written_when_its_last_building_is_done(city: Path, tmp_path: 
     are done, and tileset.json only at the end."""
     frame = json.loads((city / f"{city.name}.georef.json").read_text())
     georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
-    glbs = sorted((city / "buildings").glob("*.glb"))
+    glbs = sorted((city / "buildings").glob("*/*.glb"))
     places = [(glb.stem, (100.0 * (k % 2), 0.0)) for k, glb in enumerate(glbs)]  # two leaves
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(tileset_module, "CAPACITY", dict.fromkeys((1, 2, 3), len(glbs) // 2))
@@ -468,7 +468,7 @@ def test_a_viewer_goes_on_through_empty_squares_to_the_content_below(
     content, or a viewer would stop refining at them and show nothing there."""
     frame = json.loads((city / f"{city.name}.georef.json").read_text())
     georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
-    glbs = sorted((city / "buildings").glob("*.glb"))
+    glbs = sorted((city / "buildings").glob("*/*.glb"))
     places = [(glb.stem, (37.0 * k % 100, 11.0 * k)) for k, glb in enumerate(glbs)]
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(tileset_module, "CAPACITY", {1: 10, 2: 10, 3: 1})

@@ -14,6 +14,7 @@ from urllib.parse import quote
 import pytest
 
 from facadecli import load_spec, solve
+from facadecli.city.folders import building_file
 from facadecli.cli import main
 from facadecli.export import OutputOptions, write_outputs
 from facadecli.viewer import gallery
@@ -152,18 +153,20 @@ def test_view_writes_index_html_and_the_same_bytes_each_time(
     assert not [p for p in folder.iterdir() if p.name.startswith(".")]  # no temporary left
 
 
+@pytest.mark.parametrize("sharded", [True, False])  # buildings/<shard>/, or as before them
 def test_view_shows_a_citys_buildings_when_the_folder_has_no_other_model(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, varied: Path, sharded: bool
 ) -> None:
-    (tmp_path / "buildings").mkdir()
     model = varied / "residential-house-8x3-0.glb"
-    for name in ("b10", "b9"):
-        shutil.copy(model, tmp_path / "buildings" / f"{name}.glb")
+    for name in ("b10", "b9", "b11"):
+        path = tmp_path / (str(building_file(name)) if sharded else f"buildings/{name}.glb")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(model, path)
     code, out, err = facade(capsys, "view", tmp_path)
-    assert code == 0 and out.strip() == f"2 models -> {tmp_path / 'index.html'}", err
+    assert code == 0 and out.strip() == f"3 models -> {tmp_path / 'index.html'}", err
     text = (tmp_path / "index.html").read_text()
-    assert re.findall(r'data-name="([^"]+)"', text) == ["b9", "b10"]
-    assert "2 models in buildings/" in text and "<img" not in text  # no elevations
+    assert re.findall(r'data-name="([^"]+)"', text) == ["b9", "b10", "b11"]
+    assert "3 models in buildings/" in text and "<img" not in text  # no elevations
     shutil.copy(varied / "residential-house-12x3-0.glb", tmp_path / "district.glb")
     assert facade(capsys, "view", tmp_path)[0] == 0  # the merged model, not the buildings
     text = (tmp_path / "index.html").read_text()

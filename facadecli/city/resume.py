@@ -120,17 +120,29 @@ def building_hashes(city: City, tasks: Iterable[Task]) -> dict[str, str]:
     return {task.footprint.id: building_hash(task, digest) for task in tasks}
 
 
-def recorded(outdir: Path, name: str) -> dict[str, dict[str, Any]]:
+def recorded(outdir: Path, name: str) -> dict[str, bytes]:
     """The report entries of the buildings the last run into ``outdir`` built, with their
-    hashes, by id: from ``<name>.report.jsonl`` (a line a building as it ended, so a
-    killed run's too; a line cut short is skipped), or, without it, the report."""
+    hashes, by id, each as its JSON line (a few hundred bytes, where a parsed entry takes
+    kilobytes: a city of 100,000 is resumed in little memory): from
+    ``<name>.report.jsonl`` (a line a building as it ended, so a killed run's too; a line
+    cut short is skipped), or, without it, the report."""
     log = outdir / f"{name}.report.jsonl"
-    entries: list[Any] = []
+    found: dict[str, bytes] = {}
+
+    def keep(entry: Any) -> None:
+        if (
+            isinstance(entry, dict)
+            and entry.get("status") == "ok"
+            and isinstance(entry.get("id"), str)
+            and isinstance(entry.get(HASH), str)
+        ):
+            found[entry["id"]] = json.dumps(entry).encode("utf-8")
+
     try:
         with open(log, encoding="utf-8", errors="replace") as lines:
             for line in lines:
                 try:
-                    entries.append(json.loads(line))
+                    keep(json.loads(line))
                 except ValueError:
                     continue
     except FileNotFoundError:
@@ -138,27 +150,24 @@ def recorded(outdir: Path, name: str) -> dict[str, dict[str, Any]]:
             report = json.loads((outdir / f"{name}.report.json").read_bytes())
         except (OSError, ValueError):
             return {}
-        found = report.get("buildings") if isinstance(report, dict) else None
-        entries = found if isinstance(found, list) else []
-    return {
-        entry["id"]: entry
-        for entry in entries
-        if isinstance(entry, dict)
-        and entry.get("status") == "ok"
-        and isinstance(entry.get("id"), str)
-        and isinstance(entry.get(HASH), str)
-    }
+        entries = report.get("buildings") if isinstance(report, dict) else None
+        for entry in entries if isinstance(entries, list) else []:
+            keep(entry)
+    return found
 
 
 def reusable(
-    task: Task, digest: str, previous: dict[str, dict[str, Any]], usd: bool
+    task: Task, digest: str, previous: dict[str, bytes], usd: bool
 ) -> dict[str, Any] | None:
     """The last run's report entry of a building, marked ``resumed``, when it may be kept:
     its outputs exist and its hash is the one it has now; else None (build it)."""
-    entry = previous.get(task.footprint.id)
-    if entry is None or entry[HASH] != digest:
+    line = previous.get(task.footprint.id)
+    if line is None:
         return None
-    if entry.get("file") != f"buildings/{task.target.name}" or not task.target.is_file():
+    entry: dict[str, Any] = json.loads(line)
+    if entry[HASH] != digest:
+        return None
+    if entry.get("file") != task.file or not task.target.is_file():
         return None
     if usd and not task.target.with_suffix(".usda").is_file():
         return None

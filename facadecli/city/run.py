@@ -1,9 +1,11 @@
 """``facade city``: every building of a manifest, in worker processes, written atomically.
 
-The unit of work is a building; each writes ``buildings/<id>.glb`` through a temporary
-file, so an interrupted run resumes (``--resume``, :mod:`facadecli.city.resume`) where
-it stopped. Results are taken as they finish and put back in the manifest's order, so
-the report and the merged model do not depend on scheduling.
+The unit of work is a building; each writes ``buildings/<shard>/<name>.glb``
+(:mod:`facadecli.city.folders`) through a temporary file, so an interrupted run resumes
+(``--resume``, :mod:`facadecli.city.resume`) where it stopped. Results are taken as they
+finish and put back in the manifest's order, so the report and the merged model do not
+depend on scheduling; what the run ends with (merged models, CityJSON, report) is
+streamed to disk, the client holding no more a building than its task.
 Everything a user can fix (the output folder, the GeoJSON file, duplicate ids) is checked
 before the first building; then the run locks its output folder and removes the temporary
 files a killed run left there (:func:`claimed`), and only those. Features that are not
@@ -16,7 +18,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
-import json
 import os
 import queue
 import re
@@ -29,7 +30,6 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from facadecli.city.building import (
-    PLAIN_REASONS,
     AxisCache,
     Facade,
     Looks,
@@ -39,14 +39,13 @@ from facadecli.city.building import (
     rung_length,
     solve_rung,
 )
+from facadecli.city.built import BuiltCity, attributes, feature_file
 from facadecli.city.cityjson import (
     BuildingSolids,
-    CityJSONWriter,
     building_object,
-    grouped,
-    outlines,
     write_cityjson,
 )
+from facadecli.city.folders import BUILDINGS, SHARD, building_file, safe_name
 from facadecli.city.footprints import (
     BBox,
     Footprint,
@@ -54,10 +53,10 @@ from facadecli.city.footprints import (
     Rejected,
     Simplified,
     read_footprints,
-    typed,
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.manifest import Choice, City, Roof, WallRule
+from facadecli.city.report import CityReport, Entries, Summary, Tally
 from facadecli.city.resume import building_hashes, recorded, reusable, stamped
 from facadecli.city.s3db import (
     Heights,
@@ -76,14 +75,14 @@ from facadecli.city.s3db import (
     wall_colour,
 )
 from facadecli.city.straight import Straightened, straighten
-from facadecli.city.tiles import merge_city
 from facadecli.city.tileset import FOLDER as TILESET_FOLDER
 from facadecli.city.tileset import TilesetWriter
 from facadecli.errors import OutputError, SpecError
-from facadecli.export.atomic import check_output_folder, write_atomic
+from facadecli.export import CITY_WRITERS, CityWriter
+from facadecli.export.atomic import atomic_output, check_output_folder, write_atomic
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
-from facadecli.export.usd import city_usda, usda_text
+from facadecli.export.usd import usda_text
 from facadecli.geometry.facade import material_extensions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
@@ -109,21 +108,10 @@ class Task:
     usd: bool = False  # a USD stage beside the glb (``--usd``)
     above: Any = None  # the taller parts standing on this one: its roof leaves them out
 
-
-PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
-READABLE = 100  # characters of any other id kept, made safe, in front of its hash
-
-
-def safe_name(building_id: str) -> str:
-    """A file name for an id, never the same for two ids, on case-insensitive file systems
-    too. A short, lower-case, plain id is its own name; any other id (OSM ids hold '/')
-    gives its first READABLE characters with unsafe ones replaced, then '~' and a hash of
-    the whole id. No plain name holds '~', so the two kinds never meet."""
-    if PLAIN_NAME.fullmatch(building_id):
-        return building_id
-    readable = re.sub(r"[^A-Za-z0-9._-]", "_", building_id[:READABLE]).strip("._") or "building"
-    digest = hashlib.sha256(building_id.encode("utf-8", "surrogatepass")).hexdigest()[:16]
-    return f"{readable}~{digest}"
+    @property
+    def file(self) -> str:
+        """Its glb relative to the output folder (folders.py): the report's ``file``."""
+        return building_file(self.footprint.id).as_posix()
 
 
 IN_FLIGHT = 64  # chunks of tasks handed to the workers at once, at most
@@ -197,8 +185,8 @@ def build(task: Task) -> dict[str, Any]:
             task.pick,
             task.above,
         )
-        solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
-        write_cityjson(_feature_file(task.target), building_object(solids))
+        solids = BuildingSolids(task.footprint.id, result.volumes, attributes(task, result.top))
+        write_cityjson(feature_file(task.target), building_object(solids))
         write_atomic(task.target, glb_bytes(result.scene, material_extensions(task.spec)))
         if task.usd:
             write_atomic(
@@ -214,7 +202,7 @@ def build(task: Task) -> dict[str, Any]:
     return {
         "id": task.footprint.id,
         "status": "ok",
-        "file": f"buildings/{task.target.name}",
+        "file": task.file,
         "facades": result.facades,
         "plain_walls": result.plain_walls,
         "party_walls": result.party_walls,
@@ -237,34 +225,6 @@ def _centroid(footprint: Footprint) -> tuple[float, float]:
     """Where a building is, for its tile: the centroid of its largest part."""
     largest = max(footprint.parts, key=lambda part: part.area)
     return largest.centroid.x, largest.centroid.y
-
-
-def _feature_file(target: Path) -> Path:
-    """Where a building's CityJSON feature goes, beside its glb (written before the glb,
-    which marks the building done for --resume)."""
-    return target.with_suffix(".city.jsonl")
-
-
-def _attributes(task: Task, top: float) -> dict[str, Any]:
-    """A building's CityJSON attributes: its tags, how tall it is, its roof and spec."""
-    return {
-        **typed(task.footprint.properties),
-        "measuredHeight": top,
-        "roofType": task.roof.type,
-        "facade": task.spec_key,
-    }
-
-
-def _feature(task: Task) -> dict[str, Any]:
-    """A building's CityJSON feature: the one its worker wrote, or (a building resumed from
-    a run before features were written) made here from its volumes."""
-    path = _feature_file(task.target)
-    if path.is_file():
-        loaded: dict[str, Any] = json.loads(path.read_bytes())
-        return loaded
-    volumes = [volume(part, task.heights, task.roof) for part in task.footprint.parts]
-    top = max(v.top for v in volumes)
-    return building_object(BuildingSolids(task.footprint.id, volumes, _attributes(task, top)))
 
 
 def _simplified(simplified: Simplified | None) -> dict[str, Any]:
@@ -337,7 +297,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 heights,
                 roof,
                 defaults.min_facade_width,
-                outdir / "buildings" / f"{name}.glb",
+                outdir / building_file(footprint.id),
                 (city.folder / choice.facade).parent.resolve(),
                 looks,
                 shared.get(footprint.id),
@@ -422,7 +382,7 @@ def check_output(outdir: Path, name: str) -> None:
     ``--output`` if not); nothing is created here."""
     check_output_folder(outdir)
     problem = None
-    buildings = outdir / "buildings"
+    buildings = outdir / BUILDINGS
     if os.path.lexists(buildings) and not os.path.isdir(buildings):
         problem = f"'{buildings}' is a file, where the buildings' folder goes"
     elif os.path.isdir(buildings) and not os.access(buildings, os.W_OK | os.X_OK):
@@ -448,6 +408,7 @@ def check_output(outdir: Path, name: str) -> None:
 # mkstemp's names: a prefix, 8 characters of these, a suffix (facadecli.export.atomic,
 # glb_merge, cityjson write ``.<target>.<8>.tmp``, ``.bin``, ``.objects``, ``.vertices``)
 _RANDOM = r"\.[a-z0-9_]{8}\."
+BUILT = rf"\.[A-Za-z0-9._~-]+\.(?:glb|city\.jsonl|usda){_RANDOM}tmp"  # a building's files
 
 
 def leftovers(outdir: Path, name: str) -> list[Path]:
@@ -457,10 +418,14 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
     patterns = {
         outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda)"
         rf"{_RANDOM}(?:tmp|bin|objects|vertices)",
-        outdir / "buildings": rf"\.[A-Za-z0-9._~-]+\.(?:glb|city\.jsonl|usda){_RANDOM}tmp",
+        outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
         outdir / TILESET_FOLDER: rf"\.tileset\.json{_RANDOM}tmp",
     }
+    with contextlib.suppress(OSError):  # buildings/<shard>/ (folders.py)
+        for entry in os.scandir(outdir / BUILDINGS):
+            if SHARD.fullmatch(entry.name) and entry.is_dir(follow_symlinks=False):
+                patterns[Path(entry.path)] = BUILT
     tileset = outdir / TILESET_FOLDER  # 3D Tiles: <level>/<column>/<row>.lod<k>.glb
     for sub, _, _ in sorted(os.walk(tileset)):
         if Path(sub) != tileset:
@@ -501,7 +466,7 @@ def run_city(
     bbox: BBox | None = None,
     usd: bool = False,
     lods: tuple[int, ...] = (),
-) -> dict[str, Any]:
+) -> CityReport:
     """Build a city; returns the report (also written to ``<name>.report.json``).
     With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py).
 
@@ -511,30 +476,54 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
-    replaced = replaced_outlines(found.footprints)  # outlines whose parts are built instead
-    footprints, kept = standing(city, inherited(found.footprints, replaced), replaced)
-    defaults = city.manifest.defaults
-    straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
-    footprints = list(straight.footprints[: limit if limit is not None else None])
-    tasks = plan(city, footprints, outdir, usd)
+    ahead = planned(city, outdir, bbox, limit, usd)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
             city,
             outdir,
-            tasks,
-            found,
-            replaced,
-            kept,
+            ahead.tasks,
+            ahead.found,
+            ahead.replaced,
+            ahead.kept,
             jobs,
             resume,
             progress,
             scheduler,
             usd,
             started,
-            straight,
+            ahead.straight,
             lods,
         )
+
+
+@dataclass(frozen=True)
+class Planned:
+    """A city read and planned, before any building: what the client holds all run."""
+
+    found: FootprintSet  # as read
+    replaced: dict[str, list[str]]  # outlines whose parts are built instead
+    kept: dict[str, float]  # of those, the area (m²) still built of each
+    straight: Straightened  # the footprints with their collinear nodes merged
+    tasks: list[Task]  # a building each, in the manifest's order
+
+
+def planned(
+    city: City,
+    outdir: Path,
+    bbox: BBox | None = None,
+    limit: int | None = None,
+    usd: bool = False,
+) -> Planned:
+    """The footprints read (those in ``bbox``), an outline's tags given to its parts, the
+    outlines with parts cut to what they leave, collinear nodes merged, the first
+    ``limit`` planned (:func:`plan`) for ``outdir``."""
+    found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
+    replaced = replaced_outlines(found.footprints)
+    footprints, kept = standing(city, inherited(found.footprints, replaced), replaced)
+    defaults = city.manifest.defaults
+    straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
+    footprints = list(straight.footprints[: limit if limit is not None else None])
+    return Planned(found, replaced, kept, straight, plan(city, footprints, outdir.resolve(), usd))
 
 
 def _build(
@@ -552,39 +541,52 @@ def _build(
     started: float,
     straight: Straightened | None = None,
     lods: tuple[int, ...] = (),
-) -> dict[str, Any]:
+) -> CityReport:
     """The planned buildings built (those built before skipped with ``resume``), then
-    the merged models, the CityJSON and the report written; returns the report."""
+    the merged models, the CityJSON and the report written; returns the report.
+
+    The client holds no more a building than its task and its report entry as a line
+    (report.py): the merged models, the CityJSON and the report are streamed to disk."""
     georef = Georef(found.crs, found.origin, found.unit)
-    results: list[dict[str, Any]] = []
+    order = {task.footprint.id: index for index, task in enumerate(tasks)}
+    entries = Entries(len(tasks))
+    built = bytearray(len(tasks))  # 1 for a building built (or kept), in the manifest's order
+    tally = Tally()
     todo = []
+    resumed = []  # positions of the buildings kept from the last run
     hashes = building_hashes(city, tasks)
     previous = recorded(outdir, city.manifest.name) if resume else {}
-    for task in tasks:
+    for index, task in enumerate(tasks):
         entry = reusable(task, hashes[task.footprint.id], previous, usd)
         if entry is None:
             todo.append(task)
         else:
-            results.append(entry)
-    done = len(results)
+            entries.put(index, entry)
+            built[index] = entry["status"] == "ok"
+            tally.add(entry)
+            resumed.append(index)
+    del previous
+    done = len(resumed)
     tileset = None
     if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
-        centroids = [(task.footprint.id, _centroid(task.footprint)) for task in tasks]
-        tileset = TilesetWriter(outdir, georef, lods, centroids)
+        places = [(task.footprint.id, _centroid(task.footprint)) for task in tasks]
+        tileset = TilesetWriter(outdir, georef, lods, places)
     local = scheduler is None
     mapped = stamped(_map_local(todo, jobs) if local else _map_dask(todo, str(scheduler)), hashes)
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
         outdir.mkdir(parents=True, exist_ok=True)
-        with open(log, "w", encoding="utf-8") as lines:
-            for result in results:
-                lines.write(json.dumps(result) + "\n")
-                _tiled(tileset, outdir, result)
+        with open(log, "wb") as lines:
+            for index in resumed:
+                lines.write(entries.line(index) + b"\n")
+                _tiled(tileset, outdir, tasks[index], built[index])
             for result in mapped:
-                results.append(result)
-                lines.write(json.dumps(result) + "\n")
+                index = order[result["id"]]
+                lines.write(entries.put(index, result) + b"\n")
                 lines.flush()
-                _tiled(tileset, outdir, result)
+                built[index] = result["status"] == "ok"
+                tally.add(result)
+                _tiled(tileset, outdir, tasks[index], built[index])
                 done += 1
                 if progress is not None:
                     progress(done, len(tasks))
@@ -593,91 +595,40 @@ def _build(
             f"{outdir}: cannot write the report: {error.strerror or error}; the buildings "
             "built are kept: run again with --resume"
         ) from None
-    order = {task.footprint.id: i for i, task in enumerate(tasks)}
-    results.sort(key=lambda r: order[r["id"]])
-    by_id = {task.footprint.id: task for task in tasks}
+
+    finished = BuiltCity(
+        city.manifest.name,
+        outdir,
+        tasks,
+        bytes(built),
+        [_centroid(task.footprint) for task in tasks],
+        found,
+        replaced,
+        georef,
+        city.manifest.tiles,
+        tileset,
+    )
+    formats = ["glb", "3dtiles", "usd", "cityjson"]  # CITY_WRITERS' order: the report's too
+    asked = {"3dtiles": tileset is not None, "usd": usd}
+    models: dict[str, Any] = {}
+    for name in (name for name in formats if asked.get(name, True)):
+        models |= _written(CITY_WRITERS[name], finished)
+    report = CityReport(
+        city.manifest.name,
+        found.crs,
+        list(found.origin),
+        georeference(georef),
+        entries,
+        [_rejected(r) for r in found.rejected],
+        [_warning(w) for w in found.warnings if w.id in order],
+        [{"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())],
+        models,
+        _summary(tally, found, kept, order, straight, time.perf_counter() - started),
+    )
     try:
-        written = merge_city(
-            (
-                (r["id"], outdir / r["file"], _centroid(by_id[r["id"]].footprint))
-                for r in results
-                if r["status"] == "ok"
-            ),
-            outdir,
-            city.manifest.name,
-            city.manifest.tiles,
-            georef,
-        )
-    except OSError as error:  # a full disk: the buildings stay, for --resume
-        raise OutputError(
-            f"{outdir}: cannot write the merged model: {error.strerror or error}; the "
-            "buildings built are kept: run again with --resume"
-        ) from None
-    if tileset is not None:
-        try:
-            written = {**written, "3dtiles": tileset.close(city.manifest.name)}
-        except OSError as error:
-            raise OutputError(
-                f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "
-                "buildings built are kept: run again with --resume"
-            ) from None
-    if usd:
-        stage = outdir / f"{city.manifest.name}.usda"
-        ok = [outdir / r["file"] for r in results if r["status"] == "ok"]
-        write_atomic(stage, city_usda(city.manifest.name, ok, outdir))
-        written = {**written, "usd": stage.name}
-    cityjson = outdir / f"{city.manifest.name}.city.json"
-    try:
-        with CityJSONWriter(cityjson, found.crs, found.origin, city.manifest.name) as writer:
-            ok = [r["id"] for r in results if r["status"] == "ok"]
-            features = (_feature(by_id[key]) for key in ok)
-            for feature in grouped(features, outlines(found.footprints, replaced, ok)):
-                writer.add(feature)
-    except OSError as error:
-        raise OutputError(
-            f"{outdir}: cannot write the CityJSON: {error.strerror or error}; the "
-            "buildings built are kept: run again with --resume"
-        ) from None
-    failed = [r for r in results if r["status"] != "ok"]
-    warned = [w for w in found.warnings if w.id in by_id]
-    report = {
-        "version": 1,
-        "name": city.manifest.name,
-        "crs": found.crs,
-        "origin": list(found.origin),
-        "georeference": georeference(georef),
-        "buildings": results,
-        "rejected": [_rejected(r) for r in found.rejected],
-        "warnings": [_warning(w) for w in warned],
-        "replaced": [
-            {"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())
-        ],
-        "models": written,
-        "summary": {
-            "buildings": len(tasks),
-            "ok": len(results) - len(failed),
-            "failed": len(failed),
-            "rejected": len(found.rejected),
-            "warnings": len(warned),
-            "outside_bbox": found.outside,
-            "replaced": sum(1 for area in kept.values() if area == 0),
-            "trimmed": sum(1 for area in kept.values() if area > 0),
-            "party_walls": sum(r.get("party_walls", 0) for r in results),
-            "plain_walls": {
-                reason: sum(r.get("plain", {}).get(reason, 0) for r in results)
-                for reason in PLAIN_REASONS
-            },
-            "collinear_nodes_merged": straight.nodes if straight else 0,
-            "warnings_by_tag": dict(
-                sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())
-            ),
-            "seconds": round(time.perf_counter() - started, 2),
-        },
-    }
-    try:
-        write_atomic(
-            outdir / f"{city.manifest.name}.report.json", json.dumps(report, indent=2) + "\n"
-        )
+        with atomic_output(outdir / f"{city.manifest.name}.report.json") as out:
+            for chunk in report.chunks():
+                out.write(chunk.encode("utf-8"))
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the report: {error.strerror or error}; run again with --resume"
@@ -685,13 +636,53 @@ def _build(
     return report
 
 
-def _tiled(tileset: TilesetWriter | None, outdir: Path, result: dict[str, Any]) -> None:
-    """A building done (built, resumed or failed), for the 3D Tiles of its leaf."""
+def _written(writer: CityWriter, finished: BuiltCity) -> dict[str, Any]:
+    """What ``writer`` wrote of the city, for the report; OutputError (exit 1) when the
+    disk refuses it: the buildings stay, for ``--resume``."""
+    try:
+        written: dict[str, Any] = writer.write(finished)
+    except OSError as error:
+        raise OutputError(
+            f"{finished.outdir}: cannot write the {writer.what}: {error.strerror or error}; "
+            "the buildings built are kept: run again with --resume"
+        ) from None
+    return written
+
+
+def _summary(
+    tally: Tally,
+    found: FootprintSet,
+    kept: dict[str, float],
+    order: dict[str, int],
+    straight: Straightened | None,
+    seconds: float,
+) -> Summary:
+    """The report's summary of a run: ``tally`` of its buildings, what was read."""
+    warned = [w for w in found.warnings if w.id in order]
+    return Summary(
+        buildings=len(order),
+        ok=tally.ok,
+        failed=tally.failed,
+        rejected=len(found.rejected),
+        warnings=len(warned),
+        outside_bbox=found.outside,
+        replaced=sum(1 for area in kept.values() if area == 0),
+        trimmed=sum(1 for area in kept.values() if area > 0),
+        party_walls=tally.party_walls,
+        plain_walls=tally.plain_by_reason(),
+        collinear_nodes_merged=straight.nodes if straight else 0,
+        warnings_by_tag=dict(sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())),
+        seconds=round(seconds, 2),
+    )
+
+
+def _tiled(tileset: TilesetWriter | None, outdir: Path, task: Task, built: int) -> None:
+    """A building done (built or resumed, or failed: ``built`` 0), for the 3D Tiles of its
+    leaf."""
     if tileset is None:
         return
-    glb = outdir / result["file"] if result["status"] == "ok" else None
     try:
-        tileset.done(result["id"], glb)
+        tileset.done(task.footprint.id, task.target if built else None)
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "

@@ -11,9 +11,11 @@ holds it too, with the CRS's WKT: it places every glb of the run, buildings' inc
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
-from collections.abc import Iterable
+from collections import Counter
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +24,7 @@ import pyproj
 from facadecli.city.georef import Georef, georeference
 from facadecli.export.atomic import write_atomic
 from facadecli.export.glb_merge import merge_glb
-from facadecli.limits import MERGED_GLB_MAX
+from facadecli.limits import MERGED_BUILDINGS_MAX, MERGED_GLB_MAX
 
 DEFAULT_TILE = 1000.0  # metres: the tiles' side when a merged model would not fit
 
@@ -32,45 +34,59 @@ def tile_of(centroid: tuple[float, float], size: float) -> tuple[int, int]:
 
 
 def merge_city(
-    buildings: Iterable[tuple[str, Path, tuple[float, float]]],
+    buildings: Callable[[], Iterable[tuple[str, Path, tuple[float, float]]]],
     outdir: Path,
     name: str,
     size: float | None,
     georef: Georef,
+    streamed: bool = False,
 ) -> dict[str, Any]:
-    """Write the merged model(s) of the built buildings (id, glb file, centroid in local
-    metres) and ``<name>.georef.json``; returns what was written for the report:
-    ``merged`` (the one glb, or None when it would pass MERGED_GLB_MAX), ``tiles`` (the
-    index file, or None) and ``georef``."""
-    buildings = list(buildings)
+    """Write the merged model(s) of the built buildings (``buildings()`` gives them again
+    each time it is called: id, glb file, centroid in local metres; none is held) and
+    ``<name>.georef.json``; returns what was written for the report: ``merged`` (the one
+    glb, or None and why in ``merged_left_out``: more than MERGED_BUILDINGS_MAX buildings
+    or MERGED_GLB_MAX bytes), ``tiles`` (the index file, or None) and ``georef``. The
+    tiles are written when ``size`` is given, or in DEFAULT_TILE squares when there is no
+    merged glb, unless the run writes 3D Tiles (``streamed``), a viewer's way in then."""
     frame = georeference(georef)
     extras = {"georeference": frame}
     sidecar = f"{name}.georef.json"
     wkt = pyproj.CRS.from_user_input(georef.crs).to_wkt()
     write_atomic(outdir / sidecar, json.dumps({**frame, "crs_wkt": wkt}, indent=2) + "\n")
-    total = sum(path.stat().st_size for _, path, _ in buildings)
+    count = total = 0
+    for _, path, _ in buildings():
+        count += 1
+        total += path.stat().st_size
     merged: str | None = f"{name}.glb"
-    if total <= MERGED_GLB_MAX:
-        merge_glb(((bid, path) for bid, path, _ in buildings), outdir / f"{name}.glb", extras)
+    left_out = _left_out(count, total, "open 3dtiles/tileset.json" if streamed else _TILED)
+    if left_out is None:
+        merged_glb = ((bid, path) for bid, path, _ in buildings())
+        merge_glb(merged_glb, outdir / f"{name}.glb", extras)
     else:
         merged = None
-        size = size or DEFAULT_TILE
+        size = size or (None if streamed else DEFAULT_TILE)
+        with contextlib.suppress(FileNotFoundError):  # an earlier, smaller run's: stale
+            (outdir / f"{name}.glb").unlink()
+    written: dict[str, Any] = {"merged": merged}
+    if left_out is not None:
+        written["merged_left_out"] = left_out
     if size is None:
-        return {"merged": merged, "tiles": None, "georef": sidecar}
-    groups: dict[tuple[int, int], list[tuple[str, Path]]] = {}
-    for bid, path, centroid in buildings:
-        groups.setdefault(tile_of(centroid, size), []).append((bid, path))
+        return {**written, "tiles": None, "georef": sidecar}
+    counts = Counter(tile_of(centroid, size) for _, _, centroid in buildings())
     index = []
-    for (i, j), members in sorted(groups.items()):
+    for (i, j), members in sorted(counts.items()):  # a pass each: no tile's list is held
         file = f"tiles/{name}_{i}_{j}.glb"
-        merge_glb(members, outdir / file, extras)
+        tiled = (
+            (bid, path) for bid, path, centroid in buildings() if tile_of(centroid, size) == (i, j)
+        )
+        merge_glb(tiled, outdir / file, extras)
         bounds = (i * size, j * size, (i + 1) * size, (j + 1) * size)
         index.append(
             {
                 "file": file,
                 "column": i,
                 "row": j,
-                "buildings": len(members),
+                "buildings": members,
                 "bounds": list(bounds),
                 "bounds_crs": [*georef.in_crs(*bounds[:2]), *georef.in_crs(*bounds[2:])],
                 "bounds_lonlat": georef.bounds_lonlat(bounds),
@@ -85,4 +101,23 @@ def merge_city(
         "tiles": index,
     }
     write_atomic(outdir / f"{name}.tiles.json", json.dumps(document, indent=2) + "\n")
-    return {"merged": merged, "tiles": f"{name}.tiles.json", "georef": sidecar}
+    return {**written, "tiles": f"{name}.tiles.json", "georef": sidecar}
+
+
+_TILED = "open the tiles (tiles/), or use --3dtiles, which a viewer streams"
+
+
+def _left_out(count: int, total: int, instead: str) -> str | None:
+    """Why a run's buildings make no single merged glb (and what to open ``instead``), or
+    None when they do."""
+    if count > MERGED_BUILDINGS_MAX:
+        return (
+            f"{count:,} buildings, more than a single glb is made of "
+            f"({MERGED_BUILDINGS_MAX:,}, MERGED_BUILDINGS_MAX): {instead}"
+        )
+    if total > MERGED_GLB_MAX:
+        return (
+            f"the buildings' models hold {total / 2**30:.1f} GiB, more than a glb may "
+            f"({MERGED_GLB_MAX / 2**30:.0f} GiB, MERGED_GLB_MAX): {instead}"
+        )
+    return None

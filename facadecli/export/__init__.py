@@ -6,13 +6,20 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, BinaryIO
+from typing import TYPE_CHECKING, Any, BinaryIO
 
-from facadecli.export.atomic import check_output_file, check_output_folder, staged, write_atomic
+from facadecli.export.atomic import (
+    atomic_output,
+    check_output_file,
+    check_output_folder,
+    staged,
+    write_atomic,
+)
 
 if TYPE_CHECKING:  # trimesh takes half a second to import: only the mesh writers need it
     import trimesh
 
+    from facadecli.city.built import BuiltCity
     from facadecli.layout import Layout
 
 
@@ -113,6 +120,64 @@ DEFAULT_FORMATS = ("glb", "obj", "json", "svg")
 SINGLE_FILE_FORMATS = ("json", "svg", "glb", "html", "usd")
 
 
+@dataclass(frozen=True)
+class CityWriter:
+    """A writer of a whole city's output, once its buildings have ended: ``write`` returns
+    what the report's ``models`` says of it; ``what`` names the output in messages."""
+
+    what: str
+    write: Callable[[BuiltCity], dict[str, Any]]
+
+
+def _write_city_models(built: BuiltCity) -> dict[str, Any]:
+    from facadecli.city.tiles import merge_city
+
+    streamed = built.tileset is not None  # 3D Tiles: no square tiles unless asked for
+    return merge_city(
+        built.placed, built.outdir, built.name, built.tile_size, built.georef, streamed
+    )
+
+
+def _write_city_3dtiles(built: BuiltCity) -> dict[str, Any]:
+    if built.tileset is None:
+        raise ValueError("a city without --3dtiles has no tileset to write")
+    return {"3dtiles": built.tileset.close(built.name)}
+
+
+def _write_city_usd(built: BuiltCity) -> dict[str, Any]:
+    from facadecli.export.usd import city_usda_lines
+
+    stage = built.outdir / f"{built.name}.usda"
+    with atomic_output(stage) as out:
+        buildings = (task.target for task in built.ok())
+        for line in city_usda_lines(built.name, buildings, built.outdir):
+            out.write(line.encode("utf-8"))
+    return {"usd": stage.name}
+
+
+def _write_cityjson(built: BuiltCity) -> dict[str, Any]:
+    from facadecli.city.cityjson import CityJSONWriter
+
+    path = built.outdir / f"{built.name}.city.json"
+    with CityJSONWriter(path, built.found.crs, built.found.origin, built.name) as writer:
+        for feature in built.features():
+            writer.add(feature)
+    return {}
+
+
+#: format name -> the writer of a city's output of that format (``facade city``), each
+#: reading the buildings' own files again in the manifest's order, never all at once:
+#: ``glb`` the merged model or its square tiles and ``<name>.georef.json``, ``3dtiles``
+#: the tileset (with ``--3dtiles``), ``usd`` the city's stage (with ``--usd``),
+#: ``cityjson`` the CityJSON
+CITY_WRITERS: dict[str, CityWriter] = {
+    "glb": CityWriter("merged model", _write_city_models),
+    "3dtiles": CityWriter("3D Tiles", _write_city_3dtiles),
+    "usd": CityWriter("USD stage", _write_city_usd),
+    "cityjson": CityWriter("CityJSON", _write_cityjson),
+}
+
+
 def write_outputs(
     layout: Layout, outdir: Path, formats: list[str], options: OutputOptions
 ) -> list[Path]:
@@ -146,9 +211,11 @@ def write_stream(layout: Layout, name: str, options: OutputOptions, stream: Bina
 
 
 __all__ = [
+    "CITY_WRITERS",
     "DEFAULT_FORMATS",
     "SINGLE_FILE_FORMATS",
     "WRITERS",
+    "CityWriter",
     "OutputOptions",
     "check_output_file",
     "check_output_folder",

@@ -1,8 +1,11 @@
 """Merge .glb files into one without holding them all: a streaming writer.
 
-Each input's binary chunk is appended to a temporary file as it is read; only the JSON
-(nodes, meshes, accessors: a few kilobytes a building) stays in memory. The output is
-assembled at the end and renamed into place, so a city of any size merges in flat memory.
+Each input's binary chunk is appended to a temporary file as it is read, and so are the
+entries of the JSON arrays that grow with every part (buffer views, accessors, meshes,
+nodes, the scene's nodes: tens of kilobytes a building as Python objects); only what
+the parts share (materials, textures, samplers, the distinct images) stays in memory.
+The output is assembled at the end and renamed into place, its bytes those of the
+whole document dumped at once, so a city of any size merges in flat memory.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ import struct
 import tempfile
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from facadecli.export.atomic import atomic_output
 
@@ -55,38 +58,73 @@ def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
     return document, binary
 
 
+#: the arrays that grow with every part, spooled to disk as they grow (:class:`_Spool`)
+_SPOOLED = ("bufferViews", "accessors", "meshes", "nodes")
+
+
+class _Spool:
+    """A JSON array written to a temporary file an entry at a time: its entries' compact
+    JSON, comma-separated, as ``json.dumps`` of the whole array would write them."""
+
+    def __init__(self, file: BinaryIO, key: str):
+        self.file = file
+        self.key = key
+        self.count = 0
+
+    def __len__(self) -> int:
+        return self.count
+
+    def append(self, entry: Any) -> None:
+        if self.count:
+            self.file.write(b",")
+        self.file.write(json.dumps(entry, separators=(",", ":")).encode("utf-8"))
+        self.count += 1
+
+    @property
+    def marker(self) -> str:
+        """What stands for the array in the document until it is assembled (:func:`_write`)."""
+        return f"\0spool:{self.key}\0"
+
+
 def merge_glb(
     parts: Iterable[tuple[str, Path]], target: Path, extras: dict[str, Any] | None = None
 ) -> None:
     """Write one glb holding every (name, file) part under a root node of that name; with
     ``extras``, as the scene's ``extras`` (glTF's place for application data)."""
-    merged: dict[str, Any] = {key: [] for key in _REFERENCES}
-    scene: dict[str, Any] = {"nodes": []}
-    if extras is not None:
-        scene["extras"] = extras
-    merged.update(
-        asset={"version": "2.0", "generator": "facadecli"},
-        scenes=[scene],
-        scene=0,
-        extensionsUsed=[],
-    )
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, binary_path = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".bin", dir=target.parent)
-    try:
-        with os.fdopen(fd, "wb") as binary:
-            known: dict[bytes, int] = {}  # a picture's digest -> its merged image
-            seen: dict[str, dict[str, int]] = {}  # shared kinds' entries already merged
-            for name, path in parts:
-                document, chunk = read_glb(path.read_bytes())
-                document, chunk = _known_images(document, chunk, known, len(merged["images"]))
-                _append(merged, document, name, binary.tell(), seen)
-                binary.write(chunk)
-                binary.write(b"\0" * (-len(chunk) % 4))
-            length = binary.tell()
-        _write(merged, binary_path, length, target)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(binary_path)
+    with contextlib.ExitStack() as stack:
+
+        def spooled() -> BinaryIO:
+            fd, path = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".bin", dir=target.parent)
+            stack.callback(_unlink, path)
+            return stack.enter_context(os.fdopen(fd, "w+b"))
+
+        binary = spooled()
+        merged: dict[str, Any] = {key: [] for key in _REFERENCES}
+        merged.update({key: _Spool(spooled(), key) for key in _SPOOLED})
+        scene: dict[str, Any] = {"nodes": _Spool(spooled(), "scene")}
+        if extras is not None:
+            scene["extras"] = extras
+        merged.update(
+            asset={"version": "2.0", "generator": "facadecli"},
+            scenes=[scene],
+            scene=0,
+            extensionsUsed=[],
+        )
+        known: dict[bytes, int] = {}  # a picture's digest -> its merged image
+        seen: dict[str, dict[str, int]] = {}  # shared kinds' entries already merged
+        for name, path in parts:
+            document, chunk = read_glb(path.read_bytes())
+            document, chunk = _known_images(document, chunk, known, len(merged["images"]))
+            _append(merged, document, name, binary.tell(), seen)
+            binary.write(chunk)
+            binary.write(b"\0" * (-len(chunk) % 4))
+        _write(merged, binary, binary.tell(), target)
+
+
+def _unlink(path: str) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(path)
 
 
 def _known_images(
@@ -229,18 +267,42 @@ def _renumber_textures(value: Any, textures: list[int]) -> Any:
     return value
 
 
-def _write(merged: dict[str, Any], binary_path: str, length: int, target: Path) -> None:
+def _write(merged: dict[str, Any], binary: BinaryIO, length: int, target: Path) -> None:
+    """The glb assembled into ``target``: the JSON chunk with each spooled array copied in
+    where its marker stands, then the binary chunk."""
     merged["buffers"] = [{"byteLength": length}]
+    spools = [value for value in merged.values() if isinstance(value, _Spool)]
+    spools.append(merged["scenes"][0]["nodes"])
     for key in list(merged):
-        if isinstance(merged[key], list) and not merged[key]:
+        if isinstance(merged[key], list | _Spool) and not len(merged[key]):
             del merged[key]
-    text = json.dumps(merged, separators=(",", ":")).encode("utf-8")
-    text += b" " * (-len(text) % 4)
-    total = 12 + 8 + len(text) + (8 + length if length else 0)
-    with atomic_output(target) as out, open(binary_path, "rb") as binary:
+    text = json.dumps(merged, separators=(",", ":"), default=lambda spool: spool.marker)
+    pieces: list[bytes | _Spool] = []
+    for spool in spools:  # in the order they stand in the text
+        marker = json.dumps(spool.marker)
+        if marker not in text:  # an empty array, left out
+            continue
+        before, text = text.split(marker, 1)
+        pieces += [before.encode("utf-8") + b"[", spool, b"]"]
+    pieces.append(text.encode("utf-8"))
+    size = sum(len(p) if isinstance(p, bytes) else p.file.tell() for p in pieces)
+    padding = b" " * (-size % 4)
+    size += len(padding)
+    total = 12 + 8 + size + (8 + length if length else 0)
+    with atomic_output(target) as out:
         out.write(struct.pack("<III", MAGIC, 2, total))
-        out.write(struct.pack("<II", len(text), JSON_CHUNK))
-        out.write(text)
+        out.write(struct.pack("<II", size, JSON_CHUNK))
+        for piece in pieces:
+            out.write(piece if isinstance(piece, bytes) else b"")
+            if isinstance(piece, _Spool):
+                _copy(piece.file, out)
+        out.write(padding)
         if length:
             out.write(struct.pack("<II", length, BIN_CHUNK))
-            shutil.copyfileobj(binary, out, 1 << 20)
+            _copy(binary, out)
+
+
+def _copy(spool: BinaryIO, out: BinaryIO) -> None:
+    spool.flush()
+    spool.seek(0)
+    shutil.copyfileobj(spool, out, 1 << 20)

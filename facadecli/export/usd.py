@@ -16,6 +16,7 @@ and the rest of the USD world, written without USD's own library.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -243,10 +244,17 @@ def _materials(scene: trimesh.Scene) -> list[tuple[str, object]]:
     return list(found.items())
 
 
-def city_usda(name: str, buildings: list[Path], folder: Path) -> str:
+def city_usda(name: str, buildings: Iterable[Path], folder: Path) -> str:
     """A city's stage: an Xform per building with its stage as a payload (loaded when a
     tool asks for it, so a city of thousands opens at once), in the city's frame."""
-    out = _head(name, "assembly")
+    return "".join(city_usda_lines(name, buildings, folder))
+
+
+def city_usda_lines(name: str, buildings: Iterable[Path], folder: Path) -> Iterator[str]:
+    """:func:`city_usda` a line at a time (each with its newline), the buildings taken as
+    they come: a city of any size is written without its text held."""
+    for line in _head(name, "assembly"):
+        yield line + "\n"
     taken: set[str] = set()
     for glb in buildings:
         prim = usd_name(glb.stem)
@@ -254,12 +262,6 @@ def city_usda(name: str, buildings: list[Path], folder: Path) -> str:
             prim += "_"
         taken.add(prim)
         stage = glb.with_suffix(".usda").relative_to(folder).as_posix()
-        out += [
-            f'    def Xform "{prim}" (',
-            f"        prepend payload = @./{stage}@",
-            "    )",
-            "    {",
-            "    }",
-        ]
-    out.append("}")
-    return "\n".join(out) + "\n"
+        yield f'    def Xform "{prim}" (\n        prepend payload = @./{stage}@\n'
+        yield "    )\n    {\n    }\n"
+    yield "}\n"

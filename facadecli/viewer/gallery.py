@@ -2,8 +2,8 @@
 ``facade solve``, ``vary`` or ``city``): a list of the models, each with its elevation as a
 thumbnail, beside the shared three.js viewer; a click shows that model and its elevation.
 
-The models are the folder's top-level ``*.glb`` files (a city's ``buildings/*.glb`` only
-when there are none), each with the ``.svg`` of the same stem when there is one, in
+The models are the folder's top-level ``*.glb`` files (a city's ``buildings/<shard>/*.glb``
+only when there are none), each with the ``.svg`` of the same stem when there is one, in
 natural order (``8x3`` before ``12x3``). What the page inlines is capped at
 :data:`~facadecli.limits.GALLERY_BYTES_MAX`; the same folder gives the same bytes.
 
@@ -63,12 +63,21 @@ def natural_key(name: str) -> tuple[tuple[str | int, ...], str]:
     return tuple(int(part) if i % 2 else part for i, part in enumerate(parts)), name
 
 
-def _glbs(folder: Path) -> list[Path]:
+def _glbs(folder: Path, pattern: str = "*.glb") -> list[Path]:
     found = [
         path
-        for path in folder.glob("*.glb")
+        for path in folder.glob(pattern)
         if not path.name.startswith(".")  # not a run's temporary file
     ]
+    return sorted(found, key=lambda path: natural_key(path.name))
+
+
+def _buildings(folder: Path) -> list[Path]:
+    """A city's buildings: ``buildings/<shard>/*.glb`` (and ``buildings/*.glb``, where
+    runs before the shards wrote them), by name whatever their shard."""
+    if not folder.is_dir():
+        return []
+    found = _glbs(folder) + _glbs(folder, "[0-9a-f][0-9a-f]/*.glb")
     return sorted(found, key=lambda path: natural_key(path.name))
 
 
@@ -84,7 +93,7 @@ def find_models(folder: Path) -> list[Model]:
             where, None, None, "is a file, not a folder", "give the folder the models are in"
         )
     try:
-        glbs = _glbs(folder) or (_glbs(folder / BUILDINGS) if (folder / BUILDINGS).is_dir() else [])
+        glbs = _glbs(folder) or _buildings(folder / BUILDINGS)
     except OSError as error:
         raise SpecError.at(
             where, None, None, f"cannot read: {error.strerror}", "check its permissions"

@@ -4,14 +4,19 @@ The town is :func:`facadecli.city.demo.terraces`: blocks of two rows of eight te
 houses back to back, seeded widths, depths, levels, heights, roof shapes and building
 tags, written as GeoJSON to a temporary folder (never kept). ``FACADE_BENCH_N`` buildings
 (default 100,000), and a quarter of them first, so the client's memory can be compared at
-two sizes; ``FACADE_BENCH_JOBS`` worker processes (default: the machine's CPUs).
+two sizes; ``FACADE_BENCH_JOBS`` worker processes (default: the machine's CPUs); 3D Tiles
+at the levels of detail ``FACADE_BENCH_LODS`` (default 1,2,3, as ``--3dtiles``).
 
 Each size runs in a fresh client process (``run_city``, as ``facade city`` calls it).
 Printed per size: wall time; CPU seconds per building, all processes (the client's own
 and its workers', from ``getrusage``: the workers are the client's children, waited for);
-the client's peak resident memory (``ru_maxrss``: the workers' are not in it); the output
-sizes. With ``FACADE_BENCH_PROFILE=1`` the smaller size also runs in one process under
-cProfile, and the functions taking the most CPU (own and cumulative) are printed.
+the client's peak resident memory (``ru_maxrss``: the workers' are not in it) and its
+resident memory when the first and the last building end; the output sizes, the shard
+folders of ``buildings/`` and the tiles' sizes. With ``FACADE_BENCH_PROFILE=1`` the
+smaller size also runs in one process under cProfile, and the functions taking the most
+CPU (own and cumulative) are printed. First, the client's memory once the town is read
+and planned (no building built) at 1,000, 10,000, 100,000 (up to ``FACADE_BENCH_N``)
+buildings, and its slope; ``FACADE_BENCH_PLAN_ONLY=1`` stops there.
 Figures depend on the machine and its load; they are for docs/benchmarks.md, never
 asserted by the tests.
 """
@@ -23,6 +28,7 @@ import json
 import os
 import pstats
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -33,12 +39,35 @@ ROOT = Path(__file__).resolve().parents[2]
 SEED = 1
 
 
+def _resident_mib() -> float:
+    """This process's resident memory now (Linux: /proc; elsewhere its peak so far)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
 def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
-    """A city run in this process; its resource use written to ``figures``."""
+    """A city run in this process; its resource use written to ``figures``: its peak, and
+    its resident memory when the first building ends (read, planned, the axes solved) and
+    when the last does (before the merged models, CityJSON and report are written)."""
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
+    from facadecli.city.tileset import parse_lods
 
-    report = run_city(load_city(manifest), out, jobs=jobs)
+    resident: dict[str, float] = {}
+
+    def progress(done: int, total: int) -> None:
+        if done == 1:
+            resident["first_built_mib"] = _resident_mib()
+        if done == total:
+            resident["all_built_mib"] = _resident_mib()
+
+    lods = parse_lods(os.environ.get("FACADE_BENCH_LODS", "1,2,3"))
+    report = run_city(load_city(manifest), out, jobs=jobs, progress=progress, lods=lods)
     own = resource.getrusage(resource.RUSAGE_SELF)
     workers = resource.getrusage(resource.RUSAGE_CHILDREN)
     summary = report["summary"]
@@ -52,9 +81,64 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
                 "workers_cpu": workers.ru_utime + workers.ru_stime,
                 "client_peak_mib": own.ru_maxrss / 1024,  # Linux: KiB
                 "models": report["models"],
+                **resident,
             }
         )
     )
+
+
+def planning(manifest: Path, figures: Path) -> None:
+    """A city read and planned in this process (:func:`facadecli.city.run.planned`, and
+    the buildings' hashes for --resume), no building built: its memory and CPU to
+    ``figures``."""
+    from facadecli.city.manifest import load_city
+    from facadecli.city.resume import building_hashes
+    from facadecli.city.run import planned
+
+    city = load_city(manifest)
+    before = _resident_mib()  # the imports
+    cpu = time.process_time()
+    ahead = planned(city, manifest.parent / "out")
+    building_hashes(city, ahead.tasks)
+    figures.write_text(
+        json.dumps(
+            {
+                "buildings": len(ahead.tasks),
+                "imports_mib": before,
+                "planned_mib": _resident_mib(),
+                "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+                "cpu": time.process_time() - cpu,
+            }
+        )
+    )
+
+
+def measure_planning(counts: list[int], folder: Path) -> None:
+    """The client's memory once a town of each size is read and planned, each in a fresh
+    process: what it holds through the run, before the buildings' entries."""
+    from facadecli.city.demo import write_terraces
+
+    rows = []
+    for count in counts:
+        manifest = write_terraces(folder / f"plan-{count}", ROOT / "specs", count, SEED)
+        figures = folder / f"plan-{count}.json"
+        command = [sys.executable, __file__, "--plan", str(manifest), str(figures)]
+        subprocess.run(command, check=True)
+        rows.append(json.loads(figures.read_text()))
+        shutil.rmtree(folder / f"plan-{count}")
+    for row in rows:
+        grown = row["planned_mib"] - row["imports_mib"]
+        print(
+            f"planning {row['buildings']} buildings: {row['cpu']:.1f} CPU-s, resident "
+            f"{row['imports_mib']:.0f} MiB after the imports, {row['planned_mib']:.0f} MiB "
+            f"planned (+{grown * 1024 / row['buildings']:.1f} KiB a building), peak "
+            f"{row['peak_mib']:.0f} MiB"
+        )
+    if len(rows) > 1:
+        first, last = rows[0], rows[-1]
+        slope = (last["planned_mib"] - first["planned_mib"]) * 1024
+        slope /= last["buildings"] - first["buildings"]
+        print(f"planning's slope: {slope:.1f} KiB a building")
 
 
 def _size(path: Path) -> int:
@@ -79,10 +163,13 @@ def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
     found = json.loads(figures.read_text())
     cpu = found["client_cpu"] + found["workers_cpu"]
     name = f"terraces-{count}"
+    shards = [folder for folder in (out / "buildings").iterdir() if folder.is_dir()]
+    most = max((len(list(folder.iterdir())) for folder in shards), default=0)
     sizes = {
         "buildings/": _size(out / "buildings"),
         f"{name}.glb": _size(out / f"{name}.glb"),
         "tiles/": _size(out / "tiles"),
+        "3dtiles/": _size(out / "3dtiles"),
         f"{name}.city.json": _size(out / f"{name}.city.json"),
         f"{name}.report.json": _size(out / f"{name}.report.json"),
     }
@@ -99,10 +186,36 @@ def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
         f"({found['client_peak_mib'] * 1024 / count:.1f} KiB a building)"
     )
     print(
+        f"  client memory: {found.get('first_built_mib', 0):.0f} MiB at the first building "
+        f"built, {found.get('all_built_mib', 0):.0f} MiB at the last"
+    )
+    print(
         "  outputs: "
         + ", ".join(f"{key} {size / 2**20:.1f} MiB" for key, size in sizes.items() if size)
     )
+    print(f"  buildings/: {len(shards)} shard folders, at most {most} files in one")
+    if found["models"].get("merged_left_out"):
+        print(f"  no merged glb: {found['models']['merged_left_out']}")
+    _tile_sizes(out)
+    shutil.rmtree(out)  # tens of GB at 10,000 buildings: not kept for the next size
     return {"peak": found["client_peak_mib"], "cpu": cpu / count}
+
+
+def _tile_sizes(out: Path) -> None:
+    """The sizes of the square tiles (``tiles/``) and of the 3D Tiles at each LOD."""
+    kinds: dict[str, list[int]] = {}
+    for path in (out / "tiles").glob("*.glb"):
+        kinds.setdefault("tiles/", []).append(path.stat().st_size)
+    for path in (out / "3dtiles").rglob("*.glb"):
+        kinds.setdefault(f"3D Tiles {path.suffixes[-2][1:].upper()}", []).append(
+            path.stat().st_size
+        )
+    for kind, sizes in sorted(kinds.items()):
+        sizes.sort()
+        print(
+            f"  {kind}: {len(sizes)} tiles, median {sizes[len(sizes) // 2] / 2**20:.2f} MiB, "
+            f"largest {sizes[-1] / 2**20:.2f} MiB, {sum(sizes) / 2**20:.1f} MiB in all"
+        )
 
 
 def profile(count: int, folder: Path) -> None:
@@ -138,6 +251,10 @@ def main() -> None:
     jobs = int(os.environ.get("FACADE_BENCH_JOBS", str(os.cpu_count() or 1)))
     with tempfile.TemporaryDirectory(prefix="city-large-") as scratch:
         folder = Path(scratch)
+        sizes = [n for n in (1_000, 10_000, 100_000) if n < count] + [count]
+        measure_planning(sizes, folder)
+        if os.environ.get("FACADE_BENCH_PLAN_ONLY"):
+            return
         small = measure(max(1, count // 4), jobs, folder)
         large = measure(count, jobs, folder)
         print(
@@ -149,7 +266,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--client"]:
+    if sys.argv[1:2] == ["--plan"]:
+        planning(Path(sys.argv[2]), Path(sys.argv[3]))
+    elif sys.argv[1:2] == ["--client"]:
         manifest, out, jobs, figures = sys.argv[2:6]
         client(Path(manifest), Path(out), int(jobs), Path(figures))
     else:

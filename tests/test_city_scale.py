@@ -1,0 +1,256 @@
+"""``facade city`` at any size: the buildings' files spread over shard folders, the merged
+glb and the report written without holding every building, the merged glb left out
+(with why) past its cap. Sizes here are small; ``make bench-large`` measures the large."""
+
+from __future__ import annotations
+
+import dataclasses
+import errno
+import json
+import tracemalloc
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import pytest
+import trimesh
+
+import facadecli.city.tiles as tiles_module
+from facadecli.city.built import BuiltCity
+from facadecli.city.folders import SHARD, SHARDS, building_file, safe_name, shard
+from facadecli.city.manifest import load_city
+from facadecli.city.report import CityReport, Entries, Summary, Tally, report_chunks
+from facadecli.city.resume import recorded
+from facadecli.city.run import run_city
+from facadecli.export import CITY_WRITERS, CityWriter
+from facadecli.export.glb_merge import merge_glb, read_glb
+from tests.running import facade
+from tests.test_city_inputs import city, square, town
+
+
+def test_a_buildings_file_is_in_a_shard_named_by_a_hash_of_its_id() -> None:
+    # the rule pinned: a change of it moves every building of every run (--resume rebuilds)
+    assert str(building_file("way/1")) == f"buildings/{shard('way/1')}/{safe_name('way/1')}.glb"
+    assert [shard(i) for i in ("a", "way/1", "b0")] == ["ca", "5c", "c0"]
+    assert str(building_file("a", ".usda")) == "buildings/ca/a.usda"
+    ids = [f"way/{n}" for n in range(20_000)]
+    counts = Counter(shard(i) for i in ids)
+    assert len(counts) == SHARDS and all(SHARD.fullmatch(name) for name in counts)
+    mean = len(ids) / SHARDS
+    assert max(counts.values()) < 1.5 * mean and min(counts.values()) > 0.5 * mean
+
+
+def test_a_run_writes_every_building_in_its_shard_and_the_report_says_where(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    ids = [f"h{i}" for i in range(6)]
+    manifest = town(tmp_path, [square(i, x=12.0 * k) for k, i in enumerate(ids)])
+    code, _, err = city(capsys, manifest, "--usd")
+    assert code == 0, err
+    out = tmp_path / "out"
+    report = json.loads((out / "town.report.json").read_text())
+    assert [b["file"] for b in report["buildings"]] == [str(building_file(i)) for i in ids]
+    files = sorted(p.relative_to(out).as_posix() for p in (out / "buildings").rglob("*.*"))
+    expected = [str(building_file(i, suffix)) for i in ids for suffix in (".glb", ".usda")]
+    features = [str(building_file(i, ".city.jsonl")) for i in ids]
+    assert files == sorted(expected + features)
+    assert not [p for p in (out / "buildings").iterdir() if p.is_file()]  # none at the top
+    stage = (out / "town.usda").read_text()
+    assert all(f"@./{building_file(i, '.usda')}@" in stage for i in ids)
+
+
+def test_resume_rebuilds_into_shards_what_a_run_before_them_left_flat(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A folder of a run before the shards (``buildings/<id>.glb``, the report's ``file``
+    naming it): nothing of it is taken for a sharded building; every building is built
+    again into its shard, and the files are those of a run from scratch."""
+    manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(3)])
+    assert city(capsys, manifest)[0] == 0
+    out = tmp_path / "out"
+    fresh = {p.relative_to(out): p.read_bytes() for p in (out / "buildings").rglob("*.*")}
+    log = out / "town.report.jsonl"
+    entries = [json.loads(line) for line in log.read_text().splitlines()]
+    for entry in entries:  # as a run before the shards left them
+        path = out / entry["file"]
+        flat = out / "buildings" / path.name
+        path.rename(flat)
+        path.with_suffix(".city.jsonl").rename(flat.with_suffix(".city.jsonl"))
+        path.parent.rmdir()
+        entry["file"] = f"buildings/{path.name}"
+    log.write_text("".join(json.dumps(entry) + "\n" for entry in entries))
+    code, _, err = city(capsys, manifest, "--resume")
+    assert code == 0, err
+    report = json.loads((out / "town.report.json").read_text())
+    assert not any(b.get("resumed") for b in report["buildings"])
+    for path, content in fresh.items():
+        assert (out / path).read_bytes() == content
+
+
+def test_a_run_past_the_merged_cap_writes_tiles_and_says_why(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(4)])
+    out = tmp_path / "out"
+    assert city(capsys, manifest)[0] == 0
+    assert (out / "town.glb").is_file()  # 4 buildings: merged
+    monkeypatch.setattr(tiles_module, "MERGED_BUILDINGS_MAX", 3)
+    code, said, err = city(capsys, manifest, "--resume")
+    assert code == 0, err
+    assert f"{out}: no merged town.glb: 4 buildings, more than a single glb" in err
+    assert "--3dtiles" in err and f"-> {out}/town.tiles.json" in said
+    assert not (out / "town.glb").exists()  # the smaller run's, not left to mislead
+    models = json.loads((out / "town.report.json").read_text())["models"]
+    assert models["merged"] is None and "MERGED_BUILDINGS_MAX" in models["merged_left_out"]
+    index = json.loads((out / "town.tiles.json").read_text())
+    assert sum(tile["buildings"] for tile in index["tiles"]) == 4
+    for tile in index["tiles"]:
+        document, _ = read_glb((out / tile["file"]).read_bytes())
+        assert len(document["scenes"][0]["nodes"]) == tile["buildings"]
+    streamed = tmp_path / "streamed"  # with 3D Tiles, they are the way in: no square tiles
+    code, said, err = facade(capsys, "city", manifest, "-o", streamed, "-j", "1", "--3dtiles")
+    assert code == 0, err
+    assert "4 buildings, more than a single glb" in err and "open 3dtiles/tileset.json" in err
+    assert not (streamed / "town.glb").exists() and not (streamed / "tiles").exists()
+    assert said.rstrip().endswith(f"{streamed}/town.report.json, {streamed}/3dtiles/tileset.json")
+
+
+ENTRIES: list[dict[str, Any]] = [
+    {"id": "a", "status": "ok", "plain": {"party": 2, "too_short": 1}, "party_walls": 2},
+    {"id": "b/é", "status": "failed", "error": 'x "y"\nz', "list": [], "empty": {}},
+    {"id": "c", "status": "ok", "height": 7.25, "nested": [[1, 2], {"k": None}], "plain": {}},
+]
+
+
+@pytest.mark.parametrize("count", [0, 1, 3])
+def test_the_report_written_a_building_at_a_time_is_the_whole_document(count: int) -> None:
+    entries = Entries(count)
+    tally = Tally()
+    for index in reversed(range(count)):  # as buildings end: in any order
+        entries.put(index, ENTRIES[index])
+        tally.add(ENTRIES[index])
+    assert list(entries) == ENTRIES[:count] and entries[-1:] == ENTRIES[count - 1 : count]
+    report = {"version": 1, "buildings": entries, "rejected": [], "summary": {"ok": tally.ok}}
+    whole = json.dumps({**report, "buildings": ENTRIES[:count]}, indent=2) + "\n"
+    assert "".join(report_chunks(report, "buildings", entries)) == whole
+    assert tally.ok == sum(1 for e in ENTRIES[:count] if e["status"] == "ok")
+    assert tally.plain_by_reason()["party"] == (2 if count else 0)
+
+
+def _parts(folder: Path, count: int) -> list[tuple[str, Path]]:
+    """``count`` small glbs, each of three meshes (a building's façade, roof and walls)."""
+    folder.mkdir()
+    parts = []
+    for i in range(count):
+        scene = trimesh.Scene()
+        for k in range(3):
+            box = trimesh.creation.box((1.0 + i % 7, 2.0 + k, 3.0))
+            scene.add_geometry(box, node_name=f"n{k}", geom_name=f"g{k}")
+        path = folder / f"b{i}.glb"
+        path.write_bytes(scene.export(file_type="glb"))
+        parts.append((f"b{i}", path))
+    return parts
+
+
+def test_merging_holds_what_one_building_needs_not_every_building(tmp_path: Path) -> None:
+    """The merged glb's JSON grows with every building merged; the merge spools it to disk
+    as it grows, so merging eight times the buildings takes no more memory (tracemalloc's
+    peak of Python's allocations; holding the JSON took about 17 KB a building here)."""
+    few = _parts(tmp_path / "few", 40)
+    many = few * 8  # the same files again under other names: 320 buildings
+    many = [(f"{name}-{k}", path) for k, (name, path) in enumerate(many)]
+    peaks = []
+    for parts, target in ((few, tmp_path / "few.glb"), (many, tmp_path / "many.glb")):
+        tracemalloc.start()
+        merge_glb(parts, target)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+    assert peaks[1] < peaks[0] * 1.5, peaks
+    document, binary = read_glb((tmp_path / "many.glb").read_bytes())
+    assert [document["nodes"][n]["name"] for n in document["scenes"][0]["nodes"]] == [
+        name for name, _ in many
+    ]
+    assert len(document["meshes"]) == 3 * len(many)
+    merged = trimesh.load(tmp_path / "many.glb", force="scene")
+    assert len(merged.geometry) == 3 * len(many)
+    assert document["buffers"] == [{"byteLength": len(binary)}]
+
+
+def test_the_report_is_a_typed_object_read_as_its_json_document(tmp_path: Path) -> None:
+    """What a run returns is a :class:`CityReport` (its summary a :class:`Summary`), its
+    buildings held as lines (:class:`Entries`); read as a mapping it is the document on
+    disk, key for key and in order."""
+    manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(3)])
+    report = run_city(load_city(manifest), tmp_path / "out")
+    assert isinstance(report, CityReport) and isinstance(report.summary, Summary)
+    assert isinstance(report.buildings, Entries) and report.summary.ok == 3
+    on_disk = json.loads((tmp_path / "out" / "town.report.json").read_text())
+    assert list(on_disk) == list(report) == [
+        "version", "name", "crs", "origin", "georeference", "buildings", "rejected",
+        "warnings", "replaced", "models", "summary",
+    ]  # fmt: skip
+    assert on_disk == {**report, "buildings": list(report["buildings"])}
+    assert on_disk["summary"] == dataclasses.asdict(report.summary)
+
+
+def test_a_city_is_ended_by_the_writers_of_the_registry(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The merged model, 3D Tiles, USD stage and CityJSON are written by CITY_WRITERS, in
+    that order; a writer the disk refuses is exit 1 naming its output, the buildings kept."""
+    manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(2)])
+    assert list(CITY_WRITERS) == ["glb", "3dtiles", "usd", "cityjson"]
+    called: list[str] = []
+    for name, writer in CITY_WRITERS.items():
+
+        def spy(built: BuiltCity, name: str = name, write: Any = writer.write) -> Any:
+            called.append(name)
+            assert [t.footprint.id for t in built.ok()] == ["h0", "h1"]
+            return write(built)
+
+        monkeypatch.setitem(CITY_WRITERS, name, dataclasses.replace(writer, write=spy))
+    code, _, err = city(capsys, manifest, "--usd", "--3dtiles")
+    assert code == 0, err
+    assert called == ["glb", "3dtiles", "usd", "cityjson"]
+    models = json.loads((tmp_path / "out" / "town.report.json").read_text())["models"]
+    assert models["usd"] == "town.usda" and models["3dtiles"]["tileset"] == "3dtiles/tileset.json"
+    called.clear()
+    assert city(capsys, manifest)[0] == 0
+    assert called == ["glb", "cityjson"]  # no --usd, no --3dtiles
+
+    def full(built: BuiltCity) -> Any:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setitem(CITY_WRITERS, "cityjson", CityWriter("CityJSON", full))
+    code, _, err = city(capsys, manifest, "--resume")
+    assert code == 1
+    assert "cannot write the CityJSON: No space left on device" in err
+    assert "run again with --resume" in err
+    assert (tmp_path / "out" / building_file("h1")).is_file()
+
+
+def test_the_command_names_the_merged_model_it_wrote(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    manifest = town(tmp_path, [square("a")])
+    code, said, err = facade(capsys, "city", manifest, "-o", tmp_path / "out", "-j", "1")
+    assert code == 0, err
+    assert f"-> {tmp_path / 'out'}/town.glb, " in said and "no merged" not in err
+
+
+def test_resume_reads_the_last_run_as_lines(tmp_path: Path) -> None:
+    """The last run's entries are kept as their lines (a city of 100,000 resumes in little
+    memory): the last line of an id wins, a line cut short or without a hash is skipped."""
+    log = tmp_path / "town.report.jsonl"
+    entries = [
+        {"id": "a", "status": "ok", "hash": "1", "height": 3.5},
+        {"id": "b", "status": "ok"},  # a run before the hashes
+        {"id": "c", "status": "failed", "hash": "2"},
+        {"id": "a", "status": "ok", "hash": "3", "height": 4.0},
+    ]
+    log.write_text("".join(json.dumps(e) + "\n" for e in entries) + '{"id": "d", "sta')
+    found = recorded(tmp_path, "town")
+    assert found == {"a": json.dumps(entries[3]).encode("utf-8")}
+    log.unlink()  # without the log, the report
+    (tmp_path / "town.report.json").write_text(json.dumps({"buildings": entries[:2]}))
+    assert recorded(tmp_path, "town") == {"a": json.dumps(entries[0]).encode("utf-8")}
