@@ -499,7 +499,8 @@ def city(
         typer.Option(
             "--lod",
             metavar="1,2,3",
-            help="3D Tiles' levels of detail: blocks, roofs, façades [default: 1,2,3].",
+            help="Levels of detail: 1 blocks, 2 roofs, 3 façades. The merged glb takes the "
+            "finest; --3dtiles makes each [default: 3, and 1,2,3 with --3dtiles].",
             show_default=False,
         ),
     ] = None,
@@ -524,12 +525,10 @@ def city(
     from facadecli.city.default import default_city
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
-    from facadecli.city.tileset import parse_lods
+    from facadecli.city.tileset import chosen_lods
 
     box = _bbox(bbox) if bbox is not None else None
-    if lod is not None and not tiles3d:
-        raise typer.BadParameter("chooses the levels of detail of --3dtiles", param_hint="--lod")
-    lods = parse_lods(lod or "1,2,3") if tiles3d else ()
+    lods, finest = chosen_lods(lod, tiles3d)
     is_manifest = source.suffix.lower() in (".yaml", ".yml")
     if is_manifest and spec is not None:
         raise typer.BadParameter(
@@ -539,7 +538,9 @@ def city(
     loaded = load_city(source) if is_manifest else default_city(source, spec)
     workers = jobs or os.cpu_count() or 1
     if _state["quiet"]:
-        report = run_city(loaded, outdir, workers, limit, resume, None, scheduler, box, usd, lods)
+        report = run_city(
+            loaded, outdir, workers, limit, resume, None, scheduler, box, usd, lods, finest
+        )
     elif sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
         from rich.progress import Progress
 
@@ -550,7 +551,7 @@ def city(
                 bar.update(task, completed=done, total=total)
 
             report = run_city(
-                loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
+                loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods, finest
             )
     else:
         step = max(1, (limit or 1000) // 20)
@@ -560,7 +561,7 @@ def city(
                 typer.echo(f"{done}/{total} buildings", err=True)
 
         report = run_city(
-            loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
+            loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods, finest
         )
     summary = report["summary"]
 

@@ -501,9 +501,11 @@ def run_city(
     bbox: BBox | None = None,
     usd: bool = False,
     lods: tuple[int, ...] = (),
+    merged_lod: int = 3,
 ) -> dict[str, Any]:
     """Build a city; returns the report (also written to ``<name>.report.json``).
-    With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py).
+    With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py); the merged
+    models are at ``merged_lod`` (tiles.py).
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -534,6 +536,7 @@ def run_city(
             started,
             straight,
             lods,
+            merged_lod,
         )
 
 
@@ -552,6 +555,7 @@ def _build(
     started: float,
     straight: Straightened | None = None,
     lods: tuple[int, ...] = (),
+    merged_lod: int = 3,
 ) -> dict[str, Any]:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report."""
@@ -607,6 +611,7 @@ def _build(
             city.manifest.name,
             city.manifest.tiles,
             georef,
+            merged_lod,
         )
     except OSError as error:  # a full disk: the buildings stay, for --resume
         raise OutputError(

@@ -7,7 +7,11 @@ column and row from the run's origin (``tiles/<name>_<i>_<j>.glb``) and listed, 
 their bounds in local metres, in the outputs' CRS (named in the index) and in WGS 84
 lon/lat, in ``<name>.tiles.json``. Every merged model carries the georeference of the
 run's frame (georef.py) in its scene's ``extras``, and ``<name>.georef.json`` beside them
-holds it too, with the CRS's WKT: it places every glb of the run, buildings' included."""
+holds it too, with the CRS's WKT: it places every glb of the run, buildings' included.
+
+The merged models are at one level of detail (``--lod``): 3, the buildings' own glb files
+with their façades (the default); 2, walls and roofs; 1, blocks (lods.py), each made from
+the CityJSON feature beside a building's glb."""
 
 from __future__ import annotations
 
@@ -20,6 +24,7 @@ from typing import Any
 import pyproj
 
 from facadecli.city.georef import Georef, georeference
+from facadecli.city.lods import lod_glb
 from facadecli.export.atomic import write_atomic
 from facadecli.export.glb_merge import merge_glb
 from facadecli.limits import MERGED_GLB_MAX
@@ -37,9 +42,11 @@ def merge_city(
     name: str,
     size: float | None,
     georef: Georef,
+    lod: int = 3,
 ) -> dict[str, Any]:
     """Write the merged model(s) of the built buildings (id, glb file, centroid in local
-    metres) and ``<name>.georef.json``; returns what was written for the report:
+    metres) at level of detail ``lod``, and ``<name>.georef.json``; returns what was
+    written for the report:
     ``merged`` (the one glb, or None when it would pass MERGED_GLB_MAX), ``tiles`` (the
     index file, or None) and ``georef``."""
     buildings = list(buildings)
@@ -51,7 +58,8 @@ def merge_city(
     total = sum(path.stat().st_size for _, path, _ in buildings)
     merged: str | None = f"{name}.glb"
     if total <= MERGED_GLB_MAX:
-        merge_glb(((bid, path) for bid, path, _ in buildings), outdir / f"{name}.glb", extras)
+        merged_parts = ((bid, _at(path, lod)) for bid, path, _ in buildings)
+        merge_glb(merged_parts, outdir / f"{name}.glb", extras)
     else:
         merged = None
         size = size or DEFAULT_TILE
@@ -63,7 +71,7 @@ def merge_city(
     index = []
     for (i, j), members in sorted(groups.items()):
         file = f"tiles/{name}_{i}_{j}.glb"
-        merge_glb(members, outdir / file, extras)
+        merge_glb(((bid, _at(path, lod)) for bid, path in members), outdir / file, extras)
         bounds = (i * size, j * size, (i + 1) * size, (j + 1) * size)
         index.append(
             {
@@ -86,3 +94,8 @@ def merge_city(
     }
     write_atomic(outdir / f"{name}.tiles.json", json.dumps(document, indent=2) + "\n")
     return {"merged": merged, "tiles": f"{name}.tiles.json", "georef": sidecar}
+
+
+def _at(glb: Path, lod: int) -> Path | bytes:
+    """A building's glb at ``lod``: its own file for 3, else made from its feature."""
+    return glb if lod == 3 else lod_glb(glb, lod)

@@ -56,10 +56,10 @@ def read_glb(data: bytes) -> tuple[dict[str, Any], bytes]:
 
 
 def merge_glb(
-    parts: Iterable[tuple[str, Path]], target: Path, extras: dict[str, Any] | None = None
+    parts: Iterable[tuple[str, Path | bytes]], target: Path, extras: dict[str, Any] | None = None
 ) -> None:
-    """Write one glb holding every (name, file) part under a root node of that name; with
-    ``extras``, as the scene's ``extras`` (glTF's place for application data)."""
+    """Write one glb holding every (name, file or glb bytes) part under a root node of that
+    name; with ``extras``, as the scene's ``extras`` (glTF's place for application data)."""
     merged: dict[str, Any] = {key: [] for key in _REFERENCES}
     scene: dict[str, Any] = {"nodes": []}
     if extras is not None:
@@ -77,7 +77,7 @@ def merge_glb(
             known: dict[bytes, int] = {}  # a picture's digest -> its merged image
             seen: dict[str, dict[str, int]] = {}  # shared kinds' entries already merged
             for name, path in parts:
-                document, chunk = read_glb(path.read_bytes())
+                document, chunk = read_glb(path.read_bytes() if isinstance(path, Path) else path)
                 document, chunk = _known_images(document, chunk, known, len(merged["images"]))
                 _append(merged, document, name, binary.tell(), seen)
                 binary.write(chunk)
