@@ -504,6 +504,14 @@ def city(
             show_default=False,
         ),
     ] = None,
+    instance: Annotated[
+        bool,
+        typer.Option(
+            "--instance",
+            help="Parts façades repeat (windows, frames, sills) as GPU instances "
+            "(EXT_mesh_gpu_instancing): a mesh stored once, drawn once for all.",
+        ),
+    ] = False,
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -539,7 +547,18 @@ def city(
     workers = jobs or os.cpu_count() or 1
     if _state["quiet"]:
         report = run_city(
-            loaded, outdir, workers, limit, resume, None, scheduler, box, usd, lods, finest
+            loaded,
+            outdir,
+            workers,
+            limit,
+            resume,
+            None,
+            scheduler,
+            box,
+            usd,
+            lods,
+            finest,
+            instance,
         )
     elif sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
         from rich.progress import Progress
@@ -551,7 +570,18 @@ def city(
                 bar.update(task, completed=done, total=total)
 
             report = run_city(
-                loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods, finest
+                loaded,
+                outdir,
+                workers,
+                limit,
+                resume,
+                progress,
+                scheduler,
+                box,
+                usd,
+                lods,
+                finest,
+                instance,
             )
     else:
         step = max(1, (limit or 1000) // 20)
@@ -561,7 +591,18 @@ def city(
                 typer.echo(f"{done}/{total} buildings", err=True)
 
         report = run_city(
-            loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods, finest
+            loaded,
+            outdir,
+            workers,
+            limit,
+            resume,
+            progress,
+            scheduler,
+            box,
+            usd,
+            lods,
+            finest,
+            instance,
         )
     summary = report["summary"]
 

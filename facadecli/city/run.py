@@ -81,6 +81,7 @@ from facadecli.city.tileset import FOLDER as TILESET_FOLDER
 from facadecli.city.tileset import TilesetWriter
 from facadecli.errors import OutputError, SpecError
 from facadecli.export.atomic import check_output_folder, write_atomic
+from facadecli.export.glb_merge import instance_nodes
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
 from facadecli.export.usd import city_usda, usda_text
@@ -108,6 +109,7 @@ class Task:
     pick: int = 0  # which of them this building takes (from the seed and its id)
     usd: bool = False  # a USD stage beside the glb (``--usd``)
     above: Any = None  # the taller parts standing on this one: its roof leaves them out
+    instanced: bool = False  # repeated parts as GPU instances (``--instance``)
 
 
 PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names as they are
@@ -196,10 +198,12 @@ def build(task: Task) -> dict[str, Any]:
             task.variants,
             task.pick,
             task.above,
+            task.instanced,
         )
         solids = BuildingSolids(task.footprint.id, result.volumes, _attributes(task, result.top))
         write_cityjson(_feature_file(task.target), building_object(solids))
-        write_atomic(task.target, glb_bytes(result.scene, material_extensions(task.spec)))
+        data = glb_bytes(result.scene, material_extensions(task.spec))
+        write_atomic(task.target, instance_nodes(data) if task.instanced else data)
         if task.usd:
             write_atomic(
                 task.target.with_suffix(".usda"), usda_text(result.scene, task.target.stem)
@@ -279,7 +283,13 @@ def _simplified(simplified: Simplified | None) -> dict[str, Any]:
     }
 
 
-def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = False) -> list[Task]:
+def plan(
+    city: City,
+    footprints: list[Footprint],
+    outdir: Path,
+    usd: bool = False,
+    instanced: bool = False,
+) -> list[Task]:
     """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
@@ -348,6 +358,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 pick,
                 usd,
                 above.get(footprint.id),
+                instanced,
             )
         )
     return tasks
@@ -502,10 +513,12 @@ def run_city(
     usd: bool = False,
     lods: tuple[int, ...] = (),
     merged_lod: int = 3,
+    instanced: bool = False,
 ) -> dict[str, Any]:
     """Build a city; returns the report (also written to ``<name>.report.json``).
     With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py); the merged
-    models are at ``merged_lod`` (tiles.py).
+    models are at ``merged_lod`` (tiles.py). With ``instanced``, the parts façades repeat
+    are GPU instances, in each building's glb and across the merged models.
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -519,7 +532,7 @@ def run_city(
     defaults = city.manifest.defaults
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
-    tasks = plan(city, footprints, outdir, usd)
+    tasks = plan(city, footprints, outdir, usd, instanced)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
             city,
@@ -537,6 +550,7 @@ def run_city(
             straight,
             lods,
             merged_lod,
+            instanced,
         )
 
 
@@ -556,6 +570,7 @@ def _build(
     straight: Straightened | None = None,
     lods: tuple[int, ...] = (),
     merged_lod: int = 3,
+    instanced: bool = False,
 ) -> dict[str, Any]:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report."""
@@ -612,6 +627,7 @@ def _build(
             city.manifest.tiles,
             georef,
             merged_lod,
+            instanced,
         )
     except OSError as error:  # a full disk: the buildings stay, for --resume
         raise OutputError(

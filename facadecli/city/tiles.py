@@ -43,9 +43,11 @@ def merge_city(
     size: float | None,
     georef: Georef,
     lod: int = 3,
+    instanced: bool = False,
 ) -> dict[str, Any]:
     """Write the merged model(s) of the built buildings (id, glb file, centroid in local
-    metres) at level of detail ``lod``, and ``<name>.georef.json``; returns what was
+    metres) at level of detail ``lod`` (with ``instanced``, each repeated part drawn by
+    one node for all: :func:`.merge_glb`), and ``<name>.georef.json``; returns what was
     written for the report:
     ``merged`` (the one glb, or None when it would pass MERGED_GLB_MAX), ``tiles`` (the
     index file, or None) and ``georef``."""
@@ -59,7 +61,7 @@ def merge_city(
     merged: str | None = f"{name}.glb"
     if total <= MERGED_GLB_MAX:
         merged_parts = ((bid, _at(path, lod)) for bid, path, _ in buildings)
-        merge_glb(merged_parts, outdir / f"{name}.glb", extras)
+        merge_glb(merged_parts, outdir / f"{name}.glb", extras, instanced)
     else:
         merged = None
         size = size or DEFAULT_TILE
@@ -71,7 +73,8 @@ def merge_city(
     index = []
     for (i, j), members in sorted(groups.items()):
         file = f"tiles/{name}_{i}_{j}.glb"
-        merge_glb(((bid, _at(path, lod)) for bid, path in members), outdir / file, extras)
+        members_at = ((bid, _at(path, lod)) for bid, path in members)
+        merge_glb(members_at, outdir / file, extras, instanced)
         bounds = (i * size, j * size, (i + 1) * size, (j + 1) * size)
         index.append(
             {
