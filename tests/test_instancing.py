@@ -143,3 +143,15 @@ def test_a_mesh_placed_again_and_again_becomes_one_instanced_node() -> None:
     for name in before:
         assert _same_triangles(before[name], after[name])
     assert instance_nodes(instanced) == instanced  # nothing left to instance
+
+
+def test_3d_tiles_see_instanced_buildings_where_they_are(towns: dict[bool, Path]) -> None:
+    """The tiles' boxes and triangle counts of a building are the same with instances:
+    its parts' boxes placed at each instance, their triangles counted at each."""
+    from facadecli.city.tileset import _glb_boxes, _glb_triangles
+
+    plain = sorted((towns[False] / "buildings").glob("*.glb"))
+    instanced = sorted((towns[True] / "buildings").glob("*.glb"))
+    assert [p.name for p in plain] == [p.name for p in instanced]
+    assert np.allclose(_glb_boxes(plain), _glb_boxes(instanced), atol=1e-3)
+    assert [_glb_triangles(p) for p in plain] == [_glb_triangles(p) for p in instanced]

@@ -53,6 +53,7 @@ from facadecli.errors import SpecError
 from facadecli.export.atomic import write_atomic
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.export.gltf import glb_bytes
+from facadecli.export.instancing import EXTENSION, node_matrix, placements
 
 FOLDER = "3dtiles"
 LODS = (1, 2, 3)
@@ -376,27 +377,54 @@ def _lod_scene(
 
 
 def _glb_boxes(paths: Iterable[Path]) -> list[Box]:
-    """Each glb's box (z up) from its positions' bounds (nodes carry no transforms)."""
+    """Each glb's box (z up) from its positions' bounds (nodes carry no transforms but
+    the instances of ``EXT_mesh_gpu_instancing``: their meshes' boxes placed at each)."""
     boxes = []
     for path in paths:
-        document, _ = read_glb(path.read_bytes())
+        document, chunk = read_glb(path.read_bytes())
         accessors = document.get("accessors", [])
+        instanced = _instances(document, chunk)
         lows, highs = [], []
-        for mesh in document.get("meshes", []):
+        for index, mesh in enumerate(document.get("meshes", [])):
             for primitive in mesh["primitives"]:
                 accessor = accessors[primitive["attributes"]["POSITION"]]
-                lows.append(accessor["min"])
-                highs.append(accessor["max"])
+                low, high = np.asarray(accessor["min"]), np.asarray(accessor["max"])
+                for matrix in instanced.get(index, [np.eye(4)]):
+                    corners = np.array(
+                        [
+                            (x, y, z, 1.0)
+                            for x in (low[0], high[0])
+                            for y in (low[1], high[1])
+                            for z in (low[2], high[2])
+                        ]
+                    )
+                    placed = (corners @ matrix.T)[:, :3]
+                    lows.append(placed.min(axis=0))
+                    highs.append(placed.max(axis=0))
         boxes.append(_z_up(np.min(lows, axis=0), np.max(highs, axis=0)))
     return boxes
 
 
+def _instances(document: dict[str, Any], chunk: bytes) -> dict[int, list[np.ndarray]]:
+    """The placements of each mesh an ``EXT_mesh_gpu_instancing`` node draws."""
+    found: dict[int, list[np.ndarray]] = {}
+    for node in document.get("nodes", []):
+        if "mesh" in node and EXTENSION in node.get("extensions", {}):
+            for row in placements(document, chunk, node):
+                t, r, scale = row[:3], row[3:7], row[7:10]
+                matrix = node_matrix({"translation": t, "rotation": r, "scale": scale})
+                found.setdefault(node["mesh"], []).append(matrix)
+    return found
+
+
 def _glb_triangles(path: Path) -> int:
-    document, _ = read_glb(path.read_bytes())
+    """A glb's triangles as drawn (an instanced mesh's once per instance)."""
+    document, chunk = read_glb(path.read_bytes())
     accessors = document.get("accessors", [])
+    instanced = _instances(document, chunk)
     return sum(
-        accessors[p["indices"]]["count"] // 3
-        for mesh in document.get("meshes", [])
+        accessors[p["indices"]]["count"] // 3 * len(instanced.get(index, [None]))
+        for index, mesh in enumerate(document.get("meshes", []))
         for p in mesh["primitives"]
     )
 
