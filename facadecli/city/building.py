@@ -27,6 +27,7 @@ import trimesh
 from shapely.geometry import Point, Polygon
 from shapely.geometry.polygon import orient
 
+from facadecli.city.entrances import DOOR_MATERIAL, along_wall, with_doors
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import Segment, roof_meshes
@@ -68,6 +69,7 @@ WALL = Material(color="#cfc6b8", roughness=0.9)
 ROOF = LIBRARY["roof-tiles"]  # pitched roofs: clay tiles, courses along the eaves
 FLAT_ROOF = LIBRARY["concrete"].model_copy(update={"color": "#77736c"})  # a flat roof's deck
 GROUND = Material(color="#808080", roughness=1.0)
+DOOR = LIBRARY["timber"].model_copy(update={"color": "#5a3a22"})  # doors at entrances
 WALL_NAME, ROOF_NAME, GROUND_NAME = "wall", "roof", "ground"  # a spec may define them
 FLAT_ROOF_NAME = "flat_roof"
 ROOFS = (ROOF_NAME, FLAT_ROOF_NAME)  # their textures lie in their slopes (plane_uv)
@@ -164,19 +166,37 @@ class AxisCache:
         horizontal, vertical = across[x], up[y]
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.facades:
-            layout = _facade(spec, horizontal, vertical)
-            merged: dict[str, list[trimesh.Trimesh]] = {}
-            for mesh in _placed(facade_scene(layout, base_dir)):
-                merged.setdefault(mesh.visual.material.name, []).append(mesh)
-            self.facades[slot] = tuple(
-                (name, joined.vertices.copy(), joined.faces.copy())
-                for name, meshes in sorted(merged.items())
-                for joined in [trimesh.util.concatenate(meshes)]
-            )
+            self.facades[slot] = _merged_facade(_facade(spec, horizontal, vertical), base_dir)
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
         return [
             (name, trimesh.Trimesh(vertices * scale, faces, process=False))
             for name, vertices, faces in self.facades[slot]
+        ]
+
+    def facade_with_doors(
+        self,
+        key: str,
+        spec: Spec,
+        width: float,
+        height: float,
+        base_dir: Path | None,
+        doors: Sequence[float],
+        variants: int = 1,
+        pick: int = 0,
+    ) -> list[tuple[str, trimesh.Trimesh]] | None:
+        """:meth:`facade` with a door at each of ``doors`` (metres along the wall, where
+        entrances are: :func:`.with_doors`); a wall's own, so not kept."""
+        across = self._layouts(key, spec, "x", width, variants)
+        up = self._layouts(key, spec, "y", height, variants)
+        if not across or not up:
+            return None
+        horizontal, vertical = across[pick % len(across)], up[pick % len(up)]
+        stretch = horizontal.canvas / width
+        layout = with_doors(_facade(spec, horizontal, vertical), [d * stretch for d in doors])
+        scale = np.array([1 / stretch, height / vertical.canvas, 1.0])
+        return [
+            (name, trimesh.Trimesh(vertices * scale, faces, process=False))
+            for name, vertices, faces in _merged_facade(layout, base_dir)
         ]
 
     def facade_parts(
@@ -226,6 +246,7 @@ class BuildingResult:
     top: float  # metres: the highest roof
     volumes: tuple[Volume, ...] = ()  # the solids: walls and roofs (on posts: the roof alone)
     plain: dict[str, int] = field(default_factory=dict)  # plain walls by reason (PLAIN_REASONS)
+    doors: int = 0  # doors put where the footprint's entrances are
 
 
 def _to_world(origin: tuple[float, float], direction: tuple[float, float]) -> np.ndarray:
@@ -302,7 +323,7 @@ def build_building(
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
     instances: dict[tuple[str, bytes, bytes], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
-    facades = plain = party = 0
+    facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
     volumes = [volume(part, heights, roof) for part in footprint.parts]
     posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
@@ -320,9 +341,13 @@ def build_building(
             placement = lift @ _to_world(a, direction)
             meshes: list[tuple[str, trimesh.Trimesh]] | None = None
             repeated: PlacedParts = []
+            doors = along_wall(footprint.entrances, a, b)
             if length >= min_facade_width and not party_wall:
                 wall_args = (chosen.key, chosen.spec, length, wall_height, chosen.base_dir)
-                if instanced:
+                if doors:  # entrances on this wall: its façade with doors, its own
+                    meshes = cache.facade_with_doors(*wall_args, doors, variants, pick)
+                    entrances += len(doors) if meshes is not None else 0
+                elif instanced:
                     found = cache.facade_parts(*wall_args, variants, pick)
                     meshes, repeated = found if found is not None else (None, [])
                 else:
@@ -414,7 +439,14 @@ def build_building(
     if posts_only:  # the solids are the roofs: the posts stand in the air under them
         volumes = [roof_solid(block, SLAB) for block in volumes]
     return BuildingResult(
-        scene, facades, plain, party, round(top, 3), tuple(volumes), dict(sorted(reasons.items()))
+        scene,
+        facades,
+        plain,
+        party,
+        round(top, 3),
+        tuple(volumes),
+        dict(sorted(reasons.items())),
+        entrances,
     )
 
 
@@ -623,7 +655,12 @@ def _materials(
     over the built-in one), and the tags' colours over both."""
     declared = {name: look(spec, name) for name in material_names(spec)}
     declared = {name: m for name, m in declared.items() if name in spec.materials or m.library}
-    builtins = ((WALL_NAME, WALL), (ROOF_NAME, ROOF), (FLAT_ROOF_NAME, FLAT_ROOF))
+    builtins = (
+        (WALL_NAME, WALL),
+        (ROOF_NAME, ROOF),
+        (FLAT_ROOF_NAME, FLAT_ROOF),
+        (DOOR_MATERIAL, DOOR),
+    )
     for name, builtin in (*builtins, (GROUND_NAME, GROUND)):
         declared.setdefault(name, builtin)
     if looks.wall is not None:
@@ -663,6 +700,18 @@ def _merged(
     )
     merged.visual = trimesh.visual.TextureVisuals(uv=np.vstack([m.visual.uv for m in mapped]))
     return merged
+
+
+def _merged_facade(layout: Layout, base_dir: Path | None) -> FacadeMeshes:
+    """A façade's meshes placed and merged per material."""
+    merged: dict[str, list[trimesh.Trimesh]] = {}
+    for mesh in _placed(facade_scene(layout, base_dir)):
+        merged.setdefault(mesh.visual.material.name, []).append(mesh)
+    return tuple(
+        (name, joined.vertices.copy(), joined.faces.copy())
+        for name, meshes in sorted(merged.items())
+        for joined in [trimesh.util.concatenate(meshes)]
+    )
 
 
 def _parts(scene: trimesh.Scene) -> tuple[FacadeMeshes, tuple[Part, ...]]:

@@ -223,6 +223,7 @@ def build(task: Task) -> dict[str, Any]:
         "plain_walls": result.plain_walls,
         "party_walls": result.party_walls,
         "plain": result.plain,
+        **({"doors": result.doors} if result.doors else {}),
         "height": result.top,
         "repaired": task.footprint.repaired,
         **_simplified(task.footprint.simplified),
