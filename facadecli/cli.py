@@ -508,7 +508,7 @@ def city(
         bool,
         typer.Option(
             "--instance",
-            help="Parts façades repeat (windows, frames, sills) as GPU instances "
+            help="Parts façades repeat (frames, sills, doors) as GPU instances "
             "(EXT_mesh_gpu_instancing): a mesh stored once, drawn once for all.",
         ),
     ] = False,

@@ -42,7 +42,7 @@ from facadecli.city.s3db import (
 )
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
-from facadecli.export.instancing import MIN_INSTANCES
+from facadecli.export.instancing import MIN_INSTANCES, MIN_TRIANGLES
 from facadecli.geometry.facade import (
     facade_scene,
     look,
@@ -210,8 +210,9 @@ class AxisCache:
         pick: int = 0,
     ) -> tuple[list[tuple[str, trimesh.Trimesh]], PlacedParts] | None:
         """:meth:`facade`, with the parts it places :data:`.MIN_INSTANCES` times or more
-        apart (each in its own frame, with its placements on the wall), for instancing;
-        the walls and the other parts merged per material."""
+        apart, those of :data:`.MIN_TRIANGLES` triangles or more (each in its own frame,
+        with its placements on the wall), for instancing; the walls and the other parts
+        merged per material."""
         across = self._layouts(key, spec, "x", width, variants)
         up = self._layouts(key, spec, "y", height, variants)
         if not across or not up:
@@ -715,9 +716,9 @@ def _merged_facade(layout: Layout, base_dir: Path | None) -> FacadeMeshes:
 
 
 def _parts(scene: trimesh.Scene) -> tuple[FacadeMeshes, tuple[Part, ...]]:
-    """A façade's meshes placed fewer than :data:`.MIN_INSTANCES` times, placed and merged
-    per material, and the others each once with their placements, in the order of the
-    scene's nodes."""
+    """A façade's meshes placed fewer than :data:`.MIN_INSTANCES` times or of fewer than
+    :data:`.MIN_TRIANGLES` triangles, placed and merged per material, and the others
+    each once with their placements, in the order of the scene's nodes."""
     uses = Counter(scene.graph[node][1] for node in scene.graph.nodes_geometry)
     merged: dict[str, list[trimesh.Trimesh]] = {}
     parts: dict[str, Part] = {}
@@ -725,7 +726,7 @@ def _parts(scene: trimesh.Scene) -> tuple[FacadeMeshes, tuple[Part, ...]]:
         matrix, geometry = scene.graph[node]
         mesh = scene.geometry[geometry]
         name = mesh.visual.material.name
-        if uses[geometry] < MIN_INSTANCES:
+        if uses[geometry] < MIN_INSTANCES or len(mesh.faces) < MIN_TRIANGLES:
             merged.setdefault(name, []).append(mesh.copy().apply_transform(matrix))
             continue
         if geometry not in parts:
