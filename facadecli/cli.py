@@ -530,6 +530,8 @@ def city(
                 "write tcp://HOST:PORT",
             )
         require("dask", "facade city --scheduler")
+    from functools import partial
+
     from facadecli.city.default import default_city
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
@@ -545,21 +547,17 @@ def city(
         )
     loaded = load_city(source) if is_manifest else default_city(source, spec)
     workers = jobs or os.cpu_count() or 1
+    run = partial(  # the run's options; the calls below differ in their progress
+        run_city,
+        scheduler=scheduler,
+        bbox=box,
+        usd=usd,
+        lods=lods,
+        merged_lod=finest,
+        instanced=instance,
+    )
     if _state["quiet"]:
-        report = run_city(
-            loaded,
-            outdir,
-            workers,
-            limit,
-            resume,
-            None,
-            scheduler,
-            box,
-            usd,
-            lods,
-            finest,
-            instance,
-        )
+        report = run(loaded, outdir, workers, limit, resume, None)
     elif sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
         from rich.progress import Progress
 
@@ -569,20 +567,7 @@ def city(
             def progress(done: int, total: int) -> None:
                 bar.update(task, completed=done, total=total)
 
-            report = run_city(
-                loaded,
-                outdir,
-                workers,
-                limit,
-                resume,
-                progress,
-                scheduler,
-                box,
-                usd,
-                lods,
-                finest,
-                instance,
-            )
+            report = run(loaded, outdir, workers, limit, resume, progress)
     else:
         step = max(1, (limit or 1000) // 20)
 
@@ -590,20 +575,7 @@ def city(
             if done == total or done % step == 0:
                 typer.echo(f"{done}/{total} buildings", err=True)
 
-        report = run_city(
-            loaded,
-            outdir,
-            workers,
-            limit,
-            resume,
-            progress,
-            scheduler,
-            box,
-            usd,
-            lods,
-            finest,
-            instance,
-        )
+        report = run(loaded, outdir, workers, limit, resume, progress)
     summary = report["summary"]
 
     def place(entry: dict[str, object]) -> str:  # a feature's place in the footprints
