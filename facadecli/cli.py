@@ -499,10 +499,19 @@ def city(
         typer.Option(
             "--lod",
             metavar="1,2,3",
-            help="3D Tiles' levels of detail: blocks, roofs, façades [default: 1,2,3].",
+            help="Levels of detail: 1 blocks, 2 roofs, 3 façades. The merged glb takes the "
+            "finest; --3dtiles makes each [default: 3, and 1,2,3 with --3dtiles].",
             show_default=False,
         ),
     ] = None,
+    instance: Annotated[
+        bool,
+        typer.Option(
+            "--instance",
+            help="Parts façades repeat (frames, sills, doors) as GPU instances "
+            "(EXT_mesh_gpu_instancing): a mesh stored once, drawn once for all.",
+        ),
+    ] = False,
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -521,15 +530,15 @@ def city(
                 "write tcp://HOST:PORT",
             )
         require("dask", "facade city --scheduler")
+    from functools import partial
+
     from facadecli.city.default import default_city
     from facadecli.city.manifest import load_city
     from facadecli.city.run import run_city
-    from facadecli.city.tileset import parse_lods
+    from facadecli.city.tileset import chosen_lods
 
     box = _bbox(bbox) if bbox is not None else None
-    if lod is not None and not tiles3d:
-        raise typer.BadParameter("chooses the levels of detail of --3dtiles", param_hint="--lod")
-    lods = parse_lods(lod or "1,2,3") if tiles3d else ()
+    lods, finest = chosen_lods(lod, tiles3d)
     is_manifest = source.suffix.lower() in (".yaml", ".yml")
     if is_manifest and spec is not None:
         raise typer.BadParameter(
@@ -538,8 +547,17 @@ def city(
         )
     loaded = load_city(source) if is_manifest else default_city(source, spec)
     workers = jobs or os.cpu_count() or 1
+    run = partial(  # the run's options; the calls below differ in their progress
+        run_city,
+        scheduler=scheduler,
+        bbox=box,
+        usd=usd,
+        lods=lods,
+        merged_lod=finest,
+        instanced=instance,
+    )
     if _state["quiet"]:
-        report = run_city(loaded, outdir, workers, limit, resume, None, scheduler, box, usd, lods)
+        report = run(loaded, outdir, workers, limit, resume, None)
     elif sys.stderr.isatty():  # a progress bar for a person; plain lines for CI logs
         from rich.progress import Progress
 
@@ -549,9 +567,7 @@ def city(
             def progress(done: int, total: int) -> None:
                 bar.update(task, completed=done, total=total)
 
-            report = run_city(
-                loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
-            )
+            report = run(loaded, outdir, workers, limit, resume, progress)
     else:
         step = max(1, (limit or 1000) // 20)
 
@@ -559,9 +575,7 @@ def city(
             if done == total or done % step == 0:
                 typer.echo(f"{done}/{total} buildings", err=True)
 
-        report = run_city(
-            loaded, outdir, workers, limit, resume, progress, scheduler, box, usd, lods
-        )
+        report = run(loaded, outdir, workers, limit, resume, progress)
     summary = report["summary"]
 
     def place(entry: dict[str, object]) -> str:  # a feature's place in the footprints

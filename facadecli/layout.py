@@ -200,7 +200,7 @@ _BACK_FIELD = {"z0": 7, "z1": 8}  # where those depths are in a shape's fields
 _Fields = tuple[str, str, str, float, float, float, float, float, float, str, str, bool, bool, bool]
 
 
-def _cull(shapes: list[Shape]) -> tuple[Shape, ...]:
+def cull(shapes: list[Shape]) -> tuple[Shape, ...]:
     """The shapes, those hidden from every viewpoint in front marked so (see _hidden)."""
     fields: list[_Fields] = [
         (

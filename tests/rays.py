@@ -23,11 +23,16 @@ def directions(count: int = 8, tilt: float = TILT) -> np.ndarray:
 
 
 def missing(
-    triangles: np.ndarray, targets: np.ndarray, direction: np.ndarray, tile: float = 1.0
+    triangles: np.ndarray,
+    targets: np.ndarray,
+    direction: np.ndarray,
+    tile: float = 1.0,
+    culled: bool = False,
 ) -> np.ndarray:
     """For rays along ``direction`` through each target point (x, y, 0), whether the ray
     meets no triangle at all (a hole). Rays are taken tile by tile, each against the
-    triangles near its tile (Möller-Trumbore, both faces)."""
+    triangles near its tile (Möller-Trumbore, both faces; with ``culled``, only the
+    triangles whose front faces the ray, as a viewer draws single-sided materials)."""
     top = float(triangles[:, :, 2].max()) + 0.1
     bottom = float(triangles[:, :, 2].min()) - 0.1
     # a ray enters above the highest point and leaves below the lowest
@@ -43,16 +48,18 @@ def missing(
         x1, y1 = (key + 1) * tile + reach
         near = (high[:, 0] >= x0) & (low[:, 0] <= x1) & (high[:, 1] >= y0) & (low[:, 1] <= y1)
         if near.any():
-            result[rays] = ~_hits(triangles[near], origins[rays], direction)
+            result[rays] = ~_hits(triangles[near], origins[rays], direction, culled)
     return result
 
 
-def _hits(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+def _hits(
+    triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray, culled: bool = False
+) -> np.ndarray:
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     e1, e2 = b - a, c - a
     p = np.cross(direction, e2)  # (T, 3)
-    det = (e1 * p).sum(axis=1)  # (T,)
-    usable = np.abs(det) > 1e-12
+    det = (e1 * p).sum(axis=1)  # (T,): -direction . normal, positive when facing the ray
+    usable = det > 1e-12 if culled else np.abs(det) > 1e-12
     inv = np.where(usable, 1.0 / np.where(usable, det, 1.0), 0.0)
     s = origins[:, None, :] - a[None, :, :]  # (R, T, 3)
     u = (s * p[None]).sum(axis=2) * inv[None]
@@ -70,19 +77,23 @@ def nearest(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -
     return np.where(np.isfinite(t.min(axis=1)), first, -1)
 
 
-def reach(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+def reach(
+    triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray, culled: bool = False
+) -> np.ndarray:
     """For each ray, how far along ``direction`` (a unit vector) it first meets a triangle
-    (infinity for none)."""
-    return _distances(triangles, origins, direction).min(axis=1)
+    (infinity for none); with ``culled``, a triangle whose front faces it."""
+    return _distances(triangles, origins, direction, culled).min(axis=1)
 
 
-def _distances(triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray) -> np.ndarray:
+def _distances(
+    triangles: np.ndarray, origins: np.ndarray, direction: np.ndarray, culled: bool = False
+) -> np.ndarray:
     """(rays, triangles): where along each ray it meets each triangle, infinity if not."""
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     e1, e2 = b - a, c - a
     p = np.cross(direction, e2)
     det = (e1 * p).sum(axis=1)
-    usable = np.abs(det) > 1e-12
+    usable = det > 1e-12 if culled else np.abs(det) > 1e-12
     inv = np.where(usable, 1.0 / np.where(usable, det, 1.0), 0.0)
     s = origins[:, None, :] - a[None, :, :]
     u = (s * p[None]).sum(axis=2) * inv[None]

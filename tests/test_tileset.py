@@ -30,8 +30,10 @@ import pytest
 import facadecli.city.tileset as tileset_module
 from facadecli.city.default import default_city
 from facadecli.city.georef import Georef
+from facadecli.city.lods import feature_of, lod_meshes
 from facadecli.city.run import run_city
-from facadecli.city.tileset import TilesetWriter, parse_lods, quadtree
+from facadecli.city.tiles import merge_city
+from facadecli.city.tileset import TilesetWriter, chosen_lods, parse_lods, quadtree
 from facadecli.errors import SpecError
 from facadecli.export.glb_merge import read_glb
 from tests.browser import BROWSER, browse
@@ -415,9 +417,61 @@ def test_the_command_line_refuses_a_bad_lod_before_any_work(
     town = ROOT / "samples" / "town.osm"
     code, _, err = facade(capsys, "city", town, "-o", tmp_path / "out", "--3dtiles", "--lod", "4")
     assert code == 2 and "--lod" in err and "1 (blocks)" in err
-    code, _, err = facade(capsys, "city", town, "-o", tmp_path / "out", "--lod", "1")
-    assert code == 2 and "--3dtiles" in err
+    code, _, err = facade(capsys, "city", town, "-o", tmp_path / "out", "--lod", "1,3")
+    assert code == 2 and "merged glb takes one" in err and "--3dtiles" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_lod_chooses_the_tiles_levels_and_the_merged_glbs() -> None:
+    assert chosen_lods(None, False) == ((), 3)  # the façades, no tiles
+    assert chosen_lods("2", False) == ((), 2)
+    assert chosen_lods(None, True) == ((1, 2, 3), 3)
+    assert chosen_lods("1,2", True) == ((1, 2), 2)  # the merged glb: the finest
+    with pytest.raises(SpecError, match="takes one"):
+        chosen_lods("1,2", False)
+
+
+@pytest.mark.parametrize("lod", [1, 2, 3])
+def test_the_merged_glb_is_at_the_level_of_detail_asked(city: Path, lod: int) -> None:
+    """``--lod`` chooses the merged glb's level: every building under its own node, as
+    blocks (the wall material only), walls and roofs, or the buildings' own glb files;
+    the coarser levels are the 3D Tiles' own meshes, and the same input gives the same
+    bytes."""
+    frame = json.loads((city / f"{city.name}.georef.json").read_text())
+    georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
+    glbs = sorted((city / "buildings").glob("*.glb"))
+    buildings = [(glb.stem, glb, (0.0, 0.0)) for glb in glbs]
+    written = [
+        merge_city(buildings, city.parent / f"lod{lod}-{k}", "town", None, georef, lod)
+        for k in range(2)
+    ]
+    merged = [city.parent / f"lod{lod}-{k}" / w["merged"] for k, w in enumerate(written)]
+    assert merged[0].read_bytes() == merged[1].read_bytes()
+    document, _ = read_glb(merged[0].read_bytes())
+    scene = document["scenes"][0]
+    assert [document["nodes"][n]["name"] for n in scene["nodes"]] == [g.stem for g in glbs]
+    materials = {m["name"] for m in document["materials"]}
+    triangles = sum(
+        document["accessors"][p["indices"]]["count"] // 3
+        for mesh in document["meshes"]
+        for p in mesh["primitives"]
+    )
+    if lod == 3:
+        assert len(materials) > 2  # the façades' own
+        assert triangles == sum(_stored_triangles(glb) for glb in glbs)
+    else:
+        assert materials == ({"wall"} if lod == 1 else {"wall", "roof"})
+        meshes = [lod_meshes(feature_of(glb), lod) for glb in glbs]
+        assert triangles == sum(len(m.faces) for found in meshes for m in found.values())
+
+
+def _stored_triangles(glb: Path) -> int:
+    document, _ = read_glb(glb.read_bytes())
+    return sum(
+        document["accessors"][p["indices"]]["count"] // 3
+        for mesh in document["meshes"]
+        for p in mesh["primitives"]
+    )
 
 
 def test_a_leaf_is_written_when_its_last_building_is_done(city: Path, tmp_path: Path) -> None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
+from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +27,7 @@ import trimesh
 from shapely.geometry import Point, Polygon
 from shapely.geometry.polygon import orient
 
+from facadecli.city.entrances import DOOR_MATERIAL, along_wall, with_doors
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import Segment, roof_meshes
@@ -40,6 +42,7 @@ from facadecli.city.s3db import (
 )
 from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
+from facadecli.export.instancing import MIN_INSTANCES, MIN_TRIANGLES
 from facadecli.geometry.facade import (
     facade_scene,
     look,
@@ -66,6 +69,7 @@ WALL = Material(color="#cfc6b8", roughness=0.9)
 ROOF = LIBRARY["roof-tiles"]  # pitched roofs: clay tiles, courses along the eaves
 FLAT_ROOF = LIBRARY["concrete"].model_copy(update={"color": "#77736c"})  # a flat roof's deck
 GROUND = Material(color="#808080", roughness=1.0)
+DOOR = LIBRARY["timber"].model_copy(update={"color": "#5a3a22"})  # doors at entrances
 WALL_NAME, ROOF_NAME, GROUND_NAME = "wall", "roof", "ground"  # a spec may define them
 FLAT_ROOF_NAME = "flat_roof"
 ROOFS = (ROOF_NAME, FLAT_ROOF_NAME)  # their textures lie in their slopes (plane_uv)
@@ -97,6 +101,9 @@ def solve_rung(spec: Spec, axis: str, canvas: float, variants: int = 1) -> tuple
 
 
 FacadeMeshes = tuple[tuple[str, np.ndarray, np.ndarray], ...]  # (material, vertices, faces)
+# a part a façade places again and again: its material, vertices, faces, and placements
+Part = tuple[str, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]
+PlacedParts = list[tuple[str, trimesh.Trimesh, list[np.ndarray]]]  # the same, on a wall
 Slot = tuple[str, str, int, int]  # a spec's cache key, an axis, a rung, how many variants
 
 
@@ -113,6 +120,9 @@ class AxisCache:
 
     axes: dict[Slot, tuple[AxisLayout, ...]] = field(default_factory=dict)
     facades: dict[tuple[str, int, int, int, int], FacadeMeshes] = field(default_factory=dict)
+    parts: dict[tuple[str, int, int, int, int], tuple[FacadeMeshes, tuple[Part, ...]]] = field(
+        default_factory=dict
+    )
     solved: int = 0  # axes this cache solved itself (not given it solved ahead)
 
     def get(
@@ -156,20 +166,76 @@ class AxisCache:
         horizontal, vertical = across[x], up[y]
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.facades:
-            layout = _facade(spec, horizontal, vertical)
-            merged: dict[str, list[trimesh.Trimesh]] = {}
-            for mesh in _placed(facade_scene(layout, base_dir)):
-                merged.setdefault(mesh.visual.material.name, []).append(mesh)
-            self.facades[slot] = tuple(
-                (name, joined.vertices.copy(), joined.faces.copy())
-                for name, meshes in sorted(merged.items())
-                for joined in [trimesh.util.concatenate(meshes)]
-            )
+            self.facades[slot] = _merged_facade(_facade(spec, horizontal, vertical), base_dir)
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
         return [
             (name, trimesh.Trimesh(vertices * scale, faces, process=False))
             for name, vertices, faces in self.facades[slot]
         ]
+
+    def facade_with_doors(
+        self,
+        key: str,
+        spec: Spec,
+        width: float,
+        height: float,
+        base_dir: Path | None,
+        doors: Sequence[float],
+        variants: int = 1,
+        pick: int = 0,
+    ) -> list[tuple[str, trimesh.Trimesh]] | None:
+        """:meth:`facade` with a door at each of ``doors`` (metres along the wall, where
+        entrances are: :func:`.with_doors`); a wall's own, so not kept."""
+        across = self._layouts(key, spec, "x", width, variants)
+        up = self._layouts(key, spec, "y", height, variants)
+        if not across or not up:
+            return None
+        horizontal, vertical = across[pick % len(across)], up[pick % len(up)]
+        stretch = horizontal.canvas / width
+        layout = with_doors(_facade(spec, horizontal, vertical), [d * stretch for d in doors])
+        scale = np.array([1 / stretch, height / vertical.canvas, 1.0])
+        return [
+            (name, trimesh.Trimesh(vertices * scale, faces, process=False))
+            for name, vertices, faces in _merged_facade(layout, base_dir)
+        ]
+
+    def facade_parts(
+        self,
+        key: str,
+        spec: Spec,
+        width: float,
+        height: float,
+        base_dir: Path | None,
+        variants: int = 1,
+        pick: int = 0,
+    ) -> tuple[list[tuple[str, trimesh.Trimesh]], PlacedParts] | None:
+        """:meth:`facade`, with the parts it places :data:`.MIN_INSTANCES` times or more
+        apart, those of :data:`.MIN_TRIANGLES` triangles or more (each in its own frame,
+        with its placements on the wall), for instancing; the walls and the other parts
+        merged per material."""
+        across = self._layouts(key, spec, "x", width, variants)
+        up = self._layouts(key, spec, "y", height, variants)
+        if not across or not up:
+            return None
+        x, y = pick % len(across), pick % len(up)
+        horizontal, vertical = across[x], up[y]
+        slot = (key, rung(width), rung(height), x, y)
+        if slot not in self.parts:
+            scene = facade_scene(_facade(spec, horizontal, vertical), base_dir)
+            self.parts[slot] = _parts(scene)
+        merged, parts = self.parts[slot]
+        scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
+        stretch = np.diag([*scale, 1.0])
+        return (
+            [
+                (name, trimesh.Trimesh(vertices * scale, faces, process=False))
+                for name, vertices, faces in merged
+            ],
+            [
+                (name, trimesh.Trimesh(points, faces, process=False), [stretch @ m for m in placed])
+                for name, points, faces, placed in parts
+            ],
+        )
 
 
 @dataclass(frozen=True)
@@ -181,6 +247,7 @@ class BuildingResult:
     top: float  # metres: the highest roof
     volumes: tuple[Volume, ...] = ()  # the solids: walls and roofs (on posts: the roof alone)
     plain: dict[str, int] = field(default_factory=dict)  # plain walls by reason (PLAIN_REASONS)
+    doors: int = 0  # doors put where the footprint's entrances are
 
 
 def _to_world(origin: tuple[float, float], direction: tuple[float, float]) -> np.ndarray:
@@ -240,6 +307,7 @@ def build_building(
     variants: int = 1,
     pick: int = 0,
     above: Any = None,
+    instanced: bool = False,
 ) -> BuildingResult:
     """The building's scene: a volume a part of its footprint, as the heights say (walls
     from ``base`` to the eaves, the roof on them); façades on every wall but the party
@@ -250,11 +318,13 @@ def build_building(
     the ``pick``-th of up to ``variants`` layouts, the same for all the building's walls.
     Roofs stand still at party walls (a gable end, not a hip down to the neighbour), and
     leave out ``above``, the taller parts standing on this one, running on into their
-    walls."""
+    walls. With ``instanced``, the parts a façade repeats are meshes of their own, each
+    placed by a node per instance (:func:`.instance_nodes` makes them one node)."""
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
-    facades = plain = party = 0
+    instances: dict[tuple[str, bytes, bytes], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
+    facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
     volumes = [volume(part, heights, roof) for part in footprint.parts]
     posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
@@ -270,13 +340,19 @@ def build_building(
                 fixed.append((a, b))
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
-            meshes = (
-                cache.facade(
-                    chosen.key, chosen.spec, length, wall_height, chosen.base_dir, variants, pick
-                )
-                if length >= min_facade_width and not party_wall
-                else None
-            )
+            meshes: list[tuple[str, trimesh.Trimesh]] | None = None
+            repeated: PlacedParts = []
+            doors = along_wall(footprint.entrances, a, b)
+            if length >= min_facade_width and not party_wall:
+                wall_args = (chosen.key, chosen.spec, length, wall_height, chosen.base_dir)
+                if doors:  # entrances on this wall: its façade with doors, its own
+                    meshes = cache.facade_with_doors(*wall_args, doors, variants, pick)
+                    entrances += len(doors) if meshes is not None else 0
+                elif instanced:
+                    found = cache.facade_parts(*wall_args, variants, pick)
+                    meshes, repeated = found if found is not None else (None, [])
+                else:
+                    meshes = cache.facade(*wall_args, variants, pick)
             if meshes is None:
                 wall = trimesh.creation.box(extents=(length, wall_height, SLAB))
                 wall.apply_translation((length / 2, wall_height / 2, -SLAB / 2))
@@ -292,11 +368,19 @@ def build_building(
                 continue
             facades += 1
             out = max(float(mesh.vertices[:, 2].max(initial=0.0)) for _, mesh in meshes)
+            for _, mesh, placed in repeated:  # how far they stand out, on the wall
+                top = float(mesh.vertices[:, 2].max(initial=0.0))
+                out = max(out, *(top + float(m[2, 3]) for m in placed))
             proud[a] = (direction, out, _wall_material(chosen.spec))
             ends.append((a, b, out))
             for name, mesh in meshes:
                 mesh.apply_transform(placement)
                 parts.setdefault(name, []).append(mesh)
+            for name, mesh, placed in repeated:
+                digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())
+                instances.setdefault(digest, (name, mesh, []))[2].extend(
+                    placement @ m for m in placed
+                )
         for name, post in _corner_posts(proud, ends, block.base, wall_height):
             parts.setdefault(name, []).append(post)
         if posts_only:
@@ -331,11 +415,39 @@ def build_building(
         scene.add_geometry(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"
         )
+    for number, (name, mesh, placed) in enumerate(instances.values()):
+        fallback = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
+        finished, folder = materials.get(name) or (fallback, None)
+        metres = texture_metres(finished)
+        if metres is None:
+            mesh.visual = trimesh.visual.TextureVisuals()
+        else:  # texture coordinates in metres of the part's own frame
+            mesh = metric_uv(mesh, metres)
+            if finished.library is not None:
+                mesh = tangent_space(mesh)
+        mesh = weld(mesh)
+        mesh.visual.material = pbr(name, finished, folder)
+        geometry = f"{footprint.id}/part-{number}"
+        scene.add_geometry(mesh, geom_name=geometry, node_name=f"{geometry}/0", transform=placed[0])
+        for k, matrix in enumerate(placed[1:], 1):
+            scene.graph.update(
+                frame_to=f"{geometry}/{k}",
+                frame_from=scene.graph.base_frame,
+                matrix=matrix,
+                geometry=geometry,
+            )
     top = max(block.top for block in volumes)
     if posts_only:  # the solids are the roofs: the posts stand in the air under them
         volumes = [roof_solid(block, SLAB) for block in volumes]
     return BuildingResult(
-        scene, facades, plain, party, round(top, 3), tuple(volumes), dict(sorted(reasons.items()))
+        scene,
+        facades,
+        plain,
+        party,
+        round(top, 3),
+        tuple(volumes),
+        dict(sorted(reasons.items())),
+        entrances,
     )
 
 
@@ -544,7 +656,12 @@ def _materials(
     over the built-in one), and the tags' colours over both."""
     declared = {name: look(spec, name) for name in material_names(spec)}
     declared = {name: m for name, m in declared.items() if name in spec.materials or m.library}
-    builtins = ((WALL_NAME, WALL), (ROOF_NAME, ROOF), (FLAT_ROOF_NAME, FLAT_ROOF))
+    builtins = (
+        (WALL_NAME, WALL),
+        (ROOF_NAME, ROOF),
+        (FLAT_ROOF_NAME, FLAT_ROOF),
+        (DOOR_MATERIAL, DOOR),
+    )
     for name, builtin in (*builtins, (GROUND_NAME, GROUND)):
         declared.setdefault(name, builtin)
     if looks.wall is not None:
@@ -584,6 +701,44 @@ def _merged(
     )
     merged.visual = trimesh.visual.TextureVisuals(uv=np.vstack([m.visual.uv for m in mapped]))
     return merged
+
+
+def _merged_facade(layout: Layout, base_dir: Path | None) -> FacadeMeshes:
+    """A façade's meshes placed and merged per material."""
+    merged: dict[str, list[trimesh.Trimesh]] = {}
+    for mesh in _placed(facade_scene(layout, base_dir)):
+        merged.setdefault(mesh.visual.material.name, []).append(mesh)
+    return tuple(
+        (name, joined.vertices.copy(), joined.faces.copy())
+        for name, meshes in sorted(merged.items())
+        for joined in [trimesh.util.concatenate(meshes)]
+    )
+
+
+def _parts(scene: trimesh.Scene) -> tuple[FacadeMeshes, tuple[Part, ...]]:
+    """A façade's meshes placed fewer than :data:`.MIN_INSTANCES` times or of fewer than
+    :data:`.MIN_TRIANGLES` triangles, placed and merged per material, and the others
+    each once with their placements, in the order of the scene's nodes."""
+    uses = Counter(scene.graph[node][1] for node in scene.graph.nodes_geometry)
+    merged: dict[str, list[trimesh.Trimesh]] = {}
+    parts: dict[str, Part] = {}
+    for node in sorted(scene.graph.nodes_geometry):
+        matrix, geometry = scene.graph[node]
+        mesh = scene.geometry[geometry]
+        name = mesh.visual.material.name
+        if uses[geometry] < MIN_INSTANCES or len(mesh.faces) < MIN_TRIANGLES:
+            merged.setdefault(name, []).append(mesh.copy().apply_transform(matrix))
+            continue
+        if geometry not in parts:
+            parts[geometry] = (name, mesh.vertices.copy(), mesh.faces.copy(), ())
+        material, vertices, faces, placed = parts[geometry]
+        parts[geometry] = (material, vertices, faces, (*placed, np.asarray(matrix, dtype=float)))
+    walls = tuple(
+        (name, joined.vertices.copy(), joined.faces.copy())
+        for name, meshes in sorted(merged.items())
+        for joined in [trimesh.util.concatenate(meshes)]
+    )
+    return walls, tuple(parts.values())
 
 
 def _placed(scene: trimesh.Scene) -> list[trimesh.Trimesh]:

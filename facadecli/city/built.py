@@ -66,6 +66,8 @@ class BuiltCity:
     georef: Georef
     tile_size: float | None = None  # the manifest's ``tiles:``
     tileset: TilesetWriter | None = None  # with --3dtiles: leaves written as buildings ended
+    merged_lod: int = 3  # the merged models' level of detail (``--lod``)
+    instanced: bool = False  # repeated parts gathered as GPU instances (``--instance``)
 
     def ok(self) -> Iterator[Task]:
         """The buildings built, in the manifest's order."""

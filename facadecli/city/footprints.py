@@ -12,6 +12,7 @@ reported per feature (id, index, line), never raised; what makes the run ambiguo
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import statistics
@@ -66,6 +67,7 @@ class Footprint:
     properties: dict[str, Any] = field(default_factory=dict)
     repaired: bool = False
     simplified: Simplified | None = None
+    entrances: tuple[tuple[float, float], ...] = ()  # OSM's entrance nodes on its outline
 
 
 @dataclass(frozen=True)
@@ -145,8 +147,13 @@ def read_footprints(
         footprint = _footprint(fid, properties, shapely.affinity.translate(geometry, -minx, -miny))
         if isinstance(footprint, str):
             rejected.append(_rejected(document, index, fid, footprint))
-        else:
-            footprints.append(footprint)
+            continue
+        points = _entrances(document.features[index])
+        if points:
+            xs, ys = _projection(document.crs, crs)(*zip(*points, strict=True))
+            local = tuple((x - minx, y - miny) for x, y in zip(xs, ys, strict=True))
+            footprint = dataclasses.replace(footprint, entrances=local)
+        footprints.append(footprint)
     rejected.sort(key=lambda r: r.index)
     if rejected and not footprints:
         raise _nothing_usable(document, rejected)
@@ -478,3 +485,18 @@ def building_height(properties: dict[str, Any], default: float, floor_height: fl
         if levels is not None and levels > 0:
             return levels * floor_height
     return default
+
+
+def _entrances(feature: Any) -> list[tuple[float, float]]:
+    """The entrances an OSM extract's reader put on a building's feature (lon, lat of its
+    ``entrance=*`` nodes, osm.py); none on any other feature."""
+    found = feature.get("entrances") if isinstance(feature, dict) else None
+    if not isinstance(found, list):
+        return []
+    return [
+        (float(p[0]), float(p[1]))
+        for p in found
+        if isinstance(p, (list, tuple))
+        and len(p) == 2
+        and all(isinstance(v, (int, float)) and math.isfinite(v) for v in p)
+    ]

@@ -7,17 +7,20 @@
 - LOD3 is the building's own glb, with its façades.
 
 Both are made from the feature written beside each building's glb, so a resumed run
-gets them too, and the roofs come from one place (roofs.py through cityjson.py). Meshes
-are in the glTF frame of every other model of the run (x east, y up, z south, metres from
-the run's origin); a building's surfaces keep the order the feature gives them, so the
-same feature gives the same bytes.
+gets them too (3D Tiles' coarser tiles, and the merged glb at ``--lod 1`` or ``2``), and
+the roofs come from one place (roofs.py through cityjson.py). Meshes are in the glTF
+frame of every other model of the run (x east, y up, z south, metres from the run's
+origin); a building's surfaces keep the order the feature gives them, so the same
+feature gives the same bytes.
 """
 
 from __future__ import annotations
 
 import itertools
+import json
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,6 +29,11 @@ import trimesh
 from facadecli.city.building import MAP_TO_WORLD, ROOF_NAME, WALL_NAME
 from facadecli.city.cityjson import SCALE
 from facadecli.city.roofs import _triangulate as triangulate_face  # roofs' own, shared
+from facadecli.export.gltf import glb_bytes
+from facadecli.geometry.facade import pbr
+from facadecli.spec.model import Material
+
+COLOURS = {WALL_NAME: "#d9d2c3", ROOF_NAME: "#8f5a48"}  # LOD1 and LOD2 materials
 
 BOTTOMS = ("GroundSurface", "OuterCeilingSurface")
 Polygon3 = list[np.ndarray]  # a planar surface: its exterior ring, then its holes, (n, 3) metres
@@ -136,3 +144,32 @@ def lod_meshes(feature: dict[str, Any], lod: int) -> dict[str, trimesh.Trimesh]:
 def roof_depth(feature: dict[str, Any]) -> float:
     """The deepest roof of a building's volumes (metres below their top)."""
     return max((solid.roof_depth for solid in solids(feature)), default=0.0)
+
+
+def feature_of(glb: Path) -> dict[str, Any]:
+    """A building's CityJSON feature, written beside its glb."""
+    feature: dict[str, Any] = json.loads(glb.with_suffix(".city.jsonl").read_text("utf-8"))
+    return feature
+
+
+def dressed(meshes: dict[str, trimesh.Trimesh]) -> dict[str, trimesh.Trimesh]:
+    """LOD meshes (by material) in their materials: flat colours, one of each kind, so
+    that every building's are the same material (one draw call a kind, merged)."""
+    found = {}
+    for name, part in sorted(meshes.items()):
+        if not len(part.faces):
+            continue
+        part = part.copy()
+        part.visual = trimesh.visual.TextureVisuals()
+        part.visual.material = pbr(name, Material(color=COLOURS[name], roughness=0.9), None)
+        found[name] = part
+    return found
+
+
+def lod_glb(glb: Path, lod: int) -> bytes:
+    """A building at ``lod`` (1 or 2) as a glb, from the feature beside its own ``glb``:
+    a node a material, named as the full building's are (``<id>/wall``, ``<id>/roof``)."""
+    scene = trimesh.Scene()
+    for name, part in dressed(lod_meshes(feature_of(glb), lod)).items():
+        scene.add_geometry(part, geom_name=f"{glb.stem}/{name}", node_name=f"{glb.stem}/{name}")
+    return glb_bytes(scene)

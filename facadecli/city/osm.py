@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +35,7 @@ SUFFIXES = (".osm.pbf", ".pbf", ".osm", ".osm.bz2", ".osm.gz")
 HINT = "give an OpenStreetMap extract (.osm.pbf or .osm), a GeoPackage or a GeoJSON file"
 SORT = "sort it: osmium sort FILE -o SORTED.osm.pbf"
 LISTED = 5  # missing nodes or members named in a reason
+ENTRANCE = "entrance"  # a node tagged so on a building's way: a door there (entrances.py)
 LOOKED_UP = 2**48  # ids looked up in a second pass: below (libosmium's id set grows with them)
 
 
@@ -62,6 +63,8 @@ class _Drawn:
     reasons: dict[int, str]  # feature index -> why it has no geometry
     ways: dict[int, tuple[bool, list[int]]]  # id -> closed, missing nodes
     relations: dict[int, tuple[str, list[tuple[str, int, str]]]]  # id -> type, members
+    entrances: dict[int, tuple[float, float]] = field(default_factory=dict)  # node -> lon, lat
+    doors: dict[int, list[tuple[float, float]]] = field(default_factory=dict)  # way -> theirs
 
 
 def read_osm(path: Path) -> GeoJSON:
@@ -103,9 +106,15 @@ def _read(file: str) -> _Drawn:
     processor = (
         osmium.FileProcessor(file)
         .with_areas(osmium.filter.KeyFilter(*KEYS))
-        .with_filter(osmium.filter.KeyFilter(*KEYS))
+        .with_filter(osmium.filter.KeyFilter(*KEYS, ENTRANCE))
     )
     for item in processor:
+        if isinstance(item, osmium.osm.Node):
+            if ENTRANCE in item.tags and item.location.valid():
+                drawn.entrances[item.id] = (item.location.lon, item.location.lat)
+            continue
+        if not any(key in item.tags for key in KEYS):  # a way or relation tagged entrance
+            continue
         if isinstance(item, osmium.osm.Area):
             kind = "way" if item.from_way() else "relation"
             reason = ""
@@ -119,10 +128,17 @@ def _read(file: str) -> _Drawn:
             _tags(file, "way", _id(file, "way", item.id), item.tags)
             missing = [node.ref for node in item.nodes if not node.location.valid()]
             drawn.ways[item.id] = (item.is_closed(), missing)
+            doors = [drawn.entrances[n.ref] for n in item.nodes if n.ref in drawn.entrances]
+            if doors:
+                drawn.doors[item.id] = list(dict.fromkeys(doors))  # a ring's last node: its first
         elif isinstance(item, osmium.osm.Relation):
             tags = _tags(file, "relation", _id(file, "relation", item.id), item.tags)
             members = [(m.type, m.ref, m.role) for m in item.members]
             drawn.relations[item.id] = (tags.get("type", ""), members)
+    for feature in drawn.features:
+        kind, oid = feature["id"].split("/")
+        if kind == "way" and int(oid) in drawn.doors:
+            feature["entrances"] = drawn.doors[int(oid)]
     return drawn
 
 

@@ -80,6 +80,7 @@ from facadecli.city.tileset import TilesetWriter
 from facadecli.errors import OutputError, SpecError
 from facadecli.export import CITY_WRITERS, CityWriter
 from facadecli.export.atomic import atomic_output, check_output_folder, write_atomic
+from facadecli.export.glb_merge import instance_nodes
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
 from facadecli.export.usd import usda_text
@@ -107,6 +108,7 @@ class Task:
     pick: int = 0  # which of them this building takes (from the seed and its id)
     usd: bool = False  # a USD stage beside the glb (``--usd``)
     above: Any = None  # the taller parts standing on this one: its roof leaves them out
+    instanced: bool = False  # repeated parts as GPU instances (``--instance``)
 
     @property
     def file(self) -> str:
@@ -184,10 +186,12 @@ def build(task: Task) -> dict[str, Any]:
             task.variants,
             task.pick,
             task.above,
+            task.instanced,
         )
         solids = BuildingSolids(task.footprint.id, result.volumes, attributes(task, result.top))
         write_cityjson(feature_file(task.target), building_object(solids))
-        write_atomic(task.target, glb_bytes(result.scene, material_extensions(task.spec)))
+        data = glb_bytes(result.scene, material_extensions(task.spec))
+        write_atomic(task.target, instance_nodes(data) if task.instanced else data)
         if task.usd:
             write_atomic(
                 task.target.with_suffix(".usda"), usda_text(result.scene, task.target.stem)
@@ -207,6 +211,7 @@ def build(task: Task) -> dict[str, Any]:
         "plain_walls": result.plain_walls,
         "party_walls": result.party_walls,
         "plain": result.plain,
+        **({"doors": result.doors} if result.doors else {}),
         "height": result.top,
         "repaired": task.footprint.repaired,
         **_simplified(task.footprint.simplified),
@@ -239,7 +244,13 @@ def _simplified(simplified: Simplified | None) -> dict[str, Any]:
     }
 
 
-def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = False) -> list[Task]:
+def plan(
+    city: City,
+    footprints: list[Footprint],
+    outdir: Path,
+    usd: bool = False,
+    instanced: bool = False,
+) -> list[Task]:
     """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
@@ -308,6 +319,7 @@ def plan(city: City, footprints: list[Footprint], outdir: Path, usd: bool = Fals
                 pick,
                 usd,
                 above.get(footprint.id),
+                instanced,
             )
         )
     return tasks
@@ -466,9 +478,13 @@ def run_city(
     bbox: BBox | None = None,
     usd: bool = False,
     lods: tuple[int, ...] = (),
+    merged_lod: int = 3,
+    instanced: bool = False,
 ) -> CityReport:
     """Build a city; returns the report (also written to ``<name>.report.json``).
-    With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py).
+    With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py); the merged
+    models are at ``merged_lod`` (tiles.py). With ``instanced``, the parts façades repeat
+    are GPU instances, in each building's glb and across the merged models.
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -476,7 +492,7 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    ahead = planned(city, outdir, bbox, limit, usd)
+    ahead = planned(city, outdir, bbox, limit, usd, instanced)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
             city,
@@ -493,6 +509,8 @@ def run_city(
             started,
             ahead.straight,
             lods,
+            merged_lod,
+            instanced,
         )
 
 
@@ -513,6 +531,7 @@ def planned(
     bbox: BBox | None = None,
     limit: int | None = None,
     usd: bool = False,
+    instanced: bool = False,
 ) -> Planned:
     """The footprints read (those in ``bbox``), an outline's tags given to its parts, the
     outlines with parts cut to what they leave, collinear nodes merged, the first
@@ -523,7 +542,9 @@ def planned(
     defaults = city.manifest.defaults
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
-    return Planned(found, replaced, kept, straight, plan(city, footprints, outdir.resolve(), usd))
+    return Planned(
+        found, replaced, kept, straight, plan(city, footprints, outdir.resolve(), usd, instanced)
+    )
 
 
 def _build(
@@ -541,6 +562,8 @@ def _build(
     started: float,
     straight: Straightened | None = None,
     lods: tuple[int, ...] = (),
+    merged_lod: int = 3,
+    instanced: bool = False,
 ) -> CityReport:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report.
@@ -607,6 +630,8 @@ def _build(
         georef,
         city.manifest.tiles,
         tileset,
+        merged_lod,
+        instanced,
     )
     formats = ["glb", "3dtiles", "usd", "cityjson"]  # CITY_WRITERS' order: the report's too
     asked = {"3dtiles": tileset is not None, "usd": usd}

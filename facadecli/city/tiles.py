@@ -7,7 +7,11 @@ column and row from the run's origin (``tiles/<name>_<i>_<j>.glb``) and listed, 
 their bounds in local metres, in the outputs' CRS (named in the index) and in WGS 84
 lon/lat, in ``<name>.tiles.json``. Every merged model carries the georeference of the
 run's frame (georef.py) in its scene's ``extras``, and ``<name>.georef.json`` beside them
-holds it too, with the CRS's WKT: it places every glb of the run, buildings' included."""
+holds it too, with the CRS's WKT: it places every glb of the run, buildings' included.
+
+The merged models are at one level of detail (``--lod``): 3, the buildings' own glb files
+with their façades (the default); 2, walls and roofs; 1, blocks (lods.py), each made from
+the CityJSON feature beside a building's glb."""
 
 from __future__ import annotations
 
@@ -22,6 +26,7 @@ from typing import Any
 import pyproj
 
 from facadecli.city.georef import Georef, georeference
+from facadecli.city.lods import lod_glb
 from facadecli.export.atomic import write_atomic
 from facadecli.export.glb_merge import merge_glb
 from facadecli.limits import MERGED_BUILDINGS_MAX, MERGED_GLB_MAX
@@ -40,14 +45,18 @@ def merge_city(
     size: float | None,
     georef: Georef,
     streamed: bool = False,
+    lod: int = 3,
+    instanced: bool = False,
 ) -> dict[str, Any]:
     """Write the merged model(s) of the built buildings (``buildings()`` gives them again
-    each time it is called: id, glb file, centroid in local metres; none is held) and
-    ``<name>.georef.json``; returns what was written for the report: ``merged`` (the one
-    glb, or None and why in ``merged_left_out``: more than MERGED_BUILDINGS_MAX buildings
-    or MERGED_GLB_MAX bytes), ``tiles`` (the index file, or None) and ``georef``. The
-    tiles are written when ``size`` is given, or in DEFAULT_TILE squares when there is no
-    merged glb, unless the run writes 3D Tiles (``streamed``), a viewer's way in then."""
+    each time it is called: id, glb file, centroid in local metres; none is held) at level
+    of detail ``lod`` (with ``instanced``, each repeated part drawn by one node for all:
+    :func:`.merge_glb`), and ``<name>.georef.json``; returns what was written for the
+    report: ``merged`` (the one glb, or None and why in ``merged_left_out``: more than
+    MERGED_BUILDINGS_MAX buildings or MERGED_GLB_MAX bytes), ``tiles`` (the index file, or
+    None) and ``georef``. The tiles are written when ``size`` is given, or in DEFAULT_TILE
+    squares when there is no merged glb, unless the run writes 3D Tiles (``streamed``), a
+    viewer's way in then."""
     frame = georeference(georef)
     extras = {"georeference": frame}
     sidecar = f"{name}.georef.json"
@@ -60,8 +69,8 @@ def merge_city(
     merged: str | None = f"{name}.glb"
     left_out = _left_out(count, total, "open 3dtiles/tileset.json" if streamed else _TILED)
     if left_out is None:
-        merged_glb = ((bid, path) for bid, path, _ in buildings())
-        merge_glb(merged_glb, outdir / f"{name}.glb", extras)
+        merged_parts = ((bid, _at(path, lod)) for bid, path, _ in buildings())
+        merge_glb(merged_parts, outdir / f"{name}.glb", extras, instanced)
     else:
         merged = None
         size = size or (None if streamed else DEFAULT_TILE)
@@ -77,9 +86,11 @@ def merge_city(
     for (i, j), members in sorted(counts.items()):  # a pass each: no tile's list is held
         file = f"tiles/{name}_{i}_{j}.glb"
         tiled = (
-            (bid, path) for bid, path, centroid in buildings() if tile_of(centroid, size) == (i, j)
+            (bid, _at(path, lod))
+            for bid, path, centroid in buildings()
+            if tile_of(centroid, size) == (i, j)
         )
-        merge_glb(tiled, outdir / file, extras)
+        merge_glb(tiled, outdir / file, extras, instanced)
         bounds = (i * size, j * size, (i + 1) * size, (j + 1) * size)
         index.append(
             {
@@ -121,3 +132,8 @@ def _left_out(count: int, total: int, instead: str) -> str | None:
             f"({MERGED_GLB_MAX / 2**30:.0f} GiB, MERGED_GLB_MAX): {instead}"
         )
     return None
+
+
+def _at(glb: Path, lod: int) -> Path | bytes:
+    """A building's glb at ``lod``: its own file for 3, else made from its feature."""
+    return glb if lod == 3 else lod_glb(glb, lod)

@@ -48,20 +48,18 @@ import pyproj
 import trimesh
 
 from facadecli.city.georef import Georef, georeference
-from facadecli.city.lods import lod_meshes, roof_depth
+from facadecli.city.lods import dressed, feature_of, lod_meshes, roof_depth
 from facadecli.errors import SpecError
 from facadecli.export.atomic import write_atomic
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.export.gltf import glb_bytes
-from facadecli.geometry.facade import pbr
-from facadecli.spec.model import Material
+from facadecli.export.instancing import EXTENSION, node_matrix, placements
 
 FOLDER = "3dtiles"
 LODS = (1, 2, 3)
 CAPACITY = {1: 256, 2: 32, 3: 8}  # buildings a tile of each level of detail holds at most
 MAX_LEVEL = 20  # quadtree levels at most (buildings sharing a centroid stay together)
 MIN_ERROR = {1: 4.0, 2: 3.0}  # metres: what a block or a façade-less model gets wrong at least
-COLOURS = {"wall": "#d9d2c3", "roof": "#8f5a48"}  # LOD1 and LOD2 materials
 TILE_FILE = re.compile(r"\d+\.lod[123]\.glb")
 Box = tuple[float, float, float, float, float, float]  # min x, y, z, max x, y, z (z up)
 
@@ -81,6 +79,23 @@ def parse_lods(text: str) -> tuple[int, ...]:
             "give some of 1 (blocks), 2 (roofs), 3 (façades), separated by commas: --lod 1,2,3",
         )
     return tuple(found)
+
+
+def chosen_lods(text: str | None, tiles: bool) -> tuple[tuple[int, ...], int]:
+    """``--lod``: the levels of detail of the 3D Tiles (none without ``tiles``) and the
+    merged glb's level (the finest asked; 3, façades, by default). Without 3D Tiles only
+    one level may be asked; SpecError (exit 2) else."""
+    lods = parse_lods(text or "1,2,3")
+    if not tiles and text is not None and len(lods) > 1:
+        raise SpecError.at(
+            "--lod",
+            None,
+            None,
+            f"'{text}' names several levels of detail; the merged glb takes one",
+            "give one of 1 (blocks), 2 (roofs), 3 (façades), or add --3dtiles to make "
+            "3D Tiles at several",
+        )
+    return (lods if tiles else ()), (lods[-1] if text is not None else 3)
 
 
 def ecef_transform(georef: Georef) -> list[float]:
@@ -222,7 +237,7 @@ class TilesetWriter:
         built = [(bid, self.ready[bid]) for bid in square.members if bid in self.ready]
         if not built:
             return
-        features = [_feature(glb) for _, glb in built] if square.lods[0] < 3 else []
+        features = [feature_of(glb) for _, glb in built] if square.lods[0] < 3 else []
         boxes: dict[int, Box] = {}
         relief = {1: 0.0, 2: 0.0}  # how far each building's LOD3 stands out of the LOD's box
         finest = [self._lod3_box(bid) for bid, _ in built]
@@ -356,41 +371,60 @@ def _lod_scene(
         parts = [m[name] for m in buildings if name in m and len(m[name].faces)]
         if not parts:
             continue
-        merged = trimesh.util.concatenate(parts)
-        merged.visual = trimesh.visual.TextureVisuals()
-        merged.visual.material = pbr(name, Material(color=COLOURS[name], roughness=0.9), None)
+        merged = dressed({name: trimesh.util.concatenate(parts)})[name]
         scene.add_geometry(merged, geom_name=name, node_name=name)
     return scene, boxes
 
 
-def _feature(glb: Path) -> dict[str, Any]:
-    """A building's CityJSON feature, written beside its glb."""
-    feature: dict[str, Any] = json.loads(glb.with_suffix(".city.jsonl").read_text("utf-8"))
-    return feature
-
-
 def _glb_boxes(paths: Iterable[Path]) -> list[Box]:
-    """Each glb's box (z up) from its positions' bounds (nodes carry no transforms)."""
+    """Each glb's box (z up) from its positions' bounds (nodes carry no transforms but
+    the instances of ``EXT_mesh_gpu_instancing``: their meshes' boxes placed at each)."""
     boxes = []
     for path in paths:
-        document, _ = read_glb(path.read_bytes())
+        document, chunk = read_glb(path.read_bytes())
         accessors = document.get("accessors", [])
+        instanced = _instances(document, chunk)
         lows, highs = [], []
-        for mesh in document.get("meshes", []):
+        for index, mesh in enumerate(document.get("meshes", [])):
             for primitive in mesh["primitives"]:
                 accessor = accessors[primitive["attributes"]["POSITION"]]
-                lows.append(accessor["min"])
-                highs.append(accessor["max"])
+                low, high = np.asarray(accessor["min"]), np.asarray(accessor["max"])
+                for matrix in instanced.get(index, [np.eye(4)]):
+                    corners = np.array(
+                        [
+                            (x, y, z, 1.0)
+                            for x in (low[0], high[0])
+                            for y in (low[1], high[1])
+                            for z in (low[2], high[2])
+                        ]
+                    )
+                    placed = (corners @ matrix.T)[:, :3]
+                    lows.append(placed.min(axis=0))
+                    highs.append(placed.max(axis=0))
         boxes.append(_z_up(np.min(lows, axis=0), np.max(highs, axis=0)))
     return boxes
 
 
+def _instances(document: dict[str, Any], chunk: bytes) -> dict[int, list[np.ndarray]]:
+    """The placements of each mesh an ``EXT_mesh_gpu_instancing`` node draws."""
+    found: dict[int, list[np.ndarray]] = {}
+    for node in document.get("nodes", []):
+        if "mesh" in node and EXTENSION in node.get("extensions", {}):
+            for row in placements(document, chunk, node):
+                t, r, scale = row[:3], row[3:7], row[7:10]
+                matrix = node_matrix({"translation": t, "rotation": r, "scale": scale})
+                found.setdefault(node["mesh"], []).append(matrix)
+    return found
+
+
 def _glb_triangles(path: Path) -> int:
-    document, _ = read_glb(path.read_bytes())
+    """A glb's triangles as drawn (an instanced mesh's once per instance)."""
+    document, chunk = read_glb(path.read_bytes())
     accessors = document.get("accessors", [])
+    instanced = _instances(document, chunk)
     return sum(
-        accessors[p["indices"]]["count"] // 3
-        for mesh in document.get("meshes", [])
+        accessors[p["indices"]]["count"] // 3 * len(instanced.get(index, [None]))
+        for index, mesh in enumerate(document.get("meshes", []))
         for p in mesh["primitives"]
     )
 

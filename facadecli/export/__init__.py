@@ -134,7 +134,14 @@ def _write_city_models(built: BuiltCity) -> dict[str, Any]:
 
     streamed = built.tileset is not None  # 3D Tiles: no square tiles unless asked for
     return merge_city(
-        built.placed, built.outdir, built.name, built.tile_size, built.georef, streamed
+        built.placed,
+        built.outdir,
+        built.name,
+        built.tile_size,
+        built.georef,
+        streamed,
+        built.merged_lod,
+        built.instanced,
     )
 
 

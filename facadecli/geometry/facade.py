@@ -332,7 +332,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
         for shape in pieces:
             if shape.layer != layer.name:
                 continue
-            if shape.mesh == "box" and not _see_through(spec, shape.material):
+            if shape.mesh == "box" and not see_through(spec, shape.material):
                 z0 = min(shape.z0, shape.z1 - 1e-4)  # as thin as a box may be
                 group = walls.setdefault((shape.material, z0, shape.z1), [])
                 group.append((shape.x0, shape.x1, shape.y0, shape.y1))
@@ -342,13 +342,13 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             cell = Cell.of(shape)
             build = partial(_build, shape, cell, base_dir, assets)
             place(shape, "", shape.material, build, node)
-            if shape.mesh in GLAZED and _see_through(spec, shape.material):
+            if shape.mesh in GLAZED and see_through(spec, shape.material):
                 place(shape, "recess", INTERIOR_MATERIAL, partial(_recess, build), f"{node}/recess")
             pane = PANES.get(shape.mesh)
             if pane is not None:
                 glass = shape.look.pane_material if shape.look else PANE_MATERIAL
                 place(shape, "pane", glass, partial(pane, cell), f"{node}/pane")
-                if _see_through(spec, glass):
+                if see_through(spec, glass):
                     back = partial(_recess, partial(pane, cell))
                     place(shape, "pane-recess", INTERIOR_MATERIAL, back, f"{node}/recess")
         for (material, z0, z1), cells in walls.items():  # one mesh each: no seams
@@ -365,7 +365,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     return scene
 
 
-def _see_through(spec: Spec, name: str) -> bool:
+def see_through(spec: Spec, name: str) -> bool:
     """Whether a material lets the view through (blended or transmitting): glass."""
     material = look(spec, name)
     return material.opacity < 1.0 or material.transmission > 0.0

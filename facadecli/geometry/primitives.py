@@ -29,7 +29,6 @@ from facadecli.geometry.cell import (
 __all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset", "recess"]
 
 RECESS_DEPTH = 0.12  # metres from the back of a window's glass to the plate behind it
-RECESS_WALL = 0.02  # how thick the recess's back plate and its reveals are
 
 
 def _block(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> trimesh.Trimesh:
@@ -338,21 +337,26 @@ def shutter(cell: Cell) -> trimesh.Trimesh:
 
 
 def recess(glass: trimesh.Trimesh) -> trimesh.Trimesh:
-    """The closed dark recess behind a window's glass (in the glass's frame): a back plate
-    :data:`RECESS_DEPTH` behind the back of the glass, as large as the glass seen head-on,
-    and four reveals from it up to the glass. A ray that passes the glass meets it, so the
-    street behind a façade never shows through its windows."""
+    """The dark recess behind a window's glass (in the glass's frame), open towards the
+    glass: a back plate :data:`RECESS_DEPTH` behind the back of the glass, as large as the
+    glass seen head-on, and four reveals from it up to the glass, each a quad facing into
+    the opening (five quads, ten triangles, eight corners). A ray that passes the glass
+    meets the front of one of them, so the street behind a façade never shows through its
+    windows; nothing faces away from the window, where no one can see it."""
     (x0, y0, z0), (x1, y1, _) = glass.bounds
-    wall = min(RECESS_WALL, (x1 - x0) / 4, (y1 - y0) / 4)
     back = z0 - RECESS_DEPTH
-    parts = [
-        _block(x0, x1, y0, y1, back - RECESS_WALL, back),  # the back plate
-        _block(x0, x0 + wall, y0, y1, back, z0),  # the reveals: sides, then bottom and top
-        _block(x1 - wall, x1, y0, y1, back, z0),
-        _block(x0 + wall, x1 - wall, y0, y0 + wall, back, z0),
-        _block(x0 + wall, x1 - wall, y1 - wall, y1, back, z0),
+    corners = np.array(
+        [(x, y, z) for z in (back, z0) for y in (y0, y1) for x in (x0, x1)], dtype=float
+    )  # 0-3 the back plate's corners, 4-7 the opening's (x fastest, then y)
+    quads = [
+        (0, 1, 3, 2),  # the back plate, facing the glass (+z)
+        (0, 2, 6, 4),  # the left reveal, facing right (+x)
+        (1, 5, 7, 3),  # the right reveal, facing left (-x)
+        (0, 4, 5, 1),  # the bottom reveal, facing up (+y)
+        (2, 3, 7, 6),  # the top reveal, facing down (-y)
     ]
-    return trimesh.util.concatenate(parts)
+    faces = np.array([f for a, b, c, d in quads for f in ((a, b, c), (a, c, d))], dtype=np.int64)
+    return trimesh.Trimesh(corners, faces, process=False)
 
 
 #: meshes that are glass all over when their material is see-through: backed like a pane

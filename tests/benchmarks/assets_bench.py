@@ -1,11 +1,15 @@
 """What a game engine would load for a city (make bench): the generated demo district's
-first 50 buildings built with ``facade city -j 1``, its merged glb counted per building.
+first 50 buildings built with ``facade city -j 1``, its merged glb counted per building:
+as built by default, with ``--instance`` (repeated parts as GPU instances), and merged at
+``--lod 2`` and ``--lod 1`` (from the default run's buildings).
 
-Prints draw calls (primitives drawn, one per mesh instance's primitive), materials, images,
-triangles and megabytes, per building and for the whole city, and the CPU seconds the run
-took (user + system of the ``facade city`` process). Counts depend only on the code;
-the CPU time on the machine and its load. Run it with PYTHONPATH=SOURCE to count another
-checkout's code (the figures "before" in docs/reference/materials.md were taken so)."""
+Prints draw calls (primitives drawn: one per node's primitive, one per primitive of an
+instanced mesh for all its instances), materials, images, triangles drawn and stored
+(an instanced mesh's once) and megabytes, per building and for the whole city, and the
+CPU seconds each run took (user + system of the ``facade city`` process). Counts depend
+only on the code; the CPU time on the machine and its load. Run it with PYTHONPATH=SOURCE
+to count another checkout's code (the figures "before" in docs/reference/materials.md
+were taken so)."""
 
 from __future__ import annotations
 
@@ -37,6 +41,7 @@ def counts(document: dict[str, Any]) -> dict[str, int]:
     its instances), and the stored materials, textures and images."""
     draws = triangles = 0
     nodes = document.get("nodes", [])
+    drawn: set[int] = set()  # meshes
 
     def visit(index: int) -> None:
         nonlocal draws, triangles
@@ -47,6 +52,7 @@ def counts(document: dict[str, Any]) -> dict[str, int]:
             if instancing:
                 first = next(iter(instancing["attributes"].values()))
                 instances = document["accessors"][first]["count"]
+            drawn.add(node["mesh"])
             for primitive in document["meshes"][node["mesh"]]["primitives"]:
                 draws += 1
                 accessor = primitive.get("indices", primitive["attributes"]["POSITION"])
@@ -57,42 +63,76 @@ def counts(document: dict[str, Any]) -> dict[str, int]:
     scene = document.get("scenes", [{}])[document.get("scene", 0)]
     for root in scene.get("nodes", []):
         visit(root)
+    stored = sum(
+        document["accessors"][p.get("indices", p["attributes"]["POSITION"])]["count"] // 3
+        for mesh in drawn
+        for p in document["meshes"][mesh]["primitives"]
+    )
+    roots = [nodes[root].get("name") for root in scene.get("nodes", [])]
     return {
-        "buildings": len(scene.get("nodes", [])),
+        "buildings": sum(1 for name in roots if name != "instanced"),
         "draws": draws,
         "triangles": triangles,
+        "stored": stored,
         "materials": len(document.get("materials", [])),
         "textures": len(document.get("textures", [])),
         "images": len(document.get("images", [])),
     }
 
 
+def line(label: str, glb: Path, cpu: float | None) -> str:
+    """The figures of a merged glb, per building and for the whole city."""
+    document, binary = read_glb(glb)
+    found = counts(document)
+    size = glb.stat().st_size
+    n = found["buildings"]
+    took = f"; {cpu:.1f} s CPU (-j 1)" if cpu is not None else ""
+    return (
+        f"city assets, demo district ({n} buildings), {label}: per building "
+        f"{found['draws'] / n:.1f} draw calls, {found['materials'] / n:.2f} materials, "
+        f"{found['images'] / n:.2f} images, {found['triangles'] / n:,.0f} triangles drawn, "
+        f"{found['stored'] / n:,.0f} stored, {size / n / 1e6:.2f} MB; whole city "
+        f"{found['draws']} draw calls, {found['materials']} materials, {found['textures']} "
+        f"textures, {found['images']} images, {size / 1e6:.1f} MB ({binary / 1e6:.1f} MB "
+        f"binary){took}"
+    )
+
+
+def build(manifest: Path, out: Path, *options: str) -> float:
+    """``facade city`` on the manifest's first buildings; its CPU seconds."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    command = [sys.executable, "-m", "facadecli", "city", str(manifest), "-o", str(out)]
+    subprocess.run(
+        [*command, "-j", "1", "--limit", str(BUILDINGS), *options], check=True, capture_output=True
+    )
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
 def main() -> None:
     from facadecli.city.demo import write_demo
+    from facadecli.city.georef import Georef
+    from facadecli.city.tiles import merge_city
 
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         manifest = write_demo(folder / "demo", ROOT / "specs", 4)
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        command = [sys.executable, "-m", "facadecli", "city", str(manifest), "-o", str(folder)]
-        subprocess.run(
-            [*command, "-j", "1", "--limit", str(BUILDINGS)], check=True, capture_output=True
-        )
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-        glb = folder / "demo-district.glb"
-        document, binary = read_glb(glb)
-        found = counts(document)
-        size = glb.stat().st_size
-    n = found["buildings"]
-    print(
-        f"city assets, demo district ({n} buildings): per building "
-        f"{found['draws'] / n:.1f} draw calls, {found['materials'] / n:.2f} materials, "
-        f"{found['images'] / n:.2f} images, {found['triangles'] / n:,.0f} triangles, "
-        f"{size / n / 1e6:.2f} MB; whole city {found['draws']} draw calls, "
-        f"{found['materials']} materials, {found['textures']} textures, {found['images']} "
-        f"images, {size / 1e6:.1f} MB ({binary / 1e6:.1f} MB binary); {cpu:.1f} s CPU (-j 1)"
-    )
+        cpu = build(manifest, folder / "plain")
+        print(line("default", folder / "plain" / "demo-district.glb", cpu), flush=True)
+        cpu = build(manifest, folder / "instanced", "--instance")
+        print(line("--instance", folder / "instanced" / "demo-district.glb", cpu), flush=True)
+        frame = json.loads((folder / "plain" / "demo-district.georef.json").read_text())
+        georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
+        report = json.loads((folder / "plain" / "demo-district.report.json").read_text())
+        built = [
+            (b["id"], folder / "plain" / b["file"], (0.0, 0.0))
+            for b in report["buildings"]
+            if b["status"] == "ok"
+        ]
+        for lod in (2, 1):
+            merge_city(built, folder / f"lod{lod}", "demo-district", None, georef, lod)
+            glb = folder / f"lod{lod}" / "demo-district.glb"
+            print(line(f"--lod {lod} (merged from the default run)", glb, None), flush=True)
 
 
 if __name__ == "__main__":
