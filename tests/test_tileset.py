@@ -439,10 +439,13 @@ def test_the_merged_glb_is_at_the_level_of_detail_asked(city: Path, lod: int) ->
     bytes."""
     frame = json.loads((city / f"{city.name}.georef.json").read_text())
     georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
-    glbs = sorted((city / "buildings").glob("*.glb"))
-    buildings = [(glb.stem, glb, (0.0, 0.0)) for glb in glbs]
+    glbs = sorted((city / "buildings").rglob("*.glb"))  # in their shard folders
+
+    def buildings() -> list[tuple[str, Path, tuple[float, float]]]:
+        return [(glb.stem, glb, (0.0, 0.0)) for glb in glbs]
+
     written = [
-        merge_city(buildings, city.parent / f"lod{lod}-{k}", "town", None, georef, lod)
+        merge_city(buildings, city.parent / f"lod{lod}-{k}", "town", None, georef, lod=lod)
         for k in range(2)
     ]
     merged = [city.parent / f"lod{lod}-{k}" / w["merged"] for k, w in enumerate(written)]
