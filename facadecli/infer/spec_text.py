@@ -242,6 +242,7 @@ def spec_text(
     unique = {elements[label][0].prefix for label in UNIQUE if label in elements}
     top = _floors_top(found)
     tops = top_floors(found, width, height)
+    roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
     for index, (layer, grid, frame) in enumerate(
         zip(layer_names(found), found, frames(found), strict=True)
     ):
@@ -278,6 +279,7 @@ def spec_text(
                 # façade gains
                 word, gap = _floors_above(tokens, pitch, gaps, counters)
                 held.update((tokens[0][0], gap))
+                roofs.add(tokens[-1][0])
                 words.append(word)
                 continue
             if axis == "y" and tokens[0][0] in ends and tokens[-1][0] in ends:
@@ -312,6 +314,7 @@ def spec_text(
     spread = spread or {}
     clear = uncovered(found)
     fixed = repeated - loose  # a run's letters keep their size where margins take the slack
+    margined -= roofs  # a layer on the same rows keeps its margin to the ground instead
     held -= loose
     sizes = [
         [
