@@ -19,7 +19,7 @@ import pytest
 from facadecli import parse_spec, solve
 from facadecli.grammar.inputs import LabelledLayout, Rect
 from facadecli.grammar.run import Options
-from facadecli.infer.layers import Grid, frames
+from facadecli.infer.layers import Grid, frames, top_floors
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.structure import NEAR, structured
 from facadecli.solve import retarget
@@ -233,3 +233,91 @@ def test_a_door_between_windows_shares_their_word_and_two_grids_of_a_label_never
     assert found[2] is None  # above the door: not beside it
     other = Grid("window", ((7.0, 8.0),), ((1.4, 3.0),))  # a ground-floor window drawn apart
     assert frames([window, door, other]) == [None, None, None]
+
+
+TWO_FLOORS = 7.0  # m: the height of a façade of two floors (and a roof's margin)
+
+
+def _two_floors(path: Path, seed: int) -> Path:
+    """A ground floor (a door between windows) under one upper floor, every window with its
+    sill: no run of floors anywhere; the upper floor drawn 2 cm off the ground floor's
+    rows and every edge jittered by up to 1 cm."""
+    rng = random.Random(seed)
+    rects = []
+    for f in range(2):
+        for k in range(5):
+            cx = 2.3 + k * 2.6 + rng.uniform(-0.01, 0.01)
+            if f == 0 and k == 2:
+                rects.append(
+                    {"label": "door", "x0": cx - 0.7, "y0": 0.0, "x1": cx + 0.7, "y1": 2.6}
+                )
+                continue
+            y0 = 1.5 + f * (PITCH_Y + 0.02) + rng.uniform(-0.01, 0.01)
+            rects.append(
+                {"label": "window", "x0": cx - 0.6, "y0": y0, "x1": cx + 0.6, "y1": y0 + 1.5}
+            )
+            rects.append(
+                {"label": "sill", "x0": cx - 0.7, "y0": y0 - 0.2, "x1": cx + 0.7, "y1": y0}
+            )
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": TWO_FLOORS}, "rects": rects}))
+    return path
+
+
+def test_the_top_floor_is_its_labels_top_row_with_a_floor_like_it_below() -> None:
+    ground = Grid("window", ((1.0, 2.0), (5.0, 6.0)), ((1.5, 3.0),))
+    upper = Grid("window", ((1.0, 2.0), (3.0, 4.0), (5.0, 6.0)), ((4.1, 5.6),))
+    sills = Grid("sill", ((0.9, 2.1), (2.9, 4.1)), ((1.3, 1.5), (3.9, 4.1)))
+    attic = Grid("window", ((3.0, 4.0),), ((7.0, 7.5),))  # too short to be a floor's
+    band = Grid("balcony", ((0.1, 9.9),), ((2.0, 2.5), (4.5, 5.0)))  # across the façade
+    assert top_floors([ground, upper, sills, band], 10.0, 10.0) == {
+        1: pytest.approx(2.6),  # from the ground floor's windows below its own
+        2: pytest.approx(2.6),  # its own rows: two floors of sills
+    }
+    assert top_floors([ground, upper, attic], 10.0, 10.0) == {}  # the attic is over them
+    assert top_floors([ground, upper], 10.0, 5.0) == {}  # 2.6 m: more than a floor of 5 m
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+@pytest.mark.parametrize("share", [1.0, 1.5, 2.0])
+def test_a_facade_of_two_floors_gains_floors_with_their_sills_at_its_pitch(
+    tmp_path: Path, seed: int, share: float
+) -> None:
+    path = _two_floors(tmp_path / "two.json", seed)
+    solved = _solved(path, WIDTH, TWO_FLOORS * share)
+    windows, sills = _of(solved, "window"), _of(solved, "sill")
+    floors = sorted({round(r.y0, 2) for r in windows})
+    assert floors[0] == pytest.approx(1.5, abs=0.03)  # the ground floor stays
+    # whole floors over the top one: as many as the height gained is pitches (one fewer
+    # where the last would not fit under the roof's margin)
+    pitch, gained = PITCH_Y + 0.02, TWO_FLOORS * (share - 1)
+    roof = TWO_FLOORS - (1.5 + pitch + 1.5)
+    assert len(floors) == 2 + min(round(gained / pitch), int((gained + roof) / pitch))
+    assert all(
+        b - a == pytest.approx(PITCH_Y + 0.02, abs=0.05) for a, b in itertools.pairwise(floors)
+    )
+    assert len(windows) == 4 + 5 * (len(floors) - 1)  # every new floor has all its bays
+    assert len(sills) == len(windows)  # and a sill under each window
+    for window in windows:
+        centre = (window.x0 + window.x1) / 2
+        assert any(
+            abs((s.x0 + s.x1) / 2 - centre) < 0.03 and abs(s.y1 - window.y0) < 0.03 for s in sills
+        )
+    assert _overlapping(solved) == 0
+    (door,) = _of(solved, "door")
+    assert (door.y0, door.y1) == (pytest.approx(0.0, abs=1e-6), pytest.approx(2.6, abs=0.03))
+
+
+@pytest.mark.parametrize(
+    "seed", [s for s in range(25, 80) if family(s)[1].floors == 2][:3]
+)  # façades of the family the bench does not measure
+def test_a_family_facade_of_two_floors_gains_floors_when_taller(tmp_path: Path, seed: int) -> None:
+    path = tmp_path / f"family-{seed}.xml"
+    path.write_text(cmp_xml(family(seed)[0]))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    spec = parse_spec(inference.text, path.stem)
+    layout = solve(retarget(spec, 15.0, 15.0 * 1.5))
+    rects = list(solved_layout(layout, spec, inference).rects)
+    known = family(seed)[1]
+    assert len(_of(rects, "window")) >= known.windows + known.bays  # a floor more, at least
+    assert _overlapping(rects) == 0
+    assert len(_of(rects, "door")) == 1

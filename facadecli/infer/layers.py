@@ -20,6 +20,9 @@ from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Re
 Span = tuple[float, float]
 BAND = 0.25  # an element longer than this share of the façade is a band across it
 EDGE = 0.01  # a band this share of the façade or less from an edge reaches the edge
+FLOOR = 0.15  # rows of a label this close in height (a share of it) are floors alike
+STOREY = 0.4  # of the façade's height: the most a floor's pitch is (two floors and a base)
+FLOOR_PITCH = 0.05  # pitches this close (a share) are the openings' floors'
 
 
 @dataclass(frozen=True)
@@ -176,3 +179,44 @@ def frames(found: list[Grid]) -> list[Frame | None]:
         for k in group:
             out[k] = tuple(columns)
     return out
+
+
+def top_floors(found: list[Grid], width: float, height: float) -> dict[int, float]:
+    """The grids whose top row is their label's top floor, by index, each with the pitch
+    of its floors: elements, not bands across the façade (``BAND`` of its ``width``: a
+    balcony or a cornice along a floor stretches with the façade and is not a bay's), no
+    element of its label starts above that row, and below it stands a
+    row of its label (of the grid, or of another in columns overlapping its own) of a
+    height within ``FLOOR`` of its own, at most ``STOREY`` of the façade's ``height``
+    lower (the floor below); the pitch is the distance from the start of the nearest such
+    row to the start of the top one. A façade of one floor over another has no run of
+    floors, nor one whose top floor is drawn apart from the rest (its windows a few
+    centimetres off the others' rows): written as a top floor that repeats upwards from
+    none more, a taller façade still gains floors at its pitch. Labels other than the
+    openings' only at the pitch of an opening's top floor (within ``FLOOR_PITCH``)."""
+    out: dict[int, float] = {}
+    for k, grid in enumerate(found):
+        low, high = grid.rows[-1]
+        if any(b - a > BAND * width for a, b in grid.columns):
+            continue
+        mine = [g for g in found if g.label == grid.label]
+        if any(row[0] >= high - 1e-9 for g in mine for row in g.rows):
+            continue  # not the top floor: something of its label stands above it
+        size = high - low
+        below = [
+            row[0]
+            for g in mine
+            if g is grid or any(_overlap(c, d) for c in g.columns for d in grid.columns)
+            for row in g.rows
+            if row[1] <= low + 1e-9 and abs(row[1] - row[0] - size) <= FLOOR * size
+        ]
+        if below and low - max(below) <= STOREY * height:
+            out[k] = low - max(below)
+    # what is not an opening repeats with the openings' floors: at their pitch, as a sill,
+    # a blind or a balcony of every floor does (a pillar's base and capital do not)
+    pitches = [p for k, p in out.items() if found[k].label in OPENINGS]
+    return {
+        k: p
+        for k, p in out.items()
+        if found[k].label in OPENINGS or any(abs(p - q) <= FLOOR_PITCH * q for q in pitches)
+    }

@@ -32,7 +32,7 @@ import re
 from dataclasses import dataclass, field
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, uncovered
+from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, top_floors, uncovered
 
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
@@ -75,9 +75,19 @@ class _Symbols:
 
 @dataclass
 class _Counters:
-    """Counters by (axis, pitch, count): runs alike share one."""
+    """Counters by (axis, pitch, count): runs alike share one; the top floors' copies
+    (``_floors_above``) one of their own, under a count of 0."""
 
     names: dict[tuple[str, float, int], str] = field(default_factory=dict)
+
+    def floors(self, pitch: float) -> str:
+        """The one counter of every top floor's copies: a taller façade gains as many
+        floors in every column (``pitch``: the first floor's, for the comment)."""
+        for (along, _, copies), name in self.names.items():
+            if along == "y" and copies == 0:
+                return name
+        name = self.names[("y", round(pitch, 4), 0)] = f"n{len(self.names) + 1}"
+        return name
 
     def of(self, axis: str, pitch: float, count: int) -> str:
         """The counter of runs along ``axis`` of ``count`` copies at ``pitch`` (within
@@ -231,7 +241,11 @@ def spec_text(
         elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
     unique = {elements[label][0].prefix for label in UNIQUE if label in elements}
     top = _floors_top(found)
-    for layer, grid, frame in zip(layer_names(found), found, frames(found), strict=True):
+    tops = top_floors(found, width, height)
+    roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
+    for index, (layer, grid, frame) in enumerate(
+        zip(layer_names(found), found, frames(found), strict=True)
+    ):
         symbols = elements[grid.label]
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
         introduced = [
@@ -258,6 +272,16 @@ def spec_text(
                 word = _word(tokens, axis, counters, repeated, True, ends | kept)
             else:
                 word = _word(tokens, axis, counters, repeated, grid.label not in UNIQUE, ends)
+            pitch = tops.get(index) if axis == "y" and grid.label not in UNIQUE else None
+            if pitch is not None and "^" not in word and ends >= {tokens[0][0], tokens[-1][0]}:
+                # the top floor repeats upwards from none more; the layer keeps its margin
+                # to the ground, and the copies and the roof's margin take what a taller
+                # façade gains
+                word, gap = _floors_above(tokens, pitch, gaps, counters)
+                held.update((tokens[0][0], gap))
+                roofs.add(tokens[-1][0])
+                words.append(word)
+                continue
             if axis == "y" and tokens[0][0] in ends and tokens[-1][0] in ends:
                 # a taller façade grows at the top of the floors: what stands on them keeps
                 # its margin to the ground, what stands above them its margin to the top
@@ -290,6 +314,7 @@ def spec_text(
     spread = spread or {}
     clear = uncovered(found)
     fixed = repeated - loose  # a run's letters keep their size where margins take the slack
+    margined -= roofs  # a layer on the same rows keeps its margin to the ground instead
     held -= loose
     sizes = [
         [
@@ -326,7 +351,8 @@ def spec_text(
     if counters.names:
         out.append("counters:")
         out += [
-            f"  {n}: {{min: 0}}  # {count} along {axis} at a pitch of {_number(pitch)} m"
+            f"  {n}: {{min: 0}}  # {count or 'floors over the top one'} along {axis} at a "
+            f"pitch of {_number(pitch)} m"
             for (axis, pitch, count), n in counters.names.items()
         ]
     out.append("patterns: {wall_x: wall_w, wall_y: wall_h}")
@@ -351,6 +377,21 @@ def spec_text(
     colours += [(ident(label), label_colour(label)) for label in elements]
     out.append("materials: {" + ", ".join(f'{n}: {{color: "{c}"}}' for n, c in colours) + "}")
     return "\n".join(out) + "\n"
+
+
+def _floors_above(
+    tokens: list[Token], pitch: float, gaps: _Symbols, counters: _Counters
+) -> tuple[str, str]:
+    """The y word of a layer whose top row is its label's top floor (``layers.top_floors``;
+    ``tokens`` from its margin below to its margin above), that floor repeating upwards
+    at ``pitch``: ``... h (g h)^n m``, the gap ``g`` the pitch less the element ``h``,
+    ``n`` none at the input's size and shared by every such layer; and the gap's symbol
+    (its size is kept: the copies stand at the pitch)."""
+    element, size = tokens[-2]
+    gap = gaps.of(pitch - size)
+    symbols = [symbol for symbol, _ in tokens]
+    run = f"({gap} {element})^{counters.floors(pitch)}"
+    return " ".join([*symbols[:-1], run, symbols[-1]]), gap
 
 
 def _floors_top(found: list[Grid]) -> float:
