@@ -193,16 +193,7 @@ def _known_images(
         return document, chunk
     order = [i for i in range(len(views)) if i not in dropped]
     renumbered = {old: new for new, old in enumerate(order)}
-    pieces: list[bytes] = []
-    offset = 0
-    new_views = []
-    for old in order:
-        view = dict(views[old])
-        start = view.get("byteOffset", 0)
-        pieces.append(chunk[start : start + view["byteLength"]] + b"\0" * (-view["byteLength"] % 4))
-        view["byteOffset"] = offset
-        offset += len(pieces[-1])
-        new_views.append(view)
+    new_views, packed = _packed(views, order, chunk)
     document = dict(document)
     document["bufferViews"] = new_views
     document["accessors"] = [
@@ -217,7 +208,7 @@ def _known_images(
         {**texture, "source": sources[texture["source"]]} if "source" in texture else texture
         for texture in document.get("textures", [])
     ]
-    return document, b"".join(pieces)
+    return document, packed
 
 
 #: kinds whose equal entries (by content, once their references are renumbered) are
@@ -507,16 +498,7 @@ def _without(
     needed |= {image["bufferView"] for image in document.get("images", []) if "bufferView" in image}
     kept_views = sorted(needed)
     view_at = {old: new for new, old in enumerate(kept_views)}
-    pieces: list[bytes] = []
-    offset = 0
-    new_views = []
-    for old in kept_views:
-        view = dict(views[old])
-        start = view.get("byteOffset", 0)
-        pieces.append(chunk[start : start + view["byteLength"]] + b"\0" * (-view["byteLength"] % 4))
-        view["byteOffset"] = offset
-        offset += len(pieces[-1])
-        new_views.append(view)
+    new_views, binary = _packed(views, kept_views, chunk)
     new_nodes = []
     for i in kept_nodes:
         node = dict(nodes[i])
@@ -564,9 +546,26 @@ def _without(
     for key in ("meshes", "accessors", "bufferViews", "images", "nodes"):
         if not document[key]:
             del document[key]
-    if not pieces:
+    if not binary:
         document.pop("buffers", None)
     else:
-        document["buffers"] = [{"byteLength": offset}]
-    binary = b"".join(pieces)
+        document["buffers"] = [{"byteLength": len(binary)}]
     return (document, binary, mesh_at) if with_meshes else (document, binary)
+
+
+def _packed(
+    views: list[dict[str, Any]], order: list[int], chunk: bytes
+) -> tuple[list[dict[str, Any]], bytes]:
+    """The buffer views ``order`` names, in that order, and their bytes packed one after
+    another (each padded to 4 bytes), their offsets moved to match."""
+    pieces: list[bytes] = []
+    offset = 0
+    packed = []
+    for old in order:
+        view = dict(views[old])
+        start = view.get("byteOffset", 0)
+        pieces.append(chunk[start : start + view["byteLength"]] + b"\0" * (-view["byteLength"] % 4))
+        view["byteOffset"] = offset
+        offset += len(pieces[-1])
+        packed.append(view)
+    return packed, b"".join(pieces)
