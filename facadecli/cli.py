@@ -512,6 +512,10 @@ def city(
             "(EXT_mesh_gpu_instancing): a mesh stored once, drawn once for all.",
         ),
     ] = False,
+    timings: Annotated[
+        bool,
+        typer.Option("--timings", help="Record the times in the report (not reproducible)."),
+    ] = False,
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -555,6 +559,7 @@ def city(
         lods=lods,
         merged_lod=finest,
         instanced=instance,
+        timings=timings,
     )
     if _state["quiet"]:
         report = run(loaded, outdir, workers, limit, resume, None)

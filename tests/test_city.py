@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -145,8 +146,15 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
     looks = [g.visual.material for g in merged.geometry.values()]
     interiors = [m for m in looks if m.name == "interior"]  # the recesses behind windows
     assert interiors and all(max(_seen_colour(m)) < 64 for m in interiors)
-    first = json.loads((out / "demo-district.report.json").read_text())["buildings"][0]
+    written = (out / "demo-district.report.json").read_bytes()
+    first = json.loads(written)["buildings"][0]
     assert first["facades"] >= 4 and first["id"] == "way/1000"
+    # the times are null in the file (the same bytes every run), kept in the object, and
+    # written with --timings
+    assert first["time_ms"] is None and json.loads(written)["summary"]["seconds"] is None
+    assert report["buildings"][0]["time_ms"] > 0 and report["summary"]["seconds"] > 0
+    timed = json.loads("".join(dataclasses.replace(report, timings=True).chunks()))
+    assert timed["buildings"][0]["time_ms"] > 0 and timed["summary"]["seconds"] > 0
     again = run_city(city, out, jobs=1, resume=True)
     assert all(b.get("resumed") for b in again["buildings"])
     serial = run_city(city, tmp_path / "serial", jobs=1)
@@ -155,6 +163,7 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
         (out / path).read_bytes() == (tmp_path / "serial" / path).read_bytes() for path in built
     )
     assert serial["summary"]["ok"] == 4
+    assert (tmp_path / "serial" / "demo-district.report.json").read_bytes() == written
 
 
 def test_the_demo_district_is_deterministic() -> None:

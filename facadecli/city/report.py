@@ -133,17 +133,28 @@ class CityReport(Mapping[str, Any]):
     models: dict[str, Any]  # what the writers wrote (facadecli.export.CITY_WRITERS)
     summary: Summary
     version: int = 1
+    timings: bool = False  # the times written as measured (else null: the file reproducible)
 
     def document(self) -> dict[str, Any]:
         """The report as JSON data: ``version`` first, then the fields in order (the
         buildings left as they are: :func:`report_chunks` writes them one at a time)."""
         fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         fields["summary"] = dataclasses.asdict(self.summary)
+        del fields["timings"]
         return {"version": fields.pop("version"), **fields}
 
     def chunks(self) -> Iterator[str]:
-        """The report's JSON text, a building at a time (:func:`report_chunks`)."""
-        return report_chunks(self.document(), "buildings", self.buildings)
+        """The report's JSON text, a building at a time (:func:`report_chunks`); without
+        ``timings``, the buildings' ``time_ms`` and the summary's ``seconds`` are null, so
+        that the same input gives the same bytes (the object keeps them, for the CLI)."""
+        document = self.document()
+        if self.timings:
+            return report_chunks(document, "buildings", self.buildings)
+        document["summary"] = {**document["summary"], "seconds": None}
+        untimed = (
+            {**entry, "time_ms": None} if "time_ms" in entry else entry for entry in self.buildings
+        )
+        return report_chunks(document, "buildings", untimed)
 
     def __getitem__(self, key: str) -> Any:
         return self.document()[key]
@@ -152,4 +163,4 @@ class CityReport(Mapping[str, Any]):
         return iter(self.document())
 
     def __len__(self) -> int:
-        return len(dataclasses.fields(self))
+        return len(dataclasses.fields(self)) - 1  # timings is how it is written, not a key

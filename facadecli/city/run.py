@@ -480,11 +480,13 @@ def run_city(
     lods: tuple[int, ...] = (),
     merged_lod: int = 3,
     instanced: bool = False,
+    timings: bool = False,
 ) -> CityReport:
     """Build a city; returns the report (also written to ``<name>.report.json``).
     With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py); the merged
     models are at ``merged_lod`` (tiles.py). With ``instanced``, the parts façades repeat
-    are GPU instances, in each building's glb and across the merged models.
+    are GPU instances, in each building's glb and across the merged models. With
+    ``timings``, the report file keeps the times (else null there: reproducible bytes).
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -511,6 +513,7 @@ def run_city(
             lods,
             merged_lod,
             instanced,
+            timings,
         )
 
 
@@ -564,6 +567,7 @@ def _build(
     lods: tuple[int, ...] = (),
     merged_lod: int = 3,
     instanced: bool = False,
+    timings: bool = False,
 ) -> CityReport:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report.
@@ -649,6 +653,7 @@ def _build(
         [{"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())],
         models,
         _summary(tally, found, kept, order, straight, time.perf_counter() - started),
+        timings=timings,
     )
     try:
         with atomic_output(outdir / f"{city.manifest.name}.report.json") as out:
