@@ -6,13 +6,12 @@ to see which word ``facade solve`` picks (marked ``*``) among the ones it looked
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 from facadecli.errors import FacadeError
 from facadecli.patterns import Enumerated, format_word
 from facadecli.solver.axis import axis_words, solve_axis
-from facadecli.solver.budgets import CANDIDATE_LIMIT
+from facadecli.solver.budgets import CANDIDATE_LIMIT, safety_clock
 from facadecli.solver.candidates import generate_candidates, pattern_uses
 from facadecli.spec.model import Spec
 from facadecli.spec.resolve import AXES, Axis
@@ -52,7 +51,7 @@ def preview_words(spec: Spec, limit: int = 5) -> list[WordPreview]:
         uses = pattern_uses(spec, axis_words(spec, axis))
         candidates = generate_candidates(spec, uses, canvas, CANDIDATE_LIMIT)
         try:
-            chosen = dict(solve_axis(spec, axis, canvas, time.perf_counter() + 60).words)
+            chosen = dict(solve_axis(spec, axis, canvas, safety_clock() + 60).words)
         except FacadeError:
             chosen = {}
         for use in uses:

@@ -11,6 +11,7 @@ from facadecli import proportions
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.layout import Layout, build_shapes, uncovered_area
 from facadecli.solver.axis import AxisLayout, solve_axis_alternatives
+from facadecli.solver.budgets import safety_clock
 from facadecli.spec.model import Canvas, Solver, Spec
 
 ALTERNATIVES_PER_AXIS = 8
@@ -38,10 +39,8 @@ def _axes(spec: Spec, alternatives: int) -> tuple[list[AxisLayout], list[AxisLay
     safety net per axis, which a normal solve never reaches."""
     started = time.perf_counter()
     limit = spec.solver.time_limit
-    x = solve_axis_alternatives(spec, "x", spec.canvas.width, started + limit, alternatives)
-    y = solve_axis_alternatives(
-        spec, "y", spec.canvas.height, time.perf_counter() + limit, alternatives
-    )
+    x = solve_axis_alternatives(spec, "x", spec.canvas.width, safety_clock() + limit, alternatives)
+    y = solve_axis_alternatives(spec, "y", spec.canvas.height, safety_clock() + limit, alternatives)
     return x, y, started
 
 

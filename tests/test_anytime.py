@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import itertools
 import random
-import time
 
 import pytest
 
@@ -17,6 +16,7 @@ from facadecli.export.report import report
 from facadecli.solver import columns, construct
 from facadecli.solver.alignment import _Row
 from facadecli.solver.axis import _AxisProblem
+from facadecli.solver.budgets import safety_clock
 from facadecli.solver.rows import Row, make_rows
 from facadecli.spec.resolve import layer_pattern
 from tests.benchmarks.distinct import GRAND_HALL_PERIODS, distinct_palace, grand_hall
@@ -470,7 +470,7 @@ def test_options_of_least_tolerance_are_made_before_any_cap(seed: int) -> None:
     assert layout.counters["f"] == floors
     assert layout.y.objective == pytest.approx(0.0, abs=1e-9)
     assert layout.y.proven
-    problem = _AxisProblem(spec, "y", spec.canvas.height, time.perf_counter() + 60, 1)
+    problem = _AxisProblem(spec, "y", spec.canvas.height, safety_clock() + 60, 1)
     assert problem.perfect_built  # no search needed
 
 

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -63,6 +62,7 @@ from facadecli.layout import (
 )
 from facadecli.materials import LIBRARY
 from facadecli.solver.axis import AxisLayout, solve_axis_alternatives
+from facadecli.solver.budgets import safety_clock
 from facadecli.spec.model import Material, Spec
 
 WALL = Material(color="#cfc6b8", roughness=0.9)
@@ -93,7 +93,7 @@ def solve_rung(spec: Spec, axis: str, canvas: float, variants: int = 1) -> tuple
     """An axis solved at a rung's length: the best layout and up to ``variants`` - 1 others
     nearly as good (as ``facade vary`` draws them); none where no layout fits."""
     try:
-        deadline = time.perf_counter() + spec.solver.time_limit / 2
+        deadline = safety_clock() + spec.solver.time_limit / 2
         found = solve_axis_alternatives(spec, axis, canvas, deadline, variants)  # type: ignore[arg-type]
     except (InfeasibleError, SearchLimitError):
         return ()

@@ -24,7 +24,6 @@ from __future__ import annotations
 import bisect
 import functools
 import math
-import time
 from collections import Counter
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -36,6 +35,7 @@ from facadecli.solver.budgets import (
     MAX_NODES,
     REFINE_NODES,
     TARGETS_PER_STATE,
+    safety_clock,
 )
 from facadecli.solver.rows import LetterTraits, Row
 
@@ -639,7 +639,7 @@ class _Search:
         ``stretchable``: a column so far holds only elastic entries, so the span can grow.
         """
         self.nodes += 1
-        if self.nodes % 128 == 0 and time.perf_counter() > self.deadline:
+        if self.nodes % 128 == 0 and safety_clock() > self.deadline:
             raise SearchTimeout
         if self.nodes > self.node_limit:
             raise SearchExhausted

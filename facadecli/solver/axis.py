@@ -44,6 +44,7 @@ from facadecli.solver.budgets import (
     TRIED,
     VARIANTS,
     WORDS_FITTED,
+    safety_clock,
 )
 from facadecli.solver.candidates import (
     Candidate,
@@ -290,8 +291,8 @@ def solve_axis_alternatives(
     proves that none exists; the heuristic alignment offers variations and is a last
     resort. Each layout says whether it is proven optimal, and the best lower bound found.
     Every budget is counted in work (:mod:`facadecli.solver.budgets`), so the answer does
-    not depend on the machine; ``deadline`` (wall clock) is only a safety net, and when it
-    fires the layout says so.
+    not depend on the machine; ``deadline`` (:func:`.safety_clock`: CPU seconds) is only a
+    safety net, and when it fires the layout says so.
 
     Raises :class:`InfeasibleError` when no layout exists (proven), and
     :class:`SearchLimitError` when the search stopped before it found one."""
@@ -454,7 +455,7 @@ class _AxisProblem:
         for candidate in self.candidates[:CANDIDATES_TO_TRY]:
             if sum(self.visited) > HEURISTIC_WORK:
                 break
-            late = time.perf_counter() > self.deadline
+            late = safety_clock() > self.deadline
             if len(evaluated) >= self.compare or self.worse >= 2 or late:
                 self.timed_out = self.timed_out or late
                 break

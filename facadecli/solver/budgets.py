@@ -6,8 +6,17 @@ unproven (the report says so), never "impossible"."""
 from __future__ import annotations
 
 import math
+import time
 
 INF = math.inf
+
+
+def safety_clock() -> float:
+    """The clock of the safety net (``solver.time_limit``): this process's CPU seconds, not
+    the wall's, so that a loaded machine (other processes taking turns on its cores) does
+    not make it fire sooner and change an answer. Deadlines are ``safety_clock() + limit``."""
+    return time.process_time()
+
 
 # -- the policy of one axis (solver.axis) ----------------------------------------------
 EXACT_WORK = 40_000  # work units of the exact searches of one axis (see solver.exact)

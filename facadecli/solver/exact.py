@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import gc
 import sys
-import time
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -39,7 +38,7 @@ from facadecli import native
 from facadecli.patterns import Word
 from facadecli.solver import columns, sizing
 from facadecli.solver.alignment import INF, Alignment, Move, _Row, prepared_row
-from facadecli.solver.budgets import RECURSION_MARGIN, SAME
+from facadecli.solver.budgets import RECURSION_MARGIN, SAME, safety_clock
 from facadecli.solver.rows import LetterTraits, Row
 from facadecli.spec.model import Spec
 
@@ -77,7 +76,7 @@ class Budget:
         self.used += units
         if self.used > self.limit:
             raise BudgetExhausted
-        if before // 256 != self.used // 256 and time.perf_counter() > self.deadline:
+        if before // 256 != self.used // 256 and safety_clock() > self.deadline:
             self.timed_out = True
             raise BudgetExhausted
 

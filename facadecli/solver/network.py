@@ -509,7 +509,7 @@ class Search:
         if (
             before // 256 != self.used // 256
             and isfinite(self.deadline)
-            and time.perf_counter() > self.deadline
+            and time.process_time() > self.deadline  # budgets.safety_clock()
         ):
             self.timed_out = True
             self.stop = EXHAUSTED
