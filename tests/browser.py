@@ -14,14 +14,15 @@ BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
 def browse(
     folder: Path,
     url: str,
-    budgets: Iterable[int] = (10_000, 40_000, 120_000),
+    budgets: Iterable[int] = (10_000, 40_000, 120_000, 120_000, 120_000),
     loaded: Callable[[str], bool] = lambda dom: "<title>loading: " not in dom,
 ) -> tuple[Path, str]:
     """A screenshot (1000 x 600, ``folder``/shot.png) of the page at ``url`` and its DOM
     once its scripts ran. Work outside Chromium's virtual time (decoding a textured
     model's pictures, fetching tiles) may not be done when a budget ends, so a page not
-    ``loaded`` yet is browsed again with the next, larger budget (a page that never loads
-    still fails the caller's check of its DOM)."""
+    ``loaded`` yet is browsed again with the next, larger budget, and the largest again:
+    on a loaded machine (the suite's other worker busy) the decoding can outlast three
+    loads (a page that never loads still fails the caller's check of its DOM)."""
     assert BROWSER is not None, "no Chromium installed"
     shot = folder / "shot.png"
     dom = ""
