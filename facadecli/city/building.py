@@ -146,6 +146,18 @@ class AxisCache:
             self.solved += 1
         return self.axes[slot]
 
+    def _picked(
+        self, key: str, spec: Spec, width: float, height: float, variants: int, pick: int
+    ) -> tuple[int, int, AxisLayout, AxisLayout] | None:
+        """The layouts of each axis a wall ``width`` x ``height`` takes (the ``pick``-th of
+        each axis's ``variants``), with their indices; None where an axis has none."""
+        across = self._layouts(key, spec, "x", width, variants)
+        up = self._layouts(key, spec, "y", height, variants)
+        if not across or not up:
+            return None
+        x, y = pick % len(across), pick % len(up)
+        return x, y, across[x], up[y]
+
     def facade(
         self,
         key: str,
@@ -158,20 +170,15 @@ class AxisCache:
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """The façade of a wall ``width`` x ``height`` in its own frame (x along, y up, z
         out), one mesh per material; None where no layout fits (a plain wall)."""
-        across = self._layouts(key, spec, "x", width, variants)
-        up = self._layouts(key, spec, "y", height, variants)
-        if not across or not up:
+        picked = self._picked(key, spec, width, height, variants, pick)
+        if picked is None:
             return None
-        x, y = pick % len(across), pick % len(up)
-        horizontal, vertical = across[x], up[y]
+        x, y, horizontal, vertical = picked
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.facades:
             self.facades[slot] = _merged_facade(_facade(spec, horizontal, vertical), base_dir)
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
-        return [
-            (name, trimesh.Trimesh(vertices * scale, faces, process=False))
-            for name, vertices, faces in self.facades[slot]
-        ]
+        return _scaled(self.facades[slot], scale)
 
     def facade_with_doors(
         self,
@@ -186,18 +193,14 @@ class AxisCache:
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """:meth:`facade` with a door at each of ``doors`` (metres along the wall, where
         entrances are: :func:`.with_doors`); a wall's own, so not kept."""
-        across = self._layouts(key, spec, "x", width, variants)
-        up = self._layouts(key, spec, "y", height, variants)
-        if not across or not up:
+        picked = self._picked(key, spec, width, height, variants, pick)
+        if picked is None:
             return None
-        horizontal, vertical = across[pick % len(across)], up[pick % len(up)]
+        _, _, horizontal, vertical = picked
         stretch = horizontal.canvas / width
         layout = with_doors(_facade(spec, horizontal, vertical), [d * stretch for d in doors])
         scale = np.array([1 / stretch, height / vertical.canvas, 1.0])
-        return [
-            (name, trimesh.Trimesh(vertices * scale, faces, process=False))
-            for name, vertices, faces in _merged_facade(layout, base_dir)
-        ]
+        return _scaled(_merged_facade(layout, base_dir), scale)
 
     def facade_parts(
         self,
@@ -213,12 +216,10 @@ class AxisCache:
         apart, those of :data:`.MIN_TRIANGLES` triangles or more (each in its own frame,
         with its placements on the wall), for instancing; the walls and the other parts
         merged per material."""
-        across = self._layouts(key, spec, "x", width, variants)
-        up = self._layouts(key, spec, "y", height, variants)
-        if not across or not up:
+        picked = self._picked(key, spec, width, height, variants, pick)
+        if picked is None:
             return None
-        x, y = pick % len(across), pick % len(up)
-        horizontal, vertical = across[x], up[y]
+        x, y, horizontal, vertical = picked
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.parts:
             scene = facade_scene(_facade(spec, horizontal, vertical), base_dir)
@@ -227,10 +228,7 @@ class AxisCache:
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
         stretch = np.diag([*scale, 1.0])
         return (
-            [
-                (name, trimesh.Trimesh(vertices * scale, faces, process=False))
-                for name, vertices, faces in merged
-            ],
+            _scaled(merged, scale),
             [
                 (name, trimesh.Trimesh(points, faces, process=False), [stretch @ m for m in placed])
                 for name, points, faces, placed in parts
@@ -750,3 +748,13 @@ def _placed(scene: trimesh.Scene) -> list[trimesh.Trimesh]:
         mesh.apply_transform(matrix)
         meshes.append(mesh)
     return meshes
+
+
+def _scaled(
+    meshes: Sequence[tuple[str, np.ndarray, np.ndarray]], scale: np.ndarray
+) -> list[tuple[str, trimesh.Trimesh]]:
+    """A façade's meshes (name, vertices, faces) as trimeshes, their vertices scaled."""
+    return [
+        (name, trimesh.Trimesh(vertices * scale, faces, process=False))
+        for name, vertices, faces in meshes
+    ]
