@@ -277,8 +277,28 @@ def test_start_up_imports_neither_the_solver_nor_numpy_nor_cvxpy_nor_trimesh(
 def test_version_imports_no_pydantic_and_solving_no_cvxpy_nor_trimesh(tmp_path: Path) -> None:
     assert _imported_by(["--version"], ("pydantic", "yaml", "facadecli.spec")) == []
     solved = ["solve", "specs/residential-house.yaml", "-o", str(tmp_path), "--format", "json"]
-    # scipy's sparse matrices feed Clarabel where a sizing has active bounds
-    assert _imported_by(solved, ("cvxpy", "trimesh", "dask")) == []
+    assert _imported_by(solved, ("cvxpy", "trimesh", "dask", "scipy")) == []
+
+
+def test_a_sizing_with_active_bounds_reaches_clarabel_without_scipy(tmp_path: Path) -> None:
+    """Clarabel takes its matrices as the arrays it reads (sizing._Csc), not SciPy's class:
+    importing scipy.sparse costs more CPU than solving a small façade."""
+    code = (
+        "import sys\n"
+        "from facadecli.cli import main\n"
+        "from facadecli.solver import sizing\n"
+        "calls = []\n"
+        "real = sizing._clarabel\n"
+        "sizing._clarabel = lambda program: calls.append(1) or real(program)\n"
+        f"sys.argv = ['facade', 'solve', 'specs/townhouse.yaml', '-o', {str(tmp_path)!r},"
+        " '--format', 'json']\n"
+        "try:\n    main()\nexcept SystemExit as stop:\n    assert not stop.code, stop.code\n"
+        "print(len(calls), any(m == 'scipy' or m.startswith('scipy.') for m in sys.modules))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    calls, scipy_loaded = result.stdout.split()[-2:]
+    assert int(calls) > 0 and scipy_loaded == "False"
 
 
 @pytest.mark.parametrize(("given", "expected"), [(None, "1"), ("3", "3")])
