@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 import trimesh
 
+from facadecli.city.building import ROOF_NAME
 from facadecli.city.folders import building_file
+from facadecli.city.lods import feature_of, lod_meshes
 from facadecli.city.manifest import load_city
 from facadecli.city.run import run_city
 from facadecli.city.s3db import COLOURS, colour, tag_problems
@@ -112,6 +114,30 @@ def test_a_terrace_of_hipped_houses_has_no_valleys(district: tuple[Path, dict[st
         {"party": 2},
         {"party": 1},
     ]
+
+
+def test_the_terrace_s_lod2_roofs_know_their_party_walls_too(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    """The CityJSON solids (and so the LOD1/LOD2 models and 3D Tiles made from them)
+    take their party walls from where the glb's roofs do: one ridge along the terrace,
+    the same as the glb's, each solid closed, its gable end at the party wall a wall."""
+    folder, _ = district
+    for oid, (west_free, east_free) in {
+        100: (True, False),
+        101: (False, False),
+        102: (False, True),
+    }.items():
+        feature = feature_of(folder / "out" / building_file(f"way/{oid}"))
+        (solid,) = [g for o in feature["CityObjects"].values() for g in o.get("geometry", [])]
+        assert solid["type"] == "Solid"
+        roof = lod_meshes(feature, 2)[ROOF_NAME]
+        west, east = _ridge_reach(roof)
+        assert (west > 3.0, east > 3.0) == (west_free, east_free), (oid, west, east)
+        assert (west < 0.05, east < 0.05) == (not west_free, not east_free), (oid, west, east)
+        glb = _mesh(folder, oid, "roof")
+        assert roof.vertices[:, 1].max() == pytest.approx(glb.vertices[:, 1].max(), abs=2e-3)
+        assert roof.area == pytest.approx(glb.area, rel=1e-3)
 
 
 def test_the_podium_roof_runs_into_the_tower_not_through_it(

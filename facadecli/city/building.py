@@ -17,7 +17,7 @@ import itertools
 import math
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -324,18 +324,15 @@ def build_building(
     instances: dict[tuple[str, bytes, bytes], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
     facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
-    volumes = [volume(part, heights, roof) for part in footprint.parts]
+    volumes = party_volumes(footprint, heights, roof, shared, tolerance)
     posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
     for block in volumes:
         wall_height = _wall_height(block)
         lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
         proud: dict[tuple[float, float], tuple[tuple[float, float], float, str]] = {}
         ends: list[tuple[tuple[float, float], tuple[float, float], float]] = []
-        fixed: list[Segment] = []
-        laid = () if posts_only else _walls(block, shared, tolerance, main, walls)
+        laid = () if posts_only else _walls(block, main, walls)
         for a, b, length, party_wall, chosen in laid:
-            if party_wall:
-                fixed.append((a, b))
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
             meshes: list[tuple[str, trimesh.Trimesh]] | None = None
@@ -383,7 +380,7 @@ def build_building(
             parts.setdefault(name, []).append(post)
         if posts_only:
             parts.setdefault(_plain_material(spec), []).extend(_posts(block))
-        for shape, still in roof_outlines(block.part, fixed, above):
+        for shape, still in roof_outlines(block.part, block.still, above):
             cover, infill = roof_meshes(shape, block.eaves, block.roof, still)
             cover.apply_transform(MAP_TO_WORLD)
             flat = block.roof.type == "flat" and ROOF_NAME not in spec.materials
@@ -527,17 +524,35 @@ class Facade:
 Wall = tuple[tuple[float, float], tuple[float, float], float, bool, Facade]
 
 
+def party_volumes(
+    footprint: Footprint, heights: Heights, roof: Roof, shared: Any, tolerance: float
+) -> list[Volume]:
+    """The building's volumes (:func:`.s3db.volume`), each with its party walls
+    (``still``): its walls along a neighbour (``shared``, within ``tolerance``), where
+    its façades stop and its roof runs on at full height. A roof on posts has no walls,
+    so none (its roof slopes down to its edges). The one place party walls are found:
+    the glb's walls and roofs and the CityJSON's solids (LOD2, and the 3D Tiles' LOD1
+    and LOD2 made from them) all take them from here."""
+    blocks = [volume(part, heights, roof) for part in footprint.parts]
+    if roof_only(footprint.properties) or shared is None:
+        return blocks
+    zone = party_zone(shared, tolerance)  # widened once for all the walls
+    return [
+        replace(block, still=tuple((a, b) for a, b in _edges(block.part) if along(a, b, zone)))
+        for block in blocks
+    ]
+
+
 def _walls(
     block: Volume,
-    shared: Any,
-    tolerance: float,
     main: Facade,
     rules: Sequence[tuple[WallRule, Facade]],
 ) -> Iterator[Wall]:
-    """The walls of a volume: ends, length, whether it is a party wall, and its façade
-    (the first rule matching its side, the way it faces and its length, else ``main``)."""
-    zone = party_zone(shared, tolerance)  # widened once for all the walls
-    edges = [(a, b, along(a, b, zone)) for a, b in _edges(block.part)]
+    """The walls of a volume: ends, length, whether it is a party wall (one of its
+    ``still`` walls: :func:`party_volumes`), and its façade (the first rule matching
+    its side, the way it faces and its length, else ``main``)."""
+    party = set(block.still)
+    edges = [(a, b, (a, b) in party) for a, b in _edges(block.part)]
     for (a, b, party), side in zip(edges, sides(edges), strict=True):
         length = math.dist(a, b)
         chosen = next((f for rule, f in rules if rule.matches(side, facing(a, b), length)), main)
@@ -566,9 +581,9 @@ def facade_axes(
     needed: set[Slot] = set()
     if roof_only(footprint.properties):
         return needed  # no walls: no façades
-    for block in (volume(part, heights, roof) for part in footprint.parts):
+    for block in party_volumes(footprint, heights, roof, shared, tolerance):
         height = rung(_wall_height(block))
-        for _, _, length, party, chosen in _walls(block, shared, tolerance, main, rules):
+        for _, _, length, party, chosen in _walls(block, main, rules):
             if length >= min_facade_width and not party:
                 needed.add((chosen.key, "y", height, variants))
                 needed.add((chosen.key, "x", rung(length), variants))

@@ -6,7 +6,8 @@ its tags, its parts its ``BuildingPart`` children: :func:`grouped`), each volume
 closed ``Solid`` whose surfaces face outwards: a
 GroundSurface at its base (an OuterCeilingSurface when the base is above the ground, as
 under a part lifted by ``min_height``), a WallSurface per footprint edge (base to eaves),
-WallSurfaces for the roof's infill (gable ends), and RoofSurfaces (the roof's coplanar
+WallSurfaces for the roof's infill (gable ends, at party walls too: the roof stands
+still at the volume's ``still`` walls, as the glb's does), and RoofSurfaces (the roof's coplanar
 triangles merged into polygons; a flat roof is the footprint at the eaves, without the
 parapet the glb's walls carry).
 
@@ -604,7 +605,7 @@ def _surfaces(
             yield "WallSurface", [[a0, b0, b1, a1]]  # outwards is right of a -> b
     flat = volume.roof.type == "flat"
     if not flat:
-        cover, infill = roof_meshes(volume.part, volume.eaves, volume.roof)
+        cover, infill = roof_meshes(volume.part, volume.eaves, volume.roof, volume.still)
         # a roof that rises nowhere (roofs may fall back to a flat slab) is flat here
         flat = len(cover.vertices) == 0 or float(np.max(cover.vertices[:, 2])) * UNITS < eaves + 1
     if flat:

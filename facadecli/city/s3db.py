@@ -30,7 +30,7 @@ from shapely.geometry.polygon import orient
 
 from facadecli.city.footprints import MAX_HEIGHT, MIN_AREA, Footprint, length, number
 from facadecli.city.manifest import OSM_ROOFS, UNBUILT, Roof
-from facadecli.city.roofs import roof_height
+from facadecli.city.roofs import Segment, roof_height
 
 MIN_WALL = 0.5  # metres: a roof taller than its building leaves at least this much wall
 SLIVER = 1.0  # metres: what parts leave of an outline narrower than this is a gap in the drawing
@@ -51,12 +51,16 @@ class Heights:
 @dataclass(frozen=True)
 class Volume:
     """One part of a building: walls from ``base`` to ``eaves`` around ``part``, and the
-    roof on them (its ``height`` set: the roof's top is ``eaves + roof.height``)."""
+    roof on them (its ``height`` set: the roof's top is ``eaves + roof.height``).
+    ``still``: its party walls, as segments, where the roof does not slope down but
+    runs on to the wall (roofs.py's fixed walls; :func:`.building.party_volumes` finds
+    them, for the glb's roofs and the CityJSON's alike)."""
 
     part: Polygon
     base: float
     eaves: float
     roof: Roof
+    still: tuple[Segment, ...] = ()
 
     @property
     def top(self) -> float:
