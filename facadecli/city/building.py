@@ -551,8 +551,8 @@ def _walls(
     """The walls of a volume: ends, length, whether it is a party wall (one of its
     ``still`` walls: :func:`party_volumes`), and its façade (the first rule matching
     its side, the way it faces and its length, else ``main``)."""
-    party = set(block.still)
-    edges = [(a, b, (a, b) in party) for a, b in _edges(block.part)]
+    still = set(block.still)
+    edges = [(a, b, (a, b) in still) for a, b in _edges(block.part)]
     for (a, b, party), side in zip(edges, sides(edges), strict=True):
         length = math.dist(a, b)
         chosen = next((f for rule, f in rules if rule.matches(side, facing(a, b), length)), main)
