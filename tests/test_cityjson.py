@@ -97,12 +97,16 @@ def _validator(root: str) -> jsonschema.Draft7Validator:
 def _surfaces(geometry: dict[str, Any]) -> list[list[list[int]]]:
     if geometry["type"] == "Solid":
         return [surface for shell in geometry["boundaries"] for surface in shell]
+    if geometry["type"] == "MultiSolid":
+        return [s for solid in geometry["boundaries"] for shell in solid for s in shell]
     surfaces: list[list[list[int]]] = geometry["boundaries"]
     return surfaces
 
 
 def _values(geometry: dict[str, Any]) -> list[int]:
     values = geometry["semantics"]["values"]
+    if geometry["type"] == "MultiSolid":
+        return [v for solid in values for shell in solid for v in shell]
     flat: list[int] = values[0] if geometry["type"] == "Solid" else values
     return flat
 

@@ -245,6 +245,25 @@ def test_a_carport_is_a_roof_on_posts(district: tuple[Path, dict[str, Any]]) -> 
         used = {i for surface in geometry["boundaries"][0] for ring in surface for i in ring}
         low = min(document["vertices"][i][2] for i in used) * scale
         assert low == pytest.approx(eaves - 0.2, abs=1e-3)
+        # its posts: a BuildingInstallation child, each post a closed box from the
+        # ground to the eaves, as many as the glb's
+        assert document["CityObjects"][f"way/{oid}"]["children"] == [f"way/{oid}-posts"]
+        posts = document["CityObjects"][f"way/{oid}-posts"]
+        assert posts["type"] == "BuildingInstallation" and posts["parents"] == [f"way/{oid}"]
+        (solids,) = posts["geometry"]
+        assert solids["type"] == "MultiSolid"
+        assert len(solids["boundaries"]) == len(_pieces(_mesh(folder, oid, "render"))) >= 4
+        for (shell,) in solids["boundaries"]:
+            edges = [
+                e
+                for surface in shell
+                for ring in surface
+                for e in zip(ring, ring[1:] + ring[:1], strict=True)
+            ]
+            assert len(shell) == 6 and len(set(edges)) == 24
+            assert all((b, a) in edges for a, b in edges)  # closed, each edge both ways
+            heights = [document["vertices"][i][2] * scale for s in shell for r in s for i in r]
+            assert min(heights) == 0 and max(heights) == pytest.approx(eaves, abs=1e-3)
 
 
 def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, Any]]) -> None:
@@ -284,11 +303,13 @@ def test_the_cityjson_keeps_the_buildings_structure(
     assert objects["way/400"]["attributes"]["height"] == pytest.approx(12.192)
     assert objects["way/100"]["attributes"]["building:levels"] == 2
     assert objects["way/100"]["attributes"]["roof:height"] == 3.0
-    # every volume a closed solid; the tower part starts on the podium's eaves
+    # every volume a closed solid (a roof's posts: closed solids too); the tower part
+    # starts on the podium's eaves
     scale = document["transform"]["scale"][2]
     for key, item in objects.items():
         for geometry in item.get("geometry", []):
-            assert geometry["type"] == "Solid", key
+            posts = item["type"] == "BuildingInstallation"
+            assert geometry["type"] == ("MultiSolid" if posts else "Solid"), key
     (tower,) = objects["way/503"]["geometry"]
     used = {i for surface in tower["boundaries"][0] for ring in surface for i in ring}
     assert min(document["vertices"][i][2] for i in used) * scale == pytest.approx(8.0)

@@ -31,7 +31,9 @@ from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import Segment, roof_meshes
 from facadecli.city.s3db import (
+    POST,
     Heights,
+    Post,
     Volume,
     along,
     party_zone,
@@ -379,7 +381,7 @@ def build_building(
         for name, post in _corner_posts(proud, ends, block.base, wall_height):
             parts.setdefault(name, []).append(post)
         if posts_only:
-            parts.setdefault(_plain_material(spec), []).extend(_posts(block))
+            parts.setdefault(_plain_material(spec), []).extend(_posts(post_places(block)))
         for shape, still in roof_outlines(block.part, block.still, above):
             cover, infill = roof_meshes(shape, block.eaves, block.roof, still)
             cover.apply_transform(MAP_TO_WORLD)
@@ -432,8 +434,7 @@ def build_building(
                 geometry=geometry,
             )
     top = max(block.top for block in volumes)
-    if posts_only:  # the solids are the roofs: the posts stand in the air under them
-        volumes = [roof_solid(block, SLAB) for block in volumes]
+    volumes = written_volumes(footprint, volumes)  # a roof on posts: the roof, its posts
     return BuildingResult(
         scene,
         facades,
@@ -460,14 +461,14 @@ def _plain_reason(party: bool, length: float, min_facade_width: float) -> str | 
     return None
 
 
-POST = 0.25  # metres: the side of a square post under a roof on posts
 POST_SPACING = 6.0  # metres: posts along a side at most this far apart
 
 
-def _posts(block: Volume) -> list[trimesh.Trimesh]:
+def post_places(block: Volume) -> tuple[Post, ...]:
     """Posts from the base to the eaves under a roof with no walls: at each corner of
     its outline, and along the sides at most POST_SPACING apart, each inside the
-    outline."""
+    outline. The one place posts are placed: the glb's boxes and the CityJSON's solids
+    (a ``BuildingInstallation``) are both made from these."""
     inset = block.part.buffer(-POST / 2, join_style="mitre")
     if not isinstance(inset, Polygon) or inset.is_empty:
         inset = block.part
@@ -479,11 +480,27 @@ def _posts(block: Volume) -> list[trimesh.Trimesh]:
         for k in range(steps):  # the corner a, then evenly along to b (b: the next side's)
             x = a[0] + (b[0] - a[0]) * k / steps
             y = a[1] + (b[1] - a[1]) * k / steps
-            post = trimesh.creation.box(extents=(POST, POST, height))
-            post.apply_translation((x, y, block.base + height / 2))
-            post.apply_transform(MAP_TO_WORLD)
-            posts.append(post)
-    return posts
+            posts.append((x, y, block.base, block.base + height))
+    return tuple(posts)
+
+
+def _posts(places: Sequence[Post]) -> list[trimesh.Trimesh]:
+    """The posts as boxes, in the glTF frame."""
+    boxes = []
+    for x, y, base, top in places:
+        post = trimesh.creation.box(extents=(POST, POST, top - base))
+        post.apply_translation((x, y, (base + top) / 2))
+        post.apply_transform(MAP_TO_WORLD)
+        boxes.append(post)
+    return boxes
+
+
+def written_volumes(footprint: Footprint, volumes: Sequence[Volume]) -> list[Volume]:
+    """The volumes as the CityJSON has them: a roof on posts is its roof on a slab
+    (:func:`.s3db.roof_solid`), with its posts; any other as it is."""
+    if not roof_only(footprint.properties):
+        return list(volumes)
+    return [roof_solid(block, SLAB, post_places(block)) for block in volumes]
 
 
 def roof_outlines(

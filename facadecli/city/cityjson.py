@@ -42,7 +42,7 @@ import trimesh
 from facadecli.city.footprints import Footprint, typed
 from facadecli.city.georef import reference_system
 from facadecli.city.roofs import roof_meshes
-from facadecli.city.s3db import Volume, outline_of
+from facadecli.city.s3db import POST, Post, Volume, outline_of
 from facadecli.export.atomic import atomic_output, write_atomic
 
 VERSION = "2.0"
@@ -85,18 +85,36 @@ def building_object(building: BuildingSolids) -> dict[str, Any]:
     geometries = [_geometry(volume, vertices) for volume in building.volumes]
     attributes = dict(sorted(_json_safe(dict(building.attributes)).items()))
     objects: dict[str, Any] = {}
+    posts: dict[str, dict[str, Any]] = {}  # a volume's owner -> its posts' object
     if len(geometries) == 1:
-        objects[building.id] = _object("Building", attributes, geometry=geometries[0])
+        owners = [building.id]
     else:
-        children = [f"{building.id}-part{n}" for n in range(1, len(geometries) + 1)]
-        objects[building.id] = _object("Building", attributes, children=children)
-        for child, volume, geometry in zip(children, building.volumes, geometries, strict=True):
+        owners = [f"{building.id}-part{n}" for n in range(1, len(geometries) + 1)]
+    for owner, volume in zip(owners, building.volumes, strict=True):
+        if volume.posts:
+            posts[owner] = _object(
+                "BuildingInstallation",
+                {"function": "posts"},
+                geometry=_posts(volume.posts, vertices),
+                parents=[owner],
+            )
+    if len(geometries) == 1:
+        own = [f"{building.id}-posts"] if posts else []
+        objects[building.id] = _object(
+            "Building", attributes, geometry=geometries[0], **_children(own)
+        )
+    else:
+        objects[building.id] = _object("Building", attributes, children=owners)
+        for child, volume, geometry in zip(owners, building.volumes, geometries, strict=True):
             objects[child] = _object(
                 "BuildingPart",
                 _part_attributes(volume, geometry, vertices.points),
                 geometry=geometry,
                 parents=[building.id],
+                **_children([f"{child}-posts"] if child in posts else []),
             )
+    for owner, installation in posts.items():
+        objects[f"{owner}-posts"] = installation
     return {
         "type": "CityJSONFeature",
         "id": building.id,
@@ -446,6 +464,34 @@ def _object(kind: str, attributes: dict[str, Any], **members: Any) -> dict[str, 
         if key in members:
             result[key] = [members[key]] if key == "geometry" else members[key]
     return result
+
+
+def _children(ids: list[str]) -> dict[str, list[str]]:
+    return {"children": ids} if ids else {}
+
+
+def _posts(places: Sequence[Post], vertices: _Vertices) -> dict[str, Any]:
+    """A roof's posts as a MultiSolid: each a closed box facing outwards, its sides
+    WallSurfaces, its foot a GroundSurface (an OuterCeilingSurface off the ground), its
+    top, under the roof, a ClosureSurface."""
+    half = round(POST / 2 * UNITS)
+    solids, values = [], []
+    for x, y, base, top in places:
+        cx, cy = round(x * UNITS), round(y * UNITS)
+        z0, z1 = round(base * UNITS), round(top * UNITS)
+        ring = [(cx - half, cy - half), (cx + half, cy - half), (cx + half, cy + half)]
+        ring.append((cx - half, cy + half))  # counter-clockwise seen from above
+        low = [vertices.add((px, py, z0)) for px, py in ring]
+        high = [vertices.add((px, py, z1)) for px, py in ring]
+        sides = [[[low[k], low[(k + 1) % 4], high[(k + 1) % 4], high[k]]] for k in range(4)]
+        solids.append([[[low[::-1]], *sides, [high]]])
+        values.append([[0 if z0 <= 0 else 1, 2, 2, 2, 2, 3]])
+    kinds = ["GroundSurface", "OuterCeilingSurface", "WallSurface", "ClosureSurface"]
+    used = sorted({v for solid in values for shell in solid for v in shell})
+    renumber = {old: new for new, old in enumerate(used)}
+    values = [[[renumber[v] for v in shell] for shell in solid] for solid in values]
+    semantics = {"surfaces": [{"type": kinds[k]} for k in used], "values": values}
+    return {"type": "MultiSolid", "lod": LOD, "boundaries": solids, "semantics": semantics}
 
 
 def _part_attributes(

@@ -504,10 +504,7 @@ def building_height(properties: dict[str, Any], default: float, floor_height: fl
 
 ENTRANCE_KEY = "entrance"  # OSM's tag of a building's door
 ON_EDGE = 0.5  # metres: an entrance point this near a footprint's edge is on it
-ASTRAY = (
-    "entrance at ({x}, {y}) is on no footprint's edge (within "
-    f"{ON_EDGE} m): no door there"
-)
+ASTRAY = f"entrance at ({{x}}, {{y}}) is on no footprint's edge (within {ON_EDGE} m): no door there"
 
 
 def entrance_point(feature: Any) -> shapely.Point | None:

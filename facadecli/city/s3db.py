@@ -48,6 +48,10 @@ class Heights:
     default: float  # the top when nothing else says
 
 
+POST = 0.25  # metres: the side of a square post under a roof on posts
+Post = tuple[float, float, float, float]  # a square post: its middle (x, y), base and top
+
+
 @dataclass(frozen=True)
 class Volume:
     """One part of a building: walls from ``base`` to ``eaves`` around ``part``, and the
@@ -61,6 +65,7 @@ class Volume:
     eaves: float
     roof: Roof
     still: tuple[Segment, ...] = ()
+    posts: tuple[Post, ...] = ()  # a roof on posts: its posts (:func:`roof_solid`)
 
     @property
     def top(self) -> float:
@@ -410,10 +415,11 @@ def roof_only(properties: dict[str, Any]) -> bool:
     )
 
 
-def roof_solid(block: Volume, thickness: float) -> Volume:
+def roof_solid(block: Volume, thickness: float, posts: tuple[Post, ...] = ()) -> Volume:
     """The solid of a roof on posts: the roof on a slab ``thickness`` thick under its
-    eaves (its underside a ceiling open to the air), not walls down to the ground."""
-    return replace(block, base=max(block.base, block.eaves - thickness))
+    eaves (its underside a ceiling open to the air), not walls down to the ground; the
+    ``posts`` it stands on."""
+    return replace(block, base=max(block.base, block.eaves - thickness), posts=posts)
 
 
 def tag_problems(properties: dict[str, Any]) -> list[str]:
