@@ -29,7 +29,7 @@ from shapely.geometry import LineString, Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.footprints import MAX_HEIGHT, MIN_AREA, Footprint, length, number
-from facadecli.city.manifest import OSM_ROOFS, UNBUILT, Roof
+from facadecli.city.manifest import OSM_ROOFS, Roof
 from facadecli.city.roofs import Segment, roof_height
 
 MIN_WALL = 0.5  # metres: a roof taller than its building leaves at least this much wall
@@ -424,7 +424,7 @@ def roof_solid(block: Volume, thickness: float, posts: tuple[Post, ...] = ()) ->
 
 def tag_problems(properties: dict[str, Any]) -> list[str]:
     """What of a feature's S3DB tags is not understood, a sentence each (the building is
-    built without it): roof shapes S3DB does not list or that are not built here,
+    built without it): roof shapes S3DB does not list,
     colours that are neither #rgb, #rrggbb nor a CSS name, unknown materials, roof
     directions, orientations and angles that are not one."""
     problems = []
@@ -436,14 +436,10 @@ def tag_problems(properties: dict[str, Any]) -> list[str]:
     shape = properties.get("roof:shape")
     if shape is not None and str(shape).strip():
         name = str(shape).strip().lower()
-        if name not in OSM_ROOFS and name not in UNBUILT:
+        if name not in OSM_ROOFS:
             problems.append(
                 f"{shown('roof:shape')} is not a roof shape of Simple 3D Buildings: "
                 "the manifest's roof instead"
-            )
-        elif name in UNBUILT:
-            problems.append(
-                f"{shown('roof:shape')} is not built here yet: a {UNBUILT[name]} roof instead"
             )
     for key in ("building:colour", "roof:colour"):
         if properties.get(key) is not None and colour(properties[key]) is None:
