@@ -97,12 +97,16 @@ def _validator(root: str) -> jsonschema.Draft7Validator:
 def _surfaces(geometry: dict[str, Any]) -> list[list[list[int]]]:
     if geometry["type"] == "Solid":
         return [surface for shell in geometry["boundaries"] for surface in shell]
+    if geometry["type"] == "MultiSolid":
+        return [s for solid in geometry["boundaries"] for shell in solid for s in shell]
     surfaces: list[list[list[int]]] = geometry["boundaries"]
     return surfaces
 
 
 def _values(geometry: dict[str, Any]) -> list[int]:
     values = geometry["semantics"]["values"]
+    if geometry["type"] == "MultiSolid":
+        return [v for solid in values for shell in solid for v in shell]
     flat: list[int] = values[0] if geometry["type"] == "Solid" else values
     return flat
 
@@ -210,17 +214,56 @@ def test_every_roof_on_every_shape_closes(kind: str, shape: str) -> None:
     assert geometry["type"] == "Solid"
 
 
+ROUND_ROOFS = ("hip", "pyramidal", "dome", "onion", "gable", "half_hip", "mansard", "zakomar")
+
+
+@pytest.mark.parametrize("kind", ROUND_ROOFS)
+def test_every_roof_on_a_round_outline_drawn_by_hand_closes(kind: str) -> None:
+    """Round outlines (a silo, a round tower: Kotka's way/424090095 is a 13-gon) drawn
+    with millimetres of jitter: their skeletons end in clusters of nodes millimetres
+    apart, which at millimetre precision left edges used by four faces, spikes and fins.
+    Every volume is a Solid, no ring visits a vertex twice. (Before the snapping 7 of
+    these 8 roofs failed here; of 3,888 such outlines, 5 to 40 sides and 9 roofs, 1,306
+    stayed MultiSurfaces.)"""
+    rng = np.random.default_rng(36)
+    for sides in (9, 13, 24, 34, 39, 40):
+        for radius in (3.0, 4.4, 7.0, 12.0):
+            turn = rng.uniform(0, 1)
+            ring = [
+                (
+                    500 + radius * np.cos(2 * np.pi * k / sides + turn) + rng.normal() * 0.002,
+                    300 + radius * np.sin(2 * np.pi * k / sides + turn) + rng.normal() * 0.002,
+                )
+                for k in range(sides)
+            ]
+            volume = Volume(Polygon(ring), 0.0, 6.6, Roof(type=kind))
+            feature = building_object(BuildingSolids("round", [volume]))
+            (geometry,) = feature["CityObjects"]["round"]["geometry"]
+            assert geometry["type"] == "Solid", (kind, sides, radius)
+            for surface in geometry["boundaries"][0]:
+                for ring_ in surface:
+                    assert len(set(ring_)) == len(ring_) >= 3
+
+
 def test_a_gable_whose_ridge_ends_in_a_sliver_closes() -> None:
     """A footprint of Kotka's (way/369849810, 37 x 61 m, ends not quite square): the
     gable's apex and the skeleton's last node are 2 mm apart, a sliver at millimetre
-    precision that folded the shell; left out, the roof closes."""
+    precision that folded the shell; snapped into one point, the roof closes."""
     corners = [(1016.77822, 122.499652), (1053.582638, 73.54338), (1068.584134, 84.780885)]
     part = Polygon([*corners, (1031.779628, 133.737006)])
     volume = Volume(part, 0.0, 4.5, Roof(type="gable", height=4.5))
-    (geometry,) = building_object(BuildingSolids("k", [volume]))["CityObjects"]["k"]["geometry"]
+    feature = building_object(BuildingSolids("k", [volume]))
+    (geometry,) = feature["CityObjects"]["k"]["geometry"]
     assert geometry["type"] == "Solid"
-    kept = cityjson._polygons(*_roof_and_vertices(volume), slivers=True)
-    assert kept != cityjson._polygons(*_roof_and_vertices(volume), slivers=False)  # the sliver
+    cover, _ = _roof_and_vertices(volume)
+    built = np.unique(np.rint(np.asarray(cover.vertices) * 1000), axis=0)
+    assert 0 < _closest(built) <= cityjson.SNAP[0]  # the sliver, as the skeleton makes it
+    assert _closest(np.asarray(feature["vertices"], dtype=float)) > cityjson.SNAP[0]
+
+
+def _closest(points: np.ndarray) -> float:
+    gaps = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2)
+    return float(gaps[~np.eye(len(points), dtype=bool)].min())
 
 
 def _roof_and_vertices(volume: Volume) -> tuple[trimesh.Trimesh, Any]:
@@ -433,8 +476,8 @@ def test_the_reference_system_is_an_epsg_projected_crs_in_metres() -> None:
 def test_a_roof_that_does_not_close_is_a_multisurface(monkeypatch: pytest.MonkeyPatch) -> None:
     original = cityjson.roof_meshes
 
-    def torn(part: Polygon, eaves: float, roof: Roof) -> Any:
-        cover, infill = original(part, eaves, roof)
+    def torn(part: Polygon, eaves: float, roof: Roof, fixed: Any = ()) -> Any:
+        cover, infill = original(part, eaves, roof, fixed)
         return cover.submesh([np.arange(1, len(cover.faces))], append=True), infill
 
     monkeypatch.setattr(cityjson, "roof_meshes", torn)
@@ -447,7 +490,7 @@ def test_a_roof_that_does_not_close_is_a_multisurface(monkeypatch: pytest.Monkey
 
 
 def test_a_roof_that_falls_back_to_a_flat_slab_is_flat(monkeypatch: pytest.MonkeyPatch) -> None:
-    def slab(part: Polygon, eaves: float, roof: Roof) -> Any:
+    def slab(part: Polygon, eaves: float, roof: Roof, fixed: Any = ()) -> Any:
         mesh = trimesh.creation.extrude_polygon(part, 0.2)
         mesh.apply_translation((0, 0, eaves - 0.2))
         return mesh, []

@@ -12,10 +12,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from shapely.geometry import Point
 
 from facadecli import load_spec, solve
 from facadecli.city.default import default_city
 from facadecli.city.entrances import GROUND_FLOOR, NEAR, along_wall, with_doors
+from facadecli.city.footprints import read_footprints
 from facadecli.city.run import run_city
 from facadecli.geometry.facade import facade_scene
 from tests.instances import placed_triangles
@@ -127,3 +129,100 @@ def test_an_osm_entrance_node_is_a_door_in_its_wall(tmp_path: Path) -> None:
     assert south - 0.5 < high[2] <= south  # in the south wall
     cityjson = json.loads((tmp_path / "out" / "two.city.json").read_text())
     assert all("entrances" not in o.get("attributes", {}) for o in cityjson["CityObjects"].values())
+
+
+def _node(nid: int, x: float, y: float, tags: str = "") -> str:
+    place = f'lat="{ORIGIN[1] + y * METRE_LAT:.9f}" lon="{ORIGIN[0] + x * METRE_LON:.9f}"'
+    return f'  <node id="{nid}" version="1" {place}>{tags}</node>'
+
+
+def test_a_multipolygon_building_s_entrances_are_read_on_its_outer_ways(tmp_path: Path) -> None:
+    """A multipolygon building (a courtyard block: its outer way and inner way untagged,
+    the relation tagged) gets the entrance nodes of its outer way, not of its inner way
+    (issue 35, item 4); a way building next to it keeps its own."""
+    entrance = '<tag k="entrance" v="yes"/>'
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6" generator="tests">']
+    outer = {1: (0, 0), 2: (30, 0), 3: (30, 30), 4: (0, 30), 5: (10, 0)}
+    inner = {11: (10, 10), 12: (10, 20), 13: (20, 20), 14: (20, 10), 15: (15, 10)}
+    house = {21: (40, 0), 22: (52, 0), 23: (52, 9), 24: (40, 9), 25: (46, 9)}
+    for nid, (x, y) in {**outer, **inner, **house}.items():
+        lines.append(_node(nid, x, y, entrance if nid in (5, 15, 25) else ""))
+    lines.append(
+        '  <way id="100" version="1">'
+        + "".join(f'<nd ref="{n}"/>' for n in (1, 5, 2, 3, 4, 1))
+        + "</way>"
+    )
+    lines.append(
+        '  <way id="101" version="1">'
+        + "".join(f'<nd ref="{n}"/>' for n in (11, 12, 13, 14, 15, 11))
+        + "</way>"
+    )
+    tags = '<tag k="building" v="yes"/>'
+    nds = "".join(f'<nd ref="{n}"/>' for n in (21, 22, 23, 25, 24, 21))
+    lines.append(f'  <way id="102" version="1">{nds}{tags}</way>')
+    members = (
+        '<member type="way" ref="100" role="outer"/><member type="way" ref="101" role="inner"/>'
+    )
+    lines.append(
+        f'  <relation id="7" version="1">{members}<tag k="type" v="multipolygon"/>{tags}</relation>'
+    )
+    lines.append("</osm>")
+    extract = tmp_path / "block.osm"
+    extract.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    found = {f.id: f for f in read_footprints(extract).footprints}
+    assert set(found) == {"relation/7", "way/102"}
+    block, house_ = found["relation/7"], found["way/102"]
+    assert len(block.entrances) == 1 and len(house_.entrances) == 1
+    # on the outline, 10 m from its nearest corner (the UTM grid turns the map a little)
+    for footprint, corner in ((block, 10.0), (house_, 6.0)):
+        (part,) = footprint.parts
+        where = Point(footprint.entrances[0])
+        assert part.exterior.distance(where) < 0.01
+        corners = [Point(c) for c in part.simplify(0.01).exterior.coords]  # not its node
+        assert min(c.distance(where) for c in corners) == pytest.approx(corner, abs=0.05)
+    assert block.parts[0].interiors[0].distance(Point(block.entrances[0])) > 5
+
+
+def _square(x: float, y: float, size: float) -> list[list[float]]:
+    return [[x, y], [x + size, y], [x + size, y + size], [x, y + size], [x, y]]
+
+
+def test_geojson_entrance_points_on_an_edge_are_doors_the_rest_warned(tmp_path: Path) -> None:
+    """Point features tagged ``entrance`` lying on a footprint's edge (within 0.5 m) are
+    its entrances, on any edge of any ring; a point farther off is warned once, by id
+    and line, and counted under ``entrance``; a point that is not an entrance stays a
+    rejected feature."""
+
+    def point(fid: str, x: float, y: float, tags: dict[str, str]) -> dict[str, object]:
+        geometry = {"type": "Point", "coordinates": [x, y]}
+        return {"type": "Feature", "id": fid, "properties": tags, "geometry": geometry}
+
+    house = {"building": "house", "building:levels": 2}
+    features = [
+        {
+            "type": "Feature",
+            "id": "a",
+            "properties": house,
+            "geometry": {"type": "Polygon", "coordinates": [_square(0, 0, 12)]},
+        },
+        {
+            "type": "Feature",
+            "id": "b",
+            "properties": house,
+            "geometry": {"type": "Polygon", "coordinates": [_square(30, 0, 12)]},
+        },
+        point("door-a", 4.0, -0.3, {"entrance": "main"}),  # 0.3 m off a's south wall
+        point("door-b", 42.2, 6.0, {"entrance": "service"}),  # 0.2 m off b's east wall
+        point("lost", 20.0, 6.0, {"entrance": "yes"}),  # between them, on neither
+        point("tree", 5.0, 5.0, {"natural": "tree"}),
+    ]
+    crs = {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::3067"}}
+    path = tmp_path / "doors.geojson"
+    document = {"type": "FeatureCollection", "crs": crs, "features": features}
+    path.write_text(json.dumps(document, indent=1), encoding="utf-8")
+    found = read_footprints(path)
+    doors = {f.id: f.entrances for f in found.footprints}
+    assert doors["a"] == ((4.0, -0.3),) and doors["b"] == ((42.2, 6.0),)
+    assert [(w.id, w.reason.split(" ")[0]) for w in found.warnings] == [("lost", "entrance")]
+    assert found.warnings[0].line is not None
+    assert [r.id for r in found.rejected] == ["tree"]

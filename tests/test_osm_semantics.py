@@ -15,12 +15,14 @@ import numpy as np
 import pytest
 import trimesh
 
+from facadecli.city.building import ROOF_NAME
 from facadecli.city.folders import building_file
+from facadecli.city.lods import feature_of, lod_meshes
 from facadecli.city.manifest import load_city
 from facadecli.city.run import run_city
 from facadecli.city.s3db import COLOURS, colour, tag_problems
 from facadecli.city.straight import merged_ring
-from tests.osm_district import ROOF_SHAPES, UNBUILT_SHAPES, box, write_district
+from tests.osm_district import ROOF_SHAPES, box, write_district
 from tests.running import facade
 from tests.test_cityjson import _check_valid
 from tests.test_s3db import SPEC
@@ -112,6 +114,30 @@ def test_a_terrace_of_hipped_houses_has_no_valleys(district: tuple[Path, dict[st
         {"party": 2},
         {"party": 1},
     ]
+
+
+def test_the_terrace_s_lod2_roofs_know_their_party_walls_too(
+    district: tuple[Path, dict[str, Any]],
+) -> None:
+    """The CityJSON solids (and so the LOD1/LOD2 models and 3D Tiles made from them)
+    take their party walls from where the glb's roofs do: one ridge along the terrace,
+    the same as the glb's, each solid closed, its gable end at the party wall a wall."""
+    folder, _ = district
+    for oid, (west_free, east_free) in {
+        100: (True, False),
+        101: (False, False),
+        102: (False, True),
+    }.items():
+        feature = feature_of(folder / "out" / building_file(f"way/{oid}"))
+        (solid,) = [g for o in feature["CityObjects"].values() for g in o.get("geometry", [])]
+        assert solid["type"] == "Solid"
+        roof = lod_meshes(feature, 2)[ROOF_NAME]
+        west, east = _ridge_reach(roof)
+        assert (west > 3.0, east > 3.0) == (west_free, east_free), (oid, west, east)
+        assert (west < 0.05, east < 0.05) == (not west_free, not east_free), (oid, west, east)
+        glb = _mesh(folder, oid, "roof")
+        assert roof.vertices[:, 1].max() == pytest.approx(glb.vertices[:, 1].max(), abs=2e-3)
+        assert roof.area == pytest.approx(glb.area, rel=1e-3)
 
 
 def test_the_podium_roof_runs_into_the_tower_not_through_it(
@@ -219,6 +245,25 @@ def test_a_carport_is_a_roof_on_posts(district: tuple[Path, dict[str, Any]]) -> 
         used = {i for surface in geometry["boundaries"][0] for ring in surface for i in ring}
         low = min(document["vertices"][i][2] for i in used) * scale
         assert low == pytest.approx(eaves - 0.2, abs=1e-3)
+        # its posts: a BuildingInstallation child, each post a closed box from the
+        # ground to the eaves, as many as the glb's
+        assert document["CityObjects"][f"way/{oid}"]["children"] == [f"way/{oid}-posts"]
+        posts = document["CityObjects"][f"way/{oid}-posts"]
+        assert posts["type"] == "BuildingInstallation" and posts["parents"] == [f"way/{oid}"]
+        (solids,) = posts["geometry"]
+        assert solids["type"] == "MultiSolid"
+        assert len(solids["boundaries"]) == len(_pieces(_mesh(folder, oid, "render"))) >= 4
+        for (shell,) in solids["boundaries"]:
+            edges = [
+                e
+                for surface in shell
+                for ring in surface
+                for e in zip(ring, ring[1:] + ring[:1], strict=True)
+            ]
+            assert len(shell) == 6 and len(set(edges)) == 24
+            assert all((b, a) in edges for a, b in edges)  # closed, each edge both ways
+            heights = [document["vertices"][i][2] * scale for s in shell for r in s for i in r]
+            assert min(heights) == 0 and max(heights) == pytest.approx(eaves, abs=1e-3)
 
 
 def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, Any]]) -> None:
@@ -258,11 +303,13 @@ def test_the_cityjson_keeps_the_buildings_structure(
     assert objects["way/400"]["attributes"]["height"] == pytest.approx(12.192)
     assert objects["way/100"]["attributes"]["building:levels"] == 2
     assert objects["way/100"]["attributes"]["roof:height"] == 3.0
-    # every volume a closed solid; the tower part starts on the podium's eaves
+    # every volume a closed solid (a roof's posts: closed solids too); the tower part
+    # starts on the podium's eaves
     scale = document["transform"]["scale"][2]
     for key, item in objects.items():
         for geometry in item.get("geometry", []):
-            assert geometry["type"] == "Solid", key
+            posts = item["type"] == "BuildingInstallation"
+            assert geometry["type"] == ("MultiSolid" if posts else "Solid"), key
     (tower,) = objects["way/503"]["geometry"]
     used = {i for surface in tower["boundaries"][0] for ring in surface for i in ring}
     assert min(document["vertices"][i][2] for i in used) * scale == pytest.approx(8.0)
@@ -296,6 +343,18 @@ def test_every_roof_shape_builds(district: tuple[Path, dict[str, Any]]) -> None:
     heights = walls.vertices[walls.faces][:, :, 1]
     gables = (heights.min(axis=1) >= up.min() - 1e-3) & (heights.max(axis=1) > up.min() + 1e-3)
     assert gables.sum() == 4  # the four gable ends, above the eaves
+    # gabled_height_moved: a gable (12 x 8 m) whose ridge runs along it a third of the
+    # depth in, not over the middle; both eaves at one height
+    roof = _mesh(folder, 700 + ROOF_SHAPES.index("gabled_height_moved"), "roof")
+    flat, up = roof.vertices[:, [0, 2]], roof.vertices[:, 1]
+    across = np.array([0.0, 1.0])  # glTF z: north-south, across the ridge (the grid turns)
+    depth = flat @ across
+    ridge = flat[up > up.max() - 0.01] @ across
+    assert np.ptp(ridge) < 0.5  # one ridge along the house
+    share = (ridge.mean() - depth.min()) / np.ptp(depth)
+    assert min(share, 1 - share) == pytest.approx(1 / 3, abs=0.03)
+    eaves = up[np.isclose(depth, depth.min(), atol=0.3) | np.isclose(depth, depth.max(), atol=0.3)]
+    assert np.ptp(eaves) < 0.3  # both long sides' eaves at one height (the ends: gables)
 
 
 def test_a_butterfly_roof_is_a_valley_between_two_high_walls(
@@ -365,12 +424,8 @@ def test_what_is_not_understood_is_warned_and_counted(
     _, report = district
     warned = {(w["id"], w["warning"].split(" ", 1)[0]) for w in report["warnings"]}
     assert ("way/600", "roof:shape") in warned and ("way/600", "building:colour") in warned
-    unbuilt = set(UNBUILT_SHAPES)  # built as another shape, warned
-    for shape in unbuilt:
-        oid = 700 + (ROOF_SHAPES + UNBUILT_SHAPES).index(shape)
-        assert (f"way/{oid}", "roof:shape") in warned
     counts = report["summary"]["warnings_by_tag"]
-    assert counts == {"building:colour": 1, "roof:shape": 1 + len(unbuilt)}
+    assert counts == {"building:colour": 1, "roof:shape": 1}
     assert report["summary"]["warnings"] == len(report["warnings"]) == sum(counts.values())
     # every shape S3DB lists is understood: no warning
     for shape in ROOF_SHAPES:

@@ -17,7 +17,7 @@ import itertools
 import math
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +31,9 @@ from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import Segment, roof_meshes
 from facadecli.city.s3db import (
+    POST,
     Heights,
+    Post,
     Volume,
     along,
     party_zone,
@@ -324,18 +326,15 @@ def build_building(
     instances: dict[tuple[str, bytes, bytes], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
     facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
-    volumes = [volume(part, heights, roof) for part in footprint.parts]
+    volumes = party_volumes(footprint, heights, roof, shared, tolerance)
     posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
     for block in volumes:
         wall_height = _wall_height(block)
         lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
         proud: dict[tuple[float, float], tuple[tuple[float, float], float, str]] = {}
         ends: list[tuple[tuple[float, float], tuple[float, float], float]] = []
-        fixed: list[Segment] = []
-        laid = () if posts_only else _walls(block, shared, tolerance, main, walls)
+        laid = () if posts_only else _walls(block, main, walls)
         for a, b, length, party_wall, chosen in laid:
-            if party_wall:
-                fixed.append((a, b))
             direction = ((b[0] - a[0]) / length, (b[1] - a[1]) / length)
             placement = lift @ _to_world(a, direction)
             meshes: list[tuple[str, trimesh.Trimesh]] | None = None
@@ -382,8 +381,8 @@ def build_building(
         for name, post in _corner_posts(proud, ends, block.base, wall_height):
             parts.setdefault(name, []).append(post)
         if posts_only:
-            parts.setdefault(_plain_material(spec), []).extend(_posts(block))
-        for shape, still in roof_outlines(block.part, fixed, above):
+            parts.setdefault(_plain_material(spec), []).extend(_posts(post_places(block)))
+        for shape, still in roof_outlines(block.part, block.still, above):
             cover, infill = roof_meshes(shape, block.eaves, block.roof, still)
             cover.apply_transform(MAP_TO_WORLD)
             flat = block.roof.type == "flat" and ROOF_NAME not in spec.materials
@@ -435,8 +434,7 @@ def build_building(
                 geometry=geometry,
             )
     top = max(block.top for block in volumes)
-    if posts_only:  # the solids are the roofs: the posts stand in the air under them
-        volumes = [roof_solid(block, SLAB) for block in volumes]
+    volumes = written_volumes(footprint, volumes)  # a roof on posts: the roof, its posts
     return BuildingResult(
         scene,
         facades,
@@ -463,14 +461,14 @@ def _plain_reason(party: bool, length: float, min_facade_width: float) -> str | 
     return None
 
 
-POST = 0.25  # metres: the side of a square post under a roof on posts
 POST_SPACING = 6.0  # metres: posts along a side at most this far apart
 
 
-def _posts(block: Volume) -> list[trimesh.Trimesh]:
+def post_places(block: Volume) -> tuple[Post, ...]:
     """Posts from the base to the eaves under a roof with no walls: at each corner of
     its outline, and along the sides at most POST_SPACING apart, each inside the
-    outline."""
+    outline. The one place posts are placed: the glb's boxes and the CityJSON's solids
+    (a ``BuildingInstallation``) are both made from these."""
     inset = block.part.buffer(-POST / 2, join_style="mitre")
     if not isinstance(inset, Polygon) or inset.is_empty:
         inset = block.part
@@ -482,11 +480,27 @@ def _posts(block: Volume) -> list[trimesh.Trimesh]:
         for k in range(steps):  # the corner a, then evenly along to b (b: the next side's)
             x = a[0] + (b[0] - a[0]) * k / steps
             y = a[1] + (b[1] - a[1]) * k / steps
-            post = trimesh.creation.box(extents=(POST, POST, height))
-            post.apply_translation((x, y, block.base + height / 2))
-            post.apply_transform(MAP_TO_WORLD)
-            posts.append(post)
-    return posts
+            posts.append((x, y, block.base, block.base + height))
+    return tuple(posts)
+
+
+def _posts(places: Sequence[Post]) -> list[trimesh.Trimesh]:
+    """The posts as boxes, in the glTF frame."""
+    boxes = []
+    for x, y, base, top in places:
+        post = trimesh.creation.box(extents=(POST, POST, top - base))
+        post.apply_translation((x, y, (base + top) / 2))
+        post.apply_transform(MAP_TO_WORLD)
+        boxes.append(post)
+    return boxes
+
+
+def written_volumes(footprint: Footprint, volumes: Sequence[Volume]) -> list[Volume]:
+    """The volumes as the CityJSON has them: a roof on posts is its roof on a slab
+    (:func:`.s3db.roof_solid`), with its posts; any other as it is."""
+    if not roof_only(footprint.properties):
+        return list(volumes)
+    return [roof_solid(block, SLAB, post_places(block)) for block in volumes]
 
 
 def roof_outlines(
@@ -527,17 +541,35 @@ class Facade:
 Wall = tuple[tuple[float, float], tuple[float, float], float, bool, Facade]
 
 
+def party_volumes(
+    footprint: Footprint, heights: Heights, roof: Roof, shared: Any, tolerance: float
+) -> list[Volume]:
+    """The building's volumes (:func:`.s3db.volume`), each with its party walls
+    (``still``): its walls along a neighbour (``shared``, within ``tolerance``), where
+    its façades stop and its roof runs on at full height. A roof on posts has no walls,
+    so none (its roof slopes down to its edges). The one place party walls are found:
+    the glb's walls and roofs and the CityJSON's solids (LOD2, and the 3D Tiles' LOD1
+    and LOD2 made from them) all take them from here."""
+    blocks = [volume(part, heights, roof) for part in footprint.parts]
+    if roof_only(footprint.properties) or shared is None:
+        return blocks
+    zone = party_zone(shared, tolerance)  # widened once for all the walls
+    return [
+        replace(block, still=tuple((a, b) for a, b in _edges(block.part) if along(a, b, zone)))
+        for block in blocks
+    ]
+
+
 def _walls(
     block: Volume,
-    shared: Any,
-    tolerance: float,
     main: Facade,
     rules: Sequence[tuple[WallRule, Facade]],
 ) -> Iterator[Wall]:
-    """The walls of a volume: ends, length, whether it is a party wall, and its façade
-    (the first rule matching its side, the way it faces and its length, else ``main``)."""
-    zone = party_zone(shared, tolerance)  # widened once for all the walls
-    edges = [(a, b, along(a, b, zone)) for a, b in _edges(block.part)]
+    """The walls of a volume: ends, length, whether it is a party wall (one of its
+    ``still`` walls: :func:`party_volumes`), and its façade (the first rule matching
+    its side, the way it faces and its length, else ``main``)."""
+    still = set(block.still)
+    edges = [(a, b, (a, b) in still) for a, b in _edges(block.part)]
     for (a, b, party), side in zip(edges, sides(edges), strict=True):
         length = math.dist(a, b)
         chosen = next((f for rule, f in rules if rule.matches(side, facing(a, b), length)), main)
@@ -566,9 +598,9 @@ def facade_axes(
     needed: set[Slot] = set()
     if roof_only(footprint.properties):
         return needed  # no walls: no façades
-    for block in (volume(part, heights, roof) for part in footprint.parts):
+    for block in party_volumes(footprint, heights, roof, shared, tolerance):
         height = rung(_wall_height(block))
-        for _, _, length, party, chosen in _walls(block, shared, tolerance, main, rules):
+        for _, _, length, party, chosen in _walls(block, main, rules):
             if length >= min_facade_width and not party:
                 needed.add((chosen.key, "y", height, variants))
                 needed.add((chosen.key, "x", rung(length), variants))

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from facadecli.city.building import party_volumes, written_volumes
 from facadecli.city.cityjson import BuildingSolids, building_object, grouped, outlines
 from facadecli.city.footprints import FootprintSet, typed
 from facadecli.city.georef import Georef
-from facadecli.city.s3db import volume
 
 if TYPE_CHECKING:
     from facadecli.city.run import Task
@@ -46,7 +46,8 @@ def feature(task: Task) -> dict[str, Any]:
     if path.is_file():
         loaded: dict[str, Any] = json.loads(path.read_bytes())
         return loaded
-    volumes = [volume(part, task.heights, task.roof) for part in task.footprint.parts]
+    volumes = party_volumes(task.footprint, task.heights, task.roof, task.shared, task.tolerance)
+    volumes = written_volumes(task.footprint, volumes)
     top = max(v.top for v in volumes)
     return building_object(BuildingSolids(task.footprint.id, volumes, attributes(task, top)))
 

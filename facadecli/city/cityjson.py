@@ -6,7 +6,8 @@ its tags, its parts its ``BuildingPart`` children: :func:`grouped`), each volume
 closed ``Solid`` whose surfaces face outwards: a
 GroundSurface at its base (an OuterCeilingSurface when the base is above the ground, as
 under a part lifted by ``min_height``), a WallSurface per footprint edge (base to eaves),
-WallSurfaces for the roof's infill (gable ends), and RoofSurfaces (the roof's coplanar
+WallSurfaces for the roof's infill (gable ends, at party walls too: the roof stands
+still at the volume's ``still`` walls, as the glb's does), and RoofSurfaces (the roof's coplanar
 triangles merged into polygons; a flat roof is the footprint at the eaves, without the
 parapet the glb's walls carry).
 
@@ -41,7 +42,7 @@ import trimesh
 from facadecli.city.footprints import Footprint, typed
 from facadecli.city.georef import reference_system
 from facadecli.city.roofs import roof_meshes
-from facadecli.city.s3db import Volume, outline_of
+from facadecli.city.s3db import POST, Post, Volume, outline_of
 from facadecli.export.atomic import atomic_output, write_atomic
 
 VERSION = "2.0"
@@ -50,6 +51,8 @@ UNITS = 1000  # vertex units a metre: millimetres
 SCALE = 1 / UNITS
 NEAR = 1.0  # squared vertex units: a vertex this close to an edge lies on it (T-junction)
 APART = 4.0  # squared vertex units: ... unless this close to an end (a sliver's corner)
+SNAP = (3, 10, 30)  # vertex units: a roof's point this near a point of its volume is that
+# point (the first; the others when the shell does not close without its slivers)
 COPLANAR = 1e-10  # 1 - cos of the angle between normals of triangles merged into a polygon
 SURFACE_TYPES = ("GroundSurface", "OuterCeilingSurface", "WallSurface", "RoofSurface")
 
@@ -82,18 +85,36 @@ def building_object(building: BuildingSolids) -> dict[str, Any]:
     geometries = [_geometry(volume, vertices) for volume in building.volumes]
     attributes = dict(sorted(_json_safe(dict(building.attributes)).items()))
     objects: dict[str, Any] = {}
+    posts: dict[str, dict[str, Any]] = {}  # a volume's owner -> its posts' object
     if len(geometries) == 1:
-        objects[building.id] = _object("Building", attributes, geometry=geometries[0])
+        owners = [building.id]
     else:
-        children = [f"{building.id}-part{n}" for n in range(1, len(geometries) + 1)]
-        objects[building.id] = _object("Building", attributes, children=children)
-        for child, volume, geometry in zip(children, building.volumes, geometries, strict=True):
+        owners = [f"{building.id}-part{n}" for n in range(1, len(geometries) + 1)]
+    for owner, volume in zip(owners, building.volumes, strict=True):
+        if volume.posts:
+            posts[owner] = _object(
+                "BuildingInstallation",
+                {"function": "posts"},
+                geometry=_posts(volume.posts, vertices),
+                parents=[owner],
+            )
+    if len(geometries) == 1:
+        own = [f"{building.id}-posts"] if posts else []
+        objects[building.id] = _object(
+            "Building", attributes, geometry=geometries[0], **_children(own)
+        )
+    else:
+        objects[building.id] = _object("Building", attributes, children=owners)
+        for child, volume, geometry in zip(owners, building.volumes, geometries, strict=True):
             objects[child] = _object(
                 "BuildingPart",
                 _part_attributes(volume, geometry, vertices.points),
                 geometry=geometry,
                 parents=[building.id],
+                **_children([f"{child}-posts"] if child in posts else []),
             )
+    for owner, installation in posts.items():
+        objects[f"{owner}-posts"] = installation
     return {
         "type": "CityJSONFeature",
         "id": building.id,
@@ -445,6 +466,34 @@ def _object(kind: str, attributes: dict[str, Any], **members: Any) -> dict[str, 
     return result
 
 
+def _children(ids: list[str]) -> dict[str, list[str]]:
+    return {"children": ids} if ids else {}
+
+
+def _posts(places: Sequence[Post], vertices: _Vertices) -> dict[str, Any]:
+    """A roof's posts as a MultiSolid: each a closed box facing outwards, its sides
+    WallSurfaces, its foot a GroundSurface (an OuterCeilingSurface off the ground), its
+    top, under the roof, a ClosureSurface."""
+    half = round(POST / 2 * UNITS)
+    solids, values = [], []
+    for x, y, base, top in places:
+        cx, cy = round(x * UNITS), round(y * UNITS)
+        z0, z1 = round(base * UNITS), round(top * UNITS)
+        ring = [(cx - half, cy - half), (cx + half, cy - half), (cx + half, cy + half)]
+        ring.append((cx - half, cy + half))  # counter-clockwise seen from above
+        low = [vertices.add((px, py, z0)) for px, py in ring]
+        high = [vertices.add((px, py, z1)) for px, py in ring]
+        sides = [[[low[k], low[(k + 1) % 4], high[(k + 1) % 4], high[k]]] for k in range(4)]
+        solids.append([[[low[::-1]], *sides, [high]]])
+        values.append([[0 if z0 <= 0 else 1, 2, 2, 2, 2, 3]])
+    kinds = ["GroundSurface", "OuterCeilingSurface", "WallSurface", "ClosureSurface"]
+    used = sorted({v for solid in values for shell in solid for v in shell})
+    renumber = {old: new for new, old in enumerate(used)}
+    values = [[[renumber[v] for v in shell] for shell in solid] for solid in values]
+    semantics = {"surfaces": [{"type": kinds[k]} for k in used], "values": values}
+    return {"type": "MultiSolid", "lod": LOD, "boundaries": solids, "semantics": semantics}
+
+
 def _part_attributes(
     volume: Volume, geometry: dict[str, Any], points: list[Point]
 ) -> dict[str, Any]:
@@ -464,23 +513,88 @@ def _surfaces_of(geometry: dict[str, Any]) -> list[Surface]:
 
 
 class _Vertices:
-    """A building's vertices, one index per integer point."""
+    """A building's vertices, one index per integer point. A roof's points within SNAP
+    units of a point already used by the volume being written are that point
+    (:meth:`add_all`): a skeleton's nodes a millimetre or two apart would otherwise be
+    distinct vertices joined by edges too short for :func:`_split_edges` to mend, and the
+    shell would not close."""
 
     def __init__(self) -> None:
         self.index: dict[Point, int] = {}
         self.points: list[Point] = []
+        self.cells: dict[Point, list[int]] = {}  # the volume's points, by snap-sized cell
+        self.snap = SNAP[0]
+
+    def volume(self, snap: int = SNAP[0]) -> None:
+        """A new volume: snap to its own points only, within ``snap`` units."""
+        self.cells = {}
+        self.snap = snap
 
     def add(self, point: Point) -> int:
         found = self.index.get(point)
         if found is None:
             found = self.index[point] = len(self.points)
             self.points.append(point)
+        cell = self.cells.setdefault(self.cell(point), [])
+        if found not in cell:
+            cell.append(found)
+        return found
+
+    def near(self, point: Point) -> list[tuple[int, int]]:
+        """The volume's points within the snap: (squared distance, index) each."""
+        x, y, z = self.cell(point)
+        found = []
+        for dx, dy, dz in itertools.product((-1, 0, 1), repeat=3):
+            for i in self.cells.get((x + dx, y + dy, z + dz), ()):
+                gap = _gap(self.points[i], point)
+                if gap <= self.snap * self.snap:
+                    found.append((gap, i))
         return found
 
     def add_all(self, array: np.ndarray) -> tuple[list[int], np.ndarray]:
-        """Indices of (n, 3) points in metres, and the points in units."""
+        """Indices of (n, 3) points in metres, and the points in units as used. Points
+        within the snap of each other, in chains, are one (a cluster of a skeleton's
+        nodes), and that is the volume's nearest point within the snap of one of them
+        if there is one, else the cluster's least point."""
         units = np.rint(np.asarray(array, dtype=float) * UNITS).astype(np.int64)
-        return [self.add((int(x), int(y), int(z))) for x, y, z in units.tolist()], units
+        points = [(int(x), int(y), int(z)) for x, y, z in units.tolist()]
+        unique = sorted(set(points))
+        parent = {p: p for p in unique}
+
+        def root(p: Point) -> Point:
+            while parent[p] != p:
+                parent[p] = parent[parent[p]]
+                p = parent[p]
+            return p
+
+        cells: dict[Point, list[Point]] = {}
+        for p in unique:
+            x, y, z = self.cell(p)
+            for dx, dy, dz in itertools.product((-1, 0, 1), repeat=3):
+                for q in cells.get((x + dx, y + dy, z + dz), ()):
+                    if _gap(p, q) <= self.snap * self.snap:
+                        parent[root(q)] = root(p)
+            cells.setdefault((x, y, z), []).append(p)
+        clusters: dict[Point, list[Point]] = {}
+        for p in unique:
+            clusters.setdefault(root(p), []).append(p)
+        chosen: dict[Point, int] = {}
+        for members in clusters.values():
+            near = [(gap, i) for p in members for gap, i in self.near(p)]
+            found = min(near)[1] if near else self.add(min(members))
+            for p in members:
+                chosen[p] = found
+        ids = [chosen[p] for p in points]
+        snapped = np.asarray([self.points[i] for i in ids], dtype=np.int64).reshape(-1, 3)
+        return ids, snapped
+
+    def cell(self, point: Point) -> Point:
+        return (point[0] // self.snap, point[1] // self.snap, point[2] // self.snap)
+
+
+def _gap(p: Point, q: Point) -> int:
+    """The squared distance of two points."""
+    return (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2
 
 
 def _geometry(volume: Volume, vertices: _Vertices) -> dict[str, Any]:
@@ -489,13 +603,17 @@ def _geometry(volume: Volume, vertices: _Vertices) -> dict[str, Any]:
     if not volume.eaves > volume.base:
         raise ValueError(f"eaves at {volume.eaves} m are not above the base at {volume.base} m")
     before = len(vertices.points)
-    for slivers in (True, False):  # a roof's slivers may fold the shell at a ridge
-        if not slivers:  # the first try's points are not written
+    tries = [(True, SNAP[0]), *((False, snap) for snap in SNAP)]
+    for number, (slivers, snap) in enumerate(tries):  # slivers may fold the shell at a ridge
+        vertices.volume(snap)
+        if number:  # the try before's points are not written
             for point in vertices.points[before:]:
                 del vertices.index[point]
             del vertices.points[before:]
         kinds, surfaces = zip(*_surfaces(volume, vertices, slivers), strict=True)
-        split = _split_edges(list(surfaces), vertices.points)
+        split = _cancelled(_despiked(_split_edges(list(surfaces), vertices.points)))
+        kinds = tuple(kind for kind, surface in zip(kinds, split, strict=True) if surface)
+        split = [surface for surface in split if surface]
         oriented = _orient(split, vertices.points)
         if oriented is not None:
             break
@@ -533,7 +651,7 @@ def _surfaces(
             yield "WallSurface", [[a0, b0, b1, a1]]  # outwards is right of a -> b
     flat = volume.roof.type == "flat"
     if not flat:
-        cover, infill = roof_meshes(volume.part, volume.eaves, volume.roof)
+        cover, infill = roof_meshes(volume.part, volume.eaves, volume.roof, volume.still)
         # a roof that rises nowhere (roofs may fall back to a flat slab) is flat here
         flat = len(cover.vertices) == 0 or float(np.max(cover.vertices[:, 2])) * UNITS < eaves + 1
     if flat:
@@ -677,6 +795,59 @@ def _split_edges(surfaces: list[Surface], points: list[Point]) -> list[Surface]:
             rings.append(out)
         result.append(rings)
     return result
+
+
+def _despiked(surfaces: list[Surface]) -> list[Surface]:
+    """Rings without spikes (an edge that runs back along itself, ``u -> v -> u``: a
+    sliver snapped flat, or a point :func:`_split_edges` put on the edge next to it) and
+    without a point twice in a row; a surface whose exterior is left with fewer than 3
+    points is empty (left out), a hole so left is dropped."""
+    result: list[Surface] = []
+    for surface in surfaces:
+        rings = []
+        for ring in surface:
+            out: Ring = []
+            for u in ring:
+                if out and out[-1] == u:
+                    continue
+                while len(out) >= 2 and out[-2] == u:  # out[-1] is a spike's tip
+                    out.pop()
+                    out.pop()
+                out.append(u)
+            while len(out) >= 3 and (out[0] == out[-1] or out[1] == out[-1] or out[0] == out[-2]):
+                if out[0] == out[-1]:
+                    out.pop()
+                elif out[1] == out[-1]:  # the tip is out[0]
+                    out = out[1:-1]
+                else:  # the tip is out[-1]
+                    out = out[:-2]
+            rings.append(out)
+        if len(rings[0]) < 3:
+            result.append([])
+            continue
+        result.append([rings[0], *(ring for ring in rings[1:] if len(ring) >= 3)])
+    return result
+
+
+def _cancelled(surfaces: list[Surface]) -> list[Surface]:
+    """The surfaces less pairs of one ring run both ways (a fin of no volume: two slivers
+    of a roof's apex snapped onto each other), each left empty."""
+
+    def key(ring: Ring) -> tuple[int, ...]:
+        at = ring.index(min(ring))
+        return tuple(ring[at:] + ring[:at])
+
+    waiting: dict[tuple[int, ...], list[int]] = {}
+    gone: set[int] = set()
+    for index, surface in enumerate(surfaces):
+        if len(surface) != 1 or not surface[0]:
+            continue
+        mine, back = key(surface[0]), key(surface[0][::-1])
+        if waiting.get(back):
+            gone.update((waiting[back].pop(), index))
+        else:
+            waiting.setdefault(mine, []).append(index)
+    return [[] if index in gone else surface for index, surface in enumerate(surfaces)]
 
 
 def _orient(surfaces: list[Surface], points: list[Point]) -> list[Surface] | None:

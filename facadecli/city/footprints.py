@@ -67,7 +67,7 @@ class Footprint:
     properties: dict[str, Any] = field(default_factory=dict)
     repaired: bool = False
     simplified: Simplified | None = None
-    entrances: tuple[tuple[float, float], ...] = ()  # OSM's entrance nodes on its outline
+    entrances: tuple[tuple[float, float], ...] = ()  # entrance nodes or points on its outline
 
 
 @dataclass(frozen=True)
@@ -135,7 +135,8 @@ def read_footprints(
     _check_unique(document, ids)
     rejected: list[Rejected] = []
     warned: list[Rejected] = []
-    readable = _readable(document, ids, rejected, warned, names)
+    doors: list[Found] = []
+    readable = _readable(document, ids, rejected, warned, names, doors)
     inside = readable if bbox is None else [f for f in readable if _within(f[3], bbox)]
     crs = _projected(document.crs, [geometry for *_, geometry in inside])
     inside_ids = {index for index, *_ in inside}
@@ -154,12 +155,20 @@ def read_footprints(
             local = tuple((x - minx, y - miny) for x, y in zip(xs, ys, strict=True))
             footprint = dataclasses.replace(footprint, entrances=local)
         footprints.append(footprint)
+    inside_doors = doors if bbox is None else [d for d in doors if _within(d[3], bbox)]
+    footprints, astray = _with_entrances(
+        footprints, inside_doors, _projection(document.crs, crs), (minx, miny)
+    )
     rejected.sort(key=lambda r: r.index)
     if rejected and not footprints:
         raise _nothing_usable(document, rejected)
     outside = len(readable) - len(inside)
     built = {footprint.id for footprint in footprints}
     warnings = tuple(w for w in warned if w.index in inside_ids and w.id in built)
+    warnings += tuple(
+        _rejected(document, index, fid, ASTRAY.format(x=point.x, y=point.y))
+        for index, fid, _, point in astray
+    )
     return FootprintSet(
         tuple(footprints),
         tuple(rejected),
@@ -182,11 +191,17 @@ def _readable(
     rejected: list[Rejected],
     warned: list[Rejected],
     names: Names | None,
+    doors: list[Found],
 ) -> list[Found]:
     """The features that are polygons, in the file's CRS, their properties checked
-    (:func:`checked_properties`: what is left out is in ``warned``)."""
+    (:func:`checked_properties`: what is left out is in ``warned``); points tagged
+    ``entrance`` go to ``doors`` (:func:`entrance_point`)."""
     found = []
     for index, (fid, feature) in enumerate(zip(ids, document.features, strict=True)):
+        point = entrance_point(feature)
+        if point is not None:
+            doors.append((index, fid, feature["properties"], point))
+            continue
         reason = document.reasons.get(index)
         read = reason if reason is not None else read_feature(feature, document.crs)
         if isinstance(read, str):
@@ -485,6 +500,67 @@ def building_height(properties: dict[str, Any], default: float, floor_height: fl
         if levels is not None and levels > 0:
             return levels * floor_height
     return default
+
+
+ENTRANCE_KEY = "entrance"  # OSM's tag of a building's door
+ON_EDGE = 0.5  # metres: an entrance point this near a footprint's edge is on it
+ASTRAY = f"entrance at ({{x}}, {{y}}) is on no footprint's edge (within {ON_EDGE} m): no door there"
+
+
+def entrance_point(feature: Any) -> shapely.Point | None:
+    """A GeoJSON (or GeoPackage, Shapefile...) feature that is a point tagged
+    ``entrance`` (any value, as OSM's entrance nodes), in the file's CRS; else None."""
+    if not isinstance(feature, dict):
+        return None
+    properties, geometry = feature.get("properties"), feature.get("geometry")
+    if not isinstance(properties, dict) or ENTRANCE_KEY not in properties:
+        return None
+    if not isinstance(geometry, dict) or geometry.get("type") != "Point":
+        return None
+    where = geometry.get("coordinates")
+    if not isinstance(where, list) or len(where) < 2:
+        return None
+    x, y = where[0], where[1]
+    numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (x, y))
+    if not numbers or not all(math.isfinite(v) for v in (x, y)):
+        return None
+    return shapely.Point(float(x), float(y))
+
+
+def _with_entrances(
+    footprints: list[Footprint],
+    doors: list[Found],
+    project: Any,
+    origin: tuple[float, float],
+) -> tuple[list[Footprint], list[Found]]:
+    """The footprints with the entrance points lying on their edges (within ON_EDGE: an
+    outer ring's or a courtyard's) added to their entrances, in local metres; and the
+    points on no footprint's edge (as given). A point on
+    a wall two footprints share goes to both (a party wall gets no façade, so no door)."""
+    if not doors:
+        return footprints, []
+    edges = [
+        shapely.MultiLineString([r for p in f.parts for r in (p.exterior, *p.interiors)])
+        for f in footprints
+    ]
+    tree = shapely.STRtree(edges)
+    added: dict[int, list[tuple[float, float]]] = {}
+    astray = []
+    for index, fid, properties, point in doors:
+        x, y = project(point.x, point.y)
+        local = shapely.Point(x - origin[0], y - origin[1])
+        near = [int(k) for k in tree.query(local, predicate="dwithin", distance=ON_EDGE)]
+        for k in sorted(near):
+            added.setdefault(k, []).append((local.x, local.y))
+        if not near:
+            astray.append((index, fid, properties, point))
+    found = [
+        dataclasses.replace(f, entrances=tuple(dict.fromkeys((*f.entrances, *added[k]))))
+        if k in added
+        else f
+        for k, f in enumerate(footprints)
+    ]
+    return found, astray
 
 
 def _entrances(feature: Any) -> list[tuple[float, float]]:

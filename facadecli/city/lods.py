@@ -63,21 +63,27 @@ class Solid:
 
 
 def solids(feature: dict[str, Any]) -> list[Solid]:
-    """The volumes of a CityJSONFeature, in the order of its objects and geometries."""
+    """The volumes of a CityJSONFeature, in the order of its objects and geometries (a
+    MultiSolid's solids, as a roof's posts, each one)."""
     points = np.asarray(feature["vertices"], dtype=float) * SCALE
     found = []
     for item in feature["CityObjects"].values():
         for geometry in item.get("geometry", []):
-            shells = geometry["boundaries"]
+            boundaries = geometry["boundaries"]
             values = geometry["semantics"]["values"]
             kinds = [entry["type"] for entry in geometry["semantics"]["surfaces"]]
-            if geometry["type"] == "Solid":  # shells of surfaces; a MultiSurface: surfaces
-                shells, values = shells[0], values[0]
-            surfaces = tuple(
-                (kinds[value], [points[ring] for ring in surface])
-                for surface, value in zip(shells, values, strict=True)
-            )
-            found.append(Solid(surfaces))
+            if geometry["type"] == "MultiSolid":  # solids of shells of surfaces
+                pieces = [(s[0], v[0]) for s, v in zip(boundaries, values, strict=True)]
+            elif geometry["type"] == "Solid":  # shells of surfaces
+                pieces = [(boundaries[0], values[0])]
+            else:  # a MultiSurface: surfaces
+                pieces = [(boundaries, values)]
+            for shell, shell_values in pieces:
+                surfaces = tuple(
+                    (kinds[value], [points[ring] for ring in surface])
+                    for surface, value in zip(shell, shell_values, strict=True)
+                )
+                found.append(Solid(surfaces))
     return found
 
 

@@ -224,6 +224,9 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
     "bellcast_gable": "bellcast",
     "mansard": "mansard",
     "saltbox": "saltbox",
+    # a gable whose ridge is moved off the middle, both eaves at one height: the ridge
+    # as the saltbox has it, a third of the depth in, the long slope facing roof:direction
+    "gabled_height_moved": "saltbox",
     "crosspitched": "crosspitched",
     "sawtooth": "sawtooth",
     "butterfly": "butterfly",
@@ -234,14 +237,9 @@ OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built
 }
 
 
-UNBUILT: dict[str, RoofType] = {  # roof:shape OSM documents -> the roof built instead (warned)
-    "gabled_height_moved": "gable",  # a gable whose ridge is off the middle
-}
-
-
 def _tagged_roof(properties: dict[str, Any]) -> Roof | None:
     name = str(properties.get("roof:shape", "")).strip().lower()
-    kind = OSM_ROOFS.get(name) or UNBUILT.get(name)
+    kind = OSM_ROOFS.get(name)
     if kind is None:
         return None
     angle = number(properties.get("roof:angle"))

@@ -35,7 +35,9 @@ SUFFIXES = (".osm.pbf", ".pbf", ".osm", ".osm.bz2", ".osm.gz")
 HINT = "give an OpenStreetMap extract (.osm.pbf or .osm), a GeoPackage or a GeoJSON file"
 SORT = "sort it: osmium sort FILE -o SORTED.osm.pbf"
 LISTED = 5  # missing nodes or members named in a reason
-ENTRANCE = "entrance"  # a node tagged so on a building's way: a door there (entrances.py)
+ENTRANCE = "entrance"  # a node tagged so on a building's way, or on a multipolygon
+# building's outer way: a door there (entrances.py)
+OUTER = ("outer", "")  # roles of a multipolygon's outer ways (none: old multipolygons)
 LOOKED_UP = 2**48  # ids looked up in a second pass: below (libosmium's id set grows with them)
 
 
@@ -135,11 +137,56 @@ def _read(file: str) -> _Drawn:
             tags = _tags(file, "relation", _id(file, "relation", item.id), item.tags)
             members = [(m.type, m.ref, m.role) for m in item.members]
             drawn.relations[item.id] = (tags.get("type", ""), members)
+    _relation_doors(file, drawn)
     for feature in drawn.features:
         kind, oid = feature["id"].split("/")
         if kind == "way" and int(oid) in drawn.doors:
             feature["entrances"] = drawn.doors[int(oid)]
     return drawn
+
+
+def _relation_doors(file: str, drawn: _Drawn) -> None:
+    """The entrances of multipolygon buildings: the entrance nodes of their outer member
+    ways (role ``outer``, or none as in old multipolygons), which the pass over the file
+    did not see when untagged; read in a second pass over those ways only."""
+    drawn_relations = [
+        int(f["id"].split("/")[1]) for f in drawn.features if f["id"].startswith("relation/")
+    ]
+    outers = {
+        oid: [ref for kind, ref, role in drawn.relations[oid][1] if kind == "w" and role in OUTER]
+        for oid in drawn_relations
+        if oid in drawn.relations
+    }
+    if not drawn.entrances or not any(outers.values()):
+        return
+    nodes = _way_nodes(file, {ref for refs in outers.values() for ref in refs})
+    for feature in drawn.features:
+        kind, oid = feature["id"].split("/")
+        if kind != "relation" or int(oid) not in outers:
+            continue
+        doors = [
+            drawn.entrances[node]
+            for ref in outers[int(oid)]
+            for node in nodes.get(ref, ())
+            if node in drawn.entrances
+        ]
+        if doors:
+            feature["entrances"] = list(dict.fromkeys(doors))
+
+
+def _way_nodes(file: str, ids: set[int]) -> dict[int, list[int]]:
+    """The nodes of the ways with these ids the file holds."""
+    import osmium
+
+    ids = {i for i in ids if 0 <= i < LOOKED_UP}
+    if not ids:
+        return {}
+    processor = osmium.FileProcessor(file, osmium.osm.WAY).with_filter(osmium.filter.IdFilter(ids))
+    return {
+        item.id: [node.ref for node in item.nodes]
+        for item in processor
+        if isinstance(item, osmium.osm.Way)
+    }
 
 
 def _add(drawn: _Drawn, kind: str, oid: int, tags: dict[str, str], reason: str = "") -> None:

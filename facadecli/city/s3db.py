@@ -29,8 +29,8 @@ from shapely.geometry import LineString, Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.footprints import MAX_HEIGHT, MIN_AREA, Footprint, length, number
-from facadecli.city.manifest import OSM_ROOFS, UNBUILT, Roof
-from facadecli.city.roofs import roof_height
+from facadecli.city.manifest import OSM_ROOFS, Roof
+from facadecli.city.roofs import Segment, roof_height
 
 MIN_WALL = 0.5  # metres: a roof taller than its building leaves at least this much wall
 SLIVER = 1.0  # metres: what parts leave of an outline narrower than this is a gap in the drawing
@@ -48,15 +48,24 @@ class Heights:
     default: float  # the top when nothing else says
 
 
+POST = 0.25  # metres: the side of a square post under a roof on posts
+Post = tuple[float, float, float, float]  # a square post: its middle (x, y), base and top
+
+
 @dataclass(frozen=True)
 class Volume:
     """One part of a building: walls from ``base`` to ``eaves`` around ``part``, and the
-    roof on them (its ``height`` set: the roof's top is ``eaves + roof.height``)."""
+    roof on them (its ``height`` set: the roof's top is ``eaves + roof.height``).
+    ``still``: its party walls, as segments, where the roof does not slope down but
+    runs on to the wall (roofs.py's fixed walls; :func:`.building.party_volumes` finds
+    them, for the glb's roofs and the CityJSON's alike)."""
 
     part: Polygon
     base: float
     eaves: float
     roof: Roof
+    still: tuple[Segment, ...] = ()
+    posts: tuple[Post, ...] = ()  # a roof on posts: its posts (:func:`roof_solid`)
 
     @property
     def top(self) -> float:
@@ -406,15 +415,16 @@ def roof_only(properties: dict[str, Any]) -> bool:
     )
 
 
-def roof_solid(block: Volume, thickness: float) -> Volume:
+def roof_solid(block: Volume, thickness: float, posts: tuple[Post, ...] = ()) -> Volume:
     """The solid of a roof on posts: the roof on a slab ``thickness`` thick under its
-    eaves (its underside a ceiling open to the air), not walls down to the ground."""
-    return replace(block, base=max(block.base, block.eaves - thickness))
+    eaves (its underside a ceiling open to the air), not walls down to the ground; the
+    ``posts`` it stands on."""
+    return replace(block, base=max(block.base, block.eaves - thickness), posts=posts)
 
 
 def tag_problems(properties: dict[str, Any]) -> list[str]:
     """What of a feature's S3DB tags is not understood, a sentence each (the building is
-    built without it): roof shapes S3DB does not list or that are not built here,
+    built without it): roof shapes S3DB does not list,
     colours that are neither #rgb, #rrggbb nor a CSS name, unknown materials, roof
     directions, orientations and angles that are not one."""
     problems = []
@@ -426,14 +436,10 @@ def tag_problems(properties: dict[str, Any]) -> list[str]:
     shape = properties.get("roof:shape")
     if shape is not None and str(shape).strip():
         name = str(shape).strip().lower()
-        if name not in OSM_ROOFS and name not in UNBUILT:
+        if name not in OSM_ROOFS:
             problems.append(
                 f"{shown('roof:shape')} is not a roof shape of Simple 3D Buildings: "
                 "the manifest's roof instead"
-            )
-        elif name in UNBUILT:
-            problems.append(
-                f"{shown('roof:shape')} is not built here yet: a {UNBUILT[name]} roof instead"
             )
     for key in ("building:colour", "roof:colour"):
         if properties.get(key) is not None and colour(properties[key]) is None:
