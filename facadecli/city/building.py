@@ -434,19 +434,29 @@ def build_building(
                 matrix=matrix,
                 geometry=geometry,
             )
-    top = max(block.top for block in volumes)
-    if posts_only:  # the solids are the roofs: the posts stand in the air under them
-        volumes = [roof_solid(block, SLAB) for block in volumes]
+    solids, top = building_solids(footprint, volumes)
     return BuildingResult(
         scene,
         facades,
         plain,
         party,
-        round(top, 3),
-        tuple(volumes),
+        top,
+        solids,
         dict(sorted(reasons.items())),
         entrances,
     )
+
+
+def building_solids(
+    footprint: Footprint, volumes: Sequence[Volume]
+) -> tuple[tuple[Volume, ...], float]:
+    """A building's solids, as its CityJSON gives them, and its top (metres, to the mm):
+    its volumes, or, for a roof on posts, the roofs (the posts stand in the air under
+    them). What a coarser level of detail needs of a building, with no façade solved."""
+    top = max(block.top for block in volumes)
+    if roof_only(footprint.properties):
+        volumes = [roof_solid(block, SLAB) for block in volumes]
+    return tuple(volumes), round(top, 3)
 
 
 PLAIN_REASONS = ("party", "too_short", "too_low", "no_layout")
