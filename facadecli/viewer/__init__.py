@@ -73,10 +73,11 @@ import {OutputPass} from 'three/addons/postprocessing/OutputPass.js';
 import {SimplexNoise} from 'three/addons/math/SimplexNoise.js';
 const view = document.getElementById('model');
 const status = document.getElementById('status');
+const EXPOSURE = 0.55;  // the sky's light is 2.4 times the houses' (below): walls kept from white
 const renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
 renderer.setPixelRatio(window.devicePixelRatio);
 renderer.toneMapping = THREE.ACESFilmicToneMapping;  // filmic: highlights roll off, no clipping
-renderer.toneMappingExposure = 0.55;  // three's ACES brightens by 1/0.6: pale walls kept from white
+renderer.toneMappingExposure = EXPOSURE;  // three's ACES brightens by 1/0.6 too
 renderer.outputColorSpace = THREE.SRGBColorSpace;
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
@@ -92,6 +93,10 @@ view.appendChild(renderer.domElement);
 // the horizon it fades into, pale sunlit paving nearer; not a dark floor, which made every
 // pane a flat dark slate. Seeded: the same picture every time.
 const SKY = 0xe9edf2;  // the backdrop and the haze the ground fades into
+// as bright on the screen as at the exposure of 0.8 the viewer had before the sky's light
+// rose (the backdrop and haze are tone mapped too): a pale backdrop, not a grey one
+// darker than the ground
+const BACKDROP = new THREE.Color(SKY).multiplyScalar(0.8 / EXPOSURE);
 // The sky is brighter than the houses and paving it lights (in daylight several times
 // brighter than a wall in shade): what glass mirrors of it stands out as it does in a photo.
 const SKY_LIGHT = 2.4;
@@ -152,9 +157,9 @@ function skyEnvironment() {
   return environment;
 }
 const scene = new THREE.Scene();
-scene.background = new THREE.Color(SKY);
+scene.background = BACKDROP;
 scene.environment = skyEnvironment();
-scene.fog = new THREE.Fog(SKY, 1, 2);  // placed by frame(): the model clear, the ground fading out
+scene.fog = new THREE.Fog(BACKDROP, 1, 2);  // placed by frame(): the model clear, the ground fading out
 const sun = new THREE.DirectionalLight(0xfff3e0, 3.4);
 sun.castShadow = true;
 sun.shadow.bias = -0.0002;
