@@ -159,7 +159,8 @@ function skyEnvironment() {
 const scene = new THREE.Scene();
 scene.background = BACKDROP;
 scene.environment = skyEnvironment();
-scene.fog = new THREE.Fog(BACKDROP, 1, 2);  // placed by frame(): the model clear, the ground fading out
+// placed by frame(): the model clear, the ground fading out
+scene.fog = new THREE.Fog(BACKDROP, 1, 2);
 const sun = new THREE.DirectionalLight(0xfff3e0, 3.4);
 sun.castShadow = true;
 sun.shadow.bias = -0.0002;
