@@ -124,6 +124,55 @@ def city_pictures(chrome: str, out: Path, suffix: str = "") -> None:
         print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
 
 
+# the look of every example and of the city block from three cameras, one strip each in
+# docs/pictures/look (issue 35): front, 35° oblique, street level (around, up, zoom, x, y)
+LOOK = TARGET / "look"
+LOOK_VIEWS = ("0,6,1,0.5,0.5", "35,10,1,0.5,0.5", "25,2,1.6,0.5,0.3")
+LOOK_TILE = (600, 373)  # each view's size in a strip (its screenshot is WINDOW, downscaled)
+
+
+def strip(shots: list[Path], target: Path) -> None:
+    """The views side by side in one picture, each downscaled to :data:`LOOK_TILE`."""
+    from PIL import Image
+
+    width, height = LOOK_TILE
+    joined = Image.new("RGB", (width * len(shots), height), "white")
+    for index, shot in enumerate(shots):
+        with Image.open(shot) as image:
+            tile = image.convert("RGB").resize(LOOK_TILE, Image.Resampling.LANCZOS)
+        joined.paste(tile, (index * width, 0))
+    joined.save(target, optimize=True)
+    print(f"{target}: {target.stat().st_size // 1024} KB")
+
+
+def look_pictures(chrome: str, out: Path, suffix: str = "") -> None:
+    """Every example spec (specs/*.yaml) and the 50-building city block from the front, 35°
+    oblique and at street level (:data:`LOOK_VIEWS`), a strip each:
+    ``look/NAME{suffix}.png``."""
+    from facadecli.city.demo import write_demo
+
+    LOOK.mkdir(parents=True, exist_ok=True)
+    facade = [sys.executable, "-m", "facadecli"]
+    run = partial(subprocess.run, check=True, capture_output=True)
+    pages = {}
+    for spec in sorted((ROOT / "specs").glob("*.yaml")):
+        run([*facade, "solve", str(spec), "-o", str(out), "-f", "html"])
+        pages[spec.stem] = out / f"{spec.stem}.html"
+    manifest = write_demo(out / "district", ROOT / "specs", 4)
+    city = out / "city"
+    run([*facade, "city", str(manifest), "-o", str(city), "--limit", str(CITY_BLOCK)])
+    run([*facade, "view", str(city), "-o", str(out / "city-block.html")])
+    pages["city-block"] = out / "city-block.html"
+    for name, page in pages.items():
+        views = LOOK_VIEWS if name != "city-block" else tuple(CITY_VIEWS.values())
+        shots = []
+        for index, view in enumerate(views):
+            shot = out / f"{name}-{index}.png"
+            screenshot(chrome, f"{page.as_uri()}?bare&view={view}", shot, WINDOW, out / "profile")
+            shots.append(shot)
+        strip(shots, LOOK / f"{name}{suffix}.png")
+
+
 SWATCH = 192  # pixels a side of one material on the library's contact sheet
 
 
@@ -158,18 +207,22 @@ def material_sheet(target: Path) -> None:
 
 def main(names: list[str]) -> None:
     """The pictures named (all without names): a spec's from :data:`PICTURES`,
-    ``materials`` (the library's sheet) or ``city`` (the city block's three views;
-    SUFFIX=-before names them for the record of older code)."""
+    ``materials`` (the library's sheet), ``city`` (the city block's three views;
+    SUFFIX=-before names them for the record of older code) or ``look`` (every example
+    and the city block from three cameras, SUFFIX likewise)."""
     everything = not names
     if everything or "materials" in names:
         target = TARGET / "materials.png"
         material_sheet(target)
         print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
-    chosen = [name for name in names if name not in ("materials", "city")]
-    if not (everything or chosen or "city" in names):
+    chosen = [name for name in names if name not in ("materials", "city", "look")]
+    if not (everything or chosen or "city" in names or "look" in names):
         return
     chrome = browser()
     TARGET.mkdir(parents=True, exist_ok=True)
+    if everything or "look" in names:
+        with tempfile.TemporaryDirectory() as scratch:
+            look_pictures(chrome, Path(scratch), os.environ.get("SUFFIX", ""))
     if everything or "city" in names:
         with tempfile.TemporaryDirectory() as scratch:
             city_pictures(chrome, Path(scratch), os.environ.get("SUFFIX", ""))

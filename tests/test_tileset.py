@@ -470,6 +470,10 @@ def test_the_merged_glb_is_at_the_level_of_detail_asked(city: Path, lod: int) ->
 
 def _stored_triangles(glb: Path) -> int:
     document, _ = read_glb(glb.read_bytes())
+    return _stored_triangles_of(document)
+
+
+def _stored_triangles_of(document: dict[str, Any]) -> int:
     return sum(
         document["accessors"][p["indices"]]["count"] // 3
         for mesh in document["meshes"]
@@ -544,3 +548,46 @@ def test_a_viewer_goes_on_through_empty_squares_to_the_content_below(
                 assert tile["geometricError"] == lod2["geometricError"] > 0
             assert tile["geometricError"] <= above["geometricError"]
     assert empty > 0
+
+
+@pytest.mark.parametrize("lod", [1, 2])
+def test_a_coarser_run_solves_no_facade_and_gives_the_same_models(
+    city: Path, tmp_path: Path, lod: int
+) -> None:
+    """``--lod 1`` or ``2`` alone needs no façade: no axis is solved (the solver raises
+    here), yet each building's CityJSON feature, the city's CityJSON and the merged glb
+    are those a full run makes of the same buildings at that level; each building's glb
+    is that level's (the merged glb's part), and a full run resumed over it rebuilds."""
+    name = city.name  # the district's, as the full run's fixture names it
+    district = write_district(tmp_path / f"{name}.osm", _houses(10, seed=3))
+
+    def refuse(*_: Any, **__: Any) -> Any:
+        raise AssertionError("a coarser run solved an axis")
+
+    out = tmp_path / "coarse"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("facadecli.city.building.solve_axis_alternatives", refuse)
+        report = run_city(default_city(district, SPEC), out, merged_lod=lod)
+    assert report["summary"]["ok"] == 10
+    assert all(entry["lod"] == lod and "facades" not in entry for entry in report["buildings"])
+    full = sorted((city / "buildings").rglob("*.city.jsonl"))  # beside the full run's glb
+    coarse = sorted((out / "buildings").rglob("*.city.jsonl"))
+    assert [f.name for f in coarse] == [f.name for f in full]
+    assert [f.read_bytes() for f in coarse] == [f.read_bytes() for f in full]
+    assert (out / f"{name}.city.json").read_bytes() == (city / f"{name}.city.json").read_bytes()
+    document, _ = read_glb((out / f"{name}.glb").read_bytes())
+    meshes = [
+        lod_meshes(feature_of(f.with_name(f.name.replace(".city.jsonl", ".glb"))), lod)
+        for f in full
+    ]
+    assert _stored_triangles_of(document) == sum(
+        len(m.faces) for found in meshes for m in found.values()
+    )
+    for glb in sorted((out / "buildings").rglob("*.glb")):  # each building at the level
+        document, _ = read_glb(glb.read_bytes())
+        assert {m["name"] for m in document["materials"]} == (
+            {"wall"} if lod == 1 else {"wall", "roof"}
+        )
+    again = run_city(default_city(district, SPEC), out, resume=True)
+    assert not any(entry.get("resumed") for entry in again["buildings"])
+    assert all(entry["facades"] >= 0 for entry in again["buildings"])

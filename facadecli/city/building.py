@@ -51,6 +51,7 @@ from facadecli.geometry.facade import (
     metric_uv,
     pbr,
     plane_uv,
+    see_through,
     tangent_space,
     texture_metres,
     weld,
@@ -216,8 +217,9 @@ class AxisCache:
     ) -> tuple[list[tuple[str, trimesh.Trimesh]], PlacedParts] | None:
         """:meth:`facade`, with the parts it places :data:`.MIN_INSTANCES` times or more
         apart, those of :data:`.MIN_TRIANGLES` triangles or more (each in its own frame,
-        with its placements on the wall), for instancing; the walls and the other parts
-        merged per material."""
+        with its placements on the wall), and its panes and their recesses of every size
+        as unit meshes scaled by their placements (:func:`_unit`), for instancing; the
+        walls and the other parts merged per material."""
         picked = self._picked(key, spec, width, height, variants, pick)
         if picked is None:
             return None
@@ -225,7 +227,7 @@ class AxisCache:
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.parts:
             scene = facade_scene(_facade(spec, horizontal, vertical), base_dir)
-            self.parts[slot] = _parts(scene)
+            self.parts[slot] = _parts(scene, _stretchable(spec))
         merged, parts = self.parts[slot]
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
         stretch = np.diag([*scale, 1.0])
@@ -366,8 +368,8 @@ def build_building(
             facades += 1
             out = max(float(mesh.vertices[:, 2].max(initial=0.0)) for _, mesh in meshes)
             for _, mesh, placed in repeated:  # how far they stand out, on the wall
-                top = float(mesh.vertices[:, 2].max(initial=0.0))
-                out = max(out, *(top + float(m[2, 3]) for m in placed))
+                corners = trimesh.bounds.corners(mesh.bounds)
+                out = max(out, *(float((corners @ m[2, :3] + m[2, 3]).max()) for m in placed))
             proud[a] = (direction, out, _wall_material(chosen.spec))
             ends.append((a, b, out))
             for name, mesh in meshes:
@@ -433,18 +435,27 @@ def build_building(
                 matrix=matrix,
                 geometry=geometry,
             )
-    top = max(block.top for block in volumes)
-    volumes = written_volumes(footprint, volumes)  # a roof on posts: the roof, its posts
+    solids, top = building_solids(footprint, volumes)
     return BuildingResult(
         scene,
         facades,
         plain,
         party,
-        round(top, 3),
-        tuple(volumes),
+        top,
+        solids,
         dict(sorted(reasons.items())),
         entrances,
     )
+
+
+def building_solids(
+    footprint: Footprint, volumes: Sequence[Volume]
+) -> tuple[tuple[Volume, ...], float]:
+    """A building's solids, as its CityJSON gives them (:func:`written_volumes`: a roof on
+    posts is its roof and its posts), and its top (metres, to the mm). What a coarser level
+    of detail needs of a building, with no façade solved."""
+    top = max(block.top for block in volumes)
+    return tuple(written_volumes(footprint, volumes)), round(top, 3)
 
 
 PLAIN_REASONS = ("party", "too_short", "too_low", "no_layout")
@@ -745,17 +756,55 @@ def _merged_facade(layout: Layout, base_dir: Path | None) -> FacadeMeshes:
     )
 
 
-def _parts(scene: trimesh.Scene) -> tuple[FacadeMeshes, tuple[Part, ...]]:
+def _stretchable(spec: Spec) -> frozenset[str]:
+    """The materials whose small parts may be stretched to any size (:func:`_unit`): the
+    see-through ones (panes: a faint ripple, stretched, still reads as float glass) and
+    the interior behind them (dark, plain). A visible texture (brick, stone, timber)
+    would be stretched with its part: those parts stay a mesh a size."""
+    names = {name for name in material_names(spec) if see_through(spec, name)}
+    return frozenset(names | {INTERIOR_MATERIAL})
+
+
+def _unit(mesh: trimesh.Trimesh) -> tuple[tuple[bytes, bytes], np.ndarray, np.ndarray]:
+    """A small part as a unit mesh and the matrix that makes it the part again: its
+    vertices moved and scaled into the unit cube (an axis it does not span kept as it
+    is), and the translation x scale back. Parts of one shape and any size (a window's
+    panes, their recesses) give one unit mesh: its key (its rounded vertices and faces)
+    tells them apart from other shapes."""
+    low, high = mesh.bounds
+    extent = high - low
+    extent = np.where(extent > 1e-9, extent, 1.0)
+    vertices = (mesh.vertices - low) / extent
+    vertices = np.round(vertices, 6) + 0.0  # no -0.0: equal shapes give equal bytes
+    back = trimesh.transformations.translation_matrix(low) @ np.diag([*extent, 1.0])
+    key = (vertices.tobytes(), np.asarray(mesh.faces, dtype=np.int64).tobytes())
+    return key, vertices, back
+
+
+def _parts(
+    scene: trimesh.Scene, stretchable: frozenset[str] = frozenset()
+) -> tuple[FacadeMeshes, tuple[Part, ...]]:
     """A façade's meshes placed fewer than :data:`.MIN_INSTANCES` times or of fewer than
     :data:`.MIN_TRIANGLES` triangles, placed and merged per material, and the others
-    each once with their placements, in the order of the scene's nodes."""
+    each once with their placements, in the order of the scene's nodes. A small part in
+    a ``stretchable`` material is a unit mesh (:func:`_unit`), one for all its sizes,
+    its placements scaling it: every pane of a glass, of any size, is one mesh."""
     uses = Counter(scene.graph[node][1] for node in scene.graph.nodes_geometry)
     merged: dict[str, list[trimesh.Trimesh]] = {}
-    parts: dict[str, Part] = {}
+    parts: dict[Any, Part] = {}
     for node in sorted(scene.graph.nodes_geometry):
         matrix, geometry = scene.graph[node]
         mesh = scene.geometry[geometry]
         name = mesh.visual.material.name
+        if len(mesh.faces) < MIN_TRIANGLES and name in stretchable:
+            key, vertices, back = _unit(mesh)
+            unit = (name, *key)
+            if unit not in parts:
+                parts[unit] = (name, vertices, mesh.faces.copy(), ())
+            material, points, faces, placed = parts[unit]
+            placement = np.asarray(matrix, dtype=float) @ back
+            parts[unit] = (material, points, faces, (*placed, placement))
+            continue
         if uses[geometry] < MIN_INSTANCES or len(mesh.faces) < MIN_TRIANGLES:
             merged.setdefault(name, []).append(mesh.copy().apply_transform(matrix))
             continue

@@ -173,9 +173,14 @@ def dressed(meshes: dict[str, trimesh.Trimesh]) -> dict[str, trimesh.Trimesh]:
 
 
 def lod_glb(glb: Path, lod: int) -> bytes:
-    """A building at ``lod`` (1 or 2) as a glb, from the feature beside its own ``glb``:
-    a node a material, named as the full building's are (``<id>/wall``, ``<id>/roof``)."""
+    """A building at ``lod`` (1 or 2) as a glb, from the feature beside its own ``glb``."""
+    return glb_bytes(feature_scene(feature_of(glb), glb.stem, lod))
+
+
+def feature_scene(feature: dict[str, Any], stem: str, lod: int) -> trimesh.Scene:
+    """A building's ``feature`` at ``lod`` (1 or 2): a node a material, named as the full
+    building's are (``<stem>/wall``, ``<stem>/roof``)."""
     scene = trimesh.Scene()
-    for name, part in dressed(lod_meshes(feature_of(glb), lod)).items():
-        scene.add_geometry(part, geom_name=f"{glb.stem}/{name}", node_name=f"{glb.stem}/{name}")
-    return glb_bytes(scene)
+    for name, part in dressed(lod_meshes(feature, lod)).items():
+        scene.add_geometry(part, geom_name=f"{stem}/{name}", node_name=f"{stem}/{name}")
+    return scene

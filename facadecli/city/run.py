@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
+import json
 import os
 import queue
 import re
@@ -35,6 +36,7 @@ from facadecli.city.building import (
     Looks,
     Slot,
     build_building,
+    building_solids,
     facade_axes,
     rung_length,
     solve_rung,
@@ -43,6 +45,7 @@ from facadecli.city.built import BuiltCity, attributes, feature_file
 from facadecli.city.cityjson import (
     BuildingSolids,
     building_object,
+    cityjson_bytes,
     write_cityjson,
 )
 from facadecli.city.folders import BUILDINGS, SHARD, building_file, safe_name
@@ -55,6 +58,7 @@ from facadecli.city.footprints import (
     read_footprints,
 )
 from facadecli.city.georef import Georef, georeference
+from facadecli.city.lods import feature_scene
 from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.report import CityReport, Entries, Summary, Tally
 from facadecli.city.resume import building_hashes, recorded, reusable, stamped
@@ -109,6 +113,7 @@ class Task:
     usd: bool = False  # a USD stage beside the glb (``--usd``)
     above: Any = None  # the taller parts standing on this one: its roof leaves them out
     instanced: bool = False  # repeated parts as GPU instances (``--instance``)
+    level: int = 3  # the finest level of detail the run needs: below 3, no façade is solved
 
     @property
     def file(self) -> str:
@@ -123,7 +128,10 @@ Axes = tuple[AxisLayout, ...]  # an axis's layouts at a rung: the best and its v
 
 
 def _needs(task: Task) -> list[Slot]:
-    """The axes a building will solve, to solve them all ahead, once each."""
+    """The axes a building will solve, to solve them all ahead, once each (none for a
+    run of coarser levels of detail only)."""
+    if task.level < 3:
+        return []
     found = facade_axes(
         task.footprint,
         task.heights,
@@ -167,6 +175,8 @@ def axes_solved_while_building() -> int:
 
 def build(task: Task) -> dict[str, Any]:
     """Build one building and write its glb; never raises (failures are reported)."""
+    if task.level < 3:
+        return _build_coarse(task)
     started = time.perf_counter()
     cache = _CACHE.setdefault("axes", AxisCache())
     try:
@@ -219,6 +229,40 @@ def build(task: Task) -> dict[str, Any]:
     }
 
 
+def _build_coarse(task: Task) -> dict[str, Any]:
+    """A building of a run that needs no façades (``--lod 1`` or ``2``): its volumes and
+    roofs alone, no axis solved. Its CityJSON feature is the one a full build writes (the
+    volumes do not depend on the façades), and its glb (and USD layer) is the feature at
+    the run's level (lods.py): what the merged models and the tiles make of it anyway."""
+    started = time.perf_counter()
+    try:
+        volumes = [volume(part, task.heights, task.roof) for part in task.footprint.parts]
+        solids, top = building_solids(task.footprint, volumes)
+        feature = building_object(BuildingSolids(task.footprint.id, solids, attributes(task, top)))
+        write_cityjson(feature_file(task.target), feature)
+        scene = feature_scene(json.loads(cityjson_bytes(feature)), task.target.stem, task.level)
+        write_atomic(task.target, glb_bytes(scene))
+        if task.usd:
+            write_atomic(task.target.with_suffix(".usda"), usda_text(scene, task.target.stem))
+    except Exception as error:
+        return {
+            "id": task.footprint.id,
+            "status": "failed",
+            "error": f"{type(error).__name__}: {error}",
+            "time_ms": round((time.perf_counter() - started) * 1000, 1),
+        }
+    return {
+        "id": task.footprint.id,
+        "status": "ok",
+        "file": task.file,
+        "lod": task.level,
+        "height": top,
+        "repaired": task.footprint.repaired,
+        **_simplified(task.footprint.simplified),
+        "time_ms": round((time.perf_counter() - started) * 1000, 1),
+    }
+
+
 def _pick(seed: int, building_id: str) -> int:
     """A building's own number from the manifest's seed and its id: which of the variants
     and palette colours it takes, the same on every run and machine."""
@@ -250,8 +294,10 @@ def plan(
     outdir: Path,
     usd: bool = False,
     instanced: bool = False,
+    level: int = 3,
 ) -> list[Task]:
-    """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
+    """One task a building, built to ``level`` of detail (below 3: no façades). Paths are
+    absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
@@ -320,6 +366,7 @@ def plan(
                 usd,
                 above.get(footprint.id),
                 instanced,
+                level,
             )
         )
     return tasks
@@ -494,7 +541,8 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    ahead = planned(city, outdir, bbox, limit, usd, instanced)
+    level = max((*lods, merged_lod))  # the finest any output needs
+    ahead = planned(city, outdir, bbox, limit, usd, instanced, level)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
             city,
@@ -535,6 +583,7 @@ def planned(
     limit: int | None = None,
     usd: bool = False,
     instanced: bool = False,
+    level: int = 3,
 ) -> Planned:
     """The footprints read (those in ``bbox``), an outline's tags given to its parts, the
     outlines with parts cut to what they leave, collinear nodes merged, the first
@@ -546,7 +595,11 @@ def planned(
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
     return Planned(
-        found, replaced, kept, straight, plan(city, footprints, outdir.resolve(), usd, instanced)
+        found,
+        replaced,
+        kept,
+        straight,
+        plan(city, footprints, outdir.resolve(), usd, instanced, level),
     )
 
 

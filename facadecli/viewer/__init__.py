@@ -73,47 +73,94 @@ import {OutputPass} from 'three/addons/postprocessing/OutputPass.js';
 import {SimplexNoise} from 'three/addons/math/SimplexNoise.js';
 const view = document.getElementById('model');
 const status = document.getElementById('status');
+const EXPOSURE = 0.55;  // the sky's light is 2.4 times the houses' (below): walls kept from white
 const renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
 renderer.setPixelRatio(window.devicePixelRatio);
 renderer.toneMapping = THREE.ACESFilmicToneMapping;  // filmic: highlights roll off, no clipping
-renderer.toneMappingExposure = 0.8;  // three's ACES brightens by 1/0.6: pale walls kept from white
+renderer.toneMappingExposure = EXPOSURE;  // three's ACES brightens by 1/0.6 too
 renderer.outputColorSpace = THREE.SRGBColorSpace;
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
 renderer.shadowMap.autoUpdate = false;  // the scene holds still: drawn again when a model comes
 view.appendChild(renderer.domElement);
-// The light of an overcast-bright day: a sky dome (blue overhead, pale at the horizon, a warm
-// glow round the sun, grey-brown ground below), prefiltered (PMREM) into the environment
-// every material is lit and reflects by, and a sun casting soft shadows.
+// The light of a bright day, as a product shot takes it: a sky (blue overhead, pale at
+// the horizon, a warm glow round the sun) over a town's skyline and a street, drawn into an
+// equirectangular picture, prefiltered (PMREM) into the environment every material is lit
+// by and reflects, and a sun casting soft shadows. What glass mirrors is mostly this
+// picture's horizon band (a pane seen from the front or a street mirrors the skyline, the
+// street and the sky just over them), so the band is drawn as a street sees it: distant
+// houses in the haze of their distance (aerial perspective), the far paving as bright as
+// the horizon it fades into, pale sunlit paving nearer; not a dark floor, which made every
+// pane a flat dark slate. Seeded: the same picture every time.
 const SKY = 0xe9edf2;  // the backdrop and the haze the ground fades into
+// as bright on the screen as at the exposure of 0.8 the viewer had before the sky's light
+// rose (the backdrop and haze are tone mapped too): a pale backdrop, not a grey one
+// darker than the ground
+const BACKDROP = new THREE.Color(SKY).multiplyScalar(0.8 / EXPOSURE);
+// The sky is brighter than the houses and paving it lights (in daylight several times
+// brighter than a wall in shade): what glass mirrors of it stands out as it does in a photo.
+const SKY_LIGHT = 2.4;
 const sunDirection = new THREE.Vector3(-0.45, 0.72, 0.53).normalize();  // front left, 46 degrees up
 function skyEnvironment() {
-  const dome = new THREE.SphereGeometry(1, 96, 48);
+  const width = 1024, height = 512, data = new Float32Array(width * height * 4);
   const zenith = new THREE.Color(0x86a9d6), horizon = new THREE.Color(0xf1f4f7);
-  const ground = new THREE.Color(0x7a7266), glow = new THREE.Color(0xfff1dc);
-  const colours = [], normal = new THREE.Vector3(), colour = new THREE.Color();
-  const points = dome.attributes.position;
-  for (let i = 0; i < points.count; i++) {
-    normal.fromBufferAttribute(points, i);
-    if (normal.y >= 0) colour.copy(horizon).lerp(zenith, Math.pow(normal.y, 0.6));
-    else colour.copy(horizon).lerp(ground, Math.min(1, -normal.y * 5));
-    colour.multiplyScalar(0.6).add(glow.clone().multiplyScalar(
-      3 * Math.pow(Math.max(0, normal.dot(sunDirection)), 24)));
-    colours.push(colour.r, colour.g, colour.b);
+  zenith.multiplyScalar(SKY_LIGHT); horizon.multiplyScalar(SKY_LIGHT);
+  const paving = new THREE.Color(0xb3ada3), glow = new THREE.Color(0xfff1dc);
+  const houses = [0xd8cfc2, 0xc9b8a4, 0xe4dfd6, 0xb9a48f, 0xcfd3d6].map(c => new THREE.Color(c));
+  let seed = 7;  // mulberry32: the skyline's houses, the same each time
+  const random = () => {
+    seed = (seed + 0x6D2B79F5) | 0;
+    let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
+    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  };
+  const skyline = [];  // [from, to) of the azimuth (0..1), the top (sine of its angle), tone
+  for (let at = 0; at < 1;) {
+    const wide = 0.006 + 0.018 * random();
+    skyline.push([at, at + wide, 0.015 + 0.07 * random() * random(), houses[(random() * 5) | 0],
+                  0.55 + 0.3 * random()]);
+    at += wide;
   }
-  dome.setAttribute('color', new THREE.Float32BufferAttribute(colours, 3));
-  const sky = new THREE.Scene();
-  const material = new THREE.MeshBasicMaterial({vertexColors: true, side: THREE.BackSide});
-  sky.add(new THREE.Mesh(dome, material));
+  const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
+  let block = 0;
+  for (let row = 0; row < height; row++) {
+    const elevation = ((row + 0.5) / height - 0.5) * Math.PI, y = Math.sin(elevation);
+    block = 0;
+    for (let column = 0; column < width; column++) {
+      const u = (column + 0.5) / width, azimuth = (u - 0.5) * 2 * Math.PI;
+      direction.set(Math.cos(azimuth) * Math.cos(elevation), y,  // as three reads it
+                    Math.sin(azimuth) * Math.cos(elevation));
+      if (y >= 0) {
+        colour.copy(horizon).lerp(zenith, Math.pow(y, 0.6));
+        while (skyline[block][1] <= u) block++;
+        const [, , top, tone, light] = skyline[block];
+        if (y < top) {  // a house far off: lit by the sky, half lost in the haze
+          house.copy(tone).multiplyScalar(light);
+          colour.copy(horizon).lerp(house, 0.85 - 3 * y);
+        }
+      } else {  // the street: the far paving in the horizon's haze, sunlit paving nearer
+        colour.copy(horizon).lerp(paving, Math.min(1, Math.pow(-y * 3, 0.7)));
+      }
+      colour.add(glow.clone().multiplyScalar(
+        2.5 * Math.pow(Math.max(0, direction.dot(sunDirection)), 24)));
+      const at = (row * width + column) * 4;  // row 0: straight down
+      data[at] = colour.r; data[at + 1] = colour.g; data[at + 2] = colour.b; data[at + 3] = 1;
+    }
+  }
+  const picture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
+  picture.mapping = THREE.EquirectangularReflectionMapping;
+  picture.flipY = false;
+  picture.needsUpdate = true;
   const prefilter = new THREE.PMREMGenerator(renderer);
-  const environment = prefilter.fromScene(sky, 0.02).texture;
-  prefilter.dispose(); dome.dispose(); material.dispose();
+  const environment = prefilter.fromEquirectangular(picture).texture;
+  prefilter.dispose(); picture.dispose();
   return environment;
 }
 const scene = new THREE.Scene();
-scene.background = new THREE.Color(SKY);
+scene.background = BACKDROP;
 scene.environment = skyEnvironment();
-scene.fog = new THREE.Fog(SKY, 1, 2);  // placed by frame(): the model clear, the ground fading out
+// placed by frame(): the model clear, the ground fading out
+scene.fog = new THREE.Fog(BACKDROP, 1, 2);
 const sun = new THREE.DirectionalLight(0xfff3e0, 3.4);
 sun.castShadow = true;
 sun.shadow.bias = -0.0002;
@@ -206,12 +253,19 @@ function dispose(object) {
     }
   });
 }
-function castsShadows(model) {  // everything opaque casts and takes shadows; glass lets light by
+// Everything opaque casts and takes shadows; glass lets light by. Glass (a material with
+// KHR_materials_transmission) is drawn by its transmission alone: its alpha is the glb's
+// fallback for viewers without the extension, and blending by it too would dim the pane's
+// reflection to a third (a dark pane) and count what lies behind it twice.
+function castsShadows(model) {
   model.traverse(part => {
     if (!part.isMesh) return;
     const materials = Array.isArray(part.material) ? part.material : [part.material];
     part.castShadow = materials.every(m => !m.transparent && !(m.transmission > 0));
     part.receiveShadow = true;
+    for (const material of materials.filter(m => m.transmission > 0)) {
+      material.transparent = false; material.opacity = 1; material.depthWrite = true;
+    }
   });
 }
 // ?view=ANGLE,ELEVATION,ZOOM,X,Y: seen from ANGLE degrees around and ELEVATION up, ZOOM
