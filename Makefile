@@ -14,8 +14,8 @@ VALIDATOR := $(VENV)/node/node_modules/gltf-validator
 help: ## Show the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-9s %s\n", $$1, $$2}'
 
-# the exact search is compiled from network.py and network.pxd: editing either reinstalls (rebuilds it)
-$(STAMP): pyproject.toml setup.py facadecli/grammar/_adp.c facadecli/solver/network.py facadecli/solver/network.pxd
+# the searches are compiled from adp.py/.pxd and network.py/.pxd: editing one reinstalls (rebuilds them)
+$(STAMP): pyproject.toml setup.py facadecli/grammar/adp.py facadecli/grammar/adp.pxd facadecli/solver/network.py facadecli/solver/network.pxd
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[all,test,lint,docs]'

@@ -6,8 +6,9 @@ Both extensions are optional: where they cannot be built (no C compiler, no Pyth
 headers) the install goes on without them, and facadecli runs the same searches in pure
 Python (``facadecli.native`` says which is in use: ``facadecli.native.describe()``).
 
-The exact alignment search's walk is ``facadecli/solver/network.py`` itself, compiled by
-Cython (its types in ``network.pxd``): the module is stamped with the digest of the sources
+Each is a ``.py`` module compiled by Cython (its types in the ``.pxd`` beside it): the
+grammar search's loop ``facadecli/grammar/adp.py`` and the exact alignment search's walk
+``facadecli/solver/network.py``. A compiled module is stamped with the digest of the sources
 it was built from, so that ``facadecli.native`` never runs a compiled module older than its
 source.
 
@@ -29,8 +30,9 @@ from setuptools.errors import CCompilerError, ExecError, PlatformError
 NOTE = "facadecli: C compiler not available, using the pure-Python search (slower)"
 FAILURES = (CCompilerError, ExecError, PlatformError, OSError, ValueError)
 
+GRAMMAR_SEARCH = "facadecli.grammar.adp"  # compiled from facadecli/grammar/adp.py by Cython
 EXACT_SEARCH = "facadecli.solver.network"  # compiled from facadecli/solver/network.py by Cython
-CYTHONIZED = (EXACT_SEARCH,)
+CYTHONIZED = (GRAMMAR_SEARCH, EXACT_SEARCH)
 STAMP = "COMPILED_FROM: str | None = None"  # the line of the .py that says what it was built from
 # the .pxd types the arrays' elements: no bounds or sign checks on their indices
 DIRECTIVES = {
@@ -121,10 +123,7 @@ setup(
     cmdclass={"build_ext": OptionalBuildExt, "build_py": BuildPyWithExamples},
     ext_modules=[
         Extension(
-            "facadecli.grammar._adp",
-            ["facadecli/grammar/_adp.c"],
-            extra_compile_args=["-O2", "-Wall", "-Wextra", "-Wno-unused-parameter"],
-            optional=True,
+            GRAMMAR_SEARCH, ["facadecli/grammar/adp.py"], extra_compile_args=["-O3"], optional=True
         ),
         Extension(
             EXACT_SEARCH, ["facadecli/solver/network.py"], extra_compile_args=["-O3"], optional=True

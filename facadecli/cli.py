@@ -87,7 +87,7 @@ def _not_built() -> list[str]:
     here = Path(__file__).parent
     return [
         what
-        for what, stem in (("grammar", "grammar/_adp"), ("alignment", "solver/network"))
+        for what, stem in (("grammar", "grammar/adp"), ("alignment", "solver/network"))
         if not any((here / f"{stem}{suffix}").exists() for suffix in EXTENSION_SUFFIXES)
     ]
 
@@ -830,7 +830,7 @@ def grammar(
         typer.Option(
             "--time-limit",
             min=0.1,
-            help="Seconds for the whole run, reading included; the search keeps the best "
+            help="CPU seconds for the whole run, reading included; the search keeps the best "
             "grammar so far (reached, the result depends on the machine's speed).",
         ),
     ] = 120.0,

@@ -1,15 +1,16 @@
 """The compiled inner loops, where this install has them: the one place that says, per
 module, whether it runs compiled or as Python.
 
-- ``facadecli.grammar._adp`` (``_adp.c``): the grammar search (``facade grammar``); without
-  it :mod:`facadecli.grammar.plain` runs the same search, giving the same grammars.
+- :mod:`facadecli.grammar.adp`: the grammar search's inner loop (``facade grammar``).
 - :mod:`facadecli.solver.network`: the exact alignment search's walk through the network
   (every ``facade solve`` that the constructions leave a question to) and the elimination
-  of the sizing's equalities. setup.py compiles ``network.py`` itself with Cython (types in
-  ``network.pxd``) where there is a C compiler; without one the same file runs
-  interpreted, slower, giving the same layouts. A compiled module built from another
-  version of ``network.py`` or ``network.pxd`` (an editable install whose sources changed
-  since) is never used: the source runs instead.
+  of the sizing's equalities.
+
+setup.py compiles each ``.py`` itself with Cython (its types in the ``.pxd`` beside it) where
+there is a C compiler; without one the same file runs interpreted, slower, giving the same
+grammars and layouts. A compiled module built from another version of its ``.py`` or
+``.pxd`` (an editable install whose sources changed since) is never used: the source runs
+instead.
 
 setup.py builds them when it can and installs without them when there is no C compiler.
 """
@@ -23,12 +24,7 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-try:
-    from facadecli.grammar import _adp
-except ImportError:  # installed without a C compiler
-    _adp = None  # type: ignore[assignment]
-
-GRAMMAR_COMPILED: bool = _adp is not None
+GRAMMAR_SEARCH = "facadecli.grammar.adp"
 EXACT_SEARCH = "facadecli.solver.network"
 STALE: set[str] = set()  # modules whose compiled build was passed over for their source
 
@@ -72,21 +68,19 @@ def compiled(module: ModuleType) -> bool:
 
 def describe() -> str:
     """One line on which searches run compiled (for a bug report, or a doctor command)."""
-    search = load(EXACT_SEARCH)
 
-    def which(compiled: bool, stale: bool = False) -> str:
-        if stale:
+    def which(name: str) -> str:
+        module = load(name)
+        if name in STALE:
             return "pure Python (its compiled build is older than its source: reinstall)"
-        return "compiled" if compiled else "pure Python (no C compiler at install)"
+        return "compiled" if compiled(module) else "pure Python (no C compiler at install)"
 
-    exact = which(compiled(search), EXACT_SEARCH in STALE)
-    return f"grammar search: {which(GRAMMAR_COMPILED)}; exact search: {exact}"
+    return f"grammar search: {which(GRAMMAR_SEARCH)}; exact search: {which(EXACT_SEARCH)}"
 
 
 __all__ = [
     "EXACT_SEARCH",
-    "GRAMMAR_COMPILED",
-    "_adp",
+    "GRAMMAR_SEARCH",
     "compiled",
     "describe",
     "load",

@@ -37,8 +37,9 @@ def test_version() -> None:
     assert result.returncode == 0
     lines = result.stdout.splitlines()
     assert lines[0] == f"facade {__version__}"
-    exact = native.compiled(native.load(native.EXACT_SEARCH))
-    assert len(lines) == (1 if exact and native.GRAMMAR_COMPILED else 2)
+    searches = (native.EXACT_SEARCH, native.GRAMMAR_SEARCH)
+    compiled = all(native.compiled(native.load(name)) for name in searches)
+    assert len(lines) == (1 if compiled else 2)
 
 
 def test_validate_accepts_every_example() -> None:

@@ -135,11 +135,13 @@ def test_the_heuristic_charges_lines_that_cut_repeated_regions() -> None:
     # two bays (wall, window) and a wider wall: the bays repeat
     layout = LabelledLayout(5.5, 3.0, (Rect("window", 1, 1, 2, 2), Rect("window", 3, 1, 4, 2)))
     search = Search(tile(layout, 0))
-    # lines 1 and 3 (x = 1 and 3) cut a bay of 6 cells in a region of 15; 2 and 4 do not
-    assert search._line_costs(search.whole, "x") == pytest.approx({1: 0.4, 3: 0.4})
+    # lines 1 and 3 (x = 1 and 3) cut a bay of 6 cells in a region of 15; 2 and 4 do not;
     # both horizontal lines cut both bays
-    assert search._line_costs(search.whole, "y") == pytest.approx({1: 0.8, 2: 0.8})
+    line_costs = {"x": {1: 0.4, 3: 0.4}, "y": {1: 0.8, 2: 0.8}}
     ranked = search.actions(search.whole)
+    for a in ranked:  # Eq. 5: the rule's cost and the cost of each line it cuts
+        cut = sum(line_costs[a.axis].get(line, 0.0) for line in a.bounds[1:-1])
+        assert a.heuristic == pytest.approx(a.cost + cut), a
     assert ranked == sorted(ranked, key=lambda a: (a.heuristic, a.cost, a.axis, a.bounds))
     assert all(a.heuristic >= a.cost for a in ranked)
     assert (ranked[0].axis, ranked[0].bounds) in {("x", (0, 2, 5)), ("x", (0, 4, 5))}

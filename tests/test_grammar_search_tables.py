@@ -1,25 +1,24 @@
-"""The search's fast tables give what the plain definitions give, to the bit: the compiled
-inner loop (``_adp``) what the plain Python loop gives (``facadecli.grammar.plain``), the merged
-cost what ``Search.canonical`` gives, the rank of a cut in two, and the size test that spares
-computing contents."""
+"""The grammar search's tables (:mod:`facadecli.grammar.adp`) against plain definitions: the
+merged cost against ``Search.canonical``'s merging, what each rule reaches against the
+rules' parts, a time limit of nothing, and the search run interpreted (Cython not
+installed) against the installed build: the same grammars."""
 
 from __future__ import annotations
 
-import itertools
+import json
 import math
 import random
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
 
 import pytest
 
-from facadecli.grammar import plain
-from facadecli.grammar.search import Action, Entry, Search
-from facadecli.grammar.split import Axis
+from facadecli.grammar import adp
+from facadecli.grammar import search as search_module
+from facadecli.grammar.search import Action, Search
 from facadecli.grammar.tiling import LabelledLayout, Rect, tile
-from facadecli.native import GRAMMAR_COMPILED
-
-needs_adp = pytest.mark.skipif(
-    not GRAMMAR_COMPILED, reason="compares _adp.c with Python: this install has no compiled _adp"
-)
 
 
 def _layout(seed: int) -> LabelledLayout:
@@ -35,14 +34,26 @@ def _layout(seed: int) -> LabelledLayout:
     return LabelledLayout(8.0, 6.0, tuple(rects))
 
 
+def _random_grammar(search: Search, rng: random.Random) -> dict[int, Action]:
+    """A grammar of random actions: regions top down, each content's first region taking
+    one of its actions at random."""
+    grid = search.grid
+    rules: dict[int, Action] = {}
+    waiting = [search.whole]
+    while waiting:
+        region = waiting.pop(0)
+        cid = grid.content(region)
+        if cid in rules or cid in grid.terminal:
+            continue
+        action = rules[cid] = rng.choice(search.actions(region))
+        waiting.extend(action.written)
+    return rules
+
+
 def _grammars(search: Search, seed: int, count: int) -> list[dict[int, Action]]:
     """The greedy grammar and ``count`` grammars of random actions."""
     rng = random.Random(seed)
-
-    def any_action(entry: Entry, rules: dict[int, Action], pending: set[int]) -> Action:
-        return rng.choice(search.actions_at(entry))
-
-    return [search.greedy(), *(plain.build(search, any_action) for _ in range(count))]
+    return [search.greedy(), *(_random_grammar(search, rng) for _ in range(count))]
 
 
 def _plain_cost(search: Search, rules: dict[int, Action]) -> float:
@@ -52,6 +63,31 @@ def _plain_cost(search: Search, rules: dict[int, Action]) -> float:
         if same[cid] == cid:
             cost += rules[cid].cost
     return cost
+
+
+def _plain_reach(search: Search, rules: dict[int, Action]) -> list[set[int]]:
+    """Per rule, the positions of the rules below it, itself included (by its parts)."""
+    position = {cid: i for i, cid in enumerate(rules)}
+    found: dict[int, set[int]] = {}
+
+    def below(cid: int) -> set[int]:
+        if cid not in found:
+            reached = {position[cid]}
+            for sub in rules[cid].cids:
+                if sub in rules:
+                    reached |= below(sub)
+            found[cid] = reached
+        return found[cid]
+
+    return [below(cid) for cid in rules]
+
+
+def _region_of(action: Action) -> tuple[int, int, int, int]:
+    """The region an action splits."""
+    (r0, r1, c0, c1), (lo, hi) = action.written[0], (action.bounds[0], action.bounds[-1])
+    if action.op == "gridsplit":
+        return (lo, hi, action.across[0], action.across[-1])
+    return (r0, r1, lo, hi) if action.axis == "x" else (lo, hi, c0, c1)
 
 
 EXTENSIONS: list[tuple[str, ...]] = [(), ("repeatABA", "symsplit", "gridsplit")]
@@ -67,126 +103,68 @@ def test_the_survey_gives_the_merged_cost_and_what_each_rule_reaches(
         cost, reach = search.survey(rules)
         assert cost == _plain_cost(search, rules)  # the same sum, in the same order
         assert search.cost(rules) == cost
-        plain_cost, plain_reach = plain.survey(search, rules)
-        assert (cost, [set(r) for r in reach]) == (plain_cost, plain_reach)
+        assert [set(r) for r in reach] == _plain_reach(search, rules)
 
 
-def _described(search: Search, region: tuple[int, int, int, int]) -> list[tuple[object, ...]]:
-    """A region's actions as the compiled search describes its own."""
-    return [
-        (a.op, a.axis, a.bounds, a.across, a.count, int(a.centre), a.cost, a.heuristic)
-        for a in search.actions(region)
-    ]
-
-
-@needs_adp
-@pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("extensions", EXTENSIONS)
-def test_the_compiled_search_offers_each_region_the_actions_python_offers(
-    seed: int, extensions: tuple[str, ...]
-) -> None:
-    # every region of the tiling with two labels or more, in a random order (contents are
-    # numbered as met, and equal contents must be found equal whatever the order)
-    search = Search(tile(_layout(seed), 0), extensions=extensions)
-    grid = search.grid
-    regions = [
-        (r0, r1, c0, c1)
-        for r0, r1 in itertools.combinations(range(grid.rows + 1), 2)
-        for c0, c1 in itertools.combinations(range(grid.columns + 1), 2)
-        if grid.content((r0, r1, c0, c1)) not in grid.terminal
-    ]
-    random.Random(seed).shuffle(regions)
-    compared = 0
-    for region in regions[:400]:
-        assert search._table is not None
-        compiled = search._table.describe(search._table.entry(*region))
-        assert compiled == _described(search, region), region
-        compared += len(compiled)
-    assert compared > 400
-
-
-@pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("extensions", EXTENSIONS)
-def test_the_compiled_loop_builds_the_grammars_the_plain_loop_builds(
-    seed: int, extensions: tuple[str, ...]
-) -> None:
-    layout = tile(_layout(seed), 0)
-    fast = Search(layout, extensions=extensions)
-    reference = Search(layout, extensions=extensions)
-    greedy = plain.greedy(reference)
-    assert greedy is not None  # no time limit
-    assert _shape(fast.greedy()) == _shape(greedy)
-    for iterations in (1, 2, 60):
-        rules, best_at, done = fast.adp(iterations, seed)
-        expected, expected_at, _ = plain.adp(reference, iterations, seed)
-        assert (_shape(rules), best_at, done) == (_shape(expected), expected_at, iterations)
-        assert fast.cost(rules) == reference.cost(expected)
-
-
-@needs_adp
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("extensions", EXTENSIONS)
-def test_the_search_without_adp_gives_the_compiled_searchs_grammars(
+def test_each_region_is_offered_its_best_actions_in_order(
     seed: int, extensions: tuple[str, ...]
 ) -> None:
-    """Where the install has no compiled ``_adp`` the plain loop runs: the same contents
-    (each numbered as met), the same regions explored, the same grammars."""
-    layout = tile(_layout(seed), 0)
-    fast = Search(layout, extensions=extensions, compiled=True)
-    python = Search(layout, extensions=extensions, compiled=False)
-    assert python._table is None and python.grid.table is None
-    assert _shape(fast.greedy()) == _shape(python.greedy())
-    rules, best_at, done = fast.adp(60, seed)
-    found, found_at, found_done = python.adp(60, seed)
-    assert (_shape(found), found_at, found_done) == (_shape(rules), best_at, done)
-    assert python.survey(found) == fast.survey(rules)
-    assert python.grammar(found) == fast.grammar(rules)
-    assert python.regions_explored == fast.regions_explored
+    """At most twelve actions (eight structural cuts, then cuts in two), ranked by
+    (heuristic, cost, axis, bounds), each a rule whose cost is Eq. 2's."""
+    search = Search(tile(_layout(seed), 0), extensions=extensions)
+    costs = search.costs
+    for rules in _grammars(search, seed, 5):
+        for action in rules.values():
+            region = _region_of(action)
+            ranked = search.actions(region)
+            assert 1 <= len(ranked) <= 12 and action in ranked
+            assert ranked == sorted(ranked, key=lambda a: (a.heuristic, a.cost, a.axis, a.bounds))
+            for a in ranked:
+                repeat = a.op in ("repeat", "repeatABA")
+                assert a.cost == (costs.repeat if repeat else costs.split) + len(a.written)
+                assert a.heuristic >= a.cost
 
 
-def _shape(rules: dict[int, Action]) -> list[tuple[object, ...]]:
-    """A grammar's rules in order, without content numbers (each search numbers its own)."""
-    return [
-        (a.op, a.axis, a.bounds, a.across, a.written, a.count, a.centre, a.cost, a.heuristic)
-        for a in rules.values()
-    ]
-
-
-@pytest.mark.parametrize("compiled", [pytest.param(True, marks=needs_adp), False])
-def test_a_time_limit_of_nothing_stops_adp_after_the_greedy_grammar(compiled: bool) -> None:
-    search = Search(tile(_layout(3), 0), compiled=compiled)
+def test_a_time_limit_of_nothing_stops_adp_after_the_greedy_grammar() -> None:
+    search = Search(tile(_layout(3), 0))
     search.deadline.seconds = 0.0
     rules, best_at, done = search.adp(50, 0)
     assert (rules, best_at) == (search.greedy(), 0) and done == 1
     assert math.isfinite(search.cost(rules))
 
 
-@pytest.mark.parametrize("seed", range(8))
-def test_a_cut_in_two_is_ranked_as_its_action_would_be(seed: int) -> None:
-    search = Search(tile(_layout(seed), 0), extensions=("repeatABA", "symsplit"))
-    _grammars(search, seed, 5)  # to visit regions
-    for region in [search.whole, *search._actions]:
-        r0, r1, c0, c1 = region
-        spans: tuple[tuple[Axis, int, int], ...] = (("x", c0, c1), ("y", r0, r1))
-        for axis, lo, hi in spans:
-            costs = search._line_costs(region, axis)
-            for line in range(lo + 1, hi):
-                bounds = (lo, line, hi)
-                action = search._action(region, axis, bounds, costs)
-                assert action is not None
-                rank = (action.heuristic, action.cost, action.axis, action.bounds)
-                assert search._rank_in_two(region, axis, bounds, costs) == rank
+def _grammars_found(seeds: list[int]) -> list[list[object]]:
+    """Greedy's and ADP's grammars (60 iterations, each extension set) of the layouts of
+    these seeds, as text (the terminals sorted: a set's order varies between processes)."""
+    found = []
+    for seed in seeds:
+        for extensions in EXTENSIONS:
+            tiling = tile(_layout(seed), 0)
+            result = search_module.extract(tiling, "adp", 60, 3, extensions=extensions)
+            grammar = result.grammar
+            text = [grammar.start, repr(grammar.rules), sorted(grammar.terminals)]
+            found.append([*text, grammar.cost, result.best_iteration, result.regions])
+    return found
 
 
-@pytest.mark.parametrize("seed", range(8))
-def test_parts_of_one_content_are_never_told_apart_by_size(seed: int) -> None:
-    search = Search(tile(_layout(seed), 0))
-    grid = search.grid
-    axes: tuple[tuple[Axis, int], ...] = (("x", grid.columns), ("y", grid.rows))
-    for axis, cells in axes:
-        spans = list(itertools.combinations(range(cells + 1), 2))
-        for (a, b), (c, d) in itertools.product(spans, spans):
-            first = (0, grid.rows, a, b) if axis == "x" else (a, b, 0, grid.columns)
-            second = (0, grid.rows, c, d) if axis == "x" else (c, d, 0, grid.columns)
-            if grid.content(first) == grid.content(second):
-                assert search._may_read_same(axis, first, second, (b - a) + (d - c))
+def test_the_search_interpreted_gives_the_installed_builds_grammars() -> None:
+    """Where there is no C compiler ``adp.py`` runs interpreted (and Cython, a build
+    requirement only, may be missing): the same grammars as this install's search."""
+    source = Path(adp.__file__).with_name("adp.py")
+    script = textwrap.dedent(
+        f"""
+        import json, sys
+        sys.modules["cython"] = None  # as if it were not installed
+        from facadecli import native
+        adp = native._interpreted(native.GRAMMAR_SEARCH, native.Path({str(source)!r}))
+        assert adp.cython.compiled is False
+        sys.path.insert(0, {str(Path(__file__).parent)!r})
+        from test_grammar_search_tables import _grammars_found
+        print(json.dumps(_grammars_found([0, 1, 2])))
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout) == _grammars_found([0, 1, 2])

@@ -1,6 +1,8 @@
 """The time limit of one ``facade grammar`` run, shared by its stages.
 
-``--time-limit`` counts from the start of the extraction (reading included). At that
+``--time-limit`` counts this process's CPU seconds (``clock``: the solver's safety clock,
+:func:`facadecli.solver.budgets.safety_clock`) from the start of the extraction (reading
+included), not the wall's: a loaded machine does not make it pass sooner. At that
 *soft* limit the ADP search stops with the best grammar so far; the search for repeated
 regions stops at half of it with those found so far (the grammar then depends on the
 machine's speed, and a warning says so). The greedy grammar is always finished, unless the
@@ -13,10 +15,11 @@ steps of its work, and ends the run with exit 4 when it has passed.
 from __future__ import annotations
 
 import math
-import time
 
 from facadecli.errors import SearchLimitError
+from facadecli.solver import budgets
 
+clock = budgets.safety_clock  # the clock of the time limit: this process's CPU seconds
 HARD = 2.0  # x the time limit: the run ends (exit 4) when no grammar exists by then
 GRACE = 5.0  # seconds added to the hard limit
 
@@ -25,11 +28,11 @@ class Deadline:
     def __init__(self, seconds: float = math.inf, source: str = "layout"):
         self.seconds = seconds
         self.source = source
-        self.start = time.perf_counter()
+        self.start = clock()  # CPU seconds
         self.hard = HARD * seconds + GRACE
 
     def elapsed(self) -> float:
-        return time.perf_counter() - self.start
+        return clock() - self.start
 
     def passed(self, share: float = 1.0) -> bool:
         """Whether ``share`` of the time limit has passed (the soft limit at 1)."""

@@ -11,11 +11,18 @@ sides of it; such lines are not cut while a clean one exists.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from facadecli import native
 from facadecli.grammar.tiling import BACKGROUND, Tiling
 from facadecli.limits import GRAMMAR_WORK_MAX
-from facadecli.native import GRAMMAR_COMPILED, _adp
+
+if TYPE_CHECKING:
+    from facadecli.grammar import adp
+else:  # compiled where it was built from this very source, else interpreted
+    adp = native.load(native.GRAMMAR_SEARCH)
 
 Region = tuple[int, int, int, int]
 SIZE_QUANTUM = 1e-6  # sizes are compared in steps of this (x the façade's extent)
@@ -26,22 +33,14 @@ WORK_MAX = GRAMMAR_WORK_MAX  # work units of one search: cells its contents read
 STEP_UNITS = 50
 
 
-class BudgetError(Exception):
-    """The search's work would pass ``WORK_MAX`` units."""
-
-
-#: what a spent budget raises, here or in the compiled table
-BUDGET_ERRORS: tuple[type[Exception], ...] = (
-    (BudgetError,) if _adp is None else (BudgetError, _adp.BudgetError)
-)
+BudgetError = adp.BudgetError  # the search's work would pass ``WORK_MAX`` units
+BUDGET_ERRORS: tuple[type[Exception], ...] = (BudgetError,)  # what a spent budget raises
 
 
 class Grid:
     """A tiling's cells as integers, with prefix sums for fast line tests."""
 
-    def __init__(self, tiling: Tiling, background: str = BACKGROUND, compiled: bool | None = None):
-        """``compiled``: keep the contents in the compiled table (``_adp.c``; the default where
-        it was built, :mod:`facadecli.native`), else here in Python (the same contents)."""
+    def __init__(self, tiling: Tiling, background: str = BACKGROUND):
         self.tiling = tiling
         self.background = background
         names = sorted({label for row in tiling.labels for label in row})
@@ -64,30 +63,26 @@ class Grid:
         self.terminal: dict[int, str] = {}  # content -> its label, for one-label regions
         self._xs = np.asarray(tiling.xs, dtype=np.float64)
         self._ys = np.asarray(tiling.ys, dtype=np.float64)
-        self._keys: dict[tuple[int, ...], int] = {}  # content keys -> content, in Python
-        self._cells_read = 0  # in Python: what the contents read so far
-        self._spent = False
-        self.table: _adp.Table | None = None  # the contents, and the search over this tiling
-        if GRAMMAR_COMPILED if compiled is None else compiled:
-            self.table = _adp.Table(
-                self.labels.astype(np.int32).tobytes(),
-                self.rows,
-                self.columns,
-                self._xs.tobytes(),
-                self._ys.tobytes(),
-                self.quantum_x,
-                self.quantum_y,
-                bg,
-            )
-            self.table.limit(WORK_MAX)
+        # the contents, and the search over this tiling (:mod:`facadecli.grammar.adp`)
+        self.table = adp.Table(
+            self.labels.astype(np.int32).tobytes(),
+            self.rows,
+            self.columns,
+            self._xs.tobytes(),
+            self._ys.tobytes(),
+            self.quantum_x,
+            self.quantum_y,
+            bg,
+        )
+        self.table.limit(WORK_MAX)
         self._charged = 0  # work other than the contents' (``charge``)
 
     def content(self, region: Region) -> int:
         """The region's content number: equal for regions with the same labels at the same
         places, whatever cuts other elements make through them (neighbouring rows and
         columns with the same labels are merged first, and a merged row or column's size is
-        the difference of its cuts, in steps of the size quantum). The compiled table
-        (``_adp.c``) keeps them, for the search too.
+        the difference of its cuts, in steps of the size quantum). The search's table
+        (:mod:`facadecli.grammar.adp`) keeps them, for the search too.
 
         A region's key holds a label per merged cell, so a layout whose regions all differ
         (squares on a slant) makes keys of a size that grows with the square of the region's
@@ -95,45 +90,16 @@ class Grid:
         each is made), past ``WORK_MAX`` units :class:`BudgetError` is raised."""
         cid = self._content_of.get(region)
         if cid is None:
-            cid, label = (
-                self._numbered(region) if self.table is None else self.table.content(*region)
-            )
+            cid, label = self.table.content(*region)
             self._content_of[region] = cid
             if label >= 0:
                 self.terminal[cid] = self.names[label]
         return cid
 
-    def _numbered(self, region: Region) -> tuple[int, int]:
-        """``content`` in Python, as ``_adp.c`` numbers it: the key is the merged rows and
-        columns' counts, their labels (row by row) and their sizes in quanta; the content,
-        and its label when it is one merged cell (else -1)."""
-        r0, r1, c0, c1 = region
-        changes_x = self._change_x[r1, c0 : c1 - 1] - self._change_x[r0, c0 : c1 - 1]
-        changes_y = self._change_y[r0 : r1 - 1, c1] - self._change_y[r0 : r1 - 1, c0]
-        starts_c = np.concatenate(([0], np.nonzero(changes_x)[0] + 1))
-        starts_r = np.concatenate(([0], np.nonzero(changes_y)[0] + 1))
-        cost = 2 + len(starts_r) * len(starts_c) + len(starts_r) + len(starts_c)
-        if self._spent or self._cells_read + cost > WORK_MAX - self._charged:
-            self._spent = True
-            raise BudgetError("the contents' budget has run out")
-        self._cells_read += cost
-        labels = self.labels[np.ix_(r0 + starts_r, c0 + starts_c)]
-        widths = np.diff(self._xs[c0 + np.append(starts_c, c1 - c0)]) / self.quantum_x
-        heights = np.diff(self._ys[r0 + np.append(starts_r, r1 - r0)]) / self.quantum_y
-        key = (
-            len(starts_r),
-            len(starts_c),
-            *labels.ravel().tolist(),
-            *np.rint(widths).astype(np.int64).tolist(),
-            *np.rint(heights).astype(np.int64).tolist(),
-        )
-        cid = self._keys.setdefault(key, len(self._keys))
-        return cid, int(labels[0, 0]) if labels.size == 1 else -1
-
     @property
     def cells_read(self) -> int:
         """Cells the contents have read so far (a unit of work each)."""
-        return self._cells_read if self.table is None else self.table.cells_read()
+        return self.table.cells()
 
     @property
     def work(self) -> int:
@@ -145,13 +111,12 @@ class Grid:
         """Count work other than the contents' against the same budget (it leaves the
         contents, and the search after it, that much less)."""
         self._charged += units
-        if self.table is not None:
-            self.table.limit(WORK_MAX - self._charged)
+        self.table.limit(WORK_MAX - self._charged)
 
     @property
     def spent(self) -> bool:
         """Whether a content was refused because ``WORK_MAX`` was reached."""
-        return self._spent if self.table is None else self.table.spent()
+        return self.table.spent()
 
     def contents_of(self, regions: list[Region]) -> list[int]:
         """``content`` of each region."""
