@@ -10,7 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from facadecli.grammar import retarget, slabs
-from facadecli.grammar.pieces import Piece, elements_of, likeness
+from facadecli.grammar.model import Piece
+from facadecli.grammar.pieces import elements_of, likeness
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.style import Box, facade_of, find_style
 from facadecli.grammar.tiling import BACKGROUND

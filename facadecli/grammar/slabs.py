@@ -1,7 +1,8 @@
 """A façade at a new size made of the input's own terminals, whole bays and floors copied
 (retargeting by slabs, after Lin et al. 2011): the two-dimensional use of the
 one-dimensional plans of :mod:`facadecli.grammar.retarget`, beside the grammar's
-derivations in :mod:`facadecli.grammar.variation`, which compares them.
+derivations (:mod:`facadecli.grammar.derive`); :mod:`facadecli.grammar.variations`
+compares them.
 """
 
 from __future__ import annotations
@@ -12,7 +13,8 @@ from collections import defaultdict
 from collections.abc import Sequence
 
 from facadecli.grammar import retarget
-from facadecli.grammar.pieces import Piece, boxes_of, elements_of, score
+from facadecli.grammar.model import Piece
+from facadecli.grammar.pieces import boxes_of, elements_of, score
 from facadecli.grammar.style import Box, Constraint, Facade, check, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
