@@ -12,7 +12,7 @@ import pytest
 
 from facadecli import load_spec
 from facadecli.export.report import report_text
-from facadecli.grammar import slabs
+from facadecli.grammar import floors
 from facadecli.grammar.align import KEPT_LEAST, align
 from facadecli.grammar.derive import _run_of, derive_at
 from facadecli.grammar.extract import extract_grammar
@@ -467,7 +467,7 @@ def test_floors_whose_rows_make_no_pitch_are_copied_between_the_gaps() -> None:
     and holds a row, never the shop floor or the attic."""
     spans = [(0.0, 3.0), (4.0, 5.5), (6.5, 8.0), (9.0, 10.0)]
     elements = [StyleBox("window", 1.0, lo, 2.0, hi) for lo, hi in spans]
-    plans = slabs._floors(elements, 10.0, 15.0, [[4.75, 5.25]])
+    plans = floors.floor_plans(elements, 10.0, 15.0, [[4.75, 5.25]])
     copied = [plan.text for plan in plans if plan.text]
     assert "copied 2x: 3.5-6" in copied  # one floor, with the wall half way to the next
     assert all(text.endswith((": 3.5-6", ": 3.5-8.5")) for text in copied)  # never 0-3, 9-10
