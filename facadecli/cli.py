@@ -721,7 +721,8 @@ def infer(
 ) -> None:
     """Infer a layered spec from a labelled façade: a wall and a layer per grid of each
     label's elements, back to front, with the sizes measured."""
-    from facadecli.grammar.run import Options, stem
+    from facadecli.grammar.model import Options
+    from facadecli.grammar.read import stem
     from facadecli.infer.run import check as check_spec
     from facadecli.infer.run import infer as infer_spec
     from facadecli.spec import parse_spec
@@ -841,16 +842,13 @@ def grammar(
     """Derive a split grammar from a labelled façade (Wu et al. 2014): writes it as text,
     JSON and CityEngine CGA, the tiling as SVG and a report; with --derive, the grammar at
     new sizes."""
-    from facadecli.grammar.run import (
-        Options,
-        derive_sizes,
-        extract_grammar,
-        grammar_files,
-        stem,
-        variations_sheet,
-    )
+    from facadecli.grammar.derive import TooLarge
+    from facadecli.grammar.extract import extract_grammar
+    from facadecli.grammar.model import Options
+    from facadecli.grammar.outputs import grammar_files, variations_sheet
+    from facadecli.grammar.read import stem
     from facadecli.grammar.split import EXTENSIONS, Costs
-    from facadecli.grammar.variation import TooLarge
+    from facadecli.grammar.variations import derive_sizes
 
     if method not in ("adp", "greedy"):
         raise typer.BadParameter(f"{method!r}: use adp or greedy", param_hint="--method")

@@ -14,11 +14,12 @@ from pathlib import Path
 import pytest
 
 from facadecli.grammar.cga import grammar_cga
-from facadecli.grammar.run import Options, extract_grammar
+from facadecli.grammar.derive import derive_at
+from facadecli.grammar.extract import extract_grammar
+from facadecli.grammar.model import Options
 from facadecli.grammar.search import extract
 from facadecli.grammar.split import Box, Grammar, Part, Rule, derive
 from facadecli.grammar.tiling import LabelledLayout, Rect, tile
-from facadecli.grammar.variation import derive_at
 from tests.test_grammar import _floors, _house, _random_layout, _row, _write_plain
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -17,14 +17,18 @@ import trimesh
 
 from facadecli import load_spec, solve
 from facadecli.export.report import report_text
+from facadecli.grammar.align import align
+from facadecli.grammar.derive import derive_at, distribute
+from facadecli.grammar.extract import extract_grammar, rederivation_problems
+from facadecli.grammar.json_layouts import read_plain
+from facadecli.grammar.model import Options
 from facadecli.grammar.regions import Grid
 from facadecli.grammar.regularize import regularize
-from facadecli.grammar.run import Options, derive_sizes, extract_grammar, rederivation_problems
 from facadecli.grammar.search import Search, extract, greedy_grammar
 from facadecli.grammar.split import Costs, Part, Rule, derive
 from facadecli.grammar.symmetry import find_repeats
-from facadecli.grammar.tiling import LabelledLayout, Rect, read_plain, tile
-from facadecli.grammar.variation import align, derive_at, distribute
+from facadecli.grammar.tiling import LabelledLayout, Rect, tile
+from facadecli.grammar.variations import derive_sizes
 
 ROOT = Path(__file__).resolve().parent.parent
 VALIDATOR = Path(sys.prefix) / "node" / "node_modules"  # make test installs it in the venv
@@ -331,7 +335,7 @@ def test_a_wider_facade_gets_more_windows_equal_and_aligned() -> None:
 
 
 def test_alignment_lines_up_and_equalises_near_misses() -> None:
-    from facadecli.grammar.variation import Piece
+    from facadecli.grammar.model import Piece
 
     pieces = [
         Piece("facade", 0.0, 0.0, 1.0, 2.0, 1.0, 2.0),

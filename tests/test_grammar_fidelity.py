@@ -8,9 +8,10 @@ from pathlib import Path
 import pytest
 
 from facadecli import parse_spec
+from facadecli.grammar.extract import extract_grammar
 from facadecli.grammar.fidelity import CELLS_MAX, fidelity, grid
 from facadecli.grammar.inputs import LabelledLayout, Rect
-from facadecli.grammar.run import Options, extract_grammar
+from facadecli.grammar.model import Options
 from facadecli.infer.run import check, infer
 
 

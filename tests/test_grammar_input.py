@@ -9,7 +9,9 @@ import pytest
 
 from facadecli import load_spec, solve
 from facadecli.export.report import report_text
-from facadecli.grammar.tiling import read_cmp, read_plain, read_report, tile
+from facadecli.grammar.cmp_xml import read_cmp
+from facadecli.grammar.json_layouts import read_plain, read_report
+from facadecli.grammar.tiling import tile
 
 ROOT = Path(__file__).resolve().parent.parent
 

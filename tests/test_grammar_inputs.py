@@ -15,14 +15,16 @@ from facadecli.errors import SearchLimitError, SpecError
 from facadecli.grammar import deadline as deadlines
 from facadecli.grammar.cmp_xml import read_cmp
 from facadecli.grammar.deadline import Deadline
+from facadecli.grammar.extract import rederivation_problems
 from facadecli.grammar.inputs import RECTS_MAX, LabelledLayout, Rect
 from facadecli.grammar.json_layouts import read_plain
+from facadecli.grammar.model import Options, check_options
 from facadecli.grammar.outputs import tiling_svg
 from facadecli.grammar.regions import Grid
 from facadecli.grammar.regularize import regularize
-from facadecli.grammar.run import CELLS_MAX, Options, check_options, rederivation_problems
 from facadecli.grammar.search import extract
 from facadecli.grammar.symmetry import find_repeats
+from facadecli.grammar.tidy import CELLS_MAX
 from facadecli.grammar.tiling import tile
 from tests.running import facade as run_facade
 

@@ -145,14 +145,15 @@ def test_staggered_squares_are_refused_by_the_search_budget(
 
 
 def _tiling_of(tmp_path: Path, rects: list[tuple[float, float, float, float]]):  # type: ignore[no-untyped-def]
-    from facadecli.grammar import run
     from facadecli.grammar.deadline import Deadline
+    from facadecli.grammar.model import Options
+    from facadecli.grammar.tidy import tidy_layout
     from facadecli.grammar.tiling import tile
 
     layout = tmp_path / "slant.json"
     layout.write_text(layout_json(rects))
     deadline = Deadline()
-    return tile(run.tidy_layout(layout, run.Options(), deadline).layout, tolerance=0.0)
+    return tile(tidy_layout(layout, Options(), deadline).layout, tolerance=0.0)
 
 
 @pytest.mark.parametrize("count", [6, 20])
@@ -266,15 +267,17 @@ def test_a_grammar_deeper_than_the_limit_is_refused(
 def test_the_search_reads_its_budget_of_cells_and_stops(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from facadecli.grammar import regions, run
+    from facadecli.grammar import regions
     from facadecli.grammar.deadline import Deadline
+    from facadecli.grammar.model import Options
     from facadecli.grammar.search import Search
+    from facadecli.grammar.tidy import tidy_layout
     from facadecli.grammar.tiling import tile
 
     layout = tmp_path / "slant.json"
     layout.write_text(layout_json(staggered_rects(8)))
     deadline = Deadline()
-    tiling = tile(run.tidy_layout(layout, run.Options(), deadline).layout, tolerance=0.0)
+    tiling = tile(tidy_layout(layout, Options(), deadline).layout, tolerance=0.0)
     monkeypatch.setattr(regions, "WORK_MAX", 100_000)
     search = Search(tiling, deadline=deadline)
     search.greedy()
@@ -624,7 +627,7 @@ def test_hostile_inputs_at_each_door_end_cleanly(
 def test_a_grammar_at_the_depth_limit_is_written_derived_and_varied() -> None:
     """The limit keeps every stage that goes down a grammar one rule at a time within
     Python's recursion limit."""
-    from facadecli.grammar import variation
+    from facadecli.grammar import derive
     from facadecli.grammar.cga import grammar_cga
     from facadecli.grammar.outputs import grammar_json
     from facadecli.grammar.search import DEPTH_MAX
@@ -643,5 +646,5 @@ def test_a_grammar_at_the_depth_limit_is_written_derived_and_varied() -> None:
     assert len(derive_tree(grammar, 1000.0, 1000.0)) == 2 * DEPTH_MAX + 1
     assert len(inlined(grammar).rules) == DEPTH_MAX
     assert grammar_cga(grammar, 1000.0, 1000.0) and grammar_json(grammar) and grammar.text()
-    assert variation.derive_at(grammar, (1000.0, 1000.0), 1200.0, 900.0)
-    assert variation._with_runs(grammar, (1000.0, 1000.0)).rules
+    assert derive.derive_at(grammar, (1000.0, 1000.0), 1200.0, 900.0)
+    assert derive.with_runs(grammar, (1000.0, 1000.0)).rules

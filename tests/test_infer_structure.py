@@ -18,7 +18,7 @@ import pytest
 
 from facadecli import parse_spec, solve
 from facadecli.grammar.inputs import LabelledLayout, Rect
-from facadecli.grammar.run import Options
+from facadecli.grammar.model import Options
 from facadecli.infer.layers import Grid, frames, top_floors
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.structure import NEAR, structured

@@ -9,8 +9,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from facadecli.grammar import retarget, slabs
-from facadecli.grammar.pieces import Piece, elements_of, likeness
+from facadecli.grammar import floors, retarget, slabs
+from facadecli.grammar.model import Piece
+from facadecli.grammar.pieces import elements_of, likeness
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.style import Box, facade_of, find_style
 from facadecli.grammar.tiling import BACKGROUND
@@ -311,11 +312,11 @@ def test_what_goes_on_a_sliver_past_a_level_is_trimmed_and_made_wall() -> None:
         Piece(BACKGROUND, 0.0, 2.5, 2.0, 10.0, 2.0, 7.5),
     ]
     joined = elements_of(pieces, 2.0, 10.0).boxes  # the same at either height
-    levelled = slabs._levelled(pieces, joined, (2.0, 10.0))
+    levelled = floors.levelled(pieces, joined, (2.0, 10.0))
     assert Piece("window", 0.0, 0.0, 1.0, 2.0, 1.0, 2.08) in levelled
     assert Piece(BACKGROUND, 0.0, 2.0, 1.0, 2.08, 1.0, pytest.approx(0.08)) in levelled
     assert sum((p.x1 - p.x0) * (p.y1 - p.y0) for p in levelled) == pytest.approx(20.0)
-    assert slabs._levelled(pieces, joined, (2.0, 2.5)) == pieces  # 8 cm is no sliver of 2.5 m
+    assert floors.levelled(pieces, joined, (2.0, 2.5)) == pieces  # 8 cm is no sliver of 2.5 m
 
 
 def test_a_band_laid_across_copies_of_a_unit_is_made_of_that_much_source() -> None:

@@ -19,8 +19,10 @@ from hypothesis import strategies as st
 from facadecli.errors import SearchLimitError
 from facadecli.grammar import tiling
 from facadecli.grammar.deadline import Deadline
+from facadecli.grammar.extract import extract_grammar
 from facadecli.grammar.inputs import LabelledLayout, Rect
-from facadecli.grammar.run import Options, extract_grammar, read_layout
+from facadecli.grammar.model import Options
+from facadecli.grammar.read import read_layout
 from facadecli.grammar.tiling import snap, snap_and_count, snap_layout, tile
 from tests.running import facade
 

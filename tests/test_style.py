@@ -12,9 +12,12 @@ from pathlib import Path
 
 import pytest
 
+from facadecli.grammar.align import align
+from facadecli.grammar.derive import derive_at
+from facadecli.grammar.extract import extract_grammar
 from facadecli.grammar.inputs import BACKGROUND
+from facadecli.grammar.model import Options, Piece
 from facadecli.grammar.regularize import regularize
-from facadecli.grammar.run import Options, extract_grammar
 from facadecli.grammar.style import (
     Box,
     check,
@@ -25,7 +28,7 @@ from facadecli.grammar.style import (
     style_of_drawing,
 )
 from facadecli.grammar.tiling import LabelledLayout, Rect
-from facadecli.grammar.variation import Piece, align, derive_at, derive_variations
+from facadecli.grammar.variations import derive_variations
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -11,8 +11,9 @@ import pytest
 
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.fidelity import fidelity
+from facadecli.grammar.model import Options
 from facadecli.grammar.regularize import regularize
-from facadecli.grammar.run import Options, tidy_layout
+from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import MOVE_SHARE, LabelledLayout, Rect, snap_and_count
 from tests.benchmarks.annotated_family import cmp_xml, family
 

@@ -12,28 +12,19 @@ import pytest
 
 from facadecli import load_spec
 from facadecli.export.report import report_text
-from facadecli.grammar import slabs
-from facadecli.grammar.pieces import apart, displacement
-from facadecli.grammar.run import Extraction, Options, extract_grammar
+from facadecli.grammar import floors
+from facadecli.grammar.align import KEPT_LEAST, align
+from facadecli.grammar.derive import _run_of, derive_at
+from facadecli.grammar.extract import extract_grammar
+from facadecli.grammar.model import Extraction, Options, Piece, Variation
+from facadecli.grammar.pieces import apart, displacement, likeness, pieces_key
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Part
 from facadecli.grammar.style import Box as StyleBox
 from facadecli.grammar.style import Kept, check, facade_of
 from facadecli.grammar.tiling import LabelledLayout, Rect
-from facadecli.grammar.variation import (
-    APART,
-    KEPT_LEAST,
-    Piece,
-    Variation,
-    _key,
-    _proportioned_copies,
-    _run_of,
-    align,
-    derive_at,
-    derive_layout,
-    derive_variations,
-    likeness,
-)
+from facadecli.grammar.variations import APART, derive_layout, derive_variations
+from facadecli.grammar.vary import proportioned_copies
 from facadecli.layout import Layout
 from facadecli.solve import solve
 from tests.test_grammar import _facade, _floors, _write_plain
@@ -476,7 +467,7 @@ def test_floors_whose_rows_make_no_pitch_are_copied_between_the_gaps() -> None:
     and holds a row, never the shop floor or the attic."""
     spans = [(0.0, 3.0), (4.0, 5.5), (6.5, 8.0), (9.0, 10.0)]
     elements = [StyleBox("window", 1.0, lo, 2.0, hi) for lo, hi in spans]
-    plans = slabs._floors(elements, 10.0, 15.0, [[4.75, 5.25]])
+    plans = floors.floor_plans(elements, 10.0, 15.0, [[4.75, 5.25]])
     copied = [plan.text for plan in plans if plan.text]
     assert "copied 2x: 3.5-6" in copied  # one floor, with the wall half way to the next
     assert all(text.endswith((": 3.5-6", ": 3.5-8.5")) for text in copied)  # never 0-3, 9-10
@@ -541,19 +532,19 @@ def test_copied_bays_with_drawn_proportions_keep_the_style(tmp_path: Path) -> No
         boxes = [StyleBox(p.label, p.x0, p.y0, p.x1, p.y1) for p in found]
         return check(style, facade_of(boxes, *size, "wall"))
 
-    plain = {_key(moved) for moved, _, _ in retargeted(pieces, source, *size, style)}
-    drawn = _proportioned_copies(
+    plain = {pieces_key(moved) for moved, _, _ in retargeted(pieces, source, *size, style)}
+    drawn = proportioned_copies(
         pieces, source, size, style, random.Random(0), kept, (len(style), 3, set())
     )
     assert drawn and all(c.retarget.endswith("; proportions drawn") for c in drawn)
     assert 1 <= len({c.proportions for c in drawn}) <= 3
     good = [c for c in drawn if not c.kept.broken]
     assert any(c.retarget.startswith("x copied") for c in good)
-    assert not {_key(c.pieces) for c in good} & plain  # new layouts, not the plain copies
+    assert not {pieces_key(c.pieces) for c in good} & plain  # new layouts, not the plain copies
     for candidate in good:  # the source's sizes kept for the score
         assert candidate.score > 0 and all(p.source_w > 0 for p in candidate.pieces)
-    enough = {_key(c.pieces) for c in good[:3]}
-    assert len(enough) < 3 or not _proportioned_copies(
+    enough = {pieces_key(c.pieces) for c in good[:3]}
+    assert len(enough) < 3 or not proportioned_copies(
         pieces, source, size, style, random.Random(0), kept, (len(style), 3, enough)
     )
 

@@ -11,7 +11,7 @@ run on a façade shape.
   stretches them); ``repeatABA`` is ``{ ~a: A | { ~b: B | ~a: A }* }``; ``symsplit`` is its
   parts written out mirrored; ``gridsplit`` is a split into rows (``<Rule>_row<k>``), each
   split into the columns.
-- Sizes follow ``facade grammar --derive`` (``variation.py``): a part thinner than ``THIN``
+- Sizes follow ``facade grammar --derive`` (``derive.py``): a part thinner than ``THIN``
   of the façade keeps its absolute size (frames, sills); in a split with a part that holds a
   repeat along the split's axis, that part floats (``~``) and the others keep their size,
   so a wider façade gets more bays rather than wider windows; otherwise the parts float and
@@ -32,10 +32,10 @@ import unicodedata
 from dataclasses import dataclass, field
 from decimal import Decimal
 
+from facadecli.grammar.derive import THIN, elastic_parts
 from facadecli.grammar.inputs import BACKGROUND
 from facadecli.grammar.palette import label_colour
 from facadecli.grammar.split import Axis, Grammar, Part, Rule
-from facadecli.grammar.variation import THIN, _elastic
 
 VERSION = "2023.1"
 START = "Facade"
@@ -166,7 +166,7 @@ def grammar_cga(grammar: Grammar, width: float, height: float, name: str = "faca
     """The grammar as a CityEngine CGA rule file (see the module); ``width`` x ``height`` is
     the size it was extracted at."""
     names = rule_names(grammar)
-    elastic = _elastic(grammar)
+    elastic = elastic_parts(grammar)
     thin = {"x": THIN * width, "y": THIN * height}
     attrs = _Attrs()
     taken = set(RESERVED) | set(names.values())
@@ -177,7 +177,7 @@ def grammar_cga(grammar: Grammar, width: float, height: float, name: str = "faca
         return f"{'~' if floating else ''}{attr}: {names[p.symbol]}"
 
     def floats(rule: Rule) -> dict[Part, bool]:
-        """Which parts float (see the module): as ``variation.distribute`` sizes them."""
+        """Which parts float (see the module): as ``derive.distribute`` sizes them."""
         free = {p: p.size >= thin[rule.axis] for p in rule.parts}
         stretch = {p: f and elastic.get((p.symbol, rule.axis), False) for p, f in free.items()}
         chosen = stretch if any(stretch.values()) else free

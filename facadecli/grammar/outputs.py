@@ -11,8 +11,9 @@ from dataclasses import asdict
 from typing import Any
 from xml.sax.saxutils import escape
 
+from facadecli.grammar.cga import grammar_cga
+from facadecli.grammar.model import DerivedSize, Extraction
 from facadecli.grammar.palette import label_colour
-from facadecli.grammar.run import DerivedSize, Extraction
 from facadecli.grammar.split import Grammar, derive_tree
 from facadecli.grammar.tiling import Tiling
 
@@ -167,3 +168,36 @@ def grammar_report(
         "time_ms": round(extraction.time_ms, 3) if timings else None,
     }
     return json.dumps(data, indent=2) + "\n"
+
+
+def grammar_files(
+    extraction: Extraction,
+    name: str,
+    timings: bool = False,
+    derived: Sequence[DerivedSize] = (),
+) -> dict[str, str]:
+    """The grammar's own files by name: text, JSON, CityEngine CGA, the tiling as SVG and
+    the report (with the style each derived layout keeps)."""
+    found = extraction.grammar
+    tiling = extraction.tiling
+    return {
+        f"{name}.grammar.txt": found.text(),
+        f"{name}.grammar.json": grammar_json(found),
+        f"{name}.cga": grammar_cga(found, tiling.xs[-1], tiling.ys[-1], name),
+        f"{name}.tiling.svg": tiling_svg(tiling, found, name),
+        f"{name}.grammar-report.json": grammar_report(extraction, timings, derived),
+    }
+
+
+def variations_sheet(derived: list[DerivedSize], name: str, seed: int) -> str:
+    """A contact sheet of every size's layouts, a row a size (``<name>.variations.svg``)."""
+    from facadecli.export.contact import Variant, contact_sheet
+
+    rows = [
+        [
+            Variant(layout, (size.width, size.height), seed, k)
+            for k, layout in enumerate(size.layouts)
+        ]
+        for size in derived
+    ]
+    return contact_sheet(rows, f"{name} (grammar variations)")

@@ -1,31 +1,19 @@
-"""A derived layout's terminals: each a labelled rectangle with its size in the source
-layout (the derivations of :mod:`facadecli.grammar.variation` and the copied bays of
-:mod:`facadecli.grammar.slabs` make them), and how far their sizes are from the source's."""
+"""Measures of a derived layout's terminals (:class:`~facadecli.grammar.model.Piece`, made
+by the derivations of :mod:`facadecli.grammar.derive` and the copied bays of
+:mod:`facadecli.grammar.slabs`): their elements, how far their sizes are from the source's,
+how far two layouts are apart, and a key that tells two layouts apart."""
 
 from __future__ import annotations
 
 import math
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from facadecli.grammar.inputs import BACKGROUND
+from facadecli.grammar.model import Piece
 from facadecli.grammar.style import Box, Facade, facade_of
-
-
-@dataclass(frozen=True)
-class Piece:
-    """A derived terminal rectangle and its size in the source layout."""
-
-    label: str
-    x0: float
-    y0: float
-    x1: float
-    y1: float
-    source_w: float
-    source_h: float
 
 
 def boxes_of(pieces: Sequence[Piece]) -> list[Box]:
@@ -95,3 +83,16 @@ def _one_way(a: Sequence[Piece], b: Sequence[Piece], background: str) -> float:
         far = np.abs(edges[:, None, :] - other[None, :, :]).max(axis=2)
         total += float(far.min(axis=1).sum())
     return total / len(mine)
+
+
+PiecesKey = tuple[tuple[str, float, float, float, float], ...]
+
+
+def pieces_key(pieces: Sequence[Piece]) -> PiecesKey:
+    """The pieces as they would be written (to tell two derivations apart)."""
+    return tuple(
+        sorted(
+            (p.label, round(p.x0, 9), round(p.y0, 9), round(p.x1, 9), round(p.y1, 9))
+            for p in pieces
+        )
+    )

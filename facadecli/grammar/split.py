@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 Axis = Literal["x", "y"]
-# "run" is the derivation's own (grammar.variation): bays of one size and kind, A B A B A,
+# "run" is the derivation's own (grammar.derive): bays of one size and kind, A B A B A,
 # that a wider façade may have more of; no extracted grammar holds one
 Op = Literal["split", "repeat", "repeatABA", "symsplit", "gridsplit", "run"]
 EXTENSIONS: tuple[Op, ...] = ("repeatABA", "symsplit", "gridsplit")

@@ -7,8 +7,8 @@ background, after snapping nearly equal edges together so that hand-drawn annota
 up.
 
 The readers live in ``cmp_xml`` (CMP Facade Database XML) and ``json_layouts`` (a plain
-JSON list of ``{label, x0, y0, x1, y1}``, and facadecli's own ``<name>.layout.json``); they
-are named here too.
+JSON list of ``{label, x0, y0, x1, y1}``, and facadecli's own ``<name>.layout.json``),
+``read`` picks one by the file's name: this stage comes after them and imports none.
 """
 
 from __future__ import annotations
@@ -22,10 +22,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from facadecli.grammar.cmp_xml import read_cmp
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
-from facadecli.grammar.json_layouts import read_plain, read_report
 
 __all__ = [
     "BACKGROUND",
@@ -35,9 +33,6 @@ __all__ = [
     "Rect",
     "Snapping",
     "Tiling",
-    "read_cmp",
-    "read_plain",
-    "read_report",
     "snap",
     "snap_and_count",
     "snap_layout",

@@ -15,7 +15,8 @@ from facadecli.errors import FacadeError, SpecError
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.fidelity import Fidelity, fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
-from facadecli.grammar.run import Options, Progress, no_progress, tidy_layout
+from facadecli.grammar.model import Options, Progress, no_progress
+from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
 from facadecli.infer.layers import BAND, Grid, grids, to_edges
 from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text

@@ -21,7 +21,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from facadecli import parse_spec  # noqa: E402
-from facadecli.grammar.run import Options, extract_grammar  # noqa: E402
+from facadecli.grammar.extract import extract_grammar  # noqa: E402
+from facadecli.grammar.model import Options  # noqa: E402
 from facadecli.infer.run import check, infer  # noqa: E402
 from tests.benchmarks.annotated_family import cmp_xml, family  # noqa: E402
 

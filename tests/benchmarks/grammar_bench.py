@@ -24,16 +24,17 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from facadecli.grammar.cmp_xml import read_cmp  # noqa: E402
+from facadecli.grammar.extract import extract_grammar  # noqa: E402
+from facadecli.grammar.model import (  # noqa: E402
+    Extraction,
+    Options,
+    Piece,
+)
 from facadecli.grammar.pieces import apart, displacement  # noqa: E402
-from facadecli.grammar.run import Extraction, Options, extract_grammar, resize  # noqa: E402
+from facadecli.grammar.read import resize  # noqa: E402
 from facadecli.grammar.style import Box, facade_of, tiles_of  # noqa: E402
 from facadecli.grammar.tiling import BACKGROUND, Tiling  # noqa: E402
-from facadecli.grammar.variation import (  # noqa: E402
-    APART,
-    Piece,
-    derive_layout,
-    derive_variations,
-)
+from facadecli.grammar.variations import APART, derive_layout, derive_variations  # noqa: E402
 from facadecli.layout import Layout  # noqa: E402
 
 SCALES = (0.7, 1.5, 2.0)  # derived widths, as multiples of the input's (15 x 15 m)

@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from facadecli import parse_spec  # noqa: E402
-from facadecli.grammar.run import Options  # noqa: E402
+from facadecli.grammar.model import Options  # noqa: E402
 from facadecli.infer.run import check, infer  # noqa: E402
 
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"

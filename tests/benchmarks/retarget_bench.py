@@ -37,7 +37,7 @@ sys.path.insert(0, str(ROOT))
 from facadecli import parse_spec  # noqa: E402
 from facadecli.errors import FacadeError  # noqa: E402
 from facadecli.grammar.inputs import Rect  # noqa: E402
-from facadecli.grammar.run import Options  # noqa: E402
+from facadecli.grammar.model import Options  # noqa: E402
 from facadecli.infer.run import Inference, infer, solved_layout  # noqa: E402
 from facadecli.solve import retarget, solve  # noqa: E402
 from tests.benchmarks.annotated_family import cmp_xml, family  # noqa: E402

@@ -549,7 +549,12 @@ def main() -> None:
     if not options.exec:  # imported once, before the forks
         import importlib
 
-        for module in ("facadecli.cli", "facadecli.grammar.run", "facadecli.spec.load", "trimesh"):
+        for module in (
+            "facadecli.cli",
+            "facadecli.grammar.extract",
+            "facadecli.spec.load",
+            "trimesh",
+        ):
             importlib.import_module(module)
     root = Path(tempfile.mkdtemp(prefix="facade-fuzz-"))
     failed = 0
