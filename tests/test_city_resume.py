@@ -23,6 +23,7 @@ from facadecli.city.footprints import read_footprints
 from facadecli.city.manifest import load_city
 from facadecli.city.resume import UNHASHED, building_hash, spec_digests
 from facadecli.city.run import Task, _bounded, plan, run_city
+from facadecli.export.texture_store import image_uris
 
 ROOT = Path(__file__).resolve().parent.parent
 HOUSES = 6  # a row of terraced houses: party walls between them
@@ -82,6 +83,31 @@ def test_a_resumed_run_keeps_every_figure_and_gives_the_same_bytes(tmp_path: Pat
     assert _outputs(tmp_path / "part") == _outputs(tmp_path / "full")  # and -j 1 as -j 2
     lines = (tmp_path / "part" / f"{city.manifest.name}.report.jsonl").read_text().splitlines()
     assert sorted(json.loads(line)["id"] for line in lines) == sorted(_entries(full))
+
+
+def test_a_resumed_run_rebuilds_the_buildings_whose_pictures_are_gone(tmp_path: Path) -> None:
+    """The pictures are stored once for the run (``textures/``): a building whose glb
+    names a picture no longer there is built again, which writes it again."""
+    city = load_city(_town(tmp_path))
+    out = tmp_path / "out"
+    run_city(city, out, jobs=1)
+    before = _outputs(out)
+    named: dict[Path, set[str]] = {}  # a picture -> the buildings naming it
+    for building in json.loads((out / f"{city.manifest.name}.report.json").read_text())[
+        "buildings"
+    ]:
+        glb = out / building["file"]
+        for uri in image_uris(glb):
+            named.setdefault((glb.parent / uri).resolve(), set()).add(building["id"])
+    assert set(named) == set((out / "textures").iterdir())
+    report = run_city(city, out, jobs=1, resume=True)
+    assert all(b.get("resumed") for b in report["buildings"])
+    picture = min(named, key=lambda p: (len(named[p]), p.name))  # the fewest name it
+    assert len(named[picture]) < HOUSES
+    picture.unlink()
+    report = run_city(city, out, jobs=1, resume=True)
+    assert set(_rebuilt(report)) == named[picture]  # those naming it, not the rest
+    assert _outputs(out) == before
 
 
 def _rebuilt(report: dict[str, Any]) -> list[str]:

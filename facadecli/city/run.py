@@ -45,7 +45,7 @@ from facadecli.city.cityjson import (
     building_object,
     write_cityjson,
 )
-from facadecli.city.folders import BUILDINGS, SHARD, building_file, safe_name
+from facadecli.city.folders import BUILDINGS, SHARD, building_file, run_folder, safe_name
 from facadecli.city.footprints import (
     BBox,
     Footprint,
@@ -83,7 +83,9 @@ from facadecli.export.atomic import atomic_output, check_output_folder, write_at
 from facadecli.export.glb_merge import instance_nodes
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
-from facadecli.export.usd import usda_text
+from facadecli.export.texture_store import FOLDER as TEXTURES
+from facadecli.export.texture_store import PICTURE, TextureStore, externalised
+from facadecli.export.usd import stored_usda_text, usda_text
 from facadecli.geometry.facade import material_extensions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
@@ -109,6 +111,13 @@ class Task:
     usd: bool = False  # a USD stage beside the glb (``--usd``)
     above: Any = None  # the taller parts standing on this one: its roof leaves them out
     instanced: bool = False  # repeated parts as GPU instances (``--instance``)
+    shared_textures: bool = True  # pictures in the run's textures/, not in each glb
+
+    @property
+    def pictures(self) -> TextureStore | None:
+        """Where its pictures go: the run's ``textures/`` (texture_store.py), or None
+        when its glb embeds them (``--embed-textures``)."""
+        return TextureStore(run_folder(self.target) / TEXTURES) if self.shared_textures else None
 
     @property
     def file(self) -> str:
@@ -191,11 +200,17 @@ def build(task: Task) -> dict[str, Any]:
         solids = BuildingSolids(task.footprint.id, result.volumes, attributes(task, result.top))
         write_cityjson(feature_file(task.target), building_object(solids))
         data = glb_bytes(result.scene, material_extensions(task.spec))
-        write_atomic(task.target, instance_nodes(data) if task.instanced else data)
+        data = instance_nodes(data) if task.instanced else data
+        store = task.pictures  # its pictures are written before the files that name them
+        write_atomic(task.target, data if store is None else externalised(data, store, task.target))
         if task.usd:
-            write_atomic(
-                task.target.with_suffix(".usda"), usda_text(result.scene, task.target.stem)
+            stage = task.target.with_suffix(".usda")
+            text = (
+                usda_text(result.scene, task.target.stem)
+                if store is None
+                else stored_usda_text(result.scene, stage, store)
             )
+            write_atomic(stage, text)
     except Exception as error:
         return {
             "id": task.footprint.id,
@@ -250,6 +265,7 @@ def plan(
     outdir: Path,
     usd: bool = False,
     instanced: bool = False,
+    shared_textures: bool = True,
 ) -> list[Task]:
     """One task a building. Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
@@ -320,6 +336,7 @@ def plan(
                 usd,
                 above.get(footprint.id),
                 instanced,
+                shared_textures,
             )
         )
     return tasks
@@ -433,6 +450,7 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
         outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
         outdir / TILESET_FOLDER: rf"\.tileset\.json{_RANDOM}tmp",
+        outdir / TEXTURES: rf"\.{PICTURE.pattern}{_RANDOM}tmp",  # a picture (texture_store.py)
     }
     with contextlib.suppress(OSError):  # buildings/<shard>/ (folders.py)
         for entry in os.scandir(outdir / BUILDINGS):
@@ -481,12 +499,15 @@ def run_city(
     merged_lod: int = 3,
     instanced: bool = False,
     timings: bool = False,
+    shared_textures: bool = True,
 ) -> CityReport:
     """Build a city; returns the report (also written to ``<name>.report.json``).
     With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py); the merged
     models are at ``merged_lod`` (tiles.py). With ``instanced``, the parts façades repeat
     are GPU instances, in each building's glb and across the merged models. With
     ``timings``, the report file keeps the times (else null there: reproducible bytes).
+    The texture pictures are stored once for the run, in ``textures/`` (texture_store.py),
+    and every model names them there; with ``shared_textures`` False, each glb embeds its own.
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -494,7 +515,7 @@ def run_city(
     started = time.perf_counter()
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
-    ahead = planned(city, outdir, bbox, limit, usd, instanced)
+    ahead = planned(city, outdir, bbox, limit, usd, instanced, shared_textures)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
             city,
@@ -535,6 +556,7 @@ def planned(
     limit: int | None = None,
     usd: bool = False,
     instanced: bool = False,
+    shared_textures: bool = True,
 ) -> Planned:
     """The footprints read (those in ``bbox``), an outline's tags given to its parts, the
     outlines with parts cut to what they leave, collinear nodes merged, the first
@@ -545,9 +567,8 @@ def planned(
     defaults = city.manifest.defaults
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
-    return Planned(
-        found, replaced, kept, straight, plan(city, footprints, outdir.resolve(), usd, instanced)
-    )
+    tasks = plan(city, footprints, outdir.resolve(), usd, instanced, shared_textures)
+    return Planned(found, replaced, kept, straight, tasks)
 
 
 def _build(
