@@ -10,6 +10,7 @@ import hashlib
 import io
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -20,6 +21,9 @@ import pytest
 import trimesh
 from PIL import Image
 
+from facadecli.city.demo import write_demo
+from facadecli.city.manifest import load_city
+from facadecli.city.run import run_city
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.export.texture_store import (
     PICTURE,
@@ -147,7 +151,11 @@ def test_merged_models_name_the_pictures_from_where_they_are(tmp_path: Path) -> 
         glb.parent.mkdir(parents=True)
         glb.write_bytes(externalised(_textured_glb(colours), store, glb))
         parts.append((shard, glb))
-    for target in (tmp_path / "city.glb", tmp_path / "3dtiles" / "0" / "0" / "0.lod3.glb"):
+    for target in (
+        tmp_path / "city.glb",
+        tmp_path / "tiles" / "city_0_0.glb",
+        tmp_path / "3dtiles" / "0" / "0" / "0.lod3.glb",
+    ):
         merge_glb(parts, target)
         uris = image_uris(target)
         assert len(uris) == len(set(uris)) == 3  # the picture both houses wear, once
@@ -171,3 +179,25 @@ def test_a_page_inlines_the_pictures_of_a_city_folder(tmp_path: Path) -> None:
         os.unlink(picture)
     _, skipped = read_models(written.models, out)  # a picture gone: the model left out
     assert len(skipped) == 1 and "its texture picture ../../textures/" in skipped[0].reason
+
+
+def test_a_citys_usd_stages_name_the_glbs_pictures_and_embed_textures_keeps_them_in(
+    tmp_path: Path,
+) -> None:
+    """A building's USD stage names the very files its glb names (one PNG encoding for
+    both); with ``shared_textures`` off (``--embed-textures``) each glb holds its own."""
+    manifest = write_demo(tmp_path / "demo", ROOT / "specs", 1)
+    shared = tmp_path / "shared"
+    run_city(load_city(manifest), shared, jobs=1, limit=2, usd=True)
+    glbs = sorted((shared / "buildings").glob("*/*.glb"))
+    assert len(glbs) == 2
+    for glb in glbs:
+        stage = glb.with_suffix(".usda").read_text()
+        assets = set(re.findall(r"asset inputs:file = @([^@]+)@", stage))
+        assert assets and assets <= set(image_uris(glb))
+    alone = tmp_path / "alone"
+    run_city(load_city(manifest), alone, jobs=1, limit=2, shared_textures=False)
+    assert not (alone / "textures").exists()
+    for glb in sorted((alone / "buildings").glob("*/*.glb")):
+        document, _ = read_glb(glb.read_bytes())
+        assert document["images"] and all("bufferView" in i for i in document["images"])
