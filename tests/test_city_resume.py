@@ -119,13 +119,20 @@ def test_an_edited_spec_or_tag_rebuilds_exactly_what_it_changes(tmp_path: Path) 
     out = tmp_path / "out"
     run_city(load_city(manifest), out, jobs=1)
     assert _rebuilt(run_city(load_city(manifest), out, jobs=1, resume=True)) == []
+    pictures = {p.name for p in (out / "textures").iterdir()}
 
     spec = tmp_path / "specs" / "terraced-house.yaml"  # the apartments' façade
-    spec.write_text(spec.read_text().replace('color: "#e8e4dc"', 'color: "#d8c4bc"'))
+    text = spec.read_text().replace('color: "#e8e4dc"', 'color: "#d8c4bc"')
+    text = text.replace('color: "#b8b5ae", resolution: 256', 'color: "#b8b5ae", resolution: 128')
+    spec.write_text(text)  # another colour, and the concrete's pictures at another size
     kinds = {str(f["id"]): f["properties"] for f in terraces(HOUSES, SEED)}
     apartments = [key for key, tags in kinds.items() if tags["building"] == "apartments"]  # type: ignore[index]
     assert 0 < len(apartments) < HOUSES  # the seed gives both kinds
     assert _rebuilt(run_city(load_city(manifest), out, jobs=1, resume=True)) == apartments
+    # its concrete's pictures changed: the old ones are gone, as from a fresh run's folder
+    run_city(load_city(manifest), tmp_path / "fresh", jobs=1)
+    now = {p.name for p in (out / "textures").iterdir()}
+    assert now != pictures and now == {p.name for p in (tmp_path / "fresh" / "textures").iterdir()}
 
     footprints = manifest.parent / "footprints.geojson"
     data = json.loads(footprints.read_text())

@@ -33,6 +33,7 @@ from facadecli.export.texture_store import (
     image_uris,
     picture_name,
     pictures_missing,
+    prune,
     unpadded,
 )
 from facadecli.viewer.gallery import read_models, write_gallery
@@ -201,3 +202,16 @@ def test_a_citys_usd_stages_name_the_glbs_pictures_and_embed_textures_keeps_them
     for glb in sorted((alone / "buildings").glob("*/*.glb")):
         document, _ = read_glb(glb.read_bytes())
         assert document["images"] and all("bufferView" in i for i in document["images"])
+
+
+def test_pictures_no_glb_names_are_removed_and_nothing_else(tmp_path: Path) -> None:
+    store = TextureStore(tmp_path / "textures")
+    glb = tmp_path / "buildings" / "ab" / "house.glb"
+    glb.parent.mkdir(parents=True)
+    glb.write_bytes(externalised(_textured_glb([(1, 1, 1)]), store, glb))
+    kept = store.folder / Path(image_uris(glb)[0]).name
+    orphan = store.put(_png((2, 2, 2)))
+    mine = store.folder / "notes.png"  # not named as the store names pictures: kept
+    mine.write_bytes(b"mine")
+    assert prune(store.folder, [glb, tmp_path / "gone.glb"]) == [orphan]
+    assert kept.is_file() and mine.is_file() and not orphan.exists()

@@ -84,7 +84,7 @@ from facadecli.export.glb_merge import instance_nodes
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
 from facadecli.export.texture_store import FOLDER as TEXTURES
-from facadecli.export.texture_store import PICTURE, TextureStore, externalised
+from facadecli.export.texture_store import PICTURE, TextureStore, externalised, prune
 from facadecli.export.usd import stored_usda_text, usda_text
 from facadecli.geometry.facade import material_extensions
 from facadecli.solver.axis import AxisLayout
@@ -658,6 +658,7 @@ def _build(
         merged_lod,
         instanced,
     )
+    _prune_pictures(outdir)
     formats = ["glb", "3dtiles", "usd", "cityjson"]  # CITY_WRITERS' order: the report's too
     asked = {"3dtiles": tileset is not None, "usd": usd}
     models: dict[str, Any] = {}
@@ -685,6 +686,35 @@ def _build(
             f"{outdir}: cannot write the report: {error.strerror or error}; run again with --resume"
         ) from None
     return report
+
+
+def _prune_pictures(outdir: Path) -> None:
+    """The pictures of ``textures/`` that no building's glb in ``buildings/`` names
+    removed (texture_store.py): an earlier run's, whose buildings changed since. Every
+    glb there counts, this run's or not (a ``--limit`` leaves an earlier run's others)."""
+    if not (outdir / TEXTURES).is_dir():
+        return
+    try:
+        prune(outdir / TEXTURES, _building_glbs(outdir / BUILDINGS))
+    except OSError as error:
+        raise OutputError(
+            f"{outdir}: cannot tidy the texture pictures: {error.strerror or error}; the "
+            "buildings built are kept: run again with --resume"
+        ) from None
+
+
+def _building_glbs(buildings: Path) -> Iterator[Path]:
+    """Every glb in ``buildings/``: in its shards (folders.py), and at its top, where runs
+    before the shards wrote."""
+    if not buildings.is_dir():
+        return
+    for entry in sorted(os.scandir(buildings), key=lambda entry: entry.name):
+        if entry.name.endswith(".glb") and entry.is_file(follow_symlinks=False):
+            yield Path(entry.path)
+        elif SHARD.fullmatch(entry.name) and entry.is_dir(follow_symlinks=False):
+            for inner in sorted(os.scandir(entry.path), key=lambda inner: inner.name):
+                if inner.name.endswith(".glb") and inner.is_file(follow_symlinks=False):
+                    yield Path(inner.path)
 
 
 def _written(writer: CityWriter, finished: BuiltCity) -> dict[str, Any]:

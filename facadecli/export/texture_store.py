@@ -14,6 +14,7 @@ decided by which worker wrote first. A file is written only when its name is mis
 atomically (a temporary file renamed into place): a name that exists holds its whole
 picture, whoever wrote it. A model is written after the pictures it names, so a model on
 disk never names a missing picture (``--resume`` keeps it only while they are there).
+A run ends by removing the pictures none of its models names (:func:`prune`).
 """
 
 from __future__ import annotations
@@ -162,6 +163,26 @@ def pictures_missing(glb_file: Path) -> list[Path]:
         for uri in image_uris(glb_file)
         if not (glb_file.parent / uri).is_file()
     ]
+
+
+def prune(folder: Path, glbs: Iterable[Path]) -> list[Path]:
+    """Remove the pictures of ``folder`` that none of ``glbs`` names (an earlier run's,
+    whose buildings changed since: a resumed run leaves the folder a fresh run would);
+    returns them. A run's USD stages name the same pictures as its glb files."""
+    if not folder.is_dir():
+        return []
+    named = {
+        os.path.normpath(os.path.abspath(glb.parent / uri))
+        for glb in glbs
+        if glb.is_file()
+        for uri in image_uris(glb)
+    }
+    removed = []
+    for entry in sorted(os.scandir(folder), key=lambda entry: entry.name):
+        if PICTURE.fullmatch(entry.name) and os.path.abspath(entry.path) not in named:
+            os.unlink(entry.path)
+            removed.append(Path(entry.path))
+    return removed
 
 
 def _without_views(document: dict[str, Any], chunk: bytes, gone: Iterable[int]) -> bytes:
