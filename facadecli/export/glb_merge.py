@@ -164,21 +164,30 @@ def _rebased(document: dict[str, Any], part: Path, target: Path) -> dict[str, An
     """A part's document with the pictures it names by relative URI (a run's shared
     ``textures/``, texture_store.py) named relative to ``target`` instead."""
     images = document.get("images", [])
-    if not any(_relative(image) for image in images):
+    if not any(relative_uri(image) for image in images):
         return document
     moved = []
     for image in images:
-        if _relative(image):
-            where = Path(os.path.abspath(part.parent / unquote(image["uri"])))
-            relative = os.path.relpath(where, os.path.abspath(target.parent))
-            image = {**image, "uri": quote(Path(relative).as_posix())}
+        if (uri := relative_uri(image)) is not None:
+            image = {**image, "uri": uri_from(target, part.parent / unquote(uri))}
         moved.append(image)
     return {**document, "images": moved}
 
 
-def _relative(image: dict[str, Any]) -> bool:
-    """Whether an image is a file named by a relative URI (not embedded, not a data URI)."""
-    return "uri" in image and ":" not in image["uri"] and not image["uri"].startswith("/")
+def uri_from(beside: Path, target: Path) -> str:
+    """The URI of the file ``target`` relative to the folder of the file ``beside``
+    (posix separators, percent-encoded as URIs are)."""
+    relative = os.path.relpath(os.path.abspath(target), os.path.abspath(beside.parent))
+    return quote(Path(relative).as_posix())
+
+
+def relative_uri(image: Any) -> str | None:
+    """An image's URI when it names a file by a relative URI (not embedded in the glb, not
+    a data URI nor another scheme, not an absolute path), else None."""
+    uri = image.get("uri") if isinstance(image, dict) else None
+    if isinstance(uri, str) and uri and ":" not in uri and not uri.startswith("/"):
+        return uri
+    return None
 
 
 def _unlink(path: str) -> None:

@@ -27,10 +27,10 @@ import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
-from urllib.parse import quote, unquote
+from urllib.parse import unquote
 
 from facadecli.export.atomic import write_atomic
-from facadecli.export.glb_merge import glb, packed_views, read_glb
+from facadecli.export.glb_merge import glb, packed_views, read_glb, relative_uri, uri_from
 
 FOLDER = "textures"  # in the output folder
 DIGEST_HEX = 32  # hexadecimal digits of a picture's SHA-256 in its name (128 bits)
@@ -57,13 +57,6 @@ def unpadded(data: bytes) -> bytes:
     return data
 
 
-def relative_uri(target: Path, beside: Path) -> str:
-    """The URI of ``target`` relative to the folder of the file ``beside`` (posix
-    separators, percent-encoded as URIs are)."""
-    relative = os.path.relpath(os.path.abspath(target), os.path.abspath(beside.parent))
-    return quote(Path(relative).as_posix())
-
-
 class TextureStore:
     """The pictures of one run, in ``folder`` (the run's ``textures/``)."""
 
@@ -82,7 +75,7 @@ class TextureStore:
 
     def uri(self, data: bytes, beside: Path) -> str:
         """The picture stored, and its URI relative to the file ``beside`` that names it."""
-        return relative_uri(self.put(data), beside)
+        return uri_from(beside, self.put(data))
 
 
 def externalised(data: bytes, store: TextureStore, beside: Path) -> bytes:
@@ -122,7 +115,7 @@ def embedded(data: bytes, read: Callable[[str], bytes]) -> bytes:
     external = [
         i
         for i, image in enumerate(images if isinstance(images, list) else [])
-        if isinstance(image, dict) and isinstance(image.get("uri"), str) and ":" not in image["uri"]
+        if relative_uri(image)
     ]
     if not external:
         return data
@@ -152,8 +145,8 @@ def image_uris(glb_file: Path) -> list[str]:
             return []
         size = int.from_bytes(header[12:16], "little")
         document = json.loads(handle.read(size))
-    uris = (image.get("uri") for image in document.get("images", []))
-    return list(dict.fromkeys(unquote(uri) for uri in uris if uri and ":" not in uri))
+    uris = (relative_uri(image) for image in document.get("images", []))
+    return list(dict.fromkeys(unquote(uri) for uri in uris if uri))
 
 
 def pictures_missing(glb_file: Path) -> list[Path]:
