@@ -516,6 +516,14 @@ def city(
         bool,
         typer.Option("--timings", help="Record the times in the report (not reproducible)."),
     ] = False,
+    embed_textures: Annotated[
+        bool,
+        typer.Option(
+            "--embed-textures",
+            help="Each glb holds its own texture pictures (self-contained, ~1.6 MiB a "
+            "building), instead of naming the run's textures/, where each is stored once.",
+        ),
+    ] = False,
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -560,6 +568,7 @@ def city(
         merged_lod=finest,
         instanced=instance,
         timings=timings,
+        shared_textures=not embed_textures,
     )
     if _state["quiet"]:
         report = run(loaded, outdir, workers, limit, resume, None)

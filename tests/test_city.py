@@ -158,7 +158,12 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
     again = run_city(city, out, jobs=1, resume=True)
     assert all(b.get("resumed") for b in again["buildings"])
     serial = run_city(city, tmp_path / "serial", jobs=1)
-    built = sorted(p.relative_to(out) for p in (out / "buildings").rglob("*") if p.is_file())
+    built = sorted(
+        p.relative_to(out)
+        for folder in ("buildings", "textures")
+        for p in (out / folder).rglob("*")
+        if p.is_file()
+    )
     assert built and all(
         (out / path).read_bytes() == (tmp_path / "serial" / path).read_bytes() for path in built
     )
@@ -189,7 +194,13 @@ def test_a_dask_cluster_gives_the_same_files_as_local_processes(tmp_path: Path) 
     assert local == sorted(
         p.relative_to(tmp_path / "dask") for p in (tmp_path / "dask").rglob("*.glb")
     )
-    for path in local:
+    pictures = sorted(
+        p.relative_to(tmp_path / "local") for p in (tmp_path / "local").rglob("*.png")
+    )
+    assert pictures == sorted(
+        p.relative_to(tmp_path / "dask") for p in (tmp_path / "dask").rglob("*.png")
+    )
+    for path in local + pictures:
         assert (tmp_path / "local" / path).read_bytes() == (tmp_path / "dask" / path).read_bytes()
 
 

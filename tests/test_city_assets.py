@@ -25,6 +25,7 @@ from facadecli.city.manifest import Roof, load_city
 from facadecli.city.roofs import roof_meshes
 from facadecli.city.run import run_city
 from facadecli.export.glb_merge import merge_glb, read_glb
+from facadecli.export.texture_store import PICTURE, image_uris, picture_name, pictures_missing
 from facadecli.geometry.facade import plane_uv, weld
 from tests.rays import opaque_parts, reach
 
@@ -44,7 +45,7 @@ def city(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_buildings_share_one_material_of_each_kind_and_each_picture(city: Path) -> None:
-    document, binary = read_glb((city / "demo-district.glb").read_bytes())
+    document, _ = read_glb((city / "demo-district.glb").read_bytes())
     materials = document["materials"]
     names = [m["name"] for m in materials]
     # one material of each kind for the whole city, but the walls' four tones (the demo's
@@ -56,16 +57,53 @@ def test_buildings_share_one_material_of_each_kind_and_each_picture(city: Path) 
     assert len({json.dumps(t, sort_keys=True) for t in document["textures"]}) == len(
         document["textures"]
     )
-    pictures = []
-    for image in document["images"]:
-        view = document["bufferViews"][image["bufferView"]]
-        start = view.get("byteOffset", 0)
-        pictures.append(binary[start : start + view["byteLength"]])
+    # each picture named once, a file of the run's textures/ (stored once for the run)
+    uris = [image["uri"] for image in document["images"]]
+    assert len(set(uris)) == len(uris) and all(uri.startswith("textures/") for uri in uris)
+    pictures = [(city / uri).read_bytes() for uri in uris]
     assert len(set(pictures)) == len(pictures)
+    assert not any("bufferView" in image for image in document["images"])
     # every building still has its own node, whose meshes name the shared materials
     assert len(document["scenes"][0]["nodes"]) == BUILDINGS
     used = {p["material"] for m in document["meshes"] for p in m["primitives"]}
     assert used == set(range(len(materials)))
+
+
+def test_each_picture_is_stored_once_for_the_run_and_named_by_every_building(
+    city: Path,
+) -> None:
+    """No building's glb embeds a picture: each names the run's ``textures/``, where
+    every picture is one file (named by its bytes) and every file is named by some
+    building; the pictures are a small part of the run."""
+    named: set[Path] = set()
+    glbs = sorted((city / "buildings").glob("*/*.glb"))
+    for glb in glbs:
+        document, _ = read_glb(glb.read_bytes())
+        assert all("bufferView" not in image for image in document.get("images", []))
+        uris = image_uris(glb)
+        assert uris and all(uri.startswith("../../textures/") for uri in uris)
+        assert not pictures_missing(glb)
+        named |= {(glb.parent / uri).resolve() for uri in uris}
+    stored = sorted((city / "textures").iterdir())
+    assert set(stored) == named and all(PICTURE.fullmatch(p.name) for p in stored)
+    assert all(picture_name(p.read_bytes()) == p.name for p in stored)
+    pictures = sum(p.stat().st_size for p in stored)
+    models = sum(glb.stat().st_size for glb in glbs)
+    assert pictures < models / 2  # stored once, not once a building
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed")
+def test_a_building_naming_the_runs_pictures_passes_the_khronos_validator(city: Path) -> None:
+    assert (VALIDATOR / "gltf-validator").exists(), "run 'make test' to install the validator"
+    glb = sorted((city / "buildings").glob("*/*.glb"))[0]
+    result = subprocess.run(
+        ["node", str(ROOT / "tests" / "gltf_validate.js"), str(VALIDATOR), str(glb)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    report = json.loads(result.stdout)
+    assert (report["errors"], report["warnings"]) == (0, 0), report
 
 
 def test_merging_the_same_buildings_twice_gives_the_same_bytes(city: Path, tmp_path: Path) -> None:
@@ -239,8 +277,9 @@ def test_tones_keep_the_hue_and_stay_within_white() -> None:
 
 
 def _wall_pictures(glb: Path) -> dict[str, bytes]:
-    """Each building's wall picture (its brick's or render's base colour), by its name."""
-    document, binary = read_glb(glb.read_bytes())
+    """Each building's wall picture (its brick's or render's base colour: a file of the
+    run's textures/), by its name."""
+    document, _ = read_glb(glb.read_bytes())
     found = {}
     for node in document["nodes"]:
         for child in node.get("children", []):
@@ -250,9 +289,7 @@ def _wall_pictures(glb: Path) -> dict[str, bytes]:
                 if material["name"] in ("brick", "render"):
                     texture = material["pbrMetallicRoughness"]["baseColorTexture"]
                     image = document["images"][document["textures"][texture["index"]]["source"]]
-                    view = document["bufferViews"][image["bufferView"]]
-                    start = view.get("byteOffset", 0)
-                    found[node["name"]] = binary[start : start + view["byteLength"]]
+                    found[node["name"]] = (glb.parent / image["uri"]).read_bytes()
     return found
 
 

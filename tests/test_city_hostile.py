@@ -327,6 +327,7 @@ def test_a_run_cleans_what_a_killed_run_left_and_nothing_else(
         (out / "buildings" / shard("b0"), ".b0.glb.", ".tmp"),
         (out / "buildings" / shard("b1"), ".b1.city.jsonl.", ".tmp"),
         (out / "tiles", ".town_0_-1.glb.", ".bin"),
+        (out / "textures", f".{'0' * 32}.png.", ".tmp"),  # a picture, stored once
     ]:
         folder.mkdir(exist_ok=True)
         fd, name = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=folder)
@@ -352,6 +353,7 @@ def test_a_run_cleans_what_a_killed_run_left_and_nothing_else(
     assert set(files(out)) == before | {p.name for p in others} | {
         ".town.glb.zzzzzzzz.tmp",
         "tiles",
+        "textures",
     }
 
 

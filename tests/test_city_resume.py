@@ -23,6 +23,7 @@ from facadecli.city.footprints import read_footprints
 from facadecli.city.manifest import load_city
 from facadecli.city.resume import UNHASHED, building_hash, spec_digests
 from facadecli.city.run import Task, _bounded, plan, run_city
+from facadecli.export.texture_store import image_uris
 
 ROOT = Path(__file__).resolve().parent.parent
 HOUSES = 6  # a row of terraced houses: party walls between them
@@ -84,6 +85,31 @@ def test_a_resumed_run_keeps_every_figure_and_gives_the_same_bytes(tmp_path: Pat
     assert sorted(json.loads(line)["id"] for line in lines) == sorted(_entries(full))
 
 
+def test_a_resumed_run_rebuilds_the_buildings_whose_pictures_are_gone(tmp_path: Path) -> None:
+    """The pictures are stored once for the run (``textures/``): a building whose glb
+    names a picture no longer there is built again, which writes it again."""
+    city = load_city(_town(tmp_path))
+    out = tmp_path / "out"
+    run_city(city, out, jobs=1)
+    before = _outputs(out)
+    named: dict[Path, set[str]] = {}  # a picture -> the buildings naming it
+    for building in json.loads((out / f"{city.manifest.name}.report.json").read_text())[
+        "buildings"
+    ]:
+        glb = out / building["file"]
+        for uri in image_uris(glb):
+            named.setdefault((glb.parent / uri).resolve(), set()).add(building["id"])
+    assert set(named) == set((out / "textures").iterdir())
+    report = run_city(city, out, jobs=1, resume=True)
+    assert all(b.get("resumed") for b in report["buildings"])
+    picture = min(named, key=lambda p: (len(named[p]), p.name))  # the fewest name it
+    assert len(named[picture]) < HOUSES
+    picture.unlink()
+    report = run_city(city, out, jobs=1, resume=True)
+    assert set(_rebuilt(report)) == named[picture]  # those naming it, not the rest
+    assert _outputs(out) == before
+
+
 def _rebuilt(report: dict[str, Any]) -> list[str]:
     return [b["id"] for b in report["buildings"] if not b.get("resumed")]
 
@@ -93,13 +119,20 @@ def test_an_edited_spec_or_tag_rebuilds_exactly_what_it_changes(tmp_path: Path) 
     out = tmp_path / "out"
     run_city(load_city(manifest), out, jobs=1)
     assert _rebuilt(run_city(load_city(manifest), out, jobs=1, resume=True)) == []
+    pictures = {p.name for p in (out / "textures").iterdir()}
 
     spec = tmp_path / "specs" / "terraced-house.yaml"  # the apartments' façade
-    spec.write_text(spec.read_text().replace('color: "#e8e4dc"', 'color: "#d8c4bc"'))
+    text = spec.read_text().replace('color: "#e8e4dc"', 'color: "#d8c4bc"')
+    text = text.replace('color: "#b8b5ae", resolution: 256', 'color: "#b8b5ae", resolution: 128')
+    spec.write_text(text)  # another colour, and the concrete's pictures at another size
     kinds = {str(f["id"]): f["properties"] for f in terraces(HOUSES, SEED)}
     apartments = [key for key, tags in kinds.items() if tags["building"] == "apartments"]  # type: ignore[index]
     assert 0 < len(apartments) < HOUSES  # the seed gives both kinds
     assert _rebuilt(run_city(load_city(manifest), out, jobs=1, resume=True)) == apartments
+    # its concrete's pictures changed: the old ones are gone, as from a fresh run's folder
+    run_city(load_city(manifest), tmp_path / "fresh", jobs=1)
+    now = {p.name for p in (out / "textures").iterdir()}
+    assert now != pictures and now == {p.name for p in (tmp_path / "fresh" / "textures").iterdir()}
 
     footprints = manifest.parent / "footprints.geojson"
     data = json.loads(footprints.read_text())

@@ -270,7 +270,8 @@ def test_parts_take_the_tags_of_their_outline(district: tuple[Path, dict[str, An
     folder, report = district
     assert _entry(report, 501)["height"] == 12.0  # the outline's height, roof and colours
     assert _entry(report, 502)["height"] == 10.0  # its own
-    scene = trimesh.load(folder / "out" / building_file("way/501"))
+    glb = folder / "out" / building_file("way/501")  # its pictures are in the run's textures/
+    scene = trimesh.load(glb, resolver=trimesh.resolvers.FilePathResolver(glb, allow_anywhere=True))
     roof = scene.geometry["way/501/roof"].visual.material  # tiles drawn in papayawhip
     assert list(roof.baseColorFactor[:3]) == [255, 255, 255]  # the colour is in the picture
     drawn = np.asarray(roof.baseColorTexture.convert("RGB"), dtype=float).reshape(-1, 3)

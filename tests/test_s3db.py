@@ -237,7 +237,9 @@ def test_colour_tags_colour_walls_and_roof(district: tuple[Path, dict[str, Any]]
         m["name"]: m["pbrMetallicRoughness"]["baseColorFactor"] for m in document["materials"]
     }
     assert colours["flat_roof"][:3] == pytest.approx([1.0, 1.0, 1.0])  # a drawn deck:
-    scene = trimesh.load(folder / "out" / building_file("tower"), force="scene")
+    glb = folder / "out" / building_file("tower")  # its pictures are in the run's textures/
+    resolver = trimesh.resolvers.FilePathResolver(glb, allow_anywhere=True)
+    scene = trimesh.load(glb, force="scene", resolver=resolver)
     deck = next(
         g.visual.material for name, g in scene.geometry.items() if name.endswith("/flat_roof")
     )

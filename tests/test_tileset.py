@@ -22,6 +22,7 @@ import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
+from urllib.parse import urljoin
 
 import numpy as np
 import pyproj
@@ -256,6 +257,29 @@ def test_the_same_city_gives_the_same_tiles(city: Path, tmp_path: Path) -> None:
     assert ours == [p for p in theirs if (tmp_path / "out" / p).is_file()]
     for path in ours:
         assert (city / path).read_bytes() == (tmp_path / "out" / path).read_bytes(), path
+
+
+def test_tile_content_finds_the_runs_pictures_relative_to_its_uri(city: Path) -> None:
+    """A LOD3 tile names the pictures the run stored once (``textures/``) by a URI relative
+    to its content's URI, as 3D Tiles resolves it: resolved from the tileset's URL, each
+    is a file of the run's ``textures/``; LOD1 and LOD2 tiles draw colours only."""
+    folder = city / "3dtiles"
+    found = 0
+    for tile, _ in _tiles(_tileset(city)["root"]):
+        if "content" not in tile:
+            continue
+        content = urljoin("https://example.org/city/3dtiles/tileset.json", tile["content"]["uri"])
+        document, _ = read_glb((folder / tile["content"]["uri"]).read_bytes())
+        images = document.get("images", [])
+        assert all("bufferView" not in image for image in images)
+        if ".lod3." not in tile["content"]["uri"]:
+            assert not images
+        for image in images:
+            url = urljoin(content, image["uri"])
+            assert url.startswith("https://example.org/city/textures/"), url
+            assert (city / "textures" / url.rsplit("/", 1)[1]).is_file()
+            found += 1
+    assert found
 
 
 def test_a_run_chooses_its_levels_of_detail(tmp_path: Path) -> None:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import hashlib
 import re
-from pathlib import PurePosixPath
+from pathlib import Path, PurePosixPath
 
 BUILDINGS = "buildings"  # the folder of the buildings' files, in the output folder
 SHARD_DIGITS = 2  # hexadecimal digits of a shard's name
@@ -53,3 +53,8 @@ def building_file(building_id: str, suffix: str = ".glb") -> PurePosixPath:
     """A building's file, relative to the output folder: ``buildings/<shard>/<name><suffix>``
     (the report's ``file``; ``.city.jsonl`` and ``.usda`` sit beside the ``.glb``)."""
     return PurePosixPath(BUILDINGS, shard(building_id), safe_name(building_id) + suffix)
+
+
+def run_folder(glb: Path) -> Path:
+    """The output folder of a run, from a building's glb in it (:func:`building_file`)."""
+    return glb.parents[2]

@@ -26,6 +26,7 @@ from pydantic import BaseModel
 from shapely.geometry.base import BaseGeometry
 
 from facadecli import __version__
+from facadecli.export.texture_store import pictures_missing
 
 if TYPE_CHECKING:
     from facadecli.city.manifest import City
@@ -173,6 +174,8 @@ def reusable(
     if entry.get("file") != task.file or not task.target.is_file():
         return None
     if usd and not task.target.with_suffix(".usda").is_file():
+        return None
+    if task.shared_textures and pictures_missing(task.target):  # textures/ emptied since
         return None
     return {**entry, "resumed": True}
 

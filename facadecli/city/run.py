@@ -38,6 +38,7 @@ from facadecli.city.building import (
     build_building,
     building_solids,
     facade_axes,
+    party_volumes,
     rung_length,
     solve_rung,
 )
@@ -48,7 +49,7 @@ from facadecli.city.cityjson import (
     cityjson_bytes,
     write_cityjson,
 )
-from facadecli.city.folders import BUILDINGS, SHARD, building_file, safe_name
+from facadecli.city.folders import BUILDINGS, SHARD, building_file, run_folder, safe_name
 from facadecli.city.footprints import (
     BBox,
     Footprint,
@@ -87,7 +88,9 @@ from facadecli.export.atomic import atomic_output, check_output_folder, write_at
 from facadecli.export.glb_merge import instance_nodes
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.lock import locked
-from facadecli.export.usd import usda_text
+from facadecli.export.texture_store import FOLDER as TEXTURES
+from facadecli.export.texture_store import PICTURE, TextureStore, externalised, prune
+from facadecli.export.usd import stored_usda_text, usda_text
 from facadecli.geometry.facade import material_extensions
 from facadecli.solver.axis import AxisLayout
 from facadecli.spec.model import Spec
@@ -114,6 +117,13 @@ class Task:
     above: Any = None  # the taller parts standing on this one: its roof leaves them out
     instanced: bool = False  # repeated parts as GPU instances (``--instance``)
     level: int = 3  # the finest level of detail the run needs: below 3, no façade is solved
+    shared_textures: bool = True  # pictures in the run's textures/, not in each glb
+
+    @property
+    def pictures(self) -> TextureStore | None:
+        """Where its pictures go: the run's ``textures/`` (texture_store.py), or None
+        when its glb embeds them (``--embed-textures``)."""
+        return TextureStore(run_folder(self.target) / TEXTURES) if self.shared_textures else None
 
     @property
     def file(self) -> str:
@@ -201,11 +211,17 @@ def build(task: Task) -> dict[str, Any]:
         solids = BuildingSolids(task.footprint.id, result.volumes, attributes(task, result.top))
         write_cityjson(feature_file(task.target), building_object(solids))
         data = glb_bytes(result.scene, material_extensions(task.spec))
-        write_atomic(task.target, instance_nodes(data) if task.instanced else data)
+        data = instance_nodes(data) if task.instanced else data
+        store = task.pictures  # its pictures are written before the files that name them
+        write_atomic(task.target, data if store is None else externalised(data, store, task.target))
         if task.usd:
-            write_atomic(
-                task.target.with_suffix(".usda"), usda_text(result.scene, task.target.stem)
+            stage = task.target.with_suffix(".usda")
+            text = (
+                usda_text(result.scene, task.target.stem)
+                if store is None
+                else stored_usda_text(result.scene, stage, store)
             )
+            write_atomic(stage, text)
     except Exception as error:
         return {
             "id": task.footprint.id,
@@ -236,7 +252,9 @@ def _build_coarse(task: Task) -> dict[str, Any]:
     the run's level (lods.py): what the merged models and the tiles make of it anyway."""
     started = time.perf_counter()
     try:
-        volumes = [volume(part, task.heights, task.roof) for part in task.footprint.parts]
+        volumes = party_volumes(
+            task.footprint, task.heights, task.roof, task.shared, task.tolerance
+        )
         solids, top = building_solids(task.footprint, volumes)
         feature = building_object(BuildingSolids(task.footprint.id, solids, attributes(task, top)))
         write_cityjson(feature_file(task.target), feature)
@@ -295,6 +313,7 @@ def plan(
     usd: bool = False,
     instanced: bool = False,
     level: int = 3,
+    shared_textures: bool = True,
 ) -> list[Task]:
     """One task a building, built to ``level`` of detail (below 3: no façades). Paths are
     absolute: workers (Dask's too) may run elsewhere."""
@@ -367,6 +386,7 @@ def plan(
                 above.get(footprint.id),
                 instanced,
                 level,
+                shared_textures,
             )
         )
     return tasks
@@ -480,6 +500,7 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
         outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
         outdir / TILESET_FOLDER: rf"\.tileset\.json{_RANDOM}tmp",
+        outdir / TEXTURES: rf"\.{PICTURE.pattern}{_RANDOM}tmp",  # a picture (texture_store.py)
     }
     with contextlib.suppress(OSError):  # buildings/<shard>/ (folders.py)
         for entry in os.scandir(outdir / BUILDINGS):
@@ -528,12 +549,15 @@ def run_city(
     merged_lod: int = 3,
     instanced: bool = False,
     timings: bool = False,
+    shared_textures: bool = True,
 ) -> CityReport:
     """Build a city; returns the report (also written to ``<name>.report.json``).
     With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py); the merged
     models are at ``merged_lod`` (tiles.py). With ``instanced``, the parts façades repeat
     are GPU instances, in each building's glb and across the merged models. With
     ``timings``, the report file keeps the times (else null there: reproducible bytes).
+    The texture pictures are stored once for the run, in ``textures/`` (texture_store.py),
+    and every model names them there; with ``shared_textures`` False, each glb embeds its own.
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -542,7 +566,7 @@ def run_city(
     check_output(outdir, city.manifest.name)
     outdir = outdir.resolve()  # workers, Dask's too, may run in another folder
     level = max((*lods, merged_lod))  # the finest any output needs
-    ahead = planned(city, outdir, bbox, limit, usd, instanced, level)
+    ahead = planned(city, outdir, bbox, limit, usd, instanced, level, shared_textures)
     with claimed(outdir, city.manifest.name):  # leftovers of a killed run removed
         return _build(
             city,
@@ -584,6 +608,7 @@ def planned(
     usd: bool = False,
     instanced: bool = False,
     level: int = 3,
+    shared_textures: bool = True,
 ) -> Planned:
     """The footprints read (those in ``bbox``), an outline's tags given to its parts, the
     outlines with parts cut to what they leave, collinear nodes merged, the first
@@ -594,13 +619,8 @@ def planned(
     defaults = city.manifest.defaults
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
-    return Planned(
-        found,
-        replaced,
-        kept,
-        straight,
-        plan(city, footprints, outdir.resolve(), usd, instanced, level),
-    )
+    tasks = plan(city, footprints, outdir.resolve(), usd, instanced, level, shared_textures)
+    return Planned(found, replaced, kept, straight, tasks)
 
 
 def _build(
@@ -690,6 +710,7 @@ def _build(
         merged_lod,
         instanced,
     )
+    _prune_pictures(outdir)
     formats = ["glb", "3dtiles", "usd", "cityjson"]  # CITY_WRITERS' order: the report's too
     asked = {"3dtiles": tileset is not None, "usd": usd}
     models: dict[str, Any] = {}
@@ -717,6 +738,35 @@ def _build(
             f"{outdir}: cannot write the report: {error.strerror or error}; run again with --resume"
         ) from None
     return report
+
+
+def _prune_pictures(outdir: Path) -> None:
+    """The pictures of ``textures/`` that no building's glb in ``buildings/`` names
+    removed (texture_store.py): an earlier run's, whose buildings changed since. Every
+    glb there counts, this run's or not (a ``--limit`` leaves an earlier run's others)."""
+    if not (outdir / TEXTURES).is_dir():
+        return
+    try:
+        prune(outdir / TEXTURES, _building_glbs(outdir / BUILDINGS))
+    except OSError as error:
+        raise OutputError(
+            f"{outdir}: cannot tidy the texture pictures: {error.strerror or error}; the "
+            "buildings built are kept: run again with --resume"
+        ) from None
+
+
+def _building_glbs(buildings: Path) -> Iterator[Path]:
+    """Every glb in ``buildings/``: in its shards (folders.py), and at its top, where runs
+    before the shards wrote."""
+    if not buildings.is_dir():
+        return
+    for entry in sorted(os.scandir(buildings), key=lambda entry: entry.name):
+        if entry.name.endswith(".glb") and entry.is_file(follow_symlinks=False):
+            yield Path(entry.path)
+        elif SHARD.fullmatch(entry.name) and entry.is_dir(follow_symlinks=False):
+            for inner in sorted(os.scandir(entry.path), key=lambda inner: inner.name):
+                if inner.name.endswith(".glb") and inner.is_file(follow_symlinks=False):
+                    yield Path(inner.path)
 
 
 def _written(writer: CityWriter, finished: BuiltCity) -> dict[str, Any]:

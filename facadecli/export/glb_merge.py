@@ -20,6 +20,7 @@ import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, BinaryIO
+from urllib.parse import quote, unquote
 
 import numpy as np
 
@@ -136,6 +137,8 @@ def merge_glb(
         groups: dict[str, list[Any]] = {}  # a mesh's digest -> [merged mesh, placements]
         for name, path in parts:
             document, chunk = read_glb(path.read_bytes() if isinstance(path, Path) else path)
+            if isinstance(path, Path):
+                document = _rebased(document, path, target)
             first: dict[str, int] = {}  # new meshes' digests -> their index in the part
             if instanced:
                 document, chunk, first = _gather(document, chunk, groups)
@@ -157,6 +160,36 @@ def merge_glb(
         _write(merged, binary, binary.tell(), target)
 
 
+def _rebased(document: dict[str, Any], part: Path, target: Path) -> dict[str, Any]:
+    """A part's document with the pictures it names by relative URI (a run's shared
+    ``textures/``, texture_store.py) named relative to ``target`` instead."""
+    images = document.get("images", [])
+    if not any(relative_uri(image) for image in images):
+        return document
+    moved = []
+    for image in images:
+        if (uri := relative_uri(image)) is not None:
+            image = {**image, "uri": uri_from(target, part.parent / unquote(uri))}
+        moved.append(image)
+    return {**document, "images": moved}
+
+
+def uri_from(beside: Path, target: Path) -> str:
+    """The URI of the file ``target`` relative to the folder of the file ``beside``
+    (posix separators, percent-encoded as URIs are)."""
+    relative = os.path.relpath(os.path.abspath(target), os.path.abspath(beside.parent))
+    return quote(Path(relative).as_posix())
+
+
+def relative_uri(image: Any) -> str | None:
+    """An image's URI when it names a file by a relative URI (not embedded in the glb, not
+    a data URI nor another scheme, not an absolute path), else None."""
+    uri = image.get("uri") if isinstance(image, dict) else None
+    if isinstance(uri, str) and uri and ":" not in uri and not uri.startswith("/"):
+        return uri
+    return None
+
+
 def _unlink(path: str) -> None:
     with contextlib.suppress(FileNotFoundError):
         os.unlink(path)
@@ -176,24 +209,24 @@ def _known_images(
     kept: list[dict[str, Any]] = []
     for image in images:
         view = views[image["bufferView"]] if "bufferView" in image else None
-        if view is None:
-            sources.append(len(kept))
-            kept.append(image)
-            continue
-        start = view.get("byteOffset", 0)
-        digest = hashlib.sha256(chunk[start : start + view["byteLength"]]).digest()
+        if view is None:  # a picture beside the model: the same URI is the same picture
+            digest = b"uri:" + str(image.get("uri", "")).encode("utf-8")
+        else:
+            start = view.get("byteOffset", 0)
+            digest = hashlib.sha256(chunk[start : start + view["byteLength"]]).digest()
         if digest in known:
             sources.append(known[digest] - first)
-            dropped.add(image["bufferView"])
+            if view is not None:
+                dropped.add(image["bufferView"])
         else:
             known[digest] = first + len(kept)
             sources.append(len(kept))
             kept.append(image)
-    if not dropped:
+    if len(kept) == len(images):
         return document, chunk
     order = [i for i in range(len(views)) if i not in dropped]
     renumbered = {old: new for new, old in enumerate(order)}
-    new_views, packed = _packed(views, order, chunk)
+    new_views, packed = packed_views(views, order, chunk)
     document = dict(document)
     document["bufferViews"] = new_views
     document["accessors"] = [
@@ -498,7 +531,7 @@ def _without(
     needed |= {image["bufferView"] for image in document.get("images", []) if "bufferView" in image}
     kept_views = sorted(needed)
     view_at = {old: new for new, old in enumerate(kept_views)}
-    new_views, binary = _packed(views, kept_views, chunk)
+    new_views, binary = packed_views(views, kept_views, chunk)
     new_nodes = []
     for i in kept_nodes:
         node = dict(nodes[i])
@@ -553,7 +586,7 @@ def _without(
     return (document, binary, mesh_at) if with_meshes else (document, binary)
 
 
-def _packed(
+def packed_views(
     views: list[dict[str, Any]], order: list[int], chunk: bytes
 ) -> tuple[list[dict[str, Any]], bytes]:
     """The buffer views ``order`` names, in that order, and their bytes packed one after

@@ -24,6 +24,7 @@ import trimesh
 
 from facadecli.export.atomic import write_atomic
 from facadecli.export.obj import ordered_nodes
+from facadecli.export.texture_store import TextureStore
 from facadecli.export.textures import SLOTS, TextureFiles, texture_files
 
 
@@ -106,7 +107,7 @@ def _texture_network(path: str, pictures: dict[str, str]) -> list[str]:
             f'            def Shader "{slot}"',
             "            {",
             '                uniform token info:id = "UsdUVTexture"',
-            f"                asset inputs:file = @./{file}@",
+            f"                asset inputs:file = @{_asset(file)}@",
             f"                float2 inputs:st.connect = <{path}/st.outputs:result>",
             f'                token inputs:sourceColorSpace = "{space}"',
             '                token inputs:wrapS = "repeat"',
@@ -125,6 +126,12 @@ def _texture_network(path: str, pictures: dict[str, str]) -> list[str]:
             "            }",
         ]
     return lines
+
+
+def _asset(file: str) -> str:
+    """A picture's asset path, relative to the stage: ``./name.png`` beside it, or the
+    relative path of a run's shared picture (``../../textures/<digest>.png``)."""
+    return file if file.startswith("../") else f"./{file}"
 
 
 def _mesh(name: str, mesh: trimesh.Trimesh, material: str, root: str) -> list[str]:
@@ -233,6 +240,14 @@ def write_usd(scene: trimesh.Scene, path: Path) -> list[Path]:
         written.append(path.parent / file)
     write_atomic(path, usda_text(scene, path.stem, pictures))
     return [path, *written]
+
+
+def stored_usda_text(scene: trimesh.Scene, path: Path, store: TextureStore) -> str:
+    """The stage to be written at ``path``, its pictures in a run's ``store`` (each
+    written once for the run, texture_store.py) instead of beside it."""
+    pictures = texture_files(_materials(scene), path.stem)
+    names = {key: store.uri(pictures.files[file], path) for key, file in pictures.names.items()}
+    return usda_text(scene, path.stem, TextureFiles(names, {}))
 
 
 def _materials(scene: trimesh.Scene) -> list[tuple[str, object]]:

@@ -20,11 +20,14 @@ import os
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass
+from functools import partial
 from html import escape
 from pathlib import Path
+from urllib.parse import unquote
 
 from facadecli.errors import OutputError, Problem, SpecError
 from facadecli.export.atomic import atomic_output, check_output_file
+from facadecli.export.texture_store import embedded
 from facadecli.files import NotRegularFile, read_regular_at_most
 from facadecli.limits import GALLERY_BYTES_MAX
 from facadecli.viewer import document_parts, glb_element
@@ -176,9 +179,15 @@ def read_models(
         used += len(data)
         return data
 
-    for model in models:
+    def picture(model: Model, uri: str) -> bytes:
         try:
-            glb = read(model.glb)
+            return read(model.glb.parent / unquote(uri))
+        except _Skip as skip:
+            raise _Skip(f"its texture picture {unquote(uri)}: {skip}") from None
+
+    for model in models:
+        try:  # a city's glb names the pictures of its run's textures/: the page holds them
+            glb = embedded(read(model.glb), partial(picture, model))
         except _Skip as skip:
             skipped.append(Skipped(model.glb, str(skip)))
             continue

@@ -5,7 +5,8 @@ as built by default, with ``--instance`` (repeated parts as GPU instances), and 
 
 Prints draw calls (primitives drawn: one per node's primitive, one per primitive of an
 instanced mesh for all its instances), materials, images, triangles drawn and stored
-(an instanced mesh's once) and megabytes, per building and for the whole city, and the
+(an instanced mesh's once) and megabytes (the glb and the pictures it names in the run's
+``textures/``), per building and for the whole city, and the
 CPU seconds each run took (user + system of the ``facade city`` process). Counts depend
 only on the code; the CPU time on the machine and its load. Run it with PYTHONPATH=SOURCE
 to count another checkout's code (the figures "before" in docs/reference/materials.md
@@ -84,7 +85,9 @@ def line(label: str, glb: Path, cpu: float | None) -> str:
     """The figures of a merged glb, per building and for the whole city."""
     document, binary = read_glb(glb)
     found = counts(document)
-    size = glb.stat().st_size
+    uris = {image["uri"] for image in document.get("images", []) if "uri" in image}
+    pictures = sum((glb.parent / uri).stat().st_size for uri in uris)  # the run's textures/
+    size = glb.stat().st_size + pictures
     n = found["buildings"]
     took = f"; {cpu:.1f} s CPU (-j 1)" if cpu is not None else ""
     return (
@@ -94,7 +97,7 @@ def line(label: str, glb: Path, cpu: float | None) -> str:
         f"{found['stored'] / n:,.0f} stored, {size / n / 1e6:.2f} MB; whole city "
         f"{found['draws']} draw calls, {found['materials']} materials, {found['textures']} "
         f"textures, {found['images']} images, {size / 1e6:.1f} MB ({binary / 1e6:.1f} MB "
-        f"binary){took}"
+        f"binary, {pictures / 1e6:.1f} MB of pictures in textures/){took}"
     )
 
 

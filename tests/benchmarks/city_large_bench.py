@@ -11,8 +11,9 @@ Each size runs in a fresh client process (``run_city``, as ``facade city`` calls
 Printed per size: wall time; CPU seconds per building, all processes (the client's own
 and its workers', from ``getrusage``: the workers are the client's children, waited for);
 the client's peak resident memory (``ru_maxrss``: the workers' are not in it) and its
-resident memory when the first and the last building end; the output sizes, the shard
-folders of ``buildings/`` and the tiles' sizes. With ``FACADE_BENCH_PROFILE=1`` the
+resident memory when the first and the last building end; the output sizes (the shared
+``textures/`` too) and the whole output folder's a building, the shard folders of
+``buildings/`` and the tiles' sizes. With ``FACADE_BENCH_PROFILE=1`` the
 smaller size also runs in one process under cProfile, and the functions taking the most
 CPU (own and cumulative) are printed. First, the client's memory once the town is read
 and planned (no building built) at 1,000, 10,000, 100,000 (up to ``FACADE_BENCH_N``)
@@ -172,6 +173,7 @@ def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
         "3dtiles/": _size(out / "3dtiles"),
         f"{name}.city.json": _size(out / f"{name}.city.json"),
         f"{name}.report.json": _size(out / f"{name}.report.json"),
+        "textures/": _size(out / "textures"),
     }
     print(
         f"{count} buildings, -j {jobs}: {found['ok']} built, {found['failed']} failed, "
@@ -192,6 +194,10 @@ def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
     print(
         "  outputs: "
         + ", ".join(f"{key} {size / 2**20:.1f} MiB" for key, size in sizes.items() if size)
+    )
+    on_disk = _size(out)
+    print(
+        f"  on disk: {on_disk / 2**20:.1f} MiB in all, {on_disk / count / 2**20:.3f} MiB a building"
     )
     print(f"  buildings/: {len(shards)} shard folders, at most {most} files in one")
     if found["models"].get("merged_left_out"):
