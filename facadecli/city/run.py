@@ -223,26 +223,17 @@ def build(task: Task) -> dict[str, Any]:
             )
             write_atomic(stage, text)
     except Exception as error:
-        return {
-            "id": task.footprint.id,
-            "status": "failed",
-            "error": f"{type(error).__name__}: {error}",
-            "time_ms": round((time.perf_counter() - started) * 1000, 1),
-        }
-    return {
-        "id": task.footprint.id,
-        "status": "ok",
-        "file": task.file,
-        "facades": result.facades,
-        "plain_walls": result.plain_walls,
-        "party_walls": result.party_walls,
-        "plain": result.plain,
+        return _failed(task, error, started)
+    return _built(
+        task,
+        started,
+        facades=result.facades,
+        plain_walls=result.plain_walls,
+        party_walls=result.party_walls,
+        plain=result.plain,
         **({"doors": result.doors} if result.doors else {}),
-        "height": result.top,
-        "repaired": task.footprint.repaired,
-        **_simplified(task.footprint.simplified),
-        "time_ms": round((time.perf_counter() - started) * 1000, 1),
-    }
+        height=result.top,
+    )
 
 
 def _build_coarse(task: Task) -> dict[str, Any]:
@@ -263,20 +254,30 @@ def _build_coarse(task: Task) -> dict[str, Any]:
         if task.usd:
             write_atomic(task.target.with_suffix(".usda"), usda_text(scene, task.target.stem))
     except Exception as error:
-        return {
-            "id": task.footprint.id,
-            "status": "failed",
-            "error": f"{type(error).__name__}: {error}",
-            "time_ms": round((time.perf_counter() - started) * 1000, 1),
-        }
+        return _failed(task, error, started)
+    return _built(task, started, lod=task.level, height=top)
+
+
+def _built(task: Task, started: float, **figures: Any) -> dict[str, Any]:
+    """A built building's report entry: its id, file, ``figures`` (what it is made of,
+    its height), how its footprint was repaired and simplified, and its time."""
     return {
         "id": task.footprint.id,
         "status": "ok",
         "file": task.file,
-        "lod": task.level,
-        "height": top,
+        **figures,
         "repaired": task.footprint.repaired,
         **_simplified(task.footprint.simplified),
+        "time_ms": round((time.perf_counter() - started) * 1000, 1),
+    }
+
+
+def _failed(task: Task, error: Exception, started: float) -> dict[str, Any]:
+    """A building that failed: its report entry, with the error."""
+    return {
+        "id": task.footprint.id,
+        "status": "failed",
+        "error": f"{type(error).__name__}: {error}",
         "time_ms": round((time.perf_counter() - started) * 1000, 1),
     }
 
