@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 
+from facadecli.city.built import feature, feature_file
 from facadecli.city.demo import terraces, write_terraces
 from facadecli.city.footprints import read_footprints
 from facadecli.city.manifest import load_city
@@ -202,3 +203,18 @@ def test_kill_9_then_resume_gives_a_fresh_runs_files(tmp_path: Path) -> None:
     assert 1 <= sum(1 for b in report["buildings"] if b.get("resumed")) < HOUSES
     assert _entries(report) == _entries(fresh)
     assert _outputs(out) == _outputs(tmp_path / "fresh")
+
+
+def test_a_feature_made_again_from_its_volumes_is_the_one_its_worker_wrote(
+    tmp_path: Path,
+) -> None:
+    """A building resumed from a run that wrote no feature file has its CityJSON made from
+    its volumes (built.feature): party walls, solids and height as a worker makes them."""
+    city = load_city(_town(tmp_path))
+    out = tmp_path / "out"
+    run_city(city, out, jobs=1)
+    tasks = plan(city, list(read_footprints(city.footprints).footprints), out)
+    for task in tasks:
+        written = json.loads(feature_file(task.target).read_bytes())
+        feature_file(task.target).unlink()
+        assert feature(task) == written, task.footprint.id

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from facadecli.city.building import party_volumes, written_volumes
+from facadecli.city.building import building_solids, party_volumes
 from facadecli.city.cityjson import BuildingSolids, building_object, grouped, outlines
 from facadecli.city.footprints import FootprintSet, typed
 from facadecli.city.georef import Georef
@@ -47,9 +47,8 @@ def feature(task: Task) -> dict[str, Any]:
         loaded: dict[str, Any] = json.loads(path.read_bytes())
         return loaded
     volumes = party_volumes(task.footprint, task.heights, task.roof, task.shared, task.tolerance)
-    volumes = written_volumes(task.footprint, volumes)
-    top = max(v.top for v in volumes)
-    return building_object(BuildingSolids(task.footprint.id, volumes, attributes(task, top)))
+    solids, top = building_solids(task.footprint, volumes)  # as its worker makes them
+    return building_object(BuildingSolids(task.footprint.id, solids, attributes(task, top)))
 
 
 @dataclass(frozen=True)
