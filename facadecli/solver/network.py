@@ -29,9 +29,7 @@ if cython.compiled:
 else:
     from math import fabs, isfinite, sqrt
 
-    def nearbyint(x: float) -> float:
-        """The nearest whole number, ties to even (C's in the default rounding mode)."""
-        return float(round(x))
+    from facadecli._libm import nearbyint
 
 
 COMPILED_FROM: str | None = None  # setup.py: the digest of the sources it was built from
