@@ -18,6 +18,7 @@ import shlex
 import shutil
 import struct
 import subprocess
+import sys
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -331,7 +332,10 @@ def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) 
 # Outside tools, where they are installed: the 3D Tiles validator and CesiumJS
 
 VALIDATOR = os.environ.get("FACADE_3DTILES_VALIDATOR")  # e.g. "npx 3d-tiles-validator"
-CESIUM = os.environ.get("FACADE_CESIUM")  # a folder with Cesium.js: npm cesium's Build/Cesium
+# a folder with Cesium.js: npm cesium's Build/Cesium, which make test installs in the venv
+CESIUM = os.environ.get(
+    "FACADE_CESIUM", str(Path(sys.prefix) / "node" / "node_modules" / "cesium" / "Build" / "Cesium")
+)
 
 
 @pytest.mark.skipif(not VALIDATOR, reason="set FACADE_3DTILES_VALIDATOR to a validator command")
@@ -366,7 +370,7 @@ async function main() {
     skyAtmosphere: false, contextOptions: { webgl: { preserveDrawingBuffer: true } },
   });
   viewer.scene.globe.baseColor = Cesium.Color.fromCssColorString("#7d9a6a");
-  const tileset = await Cesium.Cesium3DTileset.fromUrl("tiles/tileset.json",
+  const tileset = await Cesium.Cesium3DTileset.fromUrl("run/3dtiles/tileset.json",
                                                        { maximumScreenSpaceError: 2 });
   viewer.scene.primitives.add(tileset);
   const sphere = tileset.boundingSphere;
@@ -383,8 +387,27 @@ main().catch((error) => { document.title = "error: " + error; });
 """
 
 
-def _served(folder: Path) -> Iterator[str]:
-    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(folder))
+class _Counted(http.server.SimpleHTTPRequestHandler):
+    """Serves a folder quietly, keeping the paths asked for and those it could not find."""
+
+    asked: list[str]
+    missing: list[str]
+
+    def do_GET(self) -> None:
+        self.asked.append(self.path)
+        super().do_GET()
+
+    def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
+        self.missing.append(self.path)
+        super().send_error(code, message, explain)
+
+    def log_message(self, format: str, *args: Any) -> None:
+        pass
+
+
+def _served(folder: Path, asked: list[str], missing: list[str]) -> Iterator[str]:
+    kept = {"asked": asked, "missing": missing}
+    handler = functools.partial(type("Handler", (_Counted,), kept), directory=str(folder))
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
     thread = threading.Thread(target=server.serve_forever, daemon=True)
     thread.start()
@@ -399,21 +422,33 @@ def _served(folder: Path) -> Iterator[str]:
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 @pytest.mark.skipif(
     not CESIUM or not (Path(str(CESIUM)) / "Cesium.js").is_file(),
-    reason="set FACADE_CESIUM to npm cesium's Build/Cesium",
+    reason="no CesiumJS: make test installs it, or set FACADE_CESIUM to npm cesium's Build/Cesium",
 )
 def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: Path) -> None:
-    """CesiumJS in headless Chromium loads every tile it needs and flies to the tileset;
-    the centre of the bounding sphere it computed is where PROJ puts the root box's
-    centre, within a centimetre, and the picture shows the houses on the globe."""
+    """CesiumJS in headless Chromium loads every tile it needs, with the pictures they
+    name in the run's textures/ (served with the run's folder, as a user serves it), and
+    flies to the tileset; the centre of the bounding sphere it computed is where PROJ puts
+    the root box's centre, within a centimetre, and the picture shows the houses on the
+    globe."""
     site = tmp_path / "site"
     site.mkdir()
     (site / "cesium").symlink_to(Path(str(CESIUM)).resolve())
-    (site / "tiles").symlink_to(city / "3dtiles")
+    (site / "run").symlink_to(city)  # the whole output folder: 3dtiles/ and textures/
     (site / "index.html").write_text(PAGE)
-    for url in _served(site):
+    asked: list[str] = []
+    missing: list[str] = []
+    for url in _served(site, asked, missing):
         shot, dom = browse(tmp_path, url, (20_000, 60_000), lambda dom: "<title>loaded" in dom)
     title = re.search(r"<title>([^<]*)</title>", dom).group(1)  # type: ignore[union-attr]
     assert title.startswith("loaded"), title
+    assert [path for path in missing if not path.endswith("favicon.ico")] == []
+    pictures = {p.name for p in (city / "textures").glob("*.png")}
+    named = set()
+    for glb in (city / "3dtiles").rglob("*.lod3.glb"):
+        named |= {Path(i["uri"]).name for i in read_glb(glb.read_bytes())[0].get("images", [])}
+    assert named and named <= pictures  # the LOD3 tiles name the run's pictures
+    fetched = {Path(path).name for path in asked if path.startswith("/run/textures/")}
+    assert fetched and fetched <= named  # and CesiumJS fetched them from there
     lon, lat, height = (float(v) for v in title.split()[1:])
     document = _tileset(city)
     low, high = _corners(document["root"]["boundingVolume"]["box"])
