@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 from facadecli.city.building import ROOF_NAME
@@ -185,6 +186,46 @@ def test_a_tower_part_on_a_flat_podium_part_starts_on_its_roof(
     document = json.loads((folder / "out" / "d.city.json").read_text())
     tower = document["CityObjects"]["way/900"]
     assert tower["attributes"]["name"] == "Tower" and tower["children"] == ["way/901", "way/902"]
+
+
+@pytest.mark.parametrize(
+    ("podium", "tower", "cover", "tower_area"),
+    [(502, 503, "roof", 64.0), (901, 902, "flat_roof", 100.0)],
+)
+def test_the_podium_s_lod2_roof_leaves_the_tower_out_as_the_glb_s_does(
+    district: tuple[Path, dict[str, Any]], podium: int, tower: int, cover: str, tower_area: float
+) -> None:
+    """The podium's CityJSON solid (and so its LOD2 model and 3D Tiles) has the glb's
+    roof: none of it inside the tower standing on it, the same area; the solid is closed
+    at the podium's eaves under the tower by a ClosureSurface, which the LOD2 model does
+    not draw (the tower stands on it)."""
+    folder, _ = district
+    feature = feature_of(folder / "out" / building_file(f"way/{podium}"))
+    (solid,) = [g for o in feature["CityObjects"].values() for g in o.get("geometry", [])]
+    assert solid["type"] == "Solid"
+    kinds = [surface["type"] for surface in solid["semantics"]["surfaces"]]
+    closure = kinds.index("ClosureSurface")
+    (closed,) = [k for k, value in enumerate(solid["semantics"]["values"][0]) if value == closure]
+    points = np.asarray(feature["vertices"]) * 0.001
+    under = points[solid["boundaries"][0][closed][0]]
+    facades = _mesh(folder, tower, "render")
+    assert np.ptp(under[:, 2]) < 1e-9  # level, at the podium's eaves: the tower's base
+    assert under[:, 2].max() == pytest.approx(facades.bounds[0][1] + 0.01, abs=2e-3)
+    tower_plan = shapely.Polygon(under[:, :2])
+    assert tower_plan.area == pytest.approx(tower_area, rel=1e-2)  # (UTM scale, degrees)
+    within = tower_plan.buffer(-0.2)
+
+    def inside(mesh: trimesh.Trimesh) -> np.ndarray:  # glTF frame: x east, y up, z south
+        middles = mesh.triangles_center
+        return shapely.contains_xy(within, middles[:, 0], -middles[:, 2])
+
+    roof = lod_meshes(feature, 2)[ROOF_NAME]
+    assert not inside(roof).any()
+    glb = _mesh(folder, podium, cover)
+    top = glb.area_faces[glb.face_normals[:, 1] > 0.1].sum()  # a flat roof is a slab
+    assert roof.area == pytest.approx(top, rel=1e-3)
+    walls = lod_meshes(feature, 2)["wall"]
+    assert not (inside(walls) & (walls.triangles_center[:, 1] > 0.1)).any()  # no closure
 
 
 def test_a_wall_drawn_with_nodes_on_a_line_is_one_facade(

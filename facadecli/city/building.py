@@ -23,14 +23,14 @@ from typing import Any
 
 import numpy as np
 import trimesh
-from shapely.geometry import Point, Polygon
-from shapely.geometry.polygon import orient
+from shapely.geometry import Polygon
 
 from facadecli.city.entrances import DOOR_MATERIAL, along_wall, with_doors
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
-from facadecli.city.roofs import Segment, roof_meshes
+from facadecli.city.roofs import roof_meshes
 from facadecli.city.s3db import (
+    MIN_EDGE,
     POST,
     Heights,
     Post,
@@ -38,6 +38,7 @@ from facadecli.city.s3db import (
     along,
     party_zone,
     roof_only,
+    roof_outlines,
     roof_solid,
     volume,
 )
@@ -77,7 +78,6 @@ WALL_NAME, ROOF_NAME, GROUND_NAME = "wall", "roof", "ground"  # a spec may defin
 FLAT_ROOF_NAME = "flat_roof"
 ROOFS = (ROOF_NAME, FLAT_ROOF_NAME)  # their textures lie in their slopes (plane_uv)
 SLAB = 0.2  # metres: thickness of flat roofs and plain walls
-MIN_EDGE = 0.05  # metres: shorter edges are slivers, merged into the next wall
 
 
 STRETCH = 0.02  # rungs of the ladder of wall lengths are this share apart
@@ -328,7 +328,7 @@ def build_building(
     instances: dict[tuple[str, bytes, bytes], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
     facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
-    volumes = party_volumes(footprint, heights, roof, shared, tolerance)
+    volumes = party_volumes(footprint, heights, roof, shared, tolerance, above)
     posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
     for block in volumes:
         wall_height = _wall_height(block)
@@ -384,7 +384,7 @@ def build_building(
             parts.setdefault(name, []).append(post)
         if posts_only:
             parts.setdefault(_plain_material(spec), []).extend(_posts(post_places(block)))
-        for shape, still in roof_outlines(block.part, block.still, above):
+        for shape, still in roof_outlines(block):
             cover, infill = roof_meshes(shape, block.eaves, block.roof, still)
             cover.apply_transform(MAP_TO_WORLD)
             flat = block.roof.type == "flat" and ROOF_NAME not in spec.materials
@@ -514,32 +514,6 @@ def written_volumes(footprint: Footprint, volumes: Sequence[Volume]) -> list[Vol
     return [roof_solid(block, SLAB, post_places(block)) for block in volumes]
 
 
-def roof_outlines(
-    part: Polygon, party: Sequence[Segment], above: Any
-) -> list[tuple[Polygon, tuple[Segment, ...]]]:
-    """Where a volume's roof goes, and the walls it stands still at: the part less the
-    taller parts standing on it (``above``: a tower on a podium), whose walls join the
-    party walls; the part whole when that leaves too little."""
-    if above is None or above.is_empty:
-        return [(part, tuple(party))]
-    rest = part.difference(above)
-    pieces = [rest] if isinstance(rest, Polygon) else list(getattr(rest, "geoms", []))
-    pieces = [orient(p, sign=1.0) for p in pieces if isinstance(p, Polygon) and p.area >= 1.0]
-    if not pieces:
-        return [(part, tuple(party))]
-    edge = part.boundary
-    found = []
-    for piece in pieces:
-        cut = [
-            (a, b)
-            for ring in (piece.exterior, *piece.interiors)
-            for a, b in itertools.pairwise((p[0], p[1]) for p in ring.coords)
-            if edge.distance(Point((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)) > MIN_EDGE
-        ]
-        found.append((piece, (*party, *cut)))
-    return found
-
-
 @dataclass(frozen=True)
 class Facade:
     """A façade spec, its key in the caches, and its folder (for its mesh files)."""
@@ -553,15 +527,22 @@ Wall = tuple[tuple[float, float], tuple[float, float], float, bool, Facade]
 
 
 def party_volumes(
-    footprint: Footprint, heights: Heights, roof: Roof, shared: Any, tolerance: float
+    footprint: Footprint,
+    heights: Heights,
+    roof: Roof,
+    shared: Any,
+    tolerance: float,
+    above: Any = None,
 ) -> list[Volume]:
     """The building's volumes (:func:`.s3db.volume`), each with its party walls
     (``still``): its walls along a neighbour (``shared``, within ``tolerance``), where
     its façades stop and its roof runs on at full height. A roof on posts has no walls,
-    so none (its roof slopes down to its edges). The one place party walls are found:
-    the glb's walls and roofs and the CityJSON's solids (LOD2, and the 3D Tiles' LOD1
-    and LOD2 made from them) all take them from here."""
-    blocks = [volume(part, heights, roof) for part in footprint.parts]
+    so none (its roof slopes down to its edges). Each carries ``above``, the taller
+    parts standing on the building, which its roof leaves out (:func:`.s3db.roof_outlines`).
+    The one place party walls are found: the glb's walls and roofs and the CityJSON's
+    solids (LOD2, and the 3D Tiles' LOD1 and LOD2 made from them) all take them from
+    here."""
+    blocks = [replace(volume(part, heights, roof), above=above) for part in footprint.parts]
     if roof_only(footprint.properties) or shared is None:
         return blocks
     zone = party_zone(shared, tolerance)  # widened once for all the walls

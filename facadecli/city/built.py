@@ -46,7 +46,9 @@ def feature(task: Task) -> dict[str, Any]:
     if path.is_file():
         loaded: dict[str, Any] = json.loads(path.read_bytes())
         return loaded
-    volumes = party_volumes(task.footprint, task.heights, task.roof, task.shared, task.tolerance)
+    volumes = party_volumes(
+        task.footprint, task.heights, task.roof, task.shared, task.tolerance, task.above
+    )
     solids, top = building_solids(task.footprint, volumes)  # as its worker makes them
     return building_object(BuildingSolids(task.footprint.id, solids, attributes(task, top)))
 

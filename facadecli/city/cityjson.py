@@ -37,12 +37,14 @@ from types import TracebackType
 from typing import Any, BinaryIO
 
 import numpy as np
+import shapely
 import trimesh
+from shapely.geometry.polygon import orient
 
 from facadecli.city.footprints import Footprint, typed
 from facadecli.city.georef import reference_system
 from facadecli.city.roofs import roof_meshes
-from facadecli.city.s3db import POST, Post, Volume, outline_of
+from facadecli.city.s3db import POST, Post, Volume, outline_of, roof_outlines
 from facadecli.export.atomic import atomic_output, write_atomic
 
 VERSION = "2.0"
@@ -54,7 +56,13 @@ APART = 4.0  # squared vertex units: ... unless this close to an end (a sliver's
 SNAP = (3, 10, 30)  # vertex units: a roof's point this near a point of its volume is that
 # point (the first; the others when the shell does not close without its slivers)
 COPLANAR = 1e-10  # 1 - cos of the angle between normals of triangles merged into a polygon
-SURFACE_TYPES = ("GroundSurface", "OuterCeilingSurface", "WallSurface", "RoofSurface")
+SURFACE_TYPES = (
+    "GroundSurface",
+    "OuterCeilingSurface",
+    "WallSurface",
+    "RoofSurface",
+    "ClosureSurface",  # a podium's top under the tower standing on it
+)
 
 Ring = list[int]  # vertex indices, not closed
 Surface = list[Ring]  # the exterior ring, then the holes
@@ -649,19 +657,43 @@ def _surfaces(
             a0, b0 = vertices.add((ax, ay, base)), vertices.add((bx, by, base))
             a1, b1 = vertices.add((ax, ay, eaves)), vertices.add((bx, by, eaves))
             yield "WallSurface", [[a0, b0, b1, a1]]  # outwards is right of a -> b
-    flat = volume.roof.type == "flat"
-    if not flat:
-        cover, infill = roof_meshes(volume.part, volume.eaves, volume.roof, volume.still)
-        # a roof that rises nowhere (roofs may fall back to a flat slab) is flat here
-        flat = len(cover.vertices) == 0 or float(np.max(cover.vertices[:, 2])) * UNITS < eaves + 1
-    if flat:
-        yield "RoofSurface", [at(ring, eaves) for ring in rings]
+    roofed = roof_outlines(volume)  # the glb's rule: the roof leaves out a tower on it
+    for shape, still in roofed:
+        flat = volume.roof.type == "flat"
+        if not flat:
+            cover, infill = roof_meshes(shape, volume.eaves, volume.roof, still)
+            # a roof that rises nowhere (roofs may fall back to a flat slab) is flat here
+            top = float(np.max(cover.vertices[:, 2])) * UNITS if len(cover.vertices) else 0.0
+            flat = top < eaves + 1
+        if flat:
+            yield "RoofSurface", [at(ring, eaves) for ring in _plan_rings(shape, rings, volume)]
+            continue
+        for surface in _polygons(cover, vertices, slivers):
+            yield "RoofSurface", surface
+        for piece in infill:
+            for surface in _polygons(piece, vertices, slivers):
+                yield "WallSurface", surface
+    if roofed[0][0] is volume.part:
         return
-    for surface in _polygons(cover, vertices, slivers):
-        yield "RoofSurface", surface
-    for piece in infill:
-        for surface in _polygons(piece, vertices, slivers):
-            yield "WallSurface", surface
+    # under the parts standing on it, the volume is closed at its eaves: their base
+    rest = volume.part.difference(shapely.union_all([shape for shape, _ in roofed]))
+    for piece in getattr(rest, "geoms", [rest]):
+        if isinstance(piece, shapely.Polygon) and not piece.is_empty:
+            closing = [at(ring, eaves) for ring in _plan_rings(orient(piece, 1.0), [], volume)]
+            if closing:
+                yield "ClosureSurface", closing
+
+
+def _plan_rings(shape: Any, rings: list[list[tuple[int, int]]], volume: Volume) -> list[Any]:
+    """A polygon's rings in integer units (:func:`_plan_ring`), the exterior first: the
+    volume's own ``rings`` when it is the volume's part; none when the exterior
+    vanishes at millimetre precision."""
+    if shape is volume.part:
+        return rings
+    exterior = _plan_ring(shape.exterior)
+    if not exterior:
+        return []
+    return [exterior, *(r for r in map(_plan_ring, shape.interiors) if r)]
 
 
 def _plan_ring(ring: Any) -> list[tuple[int, int]]:

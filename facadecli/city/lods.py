@@ -36,6 +36,7 @@ from facadecli.spec.model import Material
 COLOURS = {WALL_NAME: "#d9d2c3", ROOF_NAME: "#8f5a48"}  # LOD1 and LOD2 materials
 
 BOTTOMS = ("GroundSurface", "OuterCeilingSurface")
+HIDDEN = ("RoofSurface", "ClosureSurface")  # not walls: roofs, and a podium's top under a tower
 Polygon3 = list[np.ndarray]  # a planar surface: its exterior ring, then its holes, (n, 3) metres
 
 
@@ -142,7 +143,7 @@ def lod_meshes(feature: dict[str, Any], lod: int) -> dict[str, trimesh.Trimesh]:
         return {WALL_NAME: mesh([p for solid in volumes for p in block_surfaces(solid)])}
     if lod != 2:
         raise ValueError(f"LOD{lod} is not made from the CityJSON")
-    walls = [p for solid in volumes for kind, p in solid.surfaces if kind != "RoofSurface"]
+    walls = [p for solid in volumes for kind, p in solid.surfaces if kind not in HIDDEN]
     roofs = [p for solid in volumes for kind, p in solid.surfaces if kind == "RoofSurface"]
     return {WALL_NAME: mesh(walls), ROOF_NAME: mesh(roofs)}
 

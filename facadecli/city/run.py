@@ -244,7 +244,7 @@ def _build_coarse(task: Task) -> dict[str, Any]:
     started = time.perf_counter()
     try:
         volumes = party_volumes(
-            task.footprint, task.heights, task.roof, task.shared, task.tolerance
+            task.footprint, task.heights, task.roof, task.shared, task.tolerance, task.above
         )
         solids, top = building_solids(task.footprint, volumes)
         feature = building_object(BuildingSolids(task.footprint.id, solids, attributes(task, top)))

@@ -17,6 +17,7 @@ Pure functions of the tags and the footprint; no mesh library.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from collections.abc import Callable, Iterable
@@ -25,7 +26,7 @@ from typing import Any
 
 import shapely
 from shapely import STRtree
-from shapely.geometry import LineString, Polygon
+from shapely.geometry import LineString, Point, Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.footprints import MAX_HEIGHT, MIN_AREA, Footprint, length, number
@@ -58,7 +59,8 @@ class Volume:
     roof on them (its ``height`` set: the roof's top is ``eaves + roof.height``).
     ``still``: its party walls, as segments, where the roof does not slope down but
     runs on to the wall (roofs.py's fixed walls; :func:`.building.party_volumes` finds
-    them, for the glb's roofs and the CityJSON's alike)."""
+    them, for the glb's roofs and the CityJSON's alike); ``above``: the taller parts
+    standing on it, which its roof leaves out (:func:`roof_outlines`)."""
 
     part: Polygon
     base: float
@@ -66,6 +68,7 @@ class Volume:
     roof: Roof
     still: tuple[Segment, ...] = ()
     posts: tuple[Post, ...] = ()  # a roof on posts: its posts (:func:`roof_solid`)
+    above: Any = None  # the taller parts standing on it (a tower on a podium), shapely
 
     @property
     def top(self) -> float:
@@ -413,6 +416,35 @@ def roof_only(properties: dict[str, Any]) -> bool:
         str(properties.get(key, "")).strip().lower() in ON_POSTS
         for key in ("building", "building:part")
     )
+
+
+MIN_EDGE = 0.05  # metres: shorter edges are slivers, merged into the next wall
+
+
+def roof_outlines(block: Volume) -> list[tuple[Polygon, tuple[Segment, ...]]]:
+    """Where a volume's roof goes, and the walls it stands still at: the part less the
+    taller parts standing on it (``above``: a tower on a podium), whose walls join the
+    party walls; the part whole when that leaves too little. The one rule for the glb's
+    roofs and the CityJSON's solids (which close the rest at the eaves)."""
+    part, party, above = block.part, block.still, block.above
+    if above is None or above.is_empty:
+        return [(part, tuple(party))]
+    rest = part.difference(above)
+    pieces = [rest] if isinstance(rest, Polygon) else list(getattr(rest, "geoms", []))
+    pieces = [orient(p, sign=1.0) for p in pieces if isinstance(p, Polygon) and p.area >= 1.0]
+    if not pieces:
+        return [(part, tuple(party))]
+    edge = part.boundary
+    found = []
+    for piece in pieces:
+        cut = [
+            (a, b)
+            for ring in (piece.exterior, *piece.interiors)
+            for a, b in itertools.pairwise((p[0], p[1]) for p in ring.coords)
+            if edge.distance(Point((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)) > MIN_EDGE
+        ]
+        found.append((piece, (*party, *cut)))
+    return found
 
 
 def roof_solid(block: Volume, thickness: float, posts: tuple[Post, ...] = ()) -> Volume:
