@@ -16,9 +16,9 @@ from shapely.geometry import Point
 
 from facadecli import load_spec, solve
 from facadecli.city.default import default_city
-from facadecli.city.entrances import GROUND_FLOOR, NEAR, along_wall, with_doors
+from facadecli.city.entrances import GROUND_FLOOR, NEAR, along_wall, door_owners, with_doors
 from facadecli.city.footprints import read_footprints
-from facadecli.city.run import run_city
+from facadecli.city.run import planned, run_city
 from facadecli.geometry.facade import facade_scene
 from tests.instances import placed_triangles
 from tests.rays import directions, missing
@@ -226,3 +226,65 @@ def test_geojson_entrance_points_on_an_edge_are_doors_the_rest_warned(tmp_path: 
     assert [(w.id, w.reason.split(" ")[0]) for w in found.warnings] == [("lost", "entrance")]
     assert found.warnings[0].line is not None
     assert [r.id for r in found.rejected] == ["tree"]
+
+
+def test_a_door_goes_to_the_building_whose_wall_is_not_a_party_wall() -> None:
+    south, party = ((0.0, 0.0), (10.0, 0.0)), ((10.0, 0.0), (10.0, 9.0))
+    neighbour = ((10.0, 0.0), (20.0, 0.0))
+    walls_a = [(*south, False), (*party, True)]
+    walls_b = [(*neighbour, False), (party[1], party[0], True)]
+    middle = (10.0, 4.5)  # on the party wall: on no façade
+    assert door_owners(middle, [("a", walls_a), ("b", walls_b)]) == []
+    assert door_owners(middle, [("a", walls_a), ("b", [(party[1], party[0], False)])]) == ["b"]
+    # at the corner both fronts have it at their ends: the first first; 2 m in b, b alone
+    assert door_owners((10.0, 0.0), [("a", walls_a), ("b", walls_b)]) == ["a", "b"]
+    assert door_owners((12.0, 0.2), [("a", walls_a), ("b", walls_b)]) == ["b"]
+    assert door_owners((50.0, 50.0), [("a", walls_a)]) == []
+
+
+def _terrace(path: Path) -> None:
+    """Houses a and b (way 100, 101), 10 x 9 m, sharing the wall from node 2 to 3 (and
+    node 9 on it); house c (way 102) of three levels with an annex d (way 103) of one
+    sharing its east wall (node 25 on it). Entrances: node 2 (a and b's south corner),
+    node 9 (a and b's party wall) and node 25 (c's east wall, d's west wall)."""
+    nodes = {1: (0, 0), 2: (10, 0), 3: (10, 9), 4: (0, 9), 6: (20, 0), 7: (20, 9), 9: (10, 4.5)}
+    nodes |= {21: (40, 0), 22: (50, 0), 23: (50, 9), 24: (40, 9), 25: (50, 4.5)}
+    nodes |= {26: (56, 0), 27: (56, 9)}
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6" generator="tests">']
+    for nid, (x, y) in nodes.items():
+        tags = '<tag k="entrance" v="yes"/>' if nid in (2, 9, 25) else ""
+        lines.append(_node(nid, x, y, tags))
+    ways = {
+        100: ((1, 2, 9, 3, 4, 1), 2),
+        101: ((2, 6, 7, 3, 9, 2), 2),
+        102: ((21, 22, 25, 23, 24, 21), 3),
+        103: ((22, 26, 27, 23, 25, 22), 1),
+    }
+    for wid, (refs, levels) in ways.items():
+        nds = "".join(f'<nd ref="{n}"/>' for n in refs)
+        tags = f'<tag k="building" v="house"/><tag k="building:levels" v="{levels}"/>'
+        lines.append(f'  <way id="{wid}" version="1">{nds}{tags}</way>')
+    lines.append("</osm>")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def test_an_entrance_two_buildings_share_is_one_door(tmp_path: Path) -> None:
+    """An entrance node in two buildings' ways is a door in one of them only: at a
+    shared corner, the first's (warned and counted, as several could have it); on a
+    party wall, in neither (warned); on a wall shared with a lower annex, the house's,
+    whose wall there stands free above the annex (not a party wall), not the annex's."""
+    extract = tmp_path / "terrace.osm"
+    _terrace(extract)
+    ahead = planned(default_city(extract, ROOT / "specs" / "residential-house.yaml"), tmp_path)
+    held = {task.footprint.id: len(task.footprint.entrances) for task in ahead.tasks}
+    read = {f.id: len(f.entrances) for f in read_footprints(extract).footprints}
+    assert read == {"way/100": 2, "way/101": 2, "way/102": 1, "way/103": 1}  # as mapped
+    assert held == {"way/100": 1, "way/101": 0, "way/102": 1, "way/103": 0}
+    warned = [(w.id, w.reason.split(" is ")[1].split(":")[0]) for w in ahead.found.warnings]
+    assert warned == [
+        ("way/100", "on walls of way/100, way/101, none a party wall"),
+        ("way/100", "on party walls of way/100, way/101 only"),
+    ]
+    (door,) = next(t for t in ahead.tasks if t.footprint.id == "way/100").footprint.entrances
+    corner = next(t for t in ahead.tasks if t.footprint.id == "way/100").footprint.parts[0]
+    assert min(Point(c).distance(Point(door)) for c in corner.exterior.coords) < 0.01

@@ -552,6 +552,20 @@ def party_volumes(
     ]
 
 
+def building_walls(
+    footprint: Footprint, heights: Heights, roof: Roof, shared: Any, tolerance: float
+) -> list[tuple[tuple[float, float], tuple[float, float], bool]]:
+    """A building's walls as its façades are laid on them: their ends and whether each
+    is a party wall (:func:`party_volumes`); none under a roof on posts."""
+    if roof_only(footprint.properties):
+        return []
+    return [
+        (a, b, (a, b) in set(block.still))
+        for block in party_volumes(footprint, heights, roof, shared, tolerance)
+        for a, b in _edges(block.part)
+    ]
+
+
 def _walls(
     block: Volume,
     main: Facade,

@@ -49,6 +49,30 @@ def along_wall(
     return tuple(sorted(found))
 
 
+Wall = tuple[tuple[float, float], tuple[float, float], bool]  # its ends; a party wall?
+
+
+def door_owners(
+    point: tuple[float, float], holders: Sequence[tuple[str, Sequence[Wall]]]
+) -> list[str]:
+    """Which of the buildings holding one entrance (``holders``: id and walls, as on a
+    node two outlines share) may have its door, best first: those with the entrance on
+    one of their walls that is not a party wall (a party wall has no façade, so no
+    door); among several, the one where the entrance lies farthest from its wall's ends
+    (a door fits whole there, not round a corner), then the first in ``holders``."""
+    ranked = []
+    for order, (key, walls) in enumerate(holders):
+        rooms = [
+            min(t, math.dist(a, b) - t)
+            for a, b, party in walls
+            if not party
+            for t in along_wall([point], a, b)
+        ]
+        if rooms:
+            ranked.append((-round(max(rooms), 6), order, key))
+    return [key for *_, key in sorted(ranked)]
+
+
 def with_doors(layout: Layout, positions: Sequence[float]) -> Layout:
     """The layout with a door at each position (metres from its left end, in the
     layout's own width)."""

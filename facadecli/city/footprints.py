@@ -76,7 +76,7 @@ class Rejected:
 
     id: str
     reason: str
-    index: int  # in the file's features
+    index: int | None  # in the file's features (None: a warning of the planning)
     line: int | None
     column: int | None
 
@@ -159,7 +159,7 @@ def read_footprints(
     footprints, astray = _with_entrances(
         footprints, inside_doors, _projection(document.crs, crs), (minx, miny)
     )
-    rejected.sort(key=lambda r: r.index)
+    rejected.sort(key=lambda r: -1 if r.index is None else r.index)
     if rejected and not footprints:
         raise _nothing_usable(document, rejected)
     outside = len(readable) - len(inside)

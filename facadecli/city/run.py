@@ -37,6 +37,7 @@ from facadecli.city.building import (
     Slot,
     build_building,
     building_solids,
+    building_walls,
     facade_axes,
     party_volumes,
     rung_length,
@@ -49,6 +50,7 @@ from facadecli.city.cityjson import (
     cityjson_bytes,
     write_cityjson,
 )
+from facadecli.city.entrances import Wall, door_owners
 from facadecli.city.folders import BUILDINGS, SHARD, building_file, run_folder, safe_name
 from facadecli.city.footprints import (
     BBox,
@@ -318,6 +320,20 @@ def plan(
 ) -> list[Task]:
     """One task a building, built to ``level`` of detail (below 3: no façades). Paths are
     absolute: workers (Dask's too) may run elsewhere."""
+    return planned_tasks(city, footprints, outdir, usd, instanced, level, shared_textures)[0]
+
+
+def planned_tasks(
+    city: City,
+    footprints: list[Footprint],
+    outdir: Path,
+    usd: bool = False,
+    instanced: bool = False,
+    level: int = 3,
+    shared_textures: bool = True,
+) -> tuple[list[Task], list[Rejected]]:
+    """:func:`plan`'s tasks, and the warnings of the planning: an entrance that two
+    buildings hold (:func:`one_door_each`)."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
@@ -329,6 +345,12 @@ def plan(
     shapes |= {key: (shapes[key][0], heights, shapes[key][2]) for key, heights in raised.items()}
     beside = _beside(footprints, shapes)
     shared = shared_edges(footprints, tolerance, beside) if tolerance > 0 else {}
+
+    def walls_of(footprint: Footprint) -> list[Wall]:
+        _, heights, roof = shapes[footprint.id]
+        return building_walls(footprint, heights, roof, shared.get(footprint.id), tolerance)
+
+    footprints, warnings = one_door_each(footprints, walls_of)
     tasks = []
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
@@ -390,7 +412,49 @@ def plan(
                 shared_textures,
             )
         )
-    return tasks
+    return tasks, warnings
+
+
+def one_door_each(
+    footprints: list[Footprint], walls: Callable[[Footprint], list[Wall]]
+) -> tuple[list[Footprint], list[Rejected]]:
+    """The footprints with each entrance held by one of them only: an entrance node two
+    outlines share (a terrace's corner, a wall two buildings share), or an entrance point
+    within reach of both, goes to the first of :func:`.entrances.door_owners` (whose wall
+    there is not a party wall, the door farthest from the wall's ends), to none when it
+    is on party walls alone. A warning (counted under ``entrance``) says which got it
+    when several could have, and that none did when it is on party walls alone."""
+    holders: dict[tuple[float, float], list[int]] = {}
+    for index, footprint in enumerate(footprints):
+        for point in footprint.entrances:
+            holders.setdefault(point, []).append(index)
+    dropped: dict[int, set[tuple[float, float]]] = {}
+    warnings = []
+    for point, indices in holders.items():
+        if len(indices) < 2:
+            continue
+        ranked = door_owners(point, [(footprints[k].id, walls(footprints[k])) for k in indices])
+        for k in indices:
+            if not ranked or footprints[k].id != ranked[0]:
+                dropped.setdefault(k, set()).add(point)
+        where = f"entrance at ({point[0]:.2f}, {point[1]:.2f})"
+        if len(ranked) > 1:
+            reason = (
+                f"{where} is on walls of {', '.join(ranked)}, none a party wall: the door "
+                f"goes to {ranked[0]}, where it lies farthest from its wall's ends"
+            )
+            warnings.append(Rejected(ranked[0], reason, None, None, None))
+        elif not ranked:
+            ids = ", ".join(footprints[k].id for k in indices)
+            reason = f"{where} is on party walls of {ids} only: no door there"
+            warnings.append(Rejected(footprints[indices[0]].id, reason, None, None, None))
+    kept = [
+        replace(f, entrances=tuple(p for p in f.entrances if p not in dropped[k]))
+        if k in dropped
+        else f
+        for k, f in enumerate(footprints)
+    ]
+    return kept, warnings
 
 
 def _shape(city: City, properties: dict[str, Any]) -> tuple[Choice, Heights, Roof]:
@@ -620,7 +684,10 @@ def planned(
     defaults = city.manifest.defaults
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
-    tasks = plan(city, footprints, outdir.resolve(), usd, instanced, level, shared_textures)
+    tasks, warnings = planned_tasks(
+        city, footprints, outdir.resolve(), usd, instanced, level, shared_textures
+    )
+    found = replace(found, warnings=(*found.warnings, *warnings))
     return Planned(found, replaced, kept, straight, tasks)
 
 
