@@ -18,6 +18,17 @@ smaller size also runs in one process under cProfile, and the functions taking t
 CPU (own and cumulative) are printed. First, the client's memory once the town is read
 and planned (no building built) at 1,000, 10,000, 100,000 (up to ``FACADE_BENCH_N``)
 buildings, and its slope; ``FACADE_BENCH_PLAN_ONLY=1`` stops there.
+
+A run of 100,000 buildings takes about an hour of a quiet 2-core machine. With
+``FACADE_BENCH_DIR`` the town and its output are kept in that folder, not a temporary
+one, so a run that is stopped (Ctrl-C, ``kill``, the end of a working day) goes on where
+it stopped when started again: the client runs ``--resume`` (the buildings already built
+are kept, :func:`facadecli.city.run.run_city`), each run of a size is a *segment* whose
+CPU, buildings built and memory are appended to ``segments-N.jsonl`` when it ends, and
+the figures are over all segments (CPU over the buildings each built; each client's
+planning is counted again, so the CPU a building is an upper bound; a segment that was
+stopped wrote no figures, so neither its CPU nor its buildings are counted). A size measured to its end is kept as
+``done-N.txt`` (its printed figures) and its output removed; the next start skips it.
 Figures depend on the machine and its load; they are for docs/benchmarks.md, never
 asserted by the tests.
 """
@@ -35,6 +46,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = 1
@@ -60,15 +72,20 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
     from facadecli.city.tileset import parse_lods
 
     resident: dict[str, float] = {}
+    built = [0]  # buildings built by this client (not kept from a stopped run)
 
     def progress(done: int, total: int) -> None:
-        if done == 1:
+        built[0] += 1
+        if built[0] == 1:
             resident["first_built_mib"] = _resident_mib()
         if done == total:
             resident["all_built_mib"] = _resident_mib()
 
     lods = parse_lods(os.environ.get("FACADE_BENCH_LODS", "1,2,3"))
-    report = run_city(load_city(manifest), out, jobs=jobs, progress=progress, lods=lods)
+    resume = out.exists()  # a stopped run's output (FACADE_BENCH_DIR): go on from there
+    report = run_city(
+        load_city(manifest), out, jobs=jobs, progress=progress, lods=lods, resume=resume
+    )
     own = resource.getrusage(resource.RUSAGE_SELF)
     workers = resource.getrusage(resource.RUSAGE_CHILDREN)
     summary = report["summary"]
@@ -78,6 +95,7 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
                 "ok": summary["ok"],
                 "failed": summary["failed"],
                 "party_walls": summary["party_walls"],
+                "built": built[0],
                 "client_cpu": own.ru_utime + own.ru_stime,
                 "workers_cpu": workers.ru_utime + workers.ru_stime,
                 "client_peak_mib": own.ru_maxrss / 1024,  # Linux: KiB
@@ -127,9 +145,10 @@ def measure_planning(counts: list[int], folder: Path) -> None:
         subprocess.run(command, check=True)
         rows.append(json.loads(figures.read_text()))
         shutil.rmtree(folder / f"plan-{count}")
+    lines = []
     for row in rows:
         grown = row["planned_mib"] - row["imports_mib"]
-        print(
+        lines.append(
             f"planning {row['buildings']} buildings: {row['cpu']:.1f} CPU-s, resident "
             f"{row['imports_mib']:.0f} MiB after the imports, {row['planned_mib']:.0f} MiB "
             f"planned (+{grown * 1024 / row['buildings']:.1f} KiB a building), peak "
@@ -139,7 +158,9 @@ def measure_planning(counts: list[int], folder: Path) -> None:
         first, last = rows[0], rows[-1]
         slope = (last["planned_mib"] - first["planned_mib"]) * 1024
         slope /= last["buildings"] - first["buildings"]
-        print(f"planning's slope: {slope:.1f} KiB a building")
+        lines.append(f"planning's slope: {slope:.1f} KiB a building")
+    (folder / "planning.txt").write_text("\n".join(lines) + "\n")  # a kept folder's next start
+    print("\n".join(lines))
 
 
 def _size(path: Path) -> int:
@@ -149,10 +170,19 @@ def _size(path: Path) -> int:
 
 
 def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
-    """The town of ``count`` buildings built by a fresh client process; prints its figures."""
+    """The town of ``count`` buildings built by a fresh client process (going on from a
+    stopped run's segments in a kept ``folder``); prints its figures."""
     from facadecli.city.demo import write_terraces
 
-    manifest = write_terraces(folder / f"town-{count}", ROOT / "specs", count, SEED)
+    done = folder / f"done-{count}.txt"
+    if done.exists():  # measured to its end by an earlier start
+        print(done.read_text(), end="")
+        return json.loads(done.read_text().splitlines()[-1].removeprefix("# "))
+    town = folder / f"town-{count}"
+    if (town / "district.yaml").exists():  # a stopped run's town: the same bytes
+        manifest = town / "district.yaml"
+    else:
+        manifest = write_terraces(town, ROOT / "specs", count, SEED)
     out = folder / f"out-{count}"
     figures = folder / f"figures-{count}.json"
     started = time.perf_counter()
@@ -162,7 +192,35 @@ def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
     )
     seconds = time.perf_counter() - started
     found = json.loads(figures.read_text())
-    cpu = found["client_cpu"] + found["workers_cpu"]
+    found["wall"] = seconds
+    with open(folder / f"segments-{count}.jsonl", "a") as segments:
+        segments.write(json.dumps(found) + "\n")
+    runs = [
+        json.loads(line) for line in (folder / f"segments-{count}.jsonl").read_text().splitlines()
+    ]
+    built = sum(run["built"] for run in runs) or 1
+    cpu = sum(run["client_cpu"] + run["workers_cpu"] for run in runs)
+    peak = max(run["client_peak_mib"] for run in runs)
+    lines = _figures(count, jobs, out, runs, found)
+    lines.append(f"# {json.dumps({'peak': peak, 'cpu': cpu / built})}")
+    text = "\n".join(lines) + "\n"
+    print(text, end="")
+    write_text = done.with_suffix(".tmp")
+    write_text.write_text(text)
+    write_text.replace(done)
+    shutil.rmtree(out)  # tens of GB at 10,000 buildings: not kept for the next size
+    return {"peak": peak, "cpu": cpu / built}
+
+
+def _figures(
+    count: int, jobs: int, out: Path, runs: list[dict[str, Any]], last: dict[str, Any]
+) -> list[str]:
+    """The printed figures of a size: CPU over every segment's buildings, memory per client."""
+    built = sum(run["built"] for run in runs) or 1
+    client = sum(run["client_cpu"] for run in runs)
+    workers = sum(run["workers_cpu"] for run in runs)
+    wall = sum(run["wall"] for run in runs)
+    peak = max(run["client_peak_mib"] for run in runs)
     name = f"terraces-{count}"
     shards = [folder for folder in (out / "buildings").iterdir() if folder.is_dir()]
     most = max((len(list(folder.iterdir())) for folder in shards), default=0)
@@ -175,39 +233,30 @@ def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
         f"{name}.report.json": _size(out / f"{name}.report.json"),
         "textures/": _size(out / "textures"),
     }
-    print(
-        f"{count} buildings, -j {jobs}: {found['ok']} built, {found['failed']} failed, "
-        f"{found['party_walls']} party walls, {seconds:.1f} s wall"
-    )
-    print(
-        f"  CPU {cpu:.1f} s = {cpu / count:.3f} CPU-s a building "
-        f"(client {found['client_cpu']:.1f} s, workers {found['workers_cpu']:.1f} s)"
-    )
-    print(
-        f"  client peak memory {found['client_peak_mib']:.0f} MiB "
-        f"({found['client_peak_mib'] * 1024 / count:.1f} KiB a building)"
-    )
-    print(
-        f"  client memory: {found.get('first_built_mib', 0):.0f} MiB at the first building "
-        f"built, {found.get('all_built_mib', 0):.0f} MiB at the last"
-    )
-    print(
+    segments = f" in {len(runs)} segments (stopped and resumed)" if len(runs) > 1 else ""
+    lines = [
+        f"{count} buildings, -j {jobs}: {last['ok']} built, {last['failed']} failed, "
+        f"{last['party_walls']} party walls, {wall:.1f} s wall{segments}",
+        f"  CPU {client + workers:.1f} s = {(client + workers) / built:.3f} CPU-s a building "
+        f"(client {client:.1f} s, workers {workers:.1f} s, {built} buildings built)",
+        f"  client peak memory {peak:.0f} MiB ({peak * 1024 / count:.1f} KiB a building)",
+        f"  client memory: {last.get('first_built_mib', 0):.0f} MiB at the first building "
+        f"built, {last.get('all_built_mib', 0):.0f} MiB at the last",
         "  outputs: "
-        + ", ".join(f"{key} {size / 2**20:.1f} MiB" for key, size in sizes.items() if size)
-    )
+        + ", ".join(f"{key} {size / 2**20:.1f} MiB" for key, size in sizes.items() if size),
+    ]
     on_disk = _size(out)
-    print(
+    lines.append(
         f"  on disk: {on_disk / 2**20:.1f} MiB in all, {on_disk / count / 2**20:.3f} MiB a building"
     )
-    print(f"  buildings/: {len(shards)} shard folders, at most {most} files in one")
-    if found["models"].get("merged_left_out"):
-        print(f"  no merged glb: {found['models']['merged_left_out']}")
-    _tile_sizes(out)
-    shutil.rmtree(out)  # tens of GB at 10,000 buildings: not kept for the next size
-    return {"peak": found["client_peak_mib"], "cpu": cpu / count}
+    lines.append(f"  buildings/: {len(shards)} shard folders, at most {most} files in one")
+    if last["models"].get("merged_left_out"):
+        lines.append(f"  no merged glb: {last['models']['merged_left_out']}")
+    lines += _tile_sizes(out)
+    return lines
 
 
-def _tile_sizes(out: Path) -> None:
+def _tile_sizes(out: Path) -> list[str]:
     """The sizes of the square tiles (``tiles/``) and of the 3D Tiles at each LOD."""
     kinds: dict[str, list[int]] = {}
     for path in (out / "tiles").glob("*.glb"):
@@ -216,12 +265,14 @@ def _tile_sizes(out: Path) -> None:
         kinds.setdefault(f"3D Tiles {path.suffixes[-2][1:].upper()}", []).append(
             path.stat().st_size
         )
+    lines = []
     for kind, sizes in sorted(kinds.items()):
         sizes.sort()
-        print(
+        lines.append(
             f"  {kind}: {len(sizes)} tiles, median {sizes[len(sizes) // 2] / 2**20:.2f} MiB, "
             f"largest {sizes[-1] / 2**20:.2f} MiB, {sum(sizes) / 2**20:.1f} MiB in all"
         )
+    return lines
 
 
 def profile(count: int, folder: Path) -> None:
@@ -255,10 +306,15 @@ def profile(count: int, folder: Path) -> None:
 def main() -> None:
     count = int(os.environ.get("FACADE_BENCH_N", "100000"))
     jobs = int(os.environ.get("FACADE_BENCH_JOBS", str(os.cpu_count() or 1)))
+    kept = os.environ.get("FACADE_BENCH_DIR")
     with tempfile.TemporaryDirectory(prefix="city-large-") as scratch:
-        folder = Path(scratch)
+        folder = Path(kept) if kept else Path(scratch)
+        folder.mkdir(parents=True, exist_ok=True)
         sizes = [n for n in (1_000, 10_000, 100_000) if n < count] + [count]
-        measure_planning(sizes, folder)
+        if (folder / "planning.txt").exists():  # FACADE_BENCH_DIR: measured by an earlier start
+            print((folder / "planning.txt").read_text(), end="")
+        else:
+            measure_planning(sizes, folder)
         if os.environ.get("FACADE_BENCH_PLAN_ONLY"):
             return
         small = measure(max(1, count // 4), jobs, folder)
