@@ -22,13 +22,13 @@ WINDOW = "900,560"
 
 # picture name -> (spec, what: "model" or "elevation", camera: around, up, zoom, x, y)
 PICTURES: dict[str, tuple[str, str, str]] = {
-    "centred-bay": ("centred-bay", "model", "35,10,1,0.5,0.5"),
-    "qualifiers": ("qualifiers", "model", "35,10,1,0.5,0.5"),
-    "residential-house": ("residential-house", "model", "35,10,1,0.5,0.5"),
-    "shop-front": ("shop-front", "model", "35,10,1,0.5,0.5"),
-    "terraced-house": ("terraced-house", "model", "35,10,1,0.5,0.5"),
-    "townhouse": ("townhouse", "model", "35,10,1,0.5,0.5"),
-    "townhouse-street": ("townhouse", "model", "25,3,1.7,0.5,0.3"),
+    "centred-bay": ("centred-bay", "model", "35,10"),
+    "qualifiers": ("qualifiers", "model", "35,10"),
+    "residential-house": ("residential-house", "model", "35,10"),
+    "shop-front": ("shop-front", "model", "35,10"),
+    "terraced-house": ("terraced-house", "model", "35,10"),
+    "townhouse": ("townhouse", "model", "35,10"),
+    "townhouse-street": ("townhouse", "model", "street,25"),
     "parts": ("parts", "model", "35,10,1.1,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
     "part-door": ("parts", "model", "25,5,2.6,0.17,0.25"),
@@ -98,9 +98,9 @@ def svg_size(svg: Path) -> str:
 # the 50-building city block: camera (around, up, zoom, x, y) of each picture
 CITY_BLOCK = 50
 CITY_VIEWS: dict[str, str] = {
-    "front": "0,12,1.5,0.5,0.5",
-    "oblique": "35,35,1.6,0.5,0.5",
-    "street": "0,3,2.5,0.5,0.2",
+    "front": "0,12",
+    "oblique": "35,35",
+    "street": "street,0",
 }
 
 
@@ -127,7 +127,7 @@ def city_pictures(chrome: str, out: Path, suffix: str = "") -> None:
 # the look of every example and of the city block from three cameras, one strip each in
 # docs/pictures/look (issue 35): front, 35° oblique, street level (around, up, zoom, x, y)
 LOOK = TARGET / "look"
-LOOK_VIEWS = ("0,6,1,0.5,0.5", "35,10,1,0.5,0.5", "25,2,1.6,0.5,0.3")
+LOOK_VIEWS = ("0,6", "35,10", "street,25")
 LOOK_TILE = (600, 373)  # each view's size in a strip (its screenshot is WINDOW, downscaled)
 
 

@@ -273,3 +273,58 @@ def test_view_refuses_a_folder_whose_every_model_is_left_out(
     assert code == 2 and out == "" and files(tmp_path) == ["empty.glb", "shadow.glb"]
     assert f"{tmp_path}: error: no model to show" in err
     assert f"{tmp_path / 'shadow.glb'}: error: left out: a link to /etc/passwd" in err
+
+
+# one wall 10 x 6 m (the screenshot's proportions) with one window 3 x 3 m in its middle
+PANE_SPEC = """
+version: 1
+name: pane
+canvas: {width: 10.0, height: 6.0}
+symbol_defaults: {opaque: true}
+symbols:
+  A: {size: 3.5, label: wall}
+  B: {size: 3.0, label: window}
+  P: {size: 1.5, label: plinth}
+  Q: {size: 3.0, label: storey}
+patterns: {across: "A B A", up: "P Q P"}
+layers: [{name: base, x: across, y: up}]
+shapes:
+  - {match: {x: B, y: Q}, material: glass, depth: -0.08, thickness: 0.02}
+materials:
+  plaster: {library: render, color: "#c9a27e", resolution: 64}
+  glass: {library: float-glass, resolution: 64}
+defaults: {mesh: box, material: plaster, thickness: 0.2}
+"""
+
+
+def _mean_grey(shot: Path, box: tuple[float, float, float, float]) -> float:
+    """The mean grey (0..255) of the screenshot's part ``box`` (left, top, right, bottom
+    as fractions of its width and height)."""
+    from PIL import Image, ImageStat
+
+    with Image.open(shot) as image:
+        grey = image.convert("L")
+        left, top, right, bottom = box
+        part = (left * grey.width, top * grey.height, right * grey.width, bottom * grey.height)
+        return float(ImageStat.Stat(grey.crop(tuple(round(edge) for edge in part))).mean[0])
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_glass_reads_neither_black_nor_white_nor_as_the_wall(tmp_path: Path) -> None:
+    """A window seen square on, framed by the model's box (which fills the 1000 x 600
+    screenshot, centred): its pane mirrors the sky and the street, so its mean grey lies
+    in a band well inside 0..255 and apart from the wall's. Glass blended by its fallback
+    alpha over a dark ground read about 37 (black); a pane as pale as the wall, or blown
+    out, fails too."""
+    spec = tmp_path / "pane.yaml"
+    spec.write_text(PANE_SPEC)
+    layout = solve(load_spec(spec))
+    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
+    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,0")
+    assert "<title>pane</title>" in dom
+    # the window spans 0.35..0.65 of the wall across and 0.25..0.75 up; the wall fills
+    # 1/1.08 of the picture, so 0.42..0.58 of it is pane and 0.12..0.2 wall
+    pane = _mean_grey(shot, (0.42, 0.42, 0.58, 0.58))
+    wall = _mean_grey(shot, (0.12, 0.4, 0.2, 0.6))
+    assert 60 < pane < 170
+    assert abs(wall - pane) > 25

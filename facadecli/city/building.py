@@ -776,6 +776,13 @@ def _unit(mesh: trimesh.Trimesh) -> tuple[tuple[bytes, bytes], np.ndarray, np.nd
     return key, vertices, back
 
 
+# A repeated part's vertices are kept to 10 micrometres: the same frame or door built on
+# walls of other lengths comes out a float32 step apart (1e-6 m) and would be stored and
+# drawn as another mesh (on the 50-building block, 39 of 160 instanced meshes were such
+# twins: 424 -> 385 draw calls with --instance)
+PART_DECIMALS = 5
+
+
 def _parts(
     scene: trimesh.Scene, stretchable: frozenset[str] = frozenset()
 ) -> tuple[FacadeMeshes, tuple[Part, ...]]:
@@ -803,8 +810,9 @@ def _parts(
         if uses[geometry] < MIN_INSTANCES or len(mesh.faces) < MIN_TRIANGLES:
             merged.setdefault(name, []).append(mesh.copy().apply_transform(matrix))
             continue
-        if geometry not in parts:
-            parts[geometry] = (name, mesh.vertices.copy(), mesh.faces.copy(), ())
+        if geometry not in parts:  # to 10 um: the same part built on two walls, equal bytes
+            vertices = np.round(mesh.vertices, PART_DECIMALS) + 0.0  # no -0.0
+            parts[geometry] = (name, vertices, mesh.faces.copy(), ())
         material, vertices, faces, placed = parts[geometry]
         parts[geometry] = (material, vertices, faces, (*placed, np.asarray(matrix, dtype=float)))
     walls = tuple(

@@ -165,9 +165,42 @@ const sun = new THREE.DirectionalLight(0xfff3e0, 3.4);
 sun.castShadow = true;
 sun.shadow.bias = -0.0002;
 scene.add(sun, sun.target);
+// The paving: square slabs of a mid grey stone (an albedo of about a fifth, as concrete
+// paving has), a little lighter or darker each (seeded), with darker joints, so the ground
+// reads as paving at street level instead of a blown-out white under the bright sky.
+const SLAB = 0.6;  // metres a side
+function pavingPicture() {
+  const slabs = 4, cell = 32, size = slabs * cell, data = new Uint8Array(size * size * 4);
+  let seed = 11;  // mulberry32, as the skyline's
+  const random = () => {
+    seed = (seed + 0x6D2B79F5) | 0;
+    let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
+    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  };
+  const tones = Array.from({length: slabs * slabs}, () => 0.92 + 0.16 * random());
+  for (let y = 0; y < size; y++) for (let x = 0; x < size; x++) {
+    const joint = x % cell === 0 || y % cell === 0;
+    const tone = joint ? 0.62 : tones[((y / cell) | 0) * slabs + ((x / cell) | 0)]
+      * (0.97 + 0.06 * random());
+    const at = (y * size + x) * 4;
+    data[at] = 134 * tone; data[at + 1] = 127 * tone; data[at + 2] = 116 * tone;
+    data[at + 3] = 255;
+  }
+  const picture = new THREE.DataTexture(data, size, size);
+  picture.colorSpace = THREE.SRGBColorSpace;
+  picture.wrapS = picture.wrapT = THREE.RepeatWrapping;
+  picture.magFilter = THREE.LinearFilter;
+  picture.minFilter = THREE.LinearMipmapLinearFilter;
+  picture.generateMipmaps = true;
+  picture.anisotropy = renderer.capabilities.getMaxAnisotropy();
+  picture.needsUpdate = true;
+  return picture;
+}
+const paving = pavingPicture();
 const ground = new THREE.Mesh(  // takes the shadows; large enough to reach the haze
   new THREE.CircleGeometry(1, 64).rotateX(-Math.PI / 2),
-  new THREE.MeshStandardMaterial({color: 0xc9c4b9, roughness: 0.95}));
+  new THREE.MeshStandardMaterial({map: paving, roughness: 0.9}));
 ground.receiveShadow = true;
 ground.visible = false;
 scene.add(ground);
@@ -269,9 +302,14 @@ function castsShadows(model) {
   });
 }
 // ?view=ANGLE,ELEVATION,ZOOM,X,Y: seen from ANGLE degrees around and ELEVATION up, ZOOM
-// times closer, looking at the point X, Y (0..1 across the model); ?bare: the model alone
+// times closer than the fit, looking at the point X, Y (0..1 across the model; without
+// them, the fit's aim); ?view=street,ANGLE: at eye height, ANGLE degrees round, the whole
+// model in view; ?bare: the model alone
 const query = new URLSearchParams(location.search);
-const [around, up, zoom, atX, atY] = (query.get('view') || '').split(',').map(parseFloat);
+const wantedView = (query.get('view') || '').split(',');
+const street = wantedView[0] === 'street';
+if (street) wantedView.shift();
+const [around, up, zoom, atX, atY] = wantedView.map(parseFloat);
 const or = (value, fallback) => Number.isFinite(value) ? value : fallback;
 if (query.has('bare')) document.body.classList.add('bare');
 function corners(box) {
@@ -279,21 +317,82 @@ function corners(box) {
   return [0, 1, 2, 3, 4, 5, 6, 7].map(i => new THREE.Vector3(
     i & 1 ? max.x : min.x, i & 2 ? max.y : min.y, i & 4 ? max.z : min.z));
 }
-// The camera's distance at which the box's eight corners fit the view (a margin of 8%):
-// a facade fills the picture, a district is seen whole.
-function fitDistance(box, centre, direction) {
-  const vertical = camera.fov * Math.PI / 180;
-  const tanV = Math.tan(vertical / 2) / 1.08, tanH = tanV * camera.aspect;
-  const right = new THREE.Vector3(0, 1, 0).cross(direction).normalize();
-  const upward = direction.clone().cross(right);
-  let distance = 0;
-  for (const corner of corners(box)) {
-    const offset = corner.sub(centre);
-    const depth = offset.dot(direction);
-    distance = Math.max(distance,
-      depth + Math.abs(offset.dot(right)) / tanH, depth + Math.abs(offset.dot(upward)) / tanV);
+// Framing: the view's half-angles as tangents, an 8% margin inside the picture's edges
+const MARGIN = 1.08;
+function halfTangents() {
+  const tanV = Math.tan(camera.fov * Math.PI / 360) / MARGIN;
+  return [tanV * camera.aspect, tanV];
+}
+// The camera looking along -seen (seen: from the model towards the camera) that holds the
+// box's eight corners in the view and stands as close as that allows: each side of the
+// view is a plane every corner must lie inside, which bounds the camera's place across,
+// up and back linearly (an exact fit, not a sphere's). The box's picture is centred and
+// fills the view along its tighter axis. Returns the point the camera aims at (where its
+// axis passes the box's centre's depth) and the camera's distance from it.
+function fitBox(box, centre, seen) {
+  const [tanH, tanV] = halfTangents();
+  const forward = seen.clone().negate();
+  const right = forward.clone().cross(new THREE.Vector3(0, 1, 0)).normalize();
+  const upward = right.clone().cross(forward);
+  const most = (values) => Math.max(...values);
+  const offsets = corners(box).map(corner => corner.sub(centre));
+  const across = offsets.map(o => [o.dot(right), o.dot(upward), o.dot(forward)]);
+  const rightmost = most(across.map(([x, , z]) => x - tanH * z));
+  const leftmost = most(across.map(([x, , z]) => -x - tanH * z));
+  const top = most(across.map(([, y, z]) => y - tanV * z));
+  const bottom = most(across.map(([, y, z]) => -y - tanV * z));
+  const distance = Math.max((rightmost + leftmost) / (2 * tanH), (top + bottom) / (2 * tanV));
+  const aim = centre.clone().addScaledVector(right, (rightmost - leftmost) / 2)
+    .addScaledVector(upward, (top - bottom) / 2);
+  return {aim, distance: Math.max(distance, 0.01)};
+}
+// A person's eye above the ground, for the street-level view
+const EYE = 1.6;
+// Street level: the camera at eye height above the box's foot, looking ANGLE degrees round
+// from the front, tilted up (or down) just enough, and as close as the whole box allows:
+// for each tilt the box's corners bound how far back the camera must stand (linearly, as
+// in fitBox, with its height fixed); of the tilts that let it stand within 1% of the
+// closest, the one that centres the box's picture up and down (when its width binds,
+// many tilts do nearly as well). The whole façade is seen, its upper windows included,
+// however low and wide it is.
+function fitStreet(box, centre, angle) {
+  const [tanH, tanV] = halfTangents();
+  const a = angle * Math.PI / 180;
+  const level = new THREE.Vector3(-Math.sin(a), 0, -Math.cos(a));  // looking, level
+  const right = level.clone().cross(new THREE.Vector3(0, 1, 0)).normalize();
+  const base = new THREE.Vector3(centre.x, box.min.y + EYE, centre.z);
+  const offsets = corners(box).map(corner => corner.sub(base));
+  const steepest = Math.atan(tanV) * 0.98;  // past it the eye's own foot is out of view
+  const tilts = [];
+  for (let step = -60; step <= 60; step++) {
+    const tilt = steepest * step / 60, cos = Math.cos(tilt), sin = Math.sin(tilt);
+    const forward = level.clone().multiplyScalar(cos).add(new THREE.Vector3(0, sin, 0));
+    const upward = right.clone().cross(forward);
+    let back = 0, rightmost = -Infinity, leftmost = Infinity;
+    for (const o of offsets) {
+      const x = o.dot(right), y = o.dot(upward), z = o.dot(forward);
+      back = Math.max(back, (y - tanV * z) / (sin + tanV * cos),
+                      (-y - tanV * z) / (tanV * cos - sin));
+      rightmost = Math.max(rightmost, x - tanH * z);
+      leftmost = Math.min(leftmost, x + tanH * z);
+    }
+    back = Math.max(back, (rightmost - leftmost) / (2 * tanH * cos));
+    const across = (rightmost + leftmost) / 2;
+    let high = -Infinity, low = Infinity;  // the box's picture, up and down (tangents)
+    for (const o of offsets) {
+      const seen = o.clone().addScaledVector(level, back).addScaledVector(right, -across);
+      const y = seen.dot(upward) / Math.max(seen.dot(forward), 1e-9);
+      high = Math.max(high, y); low = Math.min(low, y);
+    }
+    tilts.push({back, forward, across, off: Math.abs(high + low)});
   }
-  return distance;
+  const closest = Math.min(...tilts.map(tilt => tilt.back));
+  const best = tilts.filter(tilt => tilt.back <= 1.01 * closest)
+    .reduce((best, tilt) => tilt.off < best.off ? tilt : best);
+  const position = base.clone().addScaledVector(level, -best.back)
+    .addScaledVector(right, best.across);
+  const distance = Math.max(centre.clone().sub(position).dot(best.forward), 0.01);
+  return {position, aim: position.clone().addScaledVector(best.forward, distance), distance};
 }
 // The sun's shadow camera fitted round the model's box, seen from the sun, so a facade and a
 // district both get shadows as sharp as the map allows.
@@ -341,11 +440,13 @@ function direction(angle, rise) {
 // model as first framed (not to where the camera is turned: a picture is the same each time)
 function light(model) {
   const {box, centre, radius, rise} = bounds(model);
-  const fit = fitDistance(box, centre, direction(SEEN_FROM, rise));
+  const fit = fitBox(box, centre, direction(SEEN_FROM, rise)).distance;
   const haze = fit + 2 * radius;
   scene.fog.near = haze; scene.fog.far = 4 * haze;
   ground.position.set(centre.x, box.min.y - radius * 1e-4, centre.z);
   ground.scale.setScalar(4 * haze);
+  // the circle's texture coordinates span its diameter: slabs SLAB metres a side
+  paving.repeat.setScalar(8 * haze / (4 * SLAB));
   ground.visible = true;
   fitSun(box, centre, radius);
   // AO reaches about as far as a window's reveal on a facade, a yard in a district
@@ -355,13 +456,20 @@ function light(model) {
 function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a district from 30
   resize();
   const {box, size, centre, radius, rise} = bounds(model);
-  const seen = direction(or(around, SEEN_FROM), or(up, rise));
-  const fit = fitDistance(box, centre, seen);
-  const target = centre.clone();
-  target.x = box.min.x + or(atX, 0.5) * size.x;
-  target.y = box.min.y + or(atY, 0.5) * size.y;
-  const distance = fit / or(zoom, 1);
-  camera.position.copy(target).addScaledVector(seen, distance);
+  let target, distance;
+  if (street) {
+    const fit = fitStreet(box, centre, or(around, SEEN_FROM));
+    target = fit.aim; distance = fit.distance;
+    camera.position.copy(fit.position);
+  } else {
+    const seen = direction(or(around, SEEN_FROM), or(up, rise));
+    const fit = fitBox(box, centre, seen);
+    target = fit.aim;
+    if (Number.isFinite(atX)) target.x = box.min.x + atX * size.x;
+    if (Number.isFinite(atY)) target.y = box.min.y + atY * size.y;
+    distance = fit.distance / or(zoom, 1);
+    camera.position.copy(target).addScaledVector(seen, distance);
+  }
   camera.near = distance / 1000; camera.far = distance * 20 + 8 * radius;
   controls.maxDistance = distance * 10;
   camera.updateProjectionMatrix();

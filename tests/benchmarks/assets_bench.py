@@ -101,6 +101,44 @@ def line(label: str, glb: Path, cpu: float | None) -> str:
     )
 
 
+def unit_shapes(glb: Path) -> str:
+    """How many of the instanced meshes are one shape at other sizes (the same material,
+    the same triangles once scaled into the unit cube): those a unit mesh a material
+    (scaled by its placements) could draw as one, were their textures free to stretch."""
+    import numpy as np
+
+    from facadecli.export.glb_merge import read_glb as read_chunk
+    from facadecli.export.instancing import EXTENSION
+
+    document, chunk = read_chunk(glb.read_bytes())
+
+    def values(index: int) -> np.ndarray:
+        accessor = document["accessors"][index]
+        view = document["bufferViews"][accessor["bufferView"]]
+        start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+        kind = {5126: "<f4", 5125: "<u4", 5123: "<u2", 5121: "u1"}[accessor["componentType"]]
+        width = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}[accessor["type"]]
+        return np.frombuffer(chunk, kind, accessor["count"] * width, start).reshape(-1, width)
+
+    meshes, shapes = 0, set()
+    for node in document["nodes"]:
+        if EXTENSION not in node.get("extensions", {}):
+            continue
+        meshes += 1
+        key = []
+        for primitive in document["meshes"][node["mesh"]]["primitives"]:
+            points = values(primitive["attributes"]["POSITION"]).astype(float)
+            low, extent = points.min(axis=0), np.ptp(points, axis=0)
+            unit = np.round((points - low) / np.where(extent > 1e-9, extent, 1.0), 4)
+            corners = values(primitive["indices"]).tobytes()
+            key += [primitive.get("material"), corners, unit.tobytes()]
+        shapes.add(tuple(key))
+    return (
+        f"  --instance: {meshes} instanced meshes; as unit meshes, one a material and "
+        f"shape at any size, they would be {len(shapes)}"
+    )
+
+
 def build(manifest: Path, out: Path, *options: str) -> float:
     """``facade city`` on the manifest's first buildings; its CPU seconds."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -122,6 +160,7 @@ def main() -> None:
         print(line("default", folder / "plain" / "demo-district.glb", cpu), flush=True)
         cpu = build(manifest, folder / "instanced", "--instance")
         print(line("--instance", folder / "instanced" / "demo-district.glb", cpu), flush=True)
+        print(unit_shapes(folder / "instanced" / "demo-district.glb"), flush=True)
         for lod in (2, 1):  # façades not solved: the CPU is the volumes and roofs alone
             cpu = build(manifest, folder / f"lod{lod}", "--lod", str(lod))
             glb = folder / f"lod{lod}" / "demo-district.glb"
