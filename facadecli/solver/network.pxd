@@ -3,7 +3,7 @@
 cimport cython
 
 
-cdef object _DOUBLES, _INTS, _FLAGS, _NO_MASK
+cdef object _DOUBLES, _INTS, _FLAGS
 cdef double INF, NAN, SAME
 cdef long long BIG
 cdef int FREE, AFTER_EMPTY, AFTER_ATTACHED, LEAF_WORK, COMBINATION_WORK
@@ -27,8 +27,6 @@ cdef class Move:
     cdef public bint first_attached, last_attached, fixed_only
     cdef public int piece_of, tail
     cdef public double tail_size, low, high
-    cdef double[::1] whole
-    cdef bint has_whole
 
 
 cdef class Whole:
@@ -144,8 +142,8 @@ cdef class Search:
     cdef int stop, progress
     cdef object leaf
     cdef dict rejected
-    cdef list groups, done
-    cdef double[::1] row, known, shifted, reduced, coef, span, a, least, held, least_rhs
+    cdef list groups, done, builders
+    cdef double[::1] row, known, width, shifted, reduced, coef, span, a, least, held, least_rhs
     cdef object diff
     cdef double[::1] diff_view
     cdef signed char[::1] has, fixed
@@ -166,7 +164,7 @@ cdef class Search:
     cdef System system_add(self, System y, double[::1] given, double rhs, double scale)
 
     @cython.locals(value=double)
-    cdef double probe(self, System y, object given) except? -1.0
+    cdef double probe(self, System y) except? -1.0
 
     @cython.locals(nv=int, sz=int, row="double[::1]", j=int, rhs=double, norm2=double,
                    residual=double)
@@ -188,11 +186,10 @@ cdef class Search:
                    recording=bint, fits=bint, row=Row)
     cdef bint merges(self, int g, list last, list entries, int[::1] before) except -1
 
-    @cython.locals(nv=int, first=int, last=int, j=int, counts="double[::1]",
-                   view="double[::1]", made=object)
-    cdef double[::1] whole_of(self, Row row, Move m)
+    @cython.locals(nv=int, first=int, last=int, j=int, counts="double[::1]")
+    cdef void whole_into(self, Row row, Move m, double[::1] into, int at) noexcept
 
-    @cython.locals(w="double[::1]", nv=int, used="double[::1]", base=int, j=int)
+    @cython.locals(nv=int, used="double[::1]", base=int, j=int)
     cdef bint known_length(self, Row row, Move m, Node node, int r, double[::1] into,
                            int at) except -1
 
@@ -214,18 +211,18 @@ cdef class Search:
                             double rest) except *
 
     @cython.locals(key=Py_ssize_t, nv=int, sz=int, o=Options, mask="signed char[::1]",
-                   made=object, limit=double, y=System, reduced="double[::1]",
+                   at=int, limit=double, y=System, reduced="double[::1]",
                    pinned=bint, rest=double, k=int, least=double, ordered=bint,
                    order="int[::1]", nw=int, nk=int, u=int, w=int, fit=int, miss=double,
                    total=double, low=int, high=int, mid=int, start=int, fo=Options,
                    first="double[::1]", group=Group, row=Row, lens="double[::1]", fat=int)
-    cdef object fitting(self, Builder b, int fr, int j, int r)
+    cdef int fitting(self, Builder b, int fr, int j, int r) except -1
 
-    @cython.locals(r=int, o=Options, masked=bint, mask="signed char[::1]", k=int, m=Move,
-                   held=bint)
+    @cython.locals(r=int, o=Options, masked=bint, at=int, k=int, m=Move, held=bint)
     cdef int extend(self, Builder b, int i, int fr, int fj, bint solid) except -1
 
-    @cython.locals(count=int, b=Builder, order="int[::1]", i=int, v=int, k=int)
+    @cython.locals(count=int, b=Builder, order="int[::1]", i=int, v=int, k=int,
+                   stopped=int, columns=list)
     cdef list columns_of(self, int g, Node node, list opts)
 
     @cython.locals(group=Group, sz=int, nv=int, count=int, x="double[::1]",
@@ -245,7 +242,7 @@ cdef class Search:
 
     @cython.locals(group=Group, count=int, nv=int, wr=int, r=int, m=Move,
                    width="double[::1]", c=Node, used="double[::1]", j=int, y=System,
-                   known="double[::1]", row=Row, w="double[::1]", base=int)
+                   known="double[::1]", row=Row, base=int)
     cdef Node child_of(self, int g, Node node, list entries)
 
     @cython.locals(node=Node)
@@ -279,9 +276,19 @@ cdef class Builder:
     cdef list opts, chosen, out
     cdef int[::1] order, base
     cdef dict fits
+    cdef signed char[::1] masks
+    cdef int size, filled
     cdef double[::1] first
     cdef int first_at
     cdef double limit, margin
+
+    @cython.locals(total=int, r=int)
+    cdef void start(self, Node node, list opts) except *
+
+    cdef void done(self) noexcept
+
+    @cython.locals(at=int, size=int, made=object, masks="signed char[::1]", k=int)
+    cdef int reserve(self, int n) except -1
 
 
 @cython.locals(m=Py_ssize_t, i=Py_ssize_t, names=list, values=list, users=list,

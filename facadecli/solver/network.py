@@ -53,7 +53,6 @@ RowSpec = tuple[Sequence[LetterSpec], Sequence[int], Sequence[int]]
 _DOUBLES = array("d", [0.0])
 _INTS = array("i", [0])
 _FLAGS = array("b", [0])
-_NO_MASK = array("b", [1])
 
 
 def _doubles(n: int) -> Any:  # array[float]
@@ -104,8 +103,6 @@ class Move:
         self.tail_size = NAN
         self.low = 0.0
         self.high = 0.0
-        self.whole: array[float] = _DOUBLES  # the letters it holds whole, by symbol ...
-        self.has_whole = False  # ... once whole_of() made it
 
 
 class Whole:
@@ -477,10 +474,12 @@ class Search:
             made = [Row(nv, sized, *row, variables, len(rows)) for row in rows]
             self.groups.append(Group(made))
         self.done: list[Cell | None] = [None] * len(self.groups)
+        self.builders = [Builder(g, self.groups[g].n) for g in range(len(self.groups))]
         # scratch rows (no call that uses one calls another that does)
         extra = nv - sized if nv > sized else 1
         self.row = _doubles(nv + 1)
         self.known = _doubles(nv + 1)
+        self.width = _doubles(nv + 1)
         self.diff = _doubles(nv)  # fits()'s difference, an array (the probe's key) ...
         self.diff_view = self.diff  # ... and a view of it
         self.shifted = _doubles(sized + 1)
@@ -624,16 +623,17 @@ class Search:
         z.value = y.value + residual * residual
         return z
 
-    def probe(self, y: System, given: array[float]) -> float:
-        """The bound with ``given @ symbols == 0`` added (INF when it conflicts), kept with
-        the system (a child that adds no equality shares its parent's)."""
+    def probe(self, y: System) -> float:
+        """The bound with ``diff @ symbols == 0`` added (fits()'s difference; INF when it
+        conflicts), kept with the system (a child that adds no equality shares its
+        parent's)."""
         if y.probes is None:
             y.probes = {}
-        key = given.tobytes()
+        key = self.diff.tobytes()
         found = y.probes.get(key)
         if found is not None:
             return float(found)
-        value = self.probe_of(y, given)
+        value = self.probe_of(y, self.diff_view)
         y.probes[key] = value
         return value
 
@@ -752,22 +752,18 @@ class Search:
         return fits
 
     # -- options and columns ------------------------------------------------------------
-    def whole_of(self, row: Row, m: Move) -> array[float]:
-        """The length of the letters an entry holds whole, over the symbols."""
-        if not m.has_whole:
-            nv = self.nv
-            first = (m.start + 1) // 2
-            last = m.end // 2
-            if last < first:
-                last = first
-            made = _doubles(nv)
-            view = made
-            counts = row.counts
-            for j in range(nv):
-                view[j] = counts[last * nv + j] - counts[first * nv + j]
-            m.whole = view
-            m.has_whole = True
-        return m.whole
+    def whole_into(self, row: Row, m: Move, into: array[float], at: int) -> None:
+        """The length of the letters an entry holds whole, over the symbols, into
+        ``into[at:]`` (the row's counts after them less those before: made afresh, as
+        cheap as a copy)."""
+        nv = self.nv
+        first = (m.start + 1) // 2
+        last = m.end // 2
+        if last < first:
+            last = first
+        counts = row.counts
+        for j in range(nv):
+            into[at + j] = counts[last * nv + j] - counts[first * nv + j]
 
     def known_length(
         self, row: Row, m: Move, node: Node, r: int, into: array[float], at: int
@@ -777,10 +773,8 @@ class Search:
         False for pieces."""
         if m.tail >= 0 or m.start == m.end:
             return False
-        w = self.whole_of(row, m)
+        self.whole_into(row, m, into, at)
         nv = self.nv
-        for j in range(nv):
-            into[at + j] = w[j]
         if m.piece_of < 0:
             return True
         into[at + row.var[m.start // 2]] += 1.0
@@ -899,13 +893,13 @@ class Search:
             residual = off - dot(shifted if use_shifted else d, y.point, sz)
             if y.value + residual * residual / norm > b.margin:
                 return 0, miss
-        value = self.probe(b.node.system, self.diff)
+        value = self.probe(b.node.system)
         return (1 if value <= b.limit else 0), miss
 
-    def fitting(self, b: Builder, fr: int, j: int, r: int) -> array[int]:
+    def fitting(self, b: Builder, fr: int, j: int, r: int) -> int:
         """Which options of row r may be as long as the first entry (row fr, option j)
-        within the incumbent: first alone (their preferred lengths apart), then with the
-        equalities.
+        within the incumbent (a mask: where it starts in ``b.masks``): first alone (their
+        preferred lengths apart), then with the equalities.
 
         A first entry holding placeholders: with the equalities' pivots solved out of it
         (when they fix every placeholder it holds), an entry of sized letters must meet
@@ -921,12 +915,12 @@ class Search:
         key = (b.base[fr] + j) * b.R + r
         found = b.fits.get(key)
         if found is not None:
-            return found
+            return int(found)
         nv = self.nv
         sz = self.sized
         o = b.opts[r]
-        made = _flags(o.n + 1)
-        mask = made
+        at = b.reserve(o.n)
+        mask = b.masks
         fo = b.opts[fr]
         first = fo.lens
         fat = j * nv
@@ -957,12 +951,12 @@ class Search:
         nw = o.n_whole
         nk = o.n_known
         for u in range(nw + nk, o.n):
-            mask[order[u]] = 1
+            mask[at + order[u]] = 1
         # with the whole entries first when they are not checked outward
         lens = o.lens
         for w in range(0 if not ordered else nw, nw + nk):
             fit, miss = self.fits(b, lens, order[w] * nv, pinned, rest)
-            mask[order[w]] = 1 if fit == 1 else 0
+            mask[at + order[w]] = 1 if fit == 1 else 0
         if ordered:
             # the first whole entry at least as long as the first, at preferred sizes
             total = rest if pinned else 0.0
@@ -979,17 +973,16 @@ class Search:
             start = low
             for w in range(start, nw):  # longer, outward
                 fit, miss = self.fits(b, lens, order[w] * nv, pinned, rest)
-                mask[order[w]] = 1 if fit == 1 else 0
+                mask[at + order[w]] = 1 if fit == 1 else 0
                 if fit == NOT_NEAR and miss >= 0:
                     break
             for w in range(start - 1, -1, -1):  # shorter, outward
                 fit, miss = self.fits(b, lens, order[w] * nv, pinned, rest)
-                mask[order[w]] = 1 if fit == 1 else 0
+                mask[at + order[w]] = 1 if fit == 1 else 0
                 if fit == NOT_NEAR and miss < 0:
                     break
-        b.fits[key] = made
-        fitting: array[int] = made
-        return fitting
+        b.fits[key] = at
+        return at
 
     def extend(self, b: Builder, i: int, fr: int, fj: int, solid: bool) -> int:
         self.combinations += 1
@@ -1002,9 +995,9 @@ class Search:
         r = b.order[i]
         o = b.opts[r]
         masked = fr >= 0
-        mask = self.fitting(b, fr, fj, r) if masked else _NO_MASK
+        at = self.fitting(b, fr, fj, r) if masked else -1
         for k in range(o.n):
-            if masked and not mask[k]:
+            if masked and not b.masks[at + k]:
                 continue
             m = o.moves[k]
             if i == b.last and not solid and m is not None and plain(m) and m.letters > 1:
@@ -1023,7 +1016,8 @@ class Search:
         """Every valid column out of a node, but not those where two entries of known
         length could not be as long as each other within the incumbent."""
         count = self.groups[g].n
-        b = Builder(g, count, node, opts)
+        b = self.builders[g]
+        b.start(node, opts)
         order = b.order
         for i in range(count):
             order[i] = i
@@ -1034,9 +1028,12 @@ class Search:
                 order[k] = order[k - 1]
                 k -= 1
             order[k] = v
-        if self.extend(b, 0, -1, -1, False):
-            return None  # stopped
-        return b.out
+        stopped = self.extend(b, 0, -1, -1, False)
+        columns = b.out
+        b.done()
+        if stopped:
+            return None
+        return columns
 
     # -- nodes --------------------------------------------------------------------------
     def bound_within(self, g: int, y: System, child: Node) -> float:
@@ -1178,7 +1175,8 @@ class Search:
                 wr = r
                 break
         row = group.rows[wr]
-        width = self.whole_of(row, entries[wr])  # type: ignore[arg-type]
+        width = self.width
+        self.whole_into(row, entries[wr], width, 0)  # type: ignore[arg-type]
         c = Node(nv, count)
         used = c.used
         for j in range(count * nv):
@@ -1194,10 +1192,8 @@ class Search:
             if m is None:
                 continue
             row = group.rows[r]
-            w = self.whole_of(row, m)
+            self.whole_into(row, m, known, 0)
             base = r * nv
-            for j in range(nv):
-                known[j] = w[j]
             if m.piece_of >= 0:
                 if m.start == m.end:
                     for j in range(nv):
@@ -1390,27 +1386,61 @@ class Search:
 
 
 class Builder:
-    """What columns_of() builds the columns out of a node with."""
+    """What columns_of() builds the columns out of a node with: one a group, set again
+    for each node (columns_of() never runs inside another)."""
 
-    def __init__(self, g: int, count: int, node: Node, opts: list[Options]):
+    def __init__(self, g: int, count: int):
         self.g = g
         self.R = count
         self.last = count - 1
-        self.node = node
-        self.opts = opts
+        self.node = Node(0, count)  # the node of the columns it builds (start())
+        self.opts: list[Options] = []
         self.order = _ints(count + 1)  # the rows, fewest options first (columns_of())
         self.base = _ints(count + 1)  # where each row's options start in fits' keys
-        total = 0
-        for r in range(count):
-            self.base[r] = total
-            total += opts[r].n
         self.chosen: list[Move | None] = [None] * count
-        self.fits: dict[int, array[int]] = {}  # by (first row, option) and row: a fitting mask
+        self.fits: dict[int, int] = {}  # by (first row, option) and row: where its mask is
         self.out: list[list[Move | None]] = []
+        self.masks = _flags(64)  # fitting()'s masks, one after another ...
+        self.size = 64
+        self.filled = 0  # ... up to here
         self.first: array[float] = _DOUBLES  # fitting()'s first entry: first[first_at:]
         self.first_at = 0
         self.limit = 0.0
         self.margin = 0.0
+
+    def start(self, node: Node, opts: list[Options]) -> None:
+        self.node = node
+        self.opts = opts
+        total = 0
+        for r in range(self.R):
+            self.base[r] = total
+            total += opts[r].n
+        self.out = []
+
+    def done(self) -> None:
+        """Its node's columns handed over: what it held of them let go (the node stays
+        until the next one)."""
+        self.opts = []
+        self.out = []
+        self.fits.clear()
+        self.filled = 0
+
+    def reserve(self, n: int) -> int:
+        """Room for a mask of ``n`` options, cleared: where it starts in ``masks``."""
+        at = self.filled
+        if at + n > self.size:
+            size = 2 * self.size + n
+            made = _flags(size)
+            masks = made
+            for k in range(at):
+                masks[k] = self.masks[k]
+            self.masks = masks
+            self.size = size
+        else:
+            for k in range(at, at + n):
+                self.masks[k] = 0
+        self.filled = at + n
+        return at
 
 
 # -- the sizing's elimination (sizing._parametrized) ------------------------------------
