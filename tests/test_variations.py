@@ -16,12 +16,12 @@ from facadecli.grammar import floors
 from facadecli.grammar.align import KEPT_LEAST, align
 from facadecli.grammar.derive import _run_of, derive_at
 from facadecli.grammar.extract import extract_grammar
-from facadecli.grammar.model import Extraction, Options, Piece, Variation
+from facadecli.grammar.model import Extraction, Kept, Options, Piece, Variation
 from facadecli.grammar.pieces import apart, displacement, likeness, pieces_key
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Part
 from facadecli.grammar.style import Box as StyleBox
-from facadecli.grammar.style import Kept, check, facade_of
+from facadecli.grammar.style import check, facade_of
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.grammar.variations import APART, derive_layout, derive_variations
 from facadecli.grammar.vary import proportioned_copies
