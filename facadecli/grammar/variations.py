@@ -124,12 +124,13 @@ def derive_variations(
     Variation 0 keeps the most of the source's ``style`` (Bao et al. 2013's constraints),
     and among those it is the nearest the source's sizes (the best fit, when it keeps as
     much as any). The others are drawn at random (``seed``) among the candidates that keep
-    as much, then among the rest, favouring low scores, and ordered by what they keep and
-    their score; each differs visibly from every one before it (``pieces.apart``: more
-    or fewer elements of a label, or its elements a mean ``APART`` of the façade's smaller
-    side or more from theirs) and
-    keeps as much of the style as variation 0, so fewer than ``count`` may exist. Named
-    ``<name>-<W>x<H>`` when ``count`` is 1, else ``<name>-<W>x<H>-v<K>``."""
+    every constraint it keeps, then among the rest, favouring low scores, and ordered by
+    what they keep and their score; each differs visibly from every one before it
+    (``pieces.apart``: more or fewer elements of a label, or its elements a mean
+    ``APART`` of the façade's smaller side or more from theirs) and keeps every
+    constraint of the style variation 0 keeps (its windows' sizes and floor pitch among
+    them), so fewer than ``count`` may exist. Named ``<name>-<W>x<H>`` when ``count`` is
+    1, else ``<name>-<W>x<H>-v<K>``."""
     source = (tiling.xs[-1], tiling.ys[-1])
     target = Target(with_runs(grammar, source), source, width, height, style)
     stem = f"{safe_name(name)}-{width:g}x{height:g}"
@@ -139,7 +140,7 @@ def derive_variations(
     found = [variation_of(first, target, names[0])]
     if count == 1:
         return found, []
-    chosen = apart_laid(target, drawn_order(ranked, first.candidate, seed), first, count)
+    chosen = apart_laid(target, drawn_order(ranked, first, seed), first, count)
     found += [variation_of(laid, target, names[k]) for k, laid in enumerate(chosen, start=1)]
     return found, fewer_note(len(found), count)
 
@@ -252,25 +253,29 @@ def tidied(target: Target, candidate: Candidate) -> tuple[list[Piece], list[str]
     )
 
 
-def drawn_order(ranked: list[Candidate], first: Candidate, seed: int) -> list[Candidate]:
+def drawn_order(ranked: list[Candidate], first: Laid, seed: int) -> list[Candidate]:
     """The candidates other than variation 0's in a weighted draw without replacement
-    (Efraimidis and Spirakis: keys u^(1/w)), drawn first among those that keep as much
-    of the style as variation 0, favouring low scores (``TEMPERATURE``)."""
+    (Efraimidis and Spirakis: keys u^(1/w)), drawn first among those that keep every
+    constraint variation 0 keeps, then among those keeping as many, favouring low scores
+    (``TEMPERATURE``)."""
     rng = random.Random(seed)
     return sorted(
-        (c for c in ranked if c is not first),
+        (c for c in ranked if c is not first.candidate),
         key=lambda c: (
+            not keeps_all(c.kept, first.kept),
             -len(c.kept.kept),
             -math.log(rng.random() or 1e-300)
-            * math.exp(min((c.score - first.score) / TEMPERATURE, 700.0)),
+            * math.exp(min((c.score - first.candidate.score) / TEMPERATURE, 700.0)),
         ),
     )
 
 
 def apart_laid(target: Target, drawn: list[Candidate], first: Laid, count: int) -> list[Laid]:
     """Up to ``count - 1`` more variations, in the draw's order, each as written keeping
-    as much of the style as variation 0 and visibly apart from every one before it
-    (:func:`~facadecli.grammar.pieces.apart`), ordered by what they keep and their rank."""
+    every constraint of the style variation 0 keeps (not merely as many: one keeping the
+    windows' columns in place of their sizes is another style) and visibly apart from
+    every one before it (:func:`~facadecli.grammar.pieces.apart`), ordered by what they
+    keep and their rank."""
     chosen: list[Laid] = []
     seen = {pieces_key(first.pieces)}
     shown = [first.pieces]  # the variations so far: another differs visibly from each
@@ -284,7 +289,7 @@ def apart_laid(target: Target, drawn: list[Candidate], first: Laid, count: int) 
         key = pieces_key(laid.pieces)
         if (
             key not in seen
-            and len(laid.kept.kept) >= len(first.kept.kept)  # the style, as variation 0 keeps it
+            and keeps_all(laid.kept, first.kept)  # the style, as variation 0 keeps it
             and all(apart(laid.pieces, p, least) for p in shown)
         ):
             seen.add(key)
@@ -292,6 +297,11 @@ def apart_laid(target: Target, drawn: list[Candidate], first: Laid, count: int) 
             chosen.append(laid)
     chosen.sort(key=lambda c: (-len(c.kept.kept), c.candidate.rank[2:]))
     return chosen
+
+
+def keeps_all(kept: Kept, model: Kept) -> bool:
+    """Whether a layout keeps every constraint another keeps."""
+    return set(model.kept) <= set(kept.kept)
 
 
 def variation_of(laid: Laid, target: Target, name: str) -> Variation:
@@ -318,9 +328,9 @@ def fewer_note(made: int, count: int) -> list[str]:
         f"only {made} of {count} variations exist (repeat counts within 1 of the "
         f"best fit whose copies stretch by at most {STRETCH:.0%}, parts of a split "
         "that are as long as each other in a new order, and parts' proportions drawn "
-        "near the source's; each keeping as much of the style as the first, with more "
-        f"or fewer elements, or its elements a mean {APART:.0%} of the façade's smaller "
-        "side or more from every other's)"
+        "near the source's; each keeping every constraint of the style the first keeps, "
+        f"with more or fewer elements, or its elements a mean {APART:.0%} of the façade's "
+        "smaller side or more from every other's)"
     ]
 
 
