@@ -76,6 +76,7 @@ bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extrac
 	$(BIN)/python tests/benchmarks/infer_bench.py
 	$(BIN)/python tests/benchmarks/fidelity_bench.py
 	$(BIN)/python tests/benchmarks/retarget_bench.py
+	$(BIN)/python tests/benchmarks/variations_bench.py
 	$(BIN)/python tests/benchmarks/watch_bench.py
 
 bench-large: $(STAMP) ## Time facade grammar on three large generated layouts, and facade city on a generated town of FACADE_BENCH_N buildings (default 100,000: hours; its planning memory first, FACADE_BENCH_PLAN_ONLY=1 stops there)

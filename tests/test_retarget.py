@@ -13,7 +13,7 @@ from facadecli.grammar import floors, retarget, slabs
 from facadecli.grammar.model import Piece
 from facadecli.grammar.pieces import elements_of, likeness
 from facadecli.grammar.slabs import retargeted
-from facadecli.grammar.style import Box, facade_of, find_style
+from facadecli.grammar.style import BAND, Box, facade_of, find_style
 from facadecli.grammar.tiling import BACKGROUND
 
 ROW = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]  # three windows 1 m wide, 1 m apart, in 7 m
@@ -162,7 +162,7 @@ def test_every_plan_fills_the_new_extent_and_keeps_elements_whole(
         parts = sorted(  # a band may be lengthened
             (a, b, hi - lo)
             for lo, hi in spans
-            if hi - lo < retarget.BAND * extent
+            if hi - lo < BAND * extent
             for a, b in retarget.place(plan, lo, hi)
         )
         off = retarget.ALIKE_PART  # two parts of cut elements, one unit along, nearly

@@ -16,17 +16,18 @@ from facadecli.grammar import floors
 from facadecli.grammar.align import KEPT_LEAST, align
 from facadecli.grammar.derive import _run_of, derive_at
 from facadecli.grammar.extract import extract_grammar
-from facadecli.grammar.model import Extraction, Options, Piece, Variation
+from facadecli.grammar.model import Extraction, Kept, Options, Piece, Variation
 from facadecli.grammar.pieces import apart, displacement, likeness, pieces_key
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Part
 from facadecli.grammar.style import Box as StyleBox
-from facadecli.grammar.style import Kept, check, facade_of
+from facadecli.grammar.style import check, facade_of
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.grammar.variations import APART, derive_layout, derive_variations
 from facadecli.grammar.vary import proportioned_copies
 from facadecli.layout import Layout
 from facadecli.solve import solve
+from tests.benchmarks.annotated_family import cmp_xml, family
 from tests.test_grammar import _facade, _floors, _write_plain
 
 Box = tuple[str, float, float, float, float]
@@ -582,3 +583,24 @@ def test_variations_print_no_solver_warnings(tmp_path: Path) -> None:
         warnings.simplefilter("error")
         variations = _draw(extraction, (30.0, 12.0), 6)
     assert len(variations) >= 4  # (those a visible step apart that keep the style)
+
+
+def test_variations_of_generated_facades_keep_every_constraint_the_first_keeps(
+    tmp_path: Path,
+) -> None:
+    """Generated annotations (``annotated_family``) at 0.7 times their width: variation 0
+    keeps the door's size, and every other variation keeps every constraint it keeps, not
+    merely as many (seed 1's variations 1 and 2 squeezed the door, keeping as many
+    constraints by others); fewer are written when fewer exist."""
+    for seed in (1, 2):
+        path = tmp_path / f"family-{seed}.xml"
+        path.write_text(cmp_xml(family(seed)[0]))
+        extraction = extract_grammar(path, Options(size=(15.0, 15.0)))
+        variations, notes = derive_variations(
+            extraction.grammar, extraction.tiling, 10.5, 15.0, "f", 3, 0, extraction.style
+        )
+        first = set(variations[0].kept.kept)
+        assert any(c.kind == "sizes" and c.label == "door" for c in first)
+        for variation in variations[1:]:
+            assert first <= set(variation.kept.kept), (seed, first - set(variation.kept.kept))
+        assert (len(variations) < 3) == bool(notes)

@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
-from facadecli.grammar.model import Piece
+from facadecli.grammar.model import Constraint, Kept, Piece
 from facadecli.grammar.pieces import elements_of, score
 from facadecli.grammar.split import Axis
-from facadecli.grammar.style import Constraint, Equation, Kept, equations
+from facadecli.grammar.style import Equation, equations
 from facadecli.grammar.tiling import BACKGROUND, snap
 
 STRETCHED = 1.05  # an element derived longer than this times its source size is pulled back

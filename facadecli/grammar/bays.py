@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 from facadecli.grammar import retarget
 from facadecli.grammar.floors import Span, holds_column, pitched
-from facadecli.grammar.style import Box
+from facadecli.grammar.style import BAND, Box
 
 SCALED_MOST = 0.25  # of the height: strata a unit cannot be cut out of, scaled alike instead
 SCALED_ACROSS = 2.0  # ... by this at most, either way
@@ -146,7 +146,7 @@ def _rejoined(boxes: Sequence[Box], stratum: Span, extent: float, lo: float, hi:
         return {
             (b.label, round(max(b.y0, stratum[0]), 6), round(min(b.y1, stratum[1]), 6))
             for b in boxes
-            if b.x0 + near < at < b.x1 - near and b.x1 - b.x0 < retarget.BAND * extent
+            if b.x0 + near < at < b.x1 - near and b.x1 - b.x0 < BAND * extent
         }
 
     return crossed(lo) == crossed(hi)

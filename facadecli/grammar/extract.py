@@ -13,12 +13,14 @@ import bisect
 import time
 from pathlib import Path
 
+from facadecli.grammar import regions, symmetry
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.fidelity import fidelity
 from facadecli.grammar.inputs import Rect
 from facadecli.grammar.model import DEFAULT_OPTIONS, Extraction, Options, Progress, no_progress
 from facadecli.grammar.search import extract
 from facadecli.grammar.split import Grammar, derive
+from facadecli.grammar.style import style_of_drawing
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
 
@@ -55,10 +57,50 @@ def extract_grammar(
     extraction.problems = rederivation_problems(found.grammar, tiling)
     extraction.snapping = snapping
     extraction.drawn = tidied.snapped
+    extraction.style = style_of_drawing(tidied.snapped)
+    extraction.warnings = extraction_warnings(extraction)
     progress("measuring the derivation against the annotation")
     terminals = [Rect(*box) for box in derive(found.grammar, tiling.xs[-1], tiling.ys[-1])]
     extraction.fidelity = fidelity(tidied.raw, regular, terminals)
     return extraction
+
+
+def extraction_warnings(extraction: Extraction) -> list[str]:
+    """What the tidy-up changed and where the search stopped short of its iterations."""
+    found = list(extraction.regularization.warnings)
+    snapped = extraction.snapping.warning()
+    if snapped:
+        found.append(snapped)
+    search, options = extraction.found, extraction.options
+    if (
+        search.method == "adp"
+        and search.iterations < options.iterations
+        and not search.budget_spent
+    ):
+        found.append(
+            f"time limit of {options.time_limit:g} s reached after "
+            f"{search.iterations} of {options.iterations} iterations: the best "
+            "grammar so far is kept, and it depends on the machine's speed"
+        )
+    if search.budget_spent:
+        found.append(
+            f"the search did the most work it may ({regions.WORK_MAX:,} units) "
+            f"after {search.iterations} of {options.iterations} iterations: the "
+            "best grammar so far is kept"
+        )
+    if search.repeats_stopped == "time":
+        found.append(
+            f"time limit of {options.time_limit:g} s: the search for repeated regions "
+            f"stopped at {search.repeats} kinds; the grammar depends on the machine's "
+            "speed"
+        )
+    if search.repeats_stopped == "work":
+        found.append(
+            "the search for repeated regions did the most work it may "
+            f"({symmetry.WORK_SHARE * regions.WORK_MAX:,.0f} of the search's "
+            f"{regions.WORK_MAX:,} units) and stopped at {search.repeats} kinds"
+        )
+    return found
 
 
 def rederivation_problems(grammar: Grammar, tiling: Tiling, limit: int = 5) -> list[str]:

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from facadecli.grammar import retarget
 from facadecli.grammar.model import Piece
 from facadecli.grammar.pieces import boxes_of
-from facadecli.grammar.style import Box
+from facadecli.grammar.style import BAND, Box
 from facadecli.grammar.tiling import BACKGROUND
 
 SPANNED_ROWS = 3  # rows of a label an element runs across, up the façade, to be a band there
@@ -128,7 +128,7 @@ def unbanded(
     def spans_rows(b: Box) -> bool:  # a giant order: across SPANNED_ROWS of a label's rows
         return any(sum(b.y0 < c < b.y1 for c in centres) >= SPANNED_ROWS for centres in rows)
 
-    bands = [b for b in joined if length(b) >= retarget.BAND * extent or spans_rows(b)]
+    bands = [b for b in joined if length(b) >= BAND * extent or spans_rows(b)]
     if whole_labels:
         labels = {b.label for b in bands}
         return [e for e in elements if e.label not in labels]

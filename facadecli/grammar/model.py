@@ -8,14 +8,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import TYPE_CHECKING
 
 from facadecli.errors import Problem, SpecError
-from facadecli.grammar import regions, symmetry
 from facadecli.grammar.inputs import EXTENT_MAX, LabelledLayout
 from facadecli.grammar.split import DEFAULT_COSTS, Costs, Grammar
-from facadecli.grammar.style import NOTHING_KEPT, Constraint, Kept, style_of, style_of_drawing
 from facadecli.grammar.tiling import NO_SNAPPING, Snapping, Tiling
 
 if TYPE_CHECKING:
@@ -75,6 +72,48 @@ def no_progress(stage: str) -> None:
 
 
 @dataclass(frozen=True)
+class Constraint:
+    """One of Bao et al. 2013's constraints of a façade's style
+    (:mod:`facadecli.grammar.style` finds and checks them)."""
+
+    kind: str  # symmetry, columns, axis, spacing, ends, centre, sizes, pitch
+    label: str  # the label it is about ("*": every element)
+    text: str  # what it says, for people
+    share: float = 1.0  # for ``columns`` and ``spacing``: the share of the label's rows
+    other: str = ""  # for ``axis``: the label whose columns it is centred on
+    rows: int = 0  # for ``columns`` and ``spacing``: how many of the label's rows
+    # for ``sizes``: the input elements' (width, height); for ``pitch``: the input's pitches
+    sizes: tuple[tuple[float, float], ...] = ()
+    pitches: tuple[float, ...] = ()
+
+    def summary(self) -> dict[str, object]:
+        return {"kind": self.kind, "label": self.label, "text": self.text}
+
+
+@dataclass(frozen=True)
+class Kept:
+    """Which of a style's constraints a layout keeps."""
+
+    kept: tuple[Constraint, ...]
+    broken: tuple[Constraint, ...]
+
+    def summary(self) -> dict[str, object]:
+        return {"kept": len(self.kept), "broken": [c.text for c in self.broken]}
+
+    def warnings(self) -> list[str]:
+        if not self.broken:
+            return []
+        total = len(self.kept) + len(self.broken)
+        broken = "; ".join(c.text for c in self.broken)
+        return [
+            f"keeps {len(self.kept)} of {total} constraints of the source's style, not: {broken}"
+        ]
+
+
+NOTHING_KEPT = Kept((), ())  # of an empty style
+
+
+@dataclass(frozen=True)
 class Tidied:
     """A labelled layout as read, resized, snapped and regularised, and what that changed."""
 
@@ -100,52 +139,14 @@ class Extraction:
     # the annotation as drawn, only its edges within the snap tolerance joined (its tiling
     # is within the cell limit checked before the work, unlike the raw drawing's)
     drawn: LabelledLayout | None = None
-
-    @cached_property
-    def style(self) -> list[Constraint]:
-        """Bao's constraints the input holds: found on what the annotation shows (its
-        rectangles in their z-order), or on the tiling when there is no annotation."""
-        return style_of(self.tiling) if self.drawn is None else style_of_drawing(self.drawn)
+    # Bao's constraints the input holds, found on what the annotation shows (its
+    # rectangles in their z-order: ``style.style_of_drawing``)
+    style: list[Constraint] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # what the tidy-up and search met
 
     @property
     def grammar(self) -> Grammar:
         return self.found.grammar
-
-    @property
-    def warnings(self) -> list[str]:
-        found = list(self.regularization.warnings)
-        snapped = self.snapping.warning()
-        if snapped:
-            found.append(snapped)
-        if (
-            self.found.method == "adp"
-            and self.found.iterations < self.options.iterations
-            and not self.found.budget_spent
-        ):
-            found.append(
-                f"time limit of {self.options.time_limit:g} s reached after "
-                f"{self.found.iterations} of {self.options.iterations} iterations: the best "
-                "grammar so far is kept, and it depends on the machine's speed"
-            )
-        if self.found.budget_spent:
-            found.append(
-                f"the search did the most work it may ({regions.WORK_MAX:,} units) "
-                f"after {self.found.iterations} of {self.options.iterations} iterations: the "
-                "best grammar so far is kept"
-            )
-        if self.found.repeats_stopped == "time":
-            found.append(
-                f"time limit of {self.options.time_limit:g} s: the search for repeated regions "
-                f"stopped at {self.found.repeats} kinds; the grammar depends on the machine's "
-                "speed"
-            )
-        if self.found.repeats_stopped == "work":
-            found.append(
-                "the search for repeated regions did the most work it may "
-                f"({symmetry.WORK_SHARE * regions.WORK_MAX:,.0f} of the search's "
-                f"{regions.WORK_MAX:,} units) and stopped at {self.found.repeats} kinds"
-            )
-        return found
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-BAND = 0.4  # of the extent: a longer element is a band across bays, which a copy lengthens
+from facadecli.grammar.style import BAND  # a longer element is a band: a copy lengthens it
+
 UNIT_BLOCKS = 3  # blocks a unit holds at most
 UNITS_TRIED = 6  # units made into plans, the most regular first
 GAPS_LEAST = 0.5  # of their source size: gaps squeezed further squeeze everything instead

@@ -14,9 +14,9 @@ from collections.abc import Sequence
 from facadecli.grammar import retarget
 from facadecli.grammar.bays import bay_plans
 from facadecli.grammar.floors import floor_plans, levelled, unbanded
-from facadecli.grammar.model import Piece
+from facadecli.grammar.model import Constraint, Piece
 from facadecli.grammar.pieces import boxes_of, elements_of, score
-from facadecli.grammar.style import Box, Constraint, Facade, check, shared_rows
+from facadecli.grammar.style import Box, Facade, check, shared_rows
 from facadecli.grammar.tiling import BACKGROUND
 
 RETARGETS_MAX = 5  # plans up the façade tried with each plan across it (stretched first)

@@ -44,14 +44,14 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from facadecli.grammar import retarget
 from facadecli.grammar.inputs import LabelledLayout, Rect
+from facadecli.grammar.model import Constraint, Kept
 from facadecli.grammar.tiling import BACKGROUND, Tiling, tile
 
 SKIPPED = 1  # places of a row's pitch that may be empty between two elements
 TOLERANCE = 0.01  # of the façade's extent along the axis compared
 MIRRORED = 0.9  # share of the elements with a mirror partner for a symmetric façade
-BAND = retarget.BAND  # of the input's width: a wider element is a band, on no column
+BAND = 0.4  # of the input's extent: a longer element is a band across bays, on no column
 CHECKED_BAND = 0.5  # ... of a derived layout's (an element stretched there is still checked)
 SIZE_TOLERANCE = 0.15  # of a size or pitch: a derived element keeps its size within it
 SIZE_SHARE = 0.9  # of a label's derived elements that must keep an input element's size
@@ -65,22 +65,6 @@ class Box(NamedTuple):
     y0: float
     x1: float
     y1: float
-
-
-@dataclass(frozen=True)
-class Constraint:
-    kind: str  # symmetry, columns, axis, spacing, ends, centre
-    label: str  # the label it is about ("*": every element)
-    text: str  # what it says, for people
-    share: float = 1.0  # for ``columns`` and ``spacing``: the share of the label's rows
-    other: str = ""  # for ``axis``: the label whose columns it is centred on
-    rows: int = 0  # for ``columns`` and ``spacing``: how many of the label's rows
-    # for ``sizes``: the input elements' (width, height); for ``pitch``: the input's pitches
-    sizes: tuple[tuple[float, float], ...] = ()
-    pitches: tuple[float, ...] = ()
-
-    def summary(self) -> dict[str, object]:
-        return {"kind": self.kind, "label": self.label, "text": self.text}
 
 
 @dataclass(frozen=True)
@@ -482,31 +466,8 @@ def _same_centre(box: Box, other: Box) -> tuple[tuple[float, float], ...]:
     return ((box.x0, 1.0), (box.x1, 1.0), (other.x0, -1.0), (other.x1, -1.0))
 
 
-@dataclass(frozen=True)
-class Kept:
-    """Which of a style's constraints a layout keeps."""
-
-    kept: tuple[Constraint, ...]
-    broken: tuple[Constraint, ...]
-
-    def summary(self) -> dict[str, object]:
-        return {"kept": len(self.kept), "broken": [c.text for c in self.broken]}
-
-    def warnings(self) -> list[str]:
-        if not self.broken:
-            return []
-        total = len(self.kept) + len(self.broken)
-        broken = "; ".join(c.text for c in self.broken)
-        return [
-            f"keeps {len(self.kept)} of {total} constraints of the source's style, not: {broken}"
-        ]
-
-
 def check(style: Sequence[Constraint], facade: Facade) -> Kept:
     results: dict[bool, list[Constraint]] = defaultdict(list)
     for constraint in style:
         results[holds(constraint, facade)].append(constraint)
     return Kept(tuple(results[True]), tuple(results[False]))
-
-
-NOTHING_KEPT = Kept((), ())  # of an empty style

@@ -16,11 +16,11 @@ from dataclasses import replace
 from facadecli import proportions
 from facadecli.grammar.align import ALIGN
 from facadecli.grammar.derive import THIN
-from facadecli.grammar.model import Candidate, Piece, Proportions, Shuffle
+from facadecli.grammar.model import Candidate, Constraint, Kept, Piece, Proportions, Shuffle
 from facadecli.grammar.pieces import elements_of, pieces_key, score
 from facadecli.grammar.slabs import retargeted
 from facadecli.grammar.split import Grammar, Part
-from facadecli.grammar.style import Constraint, Kept, check
+from facadecli.grammar.style import check
 from facadecli.grammar.tiling import BACKGROUND
 
 CANDIDATES_MAX = 729  # repeat-count choices tried per size (all of them when fewer: 3^6)
