@@ -41,24 +41,29 @@ cdef bint _has_draft(list drafts, int axis, tuple bounds) except -1
 cdef double _lines_cost(list cost_of_line, int lo, tuple bounds) except? -1.0
 
 
+@cython.final
 cdef class SeqSet:
     cdef int[::1] pool
-    cdef long long[::1] at, slots
+    cdef long long[::1] at
+    cdef unsigned long long[::1] slots
     cdef Py_ssize_t n_slots, n, pool_n
     cdef public bint added
 
     @cython.locals(h="unsigned long long", i=Py_ssize_t)
-    cdef unsigned long long hash(self, int[::1] v, Py_ssize_t start, Py_ssize_t n) noexcept
+    cdef inline unsigned long long hash(self, int[::1] v, Py_ssize_t start, Py_ssize_t n) noexcept
 
-    @cython.locals(mask=Py_ssize_t, j=Py_ssize_t, s=Py_ssize_t, at=Py_ssize_t, same=bint,
-                   i=Py_ssize_t)
+    @cython.locals(mask=Py_ssize_t, h="unsigned long long", j=Py_ssize_t, s=Py_ssize_t,
+                   at=Py_ssize_t, same=bint, i=Py_ssize_t)
     cdef Py_ssize_t add(self, int[::1] v, Py_ssize_t start, Py_ssize_t n) except -1
 
-    @cython.locals(slots="long long[::1]", mask=Py_ssize_t, i=Py_ssize_t, at=Py_ssize_t,
-                   j=Py_ssize_t)
+    cdef void clear(self) except *
+
+    @cython.locals(slots="unsigned long long[::1]", mask=Py_ssize_t, i=Py_ssize_t,
+                   s="unsigned long long", h="unsigned long long", j=Py_ssize_t)
     cdef void rehash(self, Py_ssize_t n_slots) except *
 
 
+@cython.final
 cdef class Table:
     cdef int rows, cols
     cdef int[::1] labels

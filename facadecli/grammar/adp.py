@@ -129,12 +129,13 @@ def _more_flags(old: Any, used: int, need: int) -> array[int]:
 class SeqSet:
     """A set of int sequences numbered as added (content keys, regions, forms, kinds of
     rules, grammars seen), by open addressing: the sequences one after another in a pool
-    (each its length, then its items), the slots holding a number + 1 (0: empty)."""
+    (each its length, then its items), a slot two words, a number + 1 (0: empty) and the
+    sequence's hash, so that a probe reads the pool only when the hashes are equal."""
 
     def __init__(self) -> None:
         self.pool = _ints(64)
         self.at = _longs(16)
-        self.slots = _longs(64)
+        self.slots = _words(128)
         self.n_slots = 64
         self.n = 0
         self.pool_n = 0
@@ -152,21 +153,23 @@ class SeqSet:
         if 2 * (self.n + 1) > self.n_slots:
             self.rehash(2 * self.n_slots)
         mask = self.n_slots - 1
-        j = self.hash(v, start, n) & mask
+        h = self.hash(v, start, n)
+        j = h & mask
         while True:
-            s = self.slots[j]
+            s = self.slots[2 * j]
             if s == 0:
                 break
-            at = self.at[s - 1]
-            if self.pool[at] == n:
-                same = True
-                for i in range(n):
-                    if self.pool[at + 1 + i] != v[start + i]:
-                        same = False
-                        break
-                if same:
-                    self.added = False
-                    return s - 1
+            if self.slots[2 * j + 1] == h:
+                at = self.at[s - 1]
+                if self.pool[at] == n:
+                    same = True
+                    for i in range(n):
+                        if self.pool[at + 1 + i] != v[start + i]:
+                            same = False
+                            break
+                    if same:
+                        self.added = False
+                        return s - 1
             j = (j + 1) & mask
         if self.pool_n + n + 1 > len(self.pool):
             self.pool = _more_ints(self.pool, self.pool_n, self.pool_n + n + 1, 0)
@@ -178,19 +181,30 @@ class SeqSet:
             self.pool[self.pool_n + 1 + i] = v[start + i]
         self.pool_n += n + 1
         self.n += 1
-        self.slots[j] = self.n
+        self.slots[2 * j] = self.n
+        self.slots[2 * j + 1] = h
         self.added = True
         return self.n - 1
 
+    def clear(self) -> None:
+        """Empty, with the room it has (a new array of slots: zeroed by C in both modes)."""
+        self.slots = _words(2 * self.n_slots)
+        self.n = 0
+        self.pool_n = 0
+
     def rehash(self, n_slots: int) -> None:
-        slots = _longs(n_slots)
+        slots = _words(2 * n_slots)
         mask = n_slots - 1
-        for i in range(self.n):
-            at = self.at[i]
-            j = self.hash(self.pool, at + 1, self.pool[at]) & mask
-            while slots[j] != 0:
+        for i in range(self.n_slots):
+            s = self.slots[2 * i]
+            if s == 0:
+                continue
+            h = self.slots[2 * i + 1]
+            j = h & mask
+            while slots[2 * j] != 0:
                 j = (j + 1) & mask
-            slots[j] = i + 1
+            slots[2 * j] = s
+            slots[2 * j + 1] = h
         self.slots = slots
         self.n_slots = n_slots
 
@@ -1144,6 +1158,7 @@ class Table:
                 if self.kind_of[cid] >= 0:
                     self.first_of[self.kind_of[cid]] = -1
                 self.kind_of[cid] = -1
+            self.kinds.clear()  # kinds are compared within a survey only: a small set
         return total
 
     def learn(self) -> int:
