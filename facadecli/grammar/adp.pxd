@@ -11,6 +11,8 @@ cdef unsigned long long M32, M64, ONE, DE_BRUIJN, FNV_OFFSET, FNV_PRIME
 cdef int A_OWNER, A_OP, A_AXIS, A_COUNT, A_CENTRE, A_FORM
 cdef int A_BOUNDS, A_N_BOUNDS, A_ACROSS, A_N_ACROSS, A_PARTS, A_N_PARTS
 cdef int A_NEEDS, A_N_NEEDS, A_KIDS, A_N_KIDS, A_FIELDS
+cdef int D_AXIS, D_OP, D_COUNT, D_CENTRE, D_BOUNDS, D_N_BOUNDS, D_ACROSS, D_N_ACROSS, D_CIDS, D_M
+cdef int D_FIELDS
 cdef object _INTS, _LONGS, _DOUBLES, _WORDS, _FLAGS
 
 cdef object _ints(Py_ssize_t n)
@@ -34,31 +36,29 @@ cdef object _more_longs(long long[::1] old, Py_ssize_t used, Py_ssize_t need)
 @cython.locals(made=object, view="signed char[::1]")
 cdef object _more_flags(signed char[::1] old, Py_ssize_t used, Py_ssize_t need)
 
-@cython.locals(d=tuple)
-cdef bint _has_draft(list drafts, int axis, tuple bounds) except -1
-
-@cython.locals(i=Py_ssize_t, total=double)
-cdef double _lines_cost(list cost_of_line, int lo, tuple bounds) except? -1.0
-
-
+@cython.final
 cdef class SeqSet:
     cdef int[::1] pool
-    cdef long long[::1] at, slots
+    cdef long long[::1] at
+    cdef unsigned long long[::1] slots
     cdef Py_ssize_t n_slots, n, pool_n
     cdef public bint added
 
     @cython.locals(h="unsigned long long", i=Py_ssize_t)
-    cdef unsigned long long hash(self, int[::1] v, Py_ssize_t start, Py_ssize_t n) noexcept
+    cdef inline unsigned long long hash(self, int[::1] v, Py_ssize_t start, Py_ssize_t n) noexcept
 
-    @cython.locals(mask=Py_ssize_t, j=Py_ssize_t, s=Py_ssize_t, at=Py_ssize_t, same=bint,
-                   i=Py_ssize_t)
+    @cython.locals(mask=Py_ssize_t, h="unsigned long long", j=Py_ssize_t, s=Py_ssize_t,
+                   at=Py_ssize_t, same=bint, i=Py_ssize_t)
     cdef Py_ssize_t add(self, int[::1] v, Py_ssize_t start, Py_ssize_t n) except -1
 
-    @cython.locals(slots="long long[::1]", mask=Py_ssize_t, i=Py_ssize_t, at=Py_ssize_t,
-                   j=Py_ssize_t)
+    cdef void clear(self) except *
+
+    @cython.locals(slots="unsigned long long[::1]", mask=Py_ssize_t, i=Py_ssize_t,
+                   s="unsigned long long", h="unsigned long long", j=Py_ssize_t)
     cdef void rehash(self, Py_ssize_t n_slots) except *
 
 
+@cython.final
 cdef class Table:
     cdef int rows, cols
     cdef int[::1] labels
@@ -96,6 +96,12 @@ cdef class Table:
     cdef int[::1] heap
     cdef Py_ssize_t heap_n
     cdef int[::1] scratch, symbols
+    cdef Py_ssize_t d_stride
+    cdef int d_r0, d_r1, d_c0, d_c1
+    cdef int[::1] d_lines, d_crosses, d_full, d_runs, d_cheap, d_bounds, d_part, d_inside
+    cdef int[::1] d_spans, d_int, d_order, d_pool, h_int
+    cdef double[::1] d_cost, d_pos, d_neg, d_real, h_real
+    cdef Py_ssize_t n_inside, n_drafts, n_order, d_pool_n, n_halves
     cdef Py_ssize_t symbols_n
     cdef unsigned long long[::1] bits
     cdef Py_ssize_t words
@@ -122,56 +128,104 @@ cdef class Table:
 
     cdef int pool_room(self, Py_ssize_t n) except -9
 
-    @cython.locals(at=Py_ssize_t, r0=int, r1=int, c0=int, c1=int, drafts=list, first=Py_ssize_t,
-                   draft=tuple)
+    @cython.locals(at=Py_ssize_t, r0=int, r1=int, c0=int, c1=int, n=Py_ssize_t, first=Py_ssize_t,
+                   k=Py_ssize_t)
     cdef int provide(self, int e) except -9
 
-    @cython.locals(region=tuple, lines=list, usable=list, fallback=list, least=list, cols1=int,
-                   cols2=int, axis=int, found=list, crosses=list, i=int, at=Py_ssize_t,
-                   clean=list, inside=list, costs=list, drafts=list, halves=list, lo=int, hi=int,
-                   cost=list, full=tuple, n=Py_ssize_t, cheap=list, bounds=tuple, take=Py_ssize_t)
-    cdef list drafts(self, int r0, int r1, int c0, int c1)
+    @cython.locals(found0=int, found1=int, n0=int, n1=int, least0=int, least1=int, axis=int,
+                   n=int, lo=int, hi=int, base=Py_ssize_t, i=int, cheap=int, k=int, take=int,
+                   line=int)
+    cdef Py_ssize_t drafts(self, int r0, int r1, int c0, int c1) except -1
 
-    @cython.locals(first=int, last=int, found=list, k=int, at=Py_ssize_t)
-    cdef list _inside(self, int r0, int r1, int c0, int c1)
+    @cython.locals(r0=int, r1=int, c0=int, c1=int, base=Py_ssize_t, n=int, cols1=int, cols2=int,
+                   i=int, at=Py_ssize_t)
+    cdef int _found_lines(self, int axis) noexcept
+
+    @cython.locals(base=Py_ssize_t, k=int, i=int)
+    cdef int _lines_crossing(self, int axis, int n, int crosses) noexcept
+
+    @cython.locals(base=Py_ssize_t, least=int, i=int)
+    cdef int _least_crossed(self, int axis, int n) noexcept
+
+    @cython.locals(base=Py_ssize_t, lo=int, k=int, i=int, line=int, c=double, j=int, m=int)
+    cdef int _cheapest_lines(self, int axis, int n) noexcept
+
+    @cython.locals(r1=int, c0=int, c1=int, first=int, last=int, n=Py_ssize_t, k=int,
+                   at=Py_ssize_t)
+    cdef int _inside(self) noexcept
 
     @cython.locals(a=int, b=int, mid=int)
     cdef int _first_repeat_from(self, int row) noexcept
 
-    @cython.locals(r0=int, r1=int, c0=int, c1=int, lo=int, hi=int, size=Py_ssize_t, cost=list,
-                   pos=list, neg=list, k=int, at=Py_ssize_t, start=int, stop=int, cells=double,
-                   total=double, i=Py_ssize_t, c=double)
-    cdef list _line_costs(self, tuple region, int axis, list inside)
+    @cython.locals(r0=int, r1=int, c0=int, c1=int, lo=int, hi=int, base=Py_ssize_t, size=int,
+                   i=int, k=Py_ssize_t, at=Py_ssize_t, start=int, stop=int, cells=double,
+                   total=double, c=double)
+    cdef int _line_costs(self, int axis) noexcept
 
-    @cython.locals(n=Py_ssize_t, r0=int, r1=int, c0=int, c1=int, cids=list, i=Py_ssize_t,
-                   period=Py_ssize_t, run=list, j=Py_ssize_t, k=Py_ssize_t, end=Py_ssize_t,
-                   bounds=tuple)
-    cdef int _runs(self, list drafts, tuple region, list cost_of_line, int axis,
-                   tuple full) except -9
+    @cython.locals(base=Py_ssize_t, total=double, i=Py_ssize_t)
+    cdef double _lines_cost(self, int axis, Py_ssize_t at, Py_ssize_t n) noexcept
 
-    @cython.locals(r0=int, r1=int, c0=int, c1=int, spans=list, k=int, at=Py_ssize_t,
-                   blocks=list, free=bint, marks=set, bounds=tuple)
-    cdef int _repeated(self, list drafts, tuple region, list cost_of_line, int axis,
-                       tuple full, list inside) except -9
+    @cython.locals(d=Py_ssize_t)
+    cdef Py_ssize_t _new_draft(self, Py_ssize_t ints) except -1
 
-    @cython.locals(lo=int, line=int, hi=int, same=bint, r0=int, r1=int, c0=int, c1=int,
-                   rule_cost=double, heuristic=double)
-    cdef tuple _rank_in_two(self, tuple region, list cost_of_line, int axis, tuple bounds)
+    cdef int _add_draft(self, Py_ssize_t d, double heuristic, double rule_cost) noexcept
 
-    @cython.locals(n=Py_ssize_t, r0=int, r1=int, c0=int, c1=int, parts=list, cids=list, i=Py_ssize_t,
-                   a=int, b=int, op=int, m=Py_ssize_t, count=Py_ssize_t, repeats=bint, centre=int, period=Py_ssize_t,
-                   q=Py_ssize_t, same=bint, rule_cost=double, heuristic=double)
-    cdef int _draft(self, list drafts, tuple region, list cost_of_line, int axis,
-                    tuple bounds) except -9
+    @cython.locals(k=Py_ssize_t, f=Py_ssize_t, at=Py_ssize_t, same=bint, i=Py_ssize_t)
+    cdef bint _has_draft(self, int axis, Py_ssize_t n) noexcept
 
-    @cython.locals(heuristic=double, cost=double, axis=int, bounds=tuple, op=int, count=int,
-                   centre=int, across=tuple, parts=list, cids=list, m=Py_ssize_t,
-                   n_bounds=Py_ssize_t, n_across=Py_ssize_t, a=Py_ssize_t, f=Py_ssize_t,
-                   i=Py_ssize_t, cid=int, label=int, order=Py_ssize_t, k=Py_ssize_t,
-                   part=tuple, other=tuple, cells=long, j=Py_ssize_t, needs=Py_ssize_t,
-                   n_needs=Py_ssize_t, seen=bint, form="int[::1]", n=Py_ssize_t,
-                   kids=Py_ssize_t, n_kids=Py_ssize_t, kid=int)
-    cdef int _keep(self, int e, tuple draft) except -9
+    @cython.locals(fa=Py_ssize_t, fb=Py_ssize_t, na=Py_ssize_t, nb=Py_ssize_t, at=Py_ssize_t,
+                   bt=Py_ssize_t, i=Py_ssize_t)
+    cdef bint _draft_less(self, Py_ssize_t a, Py_ssize_t b) noexcept
+
+    @cython.locals(i=Py_ssize_t, d=int, j=Py_ssize_t)
+    cdef int _sort_drafts(self) noexcept
+
+    @cython.locals(i=Py_ssize_t, h=double, c=double, axis=int, line=int, j=Py_ssize_t,
+                   ph=double, pc=double, pa=int, pl=int)
+    cdef int _sort_halves(self) noexcept
+
+    @cython.locals(n=Py_ssize_t, r0=int, r1=int, c0=int, c1=int, d=Py_ssize_t, at=Py_ssize_t,
+                   i=Py_ssize_t, cids=Py_ssize_t, a=int, b=int, pool="int[::1]", op=int,
+                   m=Py_ssize_t, count=Py_ssize_t, centre=int, period=Py_ssize_t,
+                   q=Py_ssize_t, same=bint, repeats=bint, rule_cost=double, heuristic=double,
+                   f=Py_ssize_t)
+    cdef int _draft(self, int axis, Py_ssize_t nb) except -9
+
+    @cython.locals(nr=Py_ssize_t, nc=Py_ssize_t, m=Py_ssize_t, d=Py_ssize_t, rows=Py_ssize_t,
+                   columns=Py_ssize_t, cids=Py_ssize_t, i=Py_ssize_t, j=Py_ssize_t,
+                   k=Py_ssize_t, rule_cost=double, heuristic=double, f=Py_ssize_t)
+    cdef int _grid(self, int n0, int n1) except -9
+
+    @cython.locals(n=Py_ssize_t, r0=int, r1=int, c0=int, c1=int, full="int[::1]", i=Py_ssize_t,
+                   run=Py_ssize_t, period=Py_ssize_t, j=Py_ssize_t, k=Py_ssize_t,
+                   end=Py_ssize_t, nb=Py_ssize_t)
+    cdef int _runs(self, int axis, Py_ssize_t nf) except -9
+
+    @cython.locals(r0=int, r1=int, c0=int, c1=int, rep="int[::1]", spans=Py_ssize_t,
+                   k=Py_ssize_t, at=Py_ssize_t, a=int, b=int, j=Py_ssize_t, x=int, y=int,
+                   full="int[::1]", lo=int, hi=int, blocks=Py_ssize_t, free=bint,
+                   nb=Py_ssize_t, i=Py_ssize_t, line=int)
+    cdef int _repeated(self, int axis, Py_ssize_t nf) except -9
+
+    @cython.locals(j=Py_ssize_t, k=Py_ssize_t)
+    cdef Py_ssize_t _mark(self, Py_ssize_t n, int line) noexcept
+
+    @cython.locals(r0=int, r1=int, c0=int, c1=int, lo=int, hi=int, same=bint, rule_cost=double,
+                   heuristic=double, k=Py_ssize_t)
+    cdef int _rank_in_two(self, int axis, int line) except -9
+
+    @cython.locals(f=Py_ssize_t, at=Py_ssize_t, part="int[::1]", columns=Py_ssize_t,
+                   across=Py_ssize_t)
+    cdef long _part(self, Py_ssize_t d, Py_ssize_t i) noexcept
+
+    @cython.locals(g=Py_ssize_t, axis=int, op=int, count=int, centre=int, bounds=Py_ssize_t,
+                   n_bounds=Py_ssize_t, across=Py_ssize_t, n_across=Py_ssize_t,
+                   cids=Py_ssize_t, m=Py_ssize_t, a=Py_ssize_t, f=Py_ssize_t, i=Py_ssize_t,
+                   cid=int, label=int, order=Py_ssize_t, k=Py_ssize_t, cells=long,
+                   j=Py_ssize_t, needs=Py_ssize_t, n_needs=Py_ssize_t, seen=bint,
+                   form="int[::1]", n=Py_ssize_t, kids=Py_ssize_t, n_kids=Py_ssize_t, kid=int,
+                   part="int[::1]")
+    cdef int _keep(self, int e, Py_ssize_t d) except -9
 
     @cython.locals(x=Py_ssize_t, y=Py_ssize_t, i=int)
     cdef bint entry_less(self, int a, int b) noexcept

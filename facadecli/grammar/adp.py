@@ -129,12 +129,13 @@ def _more_flags(old: Any, used: int, need: int) -> array[int]:
 class SeqSet:
     """A set of int sequences numbered as added (content keys, regions, forms, kinds of
     rules, grammars seen), by open addressing: the sequences one after another in a pool
-    (each its length, then its items), the slots holding a number + 1 (0: empty)."""
+    (each its length, then its items), a slot two words, a number + 1 (0: empty) and the
+    sequence's hash, so that a probe reads the pool only when the hashes are equal."""
 
     def __init__(self) -> None:
         self.pool = _ints(64)
         self.at = _longs(16)
-        self.slots = _longs(64)
+        self.slots = _words(128)
         self.n_slots = 64
         self.n = 0
         self.pool_n = 0
@@ -152,21 +153,23 @@ class SeqSet:
         if 2 * (self.n + 1) > self.n_slots:
             self.rehash(2 * self.n_slots)
         mask = self.n_slots - 1
-        j = self.hash(v, start, n) & mask
+        h = self.hash(v, start, n)
+        j = h & mask
         while True:
-            s = self.slots[j]
+            s = self.slots[2 * j]
             if s == 0:
                 break
-            at = self.at[s - 1]
-            if self.pool[at] == n:
-                same = True
-                for i in range(n):
-                    if self.pool[at + 1 + i] != v[start + i]:
-                        same = False
-                        break
-                if same:
-                    self.added = False
-                    return s - 1
+            if self.slots[2 * j + 1] == h:
+                at = self.at[s - 1]
+                if self.pool[at] == n:
+                    same = True
+                    for i in range(n):
+                        if self.pool[at + 1 + i] != v[start + i]:
+                            same = False
+                            break
+                    if same:
+                        self.added = False
+                        return s - 1
             j = (j + 1) & mask
         if self.pool_n + n + 1 > len(self.pool):
             self.pool = _more_ints(self.pool, self.pool_n, self.pool_n + n + 1, 0)
@@ -178,24 +181,32 @@ class SeqSet:
             self.pool[self.pool_n + 1 + i] = v[start + i]
         self.pool_n += n + 1
         self.n += 1
-        self.slots[j] = self.n
+        self.slots[2 * j] = self.n
+        self.slots[2 * j + 1] = h
         self.added = True
         return self.n - 1
 
+    def clear(self) -> None:
+        """Empty, with the room it has (a new array of slots: zeroed by C in both modes)."""
+        self.slots = _words(2 * self.n_slots)
+        self.n = 0
+        self.pool_n = 0
+
     def rehash(self, n_slots: int) -> None:
-        slots = _longs(n_slots)
+        slots = _words(2 * n_slots)
         mask = n_slots - 1
-        for i in range(self.n):
-            at = self.at[i]
-            j = self.hash(self.pool, at + 1, self.pool[at]) & mask
-            while slots[j] != 0:
+        for i in range(self.n_slots):
+            s = self.slots[2 * i]
+            if s == 0:
+                continue
+            h = self.slots[2 * i + 1]
+            j = h & mask
+            while slots[2 * j] != 0:
                 j = (j + 1) & mask
-            slots[j] = i + 1
+            slots[2 * j] = s
+            slots[2 * j + 1] = h
         self.slots = slots
         self.n_slots = n_slots
-
-
-Draft = tuple[Any, ...]  # heuristic, cost, axis, bounds, op, count, centre, across, parts, cids
 
 
 class Table:
@@ -289,6 +300,24 @@ class Table:
         self.heap = _ints(64)
         self.heap_n = 0
         self.scratch = _ints(64)
+        # drafting a region's actions (``drafts``): by line, a row per axis of d_stride
+        stride = (rows if rows > cols else cols) + 2
+        self.d_stride = stride
+        self.d_r0 = self.d_r1 = self.d_c0 = self.d_c1 = 0
+        self.d_lines, self.d_crosses = _ints(2 * stride), _ints(2 * stride)
+        self.d_cost = _doubles(2 * stride)
+        self.d_pos, self.d_neg = _doubles(stride), _doubles(stride)
+        self.d_full, self.d_runs = _ints(stride), _ints(2 * stride)
+        self.d_cheap = _ints(TOP_ACTIONS)
+        self.d_bounds = _ints(stride)
+        self.d_part = _ints(4)
+        self.d_inside, self.d_spans = _ints(1), _ints(4)
+        self.n_inside = 0
+        self.n_drafts = self.n_order = self.d_pool_n = 0
+        self.d_real, self.d_int, self.d_order = _doubles(32), _ints(16 * D_FIELDS), _ints(16)
+        self.d_pool = _ints(256)
+        self.n_halves = 0  # the cuts in two: heuristic and cost, axis and line
+        self.h_real, self.h_int = _doubles(4 * TOP_ACTIONS), _ints(4 * TOP_ACTIONS)
         self.symbols = _ints(64)
         self.symbols_n = 0
         self.bits = _words(64)
@@ -414,89 +443,145 @@ class Table:
         return int(nearbyint((self.ys[b] - self.ys[a]) / self.qy))
 
     # -- the actions offered for a region (Wu et al. 2014, section 4.4) --------------------
+    # A region's actions are drafted in typed buffers before they are kept: per draft its
+    # heuristic and rule cost (``d_real``, two a draft), its int fields (``d_int``, D_FIELDS
+    # a draft: where its bounds, columns across and parts' contents start in ``d_pool``),
+    # and ``d_order``, the drafts in the order a list of them would hold.
 
-    def drafts(self, r0: int, r1: int, c0: int, c1: int) -> list[Draft]:
-        """The actions of a region before they are kept, best first: along each axis, a cut
-        at every clean line, cuts that keep periodic runs of parts or the repeated regions
-        found by hashing whole, the cuts in two the heuristic likes best, and with the
-        extension a two-way grid; each written as the cheapest rule that fits its parts."""
-        region = (r0, r1, c0, c1)
-        lines: list[list[int]] = [[], []]
-        usable = [False, False]
-        fallback: list[list[int]] = [[], []]
-        least = [2**31 - 1, 2**31 - 1]
-        cols1, cols2 = self.cols - 1, self.cols + 1
-        for axis in range(2):
-            found: list[int] = []
-            crosses: list[int] = []
-            if axis == 0:
-                for i in range(c1 - c0 - 1):
-                    if self.change_x[r1 * cols1 + c0 + i] - self.change_x[r0 * cols1 + c0 + i]:
-                        found.append(c0 + 1 + i)
-                        crosses.append(
-                            self.cross_x[r1 * cols1 + c0 + i] - self.cross_x[r0 * cols1 + c0 + i]
-                        )
+    def drafts(self, r0: int, r1: int, c0: int, c1: int) -> int:
+        """The actions of a region before they are kept, best first, in ``d_order`` (their
+        number returned): along each axis, a cut at every clean line, cuts that keep
+        periodic runs of parts or the repeated regions found by hashing whole, the cuts in
+        two the heuristic likes best, and with the extension a two-way grid; each written
+        as the cheapest rule that fits its parts."""
+        self.d_r0, self.d_r1, self.d_c0, self.d_c1 = r0, r1, c0, c1
+        self.n_drafts = self.d_pool_n = self.n_order = self.n_halves = 0
+        found0, found1 = self._found_lines(0), self._found_lines(1)
+        n0, n1 = self._lines_crossing(0, found0, 0), self._lines_crossing(1, found1, 0)
+        if not n0 and not n1:  # every line cuts an element: the fewest cells
+            if not found0 and not found1:
+                raise ValueError(f"region {(r0, r1, c0, c1)} has one label and no rule")
+            least0 = self._least_crossed(0, found0) if found0 else 2**31 - 1
+            least1 = self._least_crossed(1, found1) if found1 else 2**31 - 1
+            if not found0 or (found1 and least1 < least0):
+                n1 = self._lines_crossing(1, found1, least1)
             else:
-                for i in range(r1 - r0 - 1):
-                    at = (r0 + i) * cols2
-                    if self.change_y[at + c1] - self.change_y[at + c0]:
-                        found.append(r0 + 1 + i)
-                        crosses.append(self.cross_y[at + c1] - self.cross_y[at + c0])
-            clean = [found[i] for i in range(len(found)) if crosses[i] == 0]
-            if clean:
-                lines[axis], usable[axis] = clean, True
-            elif found:
-                least[axis] = min(crosses)
-                fallback[axis] = [found[i] for i in range(len(found)) if crosses[i] == least[axis]]
-        if not usable[0] and not usable[1]:  # every line cuts an element: the fewest cells
-            if not fallback[0] and not fallback[1]:
-                raise ValueError(f"region {region} has one label and no rule")
-            axis = (
-                1 if not fallback[0] else 0 if not fallback[1] else 1 if least[1] < least[0] else 0
-            )
-            lines[axis], usable[axis] = fallback[axis], True
-        inside = self._inside(r0, r1, c0, c1)
-        costs = [self._line_costs(region, 0, inside), self._line_costs(region, 1, inside)]
-        drafts: list[Draft] = []
-        halves: list[tuple[float, float, int, tuple[int, int, int]]] = []
+                n0 = self._lines_crossing(0, found0, least0)
+        self._inside()
+        self._line_costs(0)
+        self._line_costs(1)
         for axis in range(2):
-            if not usable[axis]:
+            n = n0 if axis == 0 else n1
+            if not n:
                 continue
             lo, hi = (c0, c1) if axis == 0 else (r0, r1)
-            cost = costs[axis]
-            full = (lo, *lines[axis], hi)
-            self._draft(drafts, region, cost, axis, full)
-            self._runs(drafts, region, cost, axis, full)
-            self._repeated(drafts, region, cost, axis, full, inside)
-            n = len(lines[axis])
+            base = axis * self.d_stride
+            self.d_full[0] = lo
+            for i in range(n):
+                self.d_full[1 + i] = self.d_lines[base + i]
+            self.d_full[n + 1] = hi
+            for i in range(n + 2):
+                self.d_bounds[i] = self.d_full[i]
+            self._draft(axis, n + 2)
+            self._runs(axis, n + 2)
+            self._repeated(axis, n + 2)
             if n > 1:  # cuts in two: the lines the heuristic likes best
-                cheap = sorted([(cost[line - lo], line) for line in lines[axis]])
-                for _, line in cheap[:TOP_ACTIONS]:
-                    bounds = (lo, line, hi)
-                    if not _has_draft(drafts, axis, bounds):
-                        halves.append(self._rank_in_two(region, cost, axis, bounds))
-        if (
-            self.ext & EXT_GRIDSPLIT
-            and usable[0]
-            and usable[1]
-            and (len(lines[0]) + 1) * (len(lines[1]) + 1) <= GRID_CELLS
-        ):
-            drafts.append(self._grid(region, costs, lines[1], lines[0]))
+                cheap = self._cheapest_lines(axis, n)
+                for k in range(cheap):
+                    self.d_bounds[0], self.d_bounds[1], self.d_bounds[2] = lo, self.d_cheap[k], hi
+                    if not self._has_draft(axis, 3):
+                        self._rank_in_two(axis, self.d_cheap[k])
+        if self.ext & EXT_GRIDSPLIT and n0 and n1 and (n0 + 1) * (n1 + 1) <= GRID_CELLS:
+            self._grid(n0, n1)
         # every structural cut, and the heuristic's best cuts in two to fill up the choice
-        drafts.sort(key=_rank)
-        del drafts[TOP_ACTIONS:]
-        halves.sort()
-        take = max(TOP_ACTIONS - len(drafts), TOP_ACTIONS // 2)
-        for _, _, axis, bounds in halves[:take]:
-            self._draft(drafts, region, costs[axis], axis, bounds)
-        drafts.sort(key=_rank)
-        return drafts
+        self._sort_drafts()
+        if self.n_order > TOP_ACTIONS:
+            self.n_order = TOP_ACTIONS
+        self._sort_halves()
+        take = max(TOP_ACTIONS - self.n_order, TOP_ACTIONS // 2)
+        for k in range(min(take, self.n_halves)):
+            axis, line = self.h_int[2 * k], self.h_int[2 * k + 1]
+            lo, hi = (c0, c1) if axis == 0 else (r0, r1)
+            self.d_bounds[0], self.d_bounds[1], self.d_bounds[2] = lo, line, hi
+            self._draft(axis, 3)
+        self._sort_drafts()
+        return self.n_order
 
-    def _inside(self, r0: int, r1: int, c0: int, c1: int) -> list[int]:
-        """The repeated regions' occurrences inside the region: those starting in its rows
-        (the occurrences are sorted by first row)."""
-        first, last = self._first_repeat_from(r0), self._first_repeat_from(r1)
-        found = []
+    def _found_lines(self, axis: int) -> int:
+        """The lines along the axis where labels change inside the region, in order, into
+        ``d_lines`` (from ``axis * d_stride``), the elements each cuts through into
+        ``d_crosses``; how many."""
+        r0, r1, c0, c1 = self.d_r0, self.d_r1, self.d_c0, self.d_c1
+        base = axis * self.d_stride
+        n = 0
+        if axis == 0:
+            cols1 = self.cols - 1
+            for i in range(c1 - c0 - 1):
+                if self.change_x[r1 * cols1 + c0 + i] - self.change_x[r0 * cols1 + c0 + i]:
+                    self.d_lines[base + n] = c0 + 1 + i
+                    self.d_crosses[base + n] = (
+                        self.cross_x[r1 * cols1 + c0 + i] - self.cross_x[r0 * cols1 + c0 + i]
+                    )
+                    n += 1
+        else:
+            cols2 = self.cols + 1
+            for i in range(r1 - r0 - 1):
+                at = (r0 + i) * cols2
+                if self.change_y[at + c1] - self.change_y[at + c0]:
+                    self.d_lines[base + n] = r0 + 1 + i
+                    self.d_crosses[base + n] = self.cross_y[at + c1] - self.cross_y[at + c0]
+                    n += 1
+        return n
+
+    def _lines_crossing(self, axis: int, n: int, crosses: int) -> int:
+        """Keeps, in order, the found lines that cut through this many elements; how many
+        (none kept: the lines are left as found)."""
+        base = axis * self.d_stride
+        k = 0
+        for i in range(n):
+            if self.d_crosses[base + i] == crosses:
+                self.d_lines[base + k] = self.d_lines[base + i]
+                self.d_crosses[base + k] = crosses
+                k += 1
+        return k
+
+    def _least_crossed(self, axis: int, n: int) -> int:
+        base = axis * self.d_stride
+        least = self.d_crosses[base]
+        for i in range(1, n):
+            if self.d_crosses[base + i] < least:
+                least = self.d_crosses[base + i]
+        return least
+
+    def _cheapest_lines(self, axis: int, n: int) -> int:
+        """The TOP_ACTIONS lines of least cost (then lowest) into ``d_cheap``, in that
+        order; how many."""
+        base = axis * self.d_stride
+        lo = self.d_c0 if axis == 0 else self.d_r0
+        k = 0
+        for i in range(n):
+            line = self.d_lines[base + i]
+            c = self.d_cost[base + line - lo]
+            j = k  # lines come in order, so a line goes after those of equal cost
+            while j > 0 and c < self.d_cost[base + self.d_cheap[j - 1] - lo]:
+                j -= 1
+            if j >= TOP_ACTIONS:
+                continue
+            if k < TOP_ACTIONS:
+                k += 1
+            m = k - 1
+            while m > j:
+                self.d_cheap[m] = self.d_cheap[m - 1]
+                m -= 1
+            self.d_cheap[j] = line
+        return k
+
+    def _inside(self) -> int:
+        """The repeated regions' occurrences inside the region into ``d_inside``: those
+        starting in its rows (the occurrences are sorted by first row); how many."""
+        r1, c0, c1 = self.d_r1, self.d_c0, self.d_c1
+        first, last = self._first_repeat_from(self.d_r0), self._first_repeat_from(r1)
+        n = 0
         for k in range(first, last):
             at = 5 * k
             if (
@@ -504,8 +589,10 @@ class Table:
                 and self.repeats[at + 2] >= c0
                 and self.repeats[at + 3] <= c1
             ):
-                found.append(k)
-        return found
+                self.d_inside[n] = k
+                n += 1
+        self.n_inside = n
+        return n
 
     def _first_repeat_from(self, row: int) -> int:
         a, b = 0, self.n_repeats
@@ -517,64 +604,164 @@ class Table:
                 b = mid
         return a
 
-    def _line_costs(
-        self, region: tuple[int, int, int, int], axis: int, inside: list[int]
-    ) -> list[float]:
-        """Eq. 5's cost of each line along the axis, indexed from the region's low end: the
-        cells of the repeated regions it cuts through over the region's cells (section
-        4.4); zero where not positive."""
-        r0, r1, c0, c1 = region
+    def _line_costs(self, axis: int) -> int:
+        """Eq. 5's cost of each line along the axis into ``d_cost`` (from ``axis *
+        d_stride``), indexed from the region's low end: the cells of the repeated regions
+        it cuts through over the region's cells (section 4.4); zero where not positive."""
+        r0, r1, c0, c1 = self.d_r0, self.d_r1, self.d_c0, self.d_c1
         lo, hi = (c0, c1) if axis == 0 else (r0, r1)
+        base = axis * self.d_stride
         size = hi - lo + 1
-        cost = [0.0] * (size + 1)
-        if not inside or hi - lo < 2:
-            return cost
-        pos = [0.0] * size
-        neg = [0.0] * size
-        for k in inside:
-            at = 5 * k
+        for i in range(size + 1):
+            self.d_cost[base + i] = 0.0
+        if not self.n_inside or hi - lo < 2:
+            return 0
+        for i in range(size):
+            self.d_pos[i] = 0.0
+            self.d_neg[i] = 0.0
+        for k in range(self.n_inside):
+            at = 5 * self.d_inside[k]
             start = self.repeats[at + 2] if axis == 0 else self.repeats[at]
             stop = self.repeats[at + 3] if axis == 0 else self.repeats[at + 1]
-            pos[start + 1 - lo] += float(self.repeats[at + 4])
-            neg[stop - lo] += float(self.repeats[at + 4])
+            self.d_pos[start + 1 - lo] += float(self.repeats[at + 4])
+            self.d_neg[stop - lo] += float(self.repeats[at + 4])
         cells = float(r1 - r0) * float(c1 - c0)
         total = 0.0
         for i in range(size):
-            total += pos[i] - neg[i]
+            total += self.d_pos[i] - self.d_neg[i]
             if 1 <= i < hi - lo:
                 c = total / cells
-                cost[i] = c if c > 0 else 0.0
-        return cost
+                self.d_cost[base + i] = c if c > 0 else 0.0
+        return 0
 
-    def _draft(
-        self,
-        drafts: list[Draft],
-        region: tuple[int, int, int, int],
-        cost_of_line: list[float],
-        axis: int,
-        bounds: tuple[int, ...],
-    ) -> int:
-        """The cheapest rule over the parts between the bounds (none for one part)."""
-        n = len(bounds) - 1
+    def _lines_cost(self, axis: int, at: int, n: int) -> float:
+        """Eq. 5's sum over the lines a rule cuts (its bounds ``d_pool[at:at + n]``), in
+        order."""
+        base = axis * self.d_stride - (self.d_c0 if axis == 0 else self.d_r0)
+        total = 0.0
+        for i in range(1, n - 1):
+            total += self.d_cost[base + self.d_pool[at + i]]
+        return total
+
+    def _new_draft(self, ints: int) -> int:
+        """Room for one more draft and ``ints`` more in ``d_pool``; its number."""
+        d = self.n_drafts
+        if 2 * (d + 1) > len(self.d_real):
+            self.d_real = _more_doubles(self.d_real, 2 * d, 2 * (d + 1))
+            self.d_int = _more_ints(self.d_int, D_FIELDS * d, D_FIELDS * (d + 1), 0)
+            self.d_order = _more_ints(self.d_order, self.n_order, d + 1, 0)
+        if self.d_pool_n + ints > len(self.d_pool):
+            self.d_pool = _more_ints(self.d_pool, self.d_pool_n, self.d_pool_n + ints, 0)
+        return d
+
+    def _add_draft(self, d: int, heuristic: float, rule_cost: float) -> int:
+        self.d_real[2 * d] = heuristic
+        self.d_real[2 * d + 1] = rule_cost
+        self.d_order[self.n_order] = d
+        self.n_order += 1
+        self.n_drafts = d + 1
+        return 0
+
+    def _has_draft(self, axis: int, n: int) -> bool:
+        """Whether a draft along the axis (not a gridsplit) has the bounds ``d_bounds[:n]``."""
+        for k in range(self.n_order):
+            f = D_FIELDS * self.d_order[k]
+            if (
+                self.d_int[f + D_OP] == OP_GRID
+                or self.d_int[f + D_AXIS] != axis
+                or self.d_int[f + D_N_BOUNDS] != n
+            ):
+                continue
+            at = self.d_int[f + D_BOUNDS]
+            same = True
+            for i in range(n):
+                if self.d_pool[at + i] != self.d_bounds[i]:
+                    same = False
+                    break
+            if same:
+                return True
+        return False
+
+    def _draft_less(self, a: int, b: int) -> bool:
+        """Draft a ranks before draft b: heuristic, cost, axis, bounds, least first."""
+        if self.d_real[2 * a] != self.d_real[2 * b]:
+            return self.d_real[2 * a] < self.d_real[2 * b]
+        if self.d_real[2 * a + 1] != self.d_real[2 * b + 1]:
+            return self.d_real[2 * a + 1] < self.d_real[2 * b + 1]
+        fa, fb = D_FIELDS * a, D_FIELDS * b
+        if self.d_int[fa + D_AXIS] != self.d_int[fb + D_AXIS]:
+            return self.d_int[fa + D_AXIS] < self.d_int[fb + D_AXIS]
+        na, nb = self.d_int[fa + D_N_BOUNDS], self.d_int[fb + D_N_BOUNDS]
+        at, bt = self.d_int[fa + D_BOUNDS], self.d_int[fb + D_BOUNDS]
+        for i in range(na if na < nb else nb):
+            if self.d_pool[at + i] != self.d_pool[bt + i]:
+                return self.d_pool[at + i] < self.d_pool[bt + i]
+        return na < nb
+
+    def _sort_drafts(self) -> int:
+        """``d_order`` sorted by rank, ties kept in order (insertion: a few drafts)."""
+        for i in range(1, self.n_order):
+            d = self.d_order[i]
+            j = i
+            while j > 0 and self._draft_less(d, self.d_order[j - 1]):
+                self.d_order[j] = self.d_order[j - 1]
+                j -= 1
+            self.d_order[j] = d
+        return 0
+
+    def _sort_halves(self) -> int:
+        """The cuts in two by rank: heuristic, cost, axis, line."""
+        for i in range(1, self.n_halves):
+            h, c = self.h_real[2 * i], self.h_real[2 * i + 1]
+            axis, line = self.h_int[2 * i], self.h_int[2 * i + 1]
+            j = i
+            while j > 0:
+                ph, pc = self.h_real[2 * j - 2], self.h_real[2 * j - 1]
+                pa, pl = self.h_int[2 * j - 2], self.h_int[2 * j - 1]
+                if h != ph:
+                    if h > ph:
+                        break
+                elif c != pc:
+                    if c > pc:
+                        break
+                elif axis != pa:
+                    if axis > pa:
+                        break
+                elif line > pl:
+                    break
+                self.h_real[2 * j], self.h_real[2 * j + 1] = ph, pc
+                self.h_int[2 * j], self.h_int[2 * j + 1] = pa, pl
+                j -= 1
+            self.h_real[2 * j], self.h_real[2 * j + 1] = h, c
+            self.h_int[2 * j], self.h_int[2 * j + 1] = axis, line
+        return 0
+
+    def _draft(self, axis: int, nb: int) -> int:
+        """The cheapest rule over the parts between the bounds ``d_bounds[:nb]`` (none for
+        one part)."""
+        n = nb - 1
         if n < 2:
             return 0
-        r0, r1, c0, c1 = region
-        parts = []
-        cids = []
+        r0, r1, c0, c1 = self.d_r0, self.d_r1, self.d_c0, self.d_c1
+        d = self._new_draft(nb + n)
+        at = self.d_pool_n
+        for i in range(nb):
+            self.d_pool[at + i] = self.d_bounds[i]
+        cids = at + nb
         for i in range(n):
-            a, b = bounds[i], bounds[i + 1]
+            a, b = self.d_bounds[i], self.d_bounds[i + 1]
             if axis == 0:
-                parts.append((r0, r1, a, b))
-                cids.append(self.grid_content(r0, r1, a, b))
+                self.d_pool[cids + i] = self.grid_content(r0, r1, a, b)
             else:
-                parts.append((a, b, c0, c1))
-                cids.append(self.grid_content(a, b, c0, c1))
+                self.d_pool[cids + i] = self.grid_content(a, b, c0, c1)
+        self.d_pool_n = cids + n
+        pool = self.d_pool
         op, m, count, centre, period = OP_SPLIT, n, 1, 0, 0
         for q in range(1, n // 2 + 1):
             if n % q == 0:
                 same = True
                 for i in range(q, n):
-                    if cids[i] != cids[i - q]:
+                    if pool[cids + i] != pool[cids + i - q]:
                         same = False
                         break
                 if same:
@@ -585,7 +772,7 @@ class Table:
         elif self.ext & EXT_ABA and n >= 5 and n % 2 == 1:
             same = True
             for i in range(2, n):
-                if cids[i] != cids[i - 2]:
+                if pool[cids + i] != pool[cids + i - 2]:
                     same = False
                     break
             if same:
@@ -593,149 +780,220 @@ class Table:
         if op == OP_SPLIT and self.ext & EXT_SYMSPLIT and n >= 3:
             same = True
             for i in range(n):
-                if cids[i] != cids[n - 1 - i]:
+                if pool[cids + i] != pool[cids + n - 1 - i]:
                     same = False
                     break
             if same:
                 op, m, centre = OP_SYMSPLIT, (n + 1) // 2, n % 2
         repeats = op in (OP_REPEAT, OP_ABA)
         rule_cost = (self.repeat_cost if repeats else self.split_cost) + m
-        heuristic = rule_cost + _lines_cost(cost_of_line, c0 if axis == 0 else r0, bounds)
-        drafts.append(
-            (heuristic, rule_cost, axis, bounds, op, count, centre, (), parts[:m], cids[:m])
-        )
-        return 0
+        heuristic = rule_cost + self._lines_cost(axis, at, nb)
+        f = D_FIELDS * d
+        self.d_int[f + D_AXIS] = axis
+        self.d_int[f + D_OP] = op
+        self.d_int[f + D_COUNT] = count
+        self.d_int[f + D_CENTRE] = centre
+        self.d_int[f + D_BOUNDS] = at
+        self.d_int[f + D_N_BOUNDS] = nb
+        self.d_int[f + D_ACROSS] = at
+        self.d_int[f + D_N_ACROSS] = 0
+        self.d_int[f + D_CIDS] = cids
+        self.d_int[f + D_M] = m
+        return self._add_draft(d, heuristic, rule_cost)
 
-    def _grid(
-        self,
-        region: tuple[int, int, int, int],
-        costs: list[list[float]],
-        ys: list[int],
-        xs: list[int],
-    ) -> Draft:
+    def _grid(self, n0: int, n1: int) -> int:
         """A gridsplit: rows by the usable y lines, columns by the usable x lines."""
-        r0, r1, c0, c1 = region
-        rows, columns = (r0, *ys, r1), (c0, *xs, c1)
-        parts = [
-            (rows[i], rows[i + 1], columns[j], columns[j + 1])
-            for i in range(len(rows) - 1)
-            for j in range(len(columns) - 1)
-        ]
-        cids = [self.grid_content(part[0], part[1], part[2], part[3]) for part in parts]
-        rule_cost = self.split_cost + len(parts)
-        heuristic = rule_cost + _lines_cost(costs[0], c0, columns)
-        heuristic += _lines_cost(costs[1], r0, rows)
-        return (heuristic, rule_cost, 1, rows, OP_GRID, 1, 0, columns, parts, cids)
+        nr, nc = n1 + 2, n0 + 2
+        m = (nr - 1) * (nc - 1)
+        d = self._new_draft(nr + nc + m)
+        rows = self.d_pool_n
+        self.d_pool[rows] = self.d_r0
+        for i in range(n1):
+            self.d_pool[rows + 1 + i] = self.d_lines[self.d_stride + i]
+        self.d_pool[rows + nr - 1] = self.d_r1
+        columns = rows + nr
+        self.d_pool[columns] = self.d_c0
+        for i in range(n0):
+            self.d_pool[columns + 1 + i] = self.d_lines[i]
+        self.d_pool[columns + nc - 1] = self.d_c1
+        cids = columns + nc
+        k = 0
+        for i in range(nr - 1):
+            for j in range(nc - 1):
+                self.d_pool[cids + k] = self.grid_content(
+                    self.d_pool[rows + i],
+                    self.d_pool[rows + i + 1],
+                    self.d_pool[columns + j],
+                    self.d_pool[columns + j + 1],
+                )
+                k += 1
+        self.d_pool_n = cids + m
+        rule_cost = self.split_cost + m
+        heuristic = rule_cost + self._lines_cost(0, columns, nc)
+        heuristic += self._lines_cost(1, rows, nr)
+        f = D_FIELDS * d
+        self.d_int[f + D_AXIS] = 1
+        self.d_int[f + D_OP] = OP_GRID
+        self.d_int[f + D_COUNT] = 1
+        self.d_int[f + D_CENTRE] = 0
+        self.d_int[f + D_BOUNDS] = rows
+        self.d_int[f + D_N_BOUNDS] = nr
+        self.d_int[f + D_ACROSS] = columns
+        self.d_int[f + D_N_ACROSS] = nc
+        self.d_int[f + D_CIDS] = cids
+        self.d_int[f + D_M] = m
+        return self._add_draft(d, heuristic, rule_cost)
 
-    def _runs(
-        self,
-        drafts: list[Draft],
-        region: tuple[int, int, int, int],
-        cost_of_line: list[float],
-        axis: int,
-        full: tuple[int, ...],
-    ) -> int:
-        """Bounds that keep each maximal periodic run of two or more parts as one part."""
-        n = len(full) - 1
-        r0, r1, c0, c1 = region
-        cids = []
+    def _runs(self, axis: int, nf: int) -> int:
+        """Bounds that keep each maximal periodic run of two or more parts (of the parts
+        between ``d_full[:nf]``) as one part."""
+        n = nf - 1
+        r0, r1, c0, c1 = self.d_r0, self.d_r1, self.d_c0, self.d_c1
+        full = self.d_full
         for i in range(n):
             if axis == 0:
-                cids.append(self.grid_content(r0, r1, full[i], full[i + 1]))
+                self.d_runs[i] = self.grid_content(r0, r1, full[i], full[i + 1])
             else:
-                cids.append(self.grid_content(full[i], full[i + 1], c0, c1))
+                self.d_runs[i] = self.grid_content(full[i], full[i + 1], c0, c1)
+        run = self.d_stride  # run[j] at d_runs[run + j]
         for period in range(1, n // 2 + 1):
             # run[j]: how many parts from j on equal the part a period after them, so the
             # parts from i on hold 1 + run[i] // period copies of the first period
-            run = [0] * (n - period + 1)
+            for j in range(n - period + 1):
+                self.d_runs[run + j] = 0
             for j in range(n - period - 1, -1, -1):
-                if cids[j] == cids[j + period]:
-                    run[j] = run[j + 1] + 1
+                if self.d_runs[j] == self.d_runs[j + period]:
+                    self.d_runs[run + j] = self.d_runs[run + j + 1] + 1
             i = 0
             while i + 2 * period <= n:
-                k = 1 + run[i] // period
+                k = 1 + self.d_runs[run + i] // period
                 if k >= 2 and not (i == 0 and i + k * period == n):
                     end = i + k * period
-                    bounds = (*full[: i + 1], *full[end:])
-                    if not _has_draft(drafts, axis, bounds):
-                        self._draft(drafts, region, cost_of_line, axis, bounds)
+                    for j in range(i + 1):
+                        self.d_bounds[j] = full[j]
+                    for j in range(end, nf):
+                        self.d_bounds[i + 1 + j - end] = full[j]
+                    nb = i + 1 + nf - end
+                    if not self._has_draft(axis, nb):
+                        self._draft(axis, nb)
                     i = end
                 else:
                     i += 1
         return 0
 
-    def _repeated(
-        self,
-        drafts: list[Draft],
-        region: tuple[int, int, int, int],
-        cost_of_line: list[float],
-        axis: int,
-        full: tuple[int, ...],
-        inside: list[int],
-    ) -> int:
-        """Bounds that keep whole the repeated regions spanning the region across the axis."""
-        r0, r1, c0, c1 = region
-        spans = []
-        for k in inside:
-            at = 5 * k
-            rep = self.repeats
+    def _repeated(self, axis: int, nf: int) -> int:
+        """Bounds that keep whole the repeated regions spanning the region across the axis
+        (the lines ``d_full[:nf]``)."""
+        r0, r1, c0, c1 = self.d_r0, self.d_r1, self.d_c0, self.d_c1
+        rep = self.repeats
+        spans = 0  # (a, b) pairs in d_spans, longest first, then by a and b
+        for k in range(self.n_inside):
+            at = 5 * self.d_inside[k]
             if axis == 0 and rep[at] == r0 and rep[at + 1] == r1:
-                spans.append((rep[at + 2], rep[at + 3]))
+                a, b = rep[at + 2], rep[at + 3]
             elif axis == 1 and rep[at + 2] == c0 and rep[at + 3] == c1:
-                spans.append((rep[at], rep[at + 1]))
+                a, b = rep[at], rep[at + 1]
+            else:
+                continue
+            j = spans
+            while j > 0:
+                x, y = self.d_spans[2 * j - 2], self.d_spans[2 * j - 1]
+                if x - y < a - b or (x - y == a - b and (x < a or (x == a and y <= b))):
+                    break
+                self.d_spans[2 * j], self.d_spans[2 * j + 1] = x, y
+                j -= 1
+            self.d_spans[2 * j], self.d_spans[2 * j + 1] = a, b
+            spans += 1
         if not spans:
             return 0
-        spans.sort(key=_longest_first)
-        lo, hi = full[0], full[len(full) - 1]
-        blocks: list[tuple[int, int]] = []
-        for a, b in spans:
+        full = self.d_full
+        lo, hi = full[0], full[nf - 1]
+        blocks = 0  # kept in d_spans after the spans
+        at = 2 * spans
+        for k in range(spans):
+            a, b = self.d_spans[2 * k], self.d_spans[2 * k + 1]
             free = not (a == lo and b == hi)
-            for x, y in blocks:
-                if not (b <= x or y <= a):
+            for j in range(blocks):
+                if not (b <= self.d_spans[at + 2 * j] or self.d_spans[at + 2 * j + 1] <= a):
                     free = False
                     break
             if free:
-                blocks.append((a, b))
+                self.d_spans[at + 2 * blocks], self.d_spans[at + 2 * blocks + 1] = a, b
+                blocks += 1
         if not blocks:
             return 0
-        marks = {lo, hi}
-        for a, b in blocks:
-            marks.add(a)
-            marks.add(b)
-        for line in full:
+        # the bounds: the ends, the blocks' ends, the lines outside every block; sorted, once
+        nb = self._mark(0, lo)
+        nb = self._mark(nb, hi)
+        for j in range(blocks):
+            nb = self._mark(nb, self.d_spans[at + 2 * j])
+            nb = self._mark(nb, self.d_spans[at + 2 * j + 1])
+        for i in range(nf):
+            line = full[i]
             free = True
-            for a, b in blocks:
-                if a < line < b:
+            for j in range(blocks):
+                if self.d_spans[at + 2 * j] < line < self.d_spans[at + 2 * j + 1]:
                     free = False
                     break
             if free:
-                marks.add(line)
-        bounds = tuple(sorted(marks))
-        if not _has_draft(drafts, axis, bounds):
-            self._draft(drafts, region, cost_of_line, axis, bounds)
+                nb = self._mark(nb, line)
+        if not self._has_draft(axis, nb):
+            self._draft(axis, nb)
         return 0
 
-    def _rank_in_two(
-        self,
-        region: tuple[int, int, int, int],
-        cost_of_line: list[float],
-        axis: int,
-        bounds: tuple[int, int, int],
-    ) -> tuple[float, float, int, tuple[int, int, int]]:
-        """The rank the cut in two would have as an action, without making it: a repeat of
-        one part when both parts read the same, else a split of two. Two parts whose sizes
-        differ by more than their cells' rounding cannot read the same (no content made)."""
-        lo, line, hi = bounds
+    def _mark(self, n: int, line: int) -> int:
+        """``line`` into the sorted ``d_bounds[:n]`` unless there; the new count."""
+        j = n
+        while j > 0 and self.d_bounds[j - 1] > line:
+            j -= 1
+        if j > 0 and self.d_bounds[j - 1] == line:
+            return n
+        k = n
+        while k > j:
+            self.d_bounds[k] = self.d_bounds[k - 1]
+            k -= 1
+        self.d_bounds[j] = line
+        return n + 1
+
+    def _rank_in_two(self, axis: int, line: int) -> int:
+        """The rank the cut in two would have as an action, without making it (into the
+        halves, ``h_real`` and ``h_int``): a repeat of one part when both parts read the
+        same, else a split of two. Two parts whose sizes differ by more than their cells'
+        rounding cannot read the same (no content made)."""
+        r0, r1, c0, c1 = self.d_r0, self.d_r1, self.d_c0, self.d_c1
+        lo, hi = (c0, c1) if axis == 0 else (r0, r1)
         same = abs(self.quantum(axis, lo, line) - self.quantum(axis, line, hi)) <= (hi - lo) + 2
         if same:
-            r0, r1, c0, c1 = region
             if axis == 0:
                 same = self.grid_content(r0, r1, lo, line) == self.grid_content(r0, r1, line, hi)
             else:
                 same = self.grid_content(lo, line, c0, c1) == self.grid_content(line, hi, c0, c1)
         rule_cost = self.repeat_cost + 1 if same else self.split_cost + 2
-        heuristic = rule_cost + (0.0 + cost_of_line[line - _low(region, axis)])
-        return (heuristic, rule_cost, axis, bounds)
+        heuristic = rule_cost + (0.0 + self.d_cost[axis * self.d_stride + line - lo])
+        k = self.n_halves
+        self.h_real[2 * k], self.h_real[2 * k + 1] = heuristic, rule_cost
+        self.h_int[2 * k], self.h_int[2 * k + 1] = axis, line
+        self.n_halves = k + 1
+        return 0
+
+    def _part(self, d: int, i: int) -> int:
+        """The draft's i-th part into ``d_part`` (r0, r1, c0, c1); its cells."""
+        f = D_FIELDS * d
+        at = self.d_int[f + D_BOUNDS]
+        part = self.d_part
+        if self.d_int[f + D_OP] == OP_GRID:
+            columns = self.d_int[f + D_N_ACROSS] - 1
+            across = self.d_int[f + D_ACROSS] + i % columns
+            at += i // columns
+            part[0], part[1] = self.d_pool[at], self.d_pool[at + 1]
+            part[2], part[3] = self.d_pool[across], self.d_pool[across + 1]
+        elif self.d_int[f + D_AXIS] == 0:
+            part[0], part[1] = self.d_r0, self.d_r1
+            part[2], part[3] = self.d_pool[at + i], self.d_pool[at + i + 1]
+        else:
+            part[0], part[1] = self.d_pool[at + i], self.d_pool[at + i + 1]
+            part[2], part[3] = self.d_c0, self.d_c1
+        return (part[1] - part[0]) * (part[3] - part[2])
 
     # -- entries and their actions -------------------------------------------------------
 
@@ -807,25 +1065,28 @@ class Table:
         at = 5 * e
         r0, c0 = self.e_key[at], self.e_key[at + 1]
         r1, c1 = -self.e_key[at + 2], -self.e_key[at + 3]
-        drafts = self.drafts(r0, r1, c0, c1)
+        n = self.drafts(r0, r1, c0, c1)
         first = self.n_actions
         try:
-            for draft in drafts:
-                self._keep(e, draft)
+            for k in range(n):
+                self._keep(e, self.d_order[k])
         except BaseException:
             self.n_actions = first
             raise
         self.e_first[e] = first
-        self.e_count[e] = len(drafts)
+        self.e_count[e] = n
         return 0
 
-    def _keep(self, e: int, draft: Draft) -> int:
-        """A draft made an action of entry e: its parts as symbols, its needs (non-terminal
+    def _keep(self, e: int, d: int) -> int:
+        """Draft d made an action of entry e: its parts as symbols, its needs (non-terminal
         contents, larger parts first, once each), its non-terminal parts as entries, its
         form (the rule without its symbols)."""
-        heuristic, cost, axis, bounds, op, count, centre, across, parts, cids = draft
-        m = len(parts)
-        n_bounds, n_across = len(bounds), len(across)
+        g = D_FIELDS * d
+        axis, op = self.d_int[g + D_AXIS], self.d_int[g + D_OP]
+        count, centre = self.d_int[g + D_COUNT], self.d_int[g + D_CENTRE]
+        bounds, n_bounds = self.d_int[g + D_BOUNDS], self.d_int[g + D_N_BOUNDS]
+        across, n_across = self.d_int[g + D_ACROSS], self.d_int[g + D_N_ACROSS]
+        cids, m = self.d_int[g + D_CIDS], self.d_int[g + D_M]
         a = self.n_actions
         if a + 1 > len(self.a_cost):
             self.a_cost = _more_doubles(self.a_cost, a, a + 1)
@@ -835,8 +1096,8 @@ class Table:
         if 4 + n_bounds + n_across + m > len(self.form):
             self.form = _more_ints(self.form, 0, 4 + n_bounds + n_across + m, 0)
         f = A_FIELDS * a
-        self.a_cost[a] = cost
-        self.a_heuristic[a] = heuristic
+        self.a_cost[a] = self.d_real[2 * d + 1]
+        self.a_heuristic[a] = self.d_real[2 * d]
         self.a_int[f + A_OWNER] = e
         self.a_int[f + A_OP] = op
         self.a_int[f + A_AXIS] = axis
@@ -845,17 +1106,17 @@ class Table:
         self.a_int[f + A_BOUNDS] = self.pool_n
         self.a_int[f + A_N_BOUNDS] = n_bounds
         for i in range(n_bounds):
-            self.pool[self.pool_n] = bounds[i]
+            self.pool[self.pool_n] = self.d_pool[bounds + i]
             self.pool_n += 1
         self.a_int[f + A_ACROSS] = self.pool_n
         self.a_int[f + A_N_ACROSS] = n_across
         for i in range(n_across):
-            self.pool[self.pool_n] = across[i]
+            self.pool[self.pool_n] = self.d_pool[across + i]
             self.pool_n += 1
         self.a_int[f + A_PARTS] = self.pool_n
         self.a_int[f + A_N_PARTS] = m
         for i in range(m):
-            cid = cids[i]
+            cid = self.d_pool[cids + i]
             self.content_seen(cid)
             label = self.terminal[cid]
             self.pool[self.pool_n] = -1 - label if label >= 0 else cid
@@ -865,14 +1126,12 @@ class Table:
         order = self.pool_n + m
         k = 0
         for i in range(m):
-            if self.terminal[cids[i]] >= 0:
+            if self.terminal[self.d_pool[cids + i]] >= 0:
                 continue
-            part = parts[i]
-            cells = (part[1] - part[0]) * (part[3] - part[2])
+            cells = self._part(d, i)
             j = k
             while j > 0:
-                other = parts[self.pool[order + j - 1]]
-                if (other[1] - other[0]) * (other[3] - other[2]) >= cells:
+                if self._part(d, self.pool[order + j - 1]) >= cells:
                     break
                 self.pool[order + j] = self.pool[order + j - 1]
                 j -= 1
@@ -882,7 +1141,7 @@ class Table:
         self.a_int[f + A_NEEDS] = needs
         n_needs = 0
         for j in range(k):
-            cid = cids[self.pool[order + j]]
+            cid = self.d_pool[cids + self.pool[order + j]]
             seen = False
             for i in range(n_needs):
                 if self.pool[needs + i] == cid:
@@ -901,20 +1160,16 @@ class Table:
             form[1] = n_bounds
             n = 2
             for i in range(n_bounds - 1):
-                form[n] = self.quantum(1, bounds[i], bounds[i + 1])
+                form[n] = self.quantum(1, self.d_pool[bounds + i], self.d_pool[bounds + i + 1])
                 n += 1
             for i in range(n_across - 1):
-                form[n] = self.quantum(0, across[i], across[i + 1])
+                form[n] = self.quantum(0, self.d_pool[across + i], self.d_pool[across + i + 1])
                 n += 1
         else:
             form[1], form[2], form[3] = axis, count, centre
             n = 4
             for i in range(m):
-                part = parts[i]
-                if axis == 0:
-                    form[n] = self.quantum(0, part[2], part[3])
-                else:
-                    form[n] = self.quantum(1, part[0], part[1])
+                form[n] = self.quantum(axis, self.d_pool[bounds + i], self.d_pool[bounds + i + 1])
                 n += 1
         self.a_int[f + A_FORM] = self.forms.add(form, 0, n)
         # the non-terminal parts as entries (which may add entries)
@@ -922,9 +1177,10 @@ class Table:
         self.a_int[f + A_KIDS] = kids
         n_kids = 0
         for i in range(m):
-            if self.terminal[cids[i]] >= 0:
+            if self.terminal[self.d_pool[cids + i]] >= 0:
                 continue
-            part = parts[i]
+            self._part(d, i)
+            part = self.d_part
             kid = self.entry_of(part[0], part[1], part[2], part[3])
             self.pool_room(1)
             self.pool[kids + n_kids] = kid
@@ -1144,6 +1400,7 @@ class Table:
                 if self.kind_of[cid] >= 0:
                     self.first_of[self.kind_of[cid]] = -1
                 self.kind_of[cid] = -1
+            self.kinds.clear()  # kinds are compared within a survey only: a small set
         return total
 
     def learn(self) -> int:
@@ -1255,6 +1512,8 @@ class Table:
         made.append(0)
         self.repeats = made
         self.n_repeats = len(repeats) // 20
+        self.d_inside = _ints(self.n_repeats + 1)
+        self.d_spans = _ints(4 * self.n_repeats + 4)  # the spans, then the blocks
         self.ext, self.split_cost, self.repeat_cost = extensions, split, repeat
         self.prepared = True
 
@@ -1415,36 +1674,11 @@ A_OWNER, A_OP, A_AXIS, A_COUNT, A_CENTRE, A_FORM = 0, 1, 2, 3, 4, 5
 A_BOUNDS, A_N_BOUNDS, A_ACROSS, A_N_ACROSS, A_PARTS, A_N_PARTS = 6, 7, 8, 9, 10, 11
 A_NEEDS, A_N_NEEDS, A_KIDS, A_N_KIDS = 12, 13, 14, 15
 A_FIELDS = 16
+# a draft's int fields, D_FIELDS a row in ``Table.d_int``
+D_AXIS, D_OP, D_COUNT, D_CENTRE, D_BOUNDS, D_N_BOUNDS = 0, 1, 2, 3, 4, 5
+D_ACROSS, D_N_ACROSS, D_CIDS, D_M = 6, 7, 8, 9
+D_FIELDS = 10
 
 
 def _never() -> float:
     raise AssertionError("a clock or a draw before it was given")
-
-
-def _longest_first(span: tuple[int, int]) -> tuple[int, int, int]:
-    return (span[0] - span[1], span[0], span[1])
-
-
-def _rank(draft: Draft) -> tuple[Any, ...]:
-    """heuristic, cost, axis, bounds: least first (sorts keep ties in order)."""
-    return draft[:4]
-
-
-def _has_draft(drafts: list[Draft], axis: int, bounds: tuple[int, ...]) -> bool:
-    """Whether a draft along the axis (not a gridsplit) has these bounds."""
-    for d in drafts:  # noqa: SIM110 (a loop: compiled, a generator would be an object)
-        if d[4] != OP_GRID and d[2] == axis and d[3] == bounds:
-            return True
-    return False
-
-
-def _low(region: tuple[int, int, int, int], axis: int) -> int:
-    return region[2] if axis == 0 else region[0]
-
-
-def _lines_cost(cost_of_line: list[float], lo: int, bounds: tuple[int, ...]) -> float:
-    """Eq. 5's sum over the lines a rule cuts, in order."""
-    total = 0.0
-    for i in range(1, len(bounds) - 1):
-        total += cost_of_line[bounds[i] - lo]
-    return total
