@@ -298,7 +298,7 @@ def test_workers_get_absolute_paths(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     monkeypatch.chdir(tmp_path)
     loaded = load_city(Path("m.yaml"))
     found = read_footprints(loaded.footprints)
-    (task,) = plan(loaded, list(found.footprints), Path("relative/out"))
+    (task,), _ = plan(loaded, list(found.footprints), Path("relative/out"))
     assert task.target == tmp_path / "relative" / "out" / "buildings" / shard("a") / "a.glb"
     assert task.spec_dir == manifest.parent and task.spec_dir.is_absolute()
 

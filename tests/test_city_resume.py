@@ -147,7 +147,7 @@ def test_an_edited_spec_or_tag_rebuilds_exactly_what_it_changes(tmp_path: Path) 
 def test_every_field_of_a_task_is_hashed_or_said_why_not(tmp_path: Path) -> None:
     city = load_city(_town(tmp_path))
     found = read_footprints(city.footprints)
-    tasks = plan(city, list(found.footprints), tmp_path / "out")
+    tasks, _ = plan(city, list(found.footprints), tmp_path / "out")
     digest = spec_digests(city)
     names = {f.name for f in dataclasses.fields(Task)}
     assert set(UNHASHED) <= names
@@ -213,7 +213,7 @@ def test_a_feature_made_again_from_its_volumes_is_the_one_its_worker_wrote(
     city = load_city(_town(tmp_path))
     out = tmp_path / "out"
     run_city(city, out, jobs=1)
-    tasks = plan(city, list(read_footprints(city.footprints).footprints), out)
+    tasks, _ = plan(city, list(read_footprints(city.footprints).footprints), out)
     for task in tasks:
         written = json.loads(feature_file(task.target).read_bytes())
         feature_file(task.target).unlink()

@@ -317,23 +317,10 @@ def plan(
     instanced: bool = False,
     level: int = 3,
     shared_textures: bool = True,
-) -> list[Task]:
-    """One task a building, built to ``level`` of detail (below 3: no façades). Paths are
-    absolute: workers (Dask's too) may run elsewhere."""
-    return planned_tasks(city, footprints, outdir, usd, instanced, level, shared_textures)[0]
-
-
-def planned_tasks(
-    city: City,
-    footprints: list[Footprint],
-    outdir: Path,
-    usd: bool = False,
-    instanced: bool = False,
-    level: int = 3,
-    shared_textures: bool = True,
 ) -> tuple[list[Task], list[Rejected]]:
-    """:func:`plan`'s tasks, and the warnings of the planning: an entrance that two
-    buildings hold (:func:`one_door_each`)."""
+    """One task a building, built to ``level`` of detail (below 3: no façades), and the
+    warnings of the planning: an entrance that two buildings hold (:func:`one_door_each`).
+    Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
@@ -684,7 +671,7 @@ def planned(
     defaults = city.manifest.defaults
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
-    tasks, warnings = planned_tasks(
+    tasks, warnings = plan(
         city, footprints, outdir.resolve(), usd, instanced, level, shared_textures
     )
     found = replace(found, warnings=(*found.warnings, *warnings))

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import random
 from dataclasses import dataclass
+from pathlib import Path
 
 Box = tuple[str, float, float, float, float]  # label, x0, y0, x1, y1 on the unit square, y up
 
@@ -85,3 +86,13 @@ def cmp_xml(boxes: list[Box]) -> str:
         "<flag>1</flag></object>"
         for label, x0, y0, x1, y1 in boxes
     )
+
+
+def written_family(folder: Path, seeds: list[int]) -> list[Path]:
+    """The annotations of ``seeds`` as CMP XML files in ``folder`` (``family-<seed>.xml``)."""
+    paths = []
+    for seed in seeds:
+        path = folder / f"family-{seed}.xml"
+        path.write_text(cmp_xml(family(seed)[0]))
+        paths.append(path)
+    return paths

@@ -27,8 +27,9 @@ are kept, :func:`facadecli.city.run.run_city`), each run of a size is a *segment
 CPU, buildings built and memory are appended to ``segments-N.jsonl`` when it ends, and
 the figures are over all segments (CPU over the buildings each built; each client's
 planning is counted again, so the CPU a building is an upper bound; a segment that was
-stopped wrote no figures, so neither its CPU nor its buildings are counted). A size measured to its end is kept as
-``done-N.txt`` (its printed figures) and its output removed; the next start skips it.
+stopped wrote no figures, so neither its CPU nor its buildings are counted). A size
+measured to its end is kept as ``done-N.txt`` (its printed figures) and its output
+removed; the next start skips it.
 Figures depend on the machine and its load; they are for docs/benchmarks.md, never
 asserted by the tests.
 """

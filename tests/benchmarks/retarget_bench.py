@@ -40,7 +40,7 @@ from facadecli.grammar.inputs import Rect  # noqa: E402
 from facadecli.grammar.model import Options  # noqa: E402
 from facadecli.infer.run import Inference, infer, solved_layout  # noqa: E402
 from facadecli.solve import retarget, solve  # noqa: E402
-from tests.benchmarks.annotated_family import cmp_xml, family  # noqa: E402
+from tests.benchmarks.annotated_family import written_family  # noqa: E402
 
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
 SEEDS = range(1, 25)
@@ -248,11 +248,7 @@ def main() -> None:
     if "--cmp" in sys.argv:
         return
     with tempfile.TemporaryDirectory() as folder:
-        paths = []
-        for seed in seeds:
-            path = Path(folder) / f"family-{seed}.xml"
-            path.write_text(cmp_xml(family(seed)[0]))
-            paths.append(path)
+        paths = written_family(Path(folder), seeds)
         run(paths, f"generated family (seeds {seeds[0]}-{seeds[-1]})", verbose)
 
 

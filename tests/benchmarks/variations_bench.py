@@ -50,7 +50,7 @@ from facadecli.grammar.style import (  # noqa: E402
 )
 from facadecli.grammar.tiling import BACKGROUND  # noqa: E402
 from facadecli.grammar.variations import derive_variations  # noqa: E402
-from tests.benchmarks.annotated_family import cmp_xml, family  # noqa: E402
+from tests.benchmarks.annotated_family import written_family  # noqa: E402
 
 DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
 SIZE = 15.0
@@ -202,11 +202,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         for name in (s for s in sets if s in SETS and seeds[s]):
             chosen = seeds[name]
-            paths = []
-            for seed in chosen:
-                path = Path(folder) / f"family-{seed}.xml"
-                path.write_text(cmp_xml(family(seed)[0]))
-                paths.append(path)
+            paths = written_family(Path(folder), chosen)
             run(paths, f"generated {name} (seeds {chosen[0]}-{chosen[-1]})", verbose)
 
 

@@ -55,7 +55,7 @@ def main() -> None:
                 f"{merging:.2f} CPU-s"
             )
         started = time.process_time()
-        tasks = plan(city, list(straighten(built, 3.0, 0.3).footprints), Path("unused"))
+        tasks, _ = plan(city, list(straighten(built, 3.0, 0.3).footprints), Path("unused"))
         planning = time.process_time() - started
         party = sum(1 for task in tasks if task.shared is not None)
         print(f"walls {name}: planning {planning:.2f} CPU-s, {party:,} footprints with party walls")
