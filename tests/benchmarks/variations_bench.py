@@ -51,16 +51,8 @@ from facadecli.grammar.style import (  # noqa: E402
 from facadecli.grammar.tiling import BACKGROUND  # noqa: E402
 from facadecli.grammar.variations import derive_variations  # noqa: E402
 from tests.benchmarks.annotated_family import written_family  # noqa: E402
+from tests.benchmarks.retarget_bench import DATA, SIZE, SIZES  # noqa: E402  (the same sizes)
 
-DATA = ROOT.parent / "shared" / "data" / "cmp-sample" / "xml"
-SIZE = 15.0
-SIZES = {
-    "1x": (1.0, 1.0),
-    "0.7w": (0.7, 1.0),
-    "1.5w": (1.5, 1.0),
-    "2w": (2.0, 1.0),
-    "1.5h": (1.0, 1.5),
-}
 COUNT = 3  # variations asked for at each size
 LABEL = "window"
 SETS = {"family": range(1, 25), "holdout": range(101, 125)}
