@@ -1,19 +1,22 @@
 """A city's report (:class:`CityReport`), kept and written in flat memory.
 
-Its per-building entries are held as the JSON lines they are logged as
-(:class:`Entries`: a few hundred bytes a building, where a parsed entry takes kilobytes),
-their sums are kept as they come (:class:`Tally`), and ``<name>.report.json`` is written
-a building at a time (:func:`report_chunks`), its bytes those of ``json.dumps(report,
-indent=2)`` of the whole document.
+Its per-building entries are kept as the JSON lines they are logged as, in a temporary
+file (:class:`Entries`: 12 bytes a building in memory, where a parsed entry takes
+kilobytes), their sums are kept as they come (:class:`Tally`), and
+``<name>.report.json`` is written a building at a time (:func:`report_chunks`), its
+bytes those of ``json.dumps(report, indent=2)`` of the whole document.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import tempfile
+from array import array
 from collections import Counter
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, overload
 
 from facadecli.city.building import PLAIN_REASONS
@@ -23,26 +26,36 @@ Entry = dict[str, Any]  # a building's report entry (docs/reference/report.md)
 
 class Entries(Sequence[Entry]):
     """The buildings' report entries in the manifest's order, each kept as its compact JSON
-    line and parsed when asked for. Filled by position as buildings end, in any order."""
+    line and parsed when asked for. Filled by position as buildings end, in any order.
 
-    def __init__(self, count: int):
-        self._lines: list[bytes | None] = [None] * count
+    The lines are kept in an unnamed temporary file (in ``folder``, the run's output
+    folder, or the system's), where each is and how long held in memory: 12 bytes a
+    building, however many buildings; the file goes when the object does."""
+
+    def __init__(self, count: int, folder: Path | None = None):
+        self._file = tempfile.TemporaryFile(dir=folder)  # noqa: SIM115 (closed with self)
+        self._start = array("q", [-1]) * count  # where each line starts in the file
+        self._size = array("I", [0]) * count
+        self._end = 0
 
     def put(self, index: int, entry: Entry) -> bytes:
         """Keep the entry of the building at ``index``; returns its line (no newline)."""
         line = json.dumps(entry).encode("utf-8")
-        self._lines[index] = line
+        self._file.seek(self._end)
+        self._file.write(line)
+        self._start[index], self._size[index] = self._end, len(line)
+        self._end += len(line)
         return line
 
     def line(self, index: int) -> bytes:
         """The entry of the building at ``index`` as its line (no newline)."""
-        line = self._lines[index]
-        if line is None:
+        if self._start[index] < 0:
             raise LookupError(f"no entry yet for building {index}")
-        return line
+        self._file.seek(self._start[index])
+        return self._file.read(self._size[index])
 
     def __len__(self) -> int:
-        return len(self._lines)
+        return len(self._start)
 
     @overload
     def __getitem__(self, index: int) -> Entry: ...

@@ -63,6 +63,7 @@ from facadecli.city.footprints import (
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.lods import feature_scene
 from facadecli.city.manifest import Choice, City, Roof, WallRule
+from facadecli.city.packed import Packed, Picked
 from facadecli.city.report import CityReport, Entries, Summary, Tally
 from facadecli.city.resume import building_hashes, recorded, reusable, stamped
 from facadecli.city.s3db import (
@@ -317,10 +318,11 @@ def plan(
     instanced: bool = False,
     level: int = 3,
     shared_textures: bool = True,
-) -> tuple[list[Task], list[Rejected]]:
-    """One task a building, built to ``level`` of detail (below 3: no façades), and the
-    warnings of the planning: an entrance that two buildings hold (:func:`one_door_each`).
-    Paths are absolute: workers (Dask's too) may run elsewhere."""
+) -> tuple[Packed[Task], list[Rejected]]:
+    """One task a building, built to ``level`` of detail (below 3: no façades), kept
+    packed as they are made (packed.py: a client's memory for a city of any size), and
+    the warnings of the planning: an entrance that two buildings hold
+    (:func:`one_door_each`). Paths are absolute: workers (Dask's too) may run elsewhere."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
@@ -338,7 +340,7 @@ def plan(
         return building_walls(footprint, heights, roof, shared.get(footprint.id), tolerance)
 
     footprints, warnings = one_door_each(footprints, walls_of)
-    tasks = []
+    tasks: Packed[Task] = Packed(dict(city.specs))
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
     for footprint in footprints:
@@ -645,11 +647,11 @@ def run_city(
 class Planned:
     """A city read and planned, before any building: what the client holds all run."""
 
-    found: FootprintSet  # as read
+    found: FootprintSet  # as read, its footprints the outlines with parts alone
     replaced: dict[str, list[str]]  # outlines whose parts are built instead
     kept: dict[str, float]  # of those, the area (m²) still built of each
-    straight: Straightened  # the footprints with their collinear nodes merged
-    tasks: list[Task]  # a building each, in the manifest's order
+    straight: Straightened  # how many collinear nodes were merged (not the footprints)
+    tasks: Packed[Task]  # a building each, in the manifest's order, packed
 
 
 def planned(
@@ -671,6 +673,11 @@ def planned(
     defaults = city.manifest.defaults
     straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
     footprints = list(straight.footprints[: limit if limit is not None else None])
+    # what the run holds: the outlines whose parts are built (their tags, for the
+    # CityJSON's Building), not every footprint read as well as every one planned
+    outlines = tuple(footprint for footprint in found.footprints if footprint.id in replaced)
+    found = replace(found, footprints=outlines)
+    straight = replace(straight, footprints=())
     tasks, warnings = plan(
         city, footprints, outdir.resolve(), usd, instanced, level, shared_textures
     )
@@ -681,7 +688,7 @@ def planned(
 def _build(
     city: City,
     outdir: Path,
-    tasks: list[Task],
+    tasks: Sequence[Task],
     found: FootprintSet,
     replaced: dict[str, list[str]],
     kept: dict[str, float],
@@ -704,17 +711,17 @@ def _build(
     (report.py): the merged models, the CityJSON and the report are streamed to disk."""
     georef = Georef(found.crs, found.origin, found.unit)
     order = {task.footprint.id: index for index, task in enumerate(tasks)}
-    entries = Entries(len(tasks))
+    entries = Entries(len(tasks), outdir)
     built = bytearray(len(tasks))  # 1 for a building built (or kept), in the manifest's order
     tally = Tally()
-    todo = []
+    todo = []  # positions of the buildings to build
     resumed = []  # positions of the buildings kept from the last run
     hashes = building_hashes(city, tasks)
     previous = recorded(outdir, city.manifest.name) if resume else {}
     for index, task in enumerate(tasks):
         entry = reusable(task, hashes[task.footprint.id], previous, usd)
         if entry is None:
-            todo.append(task)
+            todo.append(index)
         else:
             entries.put(index, entry)
             built[index] = entry["status"] == "ok"
@@ -723,25 +730,29 @@ def _build(
     del previous
     done = len(resumed)
     tileset = None
+    centroids = [_centroid(task.footprint) for task in tasks]
     if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
-        places = [(task.footprint.id, _centroid(task.footprint)) for task in tasks]
-        tileset = TilesetWriter(outdir, georef, lods, places)
+        tileset = TilesetWriter(outdir, georef, lods, list(zip(order, centroids, strict=True)))
     local = scheduler is None
-    mapped = stamped(_map_local(todo, jobs) if local else _map_dask(todo, str(scheduler)), hashes)
+    building = Picked(tasks, todo)
+    del todo
+    mapped = stamped(
+        _map_local(building, jobs) if local else _map_dask(building, str(scheduler)), hashes
+    )
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
         outdir.mkdir(parents=True, exist_ok=True)
         with open(log, "wb") as lines:
             for index in resumed:
                 lines.write(entries.line(index) + b"\n")
-                _tiled(tileset, outdir, tasks[index], built[index])
+                _tiled(tileset, outdir, entries[index]["id"], built[index])
             for result in mapped:
                 index = order[result["id"]]
                 lines.write(entries.put(index, result) + b"\n")
                 lines.flush()
                 built[index] = result["status"] == "ok"
                 tally.add(result)
-                _tiled(tileset, outdir, tasks[index], built[index])
+                _tiled(tileset, outdir, result["id"], built[index])
                 done += 1
                 if progress is not None:
                     progress(done, len(tasks))
@@ -756,7 +767,7 @@ def _build(
         outdir,
         tasks,
         bytes(built),
-        [_centroid(task.footprint) for task in tasks],
+        centroids,
         found,
         replaced,
         georef,
@@ -864,13 +875,13 @@ def _summary(
     )
 
 
-def _tiled(tileset: TilesetWriter | None, outdir: Path, task: Task, built: int) -> None:
+def _tiled(tileset: TilesetWriter | None, outdir: Path, building_id: str, built: int) -> None:
     """A building done (built or resumed, or failed: ``built`` 0), for the 3D Tiles of its
-    leaf."""
+    leaf: its glb (where :func:`plan` put it, in ``outdir``)."""
     if tileset is None:
         return
     try:
-        tileset.done(task.footprint.id, task.target if built else None)
+        tileset.done(building_id, outdir / building_file(building_id) if built else None)
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "
@@ -923,7 +934,7 @@ def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, A
     return dict(sorted(solved, key=lambda pair: pair[0]))  # in order: they came as they ended
 
 
-def _map_dask(tasks: list[Task], scheduler: str) -> Iterator[dict[str, Any]]:
+def _map_dask(tasks: Sequence[Task], scheduler: str) -> Iterator[dict[str, Any]]:
     """The buildings on a Dask distributed cluster, results as they finish: the axes are
     solved ahead over the cluster (:func:`_presolve`), sent to every worker once, and
     each worker's cache is seeded with them before its first building."""
@@ -940,7 +951,7 @@ def _map_dask(tasks: list[Task], scheduler: str) -> Iterator[dict[str, Any]]:
         )
 
 
-def _map_local(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
+def _map_local(tasks: Sequence[Task], jobs: int) -> Iterator[dict[str, Any]]:
     """The buildings in ``jobs`` local processes, results as they finish. With several
     processes, the axes every building needs are solved first (:func:`_presolve`) and
     handed to each process as it starts; one process solves them as it goes."""

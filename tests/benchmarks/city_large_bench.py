@@ -318,11 +318,14 @@ def main() -> None:
             measure_planning(sizes, folder)
         if os.environ.get("FACADE_BENCH_PLAN_ONLY"):
             return
-        small = measure(max(1, count // 4), jobs, folder)
+        quarter = max(1, count // 4)
+        small = measure(quarter, jobs, folder)
         large = measure(count, jobs, folder)
+        slope = (large["peak"] - small["peak"]) * 1024 / max(1, count - quarter)
         print(
-            f"client peak memory at {count} / at {max(1, count // 4)} buildings: "
-            f"{large['peak'] / small['peak']:.2f} (flat: 1.0; growing with N: 4.0)"
+            f"client peak memory: {small['peak']:.0f} MiB at {quarter} buildings, "
+            f"{large['peak']:.0f} MiB at {count}: {large['peak'] / small['peak']:.2f} times "
+            f"(flat: 1.0; in proportion to N: 4.0), {slope:.2f} KiB a building more"
         )
         if os.environ.get("FACADE_BENCH_PROFILE"):
             profile(max(1, count // 4), folder)

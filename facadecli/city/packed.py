@@ -1,0 +1,124 @@
+"""A run's tasks kept packed (:class:`Packed`): what lets a client plan a city of any
+size in little memory.
+
+A building's task holds its footprint, tags, heights, roof, party walls... as Python
+and GEOS objects: kilobytes a building, held for the whole run. Packed, tasks are kept
+in chunks of :data:`CHUNK`, each pickled (geometry as its WKB: exact coordinates) and
+compressed, the run's specs (large, and the same objects for many buildings) named by a
+key rather than copied (:meth:`pickle.Pickler.persistent_id`); a task is made again when
+it is read, equal to the one put in. Reading in order decodes each chunk once.
+"""
+
+from __future__ import annotations
+
+import io
+import pickle
+import zlib
+from array import array
+from collections.abc import Iterable, Iterator, Sequence
+from typing import Generic, TypeVar, overload
+
+T = TypeVar("T")
+
+CHUNK = 64  # items a chunk: compressed together (their tags and class names repeat)
+LEVEL = 6  # zlib's level: deterministic for a given input
+
+
+class Packed(Sequence[T], Generic[T]):
+    """Items appended (:meth:`append`) then read by position, kept packed in chunks.
+    ``shared`` names the large objects the items refer to and that stay in memory
+    anyway (the run's specs, by their manifest path): they are packed as their name.
+    Items must be picklable, and equal to themselves pickled and unpickled."""
+
+    def __init__(self, shared: dict[str, object] | None = None, chunk: int = CHUNK):
+        self._shared = dict(shared or {})
+        self._names = {id(item): name for name, item in self._shared.items()}
+        self._chunk = chunk
+        self._packed: list[bytes] = []
+        self._open: list[T] = []  # the last chunk, not yet packed
+        self._cached: tuple[int, list[T]] = (-1, [])  # the last chunk read
+
+    def append(self, item: T) -> None:
+        self._open.append(item)
+        if len(self._open) == self._chunk:
+            self._packed.append(self._pack(self._open))
+            self._open = []
+
+    def extend(self, items: Iterable[T]) -> None:
+        for item in items:
+            self.append(item)
+
+    def packed_bytes(self) -> int:
+        """The bytes the packed chunks take (their payload)."""
+        return sum(len(data) for data in self._packed)
+
+    def _pack(self, items: list[T]) -> bytes:
+        buffer = io.BytesIO()
+        pickler = pickle.Pickler(buffer, protocol=pickle.HIGHEST_PROTOCOL)
+        pickler.persistent_id = lambda item: self._names.get(id(item))  # type: ignore[method-assign]
+        pickler.dump(items)
+        return zlib.compress(buffer.getvalue(), LEVEL)
+
+    def _unpack(self, data: bytes) -> list[T]:
+        unpickler = pickle.Unpickler(io.BytesIO(zlib.decompress(data)))
+        unpickler.persistent_load = self._shared.__getitem__  # type: ignore[method-assign]
+        items: list[T] = unpickler.load()
+        return items
+
+    def _chunk_at(self, number: int) -> list[T]:
+        if number == len(self._packed):
+            return self._open
+        if self._cached[0] != number:
+            self._cached = (number, self._unpack(self._packed[number]))
+        return self._cached[1]
+
+    def __len__(self) -> int:
+        return len(self._packed) * self._chunk + len(self._open)
+
+    @overload
+    def __getitem__(self, index: int) -> T: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> list[T]: ...
+
+    def __getitem__(self, index: int | slice) -> T | list[T]:
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        if index < 0:
+            index += len(self)
+        if not 0 <= index < len(self):
+            raise IndexError(index)
+        return self._chunk_at(index // self._chunk)[index % self._chunk]
+
+    def __iter__(self) -> Iterator[T]:
+        for number in range(len(self._packed)):
+            yield from self._unpack(self._packed[number])  # not cached: a pass in order
+        yield from list(self._open)
+
+    def __repr__(self) -> str:
+        return f"Packed({len(self)} items, {self.packed_bytes()} bytes packed)"
+
+
+class Picked(Sequence[T], Generic[T]):
+    """Some of a sequence's items, by their positions in it (ascending), read from it."""
+
+    def __init__(self, items: Sequence[T], positions: Iterable[int]):
+        self._items = items
+        self.positions = array("q", positions)
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+    @overload
+    def __getitem__(self, index: int) -> T: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> list[T]: ...
+
+    def __getitem__(self, index: int | slice) -> T | list[T]:
+        if isinstance(index, slice):
+            return [self._items[p] for p in self.positions[index]]
+        return self._items[self.positions[index]]
+
+    def __iter__(self) -> Iterator[T]:
+        return (self._items[p] for p in self.positions)
