@@ -411,6 +411,7 @@ function fitStreet(box, centre, angle) {
 // each time).
 const PLAN_CELL = 0.25, PLAN_CELLS = 768, CLEARANCE = 4, STREET_STEP = 2, RAYS = 144;
 const STREET_TILT = 6;  // degrees the street camera looks up: more of the houses, less paving
+const STREET_SPOTS = 4096, STREET_REACH = 150;  // the search's bounds (see fitDistrictStreet)
 function districtPlan(model, box) {
   const size = box.getSize(new THREE.Vector3());
   const cell = Math.max(PLAN_CELL, Math.max(size.x, size.z) / PLAN_CELLS);
@@ -503,8 +504,11 @@ function fitDistrictStreet(model, box) {
   const halfH = Math.atan(tanH * MARGIN), halfV = Math.atan(tanV * MARGIN);
   const tilt = STREET_TILT * Math.PI / 180;
   const span = Math.max(1, Math.round(halfH / (2 * Math.PI / RAYS)));  // rays each side
-  const reach = Math.hypot(columns, rows);
-  const step = Math.max(1, Math.round(STREET_STEP / cell));
+  // the work is bounded whatever the district's size: at most STREET_SPOTS spots (a wider
+  // lattice in a large city), each ray STREET_REACH metres at most
+  const reach = Math.min(Math.hypot(columns, rows), STREET_REACH / cell);
+  const step = Math.max(1, Math.round(STREET_STEP / cell),
+                        Math.ceil(Math.sqrt(columns * rows / STREET_SPOTS)));
   const hitBuilding = new Int32Array(RAYS), hitFill = new Float32Array(RAYS);
   let best = null;
   for (let row = step >> 1; row < rows; row += step) {
