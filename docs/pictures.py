@@ -8,13 +8,19 @@ elevation, taken by a headless Chromium (software WebGL). Needs ``chromium`` on 
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable
 from functools import partial
 from pathlib import Path
+from typing import Any
+
+from facadecli.geometry.primitives import RECESS_DEPTH
 
 ROOT = Path(__file__).resolve().parent.parent
 TARGET = ROOT / "docs" / "pictures"
@@ -31,12 +37,72 @@ PICTURES: dict[str, tuple[str, str, str]] = {
     "townhouse-street": ("townhouse", "model", "street,25"),
     "parts": ("parts", "model", "35,10,1.1,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
-    "part-door": ("parts", "model", "25,5,2.6,0.17,0.25"),
-    "part-arch-shutters": ("parts", "model", "-30,5,2.5,0.45,0.27"),
-    "part-balcony": ("parts", "model", "45,20,2.4,0.82,0.5"),
-    "part-sill": ("parts", "model", "50,25,2.6,0.25,0.65"),
-    "part-ledge": ("parts", "model", "-60,-15,3.2,0.15,0.9"),
 }
+
+Shape = dict[str, Any]  # a shape of a solved layout's report (``layout.json``)
+
+# a part's close-up: the spec, the shapes it shows (a test of each visible shape of the
+# solved layout), the share of their height it shows from their foot up (a sill: the
+# foot of its window) and the camera's angle round and up; aimed and zoomed by
+# :func:`part_view` from where the shapes stand, so the part fills the picture
+PARTS: dict[str, tuple[str, Callable[[Shape], bool], tuple[float, float], float, float]] = {
+    "part-door": ("parts", lambda s: s["mesh"] == "door", (0.0, 1.0), 25, 5),
+    "part-arch-shutters": ("parts", lambda s: s["mesh"] in ("arch", "shutter"), (0, 1), -30, 5),
+    "part-balcony": ("parts", lambda s: s["mesh"] == "balcony", (0.0, 1.0), 45, 20),
+    "part-sill": (
+        "parts",
+        lambda s: s["mesh"] == "frame" and (s["x"], s["y"]) == ("D", "F"),
+        (0.0, 0.6),
+        50,
+        25,
+    ),
+    # the cornice's free end, where its profile shows
+    "part-ledge": ("parts", lambda s: s["y"] == "C" and s["x1"] <= 2.0, (0.0, 1.0), -60, -15),
+}
+# of the picture's width or height (the tighter) the part would span seen square on; the
+# viewer's 8% margin and the perspective of an oblique view leave about three quarters
+PART_FILL = 0.9
+ASPECT = 900 / 560  # the screenshot's (WINDOW)
+
+
+def looks(wide: float, high: float, deep: float, around: float, up: float) -> tuple[float, float]:
+    """How wide and how high a box looks from ``around`` degrees round and ``up`` degrees
+    up (seen from afar: no perspective)."""
+    a, u = math.radians(around), math.radians(up)
+    across = wide * abs(math.cos(a)) + deep * abs(math.sin(a))
+    return across, high * math.cos(u) + (deep * abs(math.cos(a))) * abs(math.sin(u))
+
+
+def part_view(
+    layout: dict[str, Any],
+    shows: Callable[[Shape], bool],
+    share: tuple[float, float],
+    around: float,
+    up: float,
+) -> str:
+    """The viewer's ``?view=`` aimed at the part: the middle of the shapes ``shows``
+    picks (the ``share`` of their height from the foot), as shares of the model's box
+    (the canvas across and up; in depth, from the deepest shape's back, less a window
+    recess, to the most proud one's front), and zoomed from the whole model's fit until
+    the part spans :data:`PART_FILL` of the picture (the fit shows the canvas, its
+    tighter side filling the picture)."""
+    visible = [s for s in layout["shapes"] if s["visible"]]
+    chosen = [s for s in visible if shows(s)]
+    assert chosen, "no shape of the layout is the part"
+    x0, x1 = min(s["x0"] for s in chosen), max(s["x1"] for s in chosen)
+    y0, y1 = min(s["y0"] for s in chosen), max(s["y1"] for s in chosen)
+    y0, y1 = y0 + share[0] * (y1 - y0), y0 + share[1] * (y1 - y0)
+    front = max(s["z1"] for s in chosen)
+    back = min(s["z0"] for s in visible) - RECESS_DEPTH
+    deep = max(s["z1"] for s in visible) - back
+    width, height = layout["canvas"]["width"], layout["canvas"]["height"]
+    depth = front - min(s["z0"] for s in chosen)
+    model_wide, model_high = looks(width, height, deep, around, up)
+    part_wide, part_high = looks(x1 - x0, y1 - y0, depth, around, up)
+    seen_wide = max(model_wide, model_high * ASPECT)  # the model's fit: what the picture spans
+    zoom = PART_FILL * min(seen_wide / part_wide, seen_wide / ASPECT / part_high)
+    at = ((x0 + x1) / 2 / width, (y0 + y1) / 2 / height, (front - depth / 2 - back) / deep)
+    return f"{around:g},{up:g},{zoom:.2f}," + ",".join(f"{share:.3f}" for share in at)
 
 
 def browser() -> str:
@@ -98,9 +164,9 @@ def svg_size(svg: Path) -> str:
 # the 50-building city block: camera (around, up, zoom, x, y) of each picture
 CITY_BLOCK = 50
 CITY_VIEWS: dict[str, str] = {
-    "front": "0,12",
+    "front": "0",  # the viewer picks the elevation at which the buildings fill the picture
     "oblique": "35,35",
-    "street": "street,0",
+    "street": "street",  # in one of the district's streets (the viewer finds it)
 }
 
 
@@ -148,7 +214,7 @@ def strip(shots: list[Path], target: Path) -> None:
 def look_pictures(chrome: str, out: Path, suffix: str = "") -> None:
     """Every example spec (specs/*.yaml) and the 50-building city block from the front, 35°
     oblique and at street level (:data:`LOOK_VIEWS`), a strip each:
-    ``look/NAME{suffix}.png``."""
+    ``look/NAME{suffix}.png``; LOOK=name,name... takes those alone."""
     from facadecli.city.demo import write_demo
 
     LOOK.mkdir(parents=True, exist_ok=True)
@@ -163,7 +229,10 @@ def look_pictures(chrome: str, out: Path, suffix: str = "") -> None:
     run([*facade, "city", str(manifest), "-o", str(city), "--limit", str(CITY_BLOCK)])
     run([*facade, "view", str(city), "-o", str(out / "city-block.html")])
     pages["city-block"] = out / "city-block.html"
+    only = [name for name in os.environ.get("LOOK", "").split(",") if name]
     for name, page in pages.items():
+        if only and name not in only:
+            continue
         views = LOOK_VIEWS if name != "city-block" else tuple(CITY_VIEWS.values())
         shots = []
         for index, view in enumerate(views):
@@ -206,8 +275,8 @@ def material_sheet(target: Path) -> None:
 
 
 def main(names: list[str]) -> None:
-    """The pictures named (all without names): a spec's from :data:`PICTURES`,
-    ``materials`` (the library's sheet), ``city`` (the city block's three views;
+    """The pictures named (all without names): a spec's from :data:`PICTURES` or
+    :data:`PARTS`, ``materials`` (the library's sheet), ``city`` (the city block's three views;
     SUFFIX=-before names them for the record of older code) or ``look`` (every example
     and the city block from three cameras, SUFFIX likewise)."""
     everything = not names
@@ -229,18 +298,24 @@ def main(names: list[str]) -> None:
     if not (everything or chosen):
         return
     facade = Path(sys.executable).parent / "facade"
-    chosen = chosen or list(PICTURES)
+    chosen = chosen or [*PICTURES, *PARTS]
     with tempfile.TemporaryDirectory() as scratch:
         out = Path(scratch)
-        for spec in sorted({PICTURES[name][0] for name in chosen}):
+        specs = {(PICTURES.get(name) or PARTS[name])[0] for name in chosen}
+        for spec in sorted(specs):
             path = ROOT / "specs" / f"{spec}.yaml"
             subprocess.run(
-                [str(facade), "solve", str(path), "-o", str(out), "-f", "html,svg"],
+                [str(facade), "solve", str(path), "-o", str(out), "-f", "html,svg,json"],
                 check=True,
                 capture_output=True,
             )
         for name in chosen:
-            spec, what, view = PICTURES[name]
+            if name in PARTS:
+                spec, shows, share, around, up = PARTS[name]
+                layout = json.loads((out / f"{spec}.layout.json").read_text(encoding="utf-8"))
+                what, view = "model", part_view(layout, shows, share, around, up)
+            else:
+                spec, what, view = PICTURES[name]
             target = TARGET / f"{name}.png"
             if what == "elevation":
                 svg = out / f"{spec}.svg"

@@ -14,6 +14,7 @@ from urllib.parse import quote
 import pytest
 
 from facadecli import load_spec, solve
+from facadecli.city.demo import write_demo
 from facadecli.city.folders import building_file
 from facadecli.cli import main
 from facadecli.export import OutputOptions, write_outputs
@@ -328,3 +329,44 @@ def test_glass_reads_neither_black_nor_white_nor_as_the_wall(tmp_path: Path) -> 
     wall = _mean_grey(shot, (0.12, 0.4, 0.2, 0.6))
     assert 60 < pane < 170
     assert abs(wall - pane) > 25
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_districts_street_view_stands_in_a_street_among_its_buildings(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """``?view=street`` of a district: the eye 1.6 m above the ground in the open between
+    the buildings (outside every footprint, a few metres from the nearest), facing several
+    of them, which fill the picture: its upper half is mostly buildings, not the backdrop
+    (the old street view stood back until the whole district was in view: a row of houses
+    on the horizon under a sky filling half the picture)."""
+    import json
+    from html import unescape
+
+    from PIL import Image
+    from shapely.geometry import Point, shape
+
+    manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
+    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
+    page = tmp_path / "city.html"
+    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
+    shot, dom = browse(tmp_path, page.as_uri() + "?bare&view=street")
+    found = re.search(r'data-street="([^"]+)"', dom)
+    assert found, "the page reports no street view"
+    street = json.loads(unescape(found.group(1)))
+    georef = json.loads((tmp_path / "city" / "demo-district.georef.json").read_text())
+    features = json.loads((tmp_path / "demo" / "footprints.geojson").read_text())["features"]
+    footprints = {f["properties"]["osm_id"]: shape(f["geometry"]) for f in features}
+    x, height, z = street["eye"]
+    eye = Point(georef["origin"][0] + x, georef["origin"][1] - z)  # glTF x east, z south
+    assert abs(height - 1.6) < 0.02  # above the model's foot (its floors' 1 cm slabs)
+    assert min(footprint.distance(eye) for footprint in footprints.values()) > 3.0
+    assert len(street["seen"]) >= 4 and set(street["seen"]) <= set(footprints)
+    with Image.open(shot) as image:
+        grey = image.convert("L")
+    backdrop = grey.getpixel((grey.width - 1, 0))  # above the houses' roofs: the backdrop
+    assert isinstance(backdrop, int)
+    upper = grey.crop((0, 0, grey.width, grey.height // 2)).tobytes()
+    sky = sum(1 for value in upper if abs(value - backdrop) <= 2) / len(upper)
+    assert sky < 0.5

@@ -301,15 +301,16 @@ function castsShadows(model) {
     }
   });
 }
-// ?view=ANGLE,ELEVATION,ZOOM,X,Y: seen from ANGLE degrees around and ELEVATION up, ZOOM
-// times closer than the fit, looking at the point X, Y (0..1 across the model; without
-// them, the fit's aim); ?view=street,ANGLE: at eye height, ANGLE degrees round, the whole
-// model in view; ?bare: the model alone
+// ?view=ANGLE,ELEVATION,ZOOM,X,Y,Z: seen from ANGLE degrees around and ELEVATION up, ZOOM
+// times closer than the fit, looking at the point X, Y, Z (0..1 across the model's box,
+// its width, height and depth; without them, the fit's aim); ?view=street,ANGLE: at eye
+// height, ANGLE degrees round, the whole model in view (a district: in one of its
+// streets, fitDistrictStreet); ?bare: the model alone
 const query = new URLSearchParams(location.search);
 const wantedView = (query.get('view') || '').split(',');
 const street = wantedView[0] === 'street';
 if (street) wantedView.shift();
-const [around, up, zoom, atX, atY] = wantedView.map(parseFloat);
+const [around, up, zoom, atX, atY, atZ] = wantedView.map(parseFloat);
 const or = (value, fallback) => Number.isFinite(value) ? value : fallback;
 if (query.has('bare')) document.body.classList.add('bare');
 function corners(box) {
@@ -328,7 +329,9 @@ function halfTangents() {
 // view is a plane every corner must lie inside, which bounds the camera's place across,
 // up and back linearly (an exact fit, not a sphere's). The box's picture is centred and
 // fills the view along its tighter axis. Returns the point the camera aims at (where its
-// axis passes the box's centre's depth) and the camera's distance from it.
+// axis passes the box's centre's depth), the camera's distance from it, the distance at
+// which the box's picture would fill the view's height (high), and whether it does
+// (filled; else its width binds, and the view has room above and below it).
 function fitBox(box, centre, seen) {
   const [tanH, tanV] = halfTangents();
   const forward = seen.clone().negate();
@@ -341,10 +344,11 @@ function fitBox(box, centre, seen) {
   const leftmost = most(across.map(([x, , z]) => -x - tanH * z));
   const top = most(across.map(([, y, z]) => y - tanV * z));
   const bottom = most(across.map(([, y, z]) => -y - tanV * z));
-  const distance = Math.max((rightmost + leftmost) / (2 * tanH), (top + bottom) / (2 * tanV));
+  const wide = (rightmost + leftmost) / (2 * tanH), high = (top + bottom) / (2 * tanV);
   const aim = centre.clone().addScaledVector(right, (rightmost - leftmost) / 2)
     .addScaledVector(upward, (top - bottom) / 2);
-  return {aim, distance: Math.max(distance, 0.01)};
+  return {aim, distance: Math.max(wide, high, 0.01), high: Math.max(high, 0.01),
+          filled: high >= wide};
 }
 // A person's eye above the ground, for the street-level view
 const EYE = 1.6;
@@ -394,6 +398,166 @@ function fitStreet(box, centre, angle) {
   const distance = Math.max(centre.clone().sub(position).dot(best.forward), 0.01);
   return {position, aim: position.clone().addScaledVector(best.forward, distance), distance};
 }
+// Street level in a district (a model of several buildings, wider and deeper than tall):
+// the eye EYE metres up in its open space, where the nearest buildings fill the view. The
+// district's plan is drawn from above (each building, a child of the model, in a colour of
+// its own: which stands highest in each cell of about PLAN_CELL metres, and how high), a
+// spot is open where nothing stands and no building is nearer than CLEARANCE; rays from
+// each open spot of a lattice every STREET_STEP metres, RAYS round, find the first
+// building each way. Of every spot and heading, the view that holds the most of buildings
+// wins: the sum over the buildings seen of the square root of the share of the picture each
+// fills (a street of houses, near and far, beats one wall close up: eight houses a sixteenth
+// of the picture each score 2, one wall filling it 1); ties keep the first (the same view
+// each time).
+const PLAN_CELL = 0.25, PLAN_CELLS = 768, CLEARANCE = 4, STREET_STEP = 2, RAYS = 144;
+const STREET_TILT = 6;  // degrees the street camera looks up: more of the houses, less paving
+const STREET_SPOTS = 4096, STREET_REACH = 150;  // the search's bounds (see fitDistrictStreet)
+function districtPlan(model, box) {
+  const size = box.getSize(new THREE.Vector3());
+  const cell = Math.max(PLAN_CELL, Math.max(size.x, size.z) / PLAN_CELLS);
+  const columns = Math.max(1, Math.ceil(size.x / cell));
+  const rows = Math.max(1, Math.ceil(size.z / cell));
+  const high = Math.max(box.max.y - box.min.y, 0.01);
+  const swapped = [];
+  model.children.forEach((building, index) => {
+    const material = new THREE.ShaderMaterial({
+      uniforms: {id: {value: index + 1}, low: {value: box.min.y}, high: {value: high}},
+      vertexShader: `uniform float low, high; varying float height;
+        void main() {
+          vec4 world = vec4(position, 1.0);
+          #ifdef USE_INSTANCING
+            world = instanceMatrix * world;
+          #endif
+          world = modelMatrix * world;
+          height = clamp((world.y - low) / high, 0.0, 1.0);
+          gl_Position = projectionMatrix * viewMatrix * world;
+        }`,
+      fragmentShader: `uniform float id; varying float height;
+        void main() {
+          gl_FragColor = vec4(floor(id / 256.0) / 255.0, mod(id, 256.0) / 255.0, height, 1.0);
+        }`,
+      side: THREE.DoubleSide,
+    });
+    building.traverse(part => {
+      if (part.isMesh) { swapped.push([part, part.material]); part.material = material; }
+    });
+  });
+  const above = new THREE.OrthographicCamera(
+    -columns * cell / 2, columns * cell / 2, rows * cell / 2, -rows * cell / 2,
+    0.5, high + 1.5);
+  above.up.set(0, 0, -1);  // the picture's right is +x, its top -z: row 0 (the bottom) +z
+  const middle = new THREE.Vector3(box.min.x + columns * cell / 2, 0,
+                                   box.min.z + rows * cell / 2);
+  above.position.set(middle.x, box.max.y + 1, middle.z);
+  above.lookAt(middle.x, box.min.y, middle.z);
+  above.updateMatrixWorld(); above.updateProjectionMatrix();
+  const target = new THREE.WebGLRenderTarget(columns, rows);
+  const pixels = new Uint8Array(columns * rows * 4);
+  const planScene = new THREE.Scene(), parent = model.parent;
+  planScene.add(model);
+  const clear = renderer.getClearColor(new THREE.Color()), alpha = renderer.getClearAlpha();
+  renderer.setClearColor(0x000000, 0);
+  renderer.setRenderTarget(target);
+  renderer.clear();
+  renderer.render(planScene, above);
+  renderer.readRenderTargetPixels(target, 0, 0, columns, rows, pixels);
+  renderer.setRenderTarget(null);
+  renderer.setClearColor(clear, alpha);
+  planScene.remove(model);
+  if (parent) parent.add(model);
+  for (const [part, material] of swapped) { part.material.dispose(); part.material = material; }
+  target.dispose();
+  const building = new Int32Array(columns * rows), height = new Float32Array(columns * rows);
+  for (let at = 0; at < columns * rows; at++) {
+    if (pixels[at * 4 + 3] === 0) continue;
+    building[at] = pixels[at * 4] * 256 + pixels[at * 4 + 1];
+    height[at] = pixels[at * 4 + 2] / 255 * high;
+  }
+  // each cell's distance to the nearest building, in cells (a two-pass chamfer, 1 and sqrt 2)
+  const near = new Float32Array(columns * rows).fill(Infinity);
+  for (let at = 0; at < columns * rows; at++) if (building[at]) near[at] = 0;
+  const pass = (from, to, step) => {
+    for (let row = from; row !== to; row += step) {
+      for (let column = step > 0 ? 0 : columns - 1; column >= 0 && column < columns;
+           column += step) {
+        const at = row * columns + column;
+        for (const [dx, dy, cost] of [[-step, 0, 1], [0, -step, 1], [-step, -step, Math.SQRT2],
+                                      [step, -step, Math.SQRT2]]) {
+          const x = column + dx, y = row + dy;
+          if (x < 0 || x >= columns || y < 0 || y >= rows) continue;
+          near[at] = Math.min(near[at], near[y * columns + x] + cost);
+        }
+      }
+    }
+  };
+  pass(0, rows, 1); pass(rows - 1, -1, -1);
+  return {cell, columns, rows, building, height, near,
+          x: column => box.min.x + (column + 0.5) * cell,
+          z: row => box.min.z + rows * cell - (row + 0.5) * cell};
+}
+function fitDistrictStreet(model, box) {
+  const buildings = model.children.length;
+  if (buildings < 2 || buildings > 65535) return null;  // its plan tells 65,535 apart
+  const plan = districtPlan(model, box);
+  const {cell, columns, rows, building, height, near} = plan;
+  const [tanH, tanV] = halfTangents();
+  const halfH = Math.atan(tanH * MARGIN), halfV = Math.atan(tanV * MARGIN);
+  const tilt = STREET_TILT * Math.PI / 180;
+  const span = Math.max(1, Math.round(halfH / (2 * Math.PI / RAYS)));  // rays each side
+  // the work is bounded whatever the district's size: at most STREET_SPOTS spots (a wider
+  // lattice in a large city), each ray STREET_REACH metres at most
+  const reach = Math.min(Math.hypot(columns, rows), STREET_REACH / cell);
+  const step = Math.max(1, Math.round(STREET_STEP / cell),
+                        Math.ceil(Math.sqrt(columns * rows / STREET_SPOTS)));
+  const hitBuilding = new Int32Array(RAYS), hitFill = new Float32Array(RAYS);
+  let best = null;
+  for (let row = step >> 1; row < rows; row += step) {
+    for (let column = step >> 1; column < columns; column += step) {
+      if (near[row * columns + column] * cell < CLEARANCE) continue;
+      for (let ray = 0; ray < RAYS; ray++) {  // the first building along each ray
+        const a = ray * 2 * Math.PI / RAYS, dx = Math.sin(a), dy = Math.cos(a);  // rows: north
+        hitBuilding[ray] = 0; hitFill[ray] = 0;
+        for (let t = 1; t < reach; t += 0.5) {
+          const x = Math.floor(column + 0.5 + dx * t), y = Math.floor(row + 0.5 + dy * t);
+          if (x < 0 || x >= columns || y < 0 || y >= rows) break;
+          const at = y * columns + x;
+          if (!building[at]) continue;
+          const distance = t * cell;  // the share of the view's height the building fills
+          const top = Math.atan2(height[at] - EYE, distance), foot = -Math.atan2(EYE, distance);
+          const shown = Math.min(top, tilt + halfV) - Math.max(foot, tilt - halfV);
+          hitBuilding[ray] = building[at]; hitFill[ray] = Math.max(0, shown) / (2 * halfV);
+          break;
+        }
+      }
+      for (let heading = 0; heading < RAYS; heading++) {
+        const shares = new Map();  // building -> the share of the picture it fills
+        for (let k = -span; k <= span; k++) {
+          const ray = (heading + k + RAYS) % RAYS;
+          if (!hitBuilding[ray]) continue;
+          const share = hitFill[ray] / (2 * span + 1);
+          shares.set(hitBuilding[ray], (shares.get(hitBuilding[ray]) || 0) + share);
+        }
+        let score = 0;
+        for (const share of shares.values()) score += Math.sqrt(share);
+        if (!best || score > best.score + 1e-9) {
+          best = {score, column, row, heading, seen: [...shares.keys()]};
+        }
+      }
+    }
+  }
+  if (!best) return null;
+  const a = best.heading * 2 * Math.PI / RAYS;  // ray 0 looks north (-z), then clockwise
+  const forward = new THREE.Vector3(Math.sin(a) * Math.cos(tilt), Math.sin(tilt),
+                                    -Math.cos(a) * Math.cos(tilt));
+  const position = new THREE.Vector3(plan.x(best.column), box.min.y + EYE, plan.z(best.row));
+  const distance = 20;
+  const named = building => building.userData.name || building.name;  // as the glb names it
+  const seen = best.seen.sort((p, q) => p - q).map(id => named(model.children[id - 1]));
+  document.body.dataset.street = JSON.stringify({
+    eye: position.toArray().map(v => +v.toFixed(3)), heading: +(a * 180 / Math.PI).toFixed(1),
+    seen});
+  return {position, aim: position.clone().addScaledVector(forward, distance), distance};
+}
 // The sun's shadow camera fitted round the model's box, seen from the sun, so a facade and a
 // district both get shadows as sharp as the map allows.
 function fitSun(box, centre, radius) {
@@ -424,13 +588,14 @@ function fitSun(box, centre, radius) {
   renderer.shadowMap.needsUpdate = true;
 }
 const SEEN_FROM = 35;  // degrees round from the front, unless ?view says otherwise
+const DISTRICT_RISE = 30;  // degrees up a district is seen from (a façade from 8.5)
 function bounds(model) {
   const box = new THREE.Box3().setFromObject(model);
   if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(10, 10, 10));
   const size = box.getSize(new THREE.Vector3());
   const district = Math.min(size.x, size.z) > 2 * size.y;  // wider and deeper than tall
   return {box, size, centre: box.getCenter(new THREE.Vector3()),
-          radius: Math.max(size.length() / 2, 0.01), rise: district ? 30 : 8.5};
+          radius: Math.max(size.length() / 2, 0.01), rise: district ? DISTRICT_RISE : 8.5};
 }
 function direction(angle, rise) {
   const a = angle * Math.PI / 180, r = rise * Math.PI / 180;
@@ -453,21 +618,48 @@ function light(model) {
   if (occlusion) occlusion.updateGtaoMaterial({radius: Math.max(0.3, fit / 60)});
   redraw();
 }
+// A district seen from ?view=ANGLE with no elevation: from the lowest elevation, from
+// DISTRICT_LOWEST up to DISTRICT_HIGHEST degrees, at which its picture fills the view's
+// height as well as its width, so the picture is its buildings, not a strip of them
+// between the paving and the sky (a block seen from 12 degrees filled a quarter of it);
+// if none does, from DISTRICT_HIGHEST (a front view, not a plan) and closer, up to
+// DISTRICT_CLOSER times, as far as filling the height asks: the district's ends a little
+// beyond the picture's sides. Returns the elevation and how much closer; a facade, or a
+// view that gives its elevation, is framed whole.
+const DISTRICT_LOWEST = 10, DISTRICT_HIGHEST = 30, DISTRICT_CLOSER = 1.3;
+function districtRise(box, centre, rise) {
+  if (rise !== DISTRICT_RISE || !Number.isFinite(around) || Number.isFinite(up)) {
+    return {rise: or(up, rise), closer: 1};
+  }
+  for (let degrees = DISTRICT_LOWEST; degrees < DISTRICT_HIGHEST; degrees++) {
+    if (fitBox(box, centre, direction(around, degrees)).filled) {
+      return {rise: degrees, closer: 1};
+    }
+  }
+  const fit = fitBox(box, centre, direction(around, DISTRICT_HIGHEST));
+  return {rise: DISTRICT_HIGHEST, closer: Math.min(DISTRICT_CLOSER, fit.distance / fit.high)};
+}
 function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a district from 30
   resize();
   const {box, size, centre, radius, rise} = bounds(model);
   let target, distance;
-  if (street) {
+  const inDistrict = street && rise === DISTRICT_RISE ? fitDistrictStreet(model, box) : null;
+  if (inDistrict) {
+    target = inDistrict.aim; distance = inDistrict.distance;
+    camera.position.copy(inDistrict.position);
+  } else if (street) {
     const fit = fitStreet(box, centre, or(around, SEEN_FROM));
     target = fit.aim; distance = fit.distance;
     camera.position.copy(fit.position);
   } else {
-    const seen = direction(or(around, SEEN_FROM), or(up, rise));
+    const elevation = districtRise(box, centre, rise);
+    const seen = direction(or(around, SEEN_FROM), elevation.rise);
     const fit = fitBox(box, centre, seen);
     target = fit.aim;
     if (Number.isFinite(atX)) target.x = box.min.x + atX * size.x;
     if (Number.isFinite(atY)) target.y = box.min.y + atY * size.y;
-    distance = fit.distance / or(zoom, 1);
+    if (Number.isFinite(atZ)) target.z = box.min.z + atZ * size.z;
+    distance = fit.distance / elevation.closer / or(zoom, 1);
     camera.position.copy(target).addScaledVector(seen, distance);
   }
   camera.near = distance / 1000; camera.far = distance * 20 + 8 * radius;
