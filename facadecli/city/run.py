@@ -710,7 +710,8 @@ def _build(
     The client holds no more a building than its task and its report entry as a line
     (report.py): the merged models, the CityJSON and the report are streamed to disk."""
     georef = Georef(found.crs, found.origin, found.unit)
-    order = {task.footprint.id: index for index, task in enumerate(tasks)}
+    order: dict[str, int] = {}  # building id -> its position in the manifest's order
+    centroids = []
     entries = Entries(len(tasks), outdir)
     built = bytearray(len(tasks))  # 1 for a building built (or kept), in the manifest's order
     tally = Tally()
@@ -718,7 +719,9 @@ def _build(
     resumed = []  # positions of the buildings kept from the last run
     hashes = building_hashes(city, tasks)
     previous = recorded(outdir, city.manifest.name) if resume else {}
-    for index, task in enumerate(tasks):
+    for index, task in enumerate(tasks):  # one pass: each read unpacks its tasks' chunk
+        order[task.footprint.id] = index
+        centroids.append(_centroid(task.footprint))
         entry = reusable(task, hashes[task.footprint.id], previous, usd)
         if entry is None:
             todo.append(index)
@@ -730,7 +733,6 @@ def _build(
     del previous
     done = len(resumed)
     tileset = None
-    centroids = [_centroid(task.footprint) for task in tasks]
     if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
         tileset = TilesetWriter(outdir, georef, lods, list(zip(order, centroids, strict=True)))
     local = scheduler is None

@@ -594,7 +594,7 @@ function bounds(model) {
   if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(10, 10, 10));
   const size = box.getSize(new THREE.Vector3());
   const district = Math.min(size.x, size.z) > 2 * size.y;  // wider and deeper than tall
-  return {box, size, centre: box.getCenter(new THREE.Vector3()),
+  return {box, size, centre: box.getCenter(new THREE.Vector3()), district,
           radius: Math.max(size.length() / 2, 0.01), rise: district ? DISTRICT_RISE : 8.5};
 }
 function direction(angle, rise) {
@@ -627,8 +627,8 @@ function light(model) {
 // beyond the picture's sides. Returns the elevation and how much closer; a facade, or a
 // view that gives its elevation, is framed whole.
 const DISTRICT_LOWEST = 10, DISTRICT_HIGHEST = 30, DISTRICT_CLOSER = 1.3;
-function districtRise(box, centre, rise) {
-  if (rise !== DISTRICT_RISE || !Number.isFinite(around) || Number.isFinite(up)) {
+function districtRise(box, centre, district, rise) {
+  if (!district || !Number.isFinite(around) || Number.isFinite(up)) {
     return {rise: or(up, rise), closer: 1};
   }
   for (let degrees = DISTRICT_LOWEST; degrees < DISTRICT_HIGHEST; degrees++) {
@@ -641,9 +641,9 @@ function districtRise(box, centre, rise) {
 }
 function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a district from 30
   resize();
-  const {box, size, centre, radius, rise} = bounds(model);
+  const {box, size, centre, radius, district, rise} = bounds(model);
   let target, distance;
-  const inDistrict = street && rise === DISTRICT_RISE ? fitDistrictStreet(model, box) : null;
+  const inDistrict = street && district ? fitDistrictStreet(model, box) : null;
   if (inDistrict) {
     target = inDistrict.aim; distance = inDistrict.distance;
     camera.position.copy(inDistrict.position);
@@ -652,7 +652,7 @@ function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a 
     target = fit.aim; distance = fit.distance;
     camera.position.copy(fit.position);
   } else {
-    const elevation = districtRise(box, centre, rise);
+    const elevation = districtRise(box, centre, district, rise);
     const seen = direction(or(around, SEEN_FROM), elevation.rise);
     const fit = fitBox(box, centre, seen);
     target = fit.aim;
