@@ -751,6 +751,8 @@ def infer(
     target.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(target, inferred.text)
     write_atomic(report_path, json.dumps(report, indent=2) + "\n")
+    if inferred.unshared:
+        _warn(f"{layout}: warning: bays {inferred.bays}; each layer has its own x word")
     summary = (
         f"{report['layers']} layers, {report['spec_lines']} lines for "
         f"{report['rectangles']} rectangles"

@@ -18,6 +18,7 @@ from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.grammar.model import Options, Progress, no_progress
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
+from facadecli.infer.bays import FEW_BAYS, Bays, find_bays, in_bays, inside
 from facadecli.infer.layers import BAND, Grid, grids, to_edges
 from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
 from facadecli.infer.structure import structured
@@ -37,6 +38,8 @@ class Inference:
     checks: dict[str, object] = field(default_factory=dict)
     raw: LabelledLayout | None = None  # as read (stretched to the size); None: ``layout``
     fidelity: Fidelity | None = None  # the spec solved at the input's size vs ``raw``
+    bays: str = ""  # how the x words follow the bays (``infer.bays``), or why they do not
+    unshared: bool = False  # the bays are not shared: each layer has its own x word
 
     def report(self) -> dict[str, object]:
         lines = [line for line in self.text.splitlines() if line.strip()[:1] not in ("", "#")]
@@ -46,6 +49,7 @@ class Inference:
             "rectangles": sum(r.label != BACKGROUND for r in self.layout.rects),
             "layers": len(self.grids) + 1,
             "spec_lines": len(lines),
+            "bays": self.bays,
             **self.checks,
         }
 
@@ -60,12 +64,24 @@ def infer(
     regular = structured(tidied.layout)
     if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
-    progress("finding the grids of each label")
-    found = [to_edges(grid, regular.width, regular.height) for grid in grids(regular)]
+    progress("finding the bays and the grids of each label")
+    bays = find_bays(regular)
+    if isinstance(bays, Bays):
+        found = [to_edges(grid, regular.width, regular.height) for grid in grids(bays.layout)]
+        if any(inside(bays, grid) and not in_bays(bays, grid) for grid in found):
+            bays = "a label's elements stand unlike in the bays of a kind"
+        else:
+            regular = bays.layout
+    if not isinstance(bays, Bays):
+        found = [to_edges(grid, regular.width, regular.height) for grid in grids(regular)]
     spread = size_spread(regular, tidied.snapped)
-    text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread)
+    text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread, bays)
     tiling = tile(regular, tolerance=0.0)
-    return Inference(path.name, regular, tiling, found, text, raw=tidied.raw)
+    note = bays.describe() if isinstance(bays, Bays) else f"not shared: {bays}"
+    unshared = isinstance(bays, str) and bays != FEW_BAYS
+    return Inference(
+        path.name, regular, tiling, found, text, raw=tidied.raw, bays=note, unshared=unshared
+    )
 
 
 def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:

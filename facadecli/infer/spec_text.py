@@ -32,6 +32,7 @@ import re
 from dataclasses import dataclass, field
 
 from facadecli.grammar.palette import label_colour
+from facadecli.infer.bays import Bays, in_bays, segment
 from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, top_floors, uncovered
 
 DECIMALS = 4  # of a metre in the sizes written
@@ -218,11 +219,18 @@ def spec_text(
     found: list[Grid],
     source: str,
     spread: Spread | None = None,
+    bays: Bays | str | None = None,
 ) -> str:
     """The spec (see the module): the sizes a line per label and a line per layer, and each
     layer in two lines under the comment that says where it came from. ``spread``: the
-    range the input's elements of a label's size span (see ``_size``)."""
+    range the input's elements of a label's size span (see ``_size``). ``bays``: the
+    façade's bays (``infer.bays``), whose one sequence the x word of every layer standing
+    in them follows; or why there are none (said in a comment)."""
     counters = _Counters()
+    shared = bays if isinstance(bays, Bays) else None
+    bay_gaps = [_Symbols(f"bay{k + 1}_g") for k in range(len(shared.widths) if shared else 0)]
+    bay_margins = _Symbols("bays_m")
+    in_bay: set[str] = set()  # element symbols of bays: they keep their size
     elements: dict[str, tuple[_Symbols, _Symbols]] = {}
     # a layer's gaps are its own, but layers with the same columns (or rows) share them:
     # their words are then alike and stay aligned at any size
@@ -243,27 +251,38 @@ def spec_text(
     top = _floors_top(found)
     tops = top_floors(found, width, height)
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
+    framed = frames(found) if shared is None else [None] * len(found)
     for index, (layer, grid, frame) in enumerate(
-        zip(layer_names(found), found, frames(found), strict=True)
+        zip(layer_names(found), found, framed, strict=True)
     ):
         symbols = elements[grid.label]
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
+        bay_word = None
+        if shared is not None and in_bays(shared, grid):
+            bay_word = _bay_word(shared, grid, symbols[0], bay_gaps, bay_margins, in_bay)
         introduced = [
             symbols
             for table, spans, axis in ((gaps_x, columns, "x"), (gaps_y, grid.rows, "y"))
-            if spans not in table
+            if spans not in table and (axis == "y" or bay_word is None)
             for symbols in table.setdefault(
                 spans, (_Symbols(f"{layer}_g{axis}"), _Symbols(f"{layer}_m{axis}"))
             )
         ]
         owned.append(introduced)
-        x_tokens = _tokens(columns, width, _by_label(frame, elements, symbols[0]), *gaps_x[columns])
         y_tokens = _tokens(grid.rows, height, symbols[1], *gaps_y[grid.rows])
         words = []
-        for axis, tokens, spans, (gaps, margins) in (
-            ("x", x_tokens, columns, gaps_x[columns]),
-            ("y", y_tokens, grid.rows, gaps_y[grid.rows]),
-        ):
+        if bay_word is not None:
+            axes = [("y", y_tokens, grid.rows, gaps_y[grid.rows])]
+            words.append(bay_word)
+        else:
+            x_tokens = _tokens(
+                columns, width, _by_label(frame, elements, symbols[0]), *gaps_x[columns]
+            )
+            axes = [
+                ("x", x_tokens, columns, gaps_x[columns]),
+                ("y", y_tokens, grid.rows, gaps_y[grid.rows]),
+            ]
+        for axis, tokens, spans, (gaps, margins) in axes:
             if len(tokens) == len(spans):  # no gap: nothing else takes a longer façade
                 stretched.update(symbol for symbol, _ in tokens)
             ends = _names(margins)
@@ -303,6 +322,7 @@ def spec_text(
         "# a label's elements on a grid (its columns x its rows), back to front, with the",
         "# gaps between them (<layer>_gx, _gy: hidden); runs repeat with counters (n1, ...).",
         "# Sizes in metres: a line per label's elements, then per layer's gaps.",
+        *_bays_note(bays),
         "version: 1",
         f"name: {name}",
         f"canvas: {{width: {_number(width)}, height: {_number(height)}}}",
@@ -313,7 +333,8 @@ def spec_text(
     ]
     spread = spread or {}
     clear = uncovered(found)
-    fixed = repeated - loose  # a run's letters keep their size where margins take the slack
+    fixed = (repeated - loose) | in_bay  # a run's letters keep their size where margins take
+    # the slack, and so do a bay's
     margined -= roofs  # a layer on the same rows keeps its margin to the ground instead
     held -= loose
     sizes = [
@@ -341,6 +362,11 @@ def spec_text(
         ]
         for mine in owned
     ]
+    sizes += [
+        [(symbol, _gap(size, True, False)) for size, symbol in gaps.sizes.items()]
+        for gaps in bay_gaps
+    ]
+    sizes.append([(symbol, _number(size)) for size, symbol in bay_margins.sizes.items()])
     out += [
         "  " + ", ".join(f"{symbol}: {size}" for symbol, size in line) + ","
         for line in sizes
@@ -348,12 +374,19 @@ def spec_text(
     ]
     out[-1] = out[-1].rstrip(",")
     out.append("}")
-    if counters.names:
+    bay_counters = shared.counters if shared is not None and in_bay else ()
+    if counters.names or bay_counters:
         out.append("counters:")
         out += [
             f"  {n}: {{min: 0}}  # {count or 'floors over the top one'} along {axis} at a "
             f"pitch of {_number(pitch)} m"
             for (axis, pitch, count), n in counters.names.items()
+        ]
+        out += [
+            f"  {n}: {{min: 0{'' if most is None else f', max: {most}'}}}  # {count} "
+            f"{'end bays (they may drop)' if most is not None else 'bays'} along x at a pitch "
+            f"of {_number(pitch)} m"
+            for n, pitch, count, most in bay_counters
         ]
     out.append("patterns: {wall_x: wall_w, wall_y: wall_h}")
     out.append("layers:")
@@ -377,6 +410,67 @@ def spec_text(
     colours += [(ident(label), label_colour(label)) for label in elements]
     out.append("materials: {" + ", ".join(f'{n}: {{color: "{c}"}}' for n, c in colours) + "}")
     return "\n".join(out) + "\n"
+
+
+def _bays_note(bays: Bays | str | None) -> list[str]:
+    """The comment saying how the x words were written: on the façade's bays, or why not."""
+    if bays is None:
+        return []
+    if isinstance(bays, str):
+        return [
+            f"# Bays not shared: {bays};",
+            "# each layer has its own x word (what a narrower façade cannot drop, it squeezes).",
+        ]
+    return [
+        f"# Bays: {bays.describe()}; every layer standing in them follows one sequence of",
+        "# bays along x (bayK_g: a bay's hidden gaps), repeated runs with counters (bays1,",
+        "# ...), the margins (bays_mx) taking the slack.",
+    ]
+
+
+def _bay_word(
+    bays: Bays,
+    grid: Grid,
+    element: _Symbols,
+    gaps: list[_Symbols],
+    margins: _Symbols,
+    fixed: set[str],
+) -> str:
+    """The grid's x word on the façade's bays (``infer.bays``): the left margin, each run
+    of bays (its unit once, with its counter, or as drawn), the right margin; mirrored
+    as the left half, the middle bay and the half reflected when the bays read so. The
+    element symbols go into ``fixed``."""
+
+    def bay(k: int) -> str:
+        kind = bays.kinds[k]
+        letters, cursor = [], 0.0
+        for a, b in segment(bays, grid, k) or []:
+            if a - cursor > 1e-9:
+                letters.append(gaps[kind].of(round(a - cursor, 4)))
+            letters.append(element.of(b - a))
+            fixed.add(letters[-1])
+            cursor = b
+        if bays.widths[kind] - cursor > 1e-9:
+            letters.append(gaps[kind].of(round(bays.widths[kind] - cursor, 4)))
+        text = " ".join(letters)
+        if not bays.mirrored[k] or letters == [gaps[kind].of(bays.widths[kind])]:
+            return text
+        return f"({text})^-1"
+
+    parts = []
+    for run in bays.runs:
+        unit = " ".join(bay(k) for k in range(run.start, run.start + run.unit))
+        if run.counter is None:
+            parts.append(unit)
+        else:
+            single = run.unit == 1 and " " not in unit and "(" not in unit
+            parts.append(f"{unit}^{run.counter}" if single else f"({unit})^{run.counter}")
+    left = margins.of(bays.margins[0])
+    if bays.reflected:
+        half = " ".join([left, *parts])
+        middle = [bay(len(bays.kinds) // 2)] if len(bays.kinds) % 2 else []
+        return " ".join([half, *middle, f"({half})^-1"])
+    return " ".join([left, *parts, margins.of(bays.margins[1])])
 
 
 def _floors_above(

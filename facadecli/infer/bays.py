@@ -1,0 +1,463 @@
+"""Shared bay kinds: a façade's elements as one sequence of bays, written with counters
+(issue 34).
+
+A *bay* is a vertical strip of the façade holding elements that no other strip's
+elements overlap along x (a window with its sill and blind, the door with the windows
+over it); bands across the façade (``layers.BAND``) are in none. The strips' boundaries
+are the middles of the walls between them; the first and last reach as far out as half
+the wall on their inner side.
+
+Bays showing the same elements (label, place in the bay, rows) within ``ALIKE`` of the
+bay's width, read as drawn or mirrored, are one *kind*. Each kind is put on one shape
+(the median of its bays, so that every layer's word repeats it exactly), and the
+façade's x words become one sequence of bays, written alike in every layer that stands
+in bays (each layer shows its own elements; a bay where it shows none is one hidden
+spacer): a repeated unit of one or two bays (never a unique label's: a door's bay is
+written once) gets a counter, at most ``COUNTERS`` of them; kinds found only at the
+façade's ends share one counter that can only drop them (its most: one, as drawn). A
+sequence that reads the same mirrored is written as its left half, the middle and the
+half reflected (SPEC 2.2), so a wider façade gains bays on both sides alike.
+
+Every bay's letters keep their size and the two margins take the slack, so the layers
+stay together at any width and a façade of another width gains or drops whole bays.
+A façade this cannot narrow to ``NARROWEST`` of its width (every bay its own kind, as
+on an irregular façade drawn by hand), or whose kinds would make elements overlap, is
+left to the per-layer words: ``bays`` says why, and the spec, the report and a warning
+say so.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections import Counter, defaultdict
+from dataclasses import dataclass
+from itertools import pairwise
+
+from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
+from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
+
+ALIKE = 0.05  # of the bay's width: elements this close are the same in two bays
+COUNTERS = 2  # the most counters of runs of bays
+NARROWEST = 0.7  # of the input's width: the bays must be able to narrow to this
+DIGITS = 4  # of a metre: a kind's shape is rounded to this, so every word adds up alike
+UNIQUE = ("door",)  # labels whose bays are never repeated
+FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
+
+Slot = tuple[str, float, float, float, float]  # label, centre x in the bay, width, y0, y1
+
+
+@dataclass(frozen=True)
+class Run:
+    """``copies`` of the unit of bays starting at ``start`` (``unit`` bays long), written
+    with ``counter`` (None: as drawn); ``most``: the counter's most (None: unbounded)."""
+
+    start: int
+    unit: int
+    copies: int
+    counter: str | None = None
+    most: int | None = None
+
+
+@dataclass(frozen=True)
+class Bays:
+    """A façade's bays (see the module): the layout with each kind on one shape, each
+    bay's span, kind and whether it is drawn mirrored, the margins, and the word's plan."""
+
+    layout: LabelledLayout
+    spans: tuple[Span, ...]
+    kinds: tuple[int, ...]
+    mirrored: tuple[bool, ...]
+    widths: tuple[float, ...]  # per kind
+    margins: tuple[float, float]
+    runs: tuple[Run, ...]  # covering the bays written (the left half if ``reflected``)
+    reflected: bool  # written as the left half, the middle bay (if odd) and the half mirrored
+    counters: tuple[tuple[str, float, int, int | None], ...]  # name, pitch, count, most
+
+    def describe(self) -> str:
+        letters = "".join(chr(ord("A") + k) for k in self.kinds)
+        return f"{len(self.spans)} bays of {len(self.widths)} kinds ({letters})"
+
+
+def find_bays(layout: LabelledLayout) -> Bays | str:
+    """The façade's bays (see the module), or why it has none to write."""
+    width = layout.width
+    strips = _strips(layout)
+    if len(strips) < 2:
+        return FEW_BAYS
+    spans = _bay_spans(strips, width)
+    order = _right_half_mirrored_first(len(spans))
+    slots = [
+        _slots([layout.rects[k] for k in held], span)
+        for (_, held), span in zip(strips, spans, strict=True)
+    ]
+    kinds, mirrored, matches = _kinds(slots, spans, order)
+    shapes = _shapes(slots, kinds, mirrored, matches, spans)
+    widths = tuple(
+        round(
+            statistics.median(b - a for (a, b), k in zip(spans, kinds, strict=True) if k == kind),
+            DIGITS,
+        )
+        for kind in range(len(shapes))
+    )
+    symmetric = _palindrome(kinds, mirrored)
+    left, right = spans[0][0], width - spans[-1][1]
+    total = sum(widths[k] for k in kinds)
+    if symmetric and abs(left - right) <= ALIKE * statistics.median(widths):
+        start = round((width - total) / 2, DIGITS)
+    else:
+        symmetric = False
+        start = round(left, DIGITS)
+    if start <= 0 or width - start - total <= 0:
+        return "the bays reach the façade's edge (no margin to take the slack)"
+    unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
+    runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
+    if symmetric and not any(r.counter and r.most is None for r in runs):
+        symmetric = False  # the halves would keep no repeat: the whole sequence, then
+        runs, counters = _plan(kinds, mirrored, unique, widths, False)
+    if not any(r.counter and r.most is None for r in runs):
+        return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
+    narrowest = _narrowest(runs, kinds, widths, symmetric)
+    if narrowest > NARROWEST * width:
+        return (
+            f"its {len(kinds)} bays of {len(shapes)} kinds cannot narrow below "
+            f"{narrowest / width:.2f} of its width (bays of a kind repeat; most are unlike)"
+        )
+    members = [held for _, held in strips]
+    placed, new_spans = _placed(layout, members, kinds, mirrored, matches, shapes, widths, start)
+    if _new_overlaps(layout.rects, placed):
+        return "its bays put on their kinds' shapes would overlap elements"
+    return Bays(
+        LabelledLayout(layout.width, layout.height, tuple(placed)),
+        tuple(new_spans),
+        tuple(kinds),
+        tuple(mirrored),
+        widths,
+        (start, round(width - start - total, DIGITS)),
+        tuple(runs),
+        symmetric,
+        tuple(counters),
+    )
+
+
+def _strips(layout: LabelledLayout) -> list[tuple[Span, list[int]]]:
+    """The elements (not bands) merged into strips along x where they overlap, left to
+    right, with the indices of their rectangles."""
+    members = sorted(
+        (
+            k
+            for k, r in enumerate(layout.rects)
+            if r.label != BACKGROUND and 0 < r.x1 - r.x0 <= BAND * layout.width
+        ),
+        key=lambda k: layout.rects[k].x0,
+    )
+    strips: list[tuple[Span, list[int]]] = []
+    for k in members:
+        r = layout.rects[k]
+        if strips and r.x0 < strips[-1][0][1] - 1e-9:
+            (a, b), held = strips[-1]
+            strips[-1] = ((a, max(b, r.x1)), [*held, k])
+        else:
+            strips.append(((r.x0, r.x1), [k]))
+    return strips
+
+
+def _bay_spans(strips: list[tuple[Span, list[int]]], width: float) -> list[Span]:
+    """Each strip widened to the middle of the wall on either side (the end ones by the
+    half wall on their inner side, within the façade)."""
+    cuts = [(a[1] + b[0]) / 2 for (a, _), (b, _) in pairwise(strips)]
+    first, last = strips[0][0], strips[-1][0]
+    low = max(0.0, first[0] - (cuts[0] - first[1]))
+    high = min(width, last[1] + (last[0] - cuts[-1]))
+    edges = [low, *cuts, high]
+    return list(pairwise(edges))
+
+
+def _right_half_mirrored_first(count: int) -> list[bool]:
+    """For each bay, whether a match read mirrored is tried first: in the right half,
+    where a mirrored façade's bays are its left half's reflected."""
+    return [k > (count - 1) / 2 for k in range(count)]
+
+
+def _slots(rects: list[Rect], span: Span) -> list[Slot]:
+    """A bay's elements in its own frame: label, centre from its left edge, width, rows
+    (in the order of ``rects``)."""
+    return [(r.label, (r.x0 + r.x1) / 2 - span[0], r.x1 - r.x0, r.y0, r.y1) for r in rects]
+
+
+def _flip(slot: Slot, width: float) -> Slot:
+    label, centre, size, y0, y1 = slot
+    return (label, width - centre, size, y0, y1)
+
+
+def _match(a: list[Slot], b: list[Slot], tolerance: float) -> list[int] | None:
+    """For each slot of ``a``, the slot of ``b`` it is (same label, centre, width and
+    rows within ``tolerance``), or None when the two are not alike."""
+    if len(a) != len(b):
+        return None
+    free = set(range(len(b)))
+    out = []
+    for slot in a:
+        found = next(
+            (
+                j
+                for j in sorted(free)
+                if b[j][0] == slot[0]
+                and all(abs(p - q) <= tolerance for p, q in zip(slot[1:], b[j][1:], strict=True))
+            ),
+            None,
+        )
+        if found is None:
+            return None
+        free.discard(found)
+        out.append(found)
+    return out
+
+
+def _kinds(
+    slots: list[list[Slot]], spans: list[Span], mirrored_first: list[bool]
+) -> tuple[list[int], list[bool], list[list[int]]]:
+    """Each bay's kind (the first bay alike, as drawn or mirrored, else a kind of its
+    own), whether it is its kind's first bay mirrored, and which of its slots is each of
+    the first bay's."""
+    reps: list[int] = []
+    kinds, mirrored, matches = [], [], []
+    for k, (mine, (a, b)) in enumerate(zip(slots, spans, strict=True)):
+        width = b - a
+        flipped = [_flip(s, width) for s in mine]
+        found = None
+        for kind, rep in enumerate(reps):
+            rep_width = spans[rep][1] - spans[rep][0]
+            tolerance = ALIKE * max(width, rep_width)
+            if abs(width - rep_width) > tolerance:
+                continue
+            tries = [(True, flipped), (False, mine)]
+            for flip, candidate in tries if mirrored_first[k] else tries[::-1]:
+                match = _match(slots[rep], candidate, tolerance)
+                if match is not None:
+                    found = (kind, flip, match)
+                    break
+            if found:
+                break
+        if found is None:
+            found = (len(reps), False, list(range(len(mine))))
+            reps.append(k)
+        kinds.append(found[0])
+        mirrored.append(found[1])
+        matches.append(found[2])
+    return kinds, mirrored, matches
+
+
+def _shapes(
+    slots: list[list[Slot]],
+    kinds: list[int],
+    mirrored: list[bool],
+    matches: list[list[int]],
+    spans: list[Span],
+) -> list[list[Slot]]:
+    """Each kind's shape: per slot of its first bay, the median over its bays (read in
+    the first bay's frame; its size and rows those of the label's elements anywhere that
+    most share them, within ``ALIKE``: ``_common``), its place and width along x rounded
+    to ``DIGITS``."""
+    count = max(kinds) + 1
+    pool: dict[tuple[str, int], Counter[float]] = defaultdict(Counter)
+    for mine in slots:
+        for slot in mine:
+            for i in (1, 2, 3):  # width, y0, y1
+                pool[slot[0], i][slot[1:][i]] += 1
+    shapes = []
+    for kind in range(count):
+        bays = [k for k in range(len(kinds)) if kinds[k] == kind]
+        first = slots[bays[0]]
+        shape: list[Slot] = []
+        for n, slot in enumerate(first):
+            seen = []
+            for k in bays:
+                width = spans[k][1] - spans[k][0]
+                own = [_flip(s, width) for s in slots[k]] if mirrored[k] else slots[k]
+                seen.append(own[matches[k][n]])
+            tolerance = ALIKE * statistics.median(spans[k][1] - spans[k][0] for k in bays)
+            values = [statistics.median(s[1:][i] for s in seen) for i in range(4)]
+            for i in (1, 2, 3):  # a size and rows the façade has most, where one is close
+                values[i] = _common(pool[slot[0], i], values[i], tolerance)
+            centre, size, y0, y1 = values  # rows as the façade has them: its floors' sizes
+            shape.append((slot[0], round(centre, DIGITS), round(size, DIGITS), y0, y1))
+        shapes.append(shape)
+    return shapes
+
+
+def _common(seen: Counter[float], value: float, tolerance: float) -> float:
+    """Of the values ``seen`` within ``tolerance`` of ``value``, the one seen most (the
+    nearest on a tie): the size or row the other kinds' elements of a label share stay
+    shared (one symbol, one row); ``value`` when none is that close."""
+    close = [v for v in seen if abs(v - value) <= tolerance]
+    if not close:
+        return value
+    return min(close, key=lambda v: (-seen[v], abs(v - value), v))
+
+
+def _palindrome(kinds: list[int], mirrored: list[bool]) -> bool:
+    """The sequence reads the same mirrored: each bay's partner is of its kind, drawn
+    mirrored the other way."""
+    n = len(kinds)
+    return n >= 2 and all(
+        kinds[k] == kinds[n - 1 - k] and mirrored[k] != mirrored[n - 1 - k] for k in range(n // 2)
+    )
+
+
+def _plan(
+    kinds: list[int],
+    mirrored: list[bool],
+    unique: set[int],
+    widths: tuple[float, ...],
+    symmetric: bool,
+) -> tuple[list[Run], list[tuple[str, float, int, int | None]]]:
+    """The runs the written bays are cut into (the left half's if ``symmetric``): ends
+    of kinds found only there on a counter of their own (at most one: drop only), then
+    up to ``COUNTERS`` repeated units of one or two bays, longest first, none of a
+    unique kind; the rest one bay a run, as drawn."""
+    n = len(kinds)
+    written = n // 2 if symmetric else n
+    seq = list(zip(kinds, mirrored, strict=True))
+    inner = kinds[1:-1]
+    ends = {k for k in (kinds[0], kinds[-1]) if k not in inner and k not in unique}
+    taken: dict[int, Run] = {}
+    counters: list[tuple[str, float, int, int | None]] = []
+
+    def counter(pitch: float, copies: int, most: int | None) -> str:
+        for name, known, count, bound in counters:
+            if most is not None and bound == most:
+                return name  # the ends' one counter, whatever their widths
+            if abs(known - pitch) < 1e-9 and count == copies and bound is None and most is None:
+                return name
+        name = f"bays{len(counters) + 1}"
+        counters.append((name, round(pitch, DIGITS), copies, most))
+        return name
+
+    for k in sorted({0, n - 1} & set(range(written))):
+        if kinds[k] in ends:
+            taken[k] = Run(k, 1, 1, counter(widths[kinds[k]], 1, 1), 1)
+    found = 0
+    while found < COUNTERS:
+        best: tuple[int, int, int, int] | None = None  # covered, start, unit, copies
+        for unit in (1, 2):
+            for start in range(written - unit + 1):
+                if any(
+                    j in taken or kinds[j] in unique or kinds[j] in ends
+                    for j in range(start, start + unit)
+                ):
+                    continue
+                copies = 1
+                while start + (copies + 1) * unit <= written and all(
+                    j not in taken and seq[j] == seq[j - unit]
+                    for j in range(start + copies * unit, start + (copies + 1) * unit)
+                ):
+                    copies += 1
+                if copies >= 2 and (best is None or copies * unit > best[0]):
+                    best = (copies * unit, start, unit, copies)
+        if best is None:
+            break
+        _, start, unit, copies = best
+        pitch = sum(widths[kinds[j]] for j in range(start, start + unit))
+        taken[start] = Run(start, unit, copies, counter(pitch, copies, None))
+        for j in range(start + 1, start + unit * copies):
+            taken[j] = taken[start]
+        found += 1
+    runs = []
+    k = 0
+    while k < written:
+        run = taken.get(k, Run(k, 1, 1))
+        runs.append(run)
+        k = run.start + run.unit * run.copies
+    return runs, counters
+
+
+def _narrowest(
+    runs: list[Run], kinds: list[int], widths: tuple[float, ...], symmetric: bool
+) -> float:
+    """The width of the bays when every counter is at none: what cannot drop."""
+    kept = sum(
+        widths[kinds[j]] * (run.counter is None)
+        for run in runs
+        for j in range(run.start, run.start + run.unit * run.copies)
+    )
+    if not symmetric:
+        return kept
+    middle = widths[kinds[len(kinds) // 2]] if len(kinds) % 2 else 0.0
+    return 2 * kept + middle
+
+
+def _placed(
+    layout: LabelledLayout,
+    members: list[list[int]],
+    kinds: list[int],
+    mirrored: list[bool],
+    matches: list[list[int]],
+    shapes: list[list[Slot]],
+    widths: tuple[float, ...],
+    start: float,
+) -> tuple[list[Rect], list[Span]]:
+    """The rectangles with each bay's elements on its kind's shape, the bays side by side
+    from ``start`` (each rectangle in its place in the list), and the bays' spans."""
+    out = list(layout.rects)
+    spans = []
+    cursor = start
+    for held, kind, flip, match in zip(members, kinds, mirrored, matches, strict=True):
+        width = widths[kind]
+        spans.append((cursor, round(cursor + width, DIGITS)))
+        for n, j in enumerate(match):
+            label, centre, size, y0, y1 = shapes[kind][n]
+            if flip:
+                centre = width - centre
+            x0 = round(cursor + centre - size / 2, DIGITS)
+            index = held[j]
+            out[index] = Rect(label, x0, y0, round(x0 + size, DIGITS), y1, layout.rects[index].z)
+        cursor = round(cursor + width, DIGITS)
+    return out, spans
+
+
+def _new_overlaps(before: tuple[Rect, ...], after: list[Rect]) -> bool:
+    """Two elements of a label (openings: any two) overlap after, not before."""
+
+    def meet(a: Rect, b: Rect) -> bool:
+        return min(a.x1, b.x1) - max(a.x0, b.x0) > 1e-9 and min(a.y1, b.y1) - max(a.y0, b.y0) > 1e-9
+
+    group = ["" if r.label in OPENINGS else r.label for r in before]
+    shown = [k for k, r in enumerate(before) if r.label != BACKGROUND]
+    return any(
+        meet(after[i], after[j]) and not meet(before[i], before[j])
+        for n, i in enumerate(shown)
+        for j in shown[n + 1 :]
+        if group[i] == group[j]
+    )
+
+
+def segment(bays: Bays, grid: Grid, bay: int) -> list[Span] | None:
+    """The grid's columns in bay ``bay``, in its kind's frame (read mirrored where the
+    bay is), left to right; None when a column of the grid is in no bay whole."""
+    a, b = bays.spans[bay]
+    width = b - a
+    inside = [c for c in grid.columns if c[0] >= a - 1e-6 and c[1] <= b + 1e-6]
+    if bays.mirrored[bay]:
+        return sorted(
+            (round(width - (y - a), DIGITS), round(width - (x - a), DIGITS)) for x, y in inside
+        )
+    return [(round(x - a, DIGITS), round(y - a, DIGITS)) for x, y in inside]
+
+
+def inside(bays: Bays, grid: Grid) -> bool:
+    """Every column of the grid is inside one bay."""
+    counted = sum(len(segment(bays, grid, k) or []) for k in range(len(bays.spans)))
+    return counted == len(grid.columns)
+
+
+def in_bays(bays: Bays, grid: Grid) -> bool:
+    """Every column of the grid is inside one bay, and the grid shows alike in every bay
+    of a kind (as the word repeats them)."""
+    if not inside(bays, grid):
+        return False
+    seen: dict[int, list[Span]] = {}
+    for k, kind in enumerate(bays.kinds):
+        mine = segment(bays, grid, k) or []
+        if seen.setdefault(kind, mine) != mine:
+            return False
+    return True
