@@ -406,9 +406,10 @@ def _placed(
         spans.append((cursor, round(cursor + width, DIGITS)))
         for n, j in enumerate(match):
             label, centre, size, y0, y1 = shapes[kind][n]
+            low = round(centre - size / 2, DIGITS)  # in the bay, to the digit: every bay alike
             if flip:
-                centre = width - centre
-            x0 = round(cursor + centre - size / 2, DIGITS)
+                low = round(width - low - size, DIGITS)
+            x0 = round(cursor + low, DIGITS)
             index = held[j]
             out[index] = Rect(label, x0, y0, round(x0 + size, DIGITS), y1, layout.rects[index].z)
         cursor = round(cursor + width, DIGITS)
