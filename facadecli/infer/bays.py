@@ -18,8 +18,11 @@ façade's ends share one counter that can only drop them (its most: one, as draw
 sequence that reads the same mirrored is written as its left half, the middle and the
 half reflected (SPEC 2.2), so a wider façade gains bays on both sides alike.
 
-Every bay's letters keep their size and the two margins take the slack, so the layers
-stay together at any width and a façade of another width gains or drops whole bays.
+Every bay's letters keep their size but the wall after its last element, which every
+layer's word of the bay ends with (one symbol a kind: the layers stay together) and
+which may narrow to ``WALL`` of itself; the two margins take the rest of the slack. A
+façade of another width gains or drops whole bays (narrower, it keeps a bay more where
+narrowing the walls between them lets it).
 A façade this cannot narrow to ``NARROWEST`` of its width (every bay its own kind, as
 on an irregular façade drawn by hand), or whose kinds would make elements overlap, is
 left to the per-layer words: ``bays`` says why, and the spec, the report and a warning
@@ -39,6 +42,9 @@ from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
 ALIKE = 0.05  # of the bay's width: elements this close are the same in two bays
 COUNTERS = 2  # the most counters of runs of bays
 NARROWEST = 0.7  # of the input's width: the bays must be able to narrow to this
+WALL = 0.85  # of itself: the narrowest the wall after a bay's last element may become
+COLUMN = 0.01  # m: a kind's elements of a label and size this close stand in one column
+MARGIN = 0.005  # of the façade's width: what an end bay leaves of the margin beyond it
 DIGITS = 4  # of a metre: a kind's shape is rounded to this, so every word adds up alike
 UNIQUE = ("door",)  # labels whose bays are never repeated
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
@@ -72,6 +78,7 @@ class Bays:
     runs: tuple[Run, ...]  # covering the bays written (the left half if ``reflected``)
     reflected: bool  # written as the left half, the middle bay (if odd) and the half mirrored
     counters: tuple[tuple[str, float, int, int | None], ...]  # name, pitch, count, most
+    walls: tuple[float, ...]  # per kind: the wall after its last element (0: none)
 
     def describe(self) -> str:
         letters = "".join(chr(ord("A") + k) for k in self.kinds)
@@ -104,9 +111,12 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
     total = sum(widths[k] for k in kinds)
     if symmetric and abs(left - right) <= ALIKE * statistics.median(widths):
         start = round((width - total) / 2, DIGITS)
-    else:
+    else:  # where the bays side by side best meet the bays as drawn (their starts' mean)
         symmetric = False
-        start = round(left, DIGITS)
+        before = [sum(widths[k] for k in kinds[:n]) for n in range(len(kinds))]
+        start = round(
+            statistics.fmean(a - b for (a, _), b in zip(spans, before, strict=True)), DIGITS
+        )
     if start <= 0 or width - start - total <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
@@ -136,6 +146,15 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
         tuple(runs),
         symmetric,
         tuple(counters),
+        tuple(
+            max(
+                0.0,
+                round(
+                    widths[k] - max(round(c - w / 2, DIGITS) + w for _, c, w, _, _ in shape), DIGITS
+                ),
+            )
+            for k, shape in enumerate(shapes)
+        ),
     )
 
 
@@ -162,12 +181,14 @@ def _strips(layout: LabelledLayout) -> list[tuple[Span, list[int]]]:
 
 
 def _bay_spans(strips: list[tuple[Span, list[int]]], width: float) -> list[Span]:
-    """Each strip widened to the middle of the wall on either side (the end ones by the
-    half wall on their inner side, within the façade)."""
+    """Each strip widened to the middle of the wall on either side (the end ones
+    outwards by the half wall on their inner side, leaving the margin ``MARGIN`` of the
+    façade where it is that wide: the margins take the slack)."""
     cuts = [(a[1] + b[0]) / 2 for (a, _), (b, _) in pairwise(strips)]
     first, last = strips[0][0], strips[-1][0]
-    low = max(0.0, first[0] - (cuts[0] - first[1]))
-    high = min(width, last[1] + (last[0] - cuts[-1]))
+    edge = MARGIN * width  # left of the margin to the façade's edge, where it is that wide
+    low = first[0] - min(cuts[0] - first[1], max(0.0, first[0] - edge))
+    high = last[1] + min(last[0] - cuts[-1], max(0.0, width - last[1] - edge))
     edges = [low, *cuts, high]
     return list(pairwise(edges))
 
@@ -281,8 +302,32 @@ def _shapes(
                 values[i] = _common(pool[slot[0], i], values[i], tolerance)
             centre, size, y0, y1 = values  # rows as the façade has them: its floors' sizes
             shape.append((slot[0], round(centre, DIGITS), round(size, DIGITS), y0, y1))
-        shapes.append(shape)
+        shapes.append(_columns(shape))
     return shapes
+
+
+def _columns(shape: list[Slot]) -> list[Slot]:
+    """A kind's elements of a label and a size whose centres are within ``COLUMN`` of one
+    another in one column (their median): what a hand draws in one column (the blinds
+    of two floors) leaves no sliver of a gap a layer's word would need to hold."""
+    out = list(shape)
+    order = sorted(range(len(shape)), key=lambda n: (shape[n][0], shape[n][2], shape[n][1]))
+    group: list[int] = []
+    for n in [*order, -1]:
+        if group and (
+            n < 0
+            or shape[n][0] != shape[group[0]][0]
+            or shape[n][2] != shape[group[0]][2]
+            or shape[n][1] - shape[group[-1]][1] > COLUMN
+        ):
+            centre = round(statistics.median(shape[m][1] for m in group), DIGITS)
+            for m in group:
+                label, _, size, y0, y1 = shape[m]
+                out[m] = (label, centre, size, y0, y1)
+            group = []
+        if n >= 0:
+            group.append(n)
+    return out
 
 
 def _common(seen: Counter[float], value: float, tolerance: float) -> float:
@@ -336,6 +381,7 @@ def _plan(
     for k in sorted({0, n - 1} & set(range(written))):
         if kinds[k] in ends:
             taken[k] = Run(k, 1, 1, counter(widths[kinds[k]], 1, 1), 1)
+    counted: dict[int, int] = {}  # the kinds runs repeat, by their copies
     found = 0
     while found < COUNTERS:
         best: tuple[int, int, int, int] | None = None  # covered, start, unit, copies
@@ -352,6 +398,8 @@ def _plan(
                     for j in range(start + copies * unit, start + (copies + 1) * unit)
                 ):
                     copies += 1
+                if any(counted.get(kinds[j], copies) != copies for j in range(start, start + unit)):
+                    continue  # a kind repeats under one counter: a run of another count stays
                 if copies >= 2 and (best is None or copies * unit > best[0]):
                     best = (copies * unit, start, unit, copies)
         if best is None:
@@ -359,6 +407,7 @@ def _plan(
         _, start, unit, copies = best
         pitch = sum(widths[kinds[j]] for j in range(start, start + unit))
         taken[start] = Run(start, unit, copies, counter(pitch, copies, None))
+        counted.update((kinds[j], copies) for j in range(start, start + unit))
         for j in range(start + 1, start + unit * copies):
             taken[j] = taken[start]
         found += 1

@@ -32,7 +32,7 @@ import re
 from dataclasses import dataclass, field
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.bays import Bays, in_bays, segment
+from facadecli.infer.bays import WALL, Bays, in_bays, segment
 from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, top_floors, uncovered
 
 DECIMALS = 4  # of a metre in the sizes written
@@ -366,6 +366,17 @@ def spec_text(
         [(symbol, _gap(size, True, False)) for size, symbol in gaps.sizes.items()]
         for gaps in bay_gaps
     ]
+    if in_bay and shared is not None:
+        sizes.append(
+            [
+                (
+                    f"bay{kind + 1}_w",
+                    f"{{size: {_number(wall)}, min: {_number(WALL * wall)}, max: {_number(wall)}}}",
+                )
+                for kind, wall in enumerate(shared.walls)
+                if wall
+            ]
+        )
     sizes.append([(symbol, _number(size)) for size, symbol in bay_margins.sizes.items()])
     out += [
         "  " + ", ".join(f"{symbol}: {size}" for symbol, size in line) + ","
@@ -423,8 +434,9 @@ def _bays_note(bays: Bays | str | None) -> list[str]:
         ]
     return [
         f"# Bays: {bays.describe()}; every layer standing in them follows one sequence of",
-        "# bays along x (bayK_g: a bay's hidden gaps), repeated runs with counters (bays1,",
-        "# ...), the margins (bays_mx) taking the slack.",
+        "# bays along x (bayK_g: a bay's hidden gaps; bayK_w: the wall after its elements,",
+        "# which may narrow), runs with counters (bays1, ...), the margins (bays_mx) taking",
+        "# the slack.",
     ]
 
 
@@ -439,7 +451,9 @@ def _bay_word(
     """The grid's x word on the façade's bays (``infer.bays``): the left margin, each run
     of bays (its unit once, with its counter, or as drawn), the right margin; mirrored
     as the left half, the middle bay and the half reflected when the bays read so. The
-    element symbols go into ``fixed``."""
+    element symbols go into ``fixed``. Each bay ends with its kind's wall (``bayK_w``:
+    ``Bays.walls``), alike in every layer."""
+    walls = [f"bay{kind + 1}_w" for kind in range(len(bays.widths))]
 
     def bay(k: int) -> str:
         kind = bays.kinds[k]
@@ -450,11 +464,16 @@ def _bay_word(
             letters.append(element.of(b - a))
             fixed.add(letters[-1])
             cursor = b
-        if bays.widths[kind] - cursor > 1e-9:
-            letters.append(gaps[kind].of(round(bays.widths[kind] - cursor, 4)))
+        wall = bays.walls[kind]
+        if bays.widths[kind] - wall - cursor > 1e-9:
+            letters.append(gaps[kind].of(round(bays.widths[kind] - wall - cursor, 4)))
+        if wall:
+            letters.append(walls[kind])
         text = " ".join(letters)
-        if not bays.mirrored[k] or letters == [gaps[kind].of(bays.widths[kind])]:
-            return text
+        if not bays.mirrored[k] or all(
+            s in gaps[kind].sizes.values() or s in walls for s in letters
+        ):
+            return text  # nothing shown: nothing to mirror
         return f"({text})^-1"
 
     parts = []

@@ -1,0 +1,152 @@
+"""Shared bay kinds (``infer.bays``, issue 34): on generated façades with known structure
+(``annotated_family``, seeds 1-24; the hold-out 101-110 is never used here), the inferred
+spec's layers follow one sequence of bays, a counter a repeated kind, so that solved at
+another width the façade gains or drops whole bays of the right kind, its door bay once;
+a façade whose bays cannot do that keeps per-layer words and says so."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from facadecli import parse_spec, solve
+from facadecli.grammar.inputs import Rect
+from facadecli.grammar.model import Options
+from facadecli.infer.run import infer, solved_layout
+from facadecli.solve import retarget
+from tests.benchmarks.annotated_family import cmp_xml, family
+
+NEAR = 0.15  # m: window centres this close are one column (1% of the façade)
+
+
+def _inferred(tmp_path: Path, seed: int):  # type: ignore[no-untyped-def]
+    path = tmp_path / f"family-{seed}.xml"
+    path.write_text(cmp_xml(family(seed)[0]))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    return inference, parse_spec(inference.text, path.stem)
+
+
+def _solved(inference, spec, share: float) -> list[Rect]:  # type: ignore[no-untyped-def]
+    width = round(inference.layout.width * share, 4)
+    layout = solve(retarget(spec, width, inference.layout.height))
+    return list(solved_layout(layout, spec, inference).rects)
+
+
+def _columns(rects: list[Rect], label: str = "window") -> list[int]:
+    """How many elements of ``label`` each column (centres within ``NEAR``) holds."""
+    centres = sorted((r.x0 + r.x1) / 2 for r in rects if r.label == label)
+    counts: list[int] = []
+    last = None
+    for c in centres:
+        if last is None or c - last > NEAR:
+            counts.append(0)
+        counts[-1] += 1
+        last = c
+    return counts
+
+
+def _x_words(text: str) -> dict[str, str]:
+    spec = parse_spec(text, "spec")
+    return {layer.name: str(layer.x) for layer in spec.layers if layer.name != "wall"}
+
+
+@pytest.mark.parametrize("seed", [1, 6, 13])
+def test_a_family_facade_is_one_sequence_of_bays_a_counter_a_repeated_kind(
+    tmp_path: Path, seed: int
+) -> None:
+    inference, spec = _inferred(tmp_path, seed)
+    assert not inference.unshared and inference.bays.startswith(f"{family(seed)[1].bays} bays")
+    words = _x_words(inference.text)
+    openings = {n: w for n, w in words.items() if n.startswith(("window", "door", "sill"))}
+    # every opening's layer (and its sills') follows the one sequence of bays
+    assert openings and all("bays_m1" in w for w in openings.values())
+    bay_counters = {n for n in spec.counters if n.startswith("bays")}
+    assert 1 <= len(bay_counters) <= 3  # at most two runs, and the ends' one
+    assert all(any(f"^{n}" in w for w in openings.values()) for n in bay_counters)
+    # one window width: the kinds share the label's sizes
+    assert [n for n in spec.symbols if n.startswith("window_w")] == ["window_w1"]
+
+
+@pytest.mark.parametrize("seed", [7, 13, 23])
+def test_other_widths_gain_or_drop_whole_bays_and_the_door_bay_never_repeats(
+    tmp_path: Path, seed: int
+) -> None:
+    """Each column of windows solved at another width holds as many windows as a column
+    of the input (whole bays, aligned between floors), there are more columns wider and
+    fewer narrower, the windows keep their width, and there is one door."""
+    inference, spec = _inferred(tmp_path, seed)
+    raw = list((inference.raw or inference.layout).rects)
+    drawn = _columns(raw)
+    widths = [r.x1 - r.x0 for r in raw if r.label == "window"]
+    for share in (0.7, 1.5, 2.0):
+        rects = _solved(inference, spec, share)
+        columns = _columns(rects)
+        assert set(columns) <= set(drawn), (share, columns, drawn)
+        assert (len(columns) < len(drawn)) if share < 1 else (len(columns) > len(drawn))
+        assert sum(r.label == "door" for r in rects) == 1
+        assert all(
+            any(abs((r.x1 - r.x0) / w - 1) <= 0.15 for w in widths)
+            for r in rects
+            if r.label == "window"
+        )
+
+
+@pytest.mark.parametrize(
+    "seed",
+    [s for s in range(1, 25) if family(s)[1].mirrored and family(s)[1].bays % 2][:3],
+)
+def test_a_mirrored_family_facade_is_written_reflected_and_stays_mirrored(
+    tmp_path: Path, seed: int
+) -> None:
+    """Mirrored halves, the door in the middle bay: the windows' word repeats one counter
+    on both sides, as the left half reflected where the bays themselves are mirrored (a
+    family's blinds are all on the windows' right: such bays are not), and solved at
+    other widths the windows stay mirrored."""
+    inference, spec = _inferred(tmp_path, seed)
+    window = _x_words(inference.text)["window"]
+    assert window.count("^bays1") == 2  # one counter, both sides
+    assert (")^-1" in window) == (not family(seed)[1].blinds)  # the left half, reflected
+    for share in (0.7, 1.5):
+        rects = _solved(inference, spec, share)
+        width = inference.layout.width * share
+        windows = [r for r in rects if r.label == "window"]
+        mirrored = sum(
+            any(
+                abs((q.x0 + q.x1) / 2 - (width - (r.x0 + r.x1) / 2)) < NEAR
+                and abs(q.y0 - r.y0) < NEAR
+                for q in windows
+            )
+            for r in windows
+        )
+        assert mirrored >= 0.9 * len(windows)
+
+
+def test_a_facade_whose_bays_cannot_narrow_keeps_per_layer_words_and_says_so(
+    tmp_path: Path,
+) -> None:
+    """Four window bays each unlike the others (widths 1.0-1.9 m): no kind repeats, so
+    nothing could drop at 0.7x; the spec keeps a word a layer, and the spec, the report
+    and a warning say why."""
+    rects = [
+        {"label": "window", "x0": x, "y0": y, "x1": x + w, "y1": y + 1.5}
+        for x, w in ((1.0, 1.0), (4.0, 1.3), (7.0, 1.6), (10.0, 1.9))
+        for y in (2.0, 5.0, 8.0)
+    ]
+    layout = tmp_path / "unlike.json"
+    layout.write_text(json.dumps({"canvas": {"width": 13.0, "height": 11.0}, "rects": rects}))
+    out = tmp_path / "unlike.yaml"
+    run = subprocess.run(
+        [sys.executable, "-m", "facadecli", "infer", str(layout), "-o", str(out), "--no-check"],
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 0, run.stderr
+    assert "warning: bays not shared: none of its 4 bays of 4 kinds repeat" in run.stderr
+    assert "# Bays not shared:" in out.read_text()
+    report = json.loads(out.with_name("unlike.infer.json").read_text())
+    assert report["bays"].startswith("not shared")
+    assert "bays_m" not in out.read_text()
