@@ -235,7 +235,9 @@ def spec_text(
     # a layer's gaps are its own, but layers with the same columns (or rows) share them:
     # their words are then alike and stay aligned at any size
     gaps_x: dict[tuple[Span, ...], tuple[_Symbols, _Symbols]] = {}
-    gaps_y: dict[tuple[Span, ...], tuple[_Symbols, _Symbols]] = {}
+    # (by rows, and whether the layer's top floor repeats upwards: one whose top margin
+    # shrinks as floors are gained never shares it with one whose margin cannot)
+    gaps_y: dict[tuple[tuple[Span, ...], bool], tuple[_Symbols, _Symbols]] = {}
     owned: list[list[_Symbols]] = []  # the gap and margin symbols each layer introduces
     repeated: set[str] = set()  # symbols of runs (written with a counter)
     stretched: set[str] = set()  # elements of words without gaps: they fill the façade
@@ -260,19 +262,24 @@ def spec_text(
         bay_word = None
         if shared is not None and in_bays(shared, grid):
             bay_word = _bay_word(shared, grid, symbols[0], bay_gaps, bay_margins, in_bay)
+        row_key = (grid.rows, index in tops and grid.label not in UNIQUE)
         introduced = [
-            symbols
-            for table, spans, axis in ((gaps_x, columns, "x"), (gaps_y, grid.rows, "y"))
-            if spans not in table and (axis == "y" or bay_word is None)
-            for symbols in table.setdefault(
-                spans, (_Symbols(f"{layer}_g{axis}"), _Symbols(f"{layer}_m{axis}"))
-            )
+            *(
+                gaps_x.setdefault(columns, (_Symbols(f"{layer}_gx"), _Symbols(f"{layer}_mx")))
+                if columns not in gaps_x and bay_word is None
+                else ()
+            ),
+            *(
+                gaps_y.setdefault(row_key, (_Symbols(f"{layer}_gy"), _Symbols(f"{layer}_my")))
+                if row_key not in gaps_y
+                else ()
+            ),
         ]
         owned.append(introduced)
-        y_tokens = _tokens(grid.rows, height, symbols[1], *gaps_y[grid.rows])
+        y_tokens = _tokens(grid.rows, height, symbols[1], *gaps_y[row_key])
         words = []
         if bay_word is not None:
-            axes = [("y", y_tokens, grid.rows, gaps_y[grid.rows])]
+            axes = [("y", y_tokens, grid.rows, gaps_y[row_key])]
             words.append(bay_word)
         else:
             x_tokens = _tokens(
@@ -280,7 +287,7 @@ def spec_text(
             )
             axes = [
                 ("x", x_tokens, columns, gaps_x[columns]),
-                ("y", y_tokens, grid.rows, gaps_y[grid.rows]),
+                ("y", y_tokens, grid.rows, gaps_y[row_key]),
             ]
         for axis, tokens, spans, (gaps, margins) in axes:
             if len(tokens) == len(spans):  # no gap: nothing else takes a longer façade
