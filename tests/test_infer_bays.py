@@ -150,3 +150,18 @@ def test_a_facade_whose_bays_cannot_narrow_keeps_per_layer_words_and_says_so(
     report = json.loads(out.with_name("unlike.infer.json").read_text())
     assert report["bays"].startswith("not shared")
     assert "bays_m" not in out.read_text()
+
+
+def test_a_two_floor_family_facade_gains_a_floor_when_taller(tmp_path: Path) -> None:
+    """Seed 15 (four bays of two floors, blinds beside the windows, the door's bay
+    without a blind under its top floor's): the top floor's windows repeat upwards, and
+    a layer on the same rows that does not (the door bay's blind) keeps its own margins,
+    so at 1.5x the height a floor is gained (sharing them, no floor could be)."""
+    inference, spec = _inferred(tmp_path, 15)
+    width, height = inference.layout.width, inference.layout.height
+    counts = []
+    for share in (1.0, 1.5):
+        layout = solve(retarget(spec, width, height * share))
+        rects = list(solved_layout(layout, spec, inference).rects)
+        counts.append(sum(r.label == "window" for r in rects))
+    assert counts[1] > counts[0]
