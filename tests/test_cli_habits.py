@@ -181,7 +181,7 @@ def test_grammar_and_infer_tell_their_stages_on_standard_error(
     target = str(tmp_path / "i" / "s.yaml")
     code, _, err = run(capsys, "infer", str(sample), "-o", target, "--no-check", "-v")
     assert code == 0, err
-    assert "finding the grids of each label (at " in err
+    assert "finding the bays and the grids of each label (at " in err
 
 
 def test_vary_tells_each_size_on_standard_error(

@@ -21,6 +21,11 @@
   A word that reads the same backwards is written as its left half, the middle, and the
   half reflected (``^-1``), when each half keeps its run: a wider façade then gains bays on
   both sides alike.
+- Shared bays (``infer.bays``): where the façade's bays repeat, the x word of every layer
+  standing in them follows their one sequence instead (``_bay_word``): the margins
+  (``bays_m1``), each bay its kind's hidden gaps (``bay1_g1``), the layer's elements and
+  the kind's wall (``bay1_w``), runs of bays with counters (``bays1``); a comment says
+  which, or why the bays are not shared.
 - Meshes and materials by label (frames for windows and shop fronts, doors, ledges for
   sills, cornices and mouldings, balconies, shutters for blinds, boxes for the rest),
   colours from the label palette; every layer says in a comment where it came from.
