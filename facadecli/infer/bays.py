@@ -36,6 +36,8 @@ from collections import Counter, defaultdict
 from dataclasses import dataclass
 from itertools import pairwise
 
+import numpy as np
+
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
 
@@ -46,6 +48,7 @@ WALL = 0.85  # of itself: the narrowest the wall after a bay's last element may 
 COLUMN = 0.01  # m: a kind's elements of a label and size this close stand in one column
 MARGIN = 0.005  # of the façade's width: what an end bay leaves of the margin beyond it
 DIGITS = 4  # of a metre: a kind's shape is rounded to this, so every word adds up alike
+SETTLE = 1e-3  # the weight of a kind's width and centres as first read, against the elements'
 UNIQUE = ("door",)  # labels whose bays are never repeated
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
@@ -100,23 +103,17 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
     kinds, mirrored, matches = _kinds(slots, spans, order)
     shapes = _shapes(slots, kinds, mirrored, matches, spans)
     widths = tuple(
-        round(
-            statistics.median(b - a for (a, b), k in zip(spans, kinds, strict=True) if k == kind),
-            DIGITS,
-        )
+        statistics.median(b - a for (a, b), k in zip(spans, kinds, strict=True) if k == kind)
         for kind in range(len(shapes))
     )
+    start, widths, shapes = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths)
     symmetric = _palindrome(kinds, mirrored)
     left, right = spans[0][0], width - spans[-1][1]
     total = sum(widths[k] for k in kinds)
     if symmetric and abs(left - right) <= ALIKE * statistics.median(widths):
         start = round((width - total) / 2, DIGITS)
-    else:  # where the bays side by side best meet the bays as drawn (their starts' mean)
+    else:
         symmetric = False
-        before = [sum(widths[k] for k in kinds[:n]) for n in range(len(kinds))]
-        start = round(
-            statistics.fmean(a - b for (a, _), b in zip(spans, before, strict=True)), DIGITS
-        )
     if start <= 0 or width - start - total <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
@@ -306,6 +303,61 @@ def _shapes(
     return shapes
 
 
+def _fitted(
+    slots: list[list[Slot]],
+    spans: list[Span],
+    kinds: list[int],
+    mirrored: list[bool],
+    matches: list[list[int]],
+    shapes: list[list[Slot]],
+    widths: tuple[float, ...],
+) -> tuple[float, tuple[float, ...], list[list[Slot]]]:
+    """Where the bays side by side best meet the elements as drawn: the start of the
+    first bay, each kind's width and each of its elements' centres in it that put the
+    elements' centres nearest (least squares) to where they were drawn, each bay
+    starting where the one before ends (read mirrored where a bay is); the kinds'
+    widths and centres as they are (``widths``, ``shapes``) where the elements say
+    nothing of them (weighed ``SETTLE``). Rounded to ``DIGITS``; elements standing in
+    one column (``_columns``) stay so."""
+    count = len(widths)
+    offsets = [sum(len(shape) for shape in shapes[:kind]) for kind in range(count)]
+    unknowns = 1 + count + sum(len(shape) for shape in shapes)
+    rows: list[list[float]] = []
+    values: list[float] = []
+    for k, (kind, flip, match) in enumerate(zip(kinds, mirrored, matches, strict=True)):
+        for n, j in enumerate(match):
+            row = [0.0] * unknowns
+            row[0] = 1.0  # the start
+            for before in kinds[:k]:
+                row[1 + before] += 1.0
+            centre = slots[k][j][1] + spans[k][0]
+            if flip:  # at the bay's width less the centre in the kind's frame
+                row[1 + kind] += 1.0
+                row[1 + count + offsets[kind] + n] = -1.0
+            else:
+                row[1 + count + offsets[kind] + n] = 1.0
+            rows.append(row)
+            values.append(centre)
+    guess = [spans[0][0], *widths, *(slot[1] for shape in shapes for slot in shape)]
+    for i, value in enumerate(guess):  # what the elements leave free stays as it was
+        row = [0.0] * unknowns
+        row[i] = SETTLE
+        rows.append(row)
+        values.append(SETTLE * value)
+    solution, *_ = np.linalg.lstsq(np.array(rows), np.array(values), rcond=None)
+    fitted = [
+        _columns(
+            [
+                (label, round(float(solution[1 + count + offsets[kind] + n]), DIGITS), w, y0, y1)
+                for n, (label, _, w, y0, y1) in enumerate(shape)
+            ]
+        )
+        for kind, shape in enumerate(shapes)
+    ]
+    fitted_widths = tuple(round(float(w), DIGITS) for w in solution[1 : 1 + count])
+    return round(float(solution[0]), DIGITS), fitted_widths, fitted
+
+
 def _columns(shape: list[Slot]) -> list[Slot]:
     """A kind's elements of a label and a size whose centres are within ``COLUMN`` of one
     another in one column (their median): what a hand draws in one column (the blinds
@@ -331,13 +383,23 @@ def _columns(shape: list[Slot]) -> list[Slot]:
 
 
 def _common(seen: Counter[float], value: float, tolerance: float) -> float:
-    """Of the values ``seen`` within ``tolerance`` of ``value``, the one seen most (the
-    nearest on a tie): the size or row the other kinds' elements of a label share stay
-    shared (one symbol, one row); ``value`` when none is that close."""
-    close = [v for v in seen if abs(v - value) <= tolerance]
-    if not close:
+    """The median of the cluster of values ``seen`` (each as often as seen) that holds
+    the one nearest ``value``, where that is within ``tolerance`` (values each within
+    ``tolerance`` of the next are one cluster): the size or row the other kinds'
+    elements of a label share stay shared (one symbol, one row) and sit where the
+    elements were drawn, on the whole; ``value`` when none is that close."""
+    if not seen or min(abs(v - value) for v in seen) > tolerance:
         return value
-    return min(close, key=lambda v: (-seen[v], abs(v - value), v))
+    ordered = sorted(seen)
+    nearest = min(ordered, key=lambda v: (abs(v - value), v))
+    k = ordered.index(nearest)
+    low = high = k
+    while low > 0 and ordered[low] - ordered[low - 1] <= tolerance:
+        low -= 1
+    while high + 1 < len(ordered) and ordered[high + 1] - ordered[high] <= tolerance:
+        high += 1
+    cluster = [v for v in ordered[low : high + 1] for _ in range(seen[v])]
+    return round(statistics.median(cluster), DIGITS)
 
 
 def _palindrome(kinds: list[int], mirrored: list[bool]) -> bool:
