@@ -22,7 +22,10 @@ Every bay's letters keep their size but the wall after its last element, which e
 layer's word of the bay ends with (one symbol a kind: the layers stay together) and
 which may narrow to ``WALL`` of itself; the two margins take the rest of the slack. A
 façade of another width gains or drops whole bays (narrower, it keeps a bay more where
-narrowing the walls between them lets it).
+narrowing the walls between them lets it). Where the openings mirror about the
+façade's middle, the bays stand in the middle (their frames shifted on the elements, as
+far as each bay's elements stay inside it): the two margins are one symbol, so the
+façade keeps its axis in the middle whatever bays it gains or drops.
 A façade this cannot narrow to ``NARROWEST`` of its width (every bay its own kind, as
 on an irregular façade drawn by hand), or whose kinds would make elements overlap, is
 left to the per-layer words: ``bays`` says why, and the spec, the report and a warning
@@ -48,7 +51,10 @@ WALL = 0.85  # of itself: the narrowest the wall after a bay's last element may 
 COLUMN = 0.01  # m: a kind's elements of a label and size this close stand in one column
 MARGIN = 0.005  # of the façade's width: what an end bay leaves of the margin beyond it
 DIGITS = 4  # of a metre: a kind's shape is rounded to this, so every word adds up alike
+CENTRED = 1e3  # the weight of a mirrored façade's bays standing in its middle
 SETTLE = 1e-3  # the weight of a kind's width and centres as first read, against the elements'
+AXIS = 0.01  # of the façade's width: an opening this close to another's reflection mirrors it
+ASIDE = 0.1  # of the openings: these may lack a mirror image on a façade mirrored as a whole
 UNIQUE = ("door",)  # labels whose bays are never repeated
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
@@ -106,7 +112,14 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
         statistics.median(b - a for (a, b), k in zip(spans, kinds, strict=True) if k == kind)
         for kind in range(len(shapes))
     )
-    start, widths, shapes = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths)
+    centred = _about_middle(list(layout.rects), width)
+    fitted = _fitted(
+        slots, spans, kinds, mirrored, matches, shapes, widths, width if centred else 0
+    )
+    if centred and not _framed(fitted[2], fitted[1]):
+        centred = False  # centred, a bay's elements would leave its frame: as drawn
+        fitted = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths, 0)
+    start, widths, shapes = fitted
     symmetric = _palindrome(kinds, mirrored)
     left, right = spans[0][0], width - spans[-1][1]
     total = sum(widths[k] for k in kinds)
@@ -114,7 +127,8 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
         start = round((width - total) / 2, DIGITS)
     else:
         symmetric = False
-    if start <= 0 or width - start - total <= 0:
+    end = start if centred else round(width - start - total, DIGITS)
+    if start <= 0 or end <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
     runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
@@ -139,7 +153,7 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
         tuple(kinds),
         tuple(mirrored),
         widths,
-        (start, round(width - start - total, DIGITS)),
+        (start, end),
         tuple(runs),
         symmetric,
         tuple(counters),
@@ -153,6 +167,25 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
             for k, shape in enumerate(shapes)
         ),
     )
+
+
+def _about_middle(rects: list[Rect], width: float) -> bool:
+    """The openings (but a unique one: a door off the middle) mirror about the façade's
+    middle: all but ``ASIDE`` of them have one of their label and size whose centre is
+    within ``AXIS`` of the façade of where their centre reflected is."""
+    shown = [r for r in rects if r.label in OPENINGS and r.label not in UNIQUE]
+    near = AXIS * width
+    kept = sum(
+        any(
+            q.label == r.label
+            and abs((q.x0 + q.x1) - (2 * width - r.x0 - r.x1)) <= 2 * near
+            and abs(q.y0 - r.y0) <= near
+            and abs((q.x1 - q.x0) - (r.x1 - r.x0)) <= near
+            for q in shown
+        )
+        for r in shown
+    )
+    return len(shown) >= 2 and kept >= (1 - ASIDE) * len(shown)
 
 
 def _strips(layout: LabelledLayout) -> list[tuple[Span, list[int]]]:
@@ -311,14 +344,16 @@ def _fitted(
     matches: list[list[int]],
     shapes: list[list[Slot]],
     widths: tuple[float, ...],
+    centred: float,
 ) -> tuple[float, tuple[float, ...], list[list[Slot]]]:
     """Where the bays side by side best meet the elements as drawn: the start of the
     first bay, each kind's width and each of its elements' centres in it that put the
     elements' centres nearest (least squares) to where they were drawn, each bay
     starting where the one before ends (read mirrored where a bay is); the kinds'
     widths and centres as they are (``widths``, ``shapes``) where the elements say
-    nothing of them (weighed ``SETTLE``). Rounded to ``DIGITS``; elements standing in
-    one column (``_columns``) stay so."""
+    nothing of them (weighed ``SETTLE``). With ``centred`` (a façade's width; 0: not),
+    the bays side by side stand in its middle (weighed ``CENTRED``). Rounded to
+    ``DIGITS``; elements standing in one column (``_columns``) stay so."""
     count = len(widths)
     offsets = [sum(len(shape) for shape in shapes[:kind]) for kind in range(count)]
     unknowns = 1 + count + sum(len(shape) for shape in shapes)
@@ -338,6 +373,13 @@ def _fitted(
                 row[1 + count + offsets[kind] + n] = 1.0
             rows.append(row)
             values.append(centre)
+    if centred:  # the start and half the bays' widths: the middle
+        row = [0.0] * unknowns
+        row[0] = CENTRED
+        for kind in kinds:
+            row[1 + kind] += CENTRED / 2
+        rows.append(row)
+        values.append(CENTRED * centred / 2)
     guess = [spans[0][0], *widths, *(slot[1] for shape in shapes for slot in shape)]
     for i, value in enumerate(guess):  # what the elements leave free stays as it was
         row = [0.0] * unknowns
@@ -356,6 +398,15 @@ def _fitted(
     ]
     fitted_widths = tuple(round(float(w), DIGITS) for w in solution[1 : 1 + count])
     return round(float(solution[0]), DIGITS), fitted_widths, fitted
+
+
+def _framed(shapes: list[list[Slot]], widths: tuple[float, ...]) -> bool:
+    """Every kind's elements stand inside its bay's frame."""
+    return all(
+        c - w / 2 >= -1e-9 and c + w / 2 <= width + 1e-9
+        for shape, width in zip(shapes, widths, strict=True)
+        for _, c, w, _, _ in shape
+    )
 
 
 def _columns(shape: list[Slot]) -> list[Slot]:
