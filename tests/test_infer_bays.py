@@ -214,3 +214,17 @@ def test_a_shared_row_is_the_middle_of_the_rows_drawn_not_the_one_drawn_most() -
     seen = Counter({4.371: 3, 4.294: 1, 4.331: 1, 4.312: 1, 4.293: 1, 7.31: 2})
     assert _common(seen, 4.35, 0.1) == 4.331
     assert _common(seen, 7.0, 0.1) == 7.0  # none that close: as it was
+
+
+@pytest.mark.parametrize("seed", [3, 12, 14])
+def test_a_floor_row_keeps_the_windows_one_height(tmp_path: Path, seed: int) -> None:
+    """A row shared by the bays' elements is their bottom and their height (their top
+    and bottom each on its own gave one floor's windows 0.1 mm less, a second height
+    symbol, and at 1.5x the height windows stretched): one height symbol, and taller
+    every window keeps its height within 15%."""
+    inference, spec = _inferred(tmp_path, seed)
+    assert [n for n in spec.symbols if n.startswith("window_h")] == ["window_h1"]
+    height = spec.symbols["window_h1"].size
+    layout = solve(retarget(spec, inference.layout.width, inference.layout.height * 1.5))
+    rects = list(solved_layout(layout, spec, inference).rects)
+    assert all(abs((r.y1 - r.y0) / height - 1) <= 0.15 for r in rects if r.label == "window")

@@ -306,15 +306,15 @@ def _shapes(
     spans: list[Span],
 ) -> list[list[Slot]]:
     """Each kind's shape: per slot of its first bay, the median over its bays (read in
-    the first bay's frame; its size and rows those of the label's elements anywhere that
-    most share them, within ``ALIKE``: ``_common``), its place and width along x rounded
+    the first bay's frame; its width, bottom and height those the label's elements
+    anywhere share, within ``ALIKE``: ``_common``), its place and width along x rounded
     to ``DIGITS``."""
     count = max(kinds) + 1
     pool: dict[tuple[str, int], Counter[float]] = defaultdict(Counter)
     for mine in slots:
         for slot in mine:
-            for i in (1, 2, 3):  # width, y0, y1
-                pool[slot[0], i][slot[1:][i]] += 1
+            for i, value in enumerate(_sized(slot)):
+                pool[slot[0], i][value] += 1
     shapes = []
     for kind in range(count):
         bays = [k for k in range(len(kinds)) if kinds[k] == kind]
@@ -327,13 +327,20 @@ def _shapes(
                 own = [_flip(s, width) for s in slots[k]] if mirrored[k] else slots[k]
                 seen.append(own[matches[k][n]])
             tolerance = ALIKE * statistics.median(spans[k][1] - spans[k][0] for k in bays)
-            values = [statistics.median(s[1:][i] for s in seen) for i in range(4)]
-            for i in (1, 2, 3):  # a size and rows the façade has most, where one is close
+            values = [statistics.median(_sized(s)[i] for s in seen) for i in range(4)]
+            for i in (1, 2, 3):  # sizes and rows as the façade's elements share them
                 values[i] = _common(pool[slot[0], i], values[i], tolerance)
-            centre, size, y0, y1 = values  # rows as the façade has them: its floors' sizes
-            shape.append((slot[0], round(centre, DIGITS), round(size, DIGITS), y0, y1))
+            centre, size, y0, height = values
+            shape.append((slot[0], round(centre, DIGITS), round(size, DIGITS), y0, y0 + height))
         shapes.append(_columns(shape))
     return shapes
+
+
+def _sized(slot: Slot) -> tuple[float, float, float, float]:
+    """A slot's centre, width, bottom and height: a row is shared by its bottom and its
+    height (each edge on its own would give elements of one height two)."""
+    _, centre, width, y0, y1 = slot
+    return centre, width, y0, y1 - y0
 
 
 def _fitted(
@@ -450,7 +457,7 @@ def _common(seen: Counter[float], value: float, tolerance: float) -> float:
     while high + 1 < len(ordered) and ordered[high + 1] - ordered[high] <= tolerance:
         high += 1
     cluster = [v for v in ordered[low : high + 1] for _ in range(seen[v])]
-    return round(statistics.median(cluster), DIGITS)
+    return statistics.median(cluster)
 
 
 def _palindrome(kinds: list[int], mirrored: list[bool]) -> bool:
