@@ -18,6 +18,12 @@ façade's ends share one counter that can only drop them (its most: one, as draw
 sequence that reads the same mirrored is written as its left half, the middle and the
 half reflected (SPEC 2.2), so a wider façade gains bays on both sides alike.
 
+The openings make the bays; a kind's other elements (sills, blinds, ledges) stand on
+its shape only where that keeps every one of them within ``HELD`` of where it was drawn
+(thin ones drawn a few centimetres off their row in some bay would move by a good share
+of their size); otherwise that slot's elements stay as the structure put them, in
+layers of their own off the bays (``Bays.apart``), with their own x words.
+
 Every bay's letters keep their size but the wall after its last element, which every
 layer's word of the bay ends with (one symbol a kind: the layers stay together) and
 which may narrow to ``WALL`` of itself; the two margins take the rest of the slack. A
@@ -43,6 +49,7 @@ import numpy as np
 
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
+from facadecli.infer.structure import SHARE, beyond_limits
 
 ALIKE = 0.05  # of the bay's width: elements this close are the same in two bays
 COUNTERS = 2  # the most counters of runs of bays
@@ -56,6 +63,7 @@ SETTLE = 1e-3  # the weight of a kind's width and centres as first read, against
 AXIS = 0.01  # of the façade's width: an opening this close to another's reflection mirrors it
 ASIDE = 0.1  # of the openings: these may lack a mirror image on a façade mirrored as a whole
 UNIQUE = ("door",)  # labels whose bays are never repeated
+HELD = SHARE / 2  # of the narrowest span an edge bounds: the most a kind's shape moves it
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
 Slot = tuple[str, float, float, float, float]  # label, centre x in the bay, width, y0, y1
@@ -88,14 +96,17 @@ class Bays:
     reflected: bool  # written as the left half, the middle bay (if odd) and the half mirrored
     counters: tuple[tuple[str, float, int, int | None], ...]  # name, pitch, count, most
     walls: tuple[float, ...]  # per kind: the wall after its last element (0: none)
+    apart: frozenset[int] = frozenset()  # rectangles left as drawn, in layers of their own
 
     def describe(self) -> str:
         letters = "".join(chr(ord("A") + k) for k in self.kinds)
         return f"{len(self.spans)} bays of {len(self.widths)} kinds ({letters})"
 
 
-def find_bays(layout: LabelledLayout) -> Bays | str:
-    """The façade's bays (see the module), or why it has none to write."""
+def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Bays | str:
+    """The façade's bays (see the module), or why it has none to write; ``drawn``: the
+    layout as drawn, its rectangles in the same order (None: ``layout``), which the
+    elements but the openings stay near (``_apart``)."""
     width = layout.width
     strips = _strips(layout)
     if len(strips) < 2:
@@ -145,6 +156,10 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
         )
     members = [held for _, held in strips]
     placed, new_spans = _placed(layout, members, kinds, mirrored, matches, shapes, widths, start)
+    drawn = drawn if drawn is not None and len(drawn.rects) == len(layout.rects) else layout
+    apart = _apart(drawn, placed, members, kinds, matches)
+    for index in apart:
+        placed[index] = layout.rects[index]
     if _new_overlaps(layout.rects, placed):
         return "its bays put on their kinds' shapes would overlap elements"
     return Bays(
@@ -166,6 +181,7 @@ def find_bays(layout: LabelledLayout) -> Bays | str:
             )
             for k, shape in enumerate(shapes)
         ),
+        frozenset(apart),
     )
 
 
@@ -583,6 +599,41 @@ def _placed(
             out[index] = Rect(label, x0, y0, round(x0 + size, DIGITS), y1, layout.rects[index].z)
         cursor = round(cursor + width, DIGITS)
     return out, spans
+
+
+def _apart(
+    drawn: LabelledLayout,
+    after: list[Rect],
+    members: list[list[int]],
+    kinds: list[int],
+    matches: list[list[int]],
+) -> set[int]:
+    """The rectangles of the slots of a kind (in every bay of it) that are not openings
+    and of which one would stand on the kind's shape with an edge further from where it
+    was ``drawn`` than ``HELD`` (``structure.beyond_limits``: half what the structure
+    lets an edge move, a sixteenth of the narrowest element, same-label gap or visible
+    part it bounds): a thin sill drawn a few centimetres off its row in one bay, a
+    blind's strip beside its window. The openings make the bays; what fits them within
+    that follows them, the rest stays as the structure put it (in layers of its own)."""
+    rects = list(drawn.rects)
+    far = [
+        a or b
+        for a, b in zip(
+            beyond_limits(rects, [(r.x0, r.x1) for r in after], "x", drawn.width, HELD),
+            beyond_limits(rects, [(r.y0, r.y1) for r in after], "y", drawn.height, HELD),
+            strict=True,
+        )
+    ]
+    slots: dict[tuple[int, int], list[int]] = defaultdict(list)  # (kind, slot): rectangles
+    for held, kind, match in zip(members, kinds, matches, strict=True):
+        for n, j in enumerate(match):
+            slots[kind, n].append(held[j])
+    return {
+        k
+        for indices in slots.values()
+        if rects[indices[0]].label not in OPENINGS and any(far[k] for k in indices)
+        for k in indices
+    }
 
 
 def _new_overlaps(before: tuple[Rect, ...], after: list[Rect]) -> bool:

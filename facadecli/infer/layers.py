@@ -32,6 +32,7 @@ class Grid:
     label: str
     columns: tuple[Span, ...]  # along x, left to right
     rows: tuple[Span, ...]  # along y, bottom up
+    apart: bool = False  # of elements left where drawn, off the façade's bays (``infer.bays``)
 
     @property
     def elements(self) -> int:
@@ -43,18 +44,28 @@ def _z(label: str, rects: list[Rect]) -> tuple[int, float, str]:
     return (CMP_Z_ORDER.get(label, 99), min(r.z for r in rects), label)
 
 
-def grids(layout: LabelledLayout, background: str = BACKGROUND) -> list[Grid]:
-    """Every label's elements as grids, back to front (see the module)."""
+def grids(
+    layout: LabelledLayout, background: str = BACKGROUND, apart: frozenset[int] = frozenset()
+) -> list[Grid]:
+    """Every label's elements as grids, back to front (see the module); the rectangles
+    ``apart`` (by index) in grids of their own, after the label's others."""
     by_label: dict[str, list[Rect]] = defaultdict(list)
     for rect in layout.rects:
         if rect.label != background:
             by_label[rect.label].append(rect)
     found: list[Grid] = []
     for label in sorted(by_label, key=lambda name: _z(name, by_label[name])):
-        spans = sorted({((r.y0, r.y1), (r.x0, r.x1)) for r in by_label[label]})
-        while spans:
-            taken, spans = _grid_rows(spans)
-            found.extend(_by_columns(label, taken))
+        for own in (False, True):
+            spans = sorted(
+                {
+                    ((r.y0, r.y1), (r.x0, r.x1))
+                    for k, r in enumerate(layout.rects)
+                    if r.label == label and (k in apart) == own
+                }
+            )
+            while spans:
+                taken, spans = _grid_rows(spans)
+                found.extend(_by_columns(label, taken, own))
     return found
 
 
@@ -73,7 +84,7 @@ def _grid_rows(
     return {row: tuple(columns) for row, columns in rows.items()}, rest
 
 
-def _by_columns(label: str, rows: dict[Span, tuple[Span, ...]]) -> list[Grid]:
+def _by_columns(label: str, rows: dict[Span, tuple[Span, ...]], apart: bool) -> list[Grid]:
     """Rows that hold the same columns, as grids whose rows do not overlap."""
     same: dict[tuple[Span, ...], list[Span]] = defaultdict(list)
     for row in sorted(rows):
@@ -87,7 +98,7 @@ def _by_columns(label: str, rows: dict[Span, tuple[Span, ...]]) -> list[Grid]:
                 stacks.append([row])
             else:
                 stack.append(row)
-        found.extend(Grid(label, columns, tuple(stack)) for stack in stacks)
+        found.extend(Grid(label, columns, tuple(stack), apart) for stack in stacks)
     return sorted(found, key=lambda g: (g.rows[0], g.columns[0]))
 
 
@@ -123,7 +134,7 @@ def to_edges(grid: Grid, width: float, height: float) -> Grid:
     façade's edges where they stop a sliver short of them (hand annotation: 0.04 m short
     on a 15 m façade). Left in, the sliver is a gap as costly to stretch as the band, so a
     wider façade would grow it as much as the band and leave the band metres short."""
-    return Grid(grid.label, _reach(grid.columns, width), _reach(grid.rows, height))
+    return Grid(grid.label, _reach(grid.columns, width), _reach(grid.rows, height), grid.apart)
 
 
 def _reach(spans: tuple[Span, ...], extent: float) -> tuple[Span, ...]:

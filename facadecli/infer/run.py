@@ -65,10 +65,13 @@ def infer(
     if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
     progress("finding the bays and the grids of each label")
-    bays = find_bays(regular)
+    bays = find_bays(regular, tidied.raw)
     if isinstance(bays, Bays):
-        found = [to_edges(grid, regular.width, regular.height) for grid in grids(bays.layout)]
-        if any(inside(bays, grid) and not in_bays(bays, grid) for grid in found):
+        found = [
+            to_edges(grid, regular.width, regular.height)
+            for grid in grids(bays.layout, apart=bays.apart)
+        ]
+        if any(inside(bays, g) and not g.apart and not in_bays(bays, g) for g in found):
             bays = "a label's elements stand unlike in the bays of a kind"
         else:
             regular = bays.layout

@@ -265,7 +265,7 @@ def spec_text(
         symbols = elements[grid.label]
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
         bay_word = None
-        if shared is not None and in_bays(shared, grid):
+        if shared is not None and not grid.apart and in_bays(shared, grid):
             bay_word = _bay_word(shared, grid, symbols[0], bay_gaps, bay_margins, in_bay)
         row_key = (grid.rows, index in tops and grid.label not in UNIQUE)
         introduced = [

@@ -204,13 +204,32 @@ def _within_limits(
     eighth of the narrowest element, same-label gap or visible part it bounds, as in the
     tidy-up): what was drawn shows."""
     spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
+    return [
+        span if far else to
+        for span, to, far in zip(
+            spans, moved, beyond_limits(rects, moved, axis, extent), strict=True
+        )
+    ]
+
+
+def beyond_limits(
+    rects: list[Rect],
+    moved: list[tuple[float, float]],
+    axis: str,
+    extent: float,
+    share: float = SHARE,
+) -> list[bool]:
+    """For each of ``rects`` (as drawn), whether an edge of its span along ``axis``
+    ``moved`` further than the structure lets an edge move (see ``_within_limits``;
+    ``share`` of the narrowest span it bounds)."""
+    spans = [(r.x0, r.x1) if axis == "x" else (r.y0, r.y1) for r in rects]
     across = [(r.y0, r.y1) if axis == "x" else (r.x0, r.x1) for r in rects]
-    limits = move_limits(rects, spans, across, NEAR * extent, SHARE)
-    out = []
-    for (a, b), (c, d) in zip(spans, moved, strict=True):
-        far = abs(c - a) > limits.get(a, NEAR * extent) or abs(d - b) > limits.get(b, NEAR * extent)
-        out.append((a, b) if far else (c, d))
-    return out
+    tolerance = NEAR * extent * share / SHARE
+    limits = move_limits(rects, spans, across, tolerance, share)
+    return [
+        abs(c - a) > limits.get(a, tolerance) or abs(d - b) > limits.get(b, tolerance)
+        for (a, b), (c, d) in zip(spans, moved, strict=True)
+    ]
 
 
 def _colliding(before: list[Rect], after: list[Rect]) -> set[int]:
