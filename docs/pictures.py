@@ -242,6 +242,41 @@ def look_pictures(chrome: str, out: Path, suffix: str = "") -> None:
         strip(shots, LOOK / f"{name}{suffix}.png")
 
 
+def cesium_picture(out: Path) -> None:
+    """The tests' OSM district (``tests/osm_district.py``: 36 buildings near Helsinki, one
+    of each case S3DB names) built with ``facade city --3dtiles`` and its tiles opened in
+    CesiumJS in headless Chromium with no network (``tests/cesium.py``, the page the
+    CesiumJS test opens): ``city-3dtiles-cesium.png``. Needs npm ``cesium`` in
+    .venv/node (``make test`` installs it) or FACADE_CESIUM."""
+    sys.path.insert(0, str(ROOT))  # the tests' district and page
+    from PIL import Image
+
+    from tests import cesium
+    from tests.osm_district import write_district
+
+    if not cesium.installed():
+        sys.exit(f"no CesiumJS in {cesium.CESIUM}: make test installs it (or set FACADE_CESIUM)")
+    district = write_district(out / "district.osm")
+    run = out / "district"
+    facade = [sys.executable, "-m", "facadecli"]
+    subprocess.run(
+        [*facade, "city", str(district), "--3dtiles", "-j", "2", "-o", str(run)],
+        check=True,
+        capture_output=True,
+    )
+    missing: list[str] = []
+    shot, dom = cesium.open_tiles(run, out, [], missing)
+    title = cesium.title(dom)
+    if not title.startswith("loaded"):
+        sys.exit(f"CesiumJS did not load the district's tiles: {title}")
+    if unanswered := [path for path in missing if not path.endswith("favicon.ico")]:
+        sys.exit(f"CesiumJS asked for what the run did not write: {unanswered}")
+    target = TARGET / "city-3dtiles-cesium.png"
+    with Image.open(shot) as image:
+        image.convert("RGB").save(target, optimize=True)
+    print(f"{target.relative_to(ROOT)}: {title}, {target.stat().st_size // 1024} KB")
+
+
 SWATCH = 192  # pixels a side of one material on the library's contact sheet
 
 
@@ -277,15 +312,16 @@ def material_sheet(target: Path) -> None:
 def main(names: list[str]) -> None:
     """The pictures named (all without names): a spec's from :data:`PICTURES` or
     :data:`PARTS`, ``materials`` (the library's sheet), ``city`` (the city block's three views;
-    SUFFIX=-before names them for the record of older code) or ``look`` (every example
-    and the city block from three cameras, SUFFIX likewise)."""
+    SUFFIX=-before names them for the record of older code), ``look`` (every example
+    and the city block from three cameras, SUFFIX likewise) or ``cesium`` (the tests' OSM
+    district's 3D Tiles in CesiumJS)."""
     everything = not names
     if everything or "materials" in names:
         target = TARGET / "materials.png"
         material_sheet(target)
         print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
-    chosen = [name for name in names if name not in ("materials", "city", "look")]
-    if not (everything or chosen or "city" in names or "look" in names):
+    chosen = [name for name in names if name not in ("materials", "city", "look", "cesium")]
+    if not (everything or chosen or {"city", "look", "cesium"} & set(names)):
         return
     chrome = browser()
     TARGET.mkdir(parents=True, exist_ok=True)
@@ -295,6 +331,9 @@ def main(names: list[str]) -> None:
     if everything or "city" in names:
         with tempfile.TemporaryDirectory() as scratch:
             city_pictures(chrome, Path(scratch), os.environ.get("SUFFIX", ""))
+    if everything or "cesium" in names:
+        with tempfile.TemporaryDirectory() as scratch:
+            cesium_picture(Path(scratch))
     if not (everything or chosen):
         return
     facade = Path(sys.executable).parent / "facade"
