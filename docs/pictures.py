@@ -62,7 +62,8 @@ PARTS: dict[str, tuple[str, Callable[[Shape], bool], tuple[float, float], float,
 # of the picture's width or height (the tighter) the part would span seen square on; the
 # viewer's 8% margin and the perspective of an oblique view leave about three quarters
 PART_FILL = 0.9
-ASPECT = 900 / 560  # the screenshot's (WINDOW)
+ASPECT = 900 / 560  # the screenshot's (WINDOW), the widest a part's picture is
+PART_NARROWEST = 0.6  # the narrowest a part's picture is, as a share of its height
 
 
 def looks(wide: float, high: float, deep: float, around: float, up: float) -> tuple[float, float]:
@@ -79,13 +80,16 @@ def part_view(
     share: tuple[float, float],
     around: float,
     up: float,
-) -> str:
-    """The viewer's ``?view=`` aimed at the part: the middle of the shapes ``shows``
-    picks (the ``share`` of their height from the foot), as shares of the model's box
-    (the canvas across and up; in depth, from the deepest shape's back, less a window
-    recess, to the most proud one's front), and zoomed from the whole model's fit until
-    the part spans :data:`PART_FILL` of the picture (the fit shows the canvas, its
-    tighter side filling the picture)."""
+) -> tuple[str, str]:
+    """The viewer's ``?view=`` aimed at the part and the window to take it in: the middle
+    of the shapes ``shows`` picks (the ``share`` of their height from the foot), as
+    shares of the model's box (the canvas across and up; in depth, from the deepest
+    shape's back, less a window recess, to the most proud one's front), and zoomed from
+    the whole model's fit until the part spans :data:`PART_FILL` of the picture (the fit
+    shows the canvas, its tighter side filling the picture). The window is as tall as
+    :data:`WINDOW` and as wide as the part looks beside its height, from
+    :data:`PART_NARROWEST` to :data:`ASPECT` times it: a tall part (a door) gets an
+    upright picture of itself, not its neighbours either side."""
     visible = [s for s in layout["shapes"] if s["visible"]]
     chosen = [s for s in visible if shows(s)]
     assert chosen, "no shape of the layout is the part"
@@ -99,10 +103,13 @@ def part_view(
     depth = front - min(s["z0"] for s in chosen)
     model_wide, model_high = looks(width, height, deep, around, up)
     part_wide, part_high = looks(x1 - x0, y1 - y0, depth, around, up)
-    seen_wide = max(model_wide, model_high * ASPECT)  # the model's fit: what the picture spans
-    zoom = PART_FILL * min(seen_wide / part_wide, seen_wide / ASPECT / part_high)
+    aspect = min(max(part_wide / part_high, PART_NARROWEST), ASPECT)
+    seen_wide = max(model_wide, model_high * aspect)  # the model's fit: what the picture spans
+    zoom = PART_FILL * min(seen_wide / part_wide, seen_wide / aspect / part_high)
     at = ((x0 + x1) / 2 / width, (y0 + y1) / 2 / height, (front - depth / 2 - back) / deep)
-    return f"{around:g},{up:g},{zoom:.2f}," + ",".join(f"{share:.3f}" for share in at)
+    high = int(WINDOW.split(",")[1])
+    view = f"{around:g},{up:g},{zoom:.2f}," + ",".join(f"{share:.3f}" for share in at)
+    return view, f"{round(high * aspect)},{high}"
 
 
 def browser() -> str:
@@ -352,16 +359,16 @@ def main(names: list[str]) -> None:
             if name in PARTS:
                 spec, shows, share, around, up = PARTS[name]
                 layout = json.loads((out / f"{spec}.layout.json").read_text(encoding="utf-8"))
-                what, view = "model", part_view(layout, shows, share, around, up)
+                what, (view, window) = "model", part_view(layout, shows, share, around, up)
             else:
-                spec, what, view = PICTURES[name]
+                (spec, what, view), window = PICTURES[name], WINDOW
             target = TARGET / f"{name}.png"
             if what == "elevation":
                 svg = out / f"{spec}.svg"
                 screenshot(chrome, svg.as_uri(), target, svg_size(svg), out / "profile")
             else:
                 url = f"{(out / f'{spec}.html').as_uri()}?bare&view={view}"
-                screenshot(chrome, url, target, WINDOW, out / "profile")
+                screenshot(chrome, url, target, window, out / "profile")
             print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
 
 
