@@ -227,19 +227,19 @@ def look_pictures(chrome: str, out: Path, suffix: str = "") -> None:
     LOOK.mkdir(parents=True, exist_ok=True)
     facade = [sys.executable, "-m", "facadecli"]
     run = partial(subprocess.run, check=True, capture_output=True)
+    only = [name for name in os.environ.get("LOOK", "").split(",") if name]
     pages = {}
     for spec in sorted((ROOT / "specs").glob("*.yaml")):
-        run([*facade, "solve", str(spec), "-o", str(out), "-f", "html"])
-        pages[spec.stem] = out / f"{spec.stem}.html"
-    manifest = write_demo(out / "district", ROOT / "specs", 4)
-    city = out / "city"
-    run([*facade, "city", str(manifest), "-o", str(city), "--limit", str(CITY_BLOCK)])
-    run([*facade, "view", str(city), "-o", str(out / "city-block.html")])
-    pages["city-block"] = out / "city-block.html"
-    only = [name for name in os.environ.get("LOOK", "").split(",") if name]
+        if not only or spec.stem in only:
+            run([*facade, "solve", str(spec), "-o", str(out), "-f", "html"])
+            pages[spec.stem] = out / f"{spec.stem}.html"
+    if not only or "city-block" in only:
+        manifest = write_demo(out / "district", ROOT / "specs", 4)
+        city = out / "city"
+        run([*facade, "city", str(manifest), "-o", str(city), "--limit", str(CITY_BLOCK)])
+        run([*facade, "view", str(city), "-o", str(out / "city-block.html")])
+        pages["city-block"] = out / "city-block.html"
     for name, page in pages.items():
-        if only and name not in only:
-            continue
         views = LOOK_VIEWS if name != "city-block" else tuple(CITY_VIEWS.values())
         shots = []
         for index, view in enumerate(views):
