@@ -164,8 +164,8 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
 
 def planning(manifest: Path, figures: Path) -> None:
     """A city read and planned in this process (:func:`facadecli.city.run.planned`, and
-    the buildings' hashes for --resume), no building built: its memory and CPU to
-    ``figures``."""
+    the buildings' hashes for --resume, as a run holds them), no building built: its
+    memory and CPU to ``figures``."""
     from facadecli.city.manifest import load_city
     from facadecli.city.resume import building_hashes
     from facadecli.city.run import planned
