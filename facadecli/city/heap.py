@@ -16,7 +16,9 @@ import ctypes.util
 import functools
 from collections.abc import Callable
 
-EVERY = 1024  # buildings ended between two calls while building: a call costs ~ms
+# buildings ended between two calls while building: a call took 17-35 ms of CPU on a
+# heap of 200,000 shapes freed among kept ones (``time.process_time``), 0.03 ms a building
+EVERY = 1024
 
 
 @functools.cache

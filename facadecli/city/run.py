@@ -690,6 +690,7 @@ def planned(
         city, footprints, outdir.resolve(), usd, instanced, level, shared_textures
     )
     found = replace(found, warnings=(*found.warnings, *warnings))
+    del footprints
     give_back()  # what planning freed (the footprints read, their neighbours...)
     return Planned(found, replaced, kept, straight, tasks)
 
