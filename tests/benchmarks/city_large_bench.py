@@ -46,7 +46,6 @@ asserted by the tests.
 from __future__ import annotations
 
 import cProfile
-import ctypes
 import gc
 import json
 import os
@@ -86,13 +85,10 @@ def _grown(before: tracemalloc.Snapshot, after: tracemalloc.Snapshot) -> list[li
 
 def _returned_mib() -> float | None:
     """The resident memory (MiB) once the C heap's freed memory is given back to the
-    system (glibc's ``malloc_trim``; None elsewhere)."""
-    try:
-        libc = ctypes.CDLL("libc.so.6")
-    except OSError:
-        return None
-    libc.malloc_trim(0)
-    return _resident_mib()
+    system (:func:`facadecli.city.heap.give_back`; None where it cannot be)."""
+    from facadecli.city.heap import give_back
+
+    return _resident_mib() if give_back() else None
 
 
 def _resident_mib() -> float:
@@ -181,6 +177,7 @@ def planning(manifest: Path, figures: Path) -> None:
     ahead = planned(city, manifest.parent / "out")
     hashes = building_hashes(city, ahead.tasks)
     cpu = time.process_time() - cpu
+    resident = _resident_mib()
     if TRACED:
         last = _trace()
         now, peak = tracemalloc.get_traced_memory()
@@ -191,7 +188,7 @@ def planning(manifest: Path, figures: Path) -> None:
             {
                 "buildings": len(ahead.tasks),
                 "imports_mib": before,
-                "planned_mib": _resident_mib(),
+                "planned_mib": resident,
                 "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
                 "cpu": cpu,
                 **traced,
