@@ -295,7 +295,7 @@ def test_a_planned_city_holds_its_tasks_packed(tmp_path: Path) -> None:
 def test_a_run_keeps_its_buildings_hashes_and_places_in_flat_buffers(tmp_path: Path) -> None:
     """What a run keeps of every building beside its packed task, for the whole run: its
     hash (resume.py) in 32 bytes and its centroid in 16, in one buffer each, not as small
-    objects (a dict of hex strings by id took 195 bytes a building, a list of tuples 112;
+    objects (a dict of hex strings by id took 145-195 bytes a building, a list of tuples 112;
     tracemalloc's count, the garbage collected before and after). Each reads back as made."""
     manifest = write_terraces(tmp_path / "town", ROOT / "specs", 600, 1)
     loaded = load_city(manifest)
