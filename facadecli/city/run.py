@@ -61,11 +61,19 @@ from facadecli.city.footprints import (
     read_footprints,
 )
 from facadecli.city.georef import Georef, georeference
+from facadecli.city.heap import EVERY, give_back
 from facadecli.city.lods import feature_scene
 from facadecli.city.manifest import Choice, City, Roof, WallRule
-from facadecli.city.packed import Packed, Picked
+from facadecli.city.packed import Packed, Picked, Points
 from facadecli.city.report import CityReport, Entries, Summary, Tally
-from facadecli.city.resume import building_hashes, recorded, reusable, stamped
+from facadecli.city.resume import (
+    Hashes,
+    building_hash,
+    recorded,
+    reusable,
+    spec_digests,
+    stamped,
+)
 from facadecli.city.s3db import (
     Heights,
     inherited,
@@ -682,6 +690,8 @@ def planned(
         city, footprints, outdir.resolve(), usd, instanced, level, shared_textures
     )
     found = replace(found, warnings=(*found.warnings, *warnings))
+    del footprints
+    give_back()  # what planning freed (the footprints read, their neighbours...)
     return Planned(found, replaced, kept, straight, tasks)
 
 
@@ -711,18 +721,20 @@ def _build(
     (report.py): the merged models, the CityJSON and the report are streamed to disk."""
     georef = Georef(found.crs, found.origin, found.unit)
     order: dict[str, int] = {}  # building id -> its position in the manifest's order
-    centroids = []
+    centroids = Points()  # each building's, in the manifest's order
     entries = Entries(len(tasks), outdir)
     built = bytearray(len(tasks))  # 1 for a building built (or kept), in the manifest's order
     tally = Tally()
     todo = []  # positions of the buildings to build
     resumed = []  # positions of the buildings kept from the last run
-    hashes = building_hashes(city, tasks)
+    hashes = Hashes()  # each building's (resume.py), in the manifest's order
+    digests = spec_digests(city)
     previous = recorded(outdir, city.manifest.name) if resume else {}
     for index, task in enumerate(tasks):  # one pass: each read unpacks its tasks' chunk
         order[task.footprint.id] = index
         centroids.append(_centroid(task.footprint))
-        entry = reusable(task, hashes[task.footprint.id], previous, usd)
+        hashes.append(building_hash(task, digests))
+        entry = reusable(task, hashes[index], previous, usd)
         if entry is None:
             todo.append(index)
         else:
@@ -731,6 +743,7 @@ def _build(
             tally.add(entry)
             resumed.append(index)
     del previous
+    give_back()  # the last run's entries read (--resume)
     done = len(resumed)
     tileset = None
     if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
@@ -739,7 +752,9 @@ def _build(
     building = Picked(tasks, todo)
     del todo
     mapped = stamped(
-        _map_local(building, jobs) if local else _map_dask(building, str(scheduler)), hashes
+        _map_local(building, jobs) if local else _map_dask(building, str(scheduler)),
+        hashes,
+        order,
     )
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
@@ -756,6 +771,8 @@ def _build(
                 tally.add(result)
                 _tiled(tileset, outdir, result["id"], built[index])
                 done += 1
+                if done % EVERY == 0:  # what the tiles written since freed
+                    give_back()
                 if progress is not None:
                     progress(done, len(tasks))
     except OSError as error:
