@@ -331,6 +331,80 @@ def test_glass_reads_neither_black_nor_white_nor_as_the_wall(tmp_path: Path) -> 
     assert abs(wall - pane) > 25
 
 
+WALLS_SPEC = """
+version: 1
+name: walls
+canvas: {width: 12.0, height: 6.0}
+symbol_defaults: {opaque: true}
+symbols:
+  A: {size: 6.0, label: wall}
+  B: {size: 6.0, label: wall}
+  Q: {size: 6.0, label: storey}
+patterns: {across: "A B", up: "Q"}
+layers: [{name: base, x: across, y: up}]
+shapes:
+  - {match: {x: B, y: Q}, material: brick}
+materials:
+  plaster: {color: "#e4d6bd", roughness: 0.9}
+  brick: {color: "#a0522d", roughness: 0.9}
+defaults: {mesh: box, material: plaster, thickness: 0.2}
+"""
+
+
+def _hue_and_saturation(shot: Path, box: tuple[float, float, float, float]) -> tuple[float, float]:
+    """The median hue (degrees) and saturation (HSV, 0..1) of the pixels of the
+    screenshot's part ``box`` (left, top, right, bottom as fractions of its size)."""
+    import colorsys
+    import statistics
+
+    from PIL import Image
+
+    with Image.open(shot) as image:
+        rgb = image.convert("RGB")
+        left, top, right, bottom = box
+        part = rgb.crop(
+            (
+                round(left * rgb.width),
+                round(top * rgb.height),
+                round(right * rgb.width),
+                round(bottom * rgb.height),
+            )
+        )
+        data = part.tobytes()
+    pixels = [
+        colorsys.rgb_to_hsv(data[at] / 255, data[at + 1] / 255, data[at + 2] / 255)
+        for at in range(0, len(data), 3)
+    ]
+    return (
+        statistics.median(hue for hue, _, _ in pixels) * 360,
+        statistics.median(saturation for _, saturation, _ in pixels),
+    )
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_lit_wall_keeps_its_colours_hue_and_saturation(tmp_path: Path) -> None:
+    """Two sunlit walls seen square on, a pale plaster (#e4d6bd: hue 38.5 degrees,
+    saturation 0.171) and a brick red (#a0522d: 19.3, 0.719), render in their own hue and
+    saturation (each pixel's, the median over the middle of the wall): the light is white
+    (the sun, and the sky's light on a wall balanced to grey) and the tone mapping
+    (Khronos PBR Neutral) keeps a colour's hue and saturation. ACES filmic tone mapping
+    under a slightly blue light drained the plaster to 0.070 (near white)."""
+    spec = tmp_path / "walls.yaml"
+    spec.write_text(WALLS_SPEC)
+    layout = solve(load_spec(spec))
+    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
+    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,0")
+    assert "<title>walls</title>" in dom
+    # the walls fill 1/1.08 of the picture's width, plaster left, brick right
+    for box, hue, saturation in [
+        ((0.15, 0.3, 0.4, 0.7), 38.5, 0.171),
+        ((0.6, 0.3, 0.85, 0.7), 19.3, 0.719),
+    ]:
+        seen_hue, seen_saturation = _hue_and_saturation(shot, box)
+        assert abs(seen_hue - hue) < 4, (seen_hue, hue)
+        assert abs(seen_saturation / saturation - 1) < 0.15, (seen_saturation, saturation)
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 def test_a_districts_street_view_stands_in_a_street_among_its_buildings(

@@ -1,7 +1,7 @@
 """Self-contained HTML pages of models: one layout's model with orbit controls beside its
 front elevation (``--format html``), or a gallery of every model in a folder
 (``facade view``, :mod:`facadecli.viewer.gallery`). Readable in any browser with no
-network: three.js r160 (MIT licence) is bundled here from npm and inlined into every page
+network: three.js r162 (MIT licence) is bundled here from npm and inlined into every page
 (see LICENSE-three.txt).
 
 Both pages share one viewer: :data:`VIEWER` sets up three.js in ``#model`` and defines
@@ -17,7 +17,7 @@ from functools import cache
 from html import escape
 from importlib import resources
 
-THREE_VERSION = "0.160.0"
+THREE_VERSION = "0.162.0"
 # specifier -> bundled file
 MODULES = {
     "three": "three.module.min.js",
@@ -73,11 +73,16 @@ import {OutputPass} from 'three/addons/postprocessing/OutputPass.js';
 import {SimplexNoise} from 'three/addons/math/SimplexNoise.js';
 const view = document.getElementById('model');
 const status = document.getElementById('status');
-const EXPOSURE = 0.55;  // the sky's light is 2.4 times the houses' (below): walls kept from white
+// the sky's light is 2.4 times the houses' (below): at 0.55 a sunlit wall is about as light
+// as its base colour (#e4d6bd renders as about (223, 207, 181))
+const EXPOSURE = 0.55;
 const renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
 renderer.setPixelRatio(window.devicePixelRatio);
-renderer.toneMapping = THREE.ACESFilmicToneMapping;  // filmic: highlights roll off, no clipping
-renderer.toneMappingExposure = EXPOSURE;  // three's ACES brightens by 1/0.6 too
+// Khronos PBR Neutral: a colour below its highlights keeps its hue and saturation, and
+// highlights roll off to white instead of clipping (ACES filmic, before, drained a pale
+// plaster to a near white and shifted every hue)
+renderer.toneMapping = THREE.NeutralToneMapping;
+renderer.toneMappingExposure = EXPOSURE;
 renderer.outputColorSpace = THREE.SRGBColorSpace;
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
@@ -93,9 +98,8 @@ view.appendChild(renderer.domElement);
 // the horizon it fades into, pale sunlit paving nearer; not a dark floor, which made every
 // pane a flat dark slate. Seeded: the same picture every time.
 const SKY = 0xe9edf2;  // the backdrop and the haze the ground fades into
-// as bright on the screen as at the exposure of 0.8 the viewer had before the sky's light
-// rose (the backdrop and haze are tone mapped too): a pale backdrop, not a grey one
-// darker than the ground
+// a pale backdrop, not a grey one darker than the ground (the backdrop and haze are tone
+// mapped too)
 const BACKDROP = new THREE.Color(SKY).multiplyScalar(0.8 / EXPOSURE);
 // The sky is brighter than the houses and paving it lights (in daylight several times
 // brighter than a wall in shade): what glass mirrors of it stands out as it does in a photo.
@@ -123,6 +127,7 @@ function skyEnvironment() {
   }
   const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
   let block = 0;
+  const mean = [0, 0, 0];  // the picture's light on a wall, each channel (see below)
   for (let row = 0; row < height; row++) {
     const elevation = ((row + 0.5) / height - 0.5) * Math.PI, y = Math.sin(elevation);
     block = 0;
@@ -145,7 +150,18 @@ function skyEnvironment() {
         2.5 * Math.pow(Math.max(0, direction.dot(sunDirection)), 24)));
       const at = (row * width + column) * 4;  // row 0: straight down
       data[at] = colour.r; data[at + 1] = colour.g; data[at + 2] = colour.b; data[at + 3] = 1;
+      const weight = Math.cos(elevation) ** 2;  // the texel's solid angle, a wall's cosine
+      for (let channel = 0; channel < 3; channel++) mean[channel] += weight * data[at + channel];
     }
+  }
+  // White-balanced: the light a wall takes from the picture, whichever way it faces (each
+  // direction weighted by its solid angle and by the cosine a vertical wall sees it at), is
+  // grey at its own luminance; the blue overhead and the warm paving and glow cancel, so a
+  // wall of a known colour renders as that colour, in sun (the sun is white) or in shade.
+  const luminance = 0.2126 * mean[0] + 0.7152 * mean[1] + 0.0722 * mean[2];
+  const gains = mean.map(sum => luminance / sum);
+  for (let at = 0; at < data.length; at += 4) {
+    for (let channel = 0; channel < 3; channel++) data[at + channel] *= gains[channel];
   }
   const picture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
   picture.mapping = THREE.EquirectangularReflectionMapping;
@@ -161,7 +177,7 @@ scene.background = BACKDROP;
 scene.environment = skyEnvironment();
 // placed by frame(): the model clear, the ground fading out
 scene.fog = new THREE.Fog(BACKDROP, 1, 2);
-const sun = new THREE.DirectionalLight(0xfff3e0, 3.4);
+const sun = new THREE.DirectionalLight(0xffffff, 3.4);  // white, as the sky's light is
 sun.castShadow = true;
 sun.shadow.bias = -0.0002;
 scene.add(sun, sun.target);
@@ -708,7 +724,7 @@ def document_parts(title: str, style: str, body: Iterable[str], script: str) -> 
     yield (
         '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
         f"<title>loading: {escape(title)}</title><style>{STYLE}{style}</style>"
-        f"<!-- three.js {THREE_VERSION}, MIT licence, (c) 2010-2023 three.js authors -->"
+        f"<!-- three.js {THREE_VERSION}, MIT licence, (c) 2010-2024 three.js authors -->"
         f'<script type="importmap">{import_map()}</script></head><body>'
     )
     yield from body
