@@ -306,13 +306,15 @@ function dispose(object) {
 // KHR_materials_transmission) is drawn by its transmission alone: its alpha is the glb's
 // fallback for viewers without the extension, and blending by it too would dim the pane's
 // reflection to a third (a dark pane) and count what lies behind it twice.
+const isGlass = material => material.transmission > 0;
+const materialsOf = part => Array.isArray(part.material) ? part.material : [part.material];
 function castsShadows(model) {
   model.traverse(part => {
     if (!part.isMesh) return;
-    const materials = Array.isArray(part.material) ? part.material : [part.material];
-    part.castShadow = materials.every(m => !m.transparent && !(m.transmission > 0));
+    const materials = materialsOf(part);
+    part.castShadow = materials.every(m => !m.transparent && !isGlass(m));
     part.receiveShadow = true;
-    for (const material of materials.filter(m => m.transmission > 0)) {
+    for (const material of materials.filter(isGlass)) {
       material.transparent = false; material.opacity = 1; material.depthWrite = true;
     }
   });
@@ -417,17 +419,92 @@ function fitStreet(box, centre, angle) {
 // Street level in a district (a model of several buildings, wider and deeper than tall):
 // the eye EYE metres up in its open space, where the nearest buildings fill the view. The
 // district's plan is drawn from above (each building, a child of the model, in a colour of
-// its own: which stands highest in each cell of about PLAN_CELL metres, and how high), a
-// spot is open where nothing stands and no building is nearer than CLEARANCE; rays from
-// each open spot of a lattice every STREET_STEP metres, RAYS round, find the first
-// building each way. Of every spot and heading, the view that holds the most of buildings
-// wins: the sum over the buildings seen of the square root of the share of the picture each
-// fills (a street of houses, near and far, beats one wall close up: eight houses a sixteenth
-// of the picture each score 2, one wall filling it 1); ties keep the first (the same view
-// each time).
+// its own: which stands highest in each cell of about PLAN_CELL metres, and how high), and
+// the cells of walls with openings marked: those with a corner of a pane of glass within
+// OPENING_REACH metres (a pane's corners, read from the model's meshes, lie in its wall's
+// reveal, inside the building's cells, which seen from above hide the pane). A spot is open
+// where nothing stands and no building is nearer than CLEARANCE; rays from each open spot
+// of a lattice every STREET_STEP metres, RAYS round, find the first building each way, and
+// whether the wall they meet has openings. Of every spot and heading, the view that holds
+// the most of buildings' façades wins (viewScore): the sum over the buildings seen of the
+// square root of the share of the picture each fills (a street of houses, near and far,
+// beats one wall close up: eight houses a sixteenth of the picture each score 2), a blank
+// wall's share counted BLANK_WALL of a windowed one's (a street of windows beats one of
+// blank brick), a wall by the share of its height in the picture (cut off at the top, it
+// counts less), a wall d metres away, nearer than STAND_BACK, d / STAND_BACK of its share
+// (4 m from a house, the picture holds its ground floor alone), and a building filling
+// more than FILL_MOST of the picture counted less the more it fills, nothing when it fills
+// it alone (the eye stands back from a house until others join it); ties keep the first
+// (the same view each time).
 const PLAN_CELL = 0.25, PLAN_CELLS = 768, CLEARANCE = 4, STREET_STEP = 2, RAYS = 144;
 const STREET_TILT = 6;  // degrees the street camera looks up: more of the houses, less paving
 const STREET_SPOTS = 4096, STREET_REACH = 150;  // the search's bounds (see fitDistrictStreet)
+const OPENING_REACH = 1, BLANK_WALL = 0.2, STAND_BACK = 10, FILL_MOST = 0.25;
+// the most corners of panes read for the plan's openings (past it every k-th one): the
+// work is bounded whatever the district's size
+const OPENING_CORNERS = 1 << 21;
+// The plan's cells (indices as districtPlan's) with a corner of glass within OPENING_REACH
+// metres: each glass mesh's vertices (each instance's, for a mesh drawn as GPU instances)
+// in the world, then a square dilation, across and down.
+function planOpenings(model, box, cell, columns, rows) {
+  const meshes = [];
+  let corners = 0;
+  model.traverse(part => {
+    if (!part.isMesh || !materialsOf(part).some(isGlass)) return;
+    const position = part.geometry.attributes.position;
+    if (!position) return;
+    meshes.push(part);
+    corners += position.count * (part.isInstancedMesh ? part.count : 1);
+  });
+  const stride = Math.max(1, Math.ceil(corners / OPENING_CORNERS));
+  const marked = new Uint8Array(columns * rows);
+  const corner = new THREE.Vector3(), instance = new THREE.Matrix4(), world = new THREE.Matrix4();
+  let visited = 0;
+  model.updateMatrixWorld(true);
+  for (const part of meshes) {
+    const position = part.geometry.attributes.position;
+    const copies = part.isInstancedMesh ? part.count : 1;
+    for (let copy = 0; copy < copies; copy++) {
+      world.copy(part.matrixWorld);
+      if (part.isInstancedMesh) {
+        part.getMatrixAt(copy, instance);
+        world.multiply(instance);
+      }
+      for (let vertex = 0; vertex < position.count; vertex++, visited++) {
+        if (visited % stride) continue;
+        corner.fromBufferAttribute(position, vertex).applyMatrix4(world);
+        const column = Math.floor((corner.x - box.min.x) / cell);
+        const row = Math.floor((box.min.z + rows * cell - corner.z) / cell);
+        if (column >= 0 && column < columns && row >= 0 && row < rows) {
+          marked[row * columns + column] = 1;
+        }
+      }
+    }
+  }
+  const reach = Math.max(1, Math.round(OPENING_REACH / cell));
+  const across = new Uint8Array(columns * rows), openings = new Uint8Array(columns * rows);
+  for (let row = 0; row < rows; row++) {
+    for (let column = 0, last = -Infinity; column < columns; column++) {  // the last marked
+      if (marked[row * columns + column]) last = column;
+      across[row * columns + column] = column - last <= reach ? 1 : 0;
+    }
+    for (let column = columns - 1, next = Infinity; column >= 0; column--) {
+      if (marked[row * columns + column]) next = column;
+      if (next - column <= reach) across[row * columns + column] = 1;
+    }
+  }
+  for (let column = 0; column < columns; column++) {
+    for (let row = 0, last = -Infinity; row < rows; row++) {
+      if (across[row * columns + column]) last = row;
+      openings[row * columns + column] = row - last <= reach ? 1 : 0;
+    }
+    for (let row = rows - 1, next = Infinity; row >= 0; row--) {
+      if (across[row * columns + column]) next = row;
+      if (next - row <= reach) openings[row * columns + column] = 1;
+    }
+  }
+  return openings;
+}
 function districtPlan(model, box) {
   const size = box.getSize(new THREE.Vector3());
   const cell = Math.max(PLAN_CELL, Math.max(size.x, size.z) / PLAN_CELLS);
@@ -507,15 +584,24 @@ function districtPlan(model, box) {
     }
   };
   pass(0, rows, 1); pass(rows - 1, -1, -1);
-  return {cell, columns, rows, building, height, near,
+  const openings = planOpenings(model, box, cell, columns, rows);
+  return {cell, columns, rows, building, height, near, openings,
           x: column => box.min.x + (column + 0.5) * cell,
           z: row => box.min.z + rows * cell - (row + 0.5) * cell};
+}
+// What a building adds to a street view's score: the square root of the share of the
+// picture it fills as counted (its blank walls BLANK_WALL of its windowed ones, its walls
+// nearer than STAND_BACK less), falling from FILL_MOST of the picture (as it fills it) to
+// nothing when it fills it alone
+function viewScore(share, counted) {
+  const score = Math.sqrt(counted);
+  return share <= FILL_MOST ? score : score * Math.max(0, 1 - share) / (1 - FILL_MOST);
 }
 function fitDistrictStreet(model, box) {
   const buildings = model.children.length;
   if (buildings < 2 || buildings > 65535) return null;  // its plan tells 65,535 apart
   const plan = districtPlan(model, box);
-  const {cell, columns, rows, building, height, near} = plan;
+  const {cell, columns, rows, building, height, near, openings} = plan;
   const [tanH, tanV] = halfTangents();
   const halfH = Math.atan(tanH * MARGIN), halfV = Math.atan(tanV * MARGIN);
   const tilt = STREET_TILT * Math.PI / 180;
@@ -526,13 +612,14 @@ function fitDistrictStreet(model, box) {
   const step = Math.max(1, Math.round(STREET_STEP / cell),
                         Math.ceil(Math.sqrt(columns * rows / STREET_SPOTS)));
   const hitBuilding = new Int32Array(RAYS), hitFill = new Float32Array(RAYS);
+  const hitCounted = new Float32Array(RAYS), hitOpen = new Uint8Array(RAYS);
   let best = null;
   for (let row = step >> 1; row < rows; row += step) {
     for (let column = step >> 1; column < columns; column += step) {
       if (near[row * columns + column] * cell < CLEARANCE) continue;
       for (let ray = 0; ray < RAYS; ray++) {  // the first building along each ray
         const a = ray * 2 * Math.PI / RAYS, dx = Math.sin(a), dy = Math.cos(a);  // rows: north
-        hitBuilding[ray] = 0; hitFill[ray] = 0;
+        hitBuilding[ray] = 0; hitFill[ray] = 0; hitCounted[ray] = 0; hitOpen[ray] = 0;
         for (let t = 1; t < reach; t += 0.5) {
           const x = Math.floor(column + 0.5 + dx * t), y = Math.floor(row + 0.5 + dy * t);
           if (x < 0 || x >= columns || y < 0 || y >= rows) break;
@@ -542,21 +629,31 @@ function fitDistrictStreet(model, box) {
           const top = Math.atan2(height[at] - EYE, distance), foot = -Math.atan2(EYE, distance);
           const shown = Math.min(top, tilt + halfV) - Math.max(foot, tilt - halfV);
           hitBuilding[ray] = building[at]; hitFill[ray] = Math.max(0, shown) / (2 * halfV);
+          hitOpen[ray] = openings[at];
+          // what of it counts: the share of its height in view (a house cut off at the
+          // picture's top counts less), less for a wall nearer than STAND_BACK, and less
+          // for a blank wall
+          hitCounted[ray] = hitFill[ray] * Math.max(0, shown) / (top - foot)
+            * Math.min(1, distance / STAND_BACK) * (openings[at] ? 1 : BLANK_WALL);
           break;
         }
       }
       for (let heading = 0; heading < RAYS; heading++) {
-        const shares = new Map();  // building -> the share of the picture it fills
+        // building -> the share of the picture it fills, what of that counts, and the
+        // share of its walls with openings
+        const shares = new Map();
         for (let k = -span; k <= span; k++) {
           const ray = (heading + k + RAYS) % RAYS;
           if (!hitBuilding[ray]) continue;
-          const share = hitFill[ray] / (2 * span + 1);
-          shares.set(hitBuilding[ray], (shares.get(hitBuilding[ray]) || 0) + share);
+          const seen = shares.get(hitBuilding[ray]) || [0, 0, 0];
+          seen[0] += hitFill[ray] / (2 * span + 1); seen[1] += hitCounted[ray] / (2 * span + 1);
+          if (hitOpen[ray]) seen[2] += hitFill[ray] / (2 * span + 1);
+          shares.set(hitBuilding[ray], seen);
         }
         let score = 0;
-        for (const share of shares.values()) score += Math.sqrt(share);
+        for (const [share, counted] of shares.values()) score += viewScore(share, counted);
         if (!best || score > best.score + 1e-9) {
-          best = {score, column, row, heading, seen: [...shares.keys()]};
+          best = {score, column, row, heading, shares};
         }
       }
     }
@@ -568,10 +665,14 @@ function fitDistrictStreet(model, box) {
   const position = new THREE.Vector3(plan.x(best.column), box.min.y + EYE, plan.z(best.row));
   const distance = 20;
   const named = building => building.userData.name || building.name;  // as the glb names it
-  const seen = best.seen.sort((p, q) => p - q).map(id => named(model.children[id - 1]));
+  const ids = [...best.shares.keys()].sort((p, q) => p - q);
+  const seen = ids.map(id => named(model.children[id - 1]));
+  // each building's share of the picture, and the share of its walls with openings
+  const shares = ids.map(id => +best.shares.get(id)[0].toFixed(4));
+  const open = ids.map(id => +best.shares.get(id)[2].toFixed(4));
   document.body.dataset.street = JSON.stringify({
     eye: position.toArray().map(v => +v.toFixed(3)), heading: +(a * 180 / Math.PI).toFixed(1),
-    seen});
+    seen, shares, open});
   return {position, aim: position.clone().addScaledVector(forward, distance), distance};
 }
 // The sun's shadow camera fitted round the model's box, seen from the sun, so a facade and a
