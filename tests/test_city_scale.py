@@ -335,3 +335,50 @@ def test_report_entries_are_kept_on_disk_not_in_memory(tmp_path: Path) -> None:
     assert held < 500 * 100, held
     assert entries[499] == {**entry, "id": "b499"} and entries.line(0).startswith(b'{"id": "b0"')
     assert list(tmp_path.iterdir()) == []  # its file has no name
+
+
+def _traced_peak(work: Any) -> tuple[Any, int]:
+    """What ``work()`` returns, and the peak of Python's live allocations while it ran
+    above those before (tracemalloc), the garbage collected first."""
+    gc.collect()
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    try:
+        done = work()
+        peak = tracemalloc.get_traced_memory()[1] - before
+    finally:
+        tracemalloc.stop()
+    return done, peak
+
+
+def test_planning_peaks_grow_little_with_the_city(tmp_path: Path) -> None:
+    """The two largest peaks of planning before the tasks, a building (the slope from 200
+    to 1,600 buildings, tracemalloc's count, the first read's one-off caches left out):
+    reading holds each footprint in one form at a time (1,363 -> 732 B a building when
+    it held the features as read, in metres and as footprints at once), and finding the
+    nodes a neighbour shares keeps the vertices in flat arrays (1,053 -> 668 B a building
+    with a shapely point and tuples a vertex). GEOS's own memory is not counted here:
+    ``make bench-large`` measures the resident memory (docs/benchmarks.md)."""
+    from facadecli.city.footprints import read_footprints
+    from facadecli.city.straight import straighten
+
+    def footprints(count: int) -> Path:
+        town = write_terraces(tmp_path / f"town-{count}", ROOT / "specs", count, 1)
+        return town.parent / "footprints.geojson"
+
+    read_footprints(footprints(50))  # pyproj's caches, once
+    reading, merging = [], []
+    for count in (200, 1600):
+        path = footprints(count)
+        found, peak = _traced_peak(lambda path=path: read_footprints(path))
+        reading.append(peak)
+        assert len(found.footprints) == count
+        kept = list(found.footprints)
+        del found
+        merged, peak = _traced_peak(lambda kept=kept: straighten(kept, 3.0, 0.3))
+        merging.append(peak)
+        assert merged.footprints == tuple(kept)  # rectangles: nothing to merge
+    read_slope = (reading[1] - reading[0]) / 1400
+    merge_slope = (merging[1] - merging[0]) / 1400
+    assert read_slope < 1000, read_slope
+    assert merge_slope < 850, merge_slope

@@ -30,6 +30,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TypeVar
 
+import shapely
+
 from facadecli.city.building import (
     AxisCache,
     Facade,
@@ -79,10 +81,10 @@ from facadecli.city.s3db import (
     inherited,
     lifted,
     outline_rest,
+    party_lines,
     replaced_outlines,
     roof_colour,
     screens,
-    shared_edges,
     side_by_side,
     standing_on,
     tagged_heights,
@@ -341,18 +343,23 @@ def plan(
     )
     shapes |= {key: (shapes[key][0], heights, shapes[key][2]) for key, heights in raised.items()}
     beside = _beside(footprints, shapes)
-    shared = shared_edges(footprints, tolerance, beside) if tolerance > 0 else {}
+    # each building's party walls kept as their WKB until its task is made (exact
+    # coordinates, as the packed task keeps them): 40,000 generated terraces planned held
+    # 67 MiB more resident with them as GEOS objects, 9 MiB as WKB
+    lines = party_lines(footprints, tolerance, beside) if tolerance > 0 else iter(())
+    shared = {key: shapely.to_wkb(found) for key, found in lines}
 
     def walls_of(footprint: Footprint) -> list[Wall]:
         _, heights, roof = shapes[footprint.id]
-        return building_walls(footprint, heights, roof, shared.get(footprint.id), tolerance)
+        lines = _from_wkb(shared.get(footprint.id))
+        return building_walls(footprint, heights, roof, lines, tolerance)
 
     footprints, warnings = one_door_each(footprints, walls_of)
     tasks: Packed[Task] = Packed(dict(city.specs))
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
     for footprint in footprints:
-        choice, heights, roof = shapes[footprint.id]
+        choice, heights, roof = shapes.pop(footprint.id)  # let go as its task is packed
         name = safe_name(footprint.id)
         if owners.setdefault(name, footprint.id) != footprint.id:
             raise SpecError.at(
@@ -396,7 +403,7 @@ def plan(
                 outdir / building_file(footprint.id),
                 (city.folder / choice.facade).parent.resolve(),
                 looks,
-                shared.get(footprint.id),
+                _from_wkb(shared.pop(footprint.id, None)),
                 tolerance,
                 identities[choice.facade],
                 walls,
@@ -410,6 +417,11 @@ def plan(
             )
         )
     return tasks, warnings
+
+
+def _from_wkb(data: bytes | None) -> Any:
+    """A footprint's party walls kept as WKB (:func:`plan`), None when it has none."""
+    return None if data is None else shapely.from_wkb(data)
 
 
 def one_door_each(
