@@ -19,13 +19,14 @@ import hashlib
 import json
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, overload
+from typing import TYPE_CHECKING, Any
 
 import shapely
 from pydantic import BaseModel
 from shapely.geometry.base import BaseGeometry
 
 from facadecli import __version__
+from facadecli.city.packed import Positional
 from facadecli.export.texture_store import pictures_missing
 
 if TYPE_CHECKING:
@@ -119,7 +120,7 @@ def building_hash(task: Task, spec_digest: Callable[[str], str]) -> str:
     return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 
-class Hashes(Sequence[str]):
+class Hashes(Positional[str]):
     """The buildings' hashes (:func:`building_hash`) by their position in the manifest's
     order, kept as their 32 bytes in one buffer: 32 bytes a building in memory, where a
     dict of hex strings by id takes 195, in small objects that stay for the whole run
@@ -134,19 +135,7 @@ class Hashes(Sequence[str]):
     def __len__(self) -> int:
         return len(self._digests) // DIGEST
 
-    @overload
-    def __getitem__(self, index: int) -> str: ...
-
-    @overload
-    def __getitem__(self, index: slice) -> list[str]: ...
-
-    def __getitem__(self, index: int | slice) -> str | list[str]:
-        if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(len(self)))]
-        if index < 0:
-            index += len(self)
-        if not 0 <= index < len(self):
-            raise IndexError(index)
+    def _at(self, index: int) -> str:
         return self._digests[index * DIGEST : (index + 1) * DIGEST].hex()
 
 
