@@ -483,27 +483,23 @@ function planOpenings(model, box, cell, columns, rows) {
   }
   const reach = Math.max(1, Math.round(OPENING_REACH / cell));
   const across = new Uint8Array(columns * rows), openings = new Uint8Array(columns * rows);
-  for (let row = 0; row < rows; row++) {
-    for (let column = 0, last = -Infinity; column < columns; column++) {  // the last marked
-      if (marked[row * columns + column]) last = column;
-      across[row * columns + column] = column - last <= reach ? 1 : 0;
-    }
-    for (let column = columns - 1, next = Infinity; column >= 0; column--) {
-      if (marked[row * columns + column]) next = column;
-      if (next - column <= reach) across[row * columns + column] = 1;
-    }
-  }
+  for (let row = 0; row < rows; row++) spread(marked, across, row * columns, 1, columns, reach);
   for (let column = 0; column < columns; column++) {
-    for (let row = 0, last = -Infinity; row < rows; row++) {
-      if (across[row * columns + column]) last = row;
-      openings[row * columns + column] = row - last <= reach ? 1 : 0;
-    }
-    for (let row = rows - 1, next = Infinity; row >= 0; row--) {
-      if (across[row * columns + column]) next = row;
-      if (next - row <= reach) openings[row * columns + column] = 1;
-    }
+    spread(across, openings, column, columns, rows, reach);
   }
   return openings;
+}
+// One line of a square dilation: each of ``count`` cells of ``to`` (from ``start``, every
+// ``step``) set where ``from`` has a cell set within ``reach`` cells of it along the line.
+function spread(from, to, start, step, count, reach) {
+  for (let i = 0, last = -Infinity; i < count; i++) {  // the last set cell
+    if (from[start + i * step]) last = i;
+    to[start + i * step] = i - last <= reach ? 1 : 0;
+  }
+  for (let i = count - 1, next = Infinity; i >= 0; i--) {
+    if (from[start + i * step]) next = i;
+    if (next - i <= reach) to[start + i * step] = 1;
+  }
 }
 function districtPlan(model, box) {
   const size = box.getSize(new THREE.Vector3());
