@@ -104,7 +104,7 @@ city: $(STAMP) ## Build a city: the generated demo district, or CITY=path/to/man
 golden: $(STAMP) ## Regenerate the golden SVG elevations of the examples (tests/cases/golden)
 	$(BIN)/python tests/golden.py
 
-pictures: $(STAMP) ## Render the README's pictures into docs/pictures (needs chromium)
+pictures: $(STAMP) $(CESIUM) ## Render the README's pictures into docs/pictures (needs chromium; installs npm cesium for the 3D Tiles one)
 	$(BIN)/python docs/pictures.py
 
 .PHONY: docs

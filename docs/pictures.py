@@ -62,7 +62,8 @@ PARTS: dict[str, tuple[str, Callable[[Shape], bool], tuple[float, float], float,
 # of the picture's width or height (the tighter) the part would span seen square on; the
 # viewer's 8% margin and the perspective of an oblique view leave about three quarters
 PART_FILL = 0.9
-ASPECT = 900 / 560  # the screenshot's (WINDOW)
+ASPECT = 900 / 560  # the screenshot's (WINDOW), the widest a part's picture is
+PART_NARROWEST = 0.6  # the narrowest a part's picture is, as a share of its height
 
 
 def looks(wide: float, high: float, deep: float, around: float, up: float) -> tuple[float, float]:
@@ -79,13 +80,16 @@ def part_view(
     share: tuple[float, float],
     around: float,
     up: float,
-) -> str:
-    """The viewer's ``?view=`` aimed at the part: the middle of the shapes ``shows``
-    picks (the ``share`` of their height from the foot), as shares of the model's box
-    (the canvas across and up; in depth, from the deepest shape's back, less a window
-    recess, to the most proud one's front), and zoomed from the whole model's fit until
-    the part spans :data:`PART_FILL` of the picture (the fit shows the canvas, its
-    tighter side filling the picture)."""
+) -> tuple[str, str]:
+    """The viewer's ``?view=`` aimed at the part and the window to take it in: the middle
+    of the shapes ``shows`` picks (the ``share`` of their height from the foot), as
+    shares of the model's box (the canvas across and up; in depth, from the deepest
+    shape's back, less a window recess, to the most proud one's front), and zoomed from
+    the whole model's fit until the part spans :data:`PART_FILL` of the picture (the fit
+    shows the canvas, its tighter side filling the picture). The window is as tall as
+    :data:`WINDOW` and as wide as the part looks beside its height, from
+    :data:`PART_NARROWEST` to :data:`ASPECT` times it: a tall part (a door) gets an
+    upright picture of itself, not its neighbours either side."""
     visible = [s for s in layout["shapes"] if s["visible"]]
     chosen = [s for s in visible if shows(s)]
     assert chosen, "no shape of the layout is the part"
@@ -99,10 +103,13 @@ def part_view(
     depth = front - min(s["z0"] for s in chosen)
     model_wide, model_high = looks(width, height, deep, around, up)
     part_wide, part_high = looks(x1 - x0, y1 - y0, depth, around, up)
-    seen_wide = max(model_wide, model_high * ASPECT)  # the model's fit: what the picture spans
-    zoom = PART_FILL * min(seen_wide / part_wide, seen_wide / ASPECT / part_high)
+    aspect = min(max(part_wide / part_high, PART_NARROWEST), ASPECT)
+    seen_wide = max(model_wide, model_high * aspect)  # the model's fit: what the picture spans
+    zoom = PART_FILL * min(seen_wide / part_wide, seen_wide / aspect / part_high)
     at = ((x0 + x1) / 2 / width, (y0 + y1) / 2 / height, (front - depth / 2 - back) / deep)
-    return f"{around:g},{up:g},{zoom:.2f}," + ",".join(f"{share:.3f}" for share in at)
+    high = int(WINDOW.split(",")[1])
+    view = f"{around:g},{up:g},{zoom:.2f}," + ",".join(f"{share:.3f}" for share in at)
+    return view, f"{round(high * aspect)},{high}"
 
 
 def browser() -> str:
@@ -220,19 +227,19 @@ def look_pictures(chrome: str, out: Path, suffix: str = "") -> None:
     LOOK.mkdir(parents=True, exist_ok=True)
     facade = [sys.executable, "-m", "facadecli"]
     run = partial(subprocess.run, check=True, capture_output=True)
+    only = [name for name in os.environ.get("LOOK", "").split(",") if name]
     pages = {}
     for spec in sorted((ROOT / "specs").glob("*.yaml")):
-        run([*facade, "solve", str(spec), "-o", str(out), "-f", "html"])
-        pages[spec.stem] = out / f"{spec.stem}.html"
-    manifest = write_demo(out / "district", ROOT / "specs", 4)
-    city = out / "city"
-    run([*facade, "city", str(manifest), "-o", str(city), "--limit", str(CITY_BLOCK)])
-    run([*facade, "view", str(city), "-o", str(out / "city-block.html")])
-    pages["city-block"] = out / "city-block.html"
-    only = [name for name in os.environ.get("LOOK", "").split(",") if name]
+        if not only or spec.stem in only:
+            run([*facade, "solve", str(spec), "-o", str(out), "-f", "html"])
+            pages[spec.stem] = out / f"{spec.stem}.html"
+    if not only or "city-block" in only:
+        manifest = write_demo(out / "district", ROOT / "specs", 4)
+        city = out / "city"
+        run([*facade, "city", str(manifest), "-o", str(city), "--limit", str(CITY_BLOCK)])
+        run([*facade, "view", str(city), "-o", str(out / "city-block.html")])
+        pages["city-block"] = out / "city-block.html"
     for name, page in pages.items():
-        if only and name not in only:
-            continue
         views = LOOK_VIEWS if name != "city-block" else tuple(CITY_VIEWS.values())
         shots = []
         for index, view in enumerate(views):
@@ -240,6 +247,41 @@ def look_pictures(chrome: str, out: Path, suffix: str = "") -> None:
             screenshot(chrome, f"{page.as_uri()}?bare&view={view}", shot, WINDOW, out / "profile")
             shots.append(shot)
         strip(shots, LOOK / f"{name}{suffix}.png")
+
+
+def cesium_picture(out: Path) -> None:
+    """The tests' OSM district (``tests/osm_district.py``: 36 buildings near Helsinki, one
+    of each case S3DB names) built with ``facade city --3dtiles`` and its tiles opened in
+    CesiumJS in headless Chromium with no network (``tests/cesium.py``, the page the
+    CesiumJS test opens): ``city-3dtiles-cesium.png``. Needs npm ``cesium`` in
+    .venv/node (``make test`` installs it) or FACADE_CESIUM."""
+    sys.path.insert(0, str(ROOT))  # the tests' district and page
+    from PIL import Image
+
+    from tests import cesium
+    from tests.osm_district import write_district
+
+    if not cesium.installed():
+        sys.exit(f"no CesiumJS in {cesium.CESIUM}: make test installs it (or set FACADE_CESIUM)")
+    district = write_district(out / "district.osm")
+    run = out / "district"
+    facade = [sys.executable, "-m", "facadecli"]
+    subprocess.run(
+        [*facade, "city", str(district), "--3dtiles", "-j", "2", "-o", str(run)],
+        check=True,
+        capture_output=True,
+    )
+    missing: list[str] = []
+    shot, dom = cesium.open_tiles(run, out, [], missing)
+    title = cesium.title(dom)
+    if not title.startswith("loaded"):
+        sys.exit(f"CesiumJS did not load the district's tiles: {title}")
+    if unanswered := [path for path in missing if not path.endswith("favicon.ico")]:
+        sys.exit(f"CesiumJS asked for what the run did not write: {unanswered}")
+    target = TARGET / "city-3dtiles-cesium.png"
+    with Image.open(shot) as image:
+        image.convert("RGB").save(target, optimize=True)
+    print(f"{target.relative_to(ROOT)}: {title}, {target.stat().st_size // 1024} KB")
 
 
 SWATCH = 192  # pixels a side of one material on the library's contact sheet
@@ -277,15 +319,16 @@ def material_sheet(target: Path) -> None:
 def main(names: list[str]) -> None:
     """The pictures named (all without names): a spec's from :data:`PICTURES` or
     :data:`PARTS`, ``materials`` (the library's sheet), ``city`` (the city block's three views;
-    SUFFIX=-before names them for the record of older code) or ``look`` (every example
-    and the city block from three cameras, SUFFIX likewise)."""
+    SUFFIX=-before names them for the record of older code), ``look`` (every example
+    and the city block from three cameras, SUFFIX likewise) or ``cesium`` (the tests' OSM
+    district's 3D Tiles in CesiumJS)."""
     everything = not names
     if everything or "materials" in names:
         target = TARGET / "materials.png"
         material_sheet(target)
         print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
-    chosen = [name for name in names if name not in ("materials", "city", "look")]
-    if not (everything or chosen or "city" in names or "look" in names):
+    chosen = [name for name in names if name not in ("materials", "city", "look", "cesium")]
+    if not (everything or chosen or {"city", "look", "cesium"} & set(names)):
         return
     chrome = browser()
     TARGET.mkdir(parents=True, exist_ok=True)
@@ -295,6 +338,9 @@ def main(names: list[str]) -> None:
     if everything or "city" in names:
         with tempfile.TemporaryDirectory() as scratch:
             city_pictures(chrome, Path(scratch), os.environ.get("SUFFIX", ""))
+    if everything or "cesium" in names:
+        with tempfile.TemporaryDirectory() as scratch:
+            cesium_picture(Path(scratch))
     if not (everything or chosen):
         return
     facade = Path(sys.executable).parent / "facade"
@@ -313,16 +359,16 @@ def main(names: list[str]) -> None:
             if name in PARTS:
                 spec, shows, share, around, up = PARTS[name]
                 layout = json.loads((out / f"{spec}.layout.json").read_text(encoding="utf-8"))
-                what, view = "model", part_view(layout, shows, share, around, up)
+                what, (view, window) = "model", part_view(layout, shows, share, around, up)
             else:
-                spec, what, view = PICTURES[name]
+                (spec, what, view), window = PICTURES[name], WINDOW
             target = TARGET / f"{name}.png"
             if what == "elevation":
                 svg = out / f"{spec}.svg"
                 screenshot(chrome, svg.as_uri(), target, svg_size(svg), out / "profile")
             else:
                 url = f"{(out / f'{spec}.html').as_uri()}?bare&view={view}"
-                screenshot(chrome, url, target, WINDOW, out / "profile")
+                screenshot(chrome, url, target, window, out / "profile")
             print(f"{target.relative_to(ROOT)}: {target.stat().st_size // 1024} KB")
 
 

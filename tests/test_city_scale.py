@@ -8,6 +8,8 @@ import dataclasses
 import errno
 import gc
 import json
+import subprocess
+import sys
 import tracemalloc
 from collections import Counter
 from pathlib import Path
@@ -20,10 +22,11 @@ import facadecli.city.tiles as tiles_module
 from facadecli.city.built import BuiltCity
 from facadecli.city.demo import write_terraces
 from facadecli.city.folders import SHARD, SHARDS, building_file, safe_name, shard
+from facadecli.city.heap import give_back
 from facadecli.city.manifest import load_city
-from facadecli.city.packed import Packed, Picked
+from facadecli.city.packed import Packed, Picked, Points
 from facadecli.city.report import CityReport, Entries, Summary, Tally, report_chunks
-from facadecli.city.resume import recorded
+from facadecli.city.resume import building_hash, building_hashes, recorded, spec_digests
 from facadecli.city.run import planned, run_city
 from facadecli.export import CITY_WRITERS, CityWriter
 from facadecli.export.glb_merge import merge_glb, read_glb
@@ -262,26 +265,48 @@ def test_resume_reads_the_last_run_as_lines(tmp_path: Path) -> None:
     assert recorded(tmp_path, "town") == {"a": json.dumps(entries[0]).encode("utf-8")}
 
 
+PLANNED_HELD = """
+import gc, json, sys, tracemalloc
+from pathlib import Path
+from facadecli.city.demo import write_terraces
+from facadecli.city.manifest import load_city
+from facadecli.city.run import planned
+root, folder = Path(sys.argv[1]), Path(sys.argv[2])
+held = []
+for count in (100, 800):
+    loaded = load_city(write_terraces(folder / f"town-{count}", root / "specs", count, 1))
+    ahead = None
+    gc.collect()
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    ahead = planned(loaded, folder / "out")
+    gc.collect()
+    held.append(tracemalloc.get_traced_memory()[0] - before)
+    tracemalloc.stop()
+print(json.dumps(held))
+"""
+
+
 def test_a_planned_city_holds_its_tasks_packed(tmp_path: Path) -> None:
     """What a client holds through a run once planned grows little with the city: the
     tasks packed (packed.py), the footprints read not kept (tracemalloc's count of
-    Python's live allocations: 0.7 KB a building here, where the unpacked tasks and
-    the footprints took 2.8 KB). Read back, each task is the one planned, its spec the
+    Python's live allocations: 0.1 KB a building here, where the unpacked tasks and
+    the footprints took 2.8 KB). Counted in a fresh Python, as a client starts: in a
+    test worker, what earlier tests left (a large heap, caches) read as 5.6-6.2 KB a
+    building held on some runs. Read back, each task is the one planned, its spec the
     city's own."""
-    held = []
-    for count in (100, 800):
-        manifest = write_terraces(tmp_path / f"town-{count}", ROOT / "specs", count, 1)
-        loaded = load_city(manifest)
-        ahead = None
-        gc.collect()
-        tracemalloc.start()  # what planning adds, whatever a worker traced before
-        before = tracemalloc.get_traced_memory()[0]
-        ahead = planned(loaded, tmp_path / "out")
-        gc.collect()  # the garbage a worker's large heap has not yet collected is not held
-        held.append(tracemalloc.get_traced_memory()[0] - before)
-        tracemalloc.stop()
+    run = subprocess.run(
+        [sys.executable, "-c", PLANNED_HELD, str(ROOT), str(tmp_path / "fresh")],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    )
+    held = json.loads(run.stdout.splitlines()[-1])
     per_building = (held[1] - held[0]) / 700
-    assert per_building < 1200, per_building
+    assert per_building < 600, per_building
+    loaded = load_city(write_terraces(tmp_path / "town", ROOT / "specs", 800, 1))
+    ahead = planned(loaded, tmp_path / "out")
     tasks = list(ahead.tasks)
     assert len(tasks) == 800 and [t.footprint.id for t in tasks[:2]] == ["t0", "t1"]
     again: Packed[Any] = Packed(dict(loaded.specs), chunk=3)
@@ -289,6 +314,36 @@ def test_a_planned_city_holds_its_tasks_packed(tmp_path: Path) -> None:
     assert list(again) == tasks and again[-1] == tasks[-1] and again[4:8] == tasks[4:8]
     assert all(task.spec is loaded.specs[task.spec_key] for task in again)
     assert Picked(again, [1, 5, 799])[:] == [tasks[1], tasks[5], tasks[799]]
+
+
+def test_a_run_keeps_its_buildings_hashes_and_places_in_flat_buffers(tmp_path: Path) -> None:
+    """What a run keeps of every building beside its packed task, for the whole run: its
+    hash (resume.py) in 32 bytes and its centroid in 16, in one buffer each, not as small
+    objects (a dict of hex strings by id took 145-195 bytes a building, a list of tuples 112;
+    tracemalloc's count, the garbage collected before and after). Each reads back as made."""
+    manifest = write_terraces(tmp_path / "town", ROOT / "specs", 600, 1)
+    loaded = load_city(manifest)
+    tasks = list(planned(loaded, tmp_path / "out").tasks)
+    centroids = [(task.footprint.parts[0].centroid.x, 0.5 + i) for i, task in enumerate(tasks)]
+    gc.collect()
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    hashes = building_hashes(loaded, tasks)
+    points = Points()
+    for point in centroids:
+        points.append(point)
+    gc.collect()
+    held = tracemalloc.get_traced_memory()[0] - before
+    tracemalloc.stop()
+    assert held / len(tasks) < 64, held / len(tasks)
+    digest = spec_digests(loaded)
+    assert len(hashes) == len(tasks) == 600 and hashes[-1] == hashes[599]
+    assert [hashes[i] for i in (0, 299)] == [building_hash(tasks[i], digest) for i in (0, 299)]
+    assert hashes[1:3] == [building_hash(task, digest) for task in tasks[1:3]]
+    assert list(points) == centroids and points[-1] == centroids[-1] and len(points) == 600
+    with pytest.raises(IndexError):
+        hashes[600]
+    assert isinstance(give_back(), bool)  # glibc's malloc_trim, or nothing elsewhere
 
 
 def test_report_entries_are_kept_on_disk_not_in_memory(tmp_path: Path) -> None:
@@ -304,3 +359,50 @@ def test_report_entries_are_kept_on_disk_not_in_memory(tmp_path: Path) -> None:
     assert held < 500 * 100, held
     assert entries[499] == {**entry, "id": "b499"} and entries.line(0).startswith(b'{"id": "b0"')
     assert list(tmp_path.iterdir()) == []  # its file has no name
+
+
+def _traced_peak(work: Any) -> tuple[Any, int]:
+    """What ``work()`` returns, and the peak of Python's live allocations while it ran
+    above those before (tracemalloc), the garbage collected first."""
+    gc.collect()
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    try:
+        done = work()
+        peak = tracemalloc.get_traced_memory()[1] - before
+    finally:
+        tracemalloc.stop()
+    return done, peak
+
+
+def test_planning_peaks_grow_little_with_the_city(tmp_path: Path) -> None:
+    """The two largest peaks of planning before the tasks, a building (the slope from 200
+    to 1,600 buildings, tracemalloc's count, the first read's one-off caches left out):
+    reading holds each footprint in one form at a time (1,363 -> 732 B a building when
+    it held the features as read, in metres and as footprints at once), and finding the
+    nodes a neighbour shares keeps the vertices in flat arrays (1,053 -> 668 B a building
+    with a shapely point and tuples a vertex). GEOS's own memory is not counted here:
+    ``make bench-large`` measures the resident memory (docs/benchmarks.md)."""
+    from facadecli.city.footprints import read_footprints
+    from facadecli.city.straight import straighten
+
+    def footprints(count: int) -> Path:
+        town = write_terraces(tmp_path / f"town-{count}", ROOT / "specs", count, 1)
+        return town.parent / "footprints.geojson"
+
+    read_footprints(footprints(50))  # pyproj's caches, once
+    reading, merging = [], []
+    for count in (200, 1600):
+        path = footprints(count)
+        found, peak = _traced_peak(lambda path=path: read_footprints(path))
+        reading.append(peak)
+        assert len(found.footprints) == count
+        kept = list(found.footprints)
+        del found
+        merged, peak = _traced_peak(lambda kept=kept: straighten(kept, 3.0, 0.3))
+        merging.append(peak)
+        assert merged.footprints == tuple(kept)  # rectangles: nothing to merge
+    read_slope = (reading[1] - reading[0]) / 1400
+    merge_slope = (merging[1] - merging[0]) / 1400
+    assert read_slope < 1000, read_slope
+    assert merge_slope < 850, merge_slope

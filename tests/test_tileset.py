@@ -7,19 +7,14 @@ lighter than LOD2 roofs, lighter than LOD3 façades."""
 
 from __future__ import annotations
 
-import functools
-import http.server
 import itertools
 import json
 import os
 import random
-import re
 import shlex
 import shutil
 import struct
 import subprocess
-import sys
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -38,7 +33,8 @@ from facadecli.city.tiles import merge_city
 from facadecli.city.tileset import TilesetWriter, chosen_lods, parse_lods, quadtree
 from facadecli.errors import SpecError
 from facadecli.export.glb_merge import read_glb
-from tests.browser import BROWSER, browse
+from tests import cesium
+from tests.browser import BROWSER
 from tests.osm_district import METRE_LAT, METRE_LON, ORIGIN, Building, box, write_district
 from tests.running import facade
 
@@ -332,10 +328,6 @@ def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) 
 # Outside tools, where they are installed: the 3D Tiles validator and CesiumJS
 
 VALIDATOR = os.environ.get("FACADE_3DTILES_VALIDATOR")  # e.g. "npx 3d-tiles-validator"
-# a folder with Cesium.js: npm cesium's Build/Cesium, which make test installs in the venv
-CESIUM = os.environ.get(
-    "FACADE_CESIUM", str(Path(sys.prefix) / "node" / "node_modules" / "cesium" / "Build" / "Cesium")
-)
 
 
 @pytest.mark.skipif(not VALIDATOR, reason="set FACADE_3DTILES_VALIDATOR to a validator command")
@@ -352,76 +344,10 @@ def test_the_3d_tiles_validator_finds_nothing(city: Path) -> None:
     assert (found["numErrors"], found["numWarnings"]) == (0, 0), done.stdout
 
 
-PAGE = """<!doctype html>
-<html><head><meta charset="utf-8"><title>loading: tileset</title>
-<script>window.CESIUM_BASE_URL = "cesium/";</script>
-<script src="cesium/Cesium.js"></script>
-<link href="cesium/Widgets/widgets.css" rel="stylesheet">
-<style>html, body, #globe { margin: 0; width: 100%; height: 100%; overflow: hidden }</style>
-</head><body><div id="globe"></div><script>
-// No network: no Cesium ion, no imagery, a plain globe on the WGS 84 ellipsoid.
-async function main() {
-  Cesium.Ion.defaultAccessToken = "";
-  const viewer = new Cesium.Viewer("globe", {
-    baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
-    animation: false, homeButton: false, sceneModePicker: false, fullscreenButton: false,
-    navigationHelpButton: false, infoBox: false, selectionIndicator: false,
-    terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false,
-    skyAtmosphere: false, contextOptions: { webgl: { preserveDrawingBuffer: true } },
-  });
-  viewer.scene.globe.baseColor = Cesium.Color.fromCssColorString("#7d9a6a");
-  const tileset = await Cesium.Cesium3DTileset.fromUrl("run/3dtiles/tileset.json",
-                                                       { maximumScreenSpaceError: 2 });
-  viewer.scene.primitives.add(tileset);
-  const sphere = tileset.boundingSphere;
-  viewer.camera.flyToBoundingSphere(sphere, { duration: 0, offset: new Cesium.HeadingPitchRange(
-    Cesium.Math.toRadians(30), Cesium.Math.toRadians(-35), sphere.radius * 2.2) });
-  const at = Cesium.Cartographic.fromCartesian(sphere.center);
-  tileset.allTilesLoaded.addEventListener(() => {
-    const degrees = (v) => Cesium.Math.toDegrees(v).toFixed(8);
-    document.title = `loaded ${degrees(at.longitude)} ${degrees(at.latitude)} ${at.height}`;
-  });
-}
-main().catch((error) => { document.title = "error: " + error; });
-</script></body></html>
-"""
-
-
-class _Counted(http.server.SimpleHTTPRequestHandler):
-    """Serves a folder quietly, keeping the paths asked for and those it could not find."""
-
-    asked: list[str]
-    missing: list[str]
-
-    def do_GET(self) -> None:
-        self.asked.append(self.path)
-        super().do_GET()
-
-    def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
-        self.missing.append(self.path)
-        super().send_error(code, message, explain)
-
-    def log_message(self, format: str, *args: Any) -> None:
-        pass
-
-
-def _served(folder: Path, asked: list[str], missing: list[str]) -> Iterator[str]:
-    kept = {"asked": asked, "missing": missing}
-    handler = functools.partial(type("Handler", (_Counted,), kept), directory=str(folder))
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{server.server_address[1]}/index.html"
-    finally:
-        server.shutdown()
-        server.server_close()
-
-
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 @pytest.mark.skipif(
-    not CESIUM or not (Path(str(CESIUM)) / "Cesium.js").is_file(),
+    not cesium.installed(),
     reason="no CesiumJS: make test installs it, or set FACADE_CESIUM to npm cesium's Build/Cesium",
 )
 def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: Path) -> None:
@@ -430,16 +356,10 @@ def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: P
     flies to the tileset; the centre of the bounding sphere it computed is where PROJ puts
     the root box's centre, within a centimetre, and the picture shows the houses on the
     globe."""
-    site = tmp_path / "site"
-    site.mkdir()
-    (site / "cesium").symlink_to(Path(str(CESIUM)).resolve())
-    (site / "run").symlink_to(city)  # the whole output folder: 3dtiles/ and textures/
-    (site / "index.html").write_text(PAGE)
     asked: list[str] = []
     missing: list[str] = []
-    for url in _served(site, asked, missing):
-        shot, dom = browse(tmp_path, url, (20_000, 60_000), lambda dom: "<title>loaded" in dom)
-    title = re.search(r"<title>([^<]*)</title>", dom).group(1)  # type: ignore[union-attr]
+    shot, dom = cesium.open_tiles(city, tmp_path, asked, missing)
+    title = cesium.title(dom)
     assert title.startswith("loaded"), title
     assert [path for path in missing if not path.endswith("favicon.ico")] == []
     pictures = {p.name for p in (city / "textures").glob("*.png")}
@@ -465,7 +385,7 @@ def test_cesium_shows_the_tiles_where_the_footprints_are(city: Path, tmp_path: P
 
     with Image.open(shot) as image:
         pixels = np.asarray(image.convert("RGB"), dtype=int)[150:450, 300:700]
-    globe = np.array([0x7D, 0x9A, 0x6A])
+    globe = np.array(cesium.GLOBE)
     houses_drawn = int((np.abs(pixels - globe).sum(axis=2) > 40).sum())
     assert houses_drawn > 0.2 * pixels.shape[0] * pixels.shape[1]  # a fifth of the middle
 

@@ -331,6 +331,80 @@ def test_glass_reads_neither_black_nor_white_nor_as_the_wall(tmp_path: Path) -> 
     assert abs(wall - pane) > 25
 
 
+WALLS_SPEC = """
+version: 1
+name: walls
+canvas: {width: 12.0, height: 6.0}
+symbol_defaults: {opaque: true}
+symbols:
+  A: {size: 6.0, label: wall}
+  B: {size: 6.0, label: wall}
+  Q: {size: 6.0, label: storey}
+patterns: {across: "A B", up: "Q"}
+layers: [{name: base, x: across, y: up}]
+shapes:
+  - {match: {x: B, y: Q}, material: brick}
+materials:
+  plaster: {color: "#e4d6bd", roughness: 0.9}
+  brick: {color: "#a0522d", roughness: 0.9}
+defaults: {mesh: box, material: plaster, thickness: 0.2}
+"""
+
+
+def _hue_and_saturation(shot: Path, box: tuple[float, float, float, float]) -> tuple[float, float]:
+    """The median hue (degrees) and saturation (HSV, 0..1) of the pixels of the
+    screenshot's part ``box`` (left, top, right, bottom as fractions of its size)."""
+    import colorsys
+    import statistics
+
+    from PIL import Image
+
+    with Image.open(shot) as image:
+        rgb = image.convert("RGB")
+        left, top, right, bottom = box
+        part = rgb.crop(
+            (
+                round(left * rgb.width),
+                round(top * rgb.height),
+                round(right * rgb.width),
+                round(bottom * rgb.height),
+            )
+        )
+        data = part.tobytes()
+    pixels = [
+        colorsys.rgb_to_hsv(data[at] / 255, data[at + 1] / 255, data[at + 2] / 255)
+        for at in range(0, len(data), 3)
+    ]
+    return (
+        statistics.median(hue for hue, _, _ in pixels) * 360,
+        statistics.median(saturation for _, saturation, _ in pixels),
+    )
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_lit_wall_keeps_its_colours_hue_and_saturation(tmp_path: Path) -> None:
+    """Two sunlit walls seen square on, a pale plaster (#e4d6bd: hue 38.5 degrees,
+    saturation 0.171) and a brick red (#a0522d: 19.3, 0.719), render in their own hue and
+    saturation (each pixel's, the median over the middle of the wall): the light is white
+    (the sun, and the sky's light on a wall balanced to grey) and the tone mapping
+    (Khronos PBR Neutral) keeps a colour's hue and saturation. ACES filmic tone mapping
+    under a slightly blue light drained the plaster to 0.070 (near white)."""
+    spec = tmp_path / "walls.yaml"
+    spec.write_text(WALLS_SPEC)
+    layout = solve(load_spec(spec))
+    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
+    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,0")
+    assert "<title>walls</title>" in dom
+    # the walls fill 1/1.08 of the picture's width, plaster left, brick right
+    for box, hue, saturation in [
+        ((0.15, 0.3, 0.4, 0.7), 38.5, 0.171),
+        ((0.6, 0.3, 0.85, 0.7), 19.3, 0.719),
+    ]:
+        seen_hue, seen_saturation = _hue_and_saturation(shot, box)
+        assert abs(seen_hue - hue) < 4, (seen_hue, hue)
+        assert abs(seen_saturation / saturation - 1) < 0.15, (seen_saturation, saturation)
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 def test_a_districts_street_view_stands_in_a_street_among_its_buildings(
@@ -370,3 +444,100 @@ def test_a_districts_street_view_stands_in_a_street_among_its_buildings(
     upper = grey.crop((0, 0, grey.width, grey.height // 2)).tobytes()
     sky = sum(1 for value in upper if abs(value - backdrop) <= 2) / len(upper)
     assert sky < 0.5
+
+
+BLANK_SPEC = """
+version: 1
+name: blank
+canvas: {width: 10.0, height: 9.0}
+symbols: {A: 1.0, F: 3.0}
+patterns: {across: "A^+", up: "F^+"}
+layers: [{name: base, x: across, y: up}]
+materials: {wall: {color: "#9c4a32", roughness: 0.9}}
+defaults: {mesh: box, material: wall, thickness: 0.2}
+solver: {tolerance: 0.5}
+"""
+
+
+def _windows_and_blank_walls(folder: Path) -> tuple[Path, set[str]]:
+    """A district of generated footprints (metres, a projected CRS): a street of tall
+    buildings with blank walls, 12 of them facing each other 12 m apart, the kind of view
+    the street camera likes best by the share of the picture it fills; and past an open
+    square behind them, a row of four lower houses with windows (the townhouse's façade),
+    each 10 m wide with 6 m between them. Returns the manifest and the windowed ids."""
+    import json
+
+    features = []
+    windowed = set()
+
+    def building(key: str, x: float, y: float, width: float, depth: float, tags: dict) -> None:
+        ring = [[x, y], [x + width, y], [x + width, y + depth], [x, y + depth], [x, y]]
+        features.append(
+            {
+                "type": "Feature",
+                "properties": {"osm_id": key, **tags},
+                "geometry": {"type": "Polygon", "coordinates": [ring]},
+            }
+        )
+
+    for k in range(6):
+        for side, y in enumerate((0.0, 24.0)):
+            building(f"blank/{side}{k}", 10.0 * k, y, 10.0, 12.0, {"building": "shed"})
+    for k in range(4):
+        building(f"house/{k}", 16.0 * k, 70.0, 10.0, 10.0, {"building": "house"})
+        windowed.add(f"house/{k}")
+    folder.mkdir()
+    (folder / "footprints.geojson").write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}},
+                "features": [
+                    {**f, "geometry": {**f["geometry"], "coordinates": [
+                        [[100000 + x, 400000 + y] for x, y in f["geometry"]["coordinates"][0]]
+                    ]}}
+                    for f in features
+                ],
+            }
+        )
+    )  # fmt: skip
+    (folder / "blank.yaml").write_text(BLANK_SPEC)
+    manifest = folder / "district.yaml"
+    manifest.write_text(
+        "version: 1\nname: streets\nfootprints: footprints.geojson\n"
+        f"defaults: {{facade: {ROOT / 'specs' / 'townhouse.yaml'}, height: 9.0,"
+        " floor_height: 3.0, roof: {type: flat}}\n"
+        "rules:\n  - when: {building: shed}\n    facade: blank.yaml\n    height: 15.0\n"
+    )
+    return manifest, windowed
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_districts_street_view_looks_at_windows_from_a_distance(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """``?view=street`` prefers façades with openings to blank walls, and stands back from
+    a house rather than fill the picture with it: of a street of tall blank buildings and
+    a row of lower windowed houses, the view looks at the houses (they fill most of the
+    buildings' share of the picture, their walls seen are windowed), at least two of them,
+    none filling more than half of the picture. The old view, scored by the share of the
+    picture alone, stood in the blank street."""
+    import json
+    from html import unescape
+
+    manifest, windowed = _windows_and_blank_walls(tmp_path / "district")
+    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
+    page = tmp_path / "city.html"
+    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
+    _shot, dom = browse(tmp_path, page.as_uri() + "?bare&view=street")
+    found = re.search(r'data-street="([^"]+)"', dom)
+    assert found, "the page reports no street view"
+    street = json.loads(unescape(found.group(1)))
+    seen = set(street["seen"])
+    assert len(seen & windowed) >= 2 and len(seen - windowed) <= len(seen & windowed), seen
+    shares = dict(zip(street["seen"], street["shares"], strict=True))
+    houses = sum(share for name, share in shares.items() if name in windowed)
+    assert houses > 0.6 * sum(shares.values()), shares
+    assert max(shares.values()) < 0.5, shares
+    assert sum(street["open"]) > 0.5 * houses, street

@@ -129,27 +129,36 @@ def read_footprints(
     """Footprints of every usable feature; rejected features with a reason and place.
     With ``bbox``, only the features whose footprint has a point inside it (in the
     file's CRS: lon/lat for OSM extracts) are read. ``names``: the manifest's properties
-    holding heights and levels, checked as the OSM tags are."""
+    holding heights and levels, checked as the OSM tags are.
+
+    The features are read one by one, each decoded once, and each footprint is held in
+    one form at a time: as read, in metres, then made the footprint, each form let go
+    as the next is made (a city's footprints are its planning's largest part)."""
     document = _document(path)
-    ids = [feature_id(feature, index) for index, feature in enumerate(document.features)]
-    _check_unique(document, ids)
     rejected: list[Rejected] = []
     warned: list[Rejected] = []
     doors: list[Found] = []
-    readable = _readable(document, ids, rejected, warned, names, doors)
-    inside = readable if bbox is None else [f for f in readable if _within(f[3], bbox)]
-    crs = _projected(document.crs, [geometry for *_, geometry in inside])
-    inside_ids = {index for index, *_ in inside}
-    found = _in_metres(document, crs, inside, rejected)
+    found, entrances = _readable(document, rejected, warned, names, doors)
+    readable = len(found)
+    inside_ids = None
+    if bbox is not None:
+        found = [f for f in found if _within(f[3], bbox)]
+        inside_ids = {index for index, *_ in found}
+    outside = readable - len(found)
+    crs = _projected(document.crs, [geometry for *_, geometry in found])
+    found = _in_metres(document, crs, found, rejected)
     minx = min((geometry.bounds[0] for *_, geometry in found), default=0.0)
     miny = min((geometry.bounds[1] for *_, geometry in found), default=0.0)
     footprints = []
-    for index, fid, properties, geometry in found:
+    found.reverse()  # taken from the end: each feature's geometry in metres let go in turn
+    while found:
+        index, fid, properties, geometry = found.pop()
         footprint = _footprint(fid, properties, shapely.affinity.translate(geometry, -minx, -miny))
+        del geometry, properties
         if isinstance(footprint, str):
             rejected.append(_rejected(document, index, fid, footprint))
             continue
-        points = _entrances(document.features[index])
+        points = entrances.get(index)
         if points:
             xs, ys = _projection(document.crs, crs)(*zip(*points, strict=True))
             local = tuple((x - minx, y - miny) for x, y in zip(xs, ys, strict=True))
@@ -162,9 +171,10 @@ def read_footprints(
     rejected.sort(key=lambda r: -1 if r.index is None else r.index)
     if rejected and not footprints:
         raise _nothing_usable(document, rejected)
-    outside = len(readable) - len(inside)
     built = {footprint.id for footprint in footprints}
-    warnings = tuple(w for w in warned if w.index in inside_ids and w.id in built)
+    warnings = tuple(
+        w for w in warned if (inside_ids is None or w.index in inside_ids) and w.id in built
+    )
     warnings += tuple(
         _rejected(document, index, fid, ASTRAY.format(x=point.x, y=point.y))
         for index, fid, _, point in astray
@@ -187,17 +197,25 @@ def _within(geometry: Any, bbox: BBox) -> bool:
 
 def _readable(
     document: GeoJSON,
-    ids: list[str],
     rejected: list[Rejected],
     warned: list[Rejected],
     names: Names | None,
     doors: list[Found],
-) -> list[Found]:
+) -> tuple[list[Found], dict[int, list[tuple[float, float]]]]:
     """The features that are polygons, in the file's CRS, their properties checked
-    (:func:`checked_properties`: what is left out is in ``warned``); points tagged
-    ``entrance`` go to ``doors`` (:func:`entrance_point`)."""
+    (:func:`checked_properties`: what is left out is in ``warned``), and the entrances
+    an OSM extract's reader put on them (:func:`_entrances`), by feature; points tagged
+    ``entrance`` go to ``doors`` (:func:`entrance_point`). One pass, each feature read
+    once; two features with one id are a SpecError after it (:func:`_duplicated`)."""
     found = []
-    for index, (fid, feature) in enumerate(zip(ids, document.features, strict=True)):
+    entrances = {}
+    first: dict[str, int] = {}  # id -> the first feature with it
+    duplicates: list[tuple[int, str]] = []
+    for index, feature in enumerate(document.features):
+        fid = feature_id(feature, index)
+        if first.setdefault(fid, index) != index:
+            duplicates.append((index, fid))
+            continue
         point = entrance_point(feature)
         if point is not None:
             doors.append((index, fid, feature["properties"], point))
@@ -210,21 +228,30 @@ def _readable(
         properties, problems = checked_properties(read[0], names)
         warned.extend(_rejected(document, index, fid, problem) for problem in problems)
         found.append((index, fid, properties, read[1]))
-    return found
+        points = _entrances(feature)
+        if points:
+            entrances[index] = points
+    if duplicates:
+        raise _duplicated(document, duplicates, first)
+    return found, entrances
 
 
 def _in_metres(
     document: GeoJSON, crs: pyproj.CRS, found: list[Found], rejected: list[Rejected]
 ) -> list[Found]:
-    """The features projected to metres in ``crs``, without those far from the others."""
+    """The features projected to metres in ``crs``, without those far from the others.
+    ``found`` is projected in place: each geometry as read is let go as it is projected."""
     transform = _projection(document.crs, crs)
-    projected = [
-        (index, fid, properties, shapely.transform(geometry, transform, interleaved=False))
-        for index, fid, properties, geometry in found
-    ]
-    middle = _middle([geometry for *_, geometry in projected])
+    for k, (index, fid, properties, geometry) in enumerate(found):
+        found[k] = (
+            index,
+            fid,
+            properties,
+            shapely.transform(geometry, transform, interleaved=False),
+        )
+    middle = _middle([geometry for *_, geometry in found])
     near = []
-    for index, fid, properties, geometry in projected:
+    for index, fid, properties, geometry in found:
         far = _far(geometry, middle)
         if far:
             rejected.append(_rejected(document, index, fid, far))
@@ -276,14 +303,13 @@ def _rejected(document: GeoJSON, index: int, fid: str, reason: str) -> Rejected:
     return Rejected(fid, reason, index, line, column)
 
 
-def _check_unique(document: GeoJSON, ids: list[str]) -> None:
-    """Two features with one id would share a file and a report entry: an error."""
-    first: dict[str, int] = {}
+def _duplicated(
+    document: GeoJSON, duplicates: list[tuple[int, str]], first: dict[str, int]
+) -> SpecError:
+    """Two features with one id would share a file and a report entry: the error, at each
+    feature repeating an earlier one's id."""
     problems = []
-    for index, fid in enumerate(ids):
-        if fid not in first:
-            first[fid] = index
-            continue
+    for index, fid in duplicates:
         line, col = document.places.feature(index) or (None, None)
         earlier = document.places.feature(first[fid])
         at = f" (line {earlier[0]})" if earlier else ""
@@ -296,8 +322,7 @@ def _check_unique(document: GeoJSON, ids: list[str]) -> None:
                 "give every feature its own id",
             )
         )
-    if problems:
-        raise SpecError(problems)
+    return SpecError(problems)
 
 
 def _nothing_usable(document: GeoJSON, rejected: list[Rejected]) -> SpecError:

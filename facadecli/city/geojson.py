@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -169,6 +169,10 @@ class Features(Sequence[Any]):
 
     def __len__(self) -> int:
         return len(self.offsets)
+
+    def __iter__(self) -> Iterator[Any]:
+        for offset in self.offsets:
+            yield self.decoder.raw_decode(self.text, offset)[0]
 
     @overload
     def __getitem__(self, index: int) -> Any: ...

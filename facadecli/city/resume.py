@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -26,6 +26,7 @@ from pydantic import BaseModel
 from shapely.geometry.base import BaseGeometry
 
 from facadecli import __version__
+from facadecli.city.packed import Positional
 from facadecli.export.texture_store import pictures_missing
 
 if TYPE_CHECKING:
@@ -33,6 +34,7 @@ if TYPE_CHECKING:
     from facadecli.city.run import Task
 
 HASH = "hash"  # a building's report entry: the hash of what decided its outputs
+DIGEST = hashlib.sha256().digest_size  # bytes of a hash
 
 # A task's fields the hash leaves out, and why: paths where this run happens to be (the
 # spec's and the output's folders; the files' bytes and the output's name are hashed
@@ -118,10 +120,32 @@ def building_hash(task: Task, spec_digest: Callable[[str], str]) -> str:
     return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 
-def building_hashes(city: City, tasks: Iterable[Task]) -> dict[str, str]:
-    """Every task's :func:`building_hash`, by building id."""
+class Hashes(Positional[str]):
+    """The buildings' hashes (:func:`building_hash`) by their position in the manifest's
+    order, kept as their 32 bytes in one buffer: 32 bytes a building in memory, where a
+    dict of hex strings by id takes 195, in small objects that stay for the whole run
+    (and keep the memory around them from being given back, :mod:`.heap`)."""
+
+    def __init__(self) -> None:
+        self._digests = bytearray()
+
+    def append(self, digest: str) -> None:
+        self._digests += bytes.fromhex(digest)
+
+    def __len__(self) -> int:
+        return len(self._digests) // DIGEST
+
+    def _at(self, index: int) -> str:
+        return self._digests[index * DIGEST : (index + 1) * DIGEST].hex()
+
+
+def building_hashes(city: City, tasks: Iterable[Task]) -> Hashes:
+    """Every task's :func:`building_hash`, in the tasks' order."""
     digest = spec_digests(city)
-    return {task.footprint.id: building_hash(task, digest) for task in tasks}
+    hashes = Hashes()
+    for task in tasks:
+        hashes.append(building_hash(task, digest))
+    return hashes
 
 
 def recorded(outdir: Path, name: str) -> dict[str, bytes]:
@@ -180,7 +204,10 @@ def reusable(
     return {**entry, "resumed": True}
 
 
-def stamped(results: Iterable[dict[str, Any]], hashes: dict[str, str]) -> Iterator[dict[str, Any]]:
-    """Report entries as they come, each with its building's hash."""
+def stamped(
+    results: Iterable[dict[str, Any]], hashes: Sequence[str], order: Mapping[str, int]
+) -> Iterator[dict[str, Any]]:
+    """Report entries as they come, each with its building's hash (``hashes`` by the
+    position ``order`` gives a building id)."""
     for result in results:
-        yield {**result, HASH: hashes[result["id"]]}
+        yield {**result, HASH: hashes[order[result["id"]]]}

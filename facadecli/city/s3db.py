@@ -20,7 +20,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -616,20 +616,31 @@ def shared_edges(
     says whether two footprints' walls stand side by side at all (see :func:`side_by_side`
     and :func:`screens`; None: all do): upper storeys drawn as a part over a podium have
     walls of their own, not party walls.
-    Footprint id -> a shapely geometry (absent: none)."""
+    Footprint id -> a shapely geometry (absent: none); :func:`party_lines` as they come."""
+    return dict(party_lines(footprints, tolerance, beside))
+
+
+def party_lines(
+    footprints: list[Footprint],
+    tolerance: float,
+    beside: Callable[[str, str], bool] | None = None,
+) -> Iterator[tuple[str, Any]]:
+    """:func:`shared_edges` footprint by footprint, in their order: its id and its lines,
+    for those that have any (a caller may keep them in another form as they come)."""
     shapes = [shape for f in footprints for shape in f.parts]
     owner = [f.id for f in footprints for _ in f.parts]
     tree = STRtree(shapes)
-    shared: dict[str, Any] = {}
+    found: tuple[str, Any] | None = None  # the footprint's lines so far
     for index, shape in enumerate(shapes):
+        if found is not None and found[0] != owner[index]:
+            yield found
+            found = None
         near = [int(i) for i in tree.query(shape.buffer(tolerance))]
         others = [
             shapes[i]
             for i in near
             if owner[i] != owner[index] and (beside is None or beside(owner[index], owner[i]))
         ]
-        if not others:
-            continue
         for other in others:  # the neighbour outside the wall, not under or over it
             beyond = other.difference(shape.buffer(tolerance / 2, join_style="mitre"))
             if beyond.is_empty:
@@ -637,9 +648,9 @@ def shared_edges(
             touching = shape.boundary.intersection(beyond.buffer(tolerance, join_style="mitre"))
             if touching.is_empty or touching.length < tolerance:
                 continue
-            before = shared.get(owner[index])
-            shared[owner[index]] = touching if before is None else before.union(touching)
-    return shared
+            found = (owner[index], touching if found is None else found[1].union(touching))
+    if found is not None:
+        yield found
 
 
 SCREEN = 0.5  # of a wall's height: a neighbour this high, at least, makes it a party wall

@@ -17,16 +17,21 @@ nodes. Pure functions of the footprints.
 from __future__ import annotations
 
 import math
+from array import array
+from bisect import bisect_left, bisect_right
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
-from shapely import STRtree
-from shapely.geometry import MultiPoint, Polygon
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
 from facadecli.city.footprints import Footprint
 
 ANGLE = 3.0  # degrees: edges this close to their run's chord are one wall (the default)
+CELL = 1.0  # metres: the side of the grid's cells that finds the vertices near a node
 
 Point = tuple[float, float]
 Kept = Callable[[Point], bool]
@@ -46,27 +51,14 @@ def straighten(footprints: Sequence[Footprint], angle: float, near: float) -> St
     0 leaves them all as they are."""
     if angle <= 0 or not footprints:
         return Straightened(tuple(footprints), 0, 0)
-    corners = [
-        (point, footprint.id)
-        for footprint in footprints
-        for part in footprint.parts
-        for ring in (part.exterior, *part.interiors)
-        for point in ring.coords[:-1]
-    ]
-    tree = STRtree(MultiPoint([p for p, _ in corners]).geoms)
-    owners = [owner for _, owner in corners]
-    points = [p for p, _ in corners]
+    corners = Corners(footprints, max(CELL, near))
     done: list[Footprint] = []
     taken = changed = 0
     for footprint in footprints:
 
         def shared(point: Point, me: str = footprint.id) -> bool:
             """Another footprint has a vertex within ``near`` of the point."""
-            box = (point[0] - near, point[1] - near, point[0] + near, point[1] + near)
-            return any(
-                owners[i] != me and math.dist(points[i][:2], point) <= near
-                for i in tree.query(_box(box))
-            )
+            return corners.near(point, near, me)
 
         parts = []
         before = taken
@@ -82,9 +74,59 @@ def straighten(footprints: Sequence[Footprint], angle: float, near: float) -> St
     return Straightened(tuple(done), taken, changed)
 
 
-def _box(bounds: tuple[float, float, float, float]) -> Polygon:
-    x0, y0, x1, y1 = bounds
-    return Polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+class Corners:
+    """Every footprint's vertices, by the footprint they are of, found by a grid: flat
+    arrays (28 bytes a vertex), not a shapely point (and a tuple) each, which for a
+    city's vertices was most of what planning held at its peak."""
+
+    def __init__(self, footprints: Sequence[Footprint], cell: float = CELL):
+        self.ids = [footprint.id for footprint in footprints]
+        xs, ys, owners = [], [], []
+        for number, footprint in enumerate(footprints):
+            for part in footprint.parts:
+                for ring in (part.exterior, *part.interiors):
+                    coords = shapely.get_coordinates(ring)[:-1]
+                    xs.append(coords[:, 0])
+                    ys.append(coords[:, 1])
+                    owners.append(np.full(len(coords), number, dtype=np.int32))
+        x = np.concatenate(xs) if xs else np.zeros(0)
+        y = np.concatenate(ys) if ys else np.zeros(0)
+        del xs, ys
+        extent = float(np.ptp(x) + np.ptp(y)) if len(x) else 0.0
+        self.cell = max(cell, extent / 2**30)  # keys (column x rows + row) fit 63 bits
+        columns, rows = self._cells(x, y)
+        self.left = int(columns.min(initial=0)) - 1
+        self.bottom = int(rows.min(initial=0)) - 1
+        self.height = int(rows.max(initial=0)) - self.bottom + 2  # rows a column
+        keys = (columns - self.left) * self.height + (rows - self.bottom)
+        order = np.argsort(keys, kind="stable")
+        self.keys = array("q", keys[order].tobytes())
+        self.xs = array("d", x[order].tobytes())
+        self.ys = array("d", y[order].tobytes())
+        owner = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int32)
+        self.owners = array("i", owner[order].astype(np.int32).tobytes())
+
+    def _cells(self, x: Any, y: Any) -> tuple[Any, Any]:
+        return np.floor(x / self.cell).astype(np.int64), np.floor(y / self.cell).astype(np.int64)
+
+    def near(self, point: Point, distance: float, me: str) -> bool:
+        """Has a footprint other than ``me`` (an id) a vertex within ``distance`` of
+        ``point``? Every vertex of the cells the square around it covers is measured."""
+        x0, y0 = point[0] - distance, point[1] - distance
+        x1, y1 = point[0] + distance, point[1] + distance
+        first, last = math.floor(x0 / self.cell), math.floor(x1 / self.cell)
+        low = math.floor(y0 / self.cell) - self.bottom
+        high = math.floor(y1 / self.cell) - self.bottom
+        for column in range(first - self.left, last - self.left + 1):
+            start = bisect_left(self.keys, column * self.height + low)
+            end = bisect_right(self.keys, column * self.height + high)
+            for i in range(start, end):
+                x, y = self.xs[i], self.ys[i]
+                if self.ids[self.owners[i]] == me or not (x0 <= x <= x1 and y0 <= y <= y1):
+                    continue
+                if math.dist((x, y), point) <= distance:
+                    return True
+        return False
 
 
 def _part(part: Polygon, angle: float, shared: Kept) -> tuple[Polygon, int]:

@@ -1,7 +1,7 @@
 """Self-contained HTML pages of models: one layout's model with orbit controls beside its
 front elevation (``--format html``), or a gallery of every model in a folder
 (``facade view``, :mod:`facadecli.viewer.gallery`). Readable in any browser with no
-network: three.js r160 (MIT licence) is bundled here from npm and inlined into every page
+network: three.js r162 (MIT licence) is bundled here from npm and inlined into every page
 (see LICENSE-three.txt).
 
 Both pages share one viewer: :data:`VIEWER` sets up three.js in ``#model`` and defines
@@ -17,7 +17,7 @@ from functools import cache
 from html import escape
 from importlib import resources
 
-THREE_VERSION = "0.160.0"
+THREE_VERSION = "0.162.0"
 # specifier -> bundled file
 MODULES = {
     "three": "three.module.min.js",
@@ -73,11 +73,16 @@ import {OutputPass} from 'three/addons/postprocessing/OutputPass.js';
 import {SimplexNoise} from 'three/addons/math/SimplexNoise.js';
 const view = document.getElementById('model');
 const status = document.getElementById('status');
-const EXPOSURE = 0.55;  // the sky's light is 2.4 times the houses' (below): walls kept from white
+// the sky's light is 2.4 times the houses' (below): at 0.55 a sunlit wall is about as light
+// as its base colour (#e4d6bd renders as about (223, 207, 181))
+const EXPOSURE = 0.55;
 const renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
 renderer.setPixelRatio(window.devicePixelRatio);
-renderer.toneMapping = THREE.ACESFilmicToneMapping;  // filmic: highlights roll off, no clipping
-renderer.toneMappingExposure = EXPOSURE;  // three's ACES brightens by 1/0.6 too
+// Khronos PBR Neutral: a colour below its highlights keeps its hue and saturation, and
+// highlights roll off to white instead of clipping (ACES filmic, before, drained a pale
+// plaster to a near white and shifted every hue)
+renderer.toneMapping = THREE.NeutralToneMapping;
+renderer.toneMappingExposure = EXPOSURE;
 renderer.outputColorSpace = THREE.SRGBColorSpace;
 renderer.shadowMap.enabled = true;
 renderer.shadowMap.type = THREE.PCFSoftShadowMap;
@@ -93,9 +98,8 @@ view.appendChild(renderer.domElement);
 // the horizon it fades into, pale sunlit paving nearer; not a dark floor, which made every
 // pane a flat dark slate. Seeded: the same picture every time.
 const SKY = 0xe9edf2;  // the backdrop and the haze the ground fades into
-// as bright on the screen as at the exposure of 0.8 the viewer had before the sky's light
-// rose (the backdrop and haze are tone mapped too): a pale backdrop, not a grey one
-// darker than the ground
+// a pale backdrop, not a grey one darker than the ground (the backdrop and haze are tone
+// mapped too)
 const BACKDROP = new THREE.Color(SKY).multiplyScalar(0.8 / EXPOSURE);
 // The sky is brighter than the houses and paving it lights (in daylight several times
 // brighter than a wall in shade): what glass mirrors of it stands out as it does in a photo.
@@ -123,6 +127,7 @@ function skyEnvironment() {
   }
   const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
   let block = 0;
+  const mean = [0, 0, 0];  // the picture's light on a wall, each channel (see below)
   for (let row = 0; row < height; row++) {
     const elevation = ((row + 0.5) / height - 0.5) * Math.PI, y = Math.sin(elevation);
     block = 0;
@@ -145,7 +150,18 @@ function skyEnvironment() {
         2.5 * Math.pow(Math.max(0, direction.dot(sunDirection)), 24)));
       const at = (row * width + column) * 4;  // row 0: straight down
       data[at] = colour.r; data[at + 1] = colour.g; data[at + 2] = colour.b; data[at + 3] = 1;
+      const weight = Math.cos(elevation) ** 2;  // the texel's solid angle, a wall's cosine
+      for (let channel = 0; channel < 3; channel++) mean[channel] += weight * data[at + channel];
     }
+  }
+  // White-balanced: the light a wall takes from the picture, whichever way it faces (each
+  // direction weighted by its solid angle and by the cosine a vertical wall sees it at), is
+  // grey at its own luminance; the blue overhead and the warm paving and glow cancel, so a
+  // wall of a known colour renders as that colour, in sun (the sun is white) or in shade.
+  const luminance = 0.2126 * mean[0] + 0.7152 * mean[1] + 0.0722 * mean[2];
+  const gains = mean.map(sum => luminance / sum);
+  for (let at = 0; at < data.length; at += 4) {
+    for (let channel = 0; channel < 3; channel++) data[at + channel] *= gains[channel];
   }
   const picture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
   picture.mapping = THREE.EquirectangularReflectionMapping;
@@ -161,7 +177,7 @@ scene.background = BACKDROP;
 scene.environment = skyEnvironment();
 // placed by frame(): the model clear, the ground fading out
 scene.fog = new THREE.Fog(BACKDROP, 1, 2);
-const sun = new THREE.DirectionalLight(0xfff3e0, 3.4);
+const sun = new THREE.DirectionalLight(0xffffff, 3.4);  // white, as the sky's light is
 sun.castShadow = true;
 sun.shadow.bias = -0.0002;
 scene.add(sun, sun.target);
@@ -290,13 +306,15 @@ function dispose(object) {
 // KHR_materials_transmission) is drawn by its transmission alone: its alpha is the glb's
 // fallback for viewers without the extension, and blending by it too would dim the pane's
 // reflection to a third (a dark pane) and count what lies behind it twice.
+const isGlass = material => material.transmission > 0;
+const materialsOf = part => Array.isArray(part.material) ? part.material : [part.material];
 function castsShadows(model) {
   model.traverse(part => {
     if (!part.isMesh) return;
-    const materials = Array.isArray(part.material) ? part.material : [part.material];
-    part.castShadow = materials.every(m => !m.transparent && !(m.transmission > 0));
+    const materials = materialsOf(part);
+    part.castShadow = materials.every(m => !m.transparent && !isGlass(m));
     part.receiveShadow = true;
-    for (const material of materials.filter(m => m.transmission > 0)) {
+    for (const material of materials.filter(isGlass)) {
       material.transparent = false; material.opacity = 1; material.depthWrite = true;
     }
   });
@@ -401,17 +419,88 @@ function fitStreet(box, centre, angle) {
 // Street level in a district (a model of several buildings, wider and deeper than tall):
 // the eye EYE metres up in its open space, where the nearest buildings fill the view. The
 // district's plan is drawn from above (each building, a child of the model, in a colour of
-// its own: which stands highest in each cell of about PLAN_CELL metres, and how high), a
-// spot is open where nothing stands and no building is nearer than CLEARANCE; rays from
-// each open spot of a lattice every STREET_STEP metres, RAYS round, find the first
-// building each way. Of every spot and heading, the view that holds the most of buildings
-// wins: the sum over the buildings seen of the square root of the share of the picture each
-// fills (a street of houses, near and far, beats one wall close up: eight houses a sixteenth
-// of the picture each score 2, one wall filling it 1); ties keep the first (the same view
-// each time).
+// its own: which stands highest in each cell of about PLAN_CELL metres, and how high), and
+// the cells of walls with openings marked: those with a corner of a pane of glass within
+// OPENING_REACH metres (a pane's corners, read from the model's meshes, lie in its wall's
+// reveal, inside the building's cells, which seen from above hide the pane). A spot is open
+// where nothing stands and no building is nearer than CLEARANCE; rays from each open spot
+// of a lattice every STREET_STEP metres, RAYS round, find the first building each way, and
+// whether the wall they meet has openings. Of every spot and heading, the view that holds
+// the most of buildings' façades wins (viewScore): the sum over the buildings seen of the
+// square root of the share of the picture each fills (a street of houses, near and far,
+// beats one wall close up: eight houses a sixteenth of the picture each score 2), a blank
+// wall's share counted BLANK_WALL of a windowed one's (a street of windows beats one of
+// blank brick), a wall by the share of its height in the picture (cut off at the top, it
+// counts less), a wall d metres away, nearer than STAND_BACK, d / STAND_BACK of its share
+// (4 m from a house, the picture holds its ground floor alone), and a building filling
+// more than FILL_MOST of the picture counted less the more it fills, nothing when it fills
+// it alone (the eye stands back from a house until others join it); ties keep the first
+// (the same view each time).
 const PLAN_CELL = 0.25, PLAN_CELLS = 768, CLEARANCE = 4, STREET_STEP = 2, RAYS = 144;
 const STREET_TILT = 6;  // degrees the street camera looks up: more of the houses, less paving
 const STREET_SPOTS = 4096, STREET_REACH = 150;  // the search's bounds (see fitDistrictStreet)
+const OPENING_REACH = 1, BLANK_WALL = 0.2, STAND_BACK = 10, FILL_MOST = 0.25;
+// the most corners of panes read for the plan's openings (past it every k-th one): the
+// work is bounded whatever the district's size
+const OPENING_CORNERS = 1 << 21;
+// The plan's cells (indices as districtPlan's) with a corner of glass within OPENING_REACH
+// metres: each glass mesh's vertices (each instance's, for a mesh drawn as GPU instances)
+// in the world, then a square dilation, across and down.
+function planOpenings(model, box, cell, columns, rows) {
+  const meshes = [];
+  let corners = 0;
+  model.traverse(part => {
+    if (!part.isMesh || !materialsOf(part).some(isGlass)) return;
+    const position = part.geometry.attributes.position;
+    if (!position) return;
+    meshes.push(part);
+    corners += position.count * (part.isInstancedMesh ? part.count : 1);
+  });
+  const stride = Math.max(1, Math.ceil(corners / OPENING_CORNERS));
+  const marked = new Uint8Array(columns * rows);
+  const corner = new THREE.Vector3(), instance = new THREE.Matrix4(), world = new THREE.Matrix4();
+  let visited = 0;
+  model.updateMatrixWorld(true);
+  for (const part of meshes) {
+    const position = part.geometry.attributes.position;
+    const copies = part.isInstancedMesh ? part.count : 1;
+    for (let copy = 0; copy < copies; copy++) {
+      world.copy(part.matrixWorld);
+      if (part.isInstancedMesh) {
+        part.getMatrixAt(copy, instance);
+        world.multiply(instance);
+      }
+      for (let vertex = 0; vertex < position.count; vertex++, visited++) {
+        if (visited % stride) continue;
+        corner.fromBufferAttribute(position, vertex).applyMatrix4(world);
+        const column = Math.floor((corner.x - box.min.x) / cell);
+        const row = Math.floor((box.min.z + rows * cell - corner.z) / cell);
+        if (column >= 0 && column < columns && row >= 0 && row < rows) {
+          marked[row * columns + column] = 1;
+        }
+      }
+    }
+  }
+  const reach = Math.max(1, Math.round(OPENING_REACH / cell));
+  const across = new Uint8Array(columns * rows), openings = new Uint8Array(columns * rows);
+  for (let row = 0; row < rows; row++) spread(marked, across, row * columns, 1, columns, reach);
+  for (let column = 0; column < columns; column++) {
+    spread(across, openings, column, columns, rows, reach);
+  }
+  return openings;
+}
+// One line of a square dilation: each of ``count`` cells of ``to`` (from ``start``, every
+// ``step``) set where ``from`` has a cell set within ``reach`` cells of it along the line.
+function spread(from, to, start, step, count, reach) {
+  for (let i = 0, last = -Infinity; i < count; i++) {  // the last set cell
+    if (from[start + i * step]) last = i;
+    to[start + i * step] = i - last <= reach ? 1 : 0;
+  }
+  for (let i = count - 1, next = Infinity; i >= 0; i--) {
+    if (from[start + i * step]) next = i;
+    if (next - i <= reach) to[start + i * step] = 1;
+  }
+}
 function districtPlan(model, box) {
   const size = box.getSize(new THREE.Vector3());
   const cell = Math.max(PLAN_CELL, Math.max(size.x, size.z) / PLAN_CELLS);
@@ -491,15 +580,24 @@ function districtPlan(model, box) {
     }
   };
   pass(0, rows, 1); pass(rows - 1, -1, -1);
-  return {cell, columns, rows, building, height, near,
+  const openings = planOpenings(model, box, cell, columns, rows);
+  return {cell, columns, rows, building, height, near, openings,
           x: column => box.min.x + (column + 0.5) * cell,
           z: row => box.min.z + rows * cell - (row + 0.5) * cell};
+}
+// What a building adds to a street view's score: the square root of the share of the
+// picture it fills as counted (its blank walls BLANK_WALL of its windowed ones, its walls
+// nearer than STAND_BACK less), falling from FILL_MOST of the picture (as it fills it) to
+// nothing when it fills it alone
+function viewScore(share, counted) {
+  const score = Math.sqrt(counted);
+  return share <= FILL_MOST ? score : score * Math.max(0, 1 - share) / (1 - FILL_MOST);
 }
 function fitDistrictStreet(model, box) {
   const buildings = model.children.length;
   if (buildings < 2 || buildings > 65535) return null;  // its plan tells 65,535 apart
   const plan = districtPlan(model, box);
-  const {cell, columns, rows, building, height, near} = plan;
+  const {cell, columns, rows, building, height, near, openings} = plan;
   const [tanH, tanV] = halfTangents();
   const halfH = Math.atan(tanH * MARGIN), halfV = Math.atan(tanV * MARGIN);
   const tilt = STREET_TILT * Math.PI / 180;
@@ -510,13 +608,14 @@ function fitDistrictStreet(model, box) {
   const step = Math.max(1, Math.round(STREET_STEP / cell),
                         Math.ceil(Math.sqrt(columns * rows / STREET_SPOTS)));
   const hitBuilding = new Int32Array(RAYS), hitFill = new Float32Array(RAYS);
+  const hitCounted = new Float32Array(RAYS), hitOpen = new Uint8Array(RAYS);
   let best = null;
   for (let row = step >> 1; row < rows; row += step) {
     for (let column = step >> 1; column < columns; column += step) {
       if (near[row * columns + column] * cell < CLEARANCE) continue;
       for (let ray = 0; ray < RAYS; ray++) {  // the first building along each ray
         const a = ray * 2 * Math.PI / RAYS, dx = Math.sin(a), dy = Math.cos(a);  // rows: north
-        hitBuilding[ray] = 0; hitFill[ray] = 0;
+        hitBuilding[ray] = 0; hitFill[ray] = 0; hitCounted[ray] = 0; hitOpen[ray] = 0;
         for (let t = 1; t < reach; t += 0.5) {
           const x = Math.floor(column + 0.5 + dx * t), y = Math.floor(row + 0.5 + dy * t);
           if (x < 0 || x >= columns || y < 0 || y >= rows) break;
@@ -526,21 +625,31 @@ function fitDistrictStreet(model, box) {
           const top = Math.atan2(height[at] - EYE, distance), foot = -Math.atan2(EYE, distance);
           const shown = Math.min(top, tilt + halfV) - Math.max(foot, tilt - halfV);
           hitBuilding[ray] = building[at]; hitFill[ray] = Math.max(0, shown) / (2 * halfV);
+          hitOpen[ray] = openings[at];
+          // what of it counts: the share of its height in view (a house cut off at the
+          // picture's top counts less), less for a wall nearer than STAND_BACK, and less
+          // for a blank wall
+          hitCounted[ray] = hitFill[ray] * Math.max(0, shown) / (top - foot)
+            * Math.min(1, distance / STAND_BACK) * (openings[at] ? 1 : BLANK_WALL);
           break;
         }
       }
       for (let heading = 0; heading < RAYS; heading++) {
-        const shares = new Map();  // building -> the share of the picture it fills
+        // building -> the share of the picture it fills, what of that counts, and the
+        // share of its walls with openings
+        const shares = new Map();
         for (let k = -span; k <= span; k++) {
           const ray = (heading + k + RAYS) % RAYS;
           if (!hitBuilding[ray]) continue;
-          const share = hitFill[ray] / (2 * span + 1);
-          shares.set(hitBuilding[ray], (shares.get(hitBuilding[ray]) || 0) + share);
+          const seen = shares.get(hitBuilding[ray]) || [0, 0, 0];
+          seen[0] += hitFill[ray] / (2 * span + 1); seen[1] += hitCounted[ray] / (2 * span + 1);
+          if (hitOpen[ray]) seen[2] += hitFill[ray] / (2 * span + 1);
+          shares.set(hitBuilding[ray], seen);
         }
         let score = 0;
-        for (const share of shares.values()) score += Math.sqrt(share);
+        for (const [share, counted] of shares.values()) score += viewScore(share, counted);
         if (!best || score > best.score + 1e-9) {
-          best = {score, column, row, heading, seen: [...shares.keys()]};
+          best = {score, column, row, heading, shares};
         }
       }
     }
@@ -552,10 +661,14 @@ function fitDistrictStreet(model, box) {
   const position = new THREE.Vector3(plan.x(best.column), box.min.y + EYE, plan.z(best.row));
   const distance = 20;
   const named = building => building.userData.name || building.name;  // as the glb names it
-  const seen = best.seen.sort((p, q) => p - q).map(id => named(model.children[id - 1]));
+  const ids = [...best.shares.keys()].sort((p, q) => p - q);
+  const seen = ids.map(id => named(model.children[id - 1]));
+  // each building's share of the picture, and the share of its walls with openings
+  const shares = ids.map(id => +best.shares.get(id)[0].toFixed(4));
+  const open = ids.map(id => +best.shares.get(id)[2].toFixed(4));
   document.body.dataset.street = JSON.stringify({
     eye: position.toArray().map(v => +v.toFixed(3)), heading: +(a * 180 / Math.PI).toFixed(1),
-    seen});
+    seen, shares, open});
   return {position, aim: position.clone().addScaledVector(forward, distance), distance};
 }
 // The sun's shadow camera fitted round the model's box, seen from the sun, so a facade and a
@@ -708,7 +821,7 @@ def document_parts(title: str, style: str, body: Iterable[str], script: str) -> 
     yield (
         '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
         f"<title>loading: {escape(title)}</title><style>{STYLE}{style}</style>"
-        f"<!-- three.js {THREE_VERSION}, MIT licence, (c) 2010-2023 three.js authors -->"
+        f"<!-- three.js {THREE_VERSION}, MIT licence, (c) 2010-2024 three.js authors -->"
         f'<script type="importmap">{import_map()}</script></head><body>'
     )
     yield from body

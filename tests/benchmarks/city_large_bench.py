@@ -19,6 +19,15 @@ CPU (own and cumulative) are printed. First, the client's memory once the town i
 and planned (no building built) at 1,000, 10,000, 100,000 (up to ``FACADE_BENCH_N``)
 buildings, and its slope; ``FACADE_BENCH_PLAN_ONLY=1`` stops there.
 
+With ``FACADE_BENCH_TRACE=1``, where that memory goes (tracemalloc, Python's own
+allocations, not GEOS's nor the C libraries'): for planning, what it holds once done
+and its peak while planning, a building, and the source lines holding the most; for a
+run, what the client's live allocations grow by from its first building built to its
+last, and the lines growing most; and the client's resident memory at the last
+building before and after the C heap's freed memory is given back to the system
+(glibc's ``malloc_trim``): what is freed but not returned, not held. Tracing slows the
+client and its bookkeeping is in the resident figures: compare traced runs with traced.
+
 A run of 100,000 buildings takes about an hour of a quiet 2-core machine. With
 ``FACADE_BENCH_DIR`` the town and its output are kept in that folder, not a temporary
 one, so a run that is stopped (Ctrl-C, ``kill``, the end of a working day) goes on where
@@ -37,6 +46,7 @@ asserted by the tests.
 from __future__ import annotations
 
 import cProfile
+import gc
 import json
 import os
 import pstats
@@ -46,11 +56,39 @@ import subprocess
 import sys
 import tempfile
 import time
+import tracemalloc
 from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = 1
+TRACED = bool(os.environ.get("FACADE_BENCH_TRACE"))
+TOP = 8  # source lines listed by FACADE_BENCH_TRACE
+
+
+def _trace() -> tracemalloc.Snapshot:
+    """What Python holds now (tracemalloc), its garbage collected first."""
+    gc.collect()
+    return tracemalloc.take_snapshot()
+
+
+def _grown(before: tracemalloc.Snapshot, after: tracemalloc.Snapshot) -> list[list[Any]]:
+    """The source lines whose live allocations grew most between two snapshots: each
+    as [file:line, bytes grown, allocations grown]."""
+    rows = []
+    for stat in after.compare_to(before, "lineno")[:TOP]:
+        frame = stat.traceback[0]
+        where = f"{Path(frame.filename).name}:{frame.lineno}"
+        rows.append([where, stat.size_diff, stat.count_diff])
+    return rows
+
+
+def _returned_mib() -> float | None:
+    """The resident memory (MiB) once the C heap's freed memory is given back to the
+    system (:func:`facadecli.city.heap.give_back`; None where it cannot be)."""
+    from facadecli.city.heap import give_back
+
+    return _resident_mib() if give_back() else None
 
 
 def _resident_mib() -> float:
@@ -72,15 +110,28 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
     from facadecli.city.run import run_city
     from facadecli.city.tileset import parse_lods
 
-    resident: dict[str, float] = {}
+    resident: dict[str, Any] = {}
     built = [0]  # buildings built by this client (not kept from a stopped run)
+    traced: list[tracemalloc.Snapshot] = []
+    if TRACED:
+        tracemalloc.start()
 
     def progress(done: int, total: int) -> None:
         built[0] += 1
         if built[0] == 1:
+            traced.extend([_trace()] if TRACED else [])
             resident["first_built_mib"] = _resident_mib()
         if done == total:
+            if TRACED:
+                last = _trace()
+                resident["traced_grown"] = _grown(traced[0], last)
+                resident["traced_grown_total"] = sum(
+                    s.size_diff for s in last.compare_to(traced[0], "filename")
+                )
+                del traced[:], last
             resident["all_built_mib"] = _resident_mib()
+            if TRACED:
+                resident["all_built_returned_mib"] = _returned_mib()
 
     lods = parse_lods(os.environ.get("FACADE_BENCH_LODS", "1,2,3"))
     resume = out.exists()  # a stopped run's output (FACADE_BENCH_DIR): go on from there
@@ -109,28 +160,42 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
 
 def planning(manifest: Path, figures: Path) -> None:
     """A city read and planned in this process (:func:`facadecli.city.run.planned`, and
-    the buildings' hashes for --resume), no building built: its memory and CPU to
-    ``figures``."""
+    the buildings' hashes for --resume, as a run holds them), no building built: its
+    memory and CPU to ``figures``."""
     from facadecli.city.manifest import load_city
     from facadecli.city.resume import building_hashes
     from facadecli.city.run import planned
 
     city = load_city(manifest)
     before = _resident_mib()  # the imports
+    traced: dict[str, Any] = {}
+    if TRACED:
+        tracemalloc.start()
+        first = _trace()
+        start = tracemalloc.get_traced_memory()[0]
     cpu = time.process_time()
     ahead = planned(city, manifest.parent / "out")
-    building_hashes(city, ahead.tasks)
+    hashes = building_hashes(city, ahead.tasks)
+    cpu = time.process_time() - cpu
+    resident = _resident_mib()
+    if TRACED:
+        last = _trace()
+        now, peak = tracemalloc.get_traced_memory()
+        traced = {"held": now - start, "peak": peak - start, "grown": _grown(first, last)}
+        traced["returned_mib"] = _returned_mib()
     figures.write_text(
         json.dumps(
             {
                 "buildings": len(ahead.tasks),
                 "imports_mib": before,
-                "planned_mib": _resident_mib(),
+                "planned_mib": resident,
                 "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-                "cpu": time.process_time() - cpu,
+                "cpu": cpu,
+                **traced,
             }
         )
     )
+    del hashes
 
 
 def measure_planning(counts: list[int], folder: Path) -> None:
@@ -155,6 +220,7 @@ def measure_planning(counts: list[int], folder: Path) -> None:
             f"planned (+{grown * 1024 / row['buildings']:.1f} KiB a building), peak "
             f"{row['peak_mib']:.0f} MiB"
         )
+        lines += _traced_lines(row, row["buildings"])
     if len(rows) > 1:
         first, last = rows[0], rows[-1]
         slope = (last["planned_mib"] - first["planned_mib"]) * 1024
@@ -162,6 +228,27 @@ def measure_planning(counts: list[int], folder: Path) -> None:
         lines.append(f"planning's slope: {slope:.1f} KiB a building")
     (folder / "planning.txt").write_text("\n".join(lines) + "\n")  # a kept folder's next start
     print("\n".join(lines))
+
+
+def _traced_lines(row: dict[str, Any], count: int) -> list[str]:
+    """What FACADE_BENCH_TRACE found (:func:`planning`, :func:`client`), a building."""
+    lines = []
+    if "held" in row:
+        lines.append(
+            f"  traced: {row['held'] / count:.0f} B a building held once planned, "
+            f"{row['peak'] / count:.0f} B at the peak of planning"
+        )
+    if "traced_grown_total" in row:
+        lines.append(
+            f"  traced: {row['traced_grown_total'] / count:+.0f} B a building grown from the "
+            "first building built to the last"
+        )
+    for where, size, allocations in row.get("grown", row.get("traced_grown", [])):
+        lines.append(f"    {size / count:+8.1f} B a building  {allocations:+8d}  {where}")
+    returned = row.get("returned_mib", row.get("all_built_returned_mib"))
+    if returned is not None:
+        lines.append(f"  resident {returned:.0f} MiB once the C heap's freed memory is returned")
+    return lines
 
 
 def _size(path: Path) -> int:
@@ -243,6 +330,7 @@ def _figures(
         f"  client peak memory {peak:.0f} MiB ({peak * 1024 / count:.1f} KiB a building)",
         f"  client memory: {last.get('first_built_mib', 0):.0f} MiB at the first building "
         f"built, {last.get('all_built_mib', 0):.0f} MiB at the last",
+        *_traced_lines(last, count),
         "  outputs: "
         + ", ".join(f"{key} {size / 2**20:.1f} MiB" for key, size in sizes.items() if size),
     ]
