@@ -292,3 +292,34 @@ def test_family_sills_at_1x_stay_where_drawn_or_where_the_structure_put_them(
     for r, d in pairs:
         q = min(solved, key=lambda q: abs(q.x0 - r.x0) + abs(q.y0 - r.y0))
         assert near(q, r, 0.0) or near(q, d, MOVE_SHARE)
+
+
+def test_elements_across_two_bays_stay_over_the_shared_bays(tmp_path: Path) -> None:
+    """Seed 6 (nine bays of six floors, blinds) with a balcony under two bays' windows
+    and a short cornice over two others: the bays are cut on the openings, so each
+    element across a wall's middle stays where it was drawn, in a layer of its own,
+    and the windows still share the nine bays (before, each merged its two bays into
+    one strip, and no bay was like another); solved wider and narrower, every window
+    column holds a window of every floor (but the door's, once) and the two elements
+    are shown."""
+    boxes, known = family(6)
+    windows = sorted((b for b in boxes if b[0] == "window"), key=lambda b: (b[2], b[1]))
+    top = sorted((b for b in windows if abs(b[2] - windows[-1][2]) < 0.02), key=lambda b: b[1])
+    second = sorted({round(b[2], 2) for b in windows})[1]
+    a, b = top[1], top[2]
+    boxes.append(("balcony", a[1] - 0.01, second - 0.03, b[3] + 0.01, second - 0.014))
+    c, d = top[5], top[6]
+    boxes.append(("cornice", c[1] - 0.01, c[4] + 0.01, d[3] + 0.01, c[4] + 0.02))
+    path = tmp_path / "across.xml"
+    path.write_text(cmp_xml(boxes))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    assert not inference.unshared, inference.bays
+    assert inference.bays.startswith(f"{known.bays} bays")
+    spec = parse_spec(inference.text, path.stem)
+    for share in (0.7, 1.5):
+        rects = _solved(inference, spec, share)
+        columns = _columns(rects)
+        # whole bays: every floor a window, but under the door's bay (once)
+        assert sorted(set(columns)) == [known.floors - 1, known.floors], columns
+        assert columns.count(known.floors - 1) == 1, columns
+        assert {"balcony", "cornice"} <= {r.label for r in rects}

@@ -1,18 +1,23 @@
 """Shared bay kinds: a façade's elements as one sequence of bays, written with counters
 (issue 34).
 
-A *bay* is a vertical strip of the façade holding elements that no other strip's
-elements overlap along x (a window with its sill and blind, the door with the windows
-over it); bands across the façade (``layers.BAND``) are in none. The strips' boundaries
-are the middles of the walls between them; the first and last reach as far out as half
-the wall on their inner side.
+A *bay* is a vertical strip of the façade cut on its openings (``CUTS``: windows and
+doors; a window with the windows over it, the door with the windows over it): openings
+overlapping along x are one strip, and the bays' boundaries are the middles of the walls
+between strips; the first and last reach as far out as half the wall on their inner
+side. Every other element (a sill, a blind, a balcony under one window) is in the bay it
+stands in; one that stands across the middle of a wall (a balcony or a cornice over two
+bays, a pillar between them, a shop front) or out in a margin is in none: it stays as
+the structure put it, in a layer of its own (``Bays.apart``) with its own x word. Bands
+across the façade (``layers.BAND``) are in no bay either.
 
-Bays showing the same elements (label, place in the bay, rows) within ``ALIKE`` of the
-bay's width, read as drawn or mirrored, are one *kind*. Each kind is put on one shape
-(the median of its bays, so that every layer's word repeats it exactly), and the
-façade's x words become one sequence of bays, written alike in every layer that stands
-in bays (each layer shows its own elements; a bay where it shows none is one hidden
-spacer): a repeated unit of one or two bays (never a unique label's: a door's bay is
+Bays whose openings are alike (label, place in the bay, size and rows within ``ALIKE``
+of the bay's width, read as drawn or mirrored) are one *kind*; of their other elements,
+those every bay of the kind shows alike stay in it, the rest stand apart (a balcony on
+one of them). Each kind is put on one shape (the median of its bays, so that every
+layer's word repeats it exactly), and the façade's x words become one sequence of
+bays, written alike in every layer that stands in bays (each layer shows its own
+elements; a bay where it shows none is one hidden spacer): a repeated unit of one or two bays (never a unique label's: a door's bay is
 written once) gets a counter, at most ``COUNTERS`` of them; kinds found only at the
 façade's ends share one counter that can only drop them (its most: one, as drawn). A
 sequence that reads the same mirrored is written as its left half, the middle and the
@@ -63,6 +68,7 @@ SETTLE = 1e-3  # the weight of a kind's width and centres as first read, against
 AXIS = 0.01  # of the façade's width: an opening this close to another's reflection mirrors it
 ASIDE = 0.1  # of the openings: these may lack a mirror image on a façade mirrored as a whole
 UNIQUE = ("door",)  # labels whose bays are never repeated
+CUTS = ("window", "door")  # the openings the bays are cut on
 HELD = SHARE / 2  # of the narrowest span an edge bounds: the most a kind's shape moves it
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
@@ -108,11 +114,13 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
     layout as drawn, its rectangles in the same order (None: ``layout``), which the
     elements but the openings stay near (``_apart``)."""
     width = layout.width
-    strips = _strips(layout)
+    strips, spans, over = _strips(layout)
     if len(strips) < 2:
         return FEW_BAYS
-    spans = _bay_spans(strips, width)
-    order = _right_half_mirrored_first(len(spans))
+    order = _right_half_mirrored_first(len(strips))
+    unlike = _unlike(layout, [held for _, held in strips], spans, order)
+    over |= unlike
+    strips = [(span, [k for k in held if k not in unlike]) for span, held in strips]
     slots = [
         _slots([layout.rects[k] for k in held], span)
         for (_, held), span in zip(strips, spans, strict=True)
@@ -157,7 +165,7 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
     members = [held for _, held in strips]
     placed, new_spans = _placed(layout, members, kinds, mirrored, matches, shapes, widths, start)
     drawn = drawn if drawn is not None and len(drawn.rects) == len(layout.rects) else layout
-    apart = _apart(drawn, placed, members, kinds, matches)
+    apart = _apart(drawn, placed, members, kinds, matches) | over
     for index in apart:
         placed[index] = layout.rects[index]
     if _new_overlaps(layout.rects, placed):
@@ -204,26 +212,124 @@ def _about_middle(rects: list[Rect], width: float) -> bool:
     return len(shown) >= 2 and kept >= (1 - ASIDE) * len(shown)
 
 
-def _strips(layout: LabelledLayout) -> list[tuple[Span, list[int]]]:
-    """The elements (not bands) merged into strips along x where they overlap, left to
-    right, with the indices of their rectangles."""
-    members = sorted(
-        (
-            k
-            for k, r in enumerate(layout.rects)
-            if r.label != BACKGROUND and 0 < r.x1 - r.x0 <= BAND * layout.width
-        ),
-        key=lambda k: layout.rects[k].x0,
-    )
-    strips: list[tuple[Span, list[int]]] = []
-    for k in members:
+def _cuts(rect: Rect) -> bool:
+    """Whether the rectangle is one of the openings the bays are cut on."""
+    return rect.label in CUTS
+
+
+def _strips(
+    layout: LabelledLayout,
+) -> tuple[list[tuple[Span, list[int]]], list[Span], set[int]]:
+    """The openings the bays are cut on (``CUTS``) merged into strips along x where they
+    overlap, left to right, each with the openings' span and the indices of its
+    openings and of every other element (not a band) standing in its bay
+    (``_bay_spans``); the bays' spans; and the elements that stand in no bay: across
+    the middle of a wall (a balcony or a cornice over two bays, a pillar between them,
+    a shop front) or out in a margin. Those stay as the structure put them, in layers
+    of their own."""
+    shown = [
+        k
+        for k, r in enumerate(layout.rects)
+        if r.label != BACKGROUND and 0 < r.x1 - r.x0 <= BAND * layout.width
+    ]
+    openings: list[tuple[Span, list[int]]] = []
+    for k in sorted((k for k in shown if _cuts(layout.rects[k])), key=lambda k: layout.rects[k].x0):
         r = layout.rects[k]
-        if strips and r.x0 < strips[-1][0][1] - 1e-9:
-            (a, b), held = strips[-1]
-            strips[-1] = ((a, max(b, r.x1)), [*held, k])
+        if openings and r.x0 < openings[-1][0][1] - 1e-9:
+            (a, b), held = openings[-1]
+            openings[-1] = ((a, max(b, r.x1)), [*held, k])
         else:
-            strips.append(((r.x0, r.x1), [k]))
-    return strips
+            openings.append(((r.x0, r.x1), [k]))
+    if len(openings) < 2:
+        return openings, [], set()
+    spans = _bay_spans(openings, layout.width)
+    over: set[int] = set()
+    for k in shown:
+        r = layout.rects[k]
+        if _cuts(r):
+            continue
+        bay = next(
+            (n for n, (a, b) in enumerate(spans) if a - 1e-9 <= r.x0 and r.x1 <= b + 1e-9),
+            None,
+        )
+        if bay is None:
+            over.add(k)
+        else:
+            openings[bay][1].append(k)
+    return [(span, sorted(held)) for span, held in openings], spans, over
+
+
+def _unlike(
+    layout: LabelledLayout,
+    members: list[list[int]],
+    spans: list[Span],
+    mirrored_first: list[bool],
+) -> set[int]:
+    """The elements of the bays but the openings that not every bay of their kind shows
+    alike (label, place and rows within ``ALIKE`` of the bay), the kinds those of the
+    openings alone (``_kinds``; a bay whose openings are alike read either way is read
+    the way more of its other elements are): a balcony on one bay of a kind but not on
+    the rest stays where the structure put it, in a layer of its own, and the bays of
+    a kind remain one kind."""
+    rects = layout.rects
+    openings = [
+        _slots([rects[j] for j in held if _cuts(rects[j])], span)
+        for held, span in zip(members, spans, strict=True)
+    ]
+    kinds, mirrored, _ = _kinds(openings, spans, mirrored_first)
+    unlike: set[int] = set()
+    for kind in set(kinds):
+        bays = [k for k, mine in enumerate(kinds) if mine == kind]
+        tolerance = ALIKE * statistics.median(spans[k][1] - spans[k][0] for k in bays)
+
+        def others(k: int, flip: bool) -> list[tuple[int, Slot]]:
+            held = [j for j in members[k] if not _cuts(rects[j])]
+            mine = _slots([rects[j] for j in held], spans[k])
+            if flip:
+                mine = [_flip(s, spans[k][1] - spans[k][0]) for s in mine]
+            return list(zip(held, mine, strict=True))
+
+        first = others(bays[0], False)
+        seen = [first]
+        for k in bays[1:]:
+            width = spans[k][1] - spans[k][0]
+            ways = [mirrored[k]]
+            turned = [_flip(s, width) for s in openings[k]] if not mirrored[k] else openings[k]
+            if _match(openings[bays[0]], turned, tolerance) is not None:
+                ways.append(not mirrored[k])  # alike read either way: the way more are
+            seen.append(
+                max(
+                    (others(k, flip) for flip in ways),
+                    key=lambda mine: sum(
+                        any(_alike(p, q, tolerance) for _, q in mine) for _, p in first
+                    ),
+                )
+            )
+        shared: set[int] = set()
+        for index, slot in first:
+            row = [index]
+            for candidates in seen[1:]:
+                match = next(
+                    (
+                        j
+                        for j, other in candidates
+                        if j not in shared and _alike(slot, other, tolerance)
+                    ),
+                    None,
+                )
+                if match is None:
+                    break
+                row.append(match)
+            else:
+                shared.update(row)
+        unlike.update(j for bay in seen for j, _ in bay if j not in shared)
+    return unlike
+
+
+def _alike(a: Slot, b: Slot, tolerance: float) -> bool:
+    """Two slots are the same element: one label, centre, width and rows within
+    ``tolerance``."""
+    return a[0] == b[0] and all(abs(p - q) <= tolerance for p, q in zip(a[1:], b[1:], strict=True))
 
 
 def _bay_spans(strips: list[tuple[Span, list[int]]], width: float) -> list[Span]:
