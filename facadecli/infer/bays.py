@@ -17,11 +17,12 @@ those every bay of the kind shows alike stay in it, the rest stand apart (a balc
 one of them). Each kind is put on one shape (the median of its bays, so that every
 layer's word repeats it exactly), and the façade's x words become one sequence of
 bays, written alike in every layer that stands in bays (each layer shows its own
-elements; a bay where it shows none is one hidden spacer): a repeated unit of one or two bays (never a unique label's: a door's bay is
-written once) gets a counter, at most ``COUNTERS`` of them; kinds found only at the
-façade's ends share one counter that can only drop them (its most: one, as drawn). A
-sequence that reads the same mirrored is written as its left half, the middle and the
-half reflected (SPEC 2.2), so a wider façade gains bays on both sides alike.
+elements; a bay where it shows none is one hidden spacer): a repeated unit of one or
+two bays (never a unique label's: a door's bay is written once) gets a counter, at
+most ``COUNTERS`` of them; kinds found only at the façade's ends share one counter
+that can only drop them (its most: one, as drawn). A sequence that reads the same
+mirrored is written as its left half, the middle and the half reflected (SPEC 2.2), so
+a wider façade gains bays on both sides alike.
 
 The openings make the bays; a kind's other elements (sills, blinds, ledges) stand on
 its shape only where that keeps every one of them within ``HELD`` of where it was drawn
