@@ -323,3 +323,16 @@ def test_elements_across_two_bays_stay_over_the_shared_bays(tmp_path: Path) -> N
         assert sorted(set(columns)) == [known.floors - 1, known.floors], columns
         assert columns.count(known.floors - 1) == 1, columns
         assert {"balcony", "cornice"} <= {r.label for r in rects}
+
+
+def test_elements_left_where_drawn_have_no_runs_of_their_own(tmp_path: Path) -> None:
+    """Seed 6 keeps some sills and blinds where drawn, off their bays: their layers'
+    x words are as drawn, with no counters of their own (before, each brought runs and
+    counters beside the bays': ten counters on this façade, each a search for the
+    solver); the bays' counters and the floors' remain."""
+    inference, spec = _inferred(tmp_path, 6)
+    words = _x_words(inference.text)
+    names = layer_names(inference.grids)
+    apart = [n for n, g in zip(names, inference.grids, strict=True) if g.apart]
+    assert apart and all("^" not in words[n].replace("^-1", "") for n in apart)
+    assert any(n.startswith("bays") for n in spec.counters)

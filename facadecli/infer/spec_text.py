@@ -25,7 +25,8 @@
   standing in them follows their one sequence instead (``_bay_word``): the margins
   (``bays_m1``), each bay its kind's hidden gaps (``bay1_g1``), the layer's elements and
   the kind's wall (``bay1_w``), runs of bays with counters (``bays1``); a comment says
-  which, or why the bays are not shared.
+  which, or why the bays are not shared. The layers of elements left where drawn, off
+  the bays (``Grid.apart``), have no runs along x: their words are as drawn.
 - Meshes and materials by label (frames for windows and shop fronts, doors, ledges for
   sills, cornices and mouldings, balconies, shutters for blinds, boxes for the rest),
   colours from the label palette; every layer says in a comment where it came from.
@@ -302,7 +303,11 @@ def spec_text(
                 kept = frozenset(s for s, _ in tokens if s.rstrip("0123456789") in unique)
                 word = _word(tokens, axis, counters, repeated, True, ends | kept)
             else:
-                word = _word(tokens, axis, counters, repeated, grid.label not in UNIQUE, ends)
+                # elements left where drawn, off the bays, stay so along x: no runs of
+                # their own (counters of their own cost the solver a search each, and
+                # could not gain or drop what the bays do anyway)
+                runs = grid.label not in UNIQUE and not (grid.apart and axis == "x")
+                word = _word(tokens, axis, counters, repeated, runs, ends)
             pitch = tops.get(index) if axis == "y" and grid.label not in UNIQUE else None
             if pitch is not None and "^" not in word and ends >= {tokens[0][0], tokens[-1][0]}:
                 # the top floor repeats upwards from none more; the layer keeps its margin
