@@ -336,3 +336,32 @@ def test_elements_left_where_drawn_have_no_runs_of_their_own(tmp_path: Path) -> 
     apart = [n for n, g in zip(names, inference.grids, strict=True) if g.apart]
     assert apart and all("^" not in words[n].replace("^-1", "") for n in apart)
     assert any(n.startswith("bays") for n in spec.counters)
+
+
+@pytest.mark.parametrize("bay", [0, 2])
+def test_a_band_within_one_bay_stands_apart_and_the_spec_parses(tmp_path: Path, bay: int) -> None:
+    """Seed 14 (three bays, the door's last) with a balcony under one bay's second-floor
+    window nearly as wide as the bay (more than a quarter of the façade: a band): it
+    stands apart, in a layer of its own, and the bays are shared. Before, a band was in
+    no bay but inside one, so the bays' word wrote it without placing it: in the door's
+    bay the spec did not parse (its mask named a width the word did not hold), in
+    another the bays fell back to per-layer words."""
+    boxes, known = family(14)
+    windows = sorted((b for b in boxes if b[0] == "window"), key=lambda b: (b[2], b[1]))
+    top = sorted((b for b in windows if abs(b[2] - windows[-1][2]) < 0.02), key=lambda b: b[1])
+    second = sorted({round(b[2], 2) for b in windows})[1]
+    pitch = top[1][1] - top[0][1]
+    centre = (top[bay][1] + top[bay][3]) / 2
+    boxes.append(
+        ("balcony", centre - 0.44 * pitch, second - 0.03, centre + 0.44 * pitch, second - 0.014)
+    )
+    path = tmp_path / "band.xml"
+    path.write_text(cmp_xml(boxes))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    assert not inference.unshared, inference.bays
+    assert inference.bays.startswith(f"{known.bays} bays")
+    spec = parse_spec(inference.text, path.stem)
+    names = layer_names(inference.grids)
+    assert any(g.label == "balcony" and g.apart for g in inference.grids), names
+    rects = _solved(inference, spec, 1.5)
+    assert "balcony" in {r.label for r in rects}

@@ -226,8 +226,9 @@ def _strips(
     openings and of every other element (not a band) standing in its bay
     (``_bay_spans``); the bays' spans; and the elements that stand in no bay: across
     the middle of a wall (a balcony or a cornice over two bays, a pillar between them,
-    a shop front) or out in a margin. Those stay as the structure put them, in layers
-    of their own."""
+    a shop front) or out in a margin, and a band across a good share of the façade
+    standing within one bay (which the bays' words would write but not place). Those
+    stay as the structure put them, in layers of their own."""
     shown = [
         k
         for k, r in enumerate(layout.rects)
@@ -257,6 +258,13 @@ def _strips(
             over.add(k)
         else:
             openings[bay][1].append(k)
+    over.update(  # a band within one bay (wider than a quarter of the façade): its own
+        k
+        for k, r in enumerate(layout.rects)
+        if r.label != BACKGROUND
+        and r.x1 - r.x0 > BAND * layout.width
+        and any(a - 1e-9 <= r.x0 and r.x1 <= b + 1e-9 for a, b in spans)
+    )
     return [(span, sorted(held)) for span, held in openings], spans, over
 
 
