@@ -9,7 +9,8 @@ side. Every other element (a sill, a blind, a balcony under one window) is in th
 stands in; one that stands across the middle of a wall (a balcony or a cornice over two
 bays, a pillar between them, a shop front) or out in a margin is in none: it stays as
 the structure put it, in a layer of its own (``Bays.apart``) with its own x word. Bands
-across the façade (``layers.BAND``) are in no bay either.
+across the façade (``layers.BAND``) are in no bay either; one standing within a bay
+stands apart too.
 
 Bays whose openings are alike (label, place in the bay, size and rows within ``ALIKE``
 of the bay's width, read as drawn or mirrored) are one *kind*; of their other elements,
