@@ -197,7 +197,7 @@ def _within(geometry: Any, bbox: BBox) -> bool:
 
 class Words:
     """The tags' keys and short values held once for all the footprints read, not once a
-    footprint (each feature decodes its own: 240 bytes a generated terrace for its four
+    footprint (each feature decodes its own: 292 bytes a generated terrace for its four
     keys and values, where the tags of most buildings say the same few words). At most
     WORDS_MAX words are kept; past it, the others stay as they are."""
 
