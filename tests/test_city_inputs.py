@@ -4,10 +4,12 @@ unusable output folder are exit 2 with their place, before anything is written."
 
 from __future__ import annotations
 
+import gc
 import itertools
 import json
 import math
 import os
+import tracemalloc
 from pathlib import Path
 from typing import Any
 
@@ -326,3 +328,91 @@ def test_a_feature_collection_is_read_one_feature_at_a_time(tmp_path: Path) -> N
     assert list(document.features) == json.loads(path.read_text())["features"]
     assert document.features[1:] == json.loads(path.read_text())["features"][1:]
     assert document.places.feature(2) == (5, 1)
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 100])
+def test_a_streamed_collection_reads_as_the_whole_text_at_any_cut(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, chunk: int
+) -> None:
+    """The file is read a chunk at a time (geojson.CHUNK bytes): wherever a chunk ends (in
+    a number, a string, a character of several bytes, the BOM, a CR LF), the features,
+    the members and every feature's line and column are those of the text read whole."""
+    from facadecli.city import geojson
+
+    monkeypatch.setattr(geojson, "CHUNK", chunk)
+    features = [square(f"b{i}", x=123.25 * i, name="é ☃ \\u00e9", levels=10**i) for i in range(9)]
+    body = ",\r\n  ".join(features[:4]) + ",\n\n" + ", ".join(features[4:])
+    text = (
+        '{"type": "FeatureCollection", "name": "Liège ☃",\r\n "bbox": [1e2, -3.5, 12345678, 0],'
+        f'\n"features": [],\n "crs": {RD_NEW}, "features": [\n  {body} ]\n}}  \n'
+    )
+    path = tmp_path / "f.geojson"
+    path.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    document = geojson.read_geojson(path)
+    assert isinstance(document.features, geojson.Features)
+    assert list(document.features) == json.loads(text)["features"]
+    whole = geojson.Places(text)
+    places = [document.places.feature(i) for i in range(len(features) + 1)]
+    assert places == [whole.feature(i) for i in range(len(features) + 1)]
+    assert places[0] == (5, 3) and places[4] == (10, 1) and places[5][0] == 10
+    assert places[-1] is None
+    assert document.places.member("crs") == whole.member("crs") == (4, 9)
+    assert document.crs.to_epsg() == 28992
+
+
+def test_a_streamed_collection_holds_neither_its_text_nor_its_features(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Reading a FeatureCollection and going through its features holds a window of the
+    file and a feature at a time, not the file's text (tracemalloc's peak: 1.3 MB of
+    text read whole before, here 16 KiB chunks)."""
+    from facadecli.city import geojson
+
+    monkeypatch.setattr(geojson, "CHUNK", 1 << 14, raising=False)
+    features = [square(f"b{i}", x=20 * i, building="house", height=9.5) for i in range(6000)]
+    path = tmp_path / "f.geojson"
+    path.write_text('{"type": "FeatureCollection", "features": [\n' + ",\n".join(features) + "]}")
+    size = path.stat().st_size
+    count = 0
+    gc.collect()
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    try:
+        for _ in geojson.read_geojson(path).features:
+            count += 1
+        peak = tracemalloc.get_traced_memory()[1] - before
+    finally:
+        tracemalloc.stop()
+    assert count == 6000 and size > 1_000_000
+    assert peak < size / 8, (peak, size)
+
+
+def test_a_footprints_file_changed_between_its_two_reads_is_an_error(tmp_path: Path) -> None:
+    from facadecli.city.geojson import read_geojson
+    from facadecli.errors import SpecError
+
+    path = tmp_path / "f.geojson"
+    path.write_text('{"type": "FeatureCollection", "features": [' + square("a") + "]}")
+    document = read_geojson(path)
+    path.write_text('{"type": "FeatureCollection", "features": [' + square("a", x=100) + "]}  ")
+    with pytest.raises(SpecError, match="changed while it was read"):
+        list(document.features)
+
+
+def test_a_bad_value_far_into_a_streamed_file_is_named_at_its_line_and_column(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Past the first chunks, a JSON error is still at its line and column, and a
+    feature that is not a footprint is listed at its own."""
+    from facadecli.city import geojson
+
+    monkeypatch.setattr(geojson, "CHUNK", 64)
+    features = [square(f"b{i}", x=20 * i) for i in range(40)]
+    manifest = town(tmp_path, [*features, square("c", x=900).replace("0]]", "0]]]]", 1)])
+    code, _, err = city(capsys, manifest)
+    assert code == 2 and "f.geojson:43:" in err, err
+    assert not (tmp_path / "out").exists()
+    manifest = town(tmp_path, [*features, feature('{"building": "yes"}')])
+    code, _, _ = city(capsys, manifest)
+    rejected = report(manifest)["rejected"]
+    assert code == 0 and [(r["line"], r["column"]) for r in rejected] == [(43, 1)], rejected

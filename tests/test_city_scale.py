@@ -316,6 +316,48 @@ def test_a_planned_city_holds_its_tasks_packed(tmp_path: Path) -> None:
     assert Picked(again, [1, 5, 799])[:] == [tasks[1], tasks[5], tasks[799]]
 
 
+PLANNING_PEAK = """
+import gc, json, sys, tracemalloc
+from pathlib import Path
+from facadecli.city.demo import write_terraces
+from facadecli.city.manifest import load_city
+from facadecli.city.run import planned
+root, folder = Path(sys.argv[1]), Path(sys.argv[2])
+planned(load_city(write_terraces(folder / "town-50", root / "specs", 50, 1)), folder / "out")
+peaks = []
+for count in (200, 1600):
+    loaded = load_city(write_terraces(folder / f"town-{count}", root / "specs", count, 1))
+    gc.collect()
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    ahead = planned(loaded, folder / "out")
+    peaks.append(tracemalloc.get_traced_memory()[1] - before)
+    tracemalloc.stop()
+    del ahead
+print(json.dumps(peaks))
+"""
+
+
+def test_planning_peaks_at_little_a_building(tmp_path: Path) -> None:
+    """Planning's peak, all of it (reading, the neighbours, the tasks), grows little with
+    the city: the slope from 200 to 1,600 buildings of tracemalloc's peak, in a fresh
+    Python (a test worker's leftovers would be counted), a town of 50 planned first (the
+    one-off caches). 2,136 bytes a building when every building's party walls were held
+    at once, its choice and roof were objects of its own and its tags' words its own
+    strings; 1,304 since. GEOS's memory is not counted: ``make bench-large`` measures the
+    resident memory (docs/benchmarks.md)."""
+    run = subprocess.run(
+        [sys.executable, "-c", PLANNING_PEAK, str(ROOT), str(tmp_path / "fresh")],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    )
+    peaks = json.loads(run.stdout.splitlines()[-1])
+    slope = (peaks[1] - peaks[0]) / 1400
+    assert slope < 1600, slope
+
+
 def test_a_run_keeps_its_buildings_hashes_and_places_in_flat_buffers(tmp_path: Path) -> None:
     """What a run keeps of every building beside its packed task, for the whole run: its
     hash (resume.py) in 32 bytes and its centroid in 16, in one buffer each, not as small
@@ -406,3 +448,44 @@ def test_planning_peaks_grow_little_with_the_city(tmp_path: Path) -> None:
     merge_slope = (merging[1] - merging[0]) / 1400
     assert read_slope < 1000, read_slope
     assert merge_slope < 850, merge_slope
+
+
+def test_equal_values_are_held_once_unless_their_text_differs() -> None:
+    from facadecli.city.manifest import Roof
+    from facadecli.city.run import Same
+    from facadecli.city.s3db import Heights
+
+    same = Same()
+    first, again = Roof(type="gable", pitch=30.0), Roof(type="gable", pitch=30.0)
+    assert same(first) is first and same(again) is first
+    whole, floating = Heights(10, None, 0.0, None, 12.0), Heights(10.0, None, 0.0, None, 12.0)
+    assert whole == floating and same(whole) is whole and same(floating) is floating
+    assert (
+        same(Heights(None, None, -0.0, None, 12.0)).base
+        == same(Heights(None, None, 0.0, None, 12.0)).base
+    )
+    assert str(same(Heights(None, None, 0.0, None, 12.0)).base) == "0.0"
+
+
+def test_the_tags_words_are_held_once_for_the_town() -> None:
+    from facadecli.city.footprints import WORD_LENGTH, Words
+
+    words = Words()
+    long = "x" * (WORD_LENGTH + 1)
+    text = json.dumps({"building": "house", "levels": 3, "name": long})
+    one, two = (words.properties(json.loads(text)) for _ in range(2))
+    assert one == two == json.loads(text)
+    assert [k1 is k2 for k1, k2 in zip(one, two, strict=True)] == [True, True, True]
+    assert one["building"] is two["building"] and one["name"] is not two["name"]
+
+
+def test_party_lines_of_some_footprints_are_theirs_among_all(tmp_path: Path) -> None:
+    from facadecli.city.footprints import read_footprints
+    from facadecli.city.s3db import party_lines
+
+    town = write_terraces(tmp_path / "town", ROOT / "specs", 48, 1).parent
+    footprints = list(read_footprints(town / "footprints.geojson").footprints)
+    every = dict(party_lines(footprints, 0.3))
+    some = dict(party_lines(footprints, 0.3, only={"t1", "t17", "t40"}))
+    assert list(some) == ["t1", "t17", "t40"] and all(key in every for key in some)
+    assert all(some[key].equals_exact(every[key], 0) for key in some)

@@ -195,6 +195,36 @@ def _within(geometry: Any, bbox: BBox) -> bool:
     return bbox[0] <= x <= bbox[2] and bbox[1] <= y <= bbox[3]
 
 
+class Words:
+    """The tags' keys and short values held once for all the footprints read, not once a
+    footprint (each feature decodes its own: 292 bytes a generated terrace for its four
+    keys and values, where the tags of most buildings say the same few words). At most
+    WORDS_MAX words are kept; past it, the others stay as they are."""
+
+    def __init__(self) -> None:
+        self.seen: dict[str, str] = {}
+
+    def word(self, text: str) -> str:
+        found = self.seen.get(text)
+        if found is not None:
+            return found
+        if len(self.seen) < WORDS_MAX:
+            self.seen[text] = text
+        return text
+
+    def properties(self, properties: dict[str, Any]) -> dict[str, Any]:
+        return {
+            self.word(key): (
+                self.word(value) if type(value) is str and len(value) <= WORD_LENGTH else value
+            )
+            for key, value in properties.items()
+        }
+
+
+WORDS_MAX = 1 << 16  # distinct keys and values held once (Words)
+WORD_LENGTH = 40  # characters: longer values (names, notes) are seldom repeated
+
+
 def _readable(
     document: GeoJSON,
     rejected: list[Rejected],
@@ -209,6 +239,7 @@ def _readable(
     once; two features with one id are a SpecError after it (:func:`_duplicated`)."""
     found = []
     entrances = {}
+    words = Words()
     first: dict[str, int] = {}  # id -> the first feature with it
     duplicates: list[tuple[int, str]] = []
     for index, feature in enumerate(document.features):
@@ -227,7 +258,7 @@ def _readable(
             continue
         properties, problems = checked_properties(read[0], names)
         warned.extend(_rejected(document, index, fid, problem) for problem in problems)
-        found.append((index, fid, properties, read[1]))
+        found.append((index, fid, words.properties(properties), read[1]))
         points = _entrances(feature)
         if points:
             entrances[index] = points

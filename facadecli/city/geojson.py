@@ -8,14 +8,19 @@ here raises anything else, whatever the file holds.
 
 from __future__ import annotations
 
+import codecs
+import itertools
 import json
 import math
+import os
 import re
+import stat
+from array import array
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any, overload
+from typing import Any, BinaryIO, overload
 
 import pyproj
 import pyproj.exceptions
@@ -23,7 +28,7 @@ import shapely.errors
 from shapely.geometry import MultiPolygon, Polygon
 
 from facadecli.errors import SpecError
-from facadecli.files import decode_utf8, read_at_most
+from facadecli.files import CHUNK, decode_utf8, read_at_most
 from facadecli.limits import GEOJSON_BYTES_MAX, PROJECTED_MAX
 
 GEOMETRY_TYPES = (
@@ -86,22 +91,22 @@ class GeoJSON:
 def read_geojson(path: Path) -> GeoJSON:
     """The file's features and CRS; raises SpecError (exit 2) when it is not GeoJSON.
 
-    A FeatureCollection is read as a stream: its features are found, checked as JSON and
-    decoded again one at a time when they are read (:class:`Features`), so only one
-    feature's objects exist at a time, not the whole file's tree. Anything else (a lone
-    Feature, a file that is not valid JSON, ...) is parsed whole, which also locates the
-    problem."""
+    A FeatureCollection in a regular file is read as a stream (:func:`_streamed`): a
+    first pass checks it a chunk of the file at a time, keeping its top-level members
+    and each feature's line and column, and its features are read again from the file
+    one at a time when they are iterated (:class:`Features`), so neither the file's text
+    nor more than one feature's objects are held at once. Anything else (a lone Feature,
+    a file that is not valid JSON, a pipe...) is read and parsed whole, which also
+    locates the problem."""
     file = str(path)
-    text = _text(path)
-    streamed = _stream(text)
+    streamed = _streamed(path)
     if streamed is not None:
-        members, offsets = streamed
-        places = Places(text)
-        return GeoJSON(file, Features(text, offsets), _crs(members, file, places), places)
+        members, places, features = streamed
+        return GeoJSON(file, features, _crs(members, file, places), places)
+    text = _text(path)
     data = _parse(text, file)
-    places = Places(text, lone=isinstance(data, dict) and data.get("type") == "Feature")
-    features = _features(data, file, places)
-    return GeoJSON(file, features, _crs(data, file, places), places)
+    whole = Places(text, lone=isinstance(data, dict) and data.get("type") == "Feature")
+    return GeoJSON(file, _features(data, file, whole), _crs(data, file, whole), whole)
 
 
 def read_feature(
@@ -159,68 +164,248 @@ class NoPlaces(Places):
         return None
 
 
-class Features(Sequence[Any]):
-    """The features of a FeatureCollection, each decoded from the text when it is read."""
+class StreamedPlaces(Places):
+    """The places a streamed FeatureCollection's first pass found (:func:`_streamed`):
+    its start, its top-level members' values and each feature's start, 8 bytes a
+    feature (line and column), not the file's text."""
 
-    def __init__(self, text: str, offsets: list[int]):
-        self.text = text
-        self.offsets = offsets
-        self.decoder = json.JSONDecoder()
+    def __init__(self, start: tuple[int, int]) -> None:
+        super().__init__("")
+        self.first = start
+        self.members: dict[str, tuple[int, int]] = {}
+        self.lines = array("I")
+        self.columns = array("I")
+
+    def start(self) -> tuple[int, int]:
+        return self.first
+
+    def member(self, key: str) -> tuple[int, int]:
+        return self.members.get(key, self.first)
+
+    def feature(self, index: int) -> tuple[int, int] | None:
+        if 0 <= index < len(self.lines):
+            return self.lines[index], self.columns[index]
+        return None
+
+
+class Features(Sequence[Any]):
+    """The features of a FeatureCollection checked by :func:`_streamed`, read again from
+    its file one at a time as they are iterated (the ``features`` list that counts: the
+    last, as in :func:`json.loads`). A file changed since the first pass is a SpecError."""
+
+    def __init__(self, path: Path, count: int, occurrence: int, status: os.stat_result):
+        self.path = path
+        self.length = count
+        self.occurrence = occurrence  # which 'features' member (0: the first) holds them
+        self.status = status  # the file's when it was checked
 
     def __len__(self) -> int:
-        return len(self.offsets)
+        return self.length
 
     def __iter__(self) -> Iterator[Any]:
-        for offset in self.offsets:
-            yield self.decoder.raw_decode(self.text, offset)[0]
+        found = 0
+        try:
+            with self.path.open("rb") as handle:
+                status = os.fstat(handle.fileno())
+                if (status.st_size, status.st_mtime_ns) != (
+                    self.status.st_size,
+                    self.status.st_mtime_ns,
+                ):
+                    raise _NotStreamed
+                for kind, value, _ in _walk(_Stream(handle, self.status.st_size)):
+                    if kind == "feature" and value[0] == self.occurrence:
+                        found += 1
+                        yield value[1]
+        except (OSError, _NotStreamed, _TooLong, json.JSONDecodeError, ValueError):
+            found = -1  # UnicodeDecodeError is a ValueError
+        if found != self.length:
+            raise SpecError.at(
+                str(self.path),
+                None,
+                None,
+                "the footprints file changed while it was read",
+                "run again once the file is written",
+            )
 
     @overload
     def __getitem__(self, index: int) -> Any: ...
     @overload
     def __getitem__(self, index: slice) -> list[Any]: ...
     def __getitem__(self, index: int | slice) -> Any:
+        """A feature by its place, read again up to it (the features are meant to be
+        iterated: this is for a few)."""
         if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(len(self)))]
-        return self.decoder.raw_decode(self.text, self.offsets[index])[0]
+            wanted = range(*index.indices(len(self)))
+            return [f for k, f in enumerate(self) if k in wanted]
+        if index < 0:
+            index += len(self)
+        if not 0 <= index < len(self):
+            raise IndexError(index)
+        return next(itertools.islice(self, index, None))
 
 
-def _stream(text: str) -> tuple[dict[str, Any], list[int]] | None:
-    """A FeatureCollection's members but its features, and where each feature starts, its
-    JSON checked value by value; None for anything else or any problem (the caller then
-    parses the file whole, which says where the problem is)."""
-    decoder = json.JSONDecoder()
+class _NotStreamed(Exception):
+    """A file :func:`_streamed` leaves to be read whole (not a FeatureCollection, not
+    valid JSON...): the whole read says what is wrong, and where."""
+
+
+class _TooLong(Exception):
+    """More bytes than the limit of a footprints file."""
+
+
+class _Stream:
+    """A JSON text read from a binary file a chunk at a time: whitespace skipped, values
+    decoded by the json module's own decoder from a window of the text, which holds what
+    is not read yet of the last chunk and grows (doubling) while a value is longer; and
+    the line and column of any place passed."""
+
+    def __init__(self, handle: BinaryIO, limit: int):
+        self.handle = handle
+        self.limit = limit  # bytes: more is _TooLong
+        self.size = 0  # bytes read
+        self.text = codecs.getincrementaldecoder("utf-8-sig")()
+        self.decoder = json.JSONDecoder()
+        self.window = ""
+        self.at = 0  # the place in the window
+        self.ended = False
+        self.origin = 0  # the place in the whole text of the window's first character
+        self.counted = 0  # lines are counted up to here in the window
+        self.line = 1
+        self.line_start = 0  # in the whole text
+
+    def _more(self) -> None:
+        self.place(self.at)  # lines counted up to the part let go
+        self.window = self.window[self.at :]
+        self.origin += self.at
+        self.counted -= self.at
+        self.at = 0
+        data = self.handle.read(min(max(CHUNK, len(self.window)), self.limit + 1 - self.size))
+        self.size += len(data)
+        if self.size > self.limit:
+            raise _TooLong
+        self.ended = not data
+        self.window += self.text.decode(data, final=self.ended)
+
+    def next(self) -> str:
+        """The next character but whitespace ('' at the end), the place at it."""
+        while True:
+            self.at = _skip(self.window, self.at)
+            if self.at < len(self.window) or self.ended:
+                return self.window[self.at : self.at + 1]
+            self._more()
+
+    def value(self) -> Any:
+        """The JSON value at the place (after :meth:`next`), the place past it."""
+        while True:
+            try:
+                found, end = self.decoder.raw_decode(self.window, self.at)
+            except json.JSONDecodeError:
+                if self.ended:
+                    raise
+                self._more()  # perhaps cut by the window's end
+                continue
+            if end < len(self.window) or self.ended:  # a number may go on past the end
+                self.at = end
+                return found
+            self._more()
+
+    def place(self, at: int | None = None) -> tuple[int, int]:
+        """The 1-based line and column of a place in the window at or past the last asked."""
+        at = self.at if at is None else at
+        newlines = self.window.count("\n", self.counted, at)
+        if newlines:
+            self.line += newlines
+            self.line_start = self.origin + self.window.rfind("\n", self.counted, at) + 1
+        self.counted = at
+        return self.line, self.origin + at - self.line_start + 1
+
+
+Walked = tuple[str, Any, tuple[int, int]]
+
+
+def _walk(stream: _Stream) -> Iterator[Walked]:
+    """A FeatureCollection's parts as they are read, each with its place: ("start", None)
+    first, then ("member", (key, value)) for each top-level member but a ``features``
+    list, ("features", occurrence) where such a list starts (0 for the first) and
+    ("feature", (occurrence, feature)) for each of its elements. _NotStreamed when the
+    file is not one object, or json's JSONDecodeError where it is not JSON."""
+    if stream.next() != "{":
+        raise _NotStreamed
+    yield "start", None, stream.place()
+    stream.at += 1
+    occurrence = 0
+    while stream.next() == '"':
+        key = stream.value()
+        if stream.next() != ":":
+            raise _NotStreamed
+        stream.at += 1
+        if key == "features" and stream.next() == "[":
+            yield "features", occurrence, stream.place()
+            stream.at += 1
+            while stream.next() != "]":
+                place = stream.place()
+                yield "feature", (occurrence, stream.value()), place
+                if stream.next() == ",":
+                    stream.at += 1
+                    if stream.next() == "]":  # a trailing comma is not JSON
+                        raise _NotStreamed
+                elif stream.next() != "]":
+                    raise _NotStreamed
+            stream.at += 1
+            occurrence += 1
+        else:
+            stream.next()
+            place = stream.place()
+            yield "member", (key, stream.value()), place
+        if stream.next() == ",":
+            stream.at += 1
+        elif stream.next() != "}":
+            raise _NotStreamed
+    if stream.next() != "}":
+        raise _NotStreamed
+    stream.at += 1
+    if stream.next() != "":
+        raise _NotStreamed
+
+
+def _streamed(path: Path) -> tuple[dict[str, Any], StreamedPlaces, Features] | None:
+    """A FeatureCollection checked a chunk of its file at a time (:func:`_walk`): its
+    members but its features, their places, and its features to be read again as they
+    are iterated; None for anything else or any problem (the caller then reads and
+    parses the file whole, which says what and where the problem is)."""
+    places: StreamedPlaces | None = None
+    found: tuple[int, StreamedPlaces] | None = None  # the 'features' list that counts
+    members: dict[str, Any] = {}
     try:
-        at = _skip(text, 0)
-        if not text.startswith("{", at):
-            return None
-        at = _skip(text, at + 1)
-        members: dict[str, Any] = {}
-        offsets: list[int] | None = None
-        while text.startswith('"', at):
-            key, at = decoder.raw_decode(text, at)
-            at = _skip(text, at)
-            if not text.startswith(":", at):
-                return None
-            at = _skip(text, at + 1)
-            if key == "features" and text.startswith("[", at):
-                offsets, at = _elements(text, at, decoder)
-                members.pop(key, None)
-            else:
-                members[key], at = decoder.raw_decode(text, at)
-                if key == "features":
-                    offsets = None  # a later 'features' that is not a list wins, as in json
-            at = _skip(text, at)
-            if text.startswith(",", at):
-                at = _skip(text, at + 1)
-            elif not text.startswith("}", at):
-                return None
-        if not text.startswith("}", at) or _skip(text, at + 1) != len(text):
-            return None
-    except (json.JSONDecodeError, RecursionError, ValueError, IndexError):
+        with path.open("rb") as handle:
+            status = os.fstat(handle.fileno())
+            if not stat.S_ISREG(status.st_mode):
+                return None  # a pipe is read once
+            for kind, value, place in _walk(_Stream(handle, GEOJSON_BYTES_MAX)):
+                if kind == "start":
+                    places = StreamedPlaces(place)
+                    continue
+                assert places is not None
+                if kind == "member":
+                    members[value[0]] = value[1]
+                    places.members[value[0]] = place
+                    if value[0] == "features":
+                        found = None  # a later 'features' that is not a list wins, as in json
+                elif kind == "features":
+                    members.pop("features", None)
+                    places.members["features"] = place
+                    found = (value, StreamedPlaces(place))
+                else:
+                    assert found is not None
+                    found[1].lines.append(place[0])
+                    found[1].columns.append(place[1])
+    except (OSError, _TooLong, _NotStreamed, json.JSONDecodeError, RecursionError, ValueError):
+        return None  # ValueError: not UTF-8, an integer of more than 4,300 digits...
+    if found is None or places is None or members.get("type") == "Feature":
         return None
-    if offsets is None or members.get("type") == "Feature":
-        return None
-    return members, offsets
+    occurrence, features = found
+    places.lines, places.columns = features.lines, features.columns
+    return members, places, Features(path, len(places.lines), occurrence, status)
 
 
 def _parse(text: str, file: str) -> Any:

@@ -24,7 +24,7 @@ import queue
 import re
 import time
 from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Container, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -336,30 +336,43 @@ def plan(
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
-    shapes = {footprint.id: _shape(city, footprint.properties) for footprint in footprints}
+    same = Same()  # most buildings share a choice and a roof: held once, not a building
+    shapes = {}
+    for footprint in footprints:
+        choice, heights, roof = _shape(city, footprint.properties)
+        shapes[footprint.id] = (same(choice), heights, same(roof))
+    del same
     above = standing_on(footprints, {key: shape[1] for key, shape in shapes.items()})
     raised = lifted(
         footprints, {k: s[1] for k, s in shapes.items()}, {k: s[2] for k, s in shapes.items()}
     )
     shapes |= {key: (shapes[key][0], heights, shapes[key][2]) for key, heights in raised.items()}
     beside = _beside(footprints, shapes)
-    # each building's party walls kept as their WKB until its task is made (exact
-    # coordinates, as the packed task keeps them): 40,000 generated terraces planned held
-    # 67 MiB more resident with them as GEOS objects, 9 MiB as WKB
-    lines = party_lines(footprints, tolerance, beside) if tolerance > 0 else iter(())
-    shared = {key: shapely.to_wkb(found) for key, found in lines}
+
+    def lines_of(only: Container[str] | None = None) -> Iterator[tuple[str, bytes]]:
+        """Party walls, footprint by footprint in their order, as WKB (exact coordinates,
+        as the packed task keeps them; a building's lines found as its task is made, not
+        every building's held: 40,000 generated terraces held 67 MiB more resident with
+        them all as GEOS objects, 9 MiB as WKB)."""
+        found = party_lines(footprints, tolerance, beside, only) if tolerance > 0 else ()
+        return ((key, shapely.to_wkb(lines)) for key, lines in found)
+
+    doors = shared_doors(footprints)  # only footprints sharing an entrance need walls ahead
+    ahead = dict(lines_of(doors)) if doors else {}
 
     def walls_of(footprint: Footprint) -> list[Wall]:
         _, heights, roof = shapes[footprint.id]
-        lines = _from_wkb(shared.get(footprint.id))
+        lines = _from_wkb(ahead.get(footprint.id))
         return building_walls(footprint, heights, roof, lines, tolerance)
 
     footprints, warnings = one_door_each(footprints, walls_of)
+    ahead.clear()
+    shared = Lockstep(lines_of())
     tasks: Packed[Task] = Packed(dict(city.specs))
     owners: dict[str, str] = {}  # file name -> building id
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
     for footprint in footprints:
-        choice, heights, roof = shapes.pop(footprint.id)  # let go as its task is packed
+        choice, heights, roof = shapes[footprint.id]  # a later neighbour's walls need it
         name = safe_name(footprint.id)
         if owners.setdefault(name, footprint.id) != footprint.id:
             raise SpecError.at(
@@ -403,7 +416,7 @@ def plan(
                 outdir / building_file(footprint.id),
                 (city.folder / choice.facade).parent.resolve(),
                 looks,
-                _from_wkb(shared.pop(footprint.id, None)),
+                _from_wkb(shared.take(footprint.id)),
                 tolerance,
                 identities[choice.facade],
                 walls,
@@ -422,6 +435,45 @@ def plan(
 def _from_wkb(data: bytes | None) -> Any:
     """A footprint's party walls kept as WKB (:func:`plan`), None when it has none."""
     return None if data is None else shapely.from_wkb(data)
+
+
+class Same:
+    """Each value as the first equal one seen, so that equal values are held once (a
+    call gives its argument back when the first is equal but not the same, as 1 and
+    1.0, or 0.0 and -0.0 are: their text tells them apart)."""
+
+    def __init__(self) -> None:
+        self.seen: dict[Any, Any] = {}
+
+    def __call__(self, value: T) -> T:
+        found: T = self.seen.setdefault(value, value)
+        return found if found is value or repr(found) == repr(value) else value
+
+
+class Lockstep:
+    """Values by key from pairs that come in the order they are asked for, each key at
+    most once (a footprint's party walls as the tasks are made, in the footprints'
+    order): :meth:`take` gives a key's value, None for a key the pairs skip."""
+
+    def __init__(self, pairs: Iterator[tuple[str, bytes]]):
+        self.pairs = pairs
+        self.next = next(pairs, None)
+
+    def take(self, key: str) -> bytes | None:
+        if self.next is None or self.next[0] != key:
+            return None
+        found = self.next[1]
+        self.next = next(self.pairs, None)
+        return found
+
+
+def shared_doors(footprints: Sequence[Footprint]) -> set[str]:
+    """The ids of the footprints holding an entrance another one holds too."""
+    holders: dict[tuple[float, float], list[str]] = {}
+    for footprint in footprints:
+        for point in footprint.entrances:
+            holders.setdefault(point, []).append(footprint.id)
+    return {key for ids in holders.values() if len(ids) > 1 for key in ids}
 
 
 def one_door_each(

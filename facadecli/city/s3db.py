@@ -20,7 +20,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Container, Iterable, Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -624,9 +624,11 @@ def party_lines(
     footprints: list[Footprint],
     tolerance: float,
     beside: Callable[[str, str], bool] | None = None,
+    only: Container[str] | None = None,
 ) -> Iterator[tuple[str, Any]]:
     """:func:`shared_edges` footprint by footprint, in their order: its id and its lines,
-    for those that have any (a caller may keep them in another form as they come)."""
+    for those that have any (a caller may take them as they come, not all at once);
+    with ``only``, for the footprints of those ids alone (the others still neighbours)."""
     shapes = [shape for f in footprints for shape in f.parts]
     owner = [f.id for f in footprints for _ in f.parts]
     tree = STRtree(shapes)
@@ -635,6 +637,8 @@ def party_lines(
         if found is not None and found[0] != owner[index]:
             yield found
             found = None
+        if only is not None and owner[index] not in only:
+            continue
         near = [int(i) for i in tree.query(shape.buffer(tolerance))]
         others = [
             shapes[i]

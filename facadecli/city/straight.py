@@ -74,6 +74,9 @@ def straighten(footprints: Sequence[Footprint], angle: float, near: float) -> St
     return Straightened(tuple(done), taken, changed)
 
 
+BATCH = 1024  # rings whose vertices are joined into one array each (Corners)
+
+
 class Corners:
     """Every footprint's vertices, by the footprint they are of, found by a grid: flat
     arrays (28 bytes a vertex), not a shapely point (and a tuple) each, which for a
@@ -81,14 +84,19 @@ class Corners:
 
     def __init__(self, footprints: Sequence[Footprint], cell: float = CELL):
         self.ids = [footprint.id for footprint in footprints]
-        xs, ys, owners = [], [], []
+        xs, ys, owners = [], [], []  # a batch's arrays, joined at its end
+        batch: list[tuple[Any, Any, Any]] = []  # a ring's arrays (three objects a ring)
         for number, footprint in enumerate(footprints):
             for part in footprint.parts:
                 for ring in (part.exterior, *part.interiors):
                     coords = shapely.get_coordinates(ring)[:-1]
-                    xs.append(coords[:, 0])
-                    ys.append(coords[:, 1])
-                    owners.append(np.full(len(coords), number, dtype=np.int32))
+                    owner = np.full(len(coords), number, dtype=np.int32)
+                    batch.append((coords[:, 0], coords[:, 1], owner))
+            if batch and (len(batch) >= BATCH or number == len(footprints) - 1):
+                xs.append(np.concatenate([ring[0] for ring in batch]))
+                ys.append(np.concatenate([ring[1] for ring in batch]))
+                owners.append(np.concatenate([ring[2] for ring in batch]))
+                batch = []
         x = np.concatenate(xs) if xs else np.zeros(0)
         y = np.concatenate(ys) if ys else np.zeros(0)
         del xs, ys
