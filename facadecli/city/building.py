@@ -324,7 +324,7 @@ def build_building(
     walls. With ``instanced``, the parts a façade repeats are meshes of their own, each
     placed by a node per instance (:func:`.instance_nodes` makes them one node). A wall
     its façade does not fit (no layout for its height or its length) takes ``fallback``'s,
-    in the building's wall material (:func:`_dressed`), before it is left plain."""
+    in the building's wall material (:func:`_worn`), before it is left plain."""
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}

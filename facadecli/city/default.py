@@ -8,10 +8,11 @@ townhouse; a building with a ``shop`` tag keeps its own and gets the shop front 
 front walls. A wall its façade does not fit (a shed's, a garage's, a bungalow's walls
 are too low for a townhouse; a short wall is too narrow for it) gets the cottage: one
 storey of windows over a plinth under an eaves band, more where the wall is taller, in
-the building's wall material; it fits walls from 2.2 m high and 1.2 m long, and
-shorter walls are plain. Each building's walls take one of four tones of its spec's wall
-colour (:func:`tones`), picked by the seed and its id. Roofs are hipped (30°) unless the
-data tags a shape; a building without a height or levels is 9 m tall, 3 m a level.
+the building's wall material; it fits walls from 1.2 m long and 1.2 m high, and
+shorter (or lower) walls are plain. Each building's walls take one of four tones of its
+spec's wall colour (:func:`tones`), picked by the seed and its id. Roofs are hipped
+(30°) unless the data tags a shape; a building without a height or levels is 9 m tall,
+3 m a level.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ RULES = (  # building tag -> the example that dresses it, when no --spec is give
     (CHURCHES, "church"),
 )
 FALLBACK = "cottage"  # the example for walls the building's own façade does not fit
-MIN_FACADE_WIDTH = 1.2  # metres: the cottage's narrowest layout, one window between piers
+MIN_FACADE_WIDTH = 1.2  # metres: the cottage has a layout from here (one window, two piers)
 TONES = (1.0, 0.86, 1.12, 0.94)  # the lightness of a wall colour's four tones, as factors
 
 
