@@ -92,12 +92,13 @@ def test_a_fallback_wall_wears_its_buildings_wall_material(tmp_path: Path) -> No
     assert "render" in names and "brick" not in names, names
 
 
-@pytest.mark.parametrize("seed", [0, 3])
-def test_low_buildings_give_the_same_bytes_for_the_same_seed(tmp_path: Path, seed: int) -> None:
+@pytest.mark.parametrize("height", [2.6, 2.9])
+def test_low_buildings_give_the_same_bytes_on_every_run(tmp_path: Path, height: float) -> None:
+    """The same footprints (and the default city's seed, 0) give the same bytes."""
     runs = []
     for run in range(2):
         folder = tmp_path / f"run{run}"
-        _run(folder, _sheds(3, height=2.6 + 0.1 * seed))
+        _run(folder, _sheds(3, height=height))
         runs.append((folder / "out" / "sheds.glb").read_bytes())
     assert runs[0] == runs[1]
 
