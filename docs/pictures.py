@@ -58,6 +58,15 @@ PARTS: dict[str, tuple[str, Callable[[Shape], bool], tuple[float, float], float,
     ),
     # the cornice's free end, where its profile shows
     "part-ledge": ("parts", lambda s: s["y"] == "C" and s["x1"] <= 2.0, (0.0, 1.0), -60, -15),
+    # the townhouse's middle pilaster on the ground floor: its coursed sandstone (the
+    # library's ashlar) close up
+    "stone-close": (
+        "townhouse",
+        lambda s: s["layer"] == "pilasters" and s["y"] == "G" and 3 < s["x0"] < 6,
+        (0.25, 0.75),
+        20,
+        5,
+    ),
 }
 # of the picture's width or height (the tighter) the part would span seen square on; the
 # viewer's 8% margin and the perspective of an oblique view leave about three quarters

@@ -5,18 +5,16 @@ of 50 buildings (the demo district's first 50), built once for the module."""
 from __future__ import annotations
 
 import json
-import math
 import shutil
 import subprocess
 import sys
-from collections import Counter, defaultdict
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
 from shapely.geometry import Polygon
-from shapely.ops import unary_union
 
 from facadecli.city.building import MAP_TO_WORLD
 from facadecli.city.default import default_city, tones
@@ -27,7 +25,7 @@ from facadecli.city.run import run_city
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.export.texture_store import PICTURE, image_uris, picture_name, pictures_missing
 from facadecli.geometry.facade import plane_uv, weld
-from tests.rays import opaque_parts, reach
+from tests.rays import city_leaks
 
 ROOT = Path(__file__).resolve().parent.parent
 VALIDATOR = Path(sys.prefix) / "node" / "node_modules"  # make test installs it in the venv
@@ -134,66 +132,11 @@ def test_a_welded_mesh_keeps_its_triangles_and_stores_each_vertex_once() -> None
     assert np.allclose(normals, np.asarray(box.vertex_attributes["NORMAL"])[box.faces])
 
 
-def _buildings(scene: trimesh.Scene, see_through: set[str]) -> dict[str, list[np.ndarray]]:
-    """The opaque triangles of each building of a merged city (its root node's name):
-    glass that blends or transmits (``see_through``) is left out, as a viewer sees
-    through it."""
-    parents = scene.graph.transforms.parents
-    found: dict[str, list[np.ndarray]] = defaultdict(list)
-    for node, triangles in opaque_parts(scene, see_through):
-        root = node
-        while parents.get(root) not in (None, scene.graph.base_frame):
-            root = parents[root]
-        found[root].append(triangles)
-    return found
-
-
 def test_rays_at_35_degrees_from_eight_directions_meet_every_building(city: Path) -> None:
-    """From eight directions 35° above the horizon, rays aimed at points inside each
-    building (a metre in from its footprint, 1 m up and at 40% of its height) meet
-    the front of the building's own opaque surface before they get there (a viewer draws
-    no back face): no building of the city lets a view through (a missing wall, a window
-    with nothing behind it)."""
-    glb = city / "demo-district.glb"
-    document, _ = read_glb(glb.read_bytes())
-    transmitting = "KHR_materials_transmission"
-    see_through = {
-        m["name"] for m in document["materials"] if transmitting in m.get("extensions", {})
-    }
-    assert see_through  # the glass of the windows: the rays pass it
-    buildings = _buildings(trimesh.load(glb, force="scene"), see_through)
-    assert len(buildings) == BUILDINGS
-    down = math.radians(35)
-    directions = np.array(
-        [
-            (math.cos(down) * math.cos(a), -math.sin(down), math.cos(down) * math.sin(a))
-            for a in np.radians(np.arange(0, 360, 45))
-        ]
-    )
-    leaks = []
-    for name, parts in sorted(buildings.items()):
-        triangles = np.concatenate(parts)
-        low, high = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
-        ground = [t for t in triangles if np.ptp(t[:, 1]) < 1e-6 and t[0, 1] <= low[1] + 0.02]
-        plan = unary_union([Polygon(t[:, [0, 2]]) for t in ground if Polygon(t[:, [0, 2]]).area])
-        inner = plan.buffer(-1.0)  # deeper than any window recess reaches
-        assert not inner.is_empty, name
-        x0, z0, x1, z1 = inner.bounds
-        points = [
-            (x, z)
-            for x in np.linspace(x0, x1, 5)
-            for z in np.linspace(z0, z1, 5)
-            if inner.contains(Polygon([(x, z), (x + 1e-3, z), (x, z + 1e-3)]))
-        ] or [inner.representative_point().coords[0]]
-        heights = (low[1] + 1.0, low[1] + 0.4 * (high[1] - low[1]))
-        targets = np.array([(x, y, z) for x, z in points for y in heights])
-        far = 2 * float(np.linalg.norm(high - low)) + 10.0
-        for direction in directions:
-            origins = targets - direction * far
-            met = reach(triangles, origins, direction, culled=True)
-            through = targets[met >= far - 1e-6]
-            if len(through):
-                leaks.append((name, direction.round(2).tolist(), through[:3].round(2).tolist()))
+    """No building of the city lets a view through (a missing wall, a window with
+    nothing behind it): :func:`tests.rays.city_leaks`."""
+    count, leaks = city_leaks(city / "demo-district.glb")
+    assert count == BUILDINGS
     assert not leaks, leaks[:5]
 
 

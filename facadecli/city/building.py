@@ -310,6 +310,7 @@ def build_building(
     pick: int = 0,
     above: Any = None,
     instanced: bool = False,
+    fallback: Facade | None = None,
 ) -> BuildingResult:
     """The building's scene: a volume a part of its footprint, as the heights say (walls
     from ``base`` to the eaves, the roof on them); façades on every wall but the party
@@ -321,7 +322,9 @@ def build_building(
     Roofs stand still at party walls (a gable end, not a hip down to the neighbour), and
     leave out ``above``, the taller parts standing on this one, running on into their
     walls. With ``instanced``, the parts a façade repeats are meshes of their own, each
-    placed by a node per instance (:func:`.instance_nodes` makes them one node)."""
+    placed by a node per instance (:func:`.instance_nodes` makes them one node). A wall
+    its façade does not fit (no layout for its height or its length) takes ``fallback``'s,
+    in the building's wall material (:func:`_worn`), before it is left plain."""
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
@@ -342,16 +345,21 @@ def build_building(
             meshes: list[tuple[str, trimesh.Trimesh]] | None = None
             repeated: PlacedParts = []
             doors = along_wall(footprint.entrances, a, b)
+            tried = _tried(chosen, fallback)
+            dressed = chosen
             if length >= min_facade_width and not party_wall:
-                wall_args = (chosen.key, chosen.spec, length, wall_height, chosen.base_dir)
-                if doors:  # entrances on this wall: its façade with doors, its own
-                    meshes = cache.facade_with_doors(*wall_args, doors, variants, pick)
-                    entrances += len(doors) if meshes is not None else 0
-                elif instanced:
-                    found = cache.facade_parts(*wall_args, variants, pick)
-                    meshes, repeated = found if found is not None else (None, [])
-                else:
-                    meshes = cache.facade(*wall_args, variants, pick)
+                for dressed in tried:
+                    wall_args = (dressed.key, dressed.spec, length, wall_height, dressed.base_dir)
+                    if doors:  # entrances on this wall: its façade with doors, its own
+                        meshes = cache.facade_with_doors(*wall_args, doors, variants, pick)
+                        entrances += len(doors) if meshes is not None else 0
+                    elif instanced:
+                        found = cache.facade_parts(*wall_args, variants, pick)
+                        meshes, repeated = found if found is not None else (None, [])
+                    else:
+                        meshes = cache.facade(*wall_args, variants, pick)
+                    if meshes is not None:
+                        break
             if meshes is None:
                 wall = trimesh.creation.box(extents=(length, wall_height, SLAB))
                 wall.apply_translation((length / 2, wall_height / 2, -SLAB / 2))
@@ -360,8 +368,8 @@ def build_building(
                 plain += 1
                 party += party_wall
                 reason = _plain_reason(party_wall, length, min_facade_width)
-                if reason is None:  # the façade did not fit: its height, or its length
-                    fits = cache.fits(chosen.key, chosen.spec, "y", wall_height, variants)
+                if reason is None:  # no façade tried fits: their heights, or their lengths
+                    fits = any(cache.fits(f.key, f.spec, "y", wall_height, variants) for f in tried)
                     reason = "no_layout" if fits else "too_low"
                 reasons[reason] = reasons.get(reason, 0) + 1
                 continue
@@ -370,12 +378,14 @@ def build_building(
             for _, mesh, placed in repeated:  # how far they stand out, on the wall
                 corners = trimesh.bounds.corners(mesh.bounds)
                 out = max(out, *(float((corners @ m[2, :3] + m[2, 3]).max()) for m in placed))
-            proud[a] = (direction, out, _wall_material(chosen.spec))
+            worn = _worn(dressed, chosen)
+            proud[a] = (direction, out, worn(_wall_material(dressed.spec)))
             ends.append((a, b, out))
             for name, mesh in meshes:
                 mesh.apply_transform(placement)
-                parts.setdefault(name, []).append(mesh)
-            for name, mesh, placed in repeated:
+                parts.setdefault(worn(name), []).append(mesh)
+            for own, mesh, placed in repeated:
+                name = worn(own)
                 digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())
                 instances.setdefault(digest, (name, mesh, []))[2].extend(
                     placement @ m for m in placed
@@ -399,12 +409,14 @@ def build_building(
         below = GROUND_NAME if block.base <= 0 else _plain_material(spec)
         parts.setdefault(below, []).append(bottom)
     materials: dict[str, tuple[Material, Path | None]] = {}
+    if fallback is not None:
+        materials.update(_materials(fallback.spec, fallback.base_dir, looks))
     for _, other in walls:  # the building's own spec wins where two name one material
         materials.update(_materials(other.spec, other.base_dir, looks))
     materials.update(_materials(spec, base_dir, looks))
     for name in sorted(parts):
-        fallback = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
-        finished, folder = materials.get(name) or (fallback, None)  # the recesses stay dark
+        builtin = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
+        finished, folder = materials.get(name) or (builtin, None)  # the recesses stay dark
         project = plane_uv if name in ROOFS else metric_uv
         merged = _merged(parts[name], texture_metres(finished), project)
         if finished.library is not None:  # a normal map: normals and tangents with it
@@ -415,8 +427,8 @@ def build_building(
             merged, geom_name=f"{footprint.id}/{name}", node_name=f"{footprint.id}/{name}"
         )
     for number, (name, mesh, placed) in enumerate(instances.values()):
-        fallback = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
-        finished, folder = materials.get(name) or (fallback, None)
+        builtin = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
+        finished, folder = materials.get(name) or (builtin, None)
         metres = texture_metres(finished)
         if metres is None:
             mesh.visual = trimesh.visual.TextureVisuals()
@@ -598,9 +610,11 @@ def facade_axes(
     main: Facade,
     rules: Sequence[tuple[WallRule, Facade]] = (),
     variants: int = 1,
+    fallback: Facade | None = None,
 ) -> set[Slot]:
     """The axes a building's façades need, as cache slots: what a run can solve ahead, in
-    parallel, before the buildings (see :meth:`AxisCache.get`)."""
+    parallel, before the buildings (see :meth:`AxisCache.get`); the ``fallback``'s too,
+    for every wall (which walls take it is known once the others are solved)."""
     needed: set[Slot] = set()
     if roof_only(footprint.properties):
         return needed  # no walls: no façades
@@ -608,9 +622,28 @@ def facade_axes(
         height = rung(_wall_height(block))
         for _, _, length, party, chosen in _walls(block, main, rules):
             if length >= min_facade_width and not party:
-                needed.add((chosen.key, "y", height, variants))
-                needed.add((chosen.key, "x", rung(length), variants))
+                for tried in _tried(chosen, fallback):
+                    needed.add((tried.key, "y", height, variants))
+                    needed.add((tried.key, "x", rung(length), variants))
     return needed
+
+
+def _tried(chosen: Facade, fallback: Facade | None) -> tuple[Facade, ...]:
+    """The façades a wall tries, in turn: its own, then the fallback (if another)."""
+    if fallback is None or fallback.key == chosen.key:
+        return (chosen,)
+    return (chosen, fallback)
+
+
+def _worn(dressed: Facade, chosen: Facade) -> Callable[[str], str]:
+    """The material a mesh of ``dressed`` wears on a wall whose own façade is ``chosen``:
+    its own, but for a fallback's wall material, which becomes the building's (the one
+    its plain walls wear: :func:`_plain_material`), so a shed's wall is the brick or
+    render of the house, tinted as the house is."""
+    if dressed is chosen:
+        return lambda name: name
+    own, building = _wall_material(dressed.spec), _plain_material(chosen.spec)
+    return lambda name: building if name == own else name
 
 
 CORNER_MIN = 0.01  # metres: façades standing out less than this need no corner post

@@ -5,10 +5,14 @@ Every building gets the façade spec given (``--spec``); without one, the shippe
 dress it by its OSM ``building`` tag: apartments get the terraced house, shops and offices
 the shop front, churches, chapels and towers the church, every other building the
 townhouse; a building with a ``shop`` tag keeps its own and gets the shop front on its
-front walls. Each building's walls take one of four tones of its spec's wall colour
-(:func:`tones`), picked by the seed and its id. Roofs are hipped (30°) unless the data
-tags a shape; a building without a height or levels is 9 m tall, 3 m a level; walls
-shorter than 3 m are plain.
+front walls. A wall its façade does not fit (a shed's, a garage's, a bungalow's walls
+are too low for a townhouse; a short wall is too narrow for it) gets the cottage: one
+storey of windows over a plinth under an eaves band, more where the wall is taller, in
+the building's wall material; it fits walls from 1.2 m long and 1.2 m high, and
+shorter (or lower) walls are plain. Each building's walls take one of four tones of its
+spec's wall colour (:func:`tones`), picked by the seed and its id. Roofs are hipped
+(30°) unless the data tags a shape; a building without a height or levels is 9 m tall,
+3 m a level.
 """
 
 from __future__ import annotations
@@ -33,6 +37,8 @@ RULES = (  # building tag -> the example that dresses it, when no --spec is give
     (("retail", "commercial", "office", "supermarket", "kiosk"), "shop-front"),
     (CHURCHES, "church"),
 )
+FALLBACK = "cottage"  # the example for walls the building's own façade does not fit
+MIN_FACADE_WIDTH = 1.2  # metres: the cottage has a layout from here (one window, two piers)
 TONES = (1.0, 0.86, 1.12, 0.94)  # the lightness of a wall colour's four tones, as factors
 
 
@@ -64,8 +70,10 @@ def default_city(footprints: Path, spec: Path | None = None) -> City:
         plan.append(({"man_made": "tower"}, str(example_spec("church")), None))
     else:
         default = str(spec)
+    fallback = str(example_spec(FALLBACK)) if spec is None else None
     specs: dict[str, Spec] = {}
     walls = [wall.facade for _, _, chosen in plan for wall in chosen or []]
+    walls += [fallback] if fallback is not None else []
     for facade in [default, *(facade for _, facade, _ in plan), *walls]:
         if facade not in specs:  # a spec's own errors name its file, line and column
             specs[facade] = load_spec(facade)
@@ -78,7 +86,8 @@ def default_city(footprints: Path, spec: Path | None = None) -> City:
             height=9.0,
             floor_height=3.0,
             roof=Roof(type="hip", pitch=30.0),
-            min_facade_width=3.0,
+            min_facade_width=MIN_FACADE_WIDTH if fallback is not None else 3.0,
+            fallback_facade=fallback,
             palette=tones(wall_colour(specs[default])),
         ),
         rules=[

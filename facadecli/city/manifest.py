@@ -107,6 +107,9 @@ class Defaults(Model):
     floor_height: Annotated[float, Field(gt=0, le=20, allow_inf_nan=False)] = 3.0
     roof: Roof = Roof()
     min_facade_width: Annotated[float, Field(ge=0)] = 2.0
+    # a façade for the walls a building's own does not fit (too low, or too short, for any
+    # layout of it), before they are left plain
+    fallback_facade: str | None = None
     colours: Colours = "tags"
     walls: list[WallRule] = Field(default_factory=list)  # façades for some walls
     variants: Annotated[int, Field(ge=1, le=8)] = 1  # layouts a wall length may take
@@ -285,6 +288,8 @@ def load_city(path: Path) -> City:
             )
         )
     facades: list[tuple[DataPath, str]] = [(("defaults", "facade"), manifest.defaults.facade)]
+    if manifest.defaults.fallback_facade is not None:
+        facades.append((("defaults", "fallback_facade"), manifest.defaults.fallback_facade))
     for index, wall in enumerate(manifest.defaults.walls):
         facades.append((("defaults", "walls", index, "facade"), wall.facade))
     for index, rule in enumerate(manifest.rules):

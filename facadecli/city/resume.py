@@ -45,6 +45,7 @@ UNHASHED = {
     "spec": "the bytes of its file are hashed (spec_key names it)",
     "cache_key": "a worker's cache key: the spec's absolute path and content",
     "walls": "its rules are hashed, and the bytes of their specs",
+    "fallback": "the bytes of its spec are hashed",
     "level": "hashed below 3 only: a run with façades keeps the hashes it had",
 }
 NAMED = ("texture", "mesh")  # a spec's fields that may name a file beside it
@@ -114,6 +115,8 @@ def building_hash(task: Task, spec_digest: Callable[[str], str]) -> str:
     hashed["file"] = task.target.name
     hashed["spec_file"] = spec_digest(task.spec_key)
     hashed["walls"] = [[canonical(rule), spec_digest(rule.facade)] for rule, _ in task.walls]
+    if task.fallback is not None:  # absent before: a run without one keeps its hashes
+        hashed["fallback"] = spec_digest(task.fallback[0])
     if task.level < 3:  # a coarser building's files are another building's
         hashed["level"] = task.level
     text = json.dumps(hashed, sort_keys=True, separators=(",", ":"), allow_nan=True)

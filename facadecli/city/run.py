@@ -131,6 +131,8 @@ class Task:
     instanced: bool = False  # repeated parts as GPU instances (``--instance``)
     level: int = 3  # the finest level of detail the run needs: below 3, no façade is solved
     shared_textures: bool = True  # pictures in the run's textures/, not in each glb
+    # the manifest's fallback façade (its path there, and it): for walls no other fits
+    fallback: tuple[str, Facade] | None = None
 
     @property
     def pictures(self) -> TextureStore | None:
@@ -165,6 +167,7 @@ def _needs(task: Task) -> list[Slot]:
         Facade(task.spec, task.cache_key, task.spec_dir),
         task.walls,
         task.variants,
+        task.fallback[1] if task.fallback is not None else None,
     )
     return sorted(found)
 
@@ -220,6 +223,7 @@ def build(task: Task) -> dict[str, Any]:
             task.pick,
             task.above,
             task.instanced,
+            task.fallback[1] if task.fallback is not None else None,
         )
         solids = BuildingSolids(task.footprint.id, result.volumes, attributes(task, result.top))
         write_cityjson(feature_file(task.target), building_object(solids))
@@ -368,9 +372,14 @@ def plan(
     footprints, warnings = one_door_each(footprints, walls_of)
     ahead.clear()
     shared = Lockstep(lines_of())
+    identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
+
+    def facade_of(path: str) -> Facade:
+        """The façade the manifest names by ``path`` (its identity made first)."""
+        return Facade(city.specs[path], identities[path], (city.folder / path).parent.resolve())
+
     tasks: Packed[Task] = Packed(dict(city.specs))
     owners: dict[str, str] = {}  # file name -> building id
-    identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
     for footprint in footprints:
         choice, heights, roof = shapes[footprint.id]  # a later neighbour's walls need it
         name = safe_name(footprint.id)
@@ -383,22 +392,14 @@ def plan(
                 "change one of the ids",
             )
         properties = footprint.properties
-        for path in (choice.facade, *(rule.facade for rule in choice.walls)):
+        fallback_path = defaults.fallback_facade
+        named = (choice.facade, *(rule.facade for rule in choice.walls))
+        for path in (*named, *([fallback_path] if fallback_path is not None else [])):
             if path not in identities:  # workers outlive a run: tell specs apart
                 content = city.specs[path].model_dump_json().encode("utf-8")
                 digest = hashlib.sha256(content).hexdigest()[:16]
                 identities[path] = f"{(city.folder / path).resolve()}#{digest}"
-        walls = tuple(
-            (
-                rule,
-                Facade(
-                    city.specs[rule.facade],
-                    identities[rule.facade],
-                    (city.folder / rule.facade).parent.resolve(),
-                ),
-            )
-            for rule in choice.walls
-        )
+        walls = tuple((rule, facade_of(rule.facade)) for rule in choice.walls)
         pick = _pick(city.manifest.seed, footprint.id)
         looks = Looks()
         if choice.colours == "tags":
@@ -427,6 +428,7 @@ def plan(
                 instanced,
                 level,
                 shared_textures,
+                None if fallback_path is None else (fallback_path, facade_of(fallback_path)),
             )
         )
     return tasks, warnings
@@ -1010,6 +1012,7 @@ def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, A
     those a worker would have solved itself, so the files are the same."""
     specs = {task.cache_key: task.spec for task in tasks}
     specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
+    specs.update({t.fallback[1].key: t.fallback[1].spec for t in tasks if t.fallback is not None})
     needs = _bounded(lambda batch: submit(_each, _needs, batch), tasks, chunk)
     slots = sorted({slot for need in needs for slot in need})
     jobs = [(specs[slot[0]], slot) for slot in slots]
