@@ -287,6 +287,19 @@ print(json.dumps(held))
 """
 
 
+def _in_fresh_python(script: str, folder: Path) -> Any:
+    """What ``script`` prints last (JSON), run in a fresh Python (as a client starts: no
+    heap or caches left by earlier tests) with the project's root and ``folder``."""
+    run = subprocess.run(
+        [sys.executable, "-c", script, str(ROOT), str(folder)],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    )
+    return json.loads(run.stdout.splitlines()[-1])
+
+
 def test_a_planned_city_holds_its_tasks_packed(tmp_path: Path) -> None:
     """What a client holds through a run once planned grows little with the city: the
     tasks packed (packed.py), the footprints read not kept (tracemalloc's count of
@@ -295,14 +308,7 @@ def test_a_planned_city_holds_its_tasks_packed(tmp_path: Path) -> None:
     test worker, what earlier tests left (a large heap, caches) read as 5.6-6.2 KB a
     building held on some runs. Read back, each task is the one planned, its spec the
     city's own."""
-    run = subprocess.run(
-        [sys.executable, "-c", PLANNED_HELD, str(ROOT), str(tmp_path / "fresh")],
-        capture_output=True,
-        text=True,
-        check=True,
-        cwd=ROOT,
-    )
-    held = json.loads(run.stdout.splitlines()[-1])
+    held = _in_fresh_python(PLANNED_HELD, tmp_path / "fresh")
     per_building = (held[1] - held[0]) / 700
     assert per_building < 600, per_building
     loaded = load_city(write_terraces(tmp_path / "town", ROOT / "specs", 800, 1))
@@ -346,14 +352,7 @@ def test_planning_peaks_at_little_a_building(tmp_path: Path) -> None:
     at once, its choice and roof were objects of its own and its tags' words its own
     strings; 1,304 since. GEOS's memory is not counted: ``make bench-large`` measures the
     resident memory (docs/benchmarks.md)."""
-    run = subprocess.run(
-        [sys.executable, "-c", PLANNING_PEAK, str(ROOT), str(tmp_path / "fresh")],
-        capture_output=True,
-        text=True,
-        check=True,
-        cwd=ROOT,
-    )
-    peaks = json.loads(run.stdout.splitlines()[-1])
+    peaks = _in_fresh_python(PLANNING_PEAK, tmp_path / "fresh")
     slope = (peaks[1] - peaks[0]) / 1400
     assert slope < 1600, slope
 

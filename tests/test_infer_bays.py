@@ -56,6 +56,13 @@ def _columns(rects: list[Rect], label: str = "window") -> list[int]:
     return counts
 
 
+def _top_and_second(boxes):  # type: ignore[no-untyped-def]
+    """The top floor's windows, left to right, and the second floor's window bottom."""
+    windows = sorted((b for b in boxes if b[0] == "window"), key=lambda b: (b[2], b[1]))
+    top = sorted((b for b in windows if abs(b[2] - windows[-1][2]) < 0.02), key=lambda b: b[1])
+    return top, sorted({round(b[2], 2) for b in windows})[1]
+
+
 def _x_words(text: str) -> dict[str, str]:
     spec = parse_spec(text, "spec")
     return {layer.name: str(layer.x) for layer in spec.layers if layer.name != "wall"}
@@ -303,9 +310,7 @@ def test_elements_across_two_bays_stay_over_the_shared_bays(tmp_path: Path) -> N
     column holds a window of every floor (but the door's, once) and the two elements
     are shown."""
     boxes, known = family(6)
-    windows = sorted((b for b in boxes if b[0] == "window"), key=lambda b: (b[2], b[1]))
-    top = sorted((b for b in windows if abs(b[2] - windows[-1][2]) < 0.02), key=lambda b: b[1])
-    second = sorted({round(b[2], 2) for b in windows})[1]
+    top, second = _top_and_second(boxes)
     a, b = top[1], top[2]
     boxes.append(("balcony", a[1] - 0.01, second - 0.03, b[3] + 0.01, second - 0.014))
     c, d = top[5], top[6]
@@ -347,9 +352,7 @@ def test_a_band_within_one_bay_stands_apart_and_the_spec_parses(tmp_path: Path, 
     bay the spec did not parse (its mask named a width the word did not hold), in
     another the bays fell back to per-layer words."""
     boxes, known = family(14)
-    windows = sorted((b for b in boxes if b[0] == "window"), key=lambda b: (b[2], b[1]))
-    top = sorted((b for b in windows if abs(b[2] - windows[-1][2]) < 0.02), key=lambda b: b[1])
-    second = sorted({round(b[2], 2) for b in windows})[1]
+    top, second = _top_and_second(boxes)
     pitch = top[1][1] - top[0][1]
     centre = (top[bay][1] + top[bay][3]) / 2
     boxes.append(
