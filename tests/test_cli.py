@@ -189,6 +189,8 @@ def test_solve_exit_codes(tmp_path: Path) -> None:
     result = facade("solve", str(infeasible), "-o", str(tmp_path / "out"))
     assert result.returncode == 3
     assert "no layout" in result.stderr and "x axis" in result.stderr
+    # proven from the pattern before any search: the reason names the layer and the range
+    assert "layer wall reaches at most 3.60 m, the canvas is 10.00 m" in result.stderr
     assert "Traceback" not in result.stderr
     assert not (tmp_path / "out").exists()  # nothing written for a failed spec
     invalid = CASES / "invalid" / "unknown-symbol.yaml"

@@ -11,7 +11,8 @@ import yaml
 from facadecli import InfeasibleError, load_spec, make_word, parse_spec, retarget, solve
 from facadecli.solver import candidates
 from facadecli.solver.alignment import align, score_alignment
-from facadecli.solver.axis import axis_words
+from facadecli.solver.axis import _check_lengths, axis_words, solve_axis_alternatives
+from facadecli.solver.budgets import safety_clock
 from facadecli.solver.candidates import (
     generate_candidates,
     pattern_uses,
@@ -23,6 +24,7 @@ from facadecli.spec.resolve import layer_pattern
 from tests.solving import letters, solve_text, spans
 
 ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = sorted((ROOT / "specs").glob("*.yaml"))
 
 FIG7 = """
 version: 1
@@ -482,3 +484,36 @@ def test_candidates_are_those_of_patterns_enumerated_on_their_own(
     narrowed = described()
     monkeypatch.setattr(candidates, "_seen_counters", lambda pattern, found: {})
     assert narrowed and narrowed == described()
+
+
+def test_a_canvas_shorter_than_every_word_is_proven_infeasible_at_once() -> None:
+    """The townhouse's wall (``Z G (K U)^f A``, G at least 3.4 m, U 2.7 m, f >= 1) on a
+    1.5 m wall: no word fits, which is proven from the pattern before any search (it
+    spent the whole work budget and ended 'a layout may still exist' before)."""
+    spec = load_spec(ROOT / "specs" / "townhouse.yaml")
+    with pytest.raises(InfeasibleError, match=r"y axis: .*layer wall needs at least 6\.10 m"):
+        solve_axis_alternatives(spec, "y", 1.5, safety_clock() + 3600)
+
+
+def test_a_canvas_longer_than_every_word_is_proven_infeasible_at_once() -> None:
+    text = """
+version: 1
+name: capped
+symbol_defaults: {opaque: true}
+canvas: {width: 9, height: 3}
+symbols: {A: {size: 1, max: 1.5}, B: {size: 1, max: 2}, H: 3}
+counters: {k: {min: 1, max: 2}}
+patterns: {row: "A (B A)^k | B"}
+layers: [{name: wall, x: row, y: H}]
+"""
+    with pytest.raises(InfeasibleError, match=r"x axis: .*layer wall reaches at most 8\.50 m"):
+        solve(parse_spec(text))
+    assert solve(retarget(parse_spec(text), 8.5, 3.0)).width == 8.5  # the longest word fits
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_the_length_bounds_admit_every_example(path: Path) -> None:
+    """Every example solves at its canvas (the golden tests), so the bounds must admit it."""
+    spec = load_spec(path)
+    for axis, canvas in (("x", spec.canvas.width), ("y", spec.canvas.height)):
+        _check_lengths(spec, axis, canvas)  # raises if it were rejected

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+from unittest import mock
+
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from facadecli import InfeasibleError, parse_spec, solve
 from facadecli.errors import SearchLimitError
 from facadecli.export.report import report
+from facadecli.solver import axis as axis_module
+from facadecli.solver.budgets import safety_clock
 from tests.layout_checker import violations
 
 X_PATTERNS = [
@@ -24,7 +28,8 @@ Y_PATTERNS = ['"P Q"', '"P Q^n"', '{control: "g f", where: {g: "P"}}']
 
 
 @st.composite
-def specs(draw: st.DrawFn) -> str:
+def specs(draw: st.DrawFn, bounded: bool = False) -> str:
+    """A random small spec; ``bounded``: its symbols have hard ``min``/``max`` too."""
     sizes = {s: draw(st.integers(4, 25)) / 10 for s in "ABCDPQ"}
     lines = [
         "version: 1",
@@ -41,6 +46,9 @@ def specs(draw: st.DrawFn) -> str:
             "unoccludable": draw(st.booleans()) and draw(st.booleans()),
         }
         flags = ", ".join(f"{k}: {str(v).lower()}" for k, v in qualifiers.items())
+        if bounded:
+            low, high = draw(st.integers(50, 100)) / 100, draw(st.integers(100, 150)) / 100
+            flags += f", min: {round(size * low, 3)}, max: {round(size * high, 3)}"
         lines.append(f"  {name}: {{size: {size}, {flags}}}")
     count = draw(st.integers(1, 3))
     lines.append("patterns:")
@@ -118,3 +126,32 @@ def test_every_solved_layout_meets_the_rules(text: str) -> None:
     except (InfeasibleError, SearchLimitError):
         return
     assert violations(spec, report(layout)) == [], text
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(specs(bounded=True))
+def test_the_length_bounds_reject_no_spec_that_has_a_layout(text: str) -> None:
+    """The check before the search (a layer's words all shorter or all longer than the
+    canvas) is a proof: on every spec it rejects, the search without it finds nothing."""
+    spec = parse_spec(text)
+    rejected = []
+    for axis, canvas in (("x", spec.canvas.width), ("y", spec.canvas.height)):
+        try:
+            axis_module._check_lengths(spec, axis, canvas)
+        except InfeasibleError:
+            rejected.append(axis)
+    if not rejected:
+        return
+    with mock.patch.object(axis_module, "_check_lengths", lambda *_: None):
+        for axis in rejected:
+            canvas = spec.canvas.width if axis == "x" else spec.canvas.height
+            try:
+                found = axis_module.solve_axis_alternatives(
+                    spec,
+                    axis,
+                    canvas,
+                    safety_clock() + 120,  # type: ignore[arg-type]
+                )
+            except (InfeasibleError, SearchLimitError):
+                continue
+            assert not found, text

@@ -21,6 +21,7 @@ from facadecli.patterns.words import (
     compile_pattern,
     enumerate_words,
     format_word,
+    length_range,
     make_word,
     mirror,
 )
@@ -44,6 +45,7 @@ __all__ = [
     "compile_pattern",
     "enumerate_words",
     "format_word",
+    "length_range",
     "make_word",
     "mirror",
     "parse_pattern",

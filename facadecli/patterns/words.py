@@ -413,6 +413,53 @@ def _missing_decisions(expander: _Expander, env: Mapping[str, int]) -> set[str]:
     return missing
 
 
+def length_range(
+    pattern: CompiledPattern,
+    *,
+    least: Mapping[str, float | None],
+    most: Mapping[str, float | None],
+    counters: Mapping[str, tuple[int, int | None]],
+) -> tuple[float, float]:
+    """The least and greatest length of any word of ``pattern``: each letter between its
+    ``least`` and ``most`` size (None: 0 and unbounded), each counter within its bounds
+    (an anonymous one unbounded), each alternation at its shortest / longest branch; a
+    placeholder's content is followed. A relaxation: counters shared with other patterns,
+    and one branch for all repetitions, are not enforced, so every word lies in the range
+    (the greatest may be infinite)."""
+    expander = _Expander(pattern, least, frozenset(), counters, float("inf"), 1 << 62)
+    low = expander.minimum(pattern.root, "", {})[0]
+    return low, _longest(pattern, pattern.root, "", most, counters)
+
+
+def _longest(
+    pattern: CompiledPattern,
+    node: Node,
+    scope: str,
+    most: Mapping[str, float | None],
+    counters: Mapping[str, tuple[int, int | None]],
+) -> float:
+    if isinstance(node, Sym):
+        if not scope and node.name in pattern.contents:
+            return _longest(pattern, pattern.contents[node.name], node.name, most, counters)
+        size = most.get(node.name)
+        return float("inf") if size is None else size
+    if isinstance(node, Seq):
+        return sum((_longest(pattern, item, scope, most, counters) for item in node.items), 0.0)
+    if isinstance(node, Alt):
+        return max(_longest(pattern, branch, scope, most, counters) for branch in node.branches)
+    count = node.count
+    times: float
+    if isinstance(count, Fixed):
+        times = abs(count.value)
+    elif isinstance(count, Named):
+        high = counters.get(count.name, (0, None))[1]
+        times = float("inf") if high is None else high
+    else:
+        times = float("inf")
+    body = _longest(pattern, node.body, scope, most, counters)
+    return 0.0 if times == 0 or body == 0 else times * body
+
+
 def enumerate_words(
     pattern: CompiledPattern,
     *,

@@ -9,7 +9,14 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from facadecli.errors import InfeasibleError, SearchLimitError
-from facadecli.patterns import CompiledPattern, Enumerated, Letter, Word, format_word
+from facadecli.patterns import (
+    CompiledPattern,
+    Enumerated,
+    Letter,
+    Word,
+    format_word,
+    length_range,
+)
 from facadecli.solver import columns, construct, exact, sizing
 from facadecli.solver.alignment import (
     INF,
@@ -296,12 +303,43 @@ def solve_axis_alternatives(
 
     Raises :class:`InfeasibleError` when no layout exists (proven), and
     :class:`SearchLimitError` when the search stopped before it found one."""
+    _check_lengths(spec, axis, canvas)
     problem = _AxisProblem(spec, axis, canvas, deadline, alternatives)
     if alternatives > 1:  # variations: layouts near the best, as the heuristic meets them
         problem.heuristic_pass()
     problem.construct()
     problem.search()
     return problem.layouts()
+
+
+def _check_lengths(spec: Spec, axis: Axis, canvas: float) -> None:
+    """Raise :class:`InfeasibleError` at once when some layer's words cannot fit the canvas
+    whatever the search does: the shortest (every letter at its hard ``min``, 0 without one)
+    is longer, or the longest (hard ``max``; unbounded without one, for a placeholder or an
+    unbounded counter) is shorter while no layer in front could have it make room (SPEC 2.4;
+    a layer behind another may leave parts of the canvas empty). A relaxation of the whole
+    problem, so it never rejects a spec that has a layout."""
+    least = {name: symbol.min for name, symbol in spec.symbols.items()}
+    most = {name: symbol.max for name, symbol in spec.symbols.items()}
+    counters = {name: counter.bounds for name, counter in spec.counters.items()}
+    slack = spec.solver.tolerance + 1e-9 * max(1.0, canvas)
+    words = axis_words(spec, axis)
+    front = max((layer for layer, _, _, _ in words), default=-1)
+    for layer, _, _, pattern in words:
+        low, high = length_range(pattern, least=least, most=most, counters=counters)
+        name = spec.layers[layer].name
+        if low > canvas + slack:
+            raise InfeasibleError(
+                f"{axis} axis: no layout exists: layer {name} needs at least {low:.2f} m, "
+                f"the canvas is {canvas:.2f} m: make the canvas larger, or the symbols' min "
+                "or the counters' min smaller"
+            )
+        if layer == front and high < canvas - slack:
+            raise InfeasibleError(
+                f"{axis} axis: no layout exists: layer {name} reaches at most {high:.2f} m, "
+                f"the canvas is {canvas:.2f} m: make the canvas smaller, or the symbols' max "
+                "or the counters' max larger"
+            )
 
 
 class _AxisProblem:
