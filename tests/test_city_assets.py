@@ -96,7 +96,7 @@ def test_each_picture_is_stored_once_for_the_run_and_named_by_every_building(
 def test_a_building_naming_the_runs_pictures_passes_the_khronos_validator(city: Path) -> None:
     assert (VALIDATOR / "gltf-validator").exists(), "run 'make test' to install the validator"
     glb = sorted((city / "buildings").glob("*/*.glb"))[0]
-    _validates(glb)
+    validates(glb)
 
 
 def test_merging_the_same_buildings_twice_gives_the_same_bytes(city: Path, tmp_path: Path) -> None:
@@ -113,7 +113,7 @@ def test_merging_the_same_buildings_twice_gives_the_same_bytes(city: Path, tmp_p
 def test_the_merged_city_passes_the_khronos_validator(city: Path) -> None:
     assert (VALIDATOR / "gltf-validator").exists(), "run 'make test' to install the validator"
     glb = city / "demo-district.glb"
-    _validates(glb)
+    validates(glb)
 
 
 def test_a_welded_mesh_keeps_its_triangles_and_stores_each_vertex_once() -> None:
@@ -241,7 +241,7 @@ def test_the_seed_varies_the_walls_and_the_same_seed_gives_the_same_bytes(
     assert walls[2] != walls[0] or walls[3] != walls[0]  # another seed: other tones somewhere
 
 
-def _validates(glb: Path) -> None:
+def validates(glb: Path) -> None:
     """The Khronos validator finds no error and no warning in ``glb``."""
     result = subprocess.run(
         ["node", str(ROOT / "tests" / "gltf_validate.js"), str(VALIDATOR), str(glb)],
