@@ -9,6 +9,13 @@ cornice across the façade over some floors, one door in a ground-floor bay (uni
 on some façades, mirrored halves (the left half drawn, then mirrored, then each edge
 jittered on its own). Every edge is then moved by a drawing jitter of a few thousandths
 of the façade. ``known(seed)`` says what is there: windows, bays, floors.
+
+With ``defects``, the façade also has what real façades (CMP's) have and a clean grid
+has not: end bays wider than the others (15-35% more wall), and in about a quarter of
+the bays (not the door's) one floor whose window is missing (with its sill and blind)
+or drawn ``ODD`` wider or narrower (its sill with it). The defects are drawn from a
+generator of their own, after the façade's, so a seed without them is the same
+annotation as ever.
 """
 
 from __future__ import annotations
@@ -18,6 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 Box = tuple[str, float, float, float, float]  # label, x0, y0, x1, y1 on the unit square, y up
+ODD = (0.1, 0.3)  # the least and most share an odd window is wider or narrower by
+DEFECTIVE = 0.25  # the share of bays (not the door's) with a missing or odd window
 
 
 @dataclass(frozen=True)
@@ -28,10 +37,13 @@ class Known:
     doors: int
     mirrored: bool
     blinds: bool
+    missing: int = 0  # windows left out (defects)
+    odd: int = 0  # windows drawn wider or narrower than their floor's (defects)
 
 
-def family(seed: int) -> tuple[list[Box], Known]:
-    """The annotation of seed ``seed`` (background first, then by label) and its structure."""
+def family(seed: int, defects: bool = False) -> tuple[list[Box], Known]:
+    """The annotation of seed ``seed`` (background first, then by label) and its structure;
+    ``defects``: with wider end bays and missing or odd windows (see the module)."""
     rng = random.Random(seed)
     bays, floors = rng.randint(3, 9), rng.randint(2, 7)
     mirrored, blinds = rng.random() < 0.5, rng.random() < 0.5
@@ -47,6 +59,19 @@ def family(seed: int) -> tuple[list[Box], Known]:
         return margin + (k + 0.5) * pitch_x + rng.uniform(-0.1, 0.1) * pitch_x * 0.1
 
     centres = [bay_x(k) for k in range(bays)]
+    flaws = random.Random(f"defects-{seed}")  # its own generator: the façade's draws stay
+    odd: dict[tuple[int, int], float] = {}  # (bay, floor): the window's width, as a share
+    if defects:
+        more = flaws.uniform(0.15, 0.35)
+        centres, inner = _wider_ends(centres, margin, pitch_x, more)
+        beside = 0.3 * width if blinds else 0.0  # a blind's reach beyond its window
+        widest = 2 * (0.9 * inner - width / 2 - beside) / width  # clear of the next bay's
+        for k in range(bays):
+            if k != door_bay and flaws.random() < DEFECTIVE:
+                scale = 1 + flaws.choice((-1, 1)) * flaws.uniform(*ODD)
+                if scale > widest:
+                    scale = 2 - scale  # as much narrower: wider would reach the next bay
+                odd[k, flaws.randrange(floors)] = 0.0 if flaws.random() < 0.5 else scale
     if mirrored:  # the left half drawn, mirrored
         half = [centres[k] for k in range(bays // 2)]
         middle = [0.5] if bays % 2 else []
@@ -60,10 +85,15 @@ def family(seed: int) -> tuple[list[Box], Known]:
                 w = width * 1.2
                 doors.append(("door", c - w / 2, 0.0, c + w / 2, base + height))
                 continue
-            windows.append(("window", c - width / 2, base, c + width / 2, base + height))
-            sills.append(("sill", c - width * 0.55, base - 0.012, c + width * 0.55, base))
+            scale = odd.get((k, f), 1.0)
+            if not scale:
+                continue  # a window missing (defects)
+            w = width * scale
+            windows.append(("window", c - w / 2, base, c + w / 2, base + height))
+            sills.append(("sill", c - w * 0.55, base - 0.012, c + w * 0.55, base))
             if blinds:
-                side.append(("blind", c + width / 2 - 0.01, base, c + width * 0.8, base + height))
+                reach = c + width * 0.8 if scale == 1.0 else c + w / 2 + width * 0.3
+                side.append(("blind", c + w / 2 - 0.01, base, reach, base + height))
         if f and rng.random() < 0.4:
             top = base + height + 0.15 * pitch_y
             cornices.append(("cornice", margin / 2, top, 1 - margin / 2, top + 0.012))
@@ -74,8 +104,27 @@ def family(seed: int) -> tuple[list[Box], Known]:
         return (label, x0, y0, x1, y1)
 
     boxes += [drawn(b) for b in (*windows, *cornices, *doors, *sills, *side)]
-    known = Known(bays, floors, len(windows), len(doors), mirrored, blinds)
+    missing = sum(1 for scale in odd.values() if not scale)
+    known = Known(
+        bays, floors, len(windows), len(doors), mirrored, blinds, missing, len(odd) - missing
+    )
     return boxes, known
+
+
+def _wider_ends(
+    centres: list[float], margin: float, pitch: float, more: float
+) -> tuple[list[float], float]:
+    """The bays' centres (each with its jitter) with the two end bays ``more`` wider than
+    the inner ones, the bays as wide in all, each end window in the middle of its bay;
+    and the inner bays' pitch."""
+    count = len(centres)
+    inner = pitch * count / (count + 2 * more)
+    pitches = [inner * (1 + more), *[inner] * (count - 2), inner * (1 + more)]
+    out, edge = [], margin
+    for k, step in enumerate(pitches):
+        out.append(edge + step / 2 + (centres[k] - margin - (k + 0.5) * pitch))
+        edge += step
+    return out, inner
 
 
 def cmp_xml(boxes: list[Box]) -> str:
@@ -88,11 +137,12 @@ def cmp_xml(boxes: list[Box]) -> str:
     )
 
 
-def written_family(folder: Path, seeds: list[int]) -> list[Path]:
-    """The annotations of ``seeds`` as CMP XML files in ``folder`` (``family-<seed>.xml``)."""
+def written_family(folder: Path, seeds: list[int], defects: bool = False) -> list[Path]:
+    """The annotations of ``seeds`` as CMP XML files in ``folder`` (``family-<seed>.xml``;
+    ``defects``: ``family``'s)."""
     paths = []
     for seed in seeds:
         path = folder / f"family-{seed}.xml"
-        path.write_text(cmp_xml(family(seed)[0]))
+        path.write_text(cmp_xml(family(seed, defects)[0]))
         paths.append(path)
     return paths

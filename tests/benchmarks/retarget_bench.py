@@ -3,7 +3,8 @@
 On the CMP sample annotations beside the project (``../shared/data/cmp-sample/xml``; never
 copied into it; skipped, saying so, when absent) and on the generated family
 (``annotated_family``, seeds 1-24), each inferred at 15 x 15 m and its spec solved at 1x,
-0.7x, 1.5x and 2x the width and 1.5x the height. Per size, over the façades:
+0.7x, 1.5x and 2x the width and 1.5x the height (``--defects``: the family with the
+defects real façades have). Per size, over the façades:
 
 - ``solve``: façades whose spec solves there (exit 0 of ``facade solve``);
 - ``size``: façades with 90% or more of their windows within +-15% (width and height) of a
@@ -232,7 +233,8 @@ def run(paths: list[Path], title: str, verbose: bool) -> None:
 def main() -> None:
     """``-v``: the façades that miss, per size; ``--seeds A-B``: the family's seeds (1-24;
     101-124 is the hold-out, never tuned on); ``--family``: the family alone, not CMP;
-    ``--cmp``: CMP alone."""
+    ``--cmp``: CMP alone; ``--defects``: the family with its defects (wider end bays,
+    missing and odd windows: ``annotated_family``)."""
     verbose = "-v" in sys.argv
     seeds = SEEDS
     if "--seeds" in sys.argv:
@@ -248,8 +250,10 @@ def main() -> None:
     if "--cmp" in sys.argv:
         return
     with tempfile.TemporaryDirectory() as folder:
-        paths = written_family(Path(folder), seeds)
-        run(paths, f"generated family (seeds {seeds[0]}-{seeds[-1]})", verbose)
+        defects = "--defects" in sys.argv
+        paths = written_family(Path(folder), seeds, defects)
+        title = f"generated family{' with defects' if defects else ''}"
+        run(paths, f"{title} (seeds {seeds[0]}-{seeds[-1]})", verbose)
 
 
 if __name__ == "__main__":
