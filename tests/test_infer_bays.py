@@ -368,3 +368,35 @@ def test_a_band_within_one_bay_stands_apart_and_the_spec_parses(tmp_path: Path, 
     assert any(g.label == "balcony" and g.apart for g in inference.grids), names
     rects = _solved(inference, spec, 1.5)
     assert "balcony" in {r.label for r in rects}
+
+
+@pytest.mark.parametrize("seed", [6, 9, 10])
+def test_a_facade_with_defects_shares_its_bays_and_keeps_its_columns_wider(
+    tmp_path: Path, seed: int
+) -> None:
+    """The family with CMP's defects (``family(defects=True)``: end bays wider than the
+    rest, a window missing or drawn wider or narrower in some bays): the bays are read
+    about their openings (an end bay's wider wall does not make its neighbour unlike),
+    a bay differing in one opening is a variant of its kind on the kind's shape, so the
+    bays are shared, and at 1.5x the width the façade gains whole columns of windows
+    (each holding as many as a column of the input), the windows keep their size and
+    the door is not repeated. Before, seeds 9 and 10 kept per-layer words (no two of
+    their bays alike); seed 6 (a bay without one window) shared them as it does now."""
+    path = tmp_path / f"family-{seed}.xml"
+    path.write_text(cmp_xml(family(seed, defects=True)[0]))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    spec = parse_spec(inference.text, path.stem)
+    assert not inference.unshared, inference.bays
+    raw = list((inference.raw or inference.layout).rects)
+    drawn = _columns(raw)
+    widths = [r.x1 - r.x0 for r in raw if r.label == "window"]
+    rects = _solved(inference, spec, 1.5)
+    columns = _columns(rects)
+    assert set(columns) <= set(drawn), (columns, drawn)
+    assert len(columns) > len(drawn)
+    assert sum(r.label == "door" for r in rects) == 1
+    assert all(
+        any(abs((r.x1 - r.x0) / w - 1) <= 0.15 for w in widths)
+        for r in rects
+        if r.label == "window"
+    )

@@ -72,9 +72,11 @@ ASIDE = 0.1  # of the openings: these may lack a mirror image on a façade mirro
 UNIQUE = ("door",)  # labels whose bays are never repeated
 CUTS = ("window", "door")  # the openings the bays are cut on
 HELD = SHARE / 2  # of the narrowest span an edge bounds: the most a kind's shape moves it
+ODD = 1  # openings: a bay this many unlike a kind's (each way) is a variant of it
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
 Slot = tuple[str, float, float, float, float]  # label, centre x in the bay, width, y0, y1
+Ties = dict[int, tuple[int, list[int | None]]]  # variant kind: its base, each slot's in it
 
 
 @dataclass(frozen=True)
@@ -111,35 +113,105 @@ class Bays:
         return f"{len(self.spans)} bays of {len(self.widths)} kinds ({letters})"
 
 
+@dataclass(frozen=True)
+class Frames:
+    """How two bays' elements are compared: each read in the other's frame. ``mids``:
+    the middle of each bay's openings in its frame, which bays alike share (read
+    mirrored: about it), so a bay's own walls (where the cut between two bays fell, a
+    wider wall beside an end bay) do not make it unlike; None: as cut, each read from its
+    left edge (mirrored: about its middle). ``measures``: each bay's width as compared."""
+
+    spans: list[Span]
+    mids: list[float] | None
+    measures: list[float]
+
+    def tolerance(self, k: int, ref: int) -> float | None:
+        """How near bays ``k`` and ``ref``'s elements must be to be alike (``ALIKE`` of
+        the wider), or None when the two are not as wide."""
+        tolerance = ALIKE * max(self.measures[k], self.measures[ref])
+        return tolerance if abs(self.measures[k] - self.measures[ref]) <= tolerance else None
+
+    def read(self, slots: list[Slot], k: int, ref: int, flip: bool) -> list[Slot]:
+        """Bay ``k``'s slots in bay ``ref``'s frame, mirrored if ``flip``."""
+        if self.mids is None:
+            width = self.spans[k][1] - self.spans[k][0]
+            return [_flip(s, width) for s in slots] if flip else slots
+        shift = self.mids[ref] - self.mids[k]
+        if flip:
+            return [
+                (lb, self.mids[ref] + self.mids[k] - c, w, y0, y1) for lb, c, w, y0, y1 in slots
+            ]
+        return [(lb, c + shift, w, y0, y1) for lb, c, w, y0, y1 in slots]
+
+
+def _frames(
+    rects: tuple[Rect, ...],
+    strips: list[tuple[Span, list[int]]],
+    spans: list[Span],
+    on_openings: bool,
+) -> Frames:
+    """The bays' frames (``Frames``): ``on_openings``, each bay read about its openings'
+    middle (those not of a unique label where it has others: a door wider than the
+    windows over it) and measured by the nearer of its pitches to the next bays' (an
+    end bay: as cut); else as cut."""
+    widths = [b - a for a, b in spans]
+    if not on_openings:
+        return Frames(spans, None, widths)
+    middles = []
+    for _, held in strips:
+        shown = [rects[k] for k in held if _cuts(rects[k])]
+        common = [r for r in shown if r.label not in UNIQUE] or shown
+        middles.append((min(r.x0 for r in common) + max(r.x1 for r in common)) / 2)
+    pitches = [b - a for a, b in pairwise(middles)]
+    measures = [
+        widths[k] if k in (0, len(spans) - 1) else min(pitches[k - 1], pitches[k])
+        for k in range(len(spans))
+    ]
+    return Frames(spans, [m - a for m, (a, _) in zip(middles, spans, strict=True)], measures)
+
+
 def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Bays | str:
     """The façade's bays (see the module), or why it has none to write; ``drawn``: the
     layout as drawn, its rectangles in the same order (None: ``layout``), which the
-    elements but the openings stay near (``_apart``)."""
+    elements but the openings stay near (``_apart``). The bays are compared about their
+    openings first (``Frames``), which must then leave every opening within the
+    structure's limits of where it was drawn; else as cut."""
+    found = _found(layout, drawn, True)
+    return found if isinstance(found, Bays) else _found(layout, drawn, False)
+
+
+def _found(layout: LabelledLayout, drawn: LabelledLayout | None, on_openings: bool) -> Bays | str:
+    """``find_bays`` with the bays' frames on their openings or as cut (``_frames``)."""
     width = layout.width
     strips, spans, over = _strips(layout)
     if len(strips) < 2:
         return FEW_BAYS
+    frames = _frames(layout.rects, strips, spans, on_openings)
     order = _right_half_mirrored_first(len(strips))
-    unlike = _unlike(layout, [held for _, held in strips], spans, order)
+    unlike = _unlike(layout, [held for _, held in strips], frames, order)
     over |= unlike
     strips = [(span, [k for k in held if k not in unlike]) for span, held in strips]
     slots = [
         _slots([layout.rects[k] for k in held], span)
         for (_, held), span in zip(strips, spans, strict=True)
     ]
-    kinds, mirrored, matches = _kinds(slots, spans, order)
-    shapes = _shapes(slots, kinds, mirrored, matches, spans)
+    kinds, mirrored, matches = _kinds(slots, frames, order)
+    ties = _variants(slots, frames, kinds, mirrored, order)
+    cut = _frames(layout.rects, strips, spans, False)  # the shapes' first guess: as cut
+    shapes = _tied(_shapes(slots, kinds, mirrored, matches, cut), ties)
     widths = tuple(
-        statistics.median(b - a for (a, b), k in zip(spans, kinds, strict=True) if k == kind)
+        statistics.median(
+            b - a for (a, b), k in zip(spans, kinds, strict=True) if k == ties.get(kind, (kind,))[0]
+        )
         for kind in range(len(shapes))
     )
     centred = _about_middle(list(layout.rects), width)
     fitted = _fitted(
-        slots, spans, kinds, mirrored, matches, shapes, widths, width if centred else 0
+        slots, spans, kinds, mirrored, matches, shapes, widths, width if centred else 0, ties
     )
     if centred and not _framed(fitted[2], fitted[1]):
         centred = False  # centred, a bay's elements would leave its frame: as drawn
-        fitted = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths, 0)
+        fitted = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths, 0, ties)
     start, widths, shapes = fitted
     symmetric = _palindrome(kinds, mirrored)
     left, right = spans[0][0], width - spans[-1][1]
@@ -152,6 +224,7 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
     if start <= 0 or end <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
+    unique |= set(ties)  # a variant is written once, as drawn
     runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
     if symmetric and not any(r.counter and r.most is None for r in runs):
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
@@ -170,6 +243,8 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
     apart = _apart(drawn, placed, members, kinds, matches) | over
     for index in apart:
         placed[index] = layout.rects[index]
+    if on_openings and _moved(layout, placed):
+        return "its bays put on their kinds' shapes would move openings from where drawn"
     if _new_overlaps(layout.rects, placed):
         return "its bays put on their kinds' shapes would overlap elements"
     return Bays(
@@ -272,7 +347,7 @@ def _strips(
 def _unlike(
     layout: LabelledLayout,
     members: list[list[int]],
-    spans: list[Span],
+    frames: Frames,
     mirrored_first: list[bool],
 ) -> set[int]:
     """The elements of the bays but the openings that not every bay of their kind shows
@@ -282,29 +357,27 @@ def _unlike(
     the rest stays where the structure put it, in a layer of its own, and the bays of
     a kind remain one kind."""
     rects = layout.rects
+    spans = frames.spans
     openings = [
         _slots([rects[j] for j in held if _cuts(rects[j])], span)
         for held, span in zip(members, spans, strict=True)
     ]
-    kinds, mirrored, _ = _kinds(openings, spans, mirrored_first)
+    kinds, mirrored, _ = _kinds(openings, frames, mirrored_first)
     unlike: set[int] = set()
     for kind in set(kinds):
         bays = [k for k, mine in enumerate(kinds) if mine == kind]
-        tolerance = ALIKE * statistics.median(spans[k][1] - spans[k][0] for k in bays)
+        tolerance = ALIKE * statistics.median(frames.measures[k] for k in bays)
 
-        def others(k: int, flip: bool) -> list[tuple[int, Slot]]:
+        def others(k: int, flip: bool, first: int = bays[0]) -> list[tuple[int, Slot]]:
             held = [j for j in members[k] if not _cuts(rects[j])]
-            mine = _slots([rects[j] for j in held], spans[k])
-            if flip:
-                mine = [_flip(s, spans[k][1] - spans[k][0]) for s in mine]
+            mine = frames.read(_slots([rects[j] for j in held], spans[k]), k, first, flip)
             return list(zip(held, mine, strict=True))
 
         first = others(bays[0], False)
         seen = [first]
         for k in bays[1:]:
-            width = spans[k][1] - spans[k][0]
             ways = [mirrored[k]]
-            turned = [_flip(s, width) for s in openings[k]] if not mirrored[k] else openings[k]
+            turned = frames.read(openings[k], k, bays[0], not mirrored[k])
             if _match(openings[bays[0]], turned, tolerance) is not None:
                 ways.append(not mirrored[k])  # alike read either way: the way more are
             seen.append(
@@ -397,23 +470,23 @@ def _match(a: list[Slot], b: list[Slot], tolerance: float) -> list[int] | None:
 
 
 def _kinds(
-    slots: list[list[Slot]], spans: list[Span], mirrored_first: list[bool]
+    slots: list[list[Slot]], frames: Frames, mirrored_first: list[bool]
 ) -> tuple[list[int], list[bool], list[list[int]]]:
     """Each bay's kind (the first bay alike, as drawn or mirrored, else a kind of its
     own), whether it is its kind's first bay mirrored, and which of its slots is each of
     the first bay's."""
     reps: list[int] = []
     kinds, mirrored, matches = [], [], []
-    for k, (mine, (a, b)) in enumerate(zip(slots, spans, strict=True)):
-        width = b - a
-        flipped = [_flip(s, width) for s in mine]
+    for k, mine in enumerate(slots):
         found = None
         for kind, rep in enumerate(reps):
-            rep_width = spans[rep][1] - spans[rep][0]
-            tolerance = ALIKE * max(width, rep_width)
-            if abs(width - rep_width) > tolerance:
+            tolerance = frames.tolerance(k, rep)
+            if tolerance is None:
                 continue
-            tries = [(True, flipped), (False, mine)]
+            tries = [
+                (True, frames.read(mine, k, rep, True)),
+                (False, frames.read(mine, k, rep, False)),
+            ]
             for flip, candidate in tries if mirrored_first[k] else tries[::-1]:
                 match = _match(slots[rep], candidate, tolerance)
                 if match is not None:
@@ -430,12 +503,82 @@ def _kinds(
     return kinds, mirrored, matches
 
 
+def _variants(
+    slots: list[list[Slot]],
+    frames: Frames,
+    kinds: list[int],
+    mirrored: list[bool],
+    mirrored_first: list[bool],
+) -> Ties:
+    """The bays of a kind of their own that are a *variant* of a kind of several bays:
+    as wide (``ALIKE``), their openings alike but at most ``ODD`` each way (a window
+    missing on a floor, or one wider or narrower than the kind's), at least one alike.
+    Such a bay stays a kind of its own (written once, never repeated), but stands on
+    its base kind's shape: its width and the elements it shares with the base are the
+    base's symbols (``_fitted``), so it keeps the base's columns wherever the bays go,
+    and its odd elements keep their place in it as drawn. ``mirrored`` is set for a
+    variant read mirrored against its base; a door's bay is no variant. Returns, per
+    variant kind, its base and each of its slots' slot in the base (None: its own)."""
+    counts = Counter(kinds)
+    reps = {kind: kinds.index(kind) for kind in counts}
+    ties: Ties = {}
+    for k, kind in enumerate(kinds):
+        if counts[kind] > 1 or any(s[0] in UNIQUE for s in slots[k]):
+            continue
+        best: tuple[int, int, bool, list[int | None]] | None = None  # alike, base, flip, tie
+        for base, rep in reps.items():
+            if counts[base] < 2 or base in ties:
+                continue
+            tolerance = frames.tolerance(k, rep)
+            if tolerance is None:
+                continue
+            for flip in (True, False) if mirrored_first[k] else (False, True):
+                read = frames.read(slots[k], k, rep, flip)
+                tie = _partial_match(slots[rep], read, tolerance)
+                if tie is None:
+                    continue
+                alike = sum(m is not None for m in tie)
+                if best is None or alike > best[0]:
+                    best = (alike, base, flip, tie)
+        if best is not None:
+            ties[kind] = (best[1], best[3])
+            mirrored[k] = best[2]
+    return ties
+
+
+def _partial_match(base: list[Slot], mine: list[Slot], tolerance: float) -> list[int | None] | None:
+    """For each of ``mine``, the slot of ``base`` it is alike (``_alike``; None: none),
+    or None when more than ``ODD`` openings of either are unlike or none is alike."""
+    free = set(range(len(base)))
+    tie: list[int | None] = []
+    for slot in mine:
+        found = next((j for j in sorted(free) if _alike(base[j], slot, tolerance)), None)
+        if found is not None:
+            free.discard(found)
+        tie.append(found)
+    odd_mine = sum(m is None and s[0] in CUTS for m, s in zip(tie, mine, strict=True))
+    odd_base = sum(base[j][0] in CUTS for j in free)
+    alike = sum(m is not None and s[0] in CUTS for m, s in zip(tie, mine, strict=True))
+    return tie if alike and odd_mine <= ODD and odd_base <= ODD else None
+
+
+def _tied(shapes: list[list[Slot]], ties: Ties) -> list[list[Slot]]:
+    """The shapes with each variant's elements it shares with its base as the base's
+    (label, place, size and rows)."""
+    out = [list(shape) for shape in shapes]
+    for kind, (base, tie) in ties.items():
+        for n, m in enumerate(tie):
+            if m is not None:
+                out[kind][n] = shapes[base][m]
+    return out
+
+
 def _shapes(
     slots: list[list[Slot]],
     kinds: list[int],
     mirrored: list[bool],
     matches: list[list[int]],
-    spans: list[Span],
+    frames: Frames,
 ) -> list[list[Slot]]:
     """Each kind's shape: per slot of its first bay, the median over its bays (read in
     the first bay's frame; its width, bottom and height those the label's elements
@@ -455,10 +598,9 @@ def _shapes(
         for n, slot in enumerate(first):
             seen = []
             for k in bays:
-                width = spans[k][1] - spans[k][0]
-                own = [_flip(s, width) for s in slots[k]] if mirrored[k] else slots[k]
+                own = frames.read(slots[k], k, bays[0], mirrored[k])
                 seen.append(own[matches[k][n]])
-            tolerance = ALIKE * statistics.median(spans[k][1] - spans[k][0] for k in bays)
+            tolerance = ALIKE * statistics.median(frames.measures[k] for k in bays)
             values = [statistics.median(_sized(s)[i] for s in seen) for i in range(4)]
             for i in (1, 2, 3):  # sizes and rows as the façade's elements share them
                 values[i] = _common(pool[slot[0], i], values[i], tolerance)
@@ -484,6 +626,7 @@ def _fitted(
     shapes: list[list[Slot]],
     widths: tuple[float, ...],
     centred: float,
+    ties: Ties,
 ) -> tuple[float, tuple[float, ...], list[list[Slot]]]:
     """Where the bays side by side best meet the elements as drawn: the start of the
     first bay, each kind's width and each of its elements' centres in it that put the
@@ -492,10 +635,17 @@ def _fitted(
     widths and centres as they are (``widths``, ``shapes``) where the elements say
     nothing of them (weighed ``SETTLE``). With ``centred`` (a façade's width; 0: not),
     the bays side by side stand in its middle (weighed ``CENTRED``). Rounded to
-    ``DIGITS``; elements standing in one column (``_columns``) stay so."""
+    ``DIGITS``; elements standing in one column (``_columns``) stay so. A variant's
+    width and its elements it shares with its base (``ties``) are its base's."""
     count = len(widths)
     offsets = [sum(len(shape) for shape in shapes[:kind]) for kind in range(count)]
     unknowns = 1 + count + sum(len(shape) for shape in shapes)
+    wide = [ties.get(kind, (kind,))[0] for kind in range(count)]  # whose width it is
+    placed = [[offsets[kind] + n for n in range(len(shape))] for kind, shape in enumerate(shapes)]
+    for kind, (base, tie) in ties.items():
+        placed[kind] = [
+            offsets[kind] + n if m is None else offsets[base] + m for n, m in enumerate(tie)
+        ]
     rows: list[list[float]] = []
     values: list[float] = []
     for k, (kind, flip, match) in enumerate(zip(kinds, mirrored, matches, strict=True)):
@@ -503,20 +653,20 @@ def _fitted(
             row = [0.0] * unknowns
             row[0] = 1.0  # the start
             for before in kinds[:k]:
-                row[1 + before] += 1.0
+                row[1 + wide[before]] += 1.0
             centre = slots[k][j][1] + spans[k][0]
             if flip:  # at the bay's width less the centre in the kind's frame
-                row[1 + kind] += 1.0
-                row[1 + count + offsets[kind] + n] = -1.0
+                row[1 + wide[kind]] += 1.0
+                row[1 + count + placed[kind][n]] = -1.0
             else:
-                row[1 + count + offsets[kind] + n] = 1.0
+                row[1 + count + placed[kind][n]] = 1.0
             rows.append(row)
             values.append(centre)
     if centred:  # the start and half the bays' widths: the middle
         row = [0.0] * unknowns
         row[0] = CENTRED
         for kind in kinds:
-            row[1 + kind] += CENTRED / 2
+            row[1 + wide[kind]] += CENTRED / 2
         rows.append(row)
         values.append(CENTRED * centred / 2)
     guess = [spans[0][0], *widths, *(slot[1] for shape in shapes for slot in shape)]
@@ -529,13 +679,14 @@ def _fitted(
     fitted = [
         _columns(
             [
-                (label, round(float(solution[1 + count + offsets[kind] + n]), DIGITS), w, y0, y1)
+                (label, round(float(solution[1 + count + placed[kind][n]]), DIGITS), w, y0, y1)
                 for n, (label, _, w, y0, y1) in enumerate(shape)
             ]
         )
         for kind, shape in enumerate(shapes)
     ]
-    fitted_widths = tuple(round(float(w), DIGITS) for w in solution[1 : 1 + count])
+    fitted = _tied(fitted, ties)  # a variant's shared elements stay its base's, columns and all
+    fitted_widths = tuple(round(float(solution[1 + wide[kind]]), DIGITS) for kind in range(count))
     return round(float(solution[0]), DIGITS), fitted_widths, fitted
 
 
@@ -611,7 +762,9 @@ def _plan(
     """The runs the written bays are cut into (the left half's if ``symmetric``): ends
     of kinds found only there on a counter of their own (at most one: drop only), then
     up to ``COUNTERS`` repeated units of one or two bays, longest first, none of a
-    unique kind; the rest one bay a run, as drawn."""
+    unique kind; where no unit is drawn twice in a row but the bays between the ends
+    that are not unique are all of one kind (a window bay between wider end bays and a
+    door's), each of them on that kind's counter; the rest one bay a run, as drawn."""
     n = len(kinds)
     written = n // 2 if symmetric else n
     seq = list(zip(kinds, mirrored, strict=True))
@@ -663,6 +816,12 @@ def _plan(
         for j in range(start + 1, start + unit * copies):
             taken[j] = taken[start]
         found += 1
+    inner_kinds = {kinds[j] for j in range(written)} - unique - ends
+    if not found and len(inner_kinds) == 1:  # one kind between the ends, never side by side
+        (kind,) = inner_kinds
+        for j in range(written):
+            if kinds[j] == kind:
+                taken[j] = Run(j, 1, 1, counter(widths[kind], 1, None))
     runs = []
     k = 0
     while k < written:
@@ -750,6 +909,24 @@ def _apart(
         if rects[indices[0]].label not in OPENINGS and any(far[k] for k in indices)
         for k in indices
     }
+
+
+def _moved(before: LabelledLayout, after: list[Rect]) -> bool:
+    """An opening stands further from where the structure put it (``before``) than
+    ``HELD`` of what the structure lets an edge move (``structure.beyond_limits``):
+    bays read alike about their openings but drawn at pitches too unlike to stand on
+    one shape."""
+    rects = list(before.rects)
+    return any(
+        (a or b) and rects[k].label in OPENINGS
+        for k, (a, b) in enumerate(
+            zip(
+                beyond_limits(rects, [(r.x0, r.x1) for r in after], "x", before.width, HELD),
+                beyond_limits(rects, [(r.y0, r.y1) for r in after], "y", before.height, HELD),
+                strict=True,
+            )
+        )
+    )
 
 
 def _new_overlaps(before: tuple[Rect, ...], after: list[Rect]) -> bool:
