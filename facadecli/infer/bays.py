@@ -54,6 +54,7 @@ from itertools import pairwise
 
 import numpy as np
 
+from facadecli.grammar.fidelity import fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
 from facadecli.infer.structure import SHARE, beyond_limits
@@ -71,6 +72,7 @@ AXIS = 0.01  # of the façade's width: an opening this close to another's reflec
 ASIDE = 0.1  # of the openings: these may lack a mirror image on a façade mirrored as a whole
 UNIQUE = ("door",)  # labels whose bays are never repeated
 CUTS = ("window", "door")  # the openings the bays are cut on
+KEEP = 0.002  # of the mean IoU against the drawing: the most the bays' shapes may lose
 HELD = SHARE / 2  # of the narrowest span an edge bounds: the most a kind's shape moves it
 ODD = 1  # openings: a bay this many unlike a kind's (each way) is a variant of it
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
@@ -175,9 +177,18 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
     layout as drawn, its rectangles in the same order (None: ``layout``), which the
     elements but the openings stay near (``_apart``). The bays are compared about their
     openings first (``Frames``), which must then leave every opening within the
-    structure's limits of where it was drawn; else as cut."""
-    found = _found(layout, drawn, True)
-    return found if isinstance(found, Bays) else _found(layout, drawn, False)
+    structure's limits of where it was drawn; else as cut. Either way the layout on the
+    kinds' shapes must be as faithful to the drawing as the structure's (``_faithful``)."""
+    reason = ""
+    for on_openings in (True, False):
+        found = _found(layout, drawn, on_openings)
+        if isinstance(found, str):
+            reason = found
+        elif drawn is not None and not _faithful(drawn, layout, found.layout):
+            reason = f"its bays on their kinds' shapes would lose more than {KEEP} of IoU"
+        else:
+            return found
+    return reason
 
 
 def _found(layout: LabelledLayout, drawn: LabelledLayout | None, on_openings: bool) -> Bays | str:
@@ -909,6 +920,14 @@ def _apart(
         if rects[indices[0]].label not in OPENINGS and any(far[k] for k in indices)
         for k in indices
     }
+
+
+def _faithful(drawn: LabelledLayout, before: LabelledLayout, after: LabelledLayout) -> bool:
+    """The layout with its bays on their kinds' shapes (``after``) is as faithful to the
+    drawing as the structure's (``before``): its mean IoU per label within ``KEEP``, no
+    element more lost or fused (``grammar.fidelity``)."""
+    was, now = fidelity(drawn, before), fidelity(drawn, after)
+    return now.iou_mean >= was.iou_mean - KEEP and now.lost <= was.lost and now.fused <= was.fused
 
 
 def _moved(before: LabelledLayout, after: list[Rect]) -> bool:
