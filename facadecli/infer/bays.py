@@ -13,11 +13,15 @@ across the façade (``layers.BAND``) are in no bay either; one standing within a
 stands apart too.
 
 Bays whose openings are alike (label, place in the bay, size and rows within ``ALIKE``
-of the bay's width, read as drawn or mirrored) are one *kind*; of their other elements,
-those every bay of the kind shows alike stay in it, the rest stand apart (a balcony on
-one of them). Each kind is put on one shape (the median of its bays, so that every
-layer's word repeats it exactly), and the façade's x words become one sequence of
-bays, written alike in every layer that stands in bays (each layer shows its own
+of the bay's width, read as drawn or mirrored) are one *kind*, compared about the middle
+of their openings and measured by their nearer pitch (``Frames``: where the cut between
+two bays fell does not make them unlike), else as cut. A bay drawn once that differs from
+a kind of several bays in at most ``ODD`` opening each way is a *variant* of it
+(``_variants``): its own kind, written once, on its base's width and symbols. Of the
+bays' other elements, those every bay of the kind shows alike stay in it, the rest stand
+apart (a balcony on one of them). Each kind is put on one shape (the median of its
+bays, so that every layer's word repeats it exactly), and the façade's x words become
+one sequence of bays, written alike in every layer that stands in bays (each layer shows its own
 elements; a bay where it shows none is one hidden spacer): a repeated unit of one or
 two bays (never a unique label's: a door's bay is written once) gets a counter, at
 most ``COUNTERS`` of them; kinds found only at the façade's ends share one counter
@@ -42,7 +46,8 @@ façade keeps its axis in the middle whatever bays it gains or drops.
 A façade this cannot narrow to ``NARROWEST`` of its width (every bay its own kind, as
 on an irregular façade drawn by hand), or whose kinds would make elements overlap, is
 left to the per-layer words: ``bays`` says why, and the spec, the report and a warning
-say so.
+say so. So is one whose layout on the kinds' shapes would be less faithful to the
+drawing than the structure's (``_faithful``: ``KEEP``).
 """
 
 from __future__ import annotations
