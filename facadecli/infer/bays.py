@@ -181,9 +181,10 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
     """The façade's bays (see the module), or why it has none to write; ``drawn``: the
     layout as drawn, its rectangles in the same order (None: ``layout``), which the
     elements but the openings stay near (``_apart``). The bays are compared about their
-    openings first (``Frames``), which must then leave every opening within the
-    structure's limits of where it was drawn; else as cut. Either way the layout on the
-    kinds' shapes must be as faithful to the drawing as the structure's (``_faithful``)."""
+    openings first (``Frames``), which must then leave every opening within ``HELD`` of
+    the structure's move limit of where the structure put it (``_moved``); else as cut.
+    Either way the layout on the kinds' shapes must be as faithful to the drawing as
+    the structure's (``_faithful``)."""
     reason = ""
     for on_openings in (True, False):
         found = _found(layout, drawn, on_openings)
