@@ -334,10 +334,9 @@ def move_limits(
         lo, hi = across[i]
         # elements of its label starting just past this one's end: the gap between them
         for j in by_start[bisect.bisect_left(starts, b) : bisect.bisect_right(starts, b + reach)]:
-            start = spans[j][0]
-            if rects[j].label == rects[i].label and start > b:
-                if across[j][0] < hi and lo < across[j][1]:
-                    limit(b, start)
+            start, facing = spans[j][0], across[j][0] < hi and lo < across[j][1]
+            if rects[j].label == rects[i].label and start > b and facing:
+                limit(b, start)
         # what shows of it between the elements in front that start or end inside it
         inside = {
             *by_start[bisect.bisect_right(starts, a) : bisect.bisect_left(starts, b)],
