@@ -304,12 +304,13 @@ def move_limits(
     - an element (``spans``, of ``rects``; ``across``: the other axis);
     - the gap between two elements of one label that face each other (overlapping
       across): the wall between two windows never closes, they stay two;
-    - the part of an element left visible beside one in front of it that covers most
-      of it across (a blind's strip beside its window): it never goes behind.
+    - each part of an element left visible beside or between elements in front of it
+      that cover most of it across (a blind's strip beside its window, a balcony's
+      strip between the moulding under it and its window): it never goes behind.
 
     So tidying keeps what was drawn: every element most of its size and what shows of
-    it. Only spans shorter than ``tolerance / share`` limit anything; each element
-    is looked up against the elements starting or ending within that of its edges."""
+    it. Only spans shorter than ``tolerance / share`` limit anything; each element is
+    looked up against the elements starting or ending inside it or just past its end."""
     limits: dict[float, float] = {}
     reach = tolerance / share
 
@@ -331,19 +332,24 @@ def move_limits(
     for i, (a, b) in enumerate(spans):
         limit(a, b)
         lo, hi = across[i]
-        # elements starting just past this one's end (a gap), or just inside its start
-        for j in by_start[bisect.bisect_left(starts, a) : bisect.bisect_right(starts, b + reach)]:
-            start = spans[j][0]
-            if start >= b and rects[j].label == rects[i].label:
-                if across[j][0] < hi and lo < across[j][1] and start > b:
-                    limit(b, start)
-            elif a < start < min(b, a + reach) and covers(j, i):
-                limit(a, start)
-        # elements ending just inside this one's end
-        for j in by_end[bisect.bisect_left(ends, b - reach) : bisect.bisect_left(ends, b)]:
-            end = spans[j][1]
-            if max(a, b - reach) < end and covers(j, i):
-                limit(end, b)
+        # elements of its label starting just past this one's end: the gap between them
+        for j in by_start[bisect.bisect_left(starts, b) : bisect.bisect_right(starts, b + reach)]:
+            start, facing = spans[j][0], across[j][0] < hi and lo < across[j][1]
+            if rects[j].label == rects[i].label and start > b and facing:
+                limit(b, start)
+        # what shows of it between the elements in front that start or end inside it
+        inside = {
+            *by_start[bisect.bisect_right(starts, a) : bisect.bisect_left(starts, b)],
+            *by_end[bisect.bisect_right(ends, a) : bisect.bisect_left(ends, b)],
+        }
+        fronts = sorted(spans[j] for j in inside if covers(j, i))
+        shown = a  # the start of the part shown now
+        for start, end in fronts:
+            if start > shown:  # a part shown before a front (after another, or from a)
+                limit(shown, start)
+            shown = max(shown, end)
+        if fronts and a < shown < b:
+            limit(shown, b)
     return limits
 
 
