@@ -525,13 +525,17 @@ def one_door_each(
 
 def _shape(city: City, properties: dict[str, Any]) -> tuple[Choice, Heights, Roof]:
     """What the manifest and a feature's tags make of a building: the manifest's choice,
-    its heights (a rule's height wins over the tags') and its roof."""
+    its heights (a rule's height wins over the tags'; under the manifest's default
+    roof, no tag shaping it, the walls keep a storey: :func:`.s3db.volume`) and its
+    roof."""
     defaults = city.manifest.defaults
     choice = city.choose(properties)
     names = city.manifest.properties.names()
     heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
     if choice.height is not None:
         heights = replace(heights, top=choice.height, eaves=None)
+    if choice.guessed_roof:  # no tag or rule gives the roof: a one-storey shed is not half roof
+        heights = replace(heights, storey=defaults.floor_height)
     return choice, heights, tagged_roof(properties, choice.roof)
 
 
