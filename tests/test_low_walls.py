@@ -160,6 +160,23 @@ def test_the_cottage_has_a_layout_at_every_rung_a_city_solves_from_the_shortest_
         assert not missing, (axis, missing)
 
 
+def test_the_cottages_storeys_are_a_storey_high_on_every_wall_height() -> None:
+    """On every rung of wall heights from 2.2 to 12 m the cottage's storeys are at least
+    2 m apart, and a wall up to 4 m (a one-storey building under a flat roof, its walls
+    full height) has one: at 3.6 to 4.25 m it drew two rows of windows 1.8 m apart, and
+    four on a 9 m wall."""
+    from facadecli import load_spec
+    from facadecli.city.building import rung_length, solve_rung
+
+    spec = load_spec(ROOT / "specs" / "cottage.yaml")
+    for step in range(rung(2.2), rung(12.0) + 1):
+        height = rung_length(step)
+        (layout,) = solve_rung(spec, "y", height)
+        storeys = [letter.symbol for letter in layout.letters[0]].count("G")
+        assert height / storeys >= 2.0, (height, storeys)
+        assert height > 4.0 or storeys == 1, (height, storeys)
+
+
 class _Asked(AxisCache):
     """An axis cache that remembers every axis a building asks it for."""
 
