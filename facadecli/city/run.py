@@ -1028,7 +1028,7 @@ def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, A
     while slots := sorted(axes_to_solve(tries, solved)):
         jobs = [(specs[slot[0]], slot) for slot in slots]
         solved.update(_bounded(lambda batch: submit(_each, _solve, batch), jobs, 1))
-    return dict(sorted(solved.items()))  # in order: they came as they ended
+    return dict(sorted(solved.items()))  # in order, whichever order they ended in
 
 
 def _map_dask(tasks: Sequence[Task], scheduler: str) -> Iterator[dict[str, Any]]:
