@@ -7,13 +7,16 @@ wall, a tall narrow one."""
 from __future__ import annotations
 
 import json
+from concurrent.futures import Future
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from facadecli.city.default import default_city
-from facadecli.city.run import run_city
+import facadecli.city.run as city_run
+from facadecli.city.building import AxisCache, Slot, rung
+from facadecli.city.default import FALLBACK, default_city
+from facadecli.city.run import planned, run_city
 from facadecli.export.glb_merge import read_glb
 from tests.osm_district import box
 from tests.test_city_assets import VALIDATOR, validates
@@ -155,3 +158,69 @@ def test_the_cottage_has_a_layout_at_every_rung_a_city_solves_from_the_shortest_
         steps = range(rung(MIN_FACADE_WIDTH), rung(top) + 1)
         missing = [rung_length(s) for s in steps if not solve_rung(spec, axis, rung_length(s))]
         assert not missing, (axis, missing)
+
+
+def test_the_cottages_storeys_are_a_storey_high_on_every_wall_height() -> None:
+    """On every rung of wall heights from 2.2 to 12 m the cottage's storeys are at least
+    2 m apart, and a wall up to 4 m (a one-storey building under a flat roof, its walls
+    full height) has one: at 3.6 to 4.25 m it drew two rows of windows 1.8 m apart, and
+    four on a 9 m wall."""
+    from facadecli import load_spec
+    from facadecli.city.building import rung_length, solve_rung
+
+    spec = load_spec(ROOT / "specs" / "cottage.yaml")
+    for step in range(rung(2.2), rung(12.0) + 1):
+        height = rung_length(step)
+        (layout,) = solve_rung(spec, "y", height)
+        storeys = [letter.symbol for letter in layout.letters[0]].count("G")
+        assert height / storeys >= 2.0, (height, storeys)
+        assert height > 4.0 or storeys == 1, (height, storeys)
+
+
+class _Asked(AxisCache):
+    """An axis cache that remembers every axis a building asks it for."""
+
+    def __init__(self, axes: dict[Slot, Any]) -> None:
+        super().__init__(axes=dict(axes))
+        self.asked: set[Slot] = set()
+
+    def _layouts(self, key: str, spec: Any, axis: str, length: float, variants: int) -> Any:
+        self.asked.add((key, axis, rung(length), variants))
+        return super()._layouts(key, spec, axis, length, variants)
+
+
+def _now(function: Any, *args: Any) -> Future[Any]:
+    """A pool's submit, run here and now."""
+    done: Future[Any] = Future()
+    done.set_result(function(*args))
+    return done
+
+
+def test_a_run_solves_ahead_the_fallbacks_axes_only_for_walls_that_need_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Solved ahead (a run of several processes), the fallback's axes are those of the
+    walls their own façade does not fit, not of every wall (the houses' walls all fit the
+    townhouse), and they are all the buildings ask for: none is solved while building."""
+    features = [
+        _feature(f"house-{k}", box(20.0 * k, 0.0, 9.0 + k, 11.0), building="house", height=9.0)
+        for k in range(3)
+    ]
+    features += _sheds(2, height=3.0)
+    features.append(_feature("tower", box(0.0, 30.0, 2.0, 12.0), building="yes", height=9.0))
+    folder = tmp_path / "in"
+    folder.mkdir()
+    footprints = folder / "town.geojson"
+    footprints.write_text(
+        json.dumps({"type": "FeatureCollection", "crs": CRS, "features": features})
+    )
+    tasks = list(planned(default_city(footprints), tmp_path / "out").tasks)
+    solved = city_run._presolve(_now, tasks, 2)
+    cache = _Asked(solved)
+    monkeypatch.setitem(city_run._CACHE, "axes", cache)
+    for task in tasks:
+        assert city_run.build(task)["status"] == "ok"
+    assert cache.solved == 0  # every axis a building asked for was solved ahead
+    fallback = {slot for slot in solved if Path(slot[0].split("#")[0]).stem == FALLBACK}
+    assert fallback, "the sheds and the tower take the cottage"
+    assert fallback <= cache.asked, sorted(fallback - cache.asked)

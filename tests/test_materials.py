@@ -334,3 +334,40 @@ def test_a_brick_or_a_block_is_even_across_its_face(name: str, resolution: int) 
     assert np.median(spread) <= 0.05 and max(spread) <= 0.08, (np.median(spread), max(spread))
     if name == "stone-ashlar":
         assert max(float(tilt[unit].mean()) for unit in units) <= 3.0
+
+
+def _open_surface(name: str, resolution: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A jointless library material's occlusion (0..1) and normals' tilt (degrees), and
+    the mask of its open surface: all of render; concrete away from its formwork lines
+    (2 cm) and tie holes (4 cm)."""
+    from facadecli.materials.library import KINDS
+    from facadecli.materials.textures import coursed, grid, linear, texture_set
+
+    material = LIBRARY[name]
+    kind, tile = KINDS[name], TILES[name]
+    rgb = tuple(linear(int(material.color[i : i + 2], 16) / 255) for i in (1, 3, 5))
+    made = texture_set(kind, resolution, tile, 0, rgb, material.roughness, 0.0)  # type: ignore[arg-type]
+    ao = made.orm[..., 0] / 255
+    normal = made.normal.astype(float) / 255 * 2 - 1
+    tilt = np.degrees(np.arccos(np.clip(normal[..., 2] / np.linalg.norm(normal, axis=-1), -1, 1)))
+    open_surface = np.ones(ao.shape, dtype=bool)
+    if kind == "concrete":  # its panels as its generator lays them
+        panels = coursed(*grid(resolution, tile), tile, [(tile / 2, [tile / 2], 0.0)] * 2)
+        holes = np.hypot(panels.u - 0.5, panels.v - 0.5) * tile / 2 <= 0.04
+        open_surface = (panels.edge > 0.02) & ~holes
+    return ao, tilt, open_surface
+
+
+@pytest.mark.parametrize("resolution", [256, 1024])
+@pytest.mark.parametrize("name", ["render", "concrete"])
+def test_render_and_concrete_shade_only_at_their_lines(name: str, resolution: int) -> None:
+    """Render and concrete take no occlusion from their surface's grain, only from what
+    is recessed (concrete's formwork lines and tie holes), and their normals lean little
+    at any resolution: their occlusion fell to 0.59 (render) and 0.41 (concrete) on the
+    open surface at 1024 px, a quarter to a third of it under 0.95, normals leaning 5-7
+    degrees on average."""
+    ao, tilt, open_surface = _open_surface(name, resolution)
+    assert ao[open_surface].min() >= 0.97, ao[open_surface].min()
+    assert float(tilt[open_surface].mean()) <= 1.5, float(tilt[open_surface].mean())
+    if name == "concrete":  # the lines and the tie holes still shade
+        assert ao[~open_surface].min() <= 0.5

@@ -5,6 +5,7 @@ property. One small hand-made district, one building a tag."""
 from __future__ import annotations
 
 import json
+import random
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,8 @@ from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, load_city
 from facadecli.city.run import run_city
 from facadecli.city.s3db import (
+    MIN_ROOF,
+    ROOF_SHARE,
     Heights,
     blind,
     colour,
@@ -561,3 +564,93 @@ def test_a_bounded_stream_of_tasks_gives_the_same_files(
     for built in sorted((folder / "out" / "buildings").glob("*/*.glb")):
         path = built.relative_to(folder / "out")
         assert built.read_bytes() == (tmp_path / "out" / path).read_bytes()
+
+
+def _outlines(rng: random.Random) -> Polygon:
+    """A rectangle or an L, 4 to 30 m across."""
+    w, d = rng.uniform(4.0, 30.0), rng.uniform(4.0, 25.0)
+    if rng.random() < 0.5:
+        return Polygon(_box(0, 0, w, d))
+    return Polygon([(0, 0), (w, 0), (w, d / 2), (w / 2, d / 2), (w / 2, d), (0, d)])
+
+
+def test_a_guessed_roof_leaves_the_walls_a_storey_and_a_tagged_one_keeps_its_share() -> None:
+    """Over generated footprints, heights, floor heights and roofs: a roof the manifest
+    guesses (no ``roof:shape``, no roof height: ``storey`` set) leaves the walls at least
+    a storey, or all the building below a storey and MIN_ROOF, under a flat roof; a
+    pitched roof below MIN_ROOF is flat. A roof the tags shape is as before: at most
+    ROOF_SHARE of the building. Delft's one-storey buildings (2.8-3.2 m, no roof tags)
+    had walls of 1.4-1.6 m under a hipped roof as high."""
+    rng = random.Random(35)
+    flat = low = 0
+    for _ in range(400):
+        part = _outlines(rng)
+        storey = rng.choice((2.7, 3.0, 3.2))
+        top = rng.uniform(2.4, 12.0)
+        roof = Roof(
+            type=rng.choice(("hip", "gable", "pyramidal", "half_hip")), pitch=rng.uniform(20, 50)
+        )
+        guessed = volume(part, Heights(top, None, 0.0, None, 9.0, storey), roof)
+        tagged = volume(part, Heights(top, None, 0.0, None, 9.0), roof)
+        assert guessed.top == pytest.approx(top) and tagged.top == pytest.approx(top)
+        assert guessed.eaves >= min(storey, top) - 1e-9, (top, storey, guessed.eaves)
+        rise = guessed.top - guessed.eaves
+        assert guessed.roof.type == "flat" or rise >= MIN_ROOF - 1e-9, (top, storey, rise)
+        assert tagged.top - tagged.eaves <= ROOF_SHARE * top + 1e-9
+        assert guessed.eaves >= tagged.eaves - 1e-9  # a guess never takes more wall
+        flat += guessed.roof.type == "flat"
+        low += top < storey + MIN_ROOF
+        if top < storey + MIN_ROOF:
+            assert guessed.roof.type == "flat" and guessed.eaves == pytest.approx(top)
+    assert flat >= low > 20  # the family has low buildings, and they are flat
+
+
+def test_a_low_building_without_roof_tags_has_a_flat_roof_and_a_shaped_one_keeps_it(
+    tmp_path: Path,
+) -> None:
+    """In a city without a manifest (a hipped roof by default), a 3 m building without
+    roof tags is flat on 3 m of wall; one tagged ``roof:shape=gabled`` keeps its gable; a
+    5 m one keeps a storey (3 m) of wall under its hipped roof."""
+    from facadecli.city.building import party_volumes
+    from facadecli.city.default import default_city
+    from facadecli.city.run import planned
+
+    features = [
+        {
+            "type": "Feature",
+            "id": ident,
+            "properties": tags,
+            "geometry": {
+                "type": "Polygon",
+                "coordinates": [[[85000 + x, 447000 + y] for x, y in [*ring, ring[0]]]],
+            },
+        }
+        for ident, ring, tags in [
+            ("low", _box(0, 0, 8, 10), {"building": "yes", "height": 3.0}),
+            (
+                "gabled",
+                _box(20, 0, 8, 10),
+                {"building": "yes", "height": 3.0, "roof:shape": "gabled"},
+            ),
+            ("five", _box(40, 0, 8, 10), {"building": "yes", "height": 5.0}),
+        ]
+    ]
+    crs = {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}}
+    path = tmp_path / "low.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "crs": crs, "features": features}))
+    volumes = {
+        task.footprint.id: party_volumes(task.footprint, task.heights, task.roof, None, 0.3)[0]
+        for task in planned(default_city(path), tmp_path / "plan").tasks
+    }
+    assert (volumes["low"].eaves, volumes["low"].roof.type) == (3.0, "flat")
+    assert volumes["gabled"].roof.type == "gable" and volumes["gabled"].eaves == 1.5
+    assert volumes["five"].roof.type == "hip"
+    assert (volumes["five"].eaves, volumes["five"].top) == pytest.approx((3.0, 5.0))
+    report = run_city(default_city(path), tmp_path / "out", jobs=1)
+    built = {entry["id"]: entry for entry in report["buildings"]}
+    materials = {}
+    for ident, entry in built.items():
+        document = json.loads(_json_chunk(tmp_path / "out" / entry["file"]))
+        materials[ident] = {m["name"] for m in document["materials"]}
+    assert "flat_roof" in materials["low"] and "roof" not in materials["low"]
+    assert "roof" in materials["gabled"] and "roof" in materials["five"]

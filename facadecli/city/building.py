@@ -16,7 +16,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -600,7 +600,10 @@ def _wall_height(block: Volume) -> float:
     return height + (block.roof.parapet if block.roof.type == "flat" else 0.0)
 
 
-def facade_axes(
+Tries = tuple[tuple[Slot, Slot], ...]  # a wall's façades in turn: the axes (x, y) of each
+
+
+def wall_tries(
     footprint: Footprint,
     heights: Heights,
     roof: Roof,
@@ -611,20 +614,45 @@ def facade_axes(
     rules: Sequence[tuple[WallRule, Facade]] = (),
     variants: int = 1,
     fallback: Facade | None = None,
-) -> set[Slot]:
-    """The axes a building's façades need, as cache slots: what a run can solve ahead, in
-    parallel, before the buildings (see :meth:`AxisCache.get`); the ``fallback``'s too,
-    for every wall (which walls take it is known once the others are solved)."""
-    needed: set[Slot] = set()
+) -> set[Tries]:
+    """The axes a building's façades may need, as cache slots: for each wall a façade is
+    tried on, those of the façades it tries in turn (its own, then the ``fallback``).
+    What a run solves ahead, in parallel, before the buildings (:func:`axes_to_solve`
+    tells which, as the axes come: a fallback's only where the wall's own does not fit;
+    see :meth:`AxisCache.get`)."""
+    needed: set[Tries] = set()
     if roof_only(footprint.properties):
         return needed  # no walls: no façades
     for block in party_volumes(footprint, heights, roof, shared, tolerance):
         height = rung(_wall_height(block))
         for _, _, length, party, chosen in _walls(block, main, rules):
             if length >= min_facade_width and not party:
-                for tried in _tried(chosen, fallback):
-                    needed.add((tried.key, "y", height, variants))
-                    needed.add((tried.key, "x", rung(length), variants))
+                across = rung(length)
+                needed.add(
+                    tuple(
+                        ((f.key, "x", across, variants), (f.key, "y", height, variants))
+                        for f in _tried(chosen, fallback)
+                    )
+                )
+    return needed
+
+
+def axes_to_solve(tries: Iterable[Tries], solved: Mapping[Slot, Any]) -> set[Slot]:
+    """The axes still to solve, given those ``solved`` (slot: its layouts, none where no
+    layout fits): for each wall, those of the first façade it tries whose axes are not
+    all solved, unless an earlier one fits (both its axes have a layout). Solving these
+    and asking again until none is left solves what the buildings will ask for (a wall
+    asks for a façade's axes only when the ones before did not fit it, and for each
+    height it tried when none did: :func:`build_building`), and nothing else."""
+    needed: set[Slot] = set()
+    for tried in tries:
+        for axes in tried:
+            missing = [slot for slot in axes if slot not in solved]
+            if missing:
+                needed.update(missing)
+                break
+            if all(solved[slot] for slot in axes):
+                break  # this façade fits: the wall tries no other
     return needed
 
 

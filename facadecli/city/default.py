@@ -11,8 +11,9 @@ storey of windows over a plinth under an eaves band, more where the wall is tall
 the building's wall material; it fits walls from 1.2 m long and 1.2 m high, and
 shorter (or lower) walls are plain. Each building's walls take one of four tones of its
 spec's wall colour (:func:`tones`), picked by the seed and its id. Roofs are hipped
-(30°) unless the data tags a shape; a building without a height or levels is 9 m tall,
-3 m a level.
+(30°) unless the data tags a shape, a guess that leaves the walls a storey (flat under
+4 m: :func:`.s3db.volume`); a building without a height or levels is 9 m tall, 3 m a
+level.
 """
 
 from __future__ import annotations

@@ -1,7 +1,8 @@
 """A demo district the project makes itself (``make city``): blocks of rectangular and
 L-shaped footprints along a street grid, with OSM-like properties, in a projected CRS:
 apartment blocks, houses, a shop in every other block (a shop front on its front wall),
-and a church now and then; the houses' walls take tones of their brick by the seed. And
+and a church now and then; the houses' walls take tones of their brick by the seed, and
+the cottage where the townhouse does not fit (a low house's walls). And
 a generated town of terraces of any size (:func:`terraces`, for benchmarks)."""
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ defaults:
   floor_height: 3.2
   roof: {{type: gable, pitch: 35}}
   min_facade_width: 3.0
-  palette: ["#9c4a32", "#86402b", "#af5338", "#93462f"]  # tones of the townhouse's brick
+{fallback}  palette: ["#9c4a32", "#86402b", "#af5338", "#93462f"]  # tones of the townhouse's brick
 rules:
   - when: {{building: church}}
     facade: {specs}/church.yaml
@@ -107,7 +108,10 @@ def write_demo(folder: Path, specs: Path, blocks: int = 3, name: str = "demo-dis
     write_atomic(folder / "footprints.geojson", json.dumps(district(blocks)) + "\n")
     relative = Path(os.path.relpath(specs.resolve(), folder.resolve())).as_posix()
     manifest = folder / "district.yaml"
-    write_atomic(manifest, MANIFEST.format(name=name, specs=relative))
+    # the cottage on the walls the townhouse does not fit: a 9.6 m house under its 35°
+    # gable has 4.8 m of wall, too low for the townhouse's three storeys
+    fallback = f"  fallback_facade: {relative}/cottage.yaml\n"
+    write_atomic(manifest, MANIFEST.format(name=name, specs=relative, fallback=fallback))
     return manifest
 
 
@@ -163,5 +167,6 @@ def write_terraces(folder: Path, specs: Path, count: int, seed: int = 0) -> Path
     write_atomic(folder / "footprints.geojson", text)
     relative = Path(os.path.relpath(specs.resolve(), folder.resolve())).as_posix()
     manifest = folder / "district.yaml"
-    write_atomic(manifest, MANIFEST.format(name=f"terraces-{count}", specs=relative))
+    text = MANIFEST.format(name=f"terraces-{count}", specs=relative, fallback="")
+    write_atomic(manifest, text)
     return manifest

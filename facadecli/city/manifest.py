@@ -179,11 +179,13 @@ class City:
 
     def choose(self, properties: dict[str, Any]) -> Choice:
         """What a building gets: the first matching rule wins; else the feature's own OSM
-        ``roof:shape`` (and ``roof:angle``); else the defaults."""
+        ``roof:shape`` (and ``roof:angle``); else the defaults (the roof a guess)."""
         defaults = self.manifest.defaults
-        facade, roof = defaults.facade, _tagged_roof(properties) or defaults.roof
+        tagged = _tagged_roof(properties)
+        facade, roof = defaults.facade, tagged or defaults.roof
         height, colours, walls = None, defaults.colours, defaults.walls
         variants, palette = defaults.variants, defaults.palette
+        guessed = tagged is None  # the defaults' roof, unless a rule gives one
         for rule in self.manifest.rules:
             if all(_matches(properties, key, want) for key, want in rule.when.items()):
                 facade = rule.facade or facade
@@ -193,8 +195,11 @@ class City:
                 walls = rule.walls if rule.walls is not None else walls
                 variants = rule.variants or variants
                 palette = rule.palette if rule.palette is not None else palette
+                guessed = guessed and rule.roof is None
                 break
-        return Choice(facade, roof, height, colours, tuple(walls), variants, tuple(palette))
+        return Choice(
+            facade, roof, height, colours, tuple(walls), variants, tuple(palette), guessed
+        )
 
 
 @dataclass(frozen=True)
@@ -208,6 +213,7 @@ class Choice:
     walls: tuple[WallRule, ...] = ()  # façades for some walls, the first match wins
     variants: int = 1  # layouts a wall may take; each building picks one by its seed
     palette: tuple[str, ...] = ()  # wall colours a building may take
+    guessed_roof: bool = False  # the defaults' roof: no roof:shape tag, no rule's roof
 
 
 OSM_ROOFS: dict[str, RoofType] = {  # roof:shape -> the roof built

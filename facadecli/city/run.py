@@ -37,13 +37,15 @@ from facadecli.city.building import (
     Facade,
     Looks,
     Slot,
+    Tries,
+    axes_to_solve,
     build_building,
     building_solids,
     building_walls,
-    facade_axes,
     party_volumes,
     rung_length,
     solve_rung,
+    wall_tries,
 )
 from facadecli.city.built import BuiltCity, attributes, feature_file
 from facadecli.city.cityjson import (
@@ -152,12 +154,13 @@ _SEEDED: dict[str, str] = {}  # per Dask worker process: the run its cache was s
 Axes = tuple[AxisLayout, ...]  # an axis's layouts at a rung: the best and its variants
 
 
-def _needs(task: Task) -> list[Slot]:
-    """The axes a building will solve, to solve them all ahead, once each (none for a
-    run of coarser levels of detail only)."""
+def _needs(task: Task) -> list[Tries]:
+    """The axes a building's walls may solve, the façades each tries in turn
+    (:func:`.wall_tries`), to solve ahead those they will, once each (none for a run of
+    coarser levels of detail only)."""
     if task.level < 3:
         return []
-    found = facade_axes(
+    found = wall_tries(
         task.footprint,
         task.heights,
         task.roof,
@@ -522,13 +525,17 @@ def one_door_each(
 
 def _shape(city: City, properties: dict[str, Any]) -> tuple[Choice, Heights, Roof]:
     """What the manifest and a feature's tags make of a building: the manifest's choice,
-    its heights (a rule's height wins over the tags') and its roof."""
+    its heights (a rule's height wins over the tags'; under the manifest's default
+    roof, no tag shaping it, the walls keep a storey: :func:`.s3db.volume`) and its
+    roof."""
     defaults = city.manifest.defaults
     choice = city.choose(properties)
     names = city.manifest.properties.names()
     heights = tagged_heights(properties, defaults.floor_height, defaults.height, names)
     if choice.height is not None:
         heights = replace(heights, top=choice.height, eaves=None)
+    if choice.guessed_roof:  # no tag or rule gives the roof: a one-storey shed is not half roof
+        heights = replace(heights, storey=defaults.floor_height)
     return choice, heights, tagged_roof(properties, choice.roof)
 
 
@@ -1007,17 +1014,21 @@ def _chunk(tasks: int, workers: int) -> int:
 
 def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, Axes]:
     """The axes every building needs (:func:`_needs`), each solved once, spread over the
-    workers ``submit`` hands work to (a local pool's or a Dask cluster's). Each worker's
-    cache is then seeded with them: no two workers solve one axis, and the layouts are
-    those a worker would have solved itself, so the files are the same."""
+    workers ``submit`` hands work to (a local pool's or a Dask cluster's), in rounds: the
+    walls' own façades' first, then the fallback's for the walls their own does not fit
+    (:func:`.axes_to_solve`). Each worker's cache is then seeded with them: no two
+    workers solve one axis, and the layouts are those a worker would have solved itself,
+    so the files are the same."""
     specs = {task.cache_key: task.spec for task in tasks}
     specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
     specs.update({t.fallback[1].key: t.fallback[1].spec for t in tasks if t.fallback is not None})
     needs = _bounded(lambda batch: submit(_each, _needs, batch), tasks, chunk)
-    slots = sorted({slot for need in needs for slot in need})
-    jobs = [(specs[slot[0]], slot) for slot in slots]
-    solved = _bounded(lambda batch: submit(_each, _solve, batch), jobs, 1)
-    return dict(sorted(solved, key=lambda pair: pair[0]))  # in order: they came as they ended
+    tries = sorted({tried for need in needs for tried in need})
+    solved: dict[Slot, Axes] = {}
+    while slots := sorted(axes_to_solve(tries, solved)):
+        jobs = [(specs[slot[0]], slot) for slot in slots]
+        solved.update(_bounded(lambda batch: submit(_each, _solve, batch), jobs, 1))
+    return dict(sorted(solved.items()))  # in order, whichever order they ended in
 
 
 def _map_dask(tasks: Sequence[Task], scheduler: str) -> Iterator[dict[str, Any]]:

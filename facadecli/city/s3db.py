@@ -36,6 +36,7 @@ from facadecli.city.roofs import Segment, roof_height
 MIN_WALL = 0.5  # metres: a roof taller than its building leaves at least this much wall
 SLIVER = 1.0  # metres: what parts leave of an outline narrower than this is a gap in the drawing
 ROOF_SHARE = 0.5  # of a building's height, at most, for a roof no tag gives a height
+MIN_ROOF = 1.0  # metres: a guessed roof lower than this is flat (OSM2World's one-level roof)
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,9 @@ class Heights:
     base: float  # the bottom of the walls (``min_height``)
     roof: float | None  # the roof's own height (``roof:height``, ``roof:levels``), if tagged
     default: float  # the top when nothing else says
+    # metres of wall a roof the manifest guesses (no roof:shape, no roof height) leaves:
+    # a storey; 0 where the tags or a rule give the roof
+    storey: float = 0.0
 
 
 POST = 0.25  # metres: the side of a square post under a roof on posts
@@ -83,7 +87,10 @@ def volume(part: Polygon, heights: Heights, roof: Roof) -> Volume:
     lowered); a roof too tall for the building is lowered to leave MIN_WALL of
     wall; a roof of no height is flat. With no height and no levels the top is the
     default, or, higher, a tagged roof on MIN_WALL of wall above the base (a dome drawn
-    as a part of its own, lifted above the default: the tag wins over the guess)."""
+    as a part of its own, lifted above the default: the tag wins over the guess). A
+    guessed roof (``heights.storey`` set) on walls no levels give leaves them a storey,
+    and is flat where that leaves it less than MIN_ROOF: a one-storey shed is not half
+    roof."""
     own = 0.0 if roof.type == "flat" else roof_height(part, roof)
     rise = heights.roof if heights.roof is not None else own
     if roof.type == "flat":
@@ -101,6 +108,10 @@ def volume(part: Polygon, heights: Heights, roof: Roof) -> Volume:
     top = max(top, heights.base + MIN_WALL)
     if pitched:  # at most a share of the building
         rise = min(rise, ROOF_SHARE * (top - heights.base))
+        if heights.storey > 0 and heights.eaves is None:  # a guess on walls no levels set
+            # the walls keep a storey, else no roof
+            rise = min(rise, top - heights.base - heights.storey)
+            rise = rise if rise >= MIN_ROOF else 0.0
     eaves = max(top - rise, min(heights.base + MIN_WALL, top))
     rise = top - eaves
     if rise <= 1e-6:

@@ -222,7 +222,12 @@ def _render(n: int, tile: float, rng: np.random.Generator) -> Surface:
     coarse, fine = noise(rng, n, 0.25, tile), noise(rng, n, 0.004, tile)
     shade = 1.0 + 0.03 * coarse + 0.02 * fine
     colour = np.repeat(shade[..., None], 3, axis=-1)
-    return Surface(0.0003 * fine + 0.0004 * coarse, colour, 0.05 * fine, np.zeros((n, n)))
+    # a float finish: its grain a trace of relief (0.03 mm; it was 0.3, and at 1024 px
+    # its normals leaned 5 degrees and its pits shaded in the occlusion map, down to
+    # 0.59), and nothing recessed to occlude
+    height = 0.00003 * fine + 0.0004 * coarse
+    flat = np.zeros((n, n))
+    return Surface(height, colour, 0.05 * fine, flat, cavities=flat)
 
 
 def _concrete(n: int, tile: float, rng: np.random.Generator) -> Surface:
@@ -233,8 +238,11 @@ def _concrete(n: int, tile: float, rng: np.random.Generator) -> Surface:
     ties = np.hypot(units.u - 0.5, units.v - 0.5) * tile / 2 > 0.012  # the tie holes
     shade = 1.0 + 0.05 * coarse + 0.025 * fine + per_unit(rng, units.ident, 0.02)
     colour = np.repeat((shade * (0.9 + 0.1 * line))[..., None], 3, axis=-1)
-    height = 0.0005 * fine + 0.002 * line + 0.004 * ties - 0.004
-    return Surface(height, colour, 0.05 * coarse, np.zeros((n, n)))
+    # only the formwork lines and the tie holes occlude; the surface's grain is a trace
+    # of relief (0.05 mm; it was 0.5, and its pits shaded like the lines, down to 0.41)
+    recessed = 0.002 * line + 0.004 * ties - 0.004
+    height = recessed + 0.00005 * fine
+    return Surface(height, colour, 0.05 * coarse, np.zeros((n, n)), cavities=recessed)
 
 
 def _timber(n: int, tile: float, rng: np.random.Generator) -> Surface:

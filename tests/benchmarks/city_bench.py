@@ -79,7 +79,7 @@ def detached(folder: Path, count: int, seed: int = 1) -> Path:
     document = {"type": "FeatureCollection", "crs": crs, "features": features}
     (folder / "footprints.geojson").write_text(json.dumps(document))
     manifest = folder / "district.yaml"
-    manifest.write_text(DEMO.format(name=f"detached-{count}", specs=ROOT / "specs"))
+    manifest.write_text(DEMO.format(name=f"detached-{count}", specs=ROOT / "specs", fallback=""))
     return manifest
 
 
