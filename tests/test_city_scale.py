@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import shapely
 import trimesh
 
 import facadecli.city.tiles as tiles_module
@@ -331,7 +332,7 @@ from facadecli.city.run import planned
 root, folder = Path(sys.argv[1]), Path(sys.argv[2])
 planned(load_city(write_terraces(folder / "town-50", root / "specs", 50, 1)), folder / "out")
 peaks = []
-for count in (200, 1600):
+for count in (400, 3200):
     loaded = load_city(write_terraces(folder / f"town-{count}", root / "specs", count, 1))
     gc.collect()
     tracemalloc.start()
@@ -345,16 +346,18 @@ print(json.dumps(peaks))
 
 
 def test_planning_peaks_at_little_a_building(tmp_path: Path) -> None:
-    """Planning's peak, all of it (reading, the neighbours, the tasks), grows little with
-    the city: the slope from 200 to 1,600 buildings of tracemalloc's peak, in a fresh
-    Python (a test worker's leftovers would be counted), a town of 50 planned first (the
-    one-off caches). 2,136 bytes a building when every building's party walls were held
-    at once, its choice and roof were objects of its own and its tags' words its own
-    strings; 1,304 since. GEOS's memory is not counted: ``make bench-large`` measures the
-    resident memory (docs/benchmarks.md)."""
+    """Planning's peak, all of it (reading, the neighbours, the tasks), hardly grows with
+    the city: the town is planned a region at a time (regions.py), so the peak is a
+    region's footprints and what is kept of every building (its task packed...). The
+    slope from 400 to 3,200 buildings of tracemalloc's peak, in a fresh Python (a test
+    worker's leftovers would be counted), a town of 50 planned first (the one-off
+    caches): 1,109 bytes a building when every footprint was read and every neighbour
+    found at once, 301 since (most of it the tasks packed, kept for the run). GEOS's
+    memory is not counted: ``make bench-large`` measures the resident memory
+    (docs/benchmarks.md)."""
     peaks = _in_fresh_python(PLANNING_PEAK, tmp_path / "fresh")
-    slope = (peaks[1] - peaks[0]) / 1400
-    assert slope < 1600, slope
+    slope = (peaks[1] - peaks[0]) / 2800
+    assert slope < 600, slope
 
 
 def test_a_run_keeps_its_buildings_hashes_and_places_in_flat_buffers(tmp_path: Path) -> None:
@@ -488,3 +491,122 @@ def test_party_lines_of_some_footprints_are_theirs_among_all(tmp_path: Path) -> 
     some = dict(party_lines(footprints, 0.3, only={"t1", "t17", "t40"}))
     assert list(some) == ["t1", "t17", "t40"] and all(key in every for key in some)
     assert all(some[key].equals_exact(every[key], 0) for key in some)
+
+
+def test_party_lines_do_not_depend_on_what_else_was_read(tmp_path: Path) -> None:
+    """A footprint's party walls are the same bytes whether the whole town was read or
+    only the footprints around it (a region of it, run.py): its neighbours' lines are
+    united in their order in the input, not in the order the tree of every shape read
+    gives them (the walls of 1,541 of 2,000 terraces changed their vertices' order)."""
+    from facadecli.city.footprints import read_footprints
+    from facadecli.city.s3db import party_lines
+
+    town = write_terraces(tmp_path / "town", ROOT / "specs", 400, 1).parent
+    footprints = list(read_footprints(town / "footprints.geojson").footprints)
+    every = dict(party_lines(footprints, 0.3))
+    middle = footprints[200].parts[0].centroid
+    near = [f for f in footprints if f.parts[0].distance(middle) < 40]
+    mine = {f.id for f in near if f.parts[0].distance(middle) < 10}
+    some = dict(party_lines(near, 0.3, only=mine))
+    assert len(some) >= 4 and all(key in every for key in some)
+    assert all(shapely.to_wkb(some[key]) == shapely.to_wkb(every[key]) for key in some)
+
+
+def _doors_and_strays(manifest: Path) -> Path:
+    """A generated town's footprints with entrance points on some walls (one on the wall
+    two terraces share, one on no wall), a feature that is no polygon and one far off."""
+    path = manifest.parent / "footprints.geojson"
+    data = json.loads(path.read_text())
+    features = data["features"]
+    for k in (0, 1, 9, 30, 31, 77):
+        x0, y0 = features[k]["geometry"]["coordinates"][0][1]  # its south-east corner
+        features.append(_point(f"door-{k}", x0 - 0.2, y0 + 4.0, {"entrance": "yes"}))
+    features.append(_point("lost", 99_000.0, 399_000.0, {"entrance": "yes"}))
+    features.append(_point("bench", 100_005.0, 400_000.5, {"amenity": "bench"}))
+    far = [[[9e5, 4e6], [9e5 + 9, 4e6], [9e5 + 9, 4e6 + 9], [9e5, 4e6]]]
+    features.append(
+        {
+            "type": "Feature",
+            "id": "far",
+            "properties": {"height": "tall"},
+            "geometry": {"type": "Polygon", "coordinates": far},
+        }
+    )
+    path.write_text(json.dumps(data))
+    return manifest
+
+
+def _point(key: str, x: float, y: float, tags: dict[str, str]) -> dict[str, Any]:
+    geometry = {"type": "Point", "coordinates": [x, y]}
+    return {"type": "Feature", "id": key, "properties": tags, "geometry": geometry}
+
+
+@pytest.mark.parametrize("region", [1, 5, 40])
+def test_a_town_planned_a_region_at_a_time_is_planned_as_at_once(
+    tmp_path: Path, region: int
+) -> None:
+    """Planned a region of ``region`` features at a time (regions.py), a town gives the
+    tasks, warnings, rejected features, outlines with parts and counts that planning it
+    at once gives: the OSM district of every S3DB case (parts in outlines, towers on
+    podiums, collinear nodes, entrance nodes), a terrace sharing entrance nodes, and
+    generated terraces with entrance points (one on a party wall, one on no wall), a
+    point that is no entrance and a far feature."""
+    from facadecli.city.default import default_city
+    from tests.osm_district import write_district
+    from tests.test_entrances import _terrace
+
+    district = write_district(tmp_path / "district.osm")
+    terrace = tmp_path / "terrace.osm"
+    _terrace(terrace)
+    spec = ROOT / "specs" / "residential-house.yaml"
+    towns = [default_city(district, spec), default_city(terrace, spec)]
+    towns.append(
+        load_city(_doors_and_strays(write_terraces(tmp_path / "t", ROOT / "specs", 120, 1)))
+    )
+    for loaded in towns:
+        once = planned(loaded, tmp_path / "out", region=10**9)
+        cut = planned(loaded, tmp_path / "out", region=region)
+        assert list(cut.tasks) == list(once.tasks) and len(once.tasks) > 3
+        assert cut.found == once.found and cut.straight == once.straight
+        assert list(cut.replaced.items()) == list(once.replaced.items())
+        assert list(cut.kept.items()) == list(once.kept.items())
+    assert once.found.warnings and once.found.rejected  # the generated town's
+    assert any("party walls" in w.reason for w in once.found.warnings)
+    assert [r.id for r in once.found.rejected] == ["bench", "far"]  # a point; far off
+    assert all(w.id != "far" for w in once.found.warnings)
+
+
+def test_regions_cover_every_feature_once_each_holding_at_most_their_size() -> None:
+    """The boxes cut by counts, not metres: every place in one region, none over the
+    size, however unevenly the boxes lie; around a region, the region itself and the
+    boxes within the margin of it, not those farther."""
+    import numpy as np
+
+    from facadecli.city.regions import around, regions
+
+    rng = np.random.default_rng(1)
+    xy = np.concatenate([rng.normal(0, 50, (900, 2)), rng.uniform(-5000, 5000, (100, 2))])
+    boxes = np.column_stack([xy, xy + rng.uniform(1, 20, (1000, 2))])
+    cut = regions(boxes, 64)
+    places = np.concatenate(cut)
+    assert sorted(places.tolist()) == list(range(1000)) and max(len(r) for r in cut) <= 64
+    assert all((np.diff(r) > 0).all() for r in cut) and len(cut) >= 1000 // 64
+    core = cut[0]
+    near = around(boxes, core, 2.0, rings=1)
+    assert set(core.tolist()) <= set(near.tolist())
+    x0, y0 = boxes[core, :2].min(axis=0) - 2.0
+    x1, y1 = boxes[core, 2:].max(axis=0) + 2.0
+    inside = (boxes[:, 0] <= x1) & (boxes[:, 2] >= x0) & (boxes[:, 1] <= y1) & (boxes[:, 3] >= y0)
+    assert near.tolist() == np.flatnonzero(inside).tolist()
+
+
+def test_spooled_items_read_back_in_any_order() -> None:
+    from facadecli.city.packed import Spooled
+
+    shared = {"big": list(range(1000))}
+    items: Spooled[Any] = Spooled(shared)
+    for k in range(50):
+        items.append((k, f"item-{k}", shared["big"]))
+    assert [items[k][0] for k in (49, 0, 17, -1)] == [49, 0, 17, 49]
+    assert items[3][2] is shared["big"] and len(items) == 50
+    assert [item[0] for item in items.only([5, 2, 40])] == [5, 2, 40]

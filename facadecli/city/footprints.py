@@ -12,14 +12,18 @@ reported per feature (id, index, line), never raised; what makes the run ambiguo
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import math
 import re
 import statistics
+from array import array
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pyproj
 import shapely
 import shapely.affinity
@@ -31,6 +35,7 @@ from facadecli.city.geopackage import read_geopackage
 from facadecli.city.georef import utm_epsg
 from facadecli.city.ogr import is_ogr, read_ogr
 from facadecli.city.osm import is_osm, read_osm
+from facadecli.city.packed import Spooled
 from facadecli.errors import Problem, SpecError
 from facadecli.limits import (
     BUILDING_HEIGHT_MAX,
@@ -106,6 +111,7 @@ def feature_id(feature: Any, index: int) -> str:
 
 
 Found = tuple[int, str, dict[str, Any], Any]  # index, id, properties, geometry
+Record = tuple[int, str, dict[str, Any], Any, list[tuple[float, float]]]  # and entrances
 
 
 def _document(path: Path) -> GeoJSON:
@@ -129,64 +135,238 @@ def read_footprints(
     """Footprints of every usable feature; rejected features with a reason and place.
     With ``bbox``, only the features whose footprint has a point inside it (in the
     file's CRS: lon/lat for OSM extracts) are read. ``names``: the manifest's properties
-    holding heights and levels, checked as the OSM tags are.
+    holding heights and levels, checked as the OSM tags are. The file is surveyed
+    (:func:`survey`), then every footprint read at once (:meth:`Survey.read`); a city
+    is planned a region at a time instead (run.py)."""
+    surveyed = survey(path, bbox, names)
+    read = surveyed.read(range(len(surveyed)), surveyed.doors_within(None))
+    footprints = [footprint for _, footprint in read.footprints]
+    made = bytearray(len(surveyed))
+    for place in read.made:
+        made[place] = 1
+    return surveyed.found(footprints, read.rejected, made, read.near_doors, [])
 
-    The features are read one by one, each decoded once, and each footprint is held in
-    one form at a time: as read, in metres, then made the footprint, each form let go
-    as the next is made (a city's footprints are its planning's largest part)."""
+
+@dataclass
+class Read:
+    """Some of a survey's footprints read (:meth:`Survey.read`): each with its place in
+    the survey, in the file's order; the features of them that are not footprints; the
+    places of those that are (``made``); the entrance points found on their edges."""
+
+    footprints: list[tuple[int, Footprint]]
+    rejected: list[Rejected]
+    made: list[int]
+    near_doors: set[int]  # the doors' feature indices
+
+
+@dataclass
+class Survey:
+    """A footprints file's first pass (:func:`survey`): what the whole city needs (the
+    CRS, the origin, the far features, two features with one id, the features that are
+    not footprints) and, for each feature kept, its bounding box in local metres and its
+    record spooled to a temporary file (:class:`.packed.Spooled`): its footprint is made when a
+    region of the city is read (:meth:`read`), not held."""
+
+    document: GeoJSON
+    crs: pyproj.CRS
+    origin: tuple[float, float]
+    outside: int  # features left out by a bounding box
+    indices: array[int]  # each kept feature's index in the file, ascending
+    boxes: Any  # numpy (n, 4): each kept feature's bounds in local metres
+    spool: Spooled[Record]  # each kept feature's record, by its place here
+    rejected: list[Rejected]  # features that are no footprint, found by the survey
+    warned: list[Rejected]  # tags left out, of every kept feature
+    doors: list[Found]  # entrance points inside the box, as read (the file's CRS)
+    door_points: Any  # numpy (m, 2): those points in local metres
+
+    def __len__(self) -> int:
+        return len(self.indices)
+
+    def doors_within(self, box: tuple[float, float, float, float] | None) -> list[int]:
+        """The doors (their numbers) whose point is in ``box`` (local metres; None: all)."""
+        if box is None:
+            return list(range(len(self.doors)))
+        xs, ys = self.door_points[:, 0], self.door_points[:, 1]
+        inside = (xs >= box[0]) & (xs <= box[2]) & (ys >= box[1]) & (ys <= box[3])
+        return [int(k) for k in np.flatnonzero(inside)]
+
+    def read(self, places: Iterable[int], doors: list[int]) -> Read:
+        """The footprints of the kept features at ``places`` (ascending), with the
+        entrance points of ``doors`` lying on their edges; each feature's footprint made
+        as :func:`read_footprints` always made it, one form at a time."""
+        project = _projection(self.document.crs, self.crs)
+        minx, miny = self.origin
+        words = Words()
+        footprints: list[tuple[int, Footprint]] = []
+        rejected: list[Rejected] = []
+        for place in places:
+            index, fid, properties, geometry, points = self.spool[place]
+            metres = shapely.transform(geometry, project, interleaved=False)
+            del geometry
+            local = shapely.affinity.translate(metres, -minx, -miny)
+            footprint = _footprint(fid, words.properties(properties), local)
+            del metres, local, properties
+            if isinstance(footprint, str):
+                rejected.append(_rejected(self.document, index, fid, footprint))
+                continue
+            if points:
+                xs, ys = project(*zip(*points, strict=True))
+                at = tuple((x - minx, y - miny) for x, y in zip(xs, ys, strict=True))
+                footprint = dataclasses.replace(footprint, entrances=at)
+            footprints.append((place, footprint))
+        made = [place for place, _ in footprints]
+        with_doors, astray = _with_entrances(
+            [footprint for _, footprint in footprints],
+            [self.doors[k] for k in doors],
+            project,
+            self.origin,
+        )
+        footprints = list(zip(made, with_doors, strict=True))
+        lost = {index for index, *_ in astray}
+        near = {self.doors[k][0] for k in doors} - lost
+        return Read(footprints, rejected, made, near)
+
+    @property
+    def unit(self) -> float:
+        return _unit(self.crs)
+
+    def found(
+        self,
+        footprints: list[Footprint],
+        rejected: list[Rejected],
+        made: bytearray,
+        near_doors: set[int],
+        planned: list[Rejected],
+    ) -> FootprintSet:
+        """The town read, its footprints ``footprints`` (those a run keeps): the features
+        rejected (the survey's and those of ``rejected``, in the file's order; a
+        SpecError when no feature is a footprint: ``made`` is 1 at the place of each
+        that is), and the
+        warnings (:meth:`warnings`, then the planning's, ``planned``)."""
+        rejected = self.all_rejected(rejected)
+        if rejected and not any(made):
+            raise _nothing_usable(self.document, rejected)
+        return FootprintSet(
+            tuple(footprints),
+            tuple(rejected),
+            self.crs.to_string(),
+            self.origin,
+            self.outside,
+            unit=self.unit,
+            warnings=(*self.warnings(made, near_doors), *planned),
+        )
+
+    def made(self, made: bytearray, index: int | None) -> bool:
+        """Is the feature of ``index`` in the file a footprint (kept here, and 1 at its
+        place in ``made``)?"""
+        place = bisect.bisect_left(self.indices, -1 if index is None else index)
+        return place < len(self.indices) and self.indices[place] == index and bool(made[place])
+
+    def all_rejected(self, read: Iterable[Rejected]) -> list[Rejected]:
+        """The survey's rejected features and ``read``'s, in the file's order."""
+        rejected = [*self.rejected, *read]
+        rejected.sort(key=lambda r: -1 if r.index is None else r.index)
+        return rejected
+
+    def warnings(self, made: bytearray, near_doors: set[int]) -> tuple[Rejected, ...]:
+        """The warnings of reading: the tags left out of the features that are footprints
+        (``made``: their places), then the entrance points on no footprint's edge (those
+        not in ``near_doors``), each in the file's order."""
+        found = tuple(w for w in self.warned if self.made(made, w.index))
+        return found + tuple(
+            _rejected(self.document, index, fid, ASTRAY.format(x=point.x, y=point.y))
+            for index, fid, _, point in self.doors
+            if index not in near_doors
+        )
+
+
+def survey(path: Path, bbox: BBox | None = None, names: Names | None = None) -> Survey:
+    """The first pass over a footprints file (:class:`Survey`): each feature read once,
+    checked (its tags, its geometry, its id against the others') and spooled as it was
+    read (its tags, its polygons in the file's CRS); what is held a feature is its index,
+    the middle of its box, and its offset in the spool. Then the features are projected
+    to metres one at a time, without those far from the others, for their boxes and the
+    origin (the south-west corner of the data)."""
     document = _document(path)
     rejected: list[Rejected] = []
     warned: list[Rejected] = []
     doors: list[Found] = []
-    found, entrances = _readable(document, rejected, warned, names, doors)
-    readable = len(found)
-    inside_ids = None
-    if bbox is not None:
-        found = [f for f in found if _within(f[3], bbox)]
-        inside_ids = {index for index, *_ in found}
-    outside = readable - len(found)
-    crs = _projected(document.crs, [geometry for *_, geometry in found])
-    found = _in_metres(document, crs, found, rejected)
-    minx = min((geometry.bounds[0] for *_, geometry in found), default=0.0)
-    miny = min((geometry.bounds[1] for *_, geometry in found), default=0.0)
-    footprints = []
-    found.reverse()  # taken from the end: each feature's geometry in metres let go in turn
-    while found:
-        index, fid, properties, geometry = found.pop()
-        footprint = _footprint(fid, properties, shapely.affinity.translate(geometry, -minx, -miny))
-        del geometry, properties
-        if isinstance(footprint, str):
-            rejected.append(_rejected(document, index, fid, footprint))
+    spool: Spooled[Record] = Spooled()
+    kept = array("q")
+    middles = array("d")  # each kept feature's box's middle, x then y (the file's CRS)
+    readable = 0
+    first: dict[str, int] = {}  # id -> the first feature with it
+    duplicates: list[tuple[int, str]] = []
+    for index, feature in enumerate(document.features):
+        fid = feature_id(feature, index)
+        if first.setdefault(fid, index) != index:
+            duplicates.append((index, fid))
             continue
-        points = entrances.get(index)
-        if points:
-            xs, ys = _projection(document.crs, crs)(*zip(*points, strict=True))
-            local = tuple((x - minx, y - miny) for x, y in zip(xs, ys, strict=True))
-            footprint = dataclasses.replace(footprint, entrances=local)
-        footprints.append(footprint)
-    inside_doors = doors if bbox is None else [d for d in doors if _within(d[3], bbox)]
-    footprints, astray = _with_entrances(
-        footprints, inside_doors, _projection(document.crs, crs), (minx, miny)
+        point = entrance_point(feature)
+        if point is not None:
+            if bbox is None or _within(point, bbox):
+                doors.append((index, fid, feature["properties"], point))
+            continue
+        reason = document.reasons.get(index)
+        read = reason if reason is not None else read_feature(feature, document.crs)
+        if isinstance(read, str):
+            rejected.append(_rejected(document, index, fid, read))
+            continue
+        readable += 1
+        properties, problems = checked_properties(read[0], names)
+        geometry = read[1]
+        if bbox is not None and not _within(geometry, bbox):
+            continue
+        warned.extend(_rejected(document, index, fid, problem) for problem in problems)
+        bounds = geometry.bounds
+        middles.extend(((bounds[0] + bounds[2]) / 2, (bounds[1] + bounds[3]) / 2))
+        spool.append((index, fid, properties, geometry, _entrances(feature)))
+        kept.append(index)
+        del feature, read, properties, geometry
+    if duplicates:
+        raise _duplicated(document, duplicates, first)
+    del first
+    crs = _projected(document.crs, middles)
+    del middles
+    project = _projection(document.crs, crs)
+    projected = array("d")  # each kept feature's bounds in metres
+    for place in range(len(spool)):
+        geometry = spool[place][3]
+        projected.extend(shapely.transform(geometry, project, interleaved=False).bounds)
+    bounds = np.frombuffer(projected, dtype=np.float64).reshape(-1, 4)
+    middle = _middle_of(
+        ((bounds[:, 0] + bounds[:, 2]) / 2).tolist(), ((bounds[:, 1] + bounds[:, 3]) / 2).tolist()
     )
-    rejected.sort(key=lambda r: -1 if r.index is None else r.index)
-    if rejected and not footprints:
-        raise _nothing_usable(document, rejected)
-    built = {footprint.id for footprint in footprints}
-    warnings = tuple(
-        w for w in warned if (inside_ids is None or w.index in inside_ids) and w.id in built
-    )
-    warnings += tuple(
-        _rejected(document, index, fid, ASTRAY.format(x=point.x, y=point.y))
-        for index, fid, _, point in astray
-    )
-    return FootprintSet(
-        tuple(footprints),
-        tuple(rejected),
-        crs.to_string(),
+    near = []
+    for place, box in enumerate(bounds):
+        far = _far((float(box[0]), float(box[1]), float(box[2]), float(box[3])), middle)
+        if far is None:
+            near.append(place)
+        else:
+            index, fid = spool[place][:2]
+            rejected.append(_rejected(document, index, fid, far))
+    spool = spool.only(near)
+    indices = array("q", (kept[place] for place in near))
+    boxes = bounds[near]
+    minx = float(boxes[:, 0].min()) if len(boxes) else 0.0
+    miny = float(boxes[:, 1].min()) if len(boxes) else 0.0
+    boxes = boxes - np.array([minx, miny, minx, miny])
+    door_points = np.zeros((len(doors), 2))
+    for k, (*_, point) in enumerate(doors):
+        x, y = project(point.x, point.y)
+        door_points[k] = (x - minx, y - miny)
+    return Survey(
+        document,
+        crs,
         (minx, miny),
-        outside,
-        unit=_unit(crs),
-        warnings=warnings,
+        readable - len(kept),
+        indices,
+        boxes,
+        spool,
+        rejected,
+        warned,
+        doors,
+        door_points,
     )
 
 
@@ -223,72 +403,6 @@ class Words:
 
 WORDS_MAX = 1 << 16  # distinct keys and values held once (Words)
 WORD_LENGTH = 40  # characters: longer values (names, notes) are seldom repeated
-
-
-def _readable(
-    document: GeoJSON,
-    rejected: list[Rejected],
-    warned: list[Rejected],
-    names: Names | None,
-    doors: list[Found],
-) -> tuple[list[Found], dict[int, list[tuple[float, float]]]]:
-    """The features that are polygons, in the file's CRS, their properties checked
-    (:func:`checked_properties`: what is left out is in ``warned``), and the entrances
-    an OSM extract's reader put on them (:func:`_entrances`), by feature; points tagged
-    ``entrance`` go to ``doors`` (:func:`entrance_point`). One pass, each feature read
-    once; two features with one id are a SpecError after it (:func:`_duplicated`)."""
-    found = []
-    entrances = {}
-    words = Words()
-    first: dict[str, int] = {}  # id -> the first feature with it
-    duplicates: list[tuple[int, str]] = []
-    for index, feature in enumerate(document.features):
-        fid = feature_id(feature, index)
-        if first.setdefault(fid, index) != index:
-            duplicates.append((index, fid))
-            continue
-        point = entrance_point(feature)
-        if point is not None:
-            doors.append((index, fid, feature["properties"], point))
-            continue
-        reason = document.reasons.get(index)
-        read = reason if reason is not None else read_feature(feature, document.crs)
-        if isinstance(read, str):
-            rejected.append(_rejected(document, index, fid, read))
-            continue
-        properties, problems = checked_properties(read[0], names)
-        warned.extend(_rejected(document, index, fid, problem) for problem in problems)
-        found.append((index, fid, words.properties(properties), read[1]))
-        points = _entrances(feature)
-        if points:
-            entrances[index] = points
-    if duplicates:
-        raise _duplicated(document, duplicates, first)
-    return found, entrances
-
-
-def _in_metres(
-    document: GeoJSON, crs: pyproj.CRS, found: list[Found], rejected: list[Rejected]
-) -> list[Found]:
-    """The features projected to metres in ``crs``, without those far from the others.
-    ``found`` is projected in place: each geometry as read is let go as it is projected."""
-    transform = _projection(document.crs, crs)
-    for k, (index, fid, properties, geometry) in enumerate(found):
-        found[k] = (
-            index,
-            fid,
-            properties,
-            shapely.transform(geometry, transform, interleaved=False),
-        )
-    middle = _middle([geometry for *_, geometry in found])
-    near = []
-    for index, fid, properties, geometry in found:
-        far = _far(geometry, middle)
-        if far:
-            rejected.append(_rejected(document, index, fid, far))
-        else:
-            near.append((index, fid, properties, geometry))
-    return near
 
 
 def _footprint(fid: str, properties: dict[str, Any], local: Any) -> Footprint | str:
@@ -385,12 +499,13 @@ def _polygons(geometry: Any) -> list[Polygon]:
     return []
 
 
-def _projected(source: pyproj.CRS, geometries: list[Any]) -> pyproj.CRS:
+def _projected(source: pyproj.CRS, middles: Sequence[float]) -> pyproj.CRS:
     """The CRS of the outputs: a projected ``source`` itself; for lon/lat, the UTM zone
-    of the middle of the data (see georef.py)."""
+    of the middle of the data (see georef.py; ``middles``: the features' boxes' middles,
+    x then y, in ``source``)."""
     if not source.is_geographic:
         return source
-    return pyproj.CRS.from_epsg(utm_epsg(*_middle(geometries)))
+    return pyproj.CRS.from_epsg(utm_epsg(*_middle_of(middles[0::2], middles[1::2])))
 
 
 def _unit(crs: pyproj.CRS) -> float:
@@ -408,23 +523,17 @@ def _projection(source: pyproj.CRS, target: pyproj.CRS) -> Any:
     return lambda x, y: (x * scale, y * scale)
 
 
-def _middle(geometries: list[Any]) -> tuple[float, float]:
-    """The (low) median of the geometries' bounding-box centres: stray features cannot
-    move it, and of two features it is one of them."""
-    if not geometries:
+def _middle_of(xs: Sequence[float], ys: Sequence[float]) -> tuple[float, float]:
+    """The (low) median of the features' bounding-box middles (``xs``, ``ys``): stray
+    features cannot move it, and of two features it is one of them."""
+    if len(xs) == 0:
         return 0.0, 0.0
-    boxes = [g.bounds for g in geometries]
-    return (
-        statistics.median_low((b[0] + b[2]) / 2 for b in boxes),
-        statistics.median_low((b[1] + b[3]) / 2 for b in boxes),
-    )
+    return float(statistics.median_low(xs)), float(statistics.median_low(ys))
 
 
-def _far(geometry: Any, middle: tuple[float, float]) -> str | None:
-    """Why a projected geometry is no place for a building of this city, if it is not."""
-    bounds = geometry.bounds
-    if not all(math.isfinite(v) for v in bounds):
-        return "coordinates that cannot be projected"
+def _far(bounds: tuple[float, float, float, float], middle: tuple[float, float]) -> str | None:
+    """Why a projected geometry (its ``bounds``) is no place for a building of this
+    city, if it is not."""
     reach = max(
         abs(bounds[0] - middle[0]),
         abs(bounds[2] - middle[0]),

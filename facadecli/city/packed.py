@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import io
 import pickle
+import tempfile
 import zlib
 from array import array
 from collections.abc import Iterable, Iterator, Sequence
-from typing import Generic, TypeVar, overload
+from typing import Any, Generic, TypeVar, overload
 
 T = TypeVar("T")
 
@@ -47,15 +48,70 @@ class Positional(Sequence[T], Generic[T]):
         return self._at(index)
 
 
-class Packed(Positional[T]):
+class Pickling:
+    """Items pickled with the large objects they refer to named, not copied (``shared``:
+    name -> object, the run's specs, which stay in memory anyway), and read back."""
+
+    def __init__(self, shared: dict[str, object] | None = None):
+        self._shared = dict(shared or {})
+        self._names = {id(item): name for name, item in self._shared.items()}
+
+    def _dumps(self, item: object) -> bytes:
+        buffer = io.BytesIO()
+        pickler = pickle.Pickler(buffer, protocol=pickle.HIGHEST_PROTOCOL)
+        pickler.persistent_id = lambda item: self._names.get(id(item))  # type: ignore[method-assign]
+        pickler.dump(item)
+        return zlib.compress(buffer.getvalue(), LEVEL)
+
+    def _loads(self, data: bytes) -> Any:
+        unpickler = pickle.Unpickler(io.BytesIO(zlib.decompress(data)))
+        unpickler.persistent_load = self._shared.__getitem__  # type: ignore[method-assign]
+        return unpickler.load()
+
+
+class Spooled(Pickling, Positional[T]):
+    """Items appended (:meth:`append`) then read by position in any order, each pickled
+    (as :class:`Pickling`) and compressed into an unnamed temporary file: 8 bytes an
+    item in memory (its offset), one item unpacked at a time. For what is put in one
+    order and read in another (a town's regions' tasks, run.py), or read again later
+    (the features a survey of a footprints file keeps, footprints.py)."""
+
+    def __init__(self, shared: dict[str, object] | None = None):
+        super().__init__(shared)
+        self._file = tempfile.TemporaryFile()  # noqa: SIM115 (open as long as the items)
+        self._offsets = array("q")
+
+    def append(self, item: T) -> None:
+        data = self._dumps(item)
+        self._file.seek(0, io.SEEK_END)
+        self._offsets.append(self._file.tell())
+        self._file.write(len(data).to_bytes(4, "little") + data)
+
+    def only(self, positions: Iterable[int]) -> Spooled[T]:
+        """The items at ``positions``, in that order (the same file, not copied)."""
+        kept: Spooled[T] = Spooled.__new__(Spooled)
+        kept._shared, kept._names, kept._file = self._shared, self._names, self._file
+        kept._offsets = array("q", (self._offsets[k] for k in positions))
+        return kept
+
+    def __len__(self) -> int:
+        return len(self._offsets)
+
+    def _at(self, index: int) -> T:
+        self._file.seek(self._offsets[index])
+        size = int.from_bytes(self._file.read(4), "little")
+        item: T = self._loads(self._file.read(size))
+        return item
+
+
+class Packed(Pickling, Positional[T]):
     """Items appended (:meth:`append`) then read by position, kept packed in chunks.
     ``shared`` names the large objects the items refer to and that stay in memory
     anyway (the run's specs, by their manifest path): they are packed as their name.
     Items must be picklable, and equal to themselves pickled and unpickled."""
 
     def __init__(self, shared: dict[str, object] | None = None, chunk: int = CHUNK):
-        self._shared = dict(shared or {})
-        self._names = {id(item): name for name, item in self._shared.items()}
+        super().__init__(shared)
         self._chunk = chunk
         self._packed: list[bytes] = []
         self._open: list[T] = []  # the last chunk, not yet packed
@@ -76,16 +132,10 @@ class Packed(Positional[T]):
         return sum(len(data) for data in self._packed)
 
     def _pack(self, items: list[T]) -> bytes:
-        buffer = io.BytesIO()
-        pickler = pickle.Pickler(buffer, protocol=pickle.HIGHEST_PROTOCOL)
-        pickler.persistent_id = lambda item: self._names.get(id(item))  # type: ignore[method-assign]
-        pickler.dump(items)
-        return zlib.compress(buffer.getvalue(), LEVEL)
+        return self._dumps(items)
 
     def _unpack(self, data: bytes) -> list[T]:
-        unpickler = pickle.Unpickler(io.BytesIO(zlib.decompress(data)))
-        unpickler.persistent_load = self._shared.__getitem__  # type: ignore[method-assign]
-        items: list[T] = unpickler.load()
+        items: list[T] = self._loads(data)
         return items
 
     def _chunk_at(self, number: int) -> list[T]:

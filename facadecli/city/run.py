@@ -23,6 +23,7 @@ import os
 import queue
 import re
 import time
+from array import array
 from collections import Counter
 from collections.abc import Callable, Container, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -30,6 +31,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numpy as np
 import shapely
 
 from facadecli.city.building import (
@@ -57,18 +59,21 @@ from facadecli.city.cityjson import (
 from facadecli.city.entrances import Wall, door_owners
 from facadecli.city.folders import BUILDINGS, SHARD, building_file, run_folder, safe_name
 from facadecli.city.footprints import (
+    ON_EDGE,
     BBox,
     Footprint,
     FootprintSet,
     Rejected,
     Simplified,
-    read_footprints,
+    Survey,
+    survey,
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.heap import EVERY, give_back
 from facadecli.city.lods import feature_scene
 from facadecli.city.manifest import Choice, City, Roof, WallRule
-from facadecli.city.packed import Packed, Picked, Points
+from facadecli.city.packed import Packed, Picked, Points, Spooled
+from facadecli.city.regions import REGION, around, extent, regions
 from facadecli.city.report import CityReport, Entries, Summary, Tally
 from facadecli.city.resume import (
     Hashes,
@@ -335,20 +340,27 @@ def plan(
     instanced: bool = False,
     level: int = 3,
     shared_textures: bool = True,
-) -> tuple[Packed[Task], list[Rejected]]:
+    core: Container[str] | None = None,
+    same: Same | None = None,
+    checked: bool = True,
+) -> tuple[Packed[Task], list[tuple[str, Rejected]]]:
     """One task a building, built to ``level`` of detail (below 3: no façades), kept
     packed as they are made (packed.py: a client's memory for a city of any size), and
-    the warnings of the planning: an entrance that two buildings hold
-    (:func:`one_door_each`). Paths are absolute: workers (Dask's too) may run elsewhere."""
+    the warnings of the planning, each with the id of the first footprint it is about:
+    an entrance that two buildings hold (:func:`one_door_each`). Paths are absolute:
+    workers (Dask's too) may run elsewhere. With ``core`` (ids), the tasks of those
+    footprints alone, the others their neighbours (a region of a town, :func:`planned`);
+    ``same`` is the town's (:class:`Same`); with ``checked`` False, two ids giving one
+    file name are left to the caller (:class:`FileNames`: a town checks them in order)."""
     outdir = outdir.resolve()
     defaults = city.manifest.defaults
     tolerance = defaults.party_wall_tolerance
-    same = Same()  # most buildings share a choice and a roof: held once, not a building
+    names = FileNames(str(city.footprints))
+    same = Same() if same is None else same  # most buildings share a choice and a roof
     shapes = {}
     for footprint in footprints:
         choice, heights, roof = _shape(city, footprint.properties)
         shapes[footprint.id] = (same(choice), heights, same(roof))
-    del same
     above = standing_on(footprints, {key: shape[1] for key, shape in shapes.items()})
     raised = lifted(
         footprints, {k: s[1] for k, s in shapes.items()}, {k: s[2] for k, s in shapes.items()}
@@ -372,9 +384,9 @@ def plan(
         lines = _from_wkb(ahead.get(footprint.id))
         return building_walls(footprint, heights, roof, lines, tolerance)
 
-    footprints, warnings = one_door_each(footprints, walls_of)
+    footprints, warnings = one_door_each(footprints, walls_of, core)
     ahead.clear()
-    shared = Lockstep(lines_of())
+    shared = Lockstep(lines_of(core))
     identities: dict[str, str] = {}  # spec path -> its path and a digest of its content
 
     def facade_of(path: str) -> Facade:
@@ -382,18 +394,12 @@ def plan(
         return Facade(city.specs[path], identities[path], (city.folder / path).parent.resolve())
 
     tasks: Packed[Task] = Packed(dict(city.specs))
-    owners: dict[str, str] = {}  # file name -> building id
     for footprint in footprints:
-        choice, heights, roof = shapes[footprint.id]  # a later neighbour's walls need it
-        name = safe_name(footprint.id)
-        if owners.setdefault(name, footprint.id) != footprint.id:
-            raise SpecError.at(
-                str(city.footprints),
-                None,
-                None,
-                f"ids '{owners[name]}' and '{footprint.id}' give one file name '{name}'",
-                "change one of the ids",
-            )
+        if core is not None and footprint.id not in core:
+            continue
+        choice, heights, roof = shapes[footprint.id]
+        if checked:
+            names.add(footprint.id)
         properties = footprint.properties
         fallback_path = defaults.fallback_facade
         named = (choice.facade, *(rule.facade for rule in choice.walls))
@@ -435,6 +441,26 @@ def plan(
             )
         )
     return tasks, warnings
+
+
+class FileNames:
+    """The buildings' file names (folders.py), each added in the manifest's order: two
+    ids giving one name are an error (exit 2) at the second, naming the first."""
+
+    def __init__(self, file: str) -> None:
+        self.file = file
+        self.owners: dict[str, str] = {}  # file name -> building id
+
+    def add(self, key: str) -> None:
+        name = safe_name(key)
+        if self.owners.setdefault(name, key) != key:
+            raise SpecError.at(
+                self.file,
+                None,
+                None,
+                f"ids '{self.owners[name]}' and '{key}' give one file name '{name}'",
+                "change one of the ids",
+            )
 
 
 def _from_wkb(data: bytes | None) -> Any:
@@ -482,14 +508,18 @@ def shared_doors(footprints: Sequence[Footprint]) -> set[str]:
 
 
 def one_door_each(
-    footprints: list[Footprint], walls: Callable[[Footprint], list[Wall]]
-) -> tuple[list[Footprint], list[Rejected]]:
+    footprints: list[Footprint],
+    walls: Callable[[Footprint], list[Wall]],
+    core: Container[str] | None = None,
+) -> tuple[list[Footprint], list[tuple[str, Rejected]]]:
     """The footprints with each entrance held by one of them only: an entrance node two
     outlines share (a terrace's corner, a wall two buildings share), or an entrance point
     within reach of both, goes to the first of :func:`.entrances.door_owners` (whose wall
     there is not a party wall, the door farthest from the wall's ends), to none when it
     is on party walls alone. A warning (counted under ``entrance``) says which got it
-    when several could have, and that none did when it is on party walls alone."""
+    when several could have, and that none did when it is on party walls alone; each
+    with the id of the first footprint holding the entrance. With ``core`` (ids), the
+    entrances those footprints hold alone, and the warnings whose first holder it is."""
     holders: dict[tuple[float, float], list[int]] = {}
     for index, footprint in enumerate(footprints):
         for point in footprint.entrances:
@@ -499,6 +529,9 @@ def one_door_each(
     for point, indices in holders.items():
         if len(indices) < 2:
             continue
+        if core is not None and not any(footprints[k].id in core for k in indices):
+            continue
+        first = footprints[indices[0]].id
         ranked = door_owners(point, [(footprints[k].id, walls(footprints[k])) for k in indices])
         for k in indices:
             if not ranked or footprints[k].id != ranked[0]:
@@ -509,11 +542,13 @@ def one_door_each(
                 f"{where} is on walls of {', '.join(ranked)}, none a party wall: the door "
                 f"goes to {ranked[0]}, where it lies farthest from its wall's ends"
             )
-            warnings.append(Rejected(ranked[0], reason, None, None, None))
+            warnings.append((first, Rejected(ranked[0], reason, None, None, None)))
         elif not ranked:
             ids = ", ".join(footprints[k].id for k in indices)
             reason = f"{where} is on party walls of {ids} only: no door there"
-            warnings.append(Rejected(footprints[indices[0]].id, reason, None, None, None))
+            warnings.append((first, Rejected(first, reason, None, None, None)))
+    if core is not None:
+        warnings = [(key, warning) for key, warning in warnings if key in core]
     kept = [
         replace(f, entrances=tuple(p for p in f.entrances if p not in dropped[k]))
         if k in dropped
@@ -744,28 +779,163 @@ def planned(
     instanced: bool = False,
     level: int = 3,
     shared_textures: bool = True,
+    region: int = REGION,
 ) -> Planned:
     """The footprints read (those in ``bbox``), an outline's tags given to its parts, the
     outlines with parts cut to what they leave, collinear nodes merged, the first
-    ``limit`` planned (:func:`plan`) for ``outdir``."""
-    found = read_footprints(city.footprints, bbox, city.manifest.properties.names())
-    replaced = replaced_outlines(found.footprints)
-    footprints, kept = standing(city, inherited(found.footprints, replaced), replaced)
-    defaults = city.manifest.defaults
-    straight = straighten(footprints, defaults.collinear_angle, defaults.party_wall_tolerance)
-    footprints = list(straight.footprints[: limit if limit is not None else None])
-    # what the run holds: the outlines whose parts are built (their tags, for the
-    # CityJSON's Building), not every footprint read as well as every one planned
-    outlines = tuple(footprint for footprint in found.footprints if footprint.id in replaced)
-    found = replace(found, footprints=outlines)
-    straight = replace(straight, footprints=())
-    tasks, warnings = plan(
-        city, footprints, outdir.resolve(), usd, instanced, level, shared_textures
+    ``limit`` planned (:func:`plan`) for ``outdir``.
+
+    The file is surveyed first (footprints.py: the CRS, the origin, the far features),
+    then the town is planned a region of at most ``region`` features at a time
+    (regions.py), each with the features around it its buildings depend on, its tasks
+    packed and the rest freed before the next; the tasks are then put in the manifest's
+    order, and the warnings in the order planning the town at once gives them: the same
+    tasks and warnings. With ``limit``, the town is one region (the first ``limit``
+    buildings are planned among themselves)."""
+    outdir = outdir.resolve()
+    surveyed = survey(city.footprints, bbox, city.manifest.properties.names())
+    same = Same()  # the town's choices and roofs, each held once
+    made = bytearray(len(surveyed))  # 1 at the place of each feature that is a footprint
+    near_doors: set[int] = set()  # the entrance points on some footprint's edge
+    rejected: list[Rejected] = []
+    outlines: list[tuple[int, Footprint]] = []  # outlines with parts (their Building)
+    replaced: list[tuple[int, str, list[str], float]] = []  # and their parts, area kept
+    nodes = changed = 0
+    warned: list[tuple[int, Rejected]] = []  # planning's, by their first footprint's index
+    spooled: Spooled[Task] = Spooled(dict(city.specs))  # the tasks, region by region
+    keys = array("q")  # the index of each one's feature in the file
+    for core in regions(surveyed.boxes, region if limit is None else len(surveyed) or 1):
+        done = _region(
+            city, surveyed, core, outdir, limit, usd, instanced, level, shared_textures, same
+        )
+        for place in done.made:
+            made[place] = 1
+        near_doors |= done.near_doors
+        rejected += done.rejected
+        outlines += done.outlines
+        replaced += done.replaced
+        nodes, changed = nodes + done.nodes, changed + done.changed
+        warned += done.warned
+        for key, task in zip(done.keys, done.tasks, strict=True):
+            keys.append(key)
+            spooled.append(task)
+        del done
+    warned.sort(key=lambda found: found[0])  # stable: a region's in their order
+    names = FileNames(str(city.footprints))
+    tasks: Packed[Task] = Packed(dict(city.specs))
+    for position in np.argsort(np.frombuffer(keys, dtype=np.int64), kind="stable"):
+        task = spooled[int(position)]
+        names.add(task.footprint.id)
+        tasks.append(task)
+    del spooled, keys
+    found = surveyed.found(
+        [footprint for _, footprint in sorted(outlines, key=_first)],
+        rejected,
+        made,
+        near_doors,
+        [warning for _, warning in warned],
     )
-    found = replace(found, warnings=(*found.warnings, *warnings))
-    del footprints
+    replaced.sort(key=lambda outline: outline[0])
     give_back()  # what planning freed (the footprints read, their neighbours...)
-    return Planned(found, replaced, kept, straight, tasks)
+    return Planned(
+        found,
+        {key: parts for _, key, parts, _ in replaced},
+        {key: area for _, key, _, area in replaced},
+        Straightened((), nodes, changed),
+        tasks,
+    )
+
+
+MARGIN = 1.0  # metres more than the party walls' tolerance around a region (regions.py)
+
+
+@dataclass
+class Region:
+    """A region of a town planned (:func:`_region`): its buildings' tasks and what the
+    town's report needs of them, each footprint's by its feature's index in the file."""
+
+    keys: list[int]  # each task's feature's index
+    tasks: Packed[Task]
+    made: list[int]  # the survey's places of the region's features that are footprints
+    near_doors: set[int]  # the entrance points found on some footprint's edge
+    rejected: list[Rejected]  # the region's features that are no footprint
+    outlines: list[tuple[int, Footprint]]  # its outlines with parts
+    replaced: list[tuple[int, str, list[str], float]]  # and their parts, the area kept
+    nodes: int  # collinear nodes merged in its footprints
+    changed: int  # its footprints with some merged
+    warned: list[tuple[int, Rejected]]  # planning's warnings, by the first footprint's
+
+
+def _region(
+    city: City,
+    surveyed: Survey,
+    core: Any,
+    outdir: Path,
+    limit: int | None,
+    usd: bool,
+    instanced: bool,
+    level: int,
+    shared_textures: bool,
+    same: Same,
+) -> Region:
+    """The buildings of the features at ``core`` (places in the survey) planned with
+    every feature around them they depend on (regions.py): read, outlines cut by their
+    parts, collinear nodes merged and tasks made as for the whole town, the others read
+    only as their neighbours."""
+    defaults = city.manifest.defaults
+    margin = max(defaults.party_wall_tolerance, ON_EDGE) + MARGIN
+    places = around(surveyed.boxes, core, margin)
+    doors = surveyed.doors_within(extent(surveyed.boxes, places, ON_EDGE))
+    read = surveyed.read(places.tolist(), doors)
+    del places
+    inner = set(core.tolist())
+    index_of = {f.id: surveyed.indices[place] for place, f in read.footprints}
+    mine = {f.id for place, f in read.footprints if place in inner}
+    indices = {surveyed.indices[place] for place in inner}
+    footprints = [footprint for _, footprint in read.footprints]
+    made = [place for place in read.made if place in inner]
+    rejected = [r for r in read.rejected if r.index in indices]
+    near_doors = read.near_doors
+    del read  # the footprints as read, let go as they are made into tasks
+    parted = replaced_outlines(footprints)
+    built, kept = standing(city, inherited(footprints, parted), parted)
+    outlines = [(index_of[f.id], f) for f in footprints if f.id in parted and f.id in mine]
+    del footprints
+    straight = straighten(
+        built, defaults.collinear_angle, defaults.party_wall_tolerance, counted=mine
+    )
+    del built
+    chosen = list(straight.footprints[: limit if limit is not None else None])
+    nodes, changed = straight.nodes, straight.footprints_changed
+    del straight
+    tasks, warnings = plan(
+        city,
+        chosen,
+        outdir,
+        usd,
+        instanced,
+        level,
+        shared_textures,
+        core=mine,
+        same=same,
+        checked=False,
+    )
+    return Region(
+        [index_of[task.footprint.id] for task in tasks],
+        tasks,
+        made,
+        near_doors,
+        rejected,
+        outlines,
+        [(key, f.id, parted[f.id], kept[f.id]) for key, f in outlines],
+        nodes,
+        changed,
+        [(index_of[key], warning) for key, warning in warnings],
+    )
+
+
+def _first(pair: tuple[int, Any]) -> int:
+    return pair[0]
 
 
 def _build(

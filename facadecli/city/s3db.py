@@ -650,7 +650,9 @@ def party_lines(
             found = None
         if only is not None and owner[index] not in only:
             continue
-        near = [int(i) for i in tree.query(shape.buffer(tolerance))]
+        # by their place in the input, not the tree's order (which depends on every
+        # shape in it): the lines are united in the same order whatever else was read
+        near = sorted(int(i) for i in tree.query(shape.buffer(tolerance)))
         others = [
             shapes[i]
             for i in near

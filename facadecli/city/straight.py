@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from array import array
 from bisect import bisect_left, bisect_right
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Container, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -46,9 +46,15 @@ class Straightened:
     footprints_changed: int  # footprints with at least one node taken out
 
 
-def straighten(footprints: Sequence[Footprint], angle: float, near: float) -> Straightened:
+def straighten(
+    footprints: Sequence[Footprint],
+    angle: float,
+    near: float,
+    counted: Container[str] | None = None,
+) -> Straightened:
     """Every footprint with its near-collinear nodes merged (see the module); ``angle``
-    0 leaves them all as they are."""
+    0 leaves them all as they are. With ``counted`` (ids), the nodes and footprints
+    counted are those footprints' alone (a region of a town, the others its neighbours)."""
     if angle <= 0 or not footprints:
         return Straightened(tuple(footprints), 0, 0)
     corners = Corners(footprints, max(CELL, near))
@@ -67,8 +73,11 @@ def straighten(footprints: Sequence[Footprint], angle: float, near: float) -> St
             parts.append(merged)
             taken += count
         if taken > before:
-            changed += 1
             done.append(replace(footprint, parts=tuple(parts)))
+            if counted is not None and footprint.id not in counted:
+                taken = before
+            else:
+                changed += 1
         else:
             done.append(footprint)
     return Straightened(tuple(done), taken, changed)
