@@ -21,8 +21,9 @@ defects real façades have). Per size, over the façades:
 - ``comp``: façades where 90% or more of the windows keep their companions: the labels
   of the elements touching a window (within 5 cm along one axis, overlapping along the
   other: its sill, its blind; not the façade, an opening or a band across a quarter of
-  the façade) that most windows of the annotation like it have (sized within +-15%, on
-  the row nearest it along y); ``comp%``: the windows so, of all windows.
+  the façade; sized within +-15% as one of its label in the annotation) that most
+  windows of the annotation like it have (sized within +-15%, on the row nearest it
+  along y); ``comp%``: the windows so, of all windows.
 
 Then the spec's size: layers, symbols, counters (mean and most), façades with no counter;
 and CPU per façade (``time.process_time``: inferring, the check at 1x, and the five
@@ -150,15 +151,19 @@ def _touching(a: Rect, b: Rect) -> bool:
     return (over_x > 0 and over_y >= -TOUCH) or (over_y > 0 and over_x >= -TOUCH)
 
 
-def companions(rects: list[Rect], width: float) -> list[tuple[Rect, frozenset[str]]]:
-    """Each window with the labels of its companions (see the module)."""
+def companions(
+    rects: list[Rect], width: float, drawn: list[Rect] | None = None
+) -> list[tuple[Rect, frozenset[str]]]:
+    """Each window with the labels of its companions (see the module); with ``drawn``
+    (the annotation), only companions sized as one of their label there (+-15%): a
+    sliver squeezed to a millimetre is none."""
     others = [
         r
         for r in rects
         if r.label not in (*OPENINGS, "facade", "background")
-        and r.x1 - r.x0 <= BAND * width
-        and r.x1 - r.x0 > 1e-6
+        and 1e-6 < r.x1 - r.x0 <= BAND * width
         and r.y1 - r.y0 > 1e-6
+        and (drawn is None or _sized(r, [q for q in drawn if q.label == r.label]))
     ]
     return [(w, frozenset(o.label for o in others if _touching(w, o))) for w in windows(rects)]
 
@@ -217,7 +222,7 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
         if mirrored:
             tally.mirrored += 1
             tally.symmetric += symmetric(found, width)
-        held = sum(expected(w, drawn) <= c for w, c in companions(rects, width))
+        held = sum(expected(w, drawn) <= c for w, c in companions(rects, width, list(raw.rects)))
         tally.windows_with += held
         along = held / len(found) if found else 1.0
         tally.companions += along >= 0.9
