@@ -17,7 +17,13 @@ defects real façades have). Per size, over the façades:
 - ``ovl``: façades with more windows and doors overlapping one another (by more than
   1 cm x 1 cm) than the annotation has;
 - ``sym``: of the façades whose annotation is mirrored (90% of windows have a mirror image
-  within 0.15 m and 10% in size), those that stay so.
+  within 0.15 m and 10% in size), those that stay so;
+- ``comp``: façades where 90% or more of the windows keep their companions: the labels
+  of the elements touching a window (within 5 cm along one axis, overlapping along the
+  other: its sill, its blind; not the façade, an opening or a band across a quarter of
+  the façade; sized within +-15% as one of its label in the annotation) that most
+  windows of the annotation like it have (sized within +-15%, on the row nearest it
+  along y); ``comp%``: the windows so, of all windows.
 
 Then the spec's size: layers, symbols, counters (mean and most), façades with no counter;
 and CPU per façade (``time.process_time``: inferring, the check at 1x, and the five
@@ -56,6 +62,8 @@ SIZES = {
 NEAR = 0.15  # m: centres this close line up (1% of the input)
 KEEP = 0.15  # a window keeps its size within this share
 OPENINGS = ("window", "door")
+TOUCH = 0.05  # m: an element this close to a window (overlapping along the other axis) is its
+BAND = 0.25  # of the façade's width: an element wider is a band, no window's companion
 
 
 @dataclass
@@ -70,6 +78,8 @@ class Tally:
     overlaps: int = 0
     mirrored: int = 0
     symmetric: int = 0
+    companions: int = 0
+    windows_with: int = 0
     worst: list[str] = field(default_factory=list)
 
 
@@ -135,6 +145,42 @@ def symmetric(found: list[Rect], width: float) -> bool:
     return hits >= 0.9 * len(found)
 
 
+def _touching(a: Rect, b: Rect) -> bool:
+    over_x = min(a.x1, b.x1) - max(a.x0, b.x0)
+    over_y = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return (over_x > 0 and over_y >= -TOUCH) or (over_y > 0 and over_x >= -TOUCH)
+
+
+def companions(
+    rects: list[Rect], width: float, drawn: list[Rect] | None = None
+) -> list[tuple[Rect, frozenset[str]]]:
+    """Each window with the labels of its companions (see the module); with ``drawn``
+    (the annotation), only companions sized as one of their label there (+-15%): a
+    sliver squeezed to a millimetre is none."""
+    others = [
+        r
+        for r in rects
+        if r.label not in (*OPENINGS, "facade", "background")
+        and 1e-6 < r.x1 - r.x0 <= BAND * width
+        and r.y1 - r.y0 > 1e-6
+        and (drawn is None or _sized(r, [q for q in drawn if q.label == r.label]))
+    ]
+    return [(w, frozenset(o.label for o in others if _touching(w, o))) for w in windows(rects)]
+
+
+def expected(window: Rect, reference: list[tuple[Rect, frozenset[str]]]) -> frozenset[str]:
+    """The companions most windows of the annotation like ``window`` have: sized alike,
+    on the row (of those) nearest it along y."""
+    alike = [(r, c) for r, c in reference if _sized(window, [r])] or reference
+    if not alike:
+        return frozenset()
+    cy = _centre(window)[1]
+    nearest = min(abs(_centre(r)[1] - cy) for r, _ in alike)
+    row = [c for r, c in alike if abs(abs(_centre(r)[1] - cy) - nearest) <= NEAR]
+    labels = {label for c in row for label in c}
+    return frozenset(label for label in labels if 2 * sum(label in c for c in row) > len(row))
+
+
 def spec_size(text: str, name: str) -> tuple[int, int, int]:
     spec = parse_spec(text, name)
     return len(spec.layers), len(spec.symbols), len(spec.counters)
@@ -149,6 +195,7 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
     in_aligned = aligned(reference)
     in_overlaps = overlaps(list(raw.rects))
     mirrored = symmetric(reference, raw.width)
+    drawn = companions(list(raw.rects), raw.width)
     for size, (sx, sy) in SIZES.items():
         tally = tallies[size]
         tally.facades += 1
@@ -175,10 +222,15 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
         if mirrored:
             tally.mirrored += 1
             tally.symmetric += symmetric(found, width)
-        if share < 0.9 or not 0.85 <= ratio <= 1.15 or not kept or extra:
+        held = sum(expected(w, drawn) <= c for w, c in companions(rects, width, list(raw.rects)))
+        tally.windows_with += held
+        along = held / len(found) if found else 1.0
+        tally.companions += along >= 0.9
+        if share < 0.9 or not 0.85 <= ratio <= 1.15 or not kept or extra or along < 0.9:
             tally.worst.append(
                 f"{name}: {share:.0%} sized, density {ratio:.2f}, aligned "
-                f"{aligned(found):.2f} (input {in_aligned:.2f}), overlaps {overlaps(rects)}"
+                f"{aligned(found):.2f} (input {in_aligned:.2f}), overlaps {overlaps(rects)}, "
+                f"{along:.0%} with their companions"
             )
 
 
@@ -193,7 +245,7 @@ def report(
     print(f"\n{title}: {n} façades at 15 x 15 m, the spec solved at other sizes")
     print(
         f"{'size':5} {'solve':>6} {'size':>6} {'size%':>6} {'dens':>6} {'cols':>6} "
-        f"{'ovl':>6} {'sym':>7}"
+        f"{'ovl':>6} {'sym':>7} {'comp':>6} {'comp%':>6}"
     )
     for name, t in tallies.items():
         share = t.windows_ok / t.windows if t.windows else 1.0
@@ -201,7 +253,8 @@ def report(
             f"{name:5} {t.solve:3d}/{t.facades:<2d} {t.size:3d}/{t.solve:<2d} {share:6.0%} "
             f"{t.density:3d}/{t.solve:<2d} {t.columns:3d}/{t.solve:<2d} "
             f"{t.overlaps:3d}/{t.solve:<2d} "
-            f"{t.symmetric:3d}/{t.mirrored:<3d}"
+            f"{t.symmetric:3d}/{t.mirrored:<3d} {t.companions:3d}/{t.solve:<2d} "
+            f"{t.windows_with / t.windows if t.windows else 1.0:6.0%}"
         )
         if verbose:
             for line in t.worst:
