@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import statistics
 from collections import Counter, defaultdict
+from collections.abc import Iterator
 from dataclasses import dataclass
 from itertools import pairwise
 
@@ -191,8 +192,8 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
     the structure's (``_faithful``)."""
     reason = ""
     for on_openings in (True, False):
-        for follow in (FOLLOW, HELD):  # companions on the shapes, else fewer of them
-            found = _found(layout, drawn, on_openings, follow)
+        # companions on the shapes, else fewer of them: the kinds are found once for both
+        for found in _found(layout, drawn, on_openings, (FOLLOW, HELD)):
             if isinstance(found, str):
                 reason = found
             elif drawn is not None and not _faithful(drawn, layout, found.layout):
@@ -203,14 +204,20 @@ def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Ba
 
 
 def _found(
-    layout: LabelledLayout, drawn: LabelledLayout | None, on_openings: bool, follow: float
-) -> Bays | str:
-    """``find_bays`` with the bays' frames on their openings or as cut (``_frames``), the
-    openings' companions on the kinds' shapes within ``follow`` (``_apart``)."""
+    layout: LabelledLayout,
+    drawn: LabelledLayout | None,
+    on_openings: bool,
+    follows: tuple[float, ...],
+) -> Iterator[Bays | str]:
+    """``find_bays`` with the bays' frames on their openings or as cut (``_frames``): for
+    each of ``follows`` in turn, the bays with the openings' companions on the kinds'
+    shapes within it (``_apart``), or why there are none; one reason alone when it does
+    not depend on that limit (the kinds, their shapes and the bays' places do not)."""
     width = layout.width
     strips, spans, over = _strips(layout)
     if len(strips) < 2:
-        return FEW_BAYS
+        yield FEW_BAYS
+        return
     frames = _frames(layout.rects, strips, spans, on_openings)
     order = _right_half_mirrored_first(len(strips))
     unlike = _unlike(layout, [held for _, held in strips], frames, order)
@@ -247,7 +254,8 @@ def _found(
         symmetric = False
     end = start if centred else round(width - start - total, DIGITS)
     if start <= 0 or end <= 0:
-        return "the bays reach the façade's edge (no margin to take the slack)"
+        yield "the bays reach the façade's edge (no margin to take the slack)"
+        return
     unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
     unique |= set(ties)  # a variant is written once, as drawn
     runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
@@ -255,44 +263,48 @@ def _found(
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
         runs, counters = _plan(kinds, mirrored, unique, widths, False)
     if not any(r.counter and r.most is None for r in runs):
-        return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
+        yield f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
+        return
     narrowest = _narrowest(runs, kinds, widths, symmetric)
     if narrowest > NARROWEST * width:
-        return (
+        yield (
             f"its {len(kinds)} bays of {len(shapes)} kinds cannot narrow below "
             f"{narrowest / width:.2f} of its width (bays of a kind repeat; most are unlike)"
         )
+        return
     members = [held for _, held in strips]
-    placed, new_spans = _placed(layout, members, kinds, mirrored, matches, shapes, widths, start)
+    on_shapes, new_spans = _placed(layout, members, kinds, mirrored, matches, shapes, widths, start)
     drawn = drawn if drawn is not None and len(drawn.rects) == len(layout.rects) else layout
-    apart = _apart(drawn, placed, members, kinds, matches, follow) | over
-    for index in apart:
-        placed[index] = layout.rects[index]
-    if on_openings and _moved(layout, placed):
-        return "its bays put on their kinds' shapes would move openings from where drawn"
-    if _new_overlaps(layout.rects, placed):
-        return "its bays put on their kinds' shapes would overlap elements"
-    return Bays(
-        LabelledLayout(layout.width, layout.height, tuple(placed)),
-        tuple(new_spans),
-        tuple(kinds),
-        tuple(mirrored),
-        widths,
-        (start, end),
-        tuple(runs),
-        symmetric,
-        tuple(counters),
-        tuple(
-            max(
-                0.0,
-                round(
-                    widths[k] - max(round(c - w / 2, DIGITS) + w for _, c, w, _, _ in shape), DIGITS
-                ),
-            )
-            for k, shape in enumerate(shapes)
-        ),
-        frozenset(apart),
+    walls = tuple(
+        max(
+            0.0,
+            round(widths[k] - max(round(c - w / 2, DIGITS) + w for _, c, w, _, _ in shape), DIGITS),
+        )
+        for k, shape in enumerate(shapes)
     )
+    for follow in follows:
+        placed = list(on_shapes)
+        apart = _apart(drawn, on_shapes, members, kinds, matches, follow) | over
+        for index in apart:
+            placed[index] = layout.rects[index]
+        if on_openings and _moved(layout, placed):
+            yield "its bays put on their kinds' shapes would move openings from where drawn"
+        elif _new_overlaps(layout.rects, placed):
+            yield "its bays put on their kinds' shapes would overlap elements"
+        else:
+            yield Bays(
+                LabelledLayout(layout.width, layout.height, tuple(placed)),
+                tuple(new_spans),
+                tuple(kinds),
+                tuple(mirrored),
+                widths,
+                (start, end),
+                tuple(runs),
+                symmetric,
+                tuple(counters),
+                walls,
+                frozenset(apart),
+            )
 
 
 def _about_middle(rects: list[Rect], width: float) -> bool:
