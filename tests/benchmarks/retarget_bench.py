@@ -23,7 +23,10 @@ defects real façades have). Per size, over the façades:
   other: its sill, its blind; not the façade, an opening or a band across a quarter of
   the façade; sized within +-15% as one of its label in the annotation) that most
   windows of the annotation like it have (sized within +-15%, on the row nearest it
-  along y); ``comp%``: the windows so, of all windows.
+  along y); ``comp%``: the windows so, of all windows. A companion wholly behind an
+  opening (inside its rectangle, drawn before it: CMP's z-order, as the project rasterises)
+  does not show and is not kept; ``hid``: the sills and blinds so hidden, of all sills and
+  blinds.
 
 Then the spec's size: layers, symbols, counters (mean and most), façades with no counter;
 and CPU per façade (``time.process_time``: inferring, the check at 1x, and the five
@@ -43,7 +46,7 @@ sys.path.insert(0, str(ROOT))
 
 from facadecli import parse_spec  # noqa: E402
 from facadecli.errors import FacadeError  # noqa: E402
-from facadecli.grammar.inputs import Rect  # noqa: E402
+from facadecli.grammar.inputs import CMP_Z_ORDER, Rect  # noqa: E402
 from facadecli.grammar.model import Options  # noqa: E402
 from facadecli.infer.run import Inference, infer, solved_layout  # noqa: E402
 from facadecli.solve import retarget, solve  # noqa: E402
@@ -64,6 +67,7 @@ KEEP = 0.15  # a window keeps its size within this share
 OPENINGS = ("window", "door")
 TOUCH = 0.05  # m: an element this close to a window (overlapping along the other axis) is its
 BAND = 0.25  # of the façade's width: an element wider is a band, no window's companion
+HIDDEN = ("sill", "blind")  # companions counted when wholly behind an opening
 
 
 @dataclass
@@ -80,6 +84,8 @@ class Tally:
     symmetric: int = 0
     companions: int = 0
     windows_with: int = 0
+    hidden: int = 0
+    hideable: int = 0
     worst: list[str] = field(default_factory=list)
 
 
@@ -151,6 +157,25 @@ def _touching(a: Rect, b: Rect) -> bool:
     return (over_x > 0 and over_y >= -TOUCH) or (over_y > 0 and over_x >= -TOUCH)
 
 
+def _depth(r: Rect) -> tuple[int, float]:
+    """Back to front: CMP's z-order by label, then the rectangle's own z (its layer)."""
+    return CMP_Z_ORDER.get(r.label, 99), r.z
+
+
+def hidden(element: Rect, rects: list[Rect]) -> bool:
+    """Wholly behind an opening: inside its rectangle and drawn before it (a sill behind
+    its window does not show; a cornice drawn over a window does)."""
+    return any(
+        r.label in OPENINGS
+        and _depth(r) > _depth(element)
+        and r.x0 <= element.x0 + 1e-6
+        and element.x1 <= r.x1 + 1e-6
+        and r.y0 <= element.y0 + 1e-6
+        and element.y1 <= r.y1 + 1e-6
+        for r in rects
+    )
+
+
 def companions(
     rects: list[Rect], width: float, drawn: list[Rect] | None = None
 ) -> list[tuple[Rect, frozenset[str]]]:
@@ -164,6 +189,7 @@ def companions(
         and 1e-6 < r.x1 - r.x0 <= BAND * width
         and r.y1 - r.y0 > 1e-6
         and (drawn is None or _sized(r, [q for q in drawn if q.label == r.label]))
+        and not hidden(r, rects)
     ]
     return [(w, frozenset(o.label for o in others if _touching(w, o))) for w in windows(rects)]
 
@@ -222,15 +248,22 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
         if mirrored:
             tally.mirrored += 1
             tally.symmetric += symmetric(found, width)
+        shown = [
+            r for r in rects if r.label in HIDDEN and r.x1 - r.x0 > 1e-6 and r.y1 - r.y0 > 1e-6
+        ]
+        behind = sum(hidden(r, rects) for r in shown)
+        tally.hidden += behind
+        tally.hideable += len(shown)
         held = sum(expected(w, drawn) <= c for w, c in companions(rects, width, list(raw.rects)))
         tally.windows_with += held
         along = held / len(found) if found else 1.0
         tally.companions += along >= 0.9
-        if share < 0.9 or not 0.85 <= ratio <= 1.15 or not kept or extra or along < 0.9:
+        failed = share < 0.9 or not 0.85 <= ratio <= 1.15 or not kept or extra or along < 0.9
+        if failed or behind:
             tally.worst.append(
                 f"{name}: {share:.0%} sized, density {ratio:.2f}, aligned "
                 f"{aligned(found):.2f} (input {in_aligned:.2f}), overlaps {overlaps(rects)}, "
-                f"{along:.0%} with their companions"
+                f"{along:.0%} with their companions, {behind} sills and blinds hidden"
             )
 
 
@@ -245,7 +278,7 @@ def report(
     print(f"\n{title}: {n} façades at 15 x 15 m, the spec solved at other sizes")
     print(
         f"{'size':5} {'solve':>6} {'size':>6} {'size%':>6} {'dens':>6} {'cols':>6} "
-        f"{'ovl':>6} {'sym':>7} {'comp':>6} {'comp%':>6}"
+        f"{'ovl':>6} {'sym':>7} {'comp':>6} {'comp%':>6} {'hid':>10}"
     )
     for name, t in tallies.items():
         share = t.windows_ok / t.windows if t.windows else 1.0
@@ -254,7 +287,8 @@ def report(
             f"{t.density:3d}/{t.solve:<2d} {t.columns:3d}/{t.solve:<2d} "
             f"{t.overlaps:3d}/{t.solve:<2d} "
             f"{t.symmetric:3d}/{t.mirrored:<3d} {t.companions:3d}/{t.solve:<2d} "
-            f"{t.windows_with / t.windows if t.windows else 1.0:6.0%}"
+            f"{t.windows_with / t.windows if t.windows else 1.0:6.0%} "
+            f"{t.hidden:4d}/{t.hideable:<5d}"
         )
         if verbose:
             for line in t.worst:
