@@ -315,6 +315,10 @@ def spec_text(
                 # façade gains
                 word, gap = _floors_above(tokens, pitch, gaps, counters)
                 held.update((tokens[0][0], gap))
+                # and the gaps between its floors below do not grow (free, they would
+                # stretch while the openings' floors keep their pitch); a shorter façade
+                # may still close them up
+                margined.update(s for s in gaps.sizes.values() if s != gap)
                 roofs.add(tokens[-1][0])
                 words.append(word)
                 continue
@@ -330,6 +334,13 @@ def spec_text(
                 loose.update(symbol for symbol, _ in tokens)
             elif "^n" in word:  # a run: the counter and the margins take the slack
                 held.update(gaps.sizes.values())
+                bottom = tokens[0][0]
+                standing = grid.rows[0][0] < top and bottom != tokens[-1][0]
+                if axis == "y" and bottom in ends and standing:
+                    # floors standing on the ground floor keep their margin to it both
+                    # ways (as a top floor repeating upwards does, ``_floors_above``):
+                    # the roof's margin and the counter take the slack, not the ground's
+                    held.add(bottom)
             else:
                 margined.update(gaps.sizes.values())
             words.append(word)
