@@ -321,3 +321,38 @@ def test_a_family_facade_of_two_floors_gains_floors_when_taller(tmp_path: Path, 
     assert len(_of(rects, "window")) >= known.windows + known.bays  # a floor more, at least
     assert _overlapping(rects) == 0
     assert len(_of(rects, "door")) == 1
+
+
+def _behind_an_opening(rects: list[Rect]) -> list[Rect]:
+    """The sills and blinds wholly inside a window or a door (drawn over them: hidden)."""
+    openings = [r for r in rects if r.label in ("window", "door")]
+    return [
+        r
+        for r in rects
+        if r.label in ("sill", "blind")
+        and any(
+            o.x0 <= r.x0 + 1e-6
+            and r.x1 <= o.x1 + 1e-6
+            and o.y0 <= r.y0 + 1e-6
+            and r.y1 <= o.y1 + 1e-6
+            for o in openings
+        )
+    ]
+
+
+def test_a_taller_family_facade_keeps_its_first_floor_over_the_ground_floor(
+    tmp_path: Path,
+) -> None:
+    """Family seed 4 at 1.5 times its height: the floors it gains go over the top, so the
+    first upper floor keeps the gap over the ground floor's windows it was drawn with
+    (1.24 m; it slid 0.75 m down), and no sill or blind is left behind a window."""
+    path = tmp_path / "family-4.xml"
+    path.write_text(cmp_xml(family(4)[0]))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    spec = parse_spec(inference.text, path.stem)
+    rects = list(solved_layout(solve(retarget(spec, 15.0, 22.5)), spec, inference).rects)
+    drawn = sorted({round(r.y0, 3) for r in _of(list(inference.layout.rects), "window")})
+    rows = sorted({round(r.y0, 3) for r in _of(rects, "window")})
+    assert len(rows) > len(drawn)  # floors gained
+    assert rows[:2] == pytest.approx(drawn[:2], abs=0.01)
+    assert _behind_an_opening(rects) == []
