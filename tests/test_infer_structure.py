@@ -356,3 +356,45 @@ def test_a_taller_family_facade_keeps_its_first_floor_over_the_ground_floor(
     assert len(rows) > len(drawn)  # floors gained
     assert rows[:2] == pytest.approx(drawn[:2], abs=0.01)
     assert _behind_an_opening(rects) == []
+
+
+def _top_floor_sills(path: Path, seed: int) -> Path:
+    """Five floors of windows (the ground floor's too) at one pitch, sills under the top
+    floor's alone; every edge jittered by up to 1 cm."""
+    rng = random.Random(seed)
+    rects = []
+    for f in range(5):
+        for k in range(5):
+            cx = 2.3 + k * 2.6 + rng.uniform(-0.01, 0.01)
+            y0 = 1.2 + f * PITCH_Y + rng.uniform(-0.01, 0.01)
+            rects.append(
+                {"label": "window", "x0": cx - 0.6, "y0": y0, "x1": cx + 0.6, "y1": y0 + 1.5}
+            )
+            if f == 4:
+                rects.append(
+                    {"label": "sill", "x0": cx - 0.7, "y0": y0 - 0.2, "x1": cx + 0.7, "y1": y0}
+                )
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 15.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+@pytest.mark.parametrize("share", [0.8, 1.3, 1.5])
+def test_what_stands_on_the_top_floor_stays_on_it_as_floors_are_gained_or_dropped(
+    tmp_path: Path, seed: int, share: float
+) -> None:
+    """The openings' floors are one sequence every layer on them follows, with their one
+    counter: shorter or taller, the top floor's sills stay under the top floor's windows
+    (they stood where a dropped floor was, or under a gained one)."""
+    solved = _solved(_top_floor_sills(tmp_path / "top.json", seed), WIDTH, 15.0 * share)
+    windows, sills = _of(solved, "window"), _of(solved, "sill")
+    top = max(r.y0 for r in windows)
+    assert len({round(r.y0, 2) for r in windows}) != 5  # floors gained or dropped
+    assert len(sills) == 5
+    for sill in sills:
+        centre = (sill.x0 + sill.x1) / 2
+        assert any(
+            abs((w.x0 + w.x1) / 2 - centre) < 0.03 and abs(sill.y1 - w.y0) < 0.03
+            for w in windows
+            if w.y0 == top
+        )

@@ -18,6 +18,9 @@
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
   pitch and one count along an axis share the counter, so windows and sills keep together.
+  Along y, what stands on the openings' run of floors follows it (``infer.floors``,
+  ``_floor_word``): one floor of the run repeated with the openings' counter, so sills,
+  blinds and cornices are gained and dropped with their windows' floors.
   A word that reads the same backwards is written as its left half, the middle, and the
   half reflected (``^-1``), when each half keeps its run: a wider façade then gains bays on
   both sides alike.
@@ -39,7 +42,16 @@ from dataclasses import dataclass, field
 
 from facadecli.grammar.palette import label_colour
 from facadecli.infer.bays import WALL, Bays, in_bays, segment
-from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, top_floors, uncovered
+from facadecli.infer.floors import (
+    Floors,
+    floor_letters,
+    floors_grid,
+    floors_top,
+    follows,
+    mid_wall,
+    on_run,
+)
+from facadecli.infer.layers import Frame, Grid, Span, frames, top_floors, uncovered
 
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
@@ -256,10 +268,20 @@ def spec_text(
         base = ident(grid.label)
         elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
     unique = {elements[label][0].prefix for label in UNIQUE if label in elements}
-    top = _floors_top(found)
+    top = floors_top(found)
+    floors = _floor_run(found, height)
     tops = top_floors(found, width, height)
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
     framed = frames(found) if shared is None else [None] * len(found)
+    # where a layer's top floor repeats upwards with nothing on the run's floors (its
+    # floors gained are copies of the top one, ``_floors_above``), every layer with
+    # nothing on the run stays as it was drawn: the top floor stays too, and the floors
+    # gained stand over it, at its pitch, with what it shows; otherwise the top floor
+    # moves up over the floors the run gains, with what stands on it
+    copied = floors is not None and any(
+        k in tops and found[k].label not in UNIQUE and not on_run(found[k].rows, floors[1])
+        for k in range(len(found))
+    )
     for index, (layer, grid, frame) in enumerate(
         zip(layer_names(found), found, framed, strict=True)
     ):
@@ -282,19 +304,37 @@ def spec_text(
             ),
         ]
         owned.append(introduced)
-        y_tokens = _tokens(grid.rows, height, symbols[1], *gaps_y[row_key])
+        floor_word = None
+        if (
+            floors is not None
+            and index != floors[0]
+            and grid.label not in UNIQUE
+            and 0 < grid.rows[0][0] < top
+            and grid.rows[-1][1] < height
+            and follows(grid.rows, floors[1])
+            and (on_run(grid.rows, floors[1]) or not copied)
+        ):
+            # what stands on the openings' floors follows their one sequence: gained and
+            # dropped with them, at their pitch, by their counter
+            floor_word, steady, roof = _floor_word(
+                grid.rows, floors[1], height, symbols[1], *gaps_y[row_key], counters, repeated
+            )
+            held.update(steady)
+            if roof is not None:
+                roofs.add(roof)
+        y_axis = []
+        if floor_word is None:
+            y_tokens = _tokens(grid.rows, height, symbols[1], *gaps_y[row_key])
+            y_axis = [("y", y_tokens, grid.rows, gaps_y[row_key])]
         words = []
         if bay_word is not None:
-            axes = [("y", y_tokens, grid.rows, gaps_y[row_key])]
+            axes = y_axis
             words.append(bay_word)
         else:
             x_tokens = _tokens(
                 columns, width, _by_label(frame, elements, symbols[0]), *gaps_x[columns]
             )
-            axes = [
-                ("x", x_tokens, columns, gaps_x[columns]),
-                ("y", y_tokens, grid.rows, gaps_y[row_key]),
-            ]
+            axes = [("x", x_tokens, columns, gaps_x[columns]), *y_axis]
         for axis, tokens, spans, (gaps, margins) in axes:
             if len(tokens) == len(spans):  # no gap: nothing else takes a longer façade
                 stretched.update(symbol for symbol, _ in tokens)
@@ -344,6 +384,8 @@ def spec_text(
             else:
                 margined.update(gaps.sizes.values())
             words.append(word)
+        if floor_word is not None:
+            words.append(floor_word)
         layers.append((layer, grid, words[0], words[1]))
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
@@ -535,14 +577,65 @@ def _floors_above(
     return " ".join([*symbols[:-1], run, symbols[-1]]), gap
 
 
-def _floors_top(found: list[Grid]) -> float:
-    """Where the floors end: the top of the opening grid with the most rows (windows on a
-    tie); a grid starting there or higher stands above them (an attic, a top cornice)."""
-    openings = [g for g in found if g.label in OPENINGS]
-    if not openings:
-        return float("inf")
-    floors = max(openings, key=lambda g: (len(g.rows), g.label == "window", g.elements))
-    return floors.rows[-1][1]
+def _floor_run(found: list[Grid], height: float) -> tuple[int, Floors] | None:
+    """The openings' run of floors (``infer.floors``), with the index of the grid whose y
+    word writes it: the run its word gets (``_longest_run``, of an element and a gap, not
+    mirrored), or None (no run: the top floors repeat upwards instead, ``_floors_above``)."""
+    k = floors_grid(found)
+    if k is None or found[k].label in UNIQUE:
+        return None
+    element, gap, margin = _Symbols("e"), _Symbols("g"), _Symbols("m")
+    tokens = _tokens(found[k].rows, height, element, gap, margin)
+    ends = _names(margin)
+    counters = _Counters()
+    if "^-1" in _word(tokens, "y", counters, set(), True, ends):
+        return None
+    run = _longest_run(tokens, ends)
+    if run is None or run[2] != 2:
+        return None
+    _, start, unit, copies = run
+    kinds = {**{s: "element" for s in _names(element)}, **{s: "gap" for s in _names(gap)}}
+    letters = [(kinds[symbol], size) for symbol, size in tokens[start : start + unit]]
+    pitch = sum(size for _, size in letters)
+    end = sum(size for _, size in tokens[:start]) + copies * pitch
+    return k, Floors(mid_wall(end, letters, pitch), pitch, copies)
+
+
+def _floor_word(
+    rows: tuple[Span, ...],
+    floors: Floors,
+    height: float,
+    element: _Symbols,
+    gaps: _Symbols,
+    margins: _Symbols,
+    counters: _Counters,
+    repeated: set[str],
+) -> tuple[str, list[str], str | None]:
+    """The y word of a layer that follows the openings' floors (``infer.floors``): as
+    drawn under the run, one floor of it repeated with the openings' counter, as drawn
+    over it; the symbols that keep their size (the margin to the ground, the gaps), and
+    the margin to the roof (it takes the slack; None where the layer reaches the roof).
+    Its elements go into ``repeated``: they keep their size, on the run and off it."""
+    parts = floor_letters(rows, floors, height)
+    named: list[list[str]] = []
+    for letters in parts:
+        names = []
+        for kind, size in letters:
+            table = element if kind == "element" else margins if kind == "margin" else gaps
+            # a size written alike (to ``DECIMALS``) is the symbol the layer has already:
+            # the floors are cut from the openings' rows, the layer's own within that
+            same = (k for k in table.sizes if abs(k - size) < 0.5 * 10**-DECIMALS)
+            names.append(table.of(next(same, size)))
+        named.append(names)
+    under, floor, over = named
+    counter = counters.of("y", floors.pitch, floors.copies)
+    run = f"{floor[0]}^{counter}" if len(floor) == 1 else f"({' '.join(floor)})^{counter}"
+    kinds = [kind for part in parts for kind, _ in part]
+    symbols = [*under, *floor, *over]
+    roof = symbols[-1] if kinds[-1] == "margin" else None
+    steady = [s for s, kind in zip(symbols, kinds, strict=True) if kind != "element" and s != roof]
+    repeated.update(s for s, kind in zip(symbols, kinds, strict=True) if kind == "element")
+    return " ".join([*under, run, *over]), steady, roof
 
 
 def _by_label(

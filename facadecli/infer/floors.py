@@ -1,0 +1,168 @@
+"""The façade's floors along y: one sequence every layer standing on them follows (issue 34).
+
+The openings' floors are the rows of the opening grid with the most rows (``floors_top``);
+where they repeat (a run of floors alike at one pitch, written with a counter), a taller
+façade gains floors there, and a shorter one drops them. What stands on those floors (a
+window's sill, its blind, the cornice over it) must be gained and dropped with them, at
+their pitch, or a gained floor has none and the rows drawn over the run stay where they
+were while the windows move over them.
+
+So the run is cut into *floors* in the middle of the walls between them (``Floors``): the
+cut ``cut`` over the run's last floor, and the ones a pitch apart under it, one per floor
+of the run. A layer standing on the floors whose elements cross no cut and show alike on
+every floor of the run (the same rows, to a tenth of a millimetre, measured from each
+floor's cut: ``follows``) is written as the sequence of floors (``floor_letters``): what
+it shows under the run as drawn, one floor of the run repeated with the openings'
+counter (a floor it shows nothing on is one hidden spacer), what it shows over the run
+as drawn; the repeated floor is read from where the layer's first element on it starts
+(two letters, an element and a gap, as the openings' run: a unit of a gap, an element and
+a gap leaves the solver's search no layout within its budget). Its margin to the ground,
+its elements and every gap keep their size; the margin to the roof takes the slack. Its
+elements then stand where drawn at the input's size, and on every floor gained, where
+the openings' floors are, at any height; a shorter façade drops them with their floors.
+
+A layer with nothing on the run's floors (a top floor's sills alone) moves with the top
+floor, over the floors gained. Where a layer of the façade instead repeats its top floor
+upwards (``spec_text._floors_above``: its top floor is one like those under it, so the
+floors gained are copies of it, with what it shows), the layers with nothing on the run
+stay as drawn (``spec_text``): the two ways mixed would take a floor's sills up with the
+top floor and leave its blinds with the copies.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+from facadecli.infer.layers import OPENINGS, Grid, Span
+
+EPS = 1e-6  # m: an element this close to a cut does not cross it
+ALIKE = 4  # decimals of a metre to which a floor's rows must agree with the others'
+SLIVER = 0.5 * 10**-ALIKE  # m: a gap this thin or thinner is none (written, it would be 0)
+
+Letter = tuple[str, float]  # ("margin" | "gap" | "element", size)
+
+
+@dataclass(frozen=True)
+class Floors:
+    """The openings' run of floors: ``copies`` floors (the counter's value at the input's
+    size) at ``pitch``, the cut over the last ``cut`` (mid-wall), each floor from the cut
+    under it to the one over it."""
+
+    cut: float
+    pitch: float
+    copies: int
+
+    def cuts(self) -> list[float]:
+        """The cuts bottom up: under the run's first floor, ..., over its last."""
+        return [self.cut - (self.copies - k) * self.pitch for k in range(self.copies + 1)]
+
+
+def floors_top(found: list[Grid]) -> float:
+    """Where the floors end: the top of the opening grid with the most rows (windows on a
+    tie); a grid starting there or higher stands above them (an attic, a top cornice)."""
+    grid = floors_grid(found)
+    return float("inf") if grid is None else found[grid].rows[-1][1]
+
+
+def floors_grid(found: list[Grid]) -> int | None:
+    """The index of the opening grid with the most rows (windows on a tie): the floors'."""
+    openings = [k for k, g in enumerate(found) if g.label in OPENINGS]
+    if not openings:
+        return None
+    return max(
+        openings,
+        key=lambda k: (len(found[k].rows), found[k].label == "window", found[k].elements),
+    )
+
+
+def mid_wall(run_end: float, unit: list[Letter], pitch: float) -> float:
+    """The cut over a run of the openings' floors ending at ``run_end`` whose repeated unit
+    is ``unit`` (an element and a gap, in either order): the middle of the wall between
+    the run's last floor and the one over it."""
+    gap = next(size for kind, size in unit if kind == "gap")
+    return run_end - gap / 2 if unit[0][0] == "element" else run_end + gap / 2
+
+
+def follows(rows: tuple[Span, ...], floors: Floors) -> bool:
+    """Whether a layer on ``rows`` can follow the floors: something on the run or over it,
+    no element across a cut, the same rows on every floor of the run, and nothing on the
+    floor over the run under where its elements start on the run's floors."""
+    cuts = floors.cuts()
+    if cuts[0] <= EPS or rows[-1][1] <= cuts[0] + EPS:
+        return False
+    if any(a < c - EPS and b > c + EPS for a, b in rows for c in cuts):
+        return False
+    shown = [_on(rows, cuts[k], cuts[k + 1]) for k in range(floors.copies)]
+    if any(s != shown[0] for s in shown):
+        return False
+    starts = _starts(rows, floors)
+    return not any(a < starts[-1] - EPS and b > cuts[-1] + EPS for a, b in rows)
+
+
+def on_run(rows: tuple[Span, ...], floors: Floors) -> bool:
+    """Whether a layer on ``rows`` shows something on the run's floors (on the first)."""
+    cuts = floors.cuts()
+    return bool(_on(rows, cuts[0], cuts[1]))
+
+
+def _on(rows: tuple[Span, ...], low: float, high: float) -> tuple[Span, ...]:
+    """The rows from ``low`` to ``high``, measured from ``low`` (to ``ALIKE`` decimals)."""
+    return tuple(
+        (round(a - low, ALIKE), round(b - low, ALIKE))
+        for a, b in rows
+        if a >= low - EPS and b <= high + EPS
+    )
+
+
+def _starts(rows: tuple[Span, ...], floors: Floors) -> list[float]:
+    """Where the layer's floors start: each floor's cut moved up to where its first
+    element starts (so that the repeated floor starts with an element and ends with one
+    gap: a run of two letters, as the openings' own), the floor over the run's as much as
+    the last of the run's; the cuts where it shows nothing on the run."""
+    cuts = floors.cuts()
+    firsts = [
+        min((a for a, b in rows if a >= low - EPS and b <= high + EPS), default=None)
+        for low, high in itertools.pairwise(cuts)
+    ]
+    if firsts[-1] is None:
+        return cuts
+    starts = [low if a is None else a for a, low in zip(firsts, cuts, strict=False)]
+    return [*starts, cuts[-1] + firsts[-1] - cuts[-2]]
+
+
+def floor_letters(
+    rows: tuple[Span, ...], floors: Floors, height: float
+) -> tuple[list[Letter], list[Letter], list[Letter]]:
+    """The y word of a layer that ``follows`` the floors, as letters: under the run (from
+    the margin to the ground up to where its first floor starts), one floor of the run
+    (the last), over the run (from where the floor over it starts to the margin to the
+    roof)."""
+    starts = _starts(rows, floors)
+    under = _letters([r for r in rows if r[1] <= starts[0] + EPS], 0.0, starts[0], "margin", "gap")
+    floor = _letters(
+        [r for r in rows if starts[-2] - EPS <= r[0] and r[1] <= starts[-1] + EPS],
+        starts[-2],
+        starts[-1],
+        "gap",
+        "gap",
+    )
+    over = _letters(
+        [r for r in rows if r[0] >= starts[-1] - EPS], starts[-1], height, "gap", "margin"
+    )
+    return under, floor, over
+
+
+def _letters(rows: list[Span], low: float, high: float, first: str, last: str) -> list[Letter]:
+    """The rows between ``low`` and ``high`` with the gaps between them: the gap before
+    the first is a ``first``, the one after the last a ``last``; none of a ``SLIVER``."""
+    letters: list[Letter] = []
+    cursor = low
+    for a, b in sorted(rows):
+        if a - cursor > SLIVER:
+            letters.append((first if not letters else "gap", a - cursor))
+        letters.append(("element", b - a))
+        cursor = b
+    if high - cursor > SLIVER:
+        letters.append((last if letters or last == "margin" else first, high - cursor))
+    return letters
