@@ -33,10 +33,15 @@ The openings make the bays; a kind's other elements (sills, blinds, ledges: the
 openings' companions) stand on its shape only where that keeps every one of them within
 ``FOLLOW`` of where it was drawn, the tidy-up's own move limit (thin ones drawn a good
 share of their size off their row in some bay would move further), or within ``HELD``
-where the looser limit would cost the façade its bays (``_faithful``); otherwise that
-slot's elements stay as the structure put them, in layers of their own off the bays
-(``Bays.apart``), with their own x words, and do not follow their windows when the
-façade gains or drops bays.
+where the looser limit would cost the façade its bays (``_faithful``). A slot further
+only along y (a thin sill drawn a good share of its height off its row in some bay)
+stands on the shape along x and on one row of its own along y (the structure's where
+it has one in every bay of the kind, else their median where each element stays a
+companion of its openings: touching them, its height within ``SIZED``, not behind
+one), as many such slots as keep the layout within ``KEEP`` of the structure's IoU,
+the cheapest first. Otherwise a slot's elements stay as the structure put them, in
+layers of their own off the bays (``Bays.apart``), with their own x words, and do not
+follow their windows when the façade gains or drops bays.
 
 Every bay's letters keep their size but the wall after its last element, which every
 layer's word of the bay ends with (one symbol a kind: the layers stay together) and
@@ -63,7 +68,7 @@ from itertools import pairwise
 
 import numpy as np
 
-from facadecli.grammar.fidelity import fidelity
+from facadecli.grammar.fidelity import Fidelity, fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
 from facadecli.infer.structure import SHARE, beyond_limits
@@ -85,10 +90,13 @@ KEEP = 0.002  # of the mean IoU against the drawing: the most the bays' shapes m
 HELD = SHARE / 2  # of the narrowest span an edge bounds: the most a kind's shape moves it
 FOLLOW = SHARE  # of it: the most a kind's shape moves a companion's edge from where drawn
 ODD = 1  # openings: a bay this many unlike a kind's (each way) is a variant of it
+TOUCH = 0.05  # m: a companion this close to an opening (overlapping it along the other axis)
+SIZED = 0.15  # of its size: the most a companion put on its slot's row may grow or shrink
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
 Slot = tuple[str, float, float, float, float]  # label, centre x in the bay, width, y0, y1
 Ties = dict[int, tuple[int, list[int | None]]]  # variant kind: its base, each slot's in it
+Move = tuple[list[int], Span]  # a slot's rectangles, and the row they would stand on
 
 
 @dataclass(frozen=True)
@@ -283,10 +291,10 @@ def _found(
         for k, shape in enumerate(shapes)
     )
     for follow in follows:
-        placed = list(on_shapes)
-        apart = _apart(drawn, on_shapes, members, kinds, matches, follow) | over
-        for index in apart:
-            placed[index] = layout.rects[index]
+        apart, moves = _apart(drawn, layout, on_shapes, members, kinds, matches, follow)
+        count = _followed(drawn, layout, on_shapes, apart | over, moves)
+        placed = _rowed(layout, on_shapes, apart | over, moves, count)
+        apart = apart.union(over, *(indices for indices, _ in moves[count:]))
         if on_openings and _moved(layout, placed):
             yield "its bays put on their kinds' shapes would move openings from where drawn"
         elif _new_overlaps(layout.rects, placed):
@@ -305,6 +313,54 @@ def _found(
                 walls,
                 frozenset(apart),
             )
+
+
+def _rowed(
+    layout: LabelledLayout, after: list[Rect], apart: set[int], moves: list[Move], count: int
+) -> list[Rect]:
+    """The rectangles on their kinds' shapes (``after``), but those ``apart`` and those of
+    the moves after the first ``count`` as the structure put them (``layout``), and those
+    of the first ``count`` moves on the shape along x and on the move's row along y."""
+    placed = list(after)
+    for index in apart.union(*(indices for indices, _ in moves[count:])):
+        placed[index] = layout.rects[index]
+    for indices, (y0, y1) in moves[:count]:
+        for index in indices:
+            r = after[index]
+            placed[index] = Rect(r.label, r.x0, y0, r.x1, y1, r.z)
+    return placed
+
+
+def _followed(
+    drawn: LabelledLayout,
+    layout: LabelledLayout,
+    after: list[Rect],
+    apart: set[int],
+    moves: list[Move],
+) -> int:
+    """How many of the ``moves`` (the cheapest first) the bays can take and stay as
+    faithful to the drawing as the structure's layout (``KEEP``, as ``_faithful``) with no
+    new overlap: the most found by halving (each try is one comparison with the drawing;
+    what a move costs is nearly what it adds to the moves before it)."""
+    if not moves:
+        return 0
+    was = fidelity(drawn, layout)
+
+    def holds(count: int) -> bool:
+        placed = _rowed(layout, after, apart, moves, count)
+        now = LabelledLayout(layout.width, layout.height, tuple(placed))
+        return not _new_overlaps(layout.rects, placed) and _kept(was, fidelity(drawn, now))
+
+    if holds(len(moves)):
+        return len(moves)
+    low, high = 0, len(moves) - 1  # low holds (none moved: the layout as before), high may
+    while low < high:
+        middle = (low + high + 1) // 2
+        if holds(middle):
+            low = middle
+        else:
+            high = middle - 1
+    return low
 
 
 def _about_middle(rects: list[Rect], width: float) -> bool:
@@ -915,47 +971,131 @@ def _placed(
 
 def _apart(
     drawn: LabelledLayout,
+    layout: LabelledLayout,
     after: list[Rect],
     members: list[list[int]],
     kinds: list[int],
     matches: list[list[int]],
     follow: float,
-) -> set[int]:
+) -> tuple[set[int], list[Move]]:
     """The rectangles of the slots of a kind (in every bay of it) that are not openings
-    and of which one would stand on the kind's shape with an edge further from where it
-    was ``drawn`` than ``follow`` of the narrowest element, same-label gap or visible
-    part it bounds (``structure.beyond_limits``; ``FOLLOW``: what the structure lets an
-    edge move, an eighth): a thin sill drawn a good share of its height off its row in
-    one bay. The openings make the bays; what fits them within that follows them, the
-    rest stays as the structure put it (in layers of its own). Held to half that
-    (``HELD``) always, 562 of the family's 575 sills and 241 of its 284 blinds stayed
-    as drawn, and at other widths did not follow their windows."""
+    and stand apart (in layers of their own, as the structure put them), and the moves
+    of the slots that may stand on a row of their own instead, the cheapest first. A
+    slot stands on the kind's shape where each of its rectangles would have every edge
+    within ``follow`` of the narrowest element, same-label gap or visible part it bounds
+    of where it was ``drawn`` (``structure.beyond_limits``; ``FOLLOW``: what the
+    structure lets an edge move, an eighth). One further only along y (a thin sill drawn
+    a good share of its height off its row in some bay; along x, as wide as its window,
+    the hand's error is a small share of it) may still stand on the shape along x, so
+    that it is gained and dropped with its bay, on one row: the structure's, where every
+    bay of the kind has it on one, else the median of its rows where that keeps each of
+    its rectangles a companion of its bay's openings (``_companion``); the bays take as
+    many such moves as stay faithful (``_followed``). Any other slot stands apart (the
+    openings make the bays; what fits them follows them). With no such moves, 443 of
+    the generated family's 575 sills stood apart (held to half that, ``HELD``, 562), and
+    at other widths did not follow their windows; with them, 258."""
     rects = list(drawn.rects)
-    far = [
-        a or b
-        for a, b in zip(
-            beyond_limits(rects, [(r.x0, r.x1) for r in after], "x", drawn.width, follow),
-            beyond_limits(rects, [(r.y0, r.y1) for r in after], "y", drawn.height, follow),
-            strict=True,
-        )
-    ]
+    far_x = beyond_limits(rects, [(r.x0, r.x1) for r in after], "x", drawn.width, follow)
+    far_y = beyond_limits(rects, [(r.y0, r.y1) for r in after], "y", drawn.height, follow)
     slots: dict[tuple[int, int], list[int]] = defaultdict(list)  # (kind, slot): rectangles
-    for held, kind, match in zip(members, kinds, matches, strict=True):
+    bay_of: dict[int, int] = {}
+    for bay, (held, kind, match) in enumerate(zip(members, kinds, matches, strict=True)):
         for n, j in enumerate(match):
             slots[kind, n].append(held[j])
-    return {
-        k
-        for indices in slots.values()
-        if rects[indices[0]].label not in OPENINGS and any(far[k] for k in indices)
-        for k in indices
-    }
+            bay_of[held[j]] = bay
+    area: dict[str, float] = defaultdict(float)  # each label's, drawn: what a move's cost is of
+    for r in rects:
+        area[r.label] += (r.x1 - r.x0) * (r.y1 - r.y0)
+    apart: set[int] = set()
+    moves: list[tuple[float, int, Move]] = []
+    for indices in slots.values():
+        if rects[indices[0]].label in OPENINGS or not any(far_x[k] or far_y[k] for k in indices):
+            continue
+        row = None if any(far_x[k] for k in indices) else _one_row(layout, indices)
+        if row is None and not any(far_x[k] for k in indices):
+            row = _median_row(layout, indices)
+            if not all(
+                _companion(
+                    layout,
+                    after,
+                    k,
+                    row,
+                    [j for j in members[bay_of[k]] if layout.rects[j].label in OPENINGS],
+                )
+                for k in indices
+            ):
+                row = None
+        if row is None:
+            apart.update(indices)
+        else:
+            cost = sum(_changed(layout.rects[k], after[k], row) for k in indices)
+            moves.append((cost / area[rects[indices[0]].label], min(indices), (indices, row)))
+    return apart, [move for _, _, move in sorted(moves, key=lambda m: m[:2])]
+
+
+def _changed(was: Rect, after: Rect, row: Span) -> float:
+    """The area ``was`` and itself on ``after`` along x and on ``row`` do not share."""
+    x0, x1, y0, y1 = after.x0, after.x1, row[0], row[1]
+    shared = max(0.0, min(was.x1, x1) - max(was.x0, x0)) * max(
+        0.0, min(was.y1, y1) - max(was.y0, y0)
+    )
+    return (was.x1 - was.x0) * (was.y1 - was.y0) + (x1 - x0) * (y1 - y0) - 2 * shared
+
+
+def _one_row(layout: LabelledLayout, indices: list[int]) -> Span | None:
+    """The row the structure put every one of the rectangles on, if one."""
+    found = {(layout.rects[k].y0, layout.rects[k].y1) for k in indices}
+    return found.pop() if len(found) == 1 else None
+
+
+def _median_row(layout: LabelledLayout, indices: list[int]) -> Span:
+    """The median bottom and height of the rectangles as the structure put them."""
+    y0 = statistics.median(layout.rects[k].y0 for k in indices)
+    height = statistics.median(layout.rects[k].y1 - layout.rects[k].y0 for k in indices)
+    return round(y0, DIGITS), round(y0 + height, DIGITS)
+
+
+def _companion(
+    layout: LabelledLayout, after: list[Rect], k: int, row: Span, openings: list[int]
+) -> bool:
+    """Rectangle ``k`` on its shape along x (``after``) and on ``row`` along y keeps its
+    height within ``SIZED``, still touches (within ``TOUCH``) each of its bay's
+    ``openings`` it touched as the structure put them, and is not hidden wholly behind
+    one of them (on their shapes)."""
+    was = layout.rects[k]
+    now = Rect(was.label, after[k].x0, row[0], after[k].x1, row[1], was.z)
+    if abs((now.y1 - now.y0) / (was.y1 - was.y0) - 1) > SIZED:
+        return False
+    for j in openings:
+        if _touching(was, layout.rects[j]) and not _touching(now, after[j]):
+            return False
+        if _within(now, after[j]):
+            return False
+    return True
+
+
+def _touching(a: Rect, b: Rect) -> bool:
+    """Overlapping along one axis, at most ``TOUCH`` apart (or overlapping) along the other."""
+    over_x = min(a.x1, b.x1) - max(a.x0, b.x0)
+    over_y = min(a.y1, b.y1) - max(a.y0, b.y0)
+    return (over_x > 0 and over_y >= -TOUCH) or (over_y > 0 and over_x >= -TOUCH)
+
+
+def _within(a: Rect, b: Rect) -> bool:
+    """``a`` stands wholly inside ``b``."""
+    inside_x = b.x0 <= a.x0 + 1e-9 and a.x1 <= b.x1 + 1e-9
+    return inside_x and b.y0 <= a.y0 + 1e-9 and a.y1 <= b.y1 + 1e-9
 
 
 def _faithful(drawn: LabelledLayout, before: LabelledLayout, after: LabelledLayout) -> bool:
     """The layout with its bays on their kinds' shapes (``after``) is as faithful to the
     drawing as the structure's (``before``): its mean IoU per label within ``KEEP``, no
     element more lost or fused (``grammar.fidelity``)."""
-    was, now = fidelity(drawn, before), fidelity(drawn, after)
+    return _kept(fidelity(drawn, before), fidelity(drawn, after))
+
+
+def _kept(was: Fidelity, now: Fidelity) -> bool:
+    """``now`` within ``KEEP`` of ``was``'s mean IoU, no element more lost or fused."""
     return now.iou_mean >= was.iou_mean - KEEP and now.lost <= was.lost and now.fused <= was.fused
 
 

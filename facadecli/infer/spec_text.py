@@ -263,6 +263,7 @@ def spec_text(
     loose: set[str] = set()  # symbols of words without a margin: they take the slack
     held: set[str] = set()  # gaps of words with a run and a margin: they keep their size
     grounded: set[str] = set()  # elements of words from the ground up: they do not grow
+    unshrunk: set[str] = set()  # elements of layers off the bays: they never shrink below as drawn
     layers: list[tuple[str, Grid, str, str]] = []
     for grid in found:
         base = ident(grid.label)
@@ -386,6 +387,9 @@ def spec_text(
             words.append(word)
         if floor_word is not None:
             words.append(floor_word)
+        if grid.apart:
+            unshrunk.update(symbols[0].of(b - a) for a, b in columns)
+            unshrunk.update(symbols[1].of(b - a) for a, b in grid.rows)
         layers.append((layer, grid, words[0], words[1]))
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
@@ -417,6 +421,7 @@ def spec_text(
                     symbol in fixed,
                     label in clear,
                     symbol in grounded,
+                    symbol in unshrunk - loose,
                 ),
             )
             for axis, table in zip("xy", pair, strict=True)
@@ -671,6 +676,7 @@ def _size(
     repeated: bool = False,
     unoccludable: bool = False,
     grounded: bool = False,
+    kept: bool = False,
 ) -> str:
     """A symbol's size, with the bounds the input shows (``spread``: the least and
     greatest size its elements had before regularising; None for bands, which stretch
@@ -682,11 +688,17 @@ def _size(
     ``unoccludable`` for openings nothing covers in the input: each layer is its own
     alignment group, so it steers nothing until layers are grouped (SPEC 2.6), and then
     keeps what was clear clear. ``grounded``: an element of a word that starts at the
-    ground with no margin (a door): it never grows, the margin over it takes the slack."""
+    ground with no margin (a door): it never grows, the margin over it takes the slack.
+    ``kept``: an element of a layer left where drawn, off the bays (``Grid.apart``): it
+    never shrinks below the least it was drawn (``min``), or the solver, which counts a
+    symbol once however many layers share it, would squeeze one shared by many such
+    layers to a sliver to spare all their margins at once."""
     extra = []
     if spread is not None and repeated:
         extra += [f"min: {_number(size)}", f"max: {_number(size)}"]
     elif spread is not None:
+        if kept:
+            extra.append(f"min: {_number(min(spread[0], size))}")
         extra.append(f"max: {_number(max(spread[1], size))}")
     elif grounded:
         extra.append(f"max: {_number(size)}")
