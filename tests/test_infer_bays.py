@@ -21,7 +21,7 @@ from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.grammar.model import Options
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import MOVE_SHARE
-from facadecli.infer.bays import KEEP, Bays, _common, find_bays
+from facadecli.infer.bays import FAITHFUL, KEEP, LOOSE, Bays, _common, find_bays
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.spec_text import layer_names
 from facadecli.infer.structure import structured
@@ -442,9 +442,10 @@ def test_bays_are_kept_only_as_faithful_to_the_drawing_as_the_structure(
 ) -> None:
     """Putting the bays on their kinds' shapes snaps sizes and rows to the façade's
     common values; bays are kept only where that leaves the mean IoU per label against
-    the drawing within ``KEEP`` of the structure's, no element more lost or fused (on
-    the family with defects, seed 18's bays read about their openings lost 0.004 and
-    seed 19's as cut 0.002 before; they are now read as cut and not shared)."""
+    the drawing within ``KEEP`` of the structure's, or, where no way of finding them
+    does, at ``FAITHFUL`` or more and within ``LOOSE`` of it; never an element more lost
+    or fused (on the family with defects, seed 18's bays read about their openings lost
+    0.004 and seed 19's as cut 0.002)."""
     path = tmp_path / f"family-{seed}.xml"
     path.write_text(cmp_xml(family(seed, defects=True)[0]))
     options = Options(size=(15.0, 15.0))
@@ -454,7 +455,7 @@ def test_bays_are_kept_only_as_faithful_to_the_drawing_as_the_structure(
     was = fidelity(tidied.raw, regular)
     if isinstance(bays, Bays):
         now = fidelity(tidied.raw, bays.layout)
-        assert now.iou_mean >= was.iou_mean - KEEP, (now.iou_mean, was.iou_mean)
+        assert now.iou_mean >= min(was.iou_mean - KEEP, max(FAITHFUL, was.iou_mean - LOOSE))
         assert now.lost <= was.lost and now.fused <= was.fused
     else:
         assert "IoU" in bays, bays
