@@ -459,3 +459,37 @@ def test_bays_are_kept_only_as_faithful_to_the_drawing_as_the_structure(
         assert now.lost <= was.lost and now.fused <= was.fused
     else:
         assert "IoU" in bays, bays
+
+
+def test_a_facade_of_unlike_bays_keeps_its_windows_sized_when_narrower(
+    tmp_path: Path,
+) -> None:
+    """Five bays each unlike the others (window widths 0.9-1.7 m, a door, sills under the
+    windows, the top floor's windows narrower), as real façades are drawn: no kind
+    repeats, so each layer keeps its own x word and nothing can drop at 0.7x. The walls
+    and margins take the slack, not the openings: every window and the door solved there
+    are within 15% of the width of one drawn (before, the windows were squeezed to
+    slivers)."""
+    bays = ((0.6, 1.2), (3.2, 0.9), (5.6, 1.7), (8.9, 1.1), (11.4, 1.4))
+    rects = []
+    for k, (x, w) in enumerate(bays):
+        for f, y in enumerate((1.0, 4.0, 7.0, 10.0)):
+            if k == 2 and f == 0:
+                rects.append({"label": "door", "x0": x, "y0": 0.0, "x1": x + w, "y1": 2.6})
+                continue
+            width = w * (0.8 if f == 3 else 1.0)
+            rects.append({"label": "window", "x0": x, "y0": y, "x1": x + width, "y1": y + 1.6})
+            rects.append(
+                {"label": "sill", "x0": x - 0.05, "y0": y - 0.2, "x1": x + width + 0.05, "y1": y}
+            )
+    path = tmp_path / "unlike.json"
+    path.write_text(json.dumps({"canvas": {"width": 13.5, "height": 12.5}, "rects": rects}))
+    inference = infer(path, path.stem, Options())
+    assert inference.bays.startswith("not shared"), inference.bays
+    spec = parse_spec(inference.text, path.stem)
+    for label in ("window", "door"):
+        drawn = [r["x1"] - r["x0"] for r in rects if r["label"] == label]
+        found = [r.x1 - r.x0 for r in _solved(inference, spec, 0.7) if r.label == label]
+        assert len(found) == len(drawn)
+        squeezed = [w for w in found if not any(abs(w / d - 1) <= 0.15 for d in drawn)]
+        assert not squeezed, (label, squeezed)
