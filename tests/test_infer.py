@@ -14,6 +14,7 @@ from facadecli import parse_spec
 from facadecli.grammar.tiling import LabelledLayout, Rect
 from facadecli.infer.layers import grids
 from facadecli.infer.run import Inference, check, infer
+from facadecli.infer.spec_text import SQUEEZE
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -70,7 +71,7 @@ def test_the_check_sees_a_spec_that_does_not_match(tmp_path: Path) -> None:
         inferred.layout,
         inferred.tiling,
         inferred.grids,
-        re.sub(r"door_w1: \{size: 1.2,( min: 1.2,)?", "door_w1: {size: 0.6,", inferred.text),
+        re.sub(r"door_w1: \{size: 1.2,( min: [0-9.]+,)?", "door_w1: {size: 0.6,", inferred.text),
     )
     checks = check(wrong, parse_spec(wrong.text, "wrong.yaml"))
     assert checks["solves"] and checks["iou"]["door"] < 0.9  # type: ignore[index]
@@ -295,11 +296,11 @@ def test_an_element_that_does_not_repeat_never_grows_beyond_what_the_input_shows
     """The palazzo's door and shop front appear once: a wider façade widens the wall
     around them, not them (without a bound, the sizing spread the extra width over every
     letter of the word, and a 1.2 m door became 3.1 m at 1.5x); a narrower one may
-    shrink them to fit."""
+    shrink them to fit, an opening (the door) to ``SQUEEZE`` of its size at most."""
     inferred = infer(_write(tmp_path / "palazzo.json", _palazzo()), "palazzo")
     spec = parse_spec(inferred.text, "palazzo.yaml")
     assert spec.symbols["door_w1"].max == pytest.approx(1.2)
-    assert spec.symbols["door_w1"].min is None  # it may shrink
+    assert spec.symbols["door_w1"].min == pytest.approx(SQUEEZE * 1.2)  # it may shrink
     assert _widths(inferred.text, "palazzo", 17.1, "door") == [pytest.approx(1.2)]
     assert _widths(inferred.text, "palazzo", 17.1, "shop") == [pytest.approx(2.2)]
     assert all(w <= 1.2 + 1e-6 for w in _widths(inferred.text, "palazzo", 6.0, "door"))

@@ -21,7 +21,7 @@ from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.grammar.model import Options
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import MOVE_SHARE
-from facadecli.infer.bays import KEEP, Bays, _common, find_bays
+from facadecli.infer.bays import FAITHFUL, KEEP, LOOSE, Bays, _common, find_bays
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.spec_text import layer_names
 from facadecli.infer.structure import structured
@@ -491,9 +491,10 @@ def test_bays_are_kept_only_as_faithful_to_the_drawing_as_the_structure(
 ) -> None:
     """Putting the bays on their kinds' shapes snaps sizes and rows to the façade's
     common values; bays are kept only where that leaves the mean IoU per label against
-    the drawing within ``KEEP`` of the structure's, no element more lost or fused (on
-    the family with defects, seed 18's bays read about their openings lost 0.004 and
-    seed 19's as cut 0.002 before; they are now read as cut and not shared)."""
+    the drawing within ``KEEP`` of the structure's, or, where no way of finding them
+    does, at ``FAITHFUL`` or more and within ``LOOSE`` of it; never an element more lost
+    or fused (on the family with defects, seed 18's bays read about their openings lost
+    0.004 and seed 19's as cut 0.002)."""
     path = tmp_path / f"family-{seed}.xml"
     path.write_text(cmp_xml(family(seed, defects=True)[0]))
     options = Options(size=(15.0, 15.0))
@@ -503,7 +504,60 @@ def test_bays_are_kept_only_as_faithful_to_the_drawing_as_the_structure(
     was = fidelity(tidied.raw, regular)
     if isinstance(bays, Bays):
         now = fidelity(tidied.raw, bays.layout)
-        assert now.iou_mean >= was.iou_mean - KEEP, (now.iou_mean, was.iou_mean)
+        assert now.iou_mean >= min(was.iou_mean - KEEP, max(FAITHFUL, was.iou_mean - LOOSE))
         assert now.lost <= was.lost and now.fused <= was.fused
     else:
         assert "IoU" in bays, bays
+
+
+def test_a_facade_of_unlike_bays_keeps_its_windows_sized_when_narrower(
+    tmp_path: Path,
+) -> None:
+    """Five bays each unlike the others (window widths 0.9-1.7 m, a door, sills under the
+    windows, the top floor's windows narrower), as real façades are drawn: no kind
+    repeats, so each layer keeps its own x word and nothing can drop at 0.7x. The walls
+    and margins take the slack, not the openings: every window and the door solved there
+    are within 15% of the width of one drawn (before, the windows were squeezed to
+    slivers)."""
+    bays = ((0.6, 1.2), (3.2, 0.9), (5.6, 1.7), (8.9, 1.1), (11.4, 1.4))
+    rects = []
+    for k, (x, w) in enumerate(bays):
+        for f, y in enumerate((1.0, 4.0, 7.0, 10.0)):
+            if k == 2 and f == 0:
+                rects.append({"label": "door", "x0": x, "y0": 0.0, "x1": x + w, "y1": 2.6})
+                continue
+            width = w * (0.8 if f == 3 else 1.0)
+            rects.append({"label": "window", "x0": x, "y0": y, "x1": x + width, "y1": y + 1.6})
+            rects.append(
+                {"label": "sill", "x0": x - 0.05, "y0": y - 0.2, "x1": x + width + 0.05, "y1": y}
+            )
+    path = tmp_path / "unlike.json"
+    path.write_text(json.dumps({"canvas": {"width": 13.5, "height": 12.5}, "rects": rects}))
+    inference = infer(path, path.stem, Options())
+    assert inference.bays.startswith("not shared"), inference.bays
+    spec = parse_spec(inference.text, path.stem)
+    for label in ("window", "door"):
+        drawn = [r["x1"] - r["x0"] for r in rects if r["label"] == label]
+        found = [r.x1 - r.x0 for r in _solved(inference, spec, 0.7) if r.label == label]
+        assert len(found) == len(drawn)
+        squeezed = [w for w in found if not any(abs(w / d - 1) <= 0.15 for d in drawn)]
+        assert not squeezed, (label, squeezed)
+
+
+def test_bays_the_gate_refused_are_kept_where_the_facade_keeps_the_bar(tmp_path: Path) -> None:
+    """Family-with-defects seed 19: its bays on their kinds' shapes lose more than
+    ``KEEP`` of IoU against the structure's, in every way of finding them, but keep a
+    mean IoU over ``FAITHFUL`` within ``LOOSE``, nothing lost or fused: its bays are
+    shared, and at 2x width it gains whole bays (density 1.14 of the drawing's) where
+    its per-layer words gained none (0.82: the margins took the width)."""
+    path = tmp_path / "family-19.xml"
+    boxes, known = family(19, defects=True)
+    path.write_text(cmp_xml(boxes))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    assert "bays of" in inference.bays, inference.bays
+    spec = parse_spec(inference.text, path.stem)
+    solved = solved_layout(solve(spec), spec, inference)
+    faithful = fidelity(inference.raw or inference.layout, solved)
+    assert faithful.iou_mean >= FAITHFUL and faithful.lost == 0 and faithful.fused == 0
+    wider = [r for r in _solved(inference, spec, 2.0) if r.label == "window"]
+    assert len(wider) >= 2 * 0.85 * known.windows, (len(wider), known.windows)

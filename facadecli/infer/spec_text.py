@@ -58,6 +58,8 @@ TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
 RUNS = {1: 3, 2: 2}  # copies of a unit of one letter, or of two, that make a repeat
 PITCH_SHARED = 0.02  # runs of one count whose pitches are this close share a counter
 UNIQUE = ("door",)  # labels whose elements are never repeated (a portal stays one)
+SQUEEZE = 0.9  # of its size: the narrowest an opening's width may become (never slivers;
+# under the issue's 85%, with room for the solver's tolerance)
 MIRRORED = 5  # letters a word needs (two elements and more) to be written as mirrored
 MESHES = {  # CMP labels; anything else is a box
     "window": ("frame", 0.1),
@@ -422,6 +424,7 @@ def spec_text(
                     label in clear,
                     symbol in grounded,
                     symbol in unshrunk - loose,
+                    axis == "x" and label in OPENINGS,
                 ),
             )
             for axis, table in zip("xy", pair, strict=True)
@@ -677,14 +680,20 @@ def _size(
     unoccludable: bool = False,
     grounded: bool = False,
     kept: bool = False,
+    opening: bool = False,
 ) -> str:
     """A symbol's size, with the bounds the input shows (``spread``: the least and
     greatest size its elements had before regularising; None for bands, which stretch
     with the façade). An element never grows beyond the greatest (``max``): a wider
     façade widens the gaps around a door, not the door; one that does not repeat may
-    shrink to fit. A run's elements keep their size (``min`` and ``max``), as its gaps
-    do (``_gap``): a façade of another size gains or loses bays and floors at the input's
-    pitch, and the layers sharing the run's counter keep their columns together.
+    shrink to fit, an ``opening`` (a window's or a door's width) to ``SQUEEZE`` of itself
+    at most (``min``): where the layers' words cannot drop it, the walls and margins take
+    what a narrower façade loses (each symbol's deviation costs once however often the
+    word repeats it, so unbounded, the openings' widths took nearly all of it: CMP's
+    windows at 0.7x were squeezed to slivers). A run's elements keep their size (``min``
+    and ``max``), as its gaps do (``_gap``): a façade of another size gains or loses bays
+    and floors at the input's pitch, and the layers sharing the run's counter keep their
+    columns together.
     ``unoccludable`` for openings nothing covers in the input: each layer is its own
     alignment group, so it steers nothing until layers are grouped (SPEC 2.6), and then
     keeps what was clear clear. ``grounded``: an element of a word that starts at the
@@ -699,6 +708,8 @@ def _size(
     elif spread is not None:
         if kept:
             extra.append(f"min: {_number(min(spread[0], size))}")
+        elif opening:
+            extra.append(f"min: {_number(SQUEEZE * size)}")
         extra.append(f"max: {_number(max(spread[1], size))}")
     elif grounded:
         extra.append(f"max: {_number(size)}")
