@@ -51,7 +51,7 @@ from facadecli.infer.floors import (
     mid_wall,
     on_run,
 )
-from facadecli.infer.layers import Frame, Grid, Span, frames, top_floors, uncovered
+from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, top_floors, uncovered
 
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
