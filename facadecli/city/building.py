@@ -756,9 +756,9 @@ def _facade(spec: Spec, horizontal: AxisLayout, vertical: AxisLayout) -> Layout:
 
 def flat_roof(pick: int) -> Material:
     """The covering of a building's flat roofs, of :data:`FLAT_ROOFS`, from its own number
-    (``pick``: from the city's seed and its id). Its bits from the 17th on choose, so the
-    choice is independent of the palette's tone and the layout's variant, which its low
-    bits choose (a dark wall does not always come with a dark roof)."""
+    (``pick``: from the city's seed and its id). Its 17th and 18th bits choose, so the
+    choice is independent of the palette's tone (``pick`` modulo the palette's four:
+    its two lowest bits), and a dark wall does not always come with a dark roof."""
     return FLAT_ROOFS[(pick >> 16) % len(FLAT_ROOFS)]
 
 

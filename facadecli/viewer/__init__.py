@@ -167,8 +167,8 @@ function skyRadiance(direction, colour) {
   return colour;
 }
 // An equirectangular picture (row 0 straight down) of the sky above and, below the
-// horizon, ``below(direction, y, u, colour)``'s colour; with ``skyline``, the distant
-// houses of the horizon band too.
+// horizon, the horizon's haze as ``below(y, colour)`` changes it (y: the direction's
+// height, -1..0); with ``skyline``, the distant houses of the horizon band too.
 function skyPicture(width, height, below, skyline) {
   const data = new Float32Array(width * height * 4);
   const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
@@ -257,7 +257,7 @@ function sky() {
   const haze = HORIZON.clone().multiplyScalar(SKY_LIGHT);
   haze.setRGB(haze.r * gains[0], haze.g * gains[1], haze.b * gains[2]);
   const backdrop = equirectangular(
-    balanced(skyPicture(2048, 1024, () => {}, null), gains), 2048, 1024);
+    balanced(skyPicture(2048, 1024, () => {}, null), gains), 2048, 1024);  // haze below
   return {environment, backdrop, haze};
 }
 const scene = new THREE.Scene();
