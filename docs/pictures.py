@@ -163,11 +163,14 @@ def screenshot(chrome: str, url: str, target: Path, window: str, profile: Path) 
 
 
 def _blank(picture: Path) -> bool:
-    """Whether a screenshot is one flat colour (the page's backdrop, nothing drawn)."""
+    """Whether a screenshot shows nothing drawn yet: its lower third one flat colour (the
+    haze below the sky's horizon; the ground, under every view, comes with the model).
+    The whole picture's spread no longer tells: the sky has clouds before a model comes."""
     from PIL import Image, ImageStat
 
     with Image.open(picture) as image:
-        return bool(ImageStat.Stat(image.convert("L")).stddev[0] < 2.0)
+        lower = image.convert("L").crop((0, image.height * 2 // 3, image.width, image.height))
+        return bool(ImageStat.Stat(lower).stddev[0] < 2.0)
 
 
 def svg_size(svg: Path) -> str:

@@ -16,12 +16,12 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon
 
-from facadecli.city.building import MAP_TO_WORLD
+from facadecli.city.building import FLAT_ROOFS, MAP_TO_WORLD, flat_roof
 from facadecli.city.default import default_city, tones
 from facadecli.city.demo import write_demo
 from facadecli.city.manifest import Roof, load_city
 from facadecli.city.roofs import roof_meshes
-from facadecli.city.run import run_city
+from facadecli.city.run import _pick, run_city
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.export.texture_store import PICTURE, image_uris, picture_name, pictures_missing
 from facadecli.geometry.facade import plane_uv, weld
@@ -49,9 +49,10 @@ def test_buildings_share_one_material_of_each_kind_and_each_picture(city: Path) 
     # one material of each kind for the whole city, but the walls' four tones (the demo's
     # three palettes: the houses' brick, the shop fronts' render in the houses' tones, the
     # flats' render) and a name two specs give different looks (stone: the church's, the
-    # shop's; render: the shop front's, the flats')
+    # shop's; render: the shop front's, the flats') and the flat roofs' coverings (four at
+    # most: FLAT_ROOFS)
     assert max(Counter(names).values()) <= 2 * 4, Counter(names)
-    assert len(names) <= len(set(names)) + 3 * 3 + 2
+    assert len(names) <= len(set(names)) + 3 * 3 + 2 + len(FLAT_ROOFS) - 1
     canonical = [json.dumps(m, sort_keys=True) for m in materials]
     assert len(set(canonical)) == len(canonical)
     assert len({json.dumps(t, sort_keys=True) for t in document["textures"]}) == len(
@@ -175,6 +176,51 @@ def test_roofs_wear_a_library_material(city: Path) -> None:
     for material in roofs:
         assert "baseColorTexture" in material["pbrMetallicRoughness"]
         assert "normalTexture" in material
+
+
+def _flat_roofs(glb: Path) -> dict[str, str]:
+    """Each building's flat roof material (its base colour picture's file), by its name."""
+    document, _ = read_glb(glb.read_bytes())
+    found = {}
+    for node in document["nodes"]:
+        for child in node.get("children", []):
+            mesh = document["nodes"][child].get("mesh")
+            for primitive in [] if mesh is None else document["meshes"][mesh]["primitives"]:
+                material = document["materials"][primitive["material"]]
+                if material["name"] == "flat_roof":
+                    texture = material["pbrMetallicRoughness"]["baseColorTexture"]
+                    source = document["textures"][texture["index"]]["source"]
+                    found[node["name"]] = document["images"][source]["uri"]
+    return found
+
+
+def test_flat_roofs_vary_from_building_to_building_in_a_few_shared_materials(
+    city: Path,
+) -> None:
+    """The demo's flats with flat roofs (seed 0) wear more than one covering, each the one
+    the seed and the building's id pick, and the city stores each covering once."""
+    document, _ = read_glb((city / "demo-district.glb").read_bytes())
+    roofs = _flat_roofs(city / "demo-district.glb")
+    assert len(roofs) >= 4, roofs  # the block's flats with flat roofs
+    assert len(set(roofs.values())) >= 2  # more than one covering (it was one grey deck)
+    flat = [m for m in document["materials"] if m["name"] == "flat_roof"]
+    assert len(flat) == len(set(roofs.values())) <= len(FLAT_ROOFS)  # shared, not per building
+    # buildings given the same covering by their pick share one material, and buildings
+    # given different ones do not
+    by_covering: dict[str, set[str]] = {}
+    for building, picture in roofs.items():
+        by_covering.setdefault(flat_roof(_pick(0, building)).model_dump_json(), set()).add(picture)
+    assert all(len(pictures) == 1 for pictures in by_covering.values())
+    assert len(by_covering) == len(set(roofs.values()))
+
+
+def test_a_flat_roofs_covering_is_independent_of_its_walls_tone() -> None:
+    """The covering comes from other bits of a building's number than the palette's tone
+    (``pick % 4``): each tone goes with every covering across a city's buildings."""
+    picks = [_pick(0, f"way/{k}") for k in range(400)]
+    for tone in range(4):
+        coverings = {flat_roof(p).model_dump_json() for p in picks if p % 4 == tone}
+        assert len(coverings) == len(FLAT_ROOFS)
 
 
 def test_the_default_city_dresses_buildings_by_their_tags() -> None:

@@ -302,13 +302,13 @@ def _faces(name: str, resolution: int) -> tuple[list[np.ndarray], np.ndarray, np
     from scipy import ndimage
 
     from facadecli.materials.library import KINDS
-    from facadecli.materials.textures import GENERATORS, linear, texture_set
+    from facadecli.materials.textures import GENERATORS, STREAMS, linear, texture_set
 
     material = LIBRARY[name]
     kind, tile = KINDS[name], TILES[name]
     rgb = tuple(linear(int(material.color[i : i + 2], 16) / 255) for i in (1, 3, 5))
     made = texture_set(kind, resolution, tile, 0, rgb, material.roughness, 0.0)  # type: ignore[arg-type]
-    rng = np.random.default_rng([0, sorted(GENERATORS).index(kind)])
+    rng = np.random.default_rng([0, STREAMS.index(kind)])
     face = GENERATORS[kind](resolution, tile, rng).tinted
     assert face is not None
     labels, count = ndimage.label(ndimage.binary_erosion(face >= 0.999, iterations=2))

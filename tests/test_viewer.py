@@ -18,7 +18,7 @@ from facadecli.city.demo import write_demo
 from facadecli.city.folders import building_file
 from facadecli.cli import main
 from facadecli.export import OutputOptions, write_outputs
-from facadecli.viewer import gallery
+from facadecli.viewer import VIEWER, gallery
 from tests.browser import BROWSER, browse
 from tests.running import facade, files
 
@@ -403,6 +403,42 @@ def test_a_lit_wall_keeps_its_colours_hue_and_saturation(tmp_path: Path) -> None
         seen_hue, seen_saturation = _hue_and_saturation(shot, box)
         assert abs(seen_hue - hue) < 4, (seen_hue, hue)
         assert abs(seen_saturation / saturation - 1) < 0.15, (seen_saturation, saturation)
+
+
+def test_the_page_lights_the_model_by_the_sky_it_shows() -> None:
+    """One sky is the backdrop and, prefiltered, the light and what glass mirrors; the sun
+    that casts the shadows shines from the direction of the sky's sun (its disc and glow)."""
+    assert "scene.background = daylight.backdrop;" in VIEWER
+    assert "scene.environment = daylight.environment;" in VIEWER
+    assert VIEWER.count("sunDirection") >= 4  # the disc, the glow, the clouds' light, the sun
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_the_sky_behind_a_model_is_blue_and_has_clouds(tmp_path: Path) -> None:
+    """A wall seen level from twice its fit's distance: the top fifth of the picture is
+    sky, not one flat colour (its clouds and its gradient: a spread of 8.6 greys,
+    measured) and bluer at the top than lower down (blue less red: 9.8 in the top 5% of
+    the picture, 6.7 at 15-20%). The flat grey backdrop before: a spread of 0, 9.0 and
+    9.0."""
+    from PIL import Image, ImageStat
+
+    spec = tmp_path / "walls.yaml"
+    spec.write_text(WALLS_SPEC)
+    layout = solve(load_spec(spec))
+    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
+    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,0,0.5")
+    assert "<title>walls</title>" in dom
+
+    def blueness(image: Image.Image, top: float, bottom: float) -> float:
+        band = image.crop((0, round(top * image.height), image.width, round(bottom * image.height)))
+        red, _, blue = ImageStat.Stat(band).mean
+        return float(blue - red)
+
+    with Image.open(shot) as image:
+        rgb = image.convert("RGB")
+        spread = ImageStat.Stat(rgb.crop((0, 0, rgb.width, rgb.height // 5)).convert("L")).stddev[0]
+        assert spread > 3, spread
+        assert blueness(rgb, 0, 0.05) > blueness(rgb, 0.15, 0.2) + 1.5
 
 
 @pytest.mark.slow

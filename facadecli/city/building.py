@@ -72,6 +72,15 @@ from facadecli.spec.model import Material, Spec
 WALL = Material(color="#cfc6b8", roughness=0.9)
 ROOF = LIBRARY["roof-tiles"]  # pitched roofs: clay tiles, courses along the eaves
 FLAT_ROOF = LIBRARY["concrete"].model_copy(update={"color": "#77736c"})  # a flat roof's deck
+# What a flat roof is covered with, one of these a building (:func:`flat_roof`): gravel
+# ballast, dark bitumen felt, a light-grey single-ply sheet, a bare concrete deck. Four
+# materials at most for all the flat roofs of a city, shared by the buildings that wear one
+FLAT_ROOFS = (
+    LIBRARY["gravel"],
+    LIBRARY["membrane"],
+    LIBRARY["membrane"].model_copy(update={"color": "#a3a5a2", "roughness": 0.6}),
+    FLAT_ROOF,
+)
 GROUND = Material(color="#808080", roughness=1.0)
 DOOR = LIBRARY["timber"].model_copy(update={"color": "#5a3a22"})  # doors at entrances
 WALL_NAME, ROOF_NAME, GROUND_NAME = "wall", "roof", "ground"  # a spec may define them
@@ -410,10 +419,10 @@ def build_building(
         parts.setdefault(below, []).append(bottom)
     materials: dict[str, tuple[Material, Path | None]] = {}
     if fallback is not None:
-        materials.update(_materials(fallback.spec, fallback.base_dir, looks))
+        materials.update(_materials(fallback.spec, fallback.base_dir, looks, pick))
     for _, other in walls:  # the building's own spec wins where two name one material
-        materials.update(_materials(other.spec, other.base_dir, looks))
-    materials.update(_materials(spec, base_dir, looks))
+        materials.update(_materials(other.spec, other.base_dir, looks, pick))
+    materials.update(_materials(spec, base_dir, looks, pick))
     for name in sorted(parts):
         builtin = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
         finished, folder = materials.get(name) or (builtin, None)  # the recesses stay dark
@@ -745,18 +754,27 @@ def _facade(spec: Spec, horizontal: AxisLayout, vertical: AxisLayout) -> Layout:
     )
 
 
+def flat_roof(pick: int) -> Material:
+    """The covering of a building's flat roofs, of :data:`FLAT_ROOFS`, from its own number
+    (``pick``: from the city's seed and its id). Its 17th and 18th bits choose, so the
+    choice is independent of the palette's tone (``pick`` modulo the palette's four:
+    its two lowest bits), and a dark wall does not always come with a dark roof."""
+    return FLAT_ROOFS[(pick >> 16) % len(FLAT_ROOFS)]
+
+
 def _materials(
-    spec: Spec, base_dir: Path | None, looks: Looks
+    spec: Spec, base_dir: Path | None, looks: Looks, pick: int = 0
 ) -> dict[str, tuple[Material, Path | None]]:
     """The materials by name (with the folder their texture files are in): the spec's
     and the library's it names, the building's own (a spec material of that name wins
-    over the built-in one), and the tags' colours over both."""
+    over the built-in one; the flat roofs' covering is the one ``pick`` gives), and the
+    tags' colours over both."""
     declared = {name: look(spec, name) for name in material_names(spec)}
     declared = {name: m for name, m in declared.items() if name in spec.materials or m.library}
     builtins = (
         (WALL_NAME, WALL),
         (ROOF_NAME, ROOF),
-        (FLAT_ROOF_NAME, FLAT_ROOF),
+        (FLAT_ROOF_NAME, flat_roof(pick)),
         (DOOR_MATERIAL, DOOR),
     )
     for name, builtin in (*builtins, (GROUND_NAME, GROUND)):

@@ -23,6 +23,8 @@ TILES = {
     "roof-tiles": 1.2,
     "slate": 1.0,
     "float-glass": 2.0,
+    "gravel": 1.0,  # stones of about 18 mm
+    "membrane": 2.0,  # rolls a metre wide
 }
 
 #: library name -> the surface generator drawing it (:data:`.textures.GENERATORS`)
@@ -38,6 +40,8 @@ KINDS = {
     "roof-tiles": "roof-tiles",
     "slate": "slate",
     "float-glass": "glass",
+    "gravel": "gravel",
+    "membrane": "membrane",
 }
 
 
@@ -59,6 +63,8 @@ LIBRARY: dict[str, Material] = {
     "roof-tiles": _entry("roof-tiles", "#a4553b", 0.75),
     "slate": _entry("slate", "#464b53", 0.6),
     "float-glass": _entry("float-glass", "#a7bfd0", 0.04, opacity=0.35, transmission=0.9, ior=1.52),
+    "gravel": _entry("gravel", "#9a958c", 0.95),
+    "membrane": _entry("membrane", "#3f4042", 0.8),  # bitumen felt; lighter: a single-ply sheet
 }
 
 

@@ -296,6 +296,61 @@ def _slate(n: int, tile: float, rng: np.random.Generator) -> Surface:
     return Surface(height, colour, 0.07 * cleft, np.zeros((n, n)))
 
 
+def _gravel(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    """Roof ballast: rounded stones of about 18 mm, each its own shade, lying in a bed of
+    the shadows between them. The stones are the cells of a jittered grid (each pixel
+    belongs to the nearest of the points in its own and the eight neighbouring cells,
+    counted modulo the grid so that the tile wraps), domed from their centre."""
+    x, y = grid(n, tile)
+    count = round(tile / 0.018)
+    cell = tile / count
+    points = rng.uniform(0.15, 0.85, size=(count, count, 2))
+    tones = rng.standard_normal((count * count, 2))
+    cx, cy = x / cell, y / cell
+    ix, iy = np.floor(cx).astype(np.int64), np.floor(cy).astype(np.int64)
+    nearest = np.full(x.shape, np.inf)
+    second = np.full(x.shape, np.inf)
+    ident = np.zeros(x.shape, dtype=np.int64)
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            jx, jy = np.mod(ix + dx, count), np.mod(iy + dy, count)
+            px, py = ix + dx + points[jy, jx, 0], iy + dy + points[jy, jx, 1]
+            distance = np.hypot(cx - px, cy - py)
+            closer = distance < nearest
+            second = np.where(closer, nearest, np.minimum(second, distance))
+            ident = np.where(closer, jy * count + jx, ident)
+            nearest = np.minimum(nearest, distance)
+    edge = (second - nearest) * cell / 2  # metres to the stone's border, about
+    face = smoothstep(0.0, 0.004, edge)
+    dome = np.sqrt(np.clip(1.0 - (nearest / 0.8) ** 2, 0.0, 1.0))
+    height = 0.008 * dome * face
+    shade = 1.0 + 0.16 * tones[ident, 0] + 0.05 * noise(rng, n, 0.3, tile)
+    hue = 0.04 * tones[ident, 1]
+    body = np.stack([shade + hue, shade, shade - hue], axis=-1)
+    colour = body * (0.6 + 0.4 * face[..., None]) * (0.9 + 0.1 * dome[..., None])
+    return Surface(height, colour, 0.06 * tones[ident, 1], np.zeros((n, n)), cavities=height)
+
+
+def _membrane(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    """Roofing membrane (bitumen felt, or a single-ply sheet): rolls a metre wide laid
+    along the tile, each lapping the one before it (a step of 2 mm at its edge), a
+    roll's end lapping the next across it, faint wrinkles and a fine mineral grain."""
+    x, y = grid(n, tile)
+    rolls = max(1, round(tile / 1.0))
+    width = tile / rolls
+    units = coursed(x, y, tile, [(width, [tile], float(rng.uniform(0, tile)))] * rolls)
+    lap = smoothstep(0.0, 0.004, units.v * width)  # 0 at the roll's lapped edge
+    end = smoothstep(0.0, 0.004, np.minimum(units.u, 1 - units.u) * tile)
+    wrinkles = noise(rng, n, 0.15, tile, aniso=(0.3, 1.0))
+    grain = noise(rng, n, 0.004, tile)
+    height = 0.002 * lap * end + 0.0006 * wrinkles
+    shade = 1.0 + 0.04 * noise(rng, n, 0.4, tile) + 0.03 * grain
+    shade = shade + per_unit(rng, units.ident, 0.025)
+    colour = np.repeat((shade * (0.8 + 0.2 * lap * end))[..., None], 3, axis=-1)
+    seams = 0.002 * lap * end  # only the laps occlude, not the wrinkles
+    return Surface(height, colour, 0.05 * grain, np.zeros((n, n)), cavities=seams)
+
+
 def _glass(n: int, tile: float, rng: np.random.Generator) -> Surface:
     wave = noise(rng, n, 0.4, tile)  # float glass is not quite flat: a faint ripple
     colour = np.ones((n, n, 3))
@@ -315,7 +370,17 @@ GENERATORS: dict[str, Callable[[int, float, np.random.Generator], Surface]] = {
     "roof-tiles": _roof_tiles,
     "slate": _slate,
     "glass": _glass,
+    "gravel": _gravel,
+    "membrane": _membrane,
 }
+#: the kinds in the order their random streams are numbered: the first eleven in
+#: alphabetical order, the later ones as they came, so that a new kind changes no other
+#: kind's pictures
+STREAMS = (
+    *("ashlar", "brick-english", "brick-flemish", "brick-stretcher", "concrete", "glass"),
+    *("metal", "render", "roof-tiles", "slate", "timber"),
+    *("gravel", "membrane"),
+)
 
 
 def normal_map(height: Field, tile: float) -> np.ndarray:
@@ -371,7 +436,7 @@ def texture_set(
     """The images of a surface kind over one tile: ``colour`` (linear RGB 0..1) is the
     material's main colour (the bricks', the stone's; joints keep their own), and
     ``roughness``/``metallic`` the means its maps vary around."""
-    rng = np.random.default_rng([seed, sorted(GENERATORS).index(kind)])
+    rng = np.random.default_rng([seed, STREAMS.index(kind)])
     surface = GENERATORS[kind](resolution, tile, rng)
     tinted = np.ones(surface.height.shape) if surface.tinted is None else surface.tinted
     main = np.asarray(colour)

@@ -89,35 +89,154 @@ renderer.shadowMap.type = THREE.PCFSoftShadowMap;
 renderer.shadowMap.autoUpdate = false;  // the scene holds still: drawn again when a model comes
 view.appendChild(renderer.domElement);
 // The light of a bright day, as a product shot takes it: a sky (blue overhead, pale at
-// the horizon, a warm glow round the sun) over a town's skyline and a street, drawn into an
-// equirectangular picture, prefiltered (PMREM) into the environment every material is lit
-// by and reflects, and a sun casting soft shadows. What glass mirrors is mostly this
+// the horizon, a warm glow round the sun and the sun's disc, fair-weather clouds) over a
+// town's skyline and a street, drawn into an equirectangular picture, prefiltered (PMREM)
+// into the environment every material is lit by and reflects, and a sun casting soft
+// shadows from the same direction as the disc. What glass mirrors is mostly this
 // picture's horizon band (a pane seen from the front or a street mirrors the skyline, the
 // street and the sky just over them), so the band is drawn as a street sees it: distant
 // houses in the haze of their distance (aerial perspective), the far paving as bright as
 // the horizon it fades into, pale sunlit paving nearer; not a dark floor, which made every
-// pane a flat dark slate. Seeded: the same picture every time.
-const SKY = 0xe9edf2;  // the backdrop and the haze the ground fades into
-// a pale backdrop, not a grey one darker than the ground (the backdrop and haze are tone
-// mapped too)
-const BACKDROP = new THREE.Color(SKY).multiplyScalar(0.8 / EXPOSURE);
-// The sky is brighter than the houses and paving it lights (in daylight several times
-// brighter than a wall in shade): what glass mirrors of it stands out as it does in a photo.
-const SKY_LIGHT = 2.4;
-const sunDirection = new THREE.Vector3(-0.45, 0.72, 0.53).normalize();  // front left, 46 degrees up
-function skyEnvironment() {
-  const width = 1024, height = 512, data = new Float32Array(width * height * 4);
-  const zenith = new THREE.Color(0x86a9d6), horizon = new THREE.Color(0xf1f4f7);
-  zenith.multiplyScalar(SKY_LIGHT); horizon.multiplyScalar(SKY_LIGHT);
-  const paving = new THREE.Color(0xb3ada3), glow = new THREE.Color(0xfff1dc);
-  const houses = [0xd8cfc2, 0xc9b8a4, 0xe4dfd6, 0xb9a48f, 0xcfd3d6].map(c => new THREE.Color(c));
-  let seed = 7;  // mulberry32: the skyline's houses, the same each time
-  const random = () => {
+// pane a flat dark slate. The backdrop behind the model is the same sky, drawn finer and
+// without the skyline and street (the model's own ground stands there), its horizon the
+// haze the ground fades into. Seeded: the same pictures every time.
+// mulberry32: a seeded stream of numbers in [0, 1), the same for the same seed
+function seeded(seed) {
+  return () => {
     seed = (seed + 0x6D2B79F5) | 0;
     let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
     t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
     return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
   };
+}
+// The sky is brighter than the houses and paving it lights (in daylight several times
+// brighter than a wall in shade): what glass mirrors of it stands out as it does in a photo.
+const SKY_LIGHT = 2.4;
+const sunDirection = new THREE.Vector3(-0.45, 0.72, 0.53).normalize();  // front left, 46 degrees up
+const ZENITH = new THREE.Color(0x6f98cf), HORIZON = new THREE.Color(0xe4ebf2);
+const SUN_DISC = Math.cos(0.6 * Math.PI / 180);  // the disc's half-angle, a little wide
+// Clouds: seeded value noise in several octaves, laid on a plane above the
+// eye (so they shrink and crowd towards the horizon, and fade out into its haze), about a
+// quarter of the sky (CLOUD_COVER sets it), lit towards the sun and greyer where thick.
+const CLOUD_GRID = 256, CLOUD_COVER = 0.42, CLOUD_SCALE = 1.8, CLOUD_CONTRAST = 2.2;
+const cloudLattice = (() => {
+  const random = seeded(23), values = new Float32Array(CLOUD_GRID * CLOUD_GRID);
+  for (let i = 0; i < values.length; i++) values[i] = random();
+  return values;
+})();
+function valueNoise(x, y) {
+  const fx = Math.floor(x), fy = Math.floor(y), tx = x - fx, ty = y - fy;
+  const sx = tx * tx * (3 - 2 * tx), sy = ty * ty * (3 - 2 * ty);
+  const x0 = fx & (CLOUD_GRID - 1), y0 = fy & (CLOUD_GRID - 1);
+  const x1 = (x0 + 1) & (CLOUD_GRID - 1), y1 = (y0 + 1) & (CLOUD_GRID - 1);
+  const at = (column, row) => cloudLattice[row * CLOUD_GRID + column];
+  const top = at(x0, y0) + (at(x1, y0) - at(x0, y0)) * sx;
+  const bottom = at(x0, y1) + (at(x1, y1) - at(x0, y1)) * sx;
+  return top + (bottom - top) * sy;
+}
+function cloudiness(direction) {  // 0 (clear) .. 1 (thick cloud) in a direction above the horizon
+  const y = direction.y;
+  if (y <= 0.01) return 0;
+  const x = direction.x / y * CLOUD_SCALE, z = direction.z / y * CLOUD_SCALE;
+  let sum = 0, weight = 0.5, frequency = 1;
+  for (let octave = 0; octave < 5; octave++) {
+    sum += weight * valueNoise(x * frequency + 17.3 * octave, z * frequency - 9.1 * octave);
+    weight *= 0.5; frequency *= 2.03;
+  }
+  const spread = (sum / 0.97 - 0.5) * CLOUD_CONTRAST + 0.5;  // the octaves' sum is narrow
+  const density = THREE.MathUtils.smoothstep(spread, 1 - CLOUD_COVER, 1 - CLOUD_COVER + 0.22);
+  return density * THREE.MathUtils.smoothstep(y, 0.03, 0.25);  // lost in the haze low down
+}
+// The sky's radiance in a direction (linear, before the white balance): the gradient,
+// the clouds, the glow round the sun and its disc. ``colour`` receives it.
+// a little cool: the white balance (below) warms the whole sky as it cancels its blue
+const CLOUD_TOP = new THREE.Color(0xeef3ff), CLOUD_BASE = new THREE.Color(0xa9b4c6);
+const GLOW = new THREE.Color(0xfff1dc);
+function skyRadiance(direction, colour) {
+  const y = Math.max(direction.y, 0);
+  colour.copy(HORIZON).lerp(ZENITH, Math.pow(y, 0.6)).multiplyScalar(SKY_LIGHT);
+  const cloud = cloudiness(direction);
+  if (cloud > 0) {  // lit from the sun's side: brighter towards it
+    const lit = 0.9 + 0.3 * Math.max(0, direction.dot(sunDirection));
+    const shade = CLOUD_BASE.clone().lerp(CLOUD_TOP, 1 - cloud * 0.6);
+    colour.lerp(shade.multiplyScalar(SKY_LIGHT * 1.35 * lit), cloud);
+  }
+  const towards = Math.max(0, direction.dot(sunDirection));
+  colour.add(GLOW.clone().multiplyScalar(2.5 * Math.pow(towards, 24)));
+  if (towards > SUN_DISC) colour.add(GLOW.clone().multiplyScalar(40));
+  return colour;
+}
+// An equirectangular picture (row 0 straight down) of the sky above and, below the
+// horizon, the horizon's haze as ``below(y, colour)`` changes it (y: the direction's
+// height, -1..0); with ``skyline``, the distant houses of the horizon band too.
+function skyPicture(width, height, below, skyline) {
+  const data = new Float32Array(width * height * 4);
+  const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
+  const horizon = HORIZON.clone().multiplyScalar(SKY_LIGHT);
+  for (let row = 0; row < height; row++) {
+    const elevation = ((row + 0.5) / height - 0.5) * Math.PI, y = Math.sin(elevation);
+    let block = 0;
+    for (let column = 0; column < width; column++) {
+      const u = (column + 0.5) / width, azimuth = (u - 0.5) * 2 * Math.PI;
+      direction.set(Math.cos(azimuth) * Math.cos(elevation), y,  // as three reads it
+                    Math.sin(azimuth) * Math.cos(elevation));
+      if (y >= 0) {
+        skyRadiance(direction, colour);
+        if (skyline) {
+          while (skyline[block][1] <= u) block++;
+          const [, , top, tone, light] = skyline[block];
+          if (y < top) {  // a house far off: lit by the sky, half lost in the haze
+            house.copy(tone).multiplyScalar(light);
+            colour.copy(horizon).lerp(house, 0.85 - 3 * y);
+          }
+        }
+      } else {
+        below(y, colour.copy(horizon));
+      }
+      const at = (row * width + column) * 4;
+      data[at] = colour.r; data[at + 1] = colour.g; data[at + 2] = colour.b; data[at + 3] = 1;
+    }
+  }
+  return data;
+}
+// White balance: the light a wall takes from the environment, whichever way it faces
+// (each direction weighted by its solid angle and by the cosine a vertical wall sees it
+// at), is grey at its own luminance; the blue overhead and the warm paving and glow
+// cancel, so a wall of a known colour renders as that colour, in sun (the sun is white)
+// or in shade. The gains, one a channel, found on the environment's picture, apply to
+// the backdrop as well: what is seen and what lights are one sky.
+function whiteBalance(data, width, height) {
+  const mean = [0, 0, 0];
+  for (let row = 0; row < height; row++) {
+    const weight = Math.cos(((row + 0.5) / height - 0.5) * Math.PI) ** 2;
+    for (let column = 0; column < width; column++) {
+      const at = (row * width + column) * 4;
+      for (let channel = 0; channel < 3; channel++) mean[channel] += weight * data[at + channel];
+    }
+  }
+  const luminance = 0.2126 * mean[0] + 0.7152 * mean[1] + 0.0722 * mean[2];
+  return mean.map(sum => luminance / sum);
+}
+function balanced(data, gains) {
+  for (let at = 0; at < data.length; at += 4) {
+    for (let channel = 0; channel < 3; channel++) data[at + channel] *= gains[channel];
+  }
+  return data;
+}
+function equirectangular(data, width, height) {
+  const picture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
+  picture.mapping = THREE.EquirectangularReflectionMapping;
+  picture.flipY = false;
+  picture.magFilter = THREE.LinearFilter;
+  picture.needsUpdate = true;
+  return picture;
+}
+// -> the environment (PMREM), the backdrop's picture and the haze (the backdrop's colour
+// at the horizon, which the fog fades the ground into)
+function sky() {
+  const paving = new THREE.Color(0xb3ada3);
+  const houses = [0xd8cfc2, 0xc9b8a4, 0xe4dfd6, 0xb9a48f, 0xcfd3d6].map(c => new THREE.Color(c));
+  const random = seeded(7);  // the skyline's houses, the same each time
   const skyline = [];  // [from, to) of the azimuth (0..1), the top (sine of its angle), tone
   for (let at = 0; at < 1;) {
     const wide = 0.006 + 0.018 * random();
@@ -125,58 +244,28 @@ function skyEnvironment() {
                   0.55 + 0.3 * random()]);
     at += wide;
   }
-  const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
-  let block = 0;
-  const mean = [0, 0, 0];  // the picture's light on a wall, each channel (see below)
-  for (let row = 0; row < height; row++) {
-    const elevation = ((row + 0.5) / height - 0.5) * Math.PI, y = Math.sin(elevation);
-    block = 0;
-    for (let column = 0; column < width; column++) {
-      const u = (column + 0.5) / width, azimuth = (u - 0.5) * 2 * Math.PI;
-      direction.set(Math.cos(azimuth) * Math.cos(elevation), y,  // as three reads it
-                    Math.sin(azimuth) * Math.cos(elevation));
-      if (y >= 0) {
-        colour.copy(horizon).lerp(zenith, Math.pow(y, 0.6));
-        while (skyline[block][1] <= u) block++;
-        const [, , top, tone, light] = skyline[block];
-        if (y < top) {  // a house far off: lit by the sky, half lost in the haze
-          house.copy(tone).multiplyScalar(light);
-          colour.copy(horizon).lerp(house, 0.85 - 3 * y);
-        }
-      } else {  // the street: the far paving in the horizon's haze, sunlit paving nearer
-        colour.copy(horizon).lerp(paving, Math.min(1, Math.pow(-y * 3, 0.7)));
-      }
-      colour.add(glow.clone().multiplyScalar(
-        2.5 * Math.pow(Math.max(0, direction.dot(sunDirection)), 24)));
-      const at = (row * width + column) * 4;  // row 0: straight down
-      data[at] = colour.r; data[at + 1] = colour.g; data[at + 2] = colour.b; data[at + 3] = 1;
-      const weight = Math.cos(elevation) ** 2;  // the texel's solid angle, a wall's cosine
-      for (let channel = 0; channel < 3; channel++) mean[channel] += weight * data[at + channel];
-    }
-  }
-  // White-balanced: the light a wall takes from the picture, whichever way it faces (each
-  // direction weighted by its solid angle and by the cosine a vertical wall sees it at), is
-  // grey at its own luminance; the blue overhead and the warm paving and glow cancel, so a
-  // wall of a known colour renders as that colour, in sun (the sun is white) or in shade.
-  const luminance = 0.2126 * mean[0] + 0.7152 * mean[1] + 0.0722 * mean[2];
-  const gains = mean.map(sum => luminance / sum);
-  for (let at = 0; at < data.length; at += 4) {
-    for (let channel = 0; channel < 3; channel++) data[at + channel] *= gains[channel];
-  }
-  const picture = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
-  picture.mapping = THREE.EquirectangularReflectionMapping;
-  picture.flipY = false;
-  picture.needsUpdate = true;
+  // the street: the far paving in the horizon's haze, sunlit paving nearer
+  const street = (y, colour) => colour.lerp(paving, Math.min(1, Math.pow(-y * 3, 0.7)));
+  const width = 1024, height = 512;
+  const lighting = skyPicture(width, height, street, skyline);
+  const gains = whiteBalance(lighting, width, height);
+  const picture = equirectangular(balanced(lighting, gains), width, height);
   const prefilter = new THREE.PMREMGenerator(renderer);
   const environment = prefilter.fromEquirectangular(picture).texture;
   prefilter.dispose(); picture.dispose();
-  return environment;
+  // the backdrop: 0.18 degrees a texel, about three pixels of a 900-pixel view
+  const haze = HORIZON.clone().multiplyScalar(SKY_LIGHT);
+  haze.setRGB(haze.r * gains[0], haze.g * gains[1], haze.b * gains[2]);
+  const backdrop = equirectangular(
+    balanced(skyPicture(2048, 1024, () => {}, null), gains), 2048, 1024);  // haze below
+  return {environment, backdrop, haze};
 }
 const scene = new THREE.Scene();
-scene.background = BACKDROP;
-scene.environment = skyEnvironment();
-// placed by frame(): the model clear, the ground fading out
-scene.fog = new THREE.Fog(BACKDROP, 1, 2);
+const daylight = sky();
+scene.background = daylight.backdrop;
+scene.environment = daylight.environment;
+// placed by frame(): the model clear, the ground fading out into the horizon's haze
+scene.fog = new THREE.Fog(daylight.haze, 1, 2);
 const sun = new THREE.DirectionalLight(0xffffff, 3.4);  // white, as the sky's light is
 sun.castShadow = true;
 sun.shadow.bias = -0.0002;
@@ -187,13 +276,7 @@ scene.add(sun, sun.target);
 const SLAB = 0.6;  // metres a side
 function pavingPicture() {
   const slabs = 4, cell = 32, size = slabs * cell, data = new Uint8Array(size * size * 4);
-  let seed = 11;  // mulberry32, as the skyline's
-  const random = () => {
-    seed = (seed + 0x6D2B79F5) | 0;
-    let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
-    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
-    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-  };
+  const random = seeded(11);
   const tones = Array.from({length: slabs * slabs}, () => 0.92 + 0.16 * random());
   for (let y = 0; y < size; y++) for (let x = 0; x < size; x++) {
     const joint = x % cell === 0 || y % cell === 0;
@@ -226,13 +309,7 @@ const controls = new OrbitControls(camera, renderer.domElement);
 // sRGB); WebGL 1 draws without it. Its noise is seeded, so a picture is the same each time.
 class SteadyGTAOPass extends GTAOPass {
   generateNoise(size = 64) {
-    let seed = 1;  // mulberry32
-    const random = () => {
-      seed = (seed + 0x6D2B79F5) | 0;
-      let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
-      t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
-      return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-    };
+    const random = seeded(1);
     const simplex = new SimplexNoise({random});
     const data = new Uint8Array(size * size * 4);
     for (let i = 0; i < size; i++) for (let j = 0; j < size; j++) {
@@ -343,25 +420,26 @@ function halfTangents() {
   return [tanV * camera.aspect, tanV];
 }
 // The camera looking along -seen (seen: from the model towards the camera) that holds the
-// box's eight corners in the view and stands as close as that allows: each side of the
-// view is a plane every corner must lie inside, which bounds the camera's place across,
-// up and back linearly (an exact fit, not a sphere's). The box's picture is centred and
-// fills the view along its tighter axis. Returns the point the camera aims at (where its
-// axis passes the box's centre's depth), the camera's distance from it, the distance at
-// which the box's picture would fill the view's height (high), and whether it does
-// (filled; else its width binds, and the view has room above and below it).
-function fitBox(box, centre, seen) {
+// points (corners of boxes, see bounds) in the view and stands as close as that allows:
+// each side of the view is a plane every point must lie inside, which bounds the camera's
+// place across, up and back linearly (an exact fit, not a sphere's). The points' picture
+// is centred and fills the view along its tighter axis. Returns the point the camera aims
+// at (where its axis passes the centre's depth), the camera's distance from it, the
+// distance at which the points' picture would fill the view's height (high), and whether
+// it does (filled; else its width binds, and the view has room above and below it).
+function fitBox(points, centre, seen) {
   const [tanH, tanV] = halfTangents();
   const forward = seen.clone().negate();
   const right = forward.clone().cross(new THREE.Vector3(0, 1, 0)).normalize();
   const upward = right.clone().cross(forward);
-  const most = (values) => Math.max(...values);
-  const offsets = corners(box).map(corner => corner.sub(centre));
-  const across = offsets.map(o => [o.dot(right), o.dot(upward), o.dot(forward)]);
-  const rightmost = most(across.map(([x, , z]) => x - tanH * z));
-  const leftmost = most(across.map(([x, , z]) => -x - tanH * z));
-  const top = most(across.map(([, y, z]) => y - tanV * z));
-  const bottom = most(across.map(([, y, z]) => -y - tanV * z));
+  let rightmost = -Infinity, leftmost = -Infinity, top = -Infinity, bottom = -Infinity;
+  const offset = new THREE.Vector3();
+  for (const point of points) {  // a loop, not Math.max(...): a city has many points
+    offset.subVectors(point, centre);
+    const x = offset.dot(right), y = offset.dot(upward), z = offset.dot(forward);
+    rightmost = Math.max(rightmost, x - tanH * z); leftmost = Math.max(leftmost, -x - tanH * z);
+    top = Math.max(top, y - tanV * z); bottom = Math.max(bottom, -y - tanV * z);
+  }
   const wide = (rightmost + leftmost) / (2 * tanH), high = (top + bottom) / (2 * tanV);
   const aim = centre.clone().addScaledVector(right, (rightmost - leftmost) / 2)
     .addScaledVector(upward, (top - bottom) / 2);
@@ -702,12 +780,26 @@ function fitSun(box, centre, radius) {
 }
 const SEEN_FROM = 35;  // degrees round from the front, unless ?view says otherwise
 const DISTRICT_RISE = 30;  // degrees up a district is seen from (a façade from 8.5)
+// What the camera frames (points): a model's box's eight corners; a district's, those of
+// each of its buildings' boxes (up to FRAMED_BUILDINGS of them), which hug the buildings
+// (the district's box has corners in the air over low houses, and framing those left the
+// whole district too small, or cut a building at the picture's edge when brought closer)
+const FRAMED_BUILDINGS = 20000;
 function bounds(model) {
   const box = new THREE.Box3().setFromObject(model);
   if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(10, 10, 10));
   const size = box.getSize(new THREE.Vector3());
   const district = Math.min(size.x, size.z) > 2 * size.y;  // wider and deeper than tall
-  return {box, size, centre: box.getCenter(new THREE.Vector3()), district,
+  let points = corners(box);
+  if (district && model.children.length <= FRAMED_BUILDINGS) {
+    points = [];
+    for (const building of model.children) {
+      const own = new THREE.Box3().setFromObject(building);
+      if (!own.isEmpty()) points.push(...corners(own));
+    }
+    if (!points.length) points = corners(box);
+  }
+  return {box, size, centre: box.getCenter(new THREE.Vector3()), district, points,
           radius: Math.max(size.length() / 2, 0.01), rise: district ? DISTRICT_RISE : 8.5};
 }
 function direction(angle, rise) {
@@ -717,8 +809,8 @@ function direction(angle, rise) {
 // The ground, the haze, the sun's shadows and the ambient occlusion's reach, fitted to the
 // model as first framed (not to where the camera is turned: a picture is the same each time)
 function light(model) {
-  const {box, centre, radius, rise} = bounds(model);
-  const fit = fitBox(box, centre, direction(SEEN_FROM, rise)).distance;
+  const {box, centre, radius, rise, points} = bounds(model);
+  const fit = fitBox(points, centre, direction(SEEN_FROM, rise)).distance;
   const haze = fit + 2 * radius;
   scene.fog.near = haze; scene.fog.far = 4 * haze;
   ground.position.set(centre.x, box.min.y - radius * 1e-4, centre.z);
@@ -732,29 +824,22 @@ function light(model) {
   redraw();
 }
 // A district seen from ?view=ANGLE with no elevation: from the lowest elevation, from
-// DISTRICT_LOWEST up to DISTRICT_HIGHEST degrees, at which its picture fills the view's
-// height as well as its width, so the picture is its buildings, not a strip of them
-// between the paving and the sky (a block seen from 12 degrees filled a quarter of it);
-// if none does, from DISTRICT_HIGHEST (a front view, not a plan) and closer, up to
-// DISTRICT_CLOSER times, as far as filling the height asks: the district's ends a little
-// beyond the picture's sides. Returns the elevation and how much closer; a facade, or a
-// view that gives its elevation, is framed whole.
-const DISTRICT_LOWEST = 10, DISTRICT_HIGHEST = 30, DISTRICT_CLOSER = 1.3;
-function districtRise(box, centre, district, rise) {
-  if (!district || !Number.isFinite(around) || Number.isFinite(up)) {
-    return {rise: or(up, rise), closer: 1};
-  }
+// DISTRICT_LOWEST up to DISTRICT_HIGHEST degrees, at which its buildings' picture fills
+// the view's height as well as its width, so the picture is its buildings, not a strip of
+// them between the paving and the sky (a block seen from 12 degrees filled a quarter of
+// it); if none does, from DISTRICT_HIGHEST (a front view, not a plan), every building
+// whole. A facade, or a view that gives its elevation, is framed whole too.
+const DISTRICT_LOWEST = 10, DISTRICT_HIGHEST = 30;
+function districtRise(points, centre, district, rise) {
+  if (!district || !Number.isFinite(around) || Number.isFinite(up)) return or(up, rise);
   for (let degrees = DISTRICT_LOWEST; degrees < DISTRICT_HIGHEST; degrees++) {
-    if (fitBox(box, centre, direction(around, degrees)).filled) {
-      return {rise: degrees, closer: 1};
-    }
+    if (fitBox(points, centre, direction(around, degrees)).filled) return degrees;
   }
-  const fit = fitBox(box, centre, direction(around, DISTRICT_HIGHEST));
-  return {rise: DISTRICT_HIGHEST, closer: Math.min(DISTRICT_CLOSER, fit.distance / fit.high)};
+  return DISTRICT_HIGHEST;
 }
 function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a district from 30
   resize();
-  const {box, size, centre, radius, district, rise} = bounds(model);
+  const {box, size, centre, radius, district, rise, points} = bounds(model);
   let target, distance;
   const inDistrict = street && district ? fitDistrictStreet(model, box) : null;
   if (inDistrict) {
@@ -765,14 +850,13 @@ function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a 
     target = fit.aim; distance = fit.distance;
     camera.position.copy(fit.position);
   } else {
-    const elevation = districtRise(box, centre, district, rise);
-    const seen = direction(or(around, SEEN_FROM), elevation.rise);
-    const fit = fitBox(box, centre, seen);
+    const seen = direction(or(around, SEEN_FROM), districtRise(points, centre, district, rise));
+    const fit = fitBox(points, centre, seen);
     target = fit.aim;
     if (Number.isFinite(atX)) target.x = box.min.x + atX * size.x;
     if (Number.isFinite(atY)) target.y = box.min.y + atY * size.y;
     if (Number.isFinite(atZ)) target.z = box.min.z + atZ * size.z;
-    distance = fit.distance / elevation.closer / or(zoom, 1);
+    distance = fit.distance / or(zoom, 1);
     camera.position.copy(target).addScaledVector(seen, distance);
   }
   camera.near = distance / 1000; camera.far = distance * 20 + 8 * radius;
