@@ -178,8 +178,9 @@ def test_roofs_wear_a_library_material(city: Path) -> None:
         assert "normalTexture" in material
 
 
-def _flat_roofs(glb: Path) -> dict[str, str]:
-    """Each building's flat roof material (its base colour picture's file), by its name."""
+def _base_colours(glb: Path, names: tuple[str, ...]) -> dict[str, str]:
+    """Each building's base colour picture (a file of the run's textures/) of its
+    material named one of ``names``, by the building's name."""
     document, _ = read_glb(glb.read_bytes())
     found = {}
     for node in document["nodes"]:
@@ -187,11 +188,16 @@ def _flat_roofs(glb: Path) -> dict[str, str]:
             mesh = document["nodes"][child].get("mesh")
             for primitive in [] if mesh is None else document["meshes"][mesh]["primitives"]:
                 material = document["materials"][primitive["material"]]
-                if material["name"] == "flat_roof":
+                if material["name"] in names:
                     texture = material["pbrMetallicRoughness"]["baseColorTexture"]
                     source = document["textures"][texture["index"]]["source"]
                     found[node["name"]] = document["images"][source]["uri"]
     return found
+
+
+def _flat_roofs(glb: Path) -> dict[str, str]:
+    """Each building's flat roof material (its base colour picture's file), by its name."""
+    return _base_colours(glb, ("flat_roof",))
 
 
 def test_flat_roofs_vary_from_building_to_building_in_a_few_shared_materials(
@@ -256,18 +262,8 @@ def test_tones_keep_the_hue_and_stay_within_white() -> None:
 def _wall_pictures(glb: Path) -> dict[str, bytes]:
     """Each building's wall picture (its brick's or render's base colour: a file of the
     run's textures/), by its name."""
-    document, _ = read_glb(glb.read_bytes())
-    found = {}
-    for node in document["nodes"]:
-        for child in node.get("children", []):
-            mesh = document["nodes"][child].get("mesh")
-            for primitive in [] if mesh is None else document["meshes"][mesh]["primitives"]:
-                material = document["materials"][primitive["material"]]
-                if material["name"] in ("brick", "render"):
-                    texture = material["pbrMetallicRoughness"]["baseColorTexture"]
-                    image = document["images"][document["textures"][texture["index"]]["source"]]
-                    found[node["name"]] = (glb.parent / image["uri"]).read_bytes()
-    return found
+    pictures = _base_colours(glb, ("brick", "render"))
+    return {name: (glb.parent / uri).read_bytes() for name, uri in pictures.items()}
 
 
 def test_the_seed_varies_the_walls_and_the_same_seed_gives_the_same_bytes(
