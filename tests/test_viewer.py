@@ -331,6 +331,32 @@ def test_glass_reads_neither_black_nor_white_nor_as_the_wall(tmp_path: Path) -> 
     assert abs(wall - pane) > 25
 
 
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_glass_seen_at_35_degrees_mirrors_the_street_not_a_slate(tmp_path: Path) -> None:
+    """The window of :data:`PANE_SPEC` seen from 35° round and 10° up: the pane mirrors
+    what lies 10° below the horizon, the houses across the street (their fronts and their
+    windows), at the reflectance of a double-glazed unit, so it is lighter than a dark
+    slate and shows something. Measured on the pane's middle (0.33..0.45 across,
+    0.32..0.6 up): mean grey 66.3, spread (standard deviation) 4.3 when the environment
+    held plain paving there and the glass reflected one face's 4%; 83.5 and 7.4 now
+    (square on, 0.42..0.58: 65.7 and 7.1 before, 88.2 and 12.0 now)."""
+    from PIL import Image, ImageStat
+
+    spec = tmp_path / "pane.yaml"
+    spec.write_text(PANE_SPEC)
+    layout = solve(load_spec(spec))
+    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
+    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=35,10")
+    assert "<title>pane</title>" in dom
+    with Image.open(shot) as image:
+        grey = image.convert("L")
+        width, height = grey.size
+        box = (round(0.33 * width), round(0.32 * height), round(0.45 * width), round(0.6 * height))
+        pane = ImageStat.Stat(grey.crop(box))
+    assert 75 < pane.mean[0] < 170
+    assert pane.stddev[0] > 5.8
+
+
 WALLS_SPEC = """
 version: 1
 name: walls

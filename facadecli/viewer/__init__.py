@@ -95,11 +95,12 @@ view.appendChild(renderer.domElement);
 // shadows from the same direction as the disc. What glass mirrors is mostly this
 // picture's horizon band (a pane seen from the front or a street mirrors the skyline, the
 // street and the sky just over them), so the band is drawn as a street sees it: distant
-// houses in the haze of their distance (aerial perspective), the far paving as bright as
-// the horizon it fades into, pale sunlit paving nearer; not a dark floor, which made every
-// pane a flat dark slate. The backdrop behind the model is the same sky, drawn finer and
-// without the skyline and street (the model's own ground stands there), its horizon the
-// haze the ground fades into. Seeded: the same pictures every time.
+// houses in the haze of their distance (aerial perspective); below the horizon the fronts
+// of the houses across the street, then pale sunlit paving, both fading into the
+// horizon's haze; not a dark floor, which made every pane a flat dark slate. The
+// backdrop behind the model is the same sky, drawn finer and without the skyline and
+// street (the model's own ground stands there), its horizon the haze the ground fades
+// into. Seeded: the same pictures every time.
 // mulberry32: a seeded stream of numbers in [0, 1), the same for the same seed
 function seeded(seed) {
   return () => {
@@ -169,6 +170,12 @@ function skyRadiance(direction, colour) {
 // An equirectangular picture (row 0 straight down) of the sky above and, below the
 // horizon, the horizon's haze as ``below(y, colour)`` changes it (y: the direction's
 // height, -1..0); with ``skyline``, the distant houses of the horizon band too.
+// Below the horizon the street: the fronts of the houses across it down to FRONTS (the
+// sine of their foot's angle below the eye), sunlit (SUNLIT times a far house's light),
+// their windows WINDOWS as bright, then paving. What a pane seen from the front or 35°
+// mirrors is here, 5-15° below the horizon: it was paving as bright as the haze, the
+// same grey all over, so a pane showed nothing but a dark slate.
+const FRONTS = 0.26, WINDOWS = 0.5, SUNLIT = 2;
 function skyPicture(width, height, below, skyline) {
   const data = new Float32Array(width * height * 4);
   const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
@@ -180,10 +187,10 @@ function skyPicture(width, height, below, skyline) {
       const u = (column + 0.5) / width, azimuth = (u - 0.5) * 2 * Math.PI;
       direction.set(Math.cos(azimuth) * Math.cos(elevation), y,  // as three reads it
                     Math.sin(azimuth) * Math.cos(elevation));
+      if (skyline) while (skyline[block][1] <= u) block++;
       if (y >= 0) {
         skyRadiance(direction, colour);
         if (skyline) {
-          while (skyline[block][1] <= u) block++;
           const [, , top, tone, light] = skyline[block];
           if (y < top) {  // a house far off: lit by the sky, half lost in the haze
             house.copy(tone).multiplyScalar(light);
@@ -192,6 +199,13 @@ function skyPicture(width, height, below, skyline) {
         }
       } else {
         below(y, colour.copy(horizon));
+        if (skyline && y > -FRONTS) {  // the houses across the street, their windows darker
+          const [from, to, , tone, light] = skyline[block];
+          const across = (u - from) / (to - from), storey = (-y / FRONTS * 3) % 1;
+          const glazed = across > 0.2 && across < 0.8 && storey > 0.25 && storey < 0.75;
+          house.copy(tone).multiplyScalar(SUNLIT * light * (glazed ? WINDOWS : 1));
+          colour.lerp(house, 0.7 * Math.min(1, -y / 0.03));  // in the haze at the horizon
+        }
       }
       const at = (row * width + column) * 4;
       data[at] = colour.r; data[at + 1] = colour.g; data[at + 2] = colour.b; data[at + 3] = 1;
@@ -384,6 +398,12 @@ function dispose(object) {
 // fallback for viewers without the extension, and blending by it too would dim the pane's
 // reflection to a third (a dark pane) and count what lies behind it twice.
 const isGlass = material => material.transmission > 0;
+// A window's glass is a sealed unit of two panes, four faces that each reflect about 4%
+// (float glass, ior 1.52): seen square on it reflects about 15% of what lies before it, not
+// the 4% of one face, which left every pane a dark slate. The glb keeps its glass's ior;
+// the viewer scales its F0 colour to the unit's reflectance.
+const GLAZING_REFLECTANCE = 0.15;
+const fresnelAtNormal = ior => ((ior - 1) / (ior + 1)) ** 2;
 const materialsOf = part => Array.isArray(part.material) ? part.material : [part.material];
 function castsShadows(model) {
   model.traverse(part => {
@@ -393,6 +413,7 @@ function castsShadows(model) {
     part.receiveShadow = true;
     for (const material of materials.filter(isGlass)) {
       material.transparent = false; material.opacity = 1; material.depthWrite = true;
+      material.specularColor.setScalar(GLAZING_REFLECTANCE / fresnelAtNormal(material.ior));
     }
   });
 }
