@@ -31,6 +31,16 @@ def _page(tmp_path: Path) -> Path:
     return path
 
 
+def _shown(tmp_path: Path, text: str, query: str) -> tuple[Path, str]:
+    """The page of a spec (its YAML ``text``) solved, in the browser with ``query`` (its
+    view): the screenshot and the page's DOM."""
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(text)
+    layout = solve(load_spec(spec))
+    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
+    return browse(tmp_path, path.as_uri() + query)
+
+
 def test_the_page_holds_everything_it_shows(tmp_path: Path) -> None:
     text = _page(tmp_path).read_text()
     assert '<script type="importmap">' in text and "data:text/javascript;base64," in text
@@ -317,11 +327,7 @@ def test_glass_reads_neither_black_nor_white_nor_as_the_wall(tmp_path: Path) -> 
     in a band well inside 0..255 and apart from the wall's. Glass blended by its fallback
     alpha over a dark ground read about 37 (black); a pane as pale as the wall, or blown
     out, fails too."""
-    spec = tmp_path / "pane.yaml"
-    spec.write_text(PANE_SPEC)
-    layout = solve(load_spec(spec))
-    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
-    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,0")
+    shot, dom = _shown(tmp_path, PANE_SPEC, "?bare&view=0,0")
     assert "<title>pane</title>" in dom
     # the window spans 0.35..0.65 of the wall across and 0.25..0.75 up; the wall fills
     # 1/1.08 of the picture, so 0.42..0.58 of it is pane and 0.12..0.2 wall
@@ -342,11 +348,7 @@ def test_glass_seen_at_35_degrees_mirrors_the_street_not_a_slate(tmp_path: Path)
     (square on, 0.42..0.58: 65.7 and 7.1 before, 88.2 and 12.0 now)."""
     from PIL import Image, ImageStat
 
-    spec = tmp_path / "pane.yaml"
-    spec.write_text(PANE_SPEC)
-    layout = solve(load_spec(spec))
-    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
-    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=35,10")
+    shot, dom = _shown(tmp_path, PANE_SPEC, "?bare&view=35,10")
     assert "<title>pane</title>" in dom
     with Image.open(shot) as image:
         grey = image.convert("L")
@@ -415,11 +417,7 @@ def test_a_lit_wall_keeps_its_colours_hue_and_saturation(tmp_path: Path) -> None
     (the sun, and the sky's light on a wall balanced to grey) and the tone mapping
     (Khronos PBR Neutral) keeps a colour's hue and saturation. ACES filmic tone mapping
     under a slightly blue light drained the plaster to 0.070 (near white)."""
-    spec = tmp_path / "walls.yaml"
-    spec.write_text(WALLS_SPEC)
-    layout = solve(load_spec(spec))
-    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
-    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,0")
+    shot, dom = _shown(tmp_path, WALLS_SPEC, "?bare&view=0,0")
     assert "<title>walls</title>" in dom
     # the walls fill 1/1.08 of the picture's width, plaster left, brick right
     for box, hue, saturation in [
@@ -448,11 +446,7 @@ def test_the_sky_behind_a_model_is_blue_and_has_clouds(tmp_path: Path) -> None:
     9.0."""
     from PIL import Image, ImageStat
 
-    spec = tmp_path / "walls.yaml"
-    spec.write_text(WALLS_SPEC)
-    layout = solve(load_spec(spec))
-    (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
-    shot, dom = browse(tmp_path, path.as_uri() + "?bare&view=0,0,0.5")
+    shot, dom = _shown(tmp_path, WALLS_SPEC, "?bare&view=0,0,0.5")
     assert "<title>walls</title>" in dom
 
     def blueness(image: Image.Image, top: float, bottom: float) -> float:
