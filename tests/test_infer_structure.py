@@ -216,7 +216,7 @@ def test_the_ground_floor_stays_on_the_ground_as_a_taller_facade_gains_floors(
     assert _overlapping(solved) == 0
 
 
-def test_a_door_between_windows_shares_their_word_and_two_grids_of_a_label_never_do() -> None:
+def test_a_door_between_windows_shares_their_word_and_so_do_grids_of_a_label_on_a_floor() -> None:
     window = Grid("window", ((1.0, 2.0), (5.0, 6.0)), ((1.5, 3.0),))
     door = Grid("door", ((3.0, 4.0),), ((0.0, 3.0),))
     upper = Grid("window", ((1.0, 2.0), (3.0, 4.0), (5.0, 6.0)), ((4.0, 5.5),))
@@ -231,8 +231,52 @@ def test_a_door_between_windows_shares_their_word_and_two_grids_of_a_label_never
         )
     )
     assert found[2] is None  # above the door: not beside it
-    other = Grid("window", ((7.0, 8.0),), ((1.4, 3.0),))  # a ground-floor window drawn apart
-    assert frames([window, door, other]) == [None, None, None]
+    # a ground-floor window drawn a few centimetres off the others' rows joins their word
+    other = Grid("window", ((7.0, 8.0),), ((1.4, 3.0),))
+    assert frames([window, door, other]) == [(*found[0], ((7.0, 8.0), "window"))] * 3
+    # a grid of two floors whose upper column stands over the door's keeps its own word
+    # (one word cannot hold both): the ground floor's others still share theirs
+    tall = Grid("window", ((3.2, 3.8),), ((1.4, 3.0), (4.0, 5.5)))
+    assert frames([window, door, other, tall]) == [
+        (*found[0], ((7.0, 8.0), "window")),
+        (*found[0], ((7.0, 8.0), "window")),
+        (*found[0], ((7.0, 8.0), "window")),
+        None,
+    ]
+
+
+def _two_kinds(path: Path, seed: int) -> Path:
+    """One floor of windows of random widths, every other one with its head and sill 20-30
+    cm higher (as CMP draws the windows of one floor: two grids of one label on
+    overlapping rows, some widths in both)."""
+    rng = random.Random(seed)
+    rects, x, k = [], rng.uniform(0.8, 1.5), 0
+    while x + 1.6 < 14.2:
+        w = rng.uniform(0.9, 1.6)
+        y0, y1 = (3.0, 4.6) if k % 2 == 0 else (3.3, 4.8)
+        rects.append({"label": "window", "x0": x, "y0": y0, "x1": x + w, "y1": y1})
+        x, k = x + w + rng.uniform(0.4, 1.2), k + 1
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 8.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 3, 6])
+@pytest.mark.parametrize("share", [0.7, 1.5])
+def test_a_floors_windows_drawn_in_two_grids_never_meet_at_other_widths(
+    tmp_path: Path, seed: int, share: float
+) -> None:
+    """The two grids of the floor share one x word, each showing its own windows: solved
+    narrower or wider, their windows keep their order and spacing and never overlap (each
+    grid in a word of its own narrowed its gaps on its own: 2 overlaps at 0.7x)."""
+    path = _two_kinds(tmp_path / f"two-kinds-{seed}.json", seed)
+    drawn = json.loads(path.read_text())["rects"]
+    inference = infer(path, path.stem)
+    assert len(inference.grids) == 2
+    solved = _solved(path, WIDTH * share, 8.0)
+    windows = sorted(_of(solved, "window"), key=lambda r: r.x0)
+    assert len(windows) == len(drawn)
+    assert _overlapping(solved) == 0
+    assert [r.y0 > 3.1 for r in windows] == [k % 2 == 1 for k in range(len(drawn))]  # order
 
 
 TWO_FLOORS = 7.0  # m: the height of a façade of two floors (and a roof's margin)

@@ -152,44 +152,51 @@ Frame = tuple[tuple[Span, str], ...]  # columns left to right, each with its lab
 
 def frames(found: list[Grid]) -> list[Frame | None]:
     """For each grid, the columns its layer's x word is written over: its own and those of
-    the grids of other opening labels that stand beside it on a floor (rows overlapping
-    along y, columns apart along x: a door between the ground floor's windows), so that
-    the layers of one floor share one word, each showing its own elements (its mask), and
-    solved wider they gain bays together instead of over one another. None where a grid
-    has no such neighbour, where the floor's columns would overlap, or where two grids of
-    one label would share the word (each would show the other's elements)."""
+    the opening grids that stand beside it on a floor (rows overlapping along y, columns
+    apart along x: a door between the ground floor's windows, or one floor's windows drawn
+    in two grids, a few centimetres off each other's rows), so that the layers of one floor
+    share one word, each showing its own elements (its mask), and solved at another width
+    keep their order and spacing together instead of moving over one another. None where a
+    grid has no such neighbour.
+
+    Grids join one at a time, in pairs in the order found, and only where the floor's
+    columns stay apart (no two overlapping, no span of two grids): a grid that cannot join
+    (its column over one of another floor's, on a grid of several floors) keeps its own
+    word, and the floor's other grids still share theirs. Two grids of one label in one
+    word show their elements by symbols of their own where their widths meet
+    (``spec_text``: a mask names sizes)."""
     openings = [k for k, g in enumerate(found) if g.label in OPENINGS]
-    parent = {k: k for k in openings}
-
-    def root(k: int) -> int:
-        while parent[k] != k:
-            k = parent[k]
-        return k
-
+    members: dict[int, list[int]] = {k: [k] for k in openings}  # by the group's first grid
+    root = {k: k for k in openings}
     for n, a in enumerate(openings):
         for b in openings[n + 1 :]:
             ga, gb = found[a], found[b]
-            if ga.label == gb.label:
+            if root[a] == root[b] or not any(_overlap(r, s) for r in ga.rows for s in gb.rows):
                 continue
-            beside = any(_overlap(r, s) for r in ga.rows for s in gb.rows)
-            apart = not any(_overlap(c, d) for c in ga.columns for d in gb.columns)
-            if beside and apart:
-                parent[root(b)] = root(a)
-    members: dict[int, list[int]] = defaultdict(list)
-    for k in openings:
-        members[root(k)].append(k)
+            joined = members[root[a]] + members[root[b]]
+            if _one_word(found, joined):
+                first, other = sorted((root[a], root[b]))
+                members[first] = sorted(joined)
+                del members[other]
+                for k in joined:
+                    root[k] = first
     out: list[Frame | None] = [None] * len(found)
     for group in members.values():
-        labels = [found[k].label for k in group]
-        if len(group) < 2 or len(set(labels)) < len(labels):
-            continue  # two grids of a label would each show the other's elements
-        columns = sorted({(c, found[k].label) for k in group for c in found[k].columns})
-        spans = [c for c, _ in columns]
-        if any(b[0] < a[1] - 1e-9 for a, b in pairwise(spans)):
-            continue  # overlapping columns (or one span of two labels): no shared word
+        if len(group) < 2:
+            continue
+        columns = tuple(sorted((c, found[k].label) for k in group for c in found[k].columns))
         for k in group:
-            out[k] = tuple(columns)
+            out[k] = columns
     return out
+
+
+SIZE_KEY = 6  # decimals: sizes of a label's elements this alike are one symbol in a spec
+
+
+def _one_word(found: list[Grid], group: list[int]) -> bool:
+    """Whether the grids ``group`` can share one x word: their columns apart."""
+    spans = sorted(c for k in group for c in found[k].columns)
+    return all(b[0] >= a[1] - 1e-9 for a, b in pairwise(spans))
 
 
 def top_floors(found: list[Grid], width: float, height: float) -> dict[int, float]:

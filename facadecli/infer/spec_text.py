@@ -14,6 +14,13 @@
   different columns, they would tie the words so tightly that only the input's size could
   hold them), except that layers with the same columns (rows) share their x (y) gaps:
   their words are then alike, so they stay aligned at any size.
+- One floor's words: the opening layers that stand beside one another on a floor (a
+  door between windows, or a floor's windows drawn in two grids) share one x word over
+  all their columns (``layers.frames``), each showing its own elements by its mask, so
+  at another width they keep their order and spacing and never meet. Where two grids of
+  one label in such a word have a width in common, the later one's widths are symbols
+  of its own (``window_2_w1``; ``_width_tables``): a mask names symbols, so each would
+  show the other's window.
 - Repeats: where a word repeats a gap and an element twice or more (three elements), or
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
@@ -51,7 +58,16 @@ from facadecli.infer.floors import (
     mid_wall,
     on_run,
 )
-from facadecli.infer.layers import OPENINGS, Frame, Grid, Span, frames, top_floors, uncovered
+from facadecli.infer.layers import (
+    OPENINGS,
+    SIZE_KEY,
+    Frame,
+    Grid,
+    Span,
+    frames,
+    top_floors,
+    uncovered,
+)
 
 DECIMALS = 4  # of a metre in the sizes written
 TOLERANCE = 0.01  # m: the solver's tolerance (sizes are written rounded)
@@ -87,7 +103,7 @@ class _Symbols:
     sizes: dict[float, str] = field(default_factory=dict)
 
     def of(self, size: float) -> str:
-        key = round(size, 6)
+        key = round(size, SIZE_KEY)
         name = self.sizes.get(key)
         if name is None:
             name = self.sizes[key] = f"{self.prefix}{len(self.sizes) + 1}"
@@ -270,12 +286,14 @@ def spec_text(
     for grid in found:
         base = ident(grid.label)
         elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
-    unique = {elements[label][0].prefix for label in UNIQUE if label in elements}
+    names = layer_names(found)
+    framed: list[Frame | None] = frames(found) if shared is None else [None] * len(found)
+    widths = _width_tables(found, framed, names, elements)
+    unique = {t.prefix for g, t in zip(found, widths, strict=True) if g.label in UNIQUE}
     top = floors_top(found)
     floors = _floor_run(found, height)
     tops = top_floors(found, width, height)
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
-    framed = frames(found) if shared is None else [None] * len(found)
     # where a layer's top floor repeats upwards with nothing on the run's floors (its
     # floors gained are copies of the top one, ``_floors_above``), every layer with
     # nothing on the run stays as it was drawn: the top floor stays too, and the floors
@@ -285,10 +303,8 @@ def spec_text(
         k in tops and found[k].label not in UNIQUE and not on_run(found[k].rows, floors[1])
         for k in range(len(found))
     )
-    for index, (layer, grid, frame) in enumerate(
-        zip(layer_names(found), found, framed, strict=True)
-    ):
-        symbols = elements[grid.label]
+    for index, (layer, grid, frame) in enumerate(zip(names, found, framed, strict=True)):
+        symbols = (widths[index], elements[grid.label][1])
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
         bay_word = None
         if shared is not None and not grid.apart and in_bays(shared, grid):
@@ -335,7 +351,10 @@ def spec_text(
             words.append(bay_word)
         else:
             x_tokens = _tokens(
-                columns, width, _by_label(frame, elements, symbols[0]), *gaps_x[columns]
+                columns,
+                width,
+                _by_owner(frame, found, framed, widths, symbols[0]),
+                *gaps_x[columns],
             )
             axes = [("x", x_tokens, columns, gaps_x[columns]), *y_axis]
         for axis, tokens, spans, (gaps, margins) in axes:
@@ -413,6 +432,13 @@ def spec_text(
     # the slack, and so do a bay's
     margined -= roofs  # a layer on the same rows keeps its margin to the ground instead
     held -= loose
+    # a line per label's elements, then per layer's own widths (``_width_tables``)
+    tables: list[tuple[str, tuple[_Symbols, ...]]] = list(elements.items())
+    tables += [
+        (grid.label, (table,))
+        for grid, table in zip(found, widths, strict=True)
+        if table is not elements[grid.label][0]
+    ]
     sizes = [
         [
             (
@@ -427,10 +453,10 @@ def spec_text(
                     axis == "x" and label in OPENINGS,
                 ),
             )
-            for axis, table in zip("xy", pair, strict=True)
+            for axis, table in zip("xy", pair, strict=False)
             for size, symbol in table.sizes.items()
         ]
-        for label, pair in elements.items()
+        for label, pair in tables
     ]
     sizes += [
         [
@@ -484,7 +510,7 @@ def spec_text(
     for k, (layer, grid, x, y) in enumerate(layers, start=1):
         mesh, thickness = MESHES.get(grid.label, DEFAULT_MESH)
         rows = ", ".join(f"{_number(a)}-{_number(b)}" for a, b in grid.rows)
-        shown_x = sorted({elements[grid.label][0].of(b - a) for a, b in grid.columns})
+        shown_x = sorted({widths[k - 1].of(b - a) for a, b in grid.columns})
         shown_y = sorted({elements[grid.label][1].of(b - a) for a, b in grid.rows})
         out += [
             f"  # {grid.elements} {grid.label} of the input: {len(grid.columns)} columns, "
@@ -646,14 +672,47 @@ def _floor_word(
     return " ".join([*under, run, *over]), steady, roof
 
 
-def _by_label(
-    frame: Frame | None, elements: dict[str, tuple[_Symbols, _Symbols]], own: _Symbols
+def _width_tables(
+    found: list[Grid],
+    framed: list[Frame | None],
+    names: list[str],
+    elements: dict[str, tuple[_Symbols, _Symbols]],
+) -> list[_Symbols]:
+    """Each grid's table of width symbols: its label's, but for a grid that shares a
+    floor's word (``layers.frames``) with an earlier grid of its label on the label's
+    table, with a column of a width that grid has: one of its own (``<layer>_w``, sized
+    alike). A layer's mask names the symbols it shows, so two layers of one word showing
+    one symbol would each show the other's element."""
+    tables = [elements[grid.label][0] for grid in found]
+    for k, (grid, frame) in enumerate(zip(found, framed, strict=True)):
+        if frame is None:
+            continue
+        taken = {
+            round(b - a, SIZE_KEY)
+            for j in range(k)
+            if framed[j] == frame and tables[j] is tables[k]
+            for a, b in found[j].columns
+        }
+        if taken & {round(b - a, SIZE_KEY) for a, b in grid.columns}:
+            tables[k] = _Symbols(f"{names[k]}_w")
+    return tables
+
+
+def _by_owner(
+    frame: Frame | None,
+    found: list[Grid],
+    framed: list[Frame | None],
+    widths: list[_Symbols],
+    own: _Symbols,
 ) -> _Symbols | list[_Symbols]:
-    """The element symbols of a layer's columns: its label's (``own``), or along a frame,
-    each column's label's (the other labels' hidden by the layer's mask)."""
+    """The width symbols of a layer's columns: its own (``own``), or along a floor's word
+    (``layers.frames``), each column's grid's (the other grids' hidden by the mask)."""
     if frame is None:
         return own
-    return [elements[label][0] for _, label in frame]
+    owner = {
+        c: widths[k] for k, grid in enumerate(found) if framed[k] == frame for c in grid.columns
+    }
+    return [owner[c] for c, _ in frame]
 
 
 def _gap(size: float, repeated: bool, margined: bool) -> str:
