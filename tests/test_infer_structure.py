@@ -234,6 +234,9 @@ def test_a_door_between_windows_shares_their_word_and_so_do_grids_of_a_label_on_
     # a ground-floor window drawn a few centimetres off the others' rows joins their word
     other = Grid("window", ((7.0, 8.0),), ((1.4, 3.0),))
     assert frames([window, door, other]) == [(*found[0], ((7.0, 8.0), "window"))] * 3
+    # a grid on the window's columns (one drawn over it) is one unit with it: one word
+    inner = Grid("window", ((1.0, 2.0), (5.0, 6.0)), ((1.8, 2.8),))
+    assert frames([window, door, inner]) == [found[0]] * 3
     # a grid of two floors whose upper column stands over the door's keeps its own word
     # (one word cannot hold both): the ground floor's others still share theirs
     tall = Grid("window", ((3.2, 3.8),), ((1.4, 3.0), (4.0, 5.5)))

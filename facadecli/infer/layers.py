@@ -159,43 +159,49 @@ def frames(found: list[Grid]) -> list[Frame | None]:
     keep their order and spacing together instead of moving over one another. None where a
     grid has no such neighbour.
 
-    Grids join one at a time, in pairs in the order found, and only where the floor's
-    columns stay apart (no two overlapping, no span of two grids): a grid that cannot join
-    (its column over one of another floor's, on a grid of several floors) keeps its own
-    word, and the floor's other grids still share theirs. Two grids of one label in one
-    word show their elements by symbols of their own where their widths meet
-    (``spec_text``: a mask names sizes)."""
-    openings = [k for k, g in enumerate(found) if g.label in OPENINGS]
-    members: dict[int, list[int]] = {k: [k] for k in openings}  # by the group's first grid
-    root = {k: k for k in openings}
-    for n, a in enumerate(openings):
-        for b in openings[n + 1 :]:
-            ga, gb = found[a], found[b]
-            if root[a] == root[b] or not any(_overlap(r, s) for r in ga.rows for s in gb.rows):
+    Grids of a label on the same columns (floors apart, or one drawn over the other) are
+    one unit: they keep one word, as their columns are one. Units join one at a time, in
+    pairs in the order found, and only where the floor's columns stay apart (no two
+    overlapping, no span of two units): a unit that cannot join (its column over one of
+    another floor's, on a grid of several floors) keeps its own word, and the floor's
+    others still share theirs. Two units of one label in one word show their elements by
+    symbols of their own where their widths meet (``spec_text``: a mask names sizes)."""
+    units: dict[tuple[str, tuple[Span, ...]], list[int]] = defaultdict(list)
+    for k, grid in enumerate(found):  # grids of a label on the same columns: one unit
+        if grid.label in OPENINGS:
+            units[grid.label, grid.columns].append(k)
+    order = list(units)
+    rows = {u: [r for k in units[u] for r in found[k].rows] for u in order}
+    members = {u: [u] for u in order}  # by the group's first unit
+    root = {u: u for u in order}
+    for n, a in enumerate(order):
+        for b in order[n + 1 :]:
+            if root[a] == root[b] or not any(_overlap(r, s) for r in rows[a] for s in rows[b]):
                 continue
             joined = members[root[a]] + members[root[b]]
-            if _one_word(found, joined):
-                first, other = sorted((root[a], root[b]))
-                members[first] = sorted(joined)
+            if _one_word([columns for _, columns in joined]):
+                first, other = sorted((root[a], root[b]), key=order.index)
+                members[first] = sorted(joined, key=order.index)
                 del members[other]
-                for k in joined:
-                    root[k] = first
+                for u in joined:
+                    root[u] = first
     out: list[Frame | None] = [None] * len(found)
     for group in members.values():
         if len(group) < 2:
             continue
-        columns = tuple(sorted((c, found[k].label) for k in group for c in found[k].columns))
-        for k in group:
-            out[k] = columns
+        frame = tuple(sorted((c, label) for label, columns in group for c in columns))
+        for unit in group:
+            for k in units[unit]:
+                out[k] = frame
     return out
 
 
 SIZE_KEY = 6  # decimals: sizes of a label's elements this alike are one symbol in a spec
 
 
-def _one_word(found: list[Grid], group: list[int]) -> bool:
-    """Whether the grids ``group`` can share one x word: their columns apart."""
-    spans = sorted(c for k in group for c in found[k].columns)
+def _one_word(group: list[tuple[Span, ...]]) -> bool:
+    """Whether grids on these columns can share one x word: their columns apart."""
+    spans = sorted(c for columns in group for c in columns)
     return all(b[0] >= a[1] - 1e-9 for a, b in pairwise(spans))
 
 

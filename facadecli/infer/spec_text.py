@@ -680,12 +680,17 @@ def _width_tables(
 ) -> list[_Symbols]:
     """Each grid's table of width symbols: its label's, but for a grid that shares a
     floor's word (``layers.frames``) with an earlier grid of its label on the label's
-    table, with a column of a width that grid has: one of its own (``<layer>_w``, sized
-    alike). A layer's mask names the symbols it shows, so two layers of one word showing
-    one symbol would each show the other's element."""
+    table, on other columns, with a column of a width that grid has: one of its own
+    (``<layer>_w``, sized alike); grids on the same columns, one unit, share one. A
+    layer's mask names the symbols it shows, so two layers of one word showing one symbol
+    would each show the other's element."""
     tables = [elements[grid.label][0] for grid in found]
     for k, (grid, frame) in enumerate(zip(found, framed, strict=True)):
         if frame is None:
+            continue
+        same = [j for j in range(k) if framed[j] == frame and found[j].columns == grid.columns]
+        if same and found[same[0]].label == grid.label:
+            tables[k] = tables[same[0]]  # one unit (``layers.frames``): one column, one symbol
             continue
         taken = {
             round(b - a, SIZE_KEY)
