@@ -76,6 +76,7 @@ bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extrac
 	$(BIN)/python tests/benchmarks/infer_bench.py
 	$(BIN)/python tests/benchmarks/fidelity_bench.py
 	$(BIN)/python tests/benchmarks/retarget_bench.py
+	$(BIN)/python tests/benchmarks/kinds_bench.py
 	$(BIN)/python tests/benchmarks/variations_bench.py
 	$(BIN)/python tests/benchmarks/watch_bench.py
 

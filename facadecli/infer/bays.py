@@ -149,11 +149,12 @@ class Frames:
     spans: list[Span]
     mids: list[float] | None
     measures: list[float]
+    alike: float = ALIKE  # of a bay's width: how near elements alike are
 
     def tolerance(self, k: int, ref: int) -> float | None:
-        """How near bays ``k`` and ``ref``'s elements must be to be alike (``ALIKE`` of
+        """How near bays ``k`` and ``ref``'s elements must be to be alike (``alike`` of
         the wider), or None when the two are not as wide."""
-        tolerance = ALIKE * max(self.measures[k], self.measures[ref])
+        tolerance = self.alike * max(self.measures[k], self.measures[ref])
         return tolerance if abs(self.measures[k] - self.measures[ref]) <= tolerance else None
 
     def read(self, slots: list[Slot], k: int, ref: int, flip: bool) -> list[Slot]:
@@ -174,14 +175,15 @@ def _frames(
     strips: list[tuple[Span, list[int]]],
     spans: list[Span],
     on_openings: bool,
+    alike: float = ALIKE,
 ) -> Frames:
     """The bays' frames (``Frames``): ``on_openings``, each bay read about its openings'
     middle (those not of a unique label where it has others: a door wider than the
     windows over it) and measured by the nearer of its pitches to the next bays' (an
-    end bay: as cut); else as cut."""
+    end bay: as cut); else as cut. ``alike``: how near elements alike are (``Frames``)."""
     widths = [b - a for a, b in spans]
     if not on_openings:
-        return Frames(spans, None, widths)
+        return Frames(spans, None, widths, alike)
     middles = []
     for _, held in strips:
         shown = [rects[k] for k in held if _cuts(rects[k])]
@@ -192,7 +194,8 @@ def _frames(
         widths[k] if k in (0, len(spans) - 1) else min(pitches[k - 1], pitches[k])
         for k in range(len(spans))
     ]
-    return Frames(spans, [m - a for m, (a, _) in zip(middles, spans, strict=True)], measures)
+    mids = [m - a for m, (a, _) in zip(middles, spans, strict=True)]
+    return Frames(spans, mids, measures, alike)
 
 
 def find_bays(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> Bays | str:
@@ -228,17 +231,20 @@ def _found(
     drawn: LabelledLayout | None,
     on_openings: bool,
     follows: tuple[float, ...],
+    alike: float = ALIKE,
 ) -> Iterator[Bays | str]:
     """``find_bays`` with the bays' frames on their openings or as cut (``_frames``): for
     each of ``follows`` in turn, the bays with the openings' companions on the kinds'
     shapes within it (``_apart``), or why there are none; one reason alone when it does
-    not depend on that limit (the kinds, their shapes and the bays' places do not)."""
+    not depend on that limit (the kinds, their shapes and the bays' places do not).
+    ``alike``: the share of a bay's width within which two bays' elements are alike
+    (``ALIKE``; ``tests/benchmarks/kinds_bench.py`` reads the bays at looser ones)."""
     width = layout.width
     strips, spans, over = _strips(layout)
     if len(strips) < 2:
         yield FEW_BAYS
         return
-    frames = _frames(layout.rects, strips, spans, on_openings)
+    frames = _frames(layout.rects, strips, spans, on_openings, alike)
     order = _right_half_mirrored_first(len(strips))
     unlike = _unlike(layout, [held for _, held in strips], frames, order)
     over |= unlike
@@ -249,7 +255,7 @@ def _found(
     ]
     kinds, mirrored, matches = _kinds(slots, frames, order)
     ties = _variants(slots, frames, kinds, mirrored, order)
-    cut = _frames(layout.rects, strips, spans, False)  # the shapes' first guess: as cut
+    cut = _frames(layout.rects, strips, spans, False, alike)  # the shapes' first guess: as cut
     shapes = _tied(_shapes(slots, kinds, mirrored, matches, cut), ties)
     widths = tuple(
         statistics.median(
@@ -471,7 +477,7 @@ def _unlike(
     unlike: set[int] = set()
     for kind in set(kinds):
         bays = [k for k, mine in enumerate(kinds) if mine == kind]
-        tolerance = ALIKE * statistics.median(frames.measures[k] for k in bays)
+        tolerance = frames.alike * statistics.median(frames.measures[k] for k in bays)
 
         def others(k: int, flip: bool, first: int = bays[0]) -> list[tuple[int, Slot]]:
             held = [j for j in members[k] if not _cuts(rects[j])]
@@ -705,7 +711,7 @@ def _shapes(
             for k in bays:
                 own = frames.read(slots[k], k, bays[0], mirrored[k])
                 seen.append(own[matches[k][n]])
-            tolerance = ALIKE * statistics.median(frames.measures[k] for k in bays)
+            tolerance = frames.alike * statistics.median(frames.measures[k] for k in bays)
             values = [statistics.median(_sized(s)[i] for s in seen) for i in range(4)]
             for i in (1, 2, 3):  # sizes and rows as the façade's elements share them
                 values[i] = _common(pool[slot[0], i], values[i], tolerance)
