@@ -34,6 +34,8 @@ from facadecli.city.rooftop import (
     plant,
 )
 from facadecli.city.run import run_city
+from facadecli.export.glb_merge import read_glb
+from facadecli.export.instancing import EXTENSION
 
 ROOT = Path(__file__).resolve().parent.parent
 TOLERANCE = 1e-6
@@ -226,3 +228,32 @@ def test_a_city_with_plant_gives_the_same_bytes_with_the_same_seed(
     for glb in sorted((out / "buildings").rglob("*.glb")):
         twin = tmp_path / "again" / glb.relative_to(out)
         assert glb.read_bytes() == twin.read_bytes(), glb.name
+
+
+def test_with_instance_plant_placed_twice_or_more_is_instanced_and_the_rest_merged(
+    small_city: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """With ``--instance`` a unit placed twice or more on a building (its vents) is one
+    mesh drawn at each place; one placed once (a building's one condenser, its housing) is
+    merged with the building's metal, not a draw call of its own."""
+    manifest, _ = small_city
+    run_city(load_city(manifest), tmp_path / "out", jobs=1, instanced=True)
+    for name in ("a", "b"):
+        glb = next((tmp_path / "out" / "buildings").rglob(f"{name}.glb"))
+        document, _ = read_glb(glb.read_bytes())
+        metal = [k for k, m in enumerate(document["materials"]) if m["name"] == METAL_NAME]
+        drawn = [
+            node
+            for node in document["nodes"]
+            if "mesh" in node
+            and any(
+                p.get("material") in metal for p in document["meshes"][node["mesh"]]["primitives"]
+            )
+        ]
+        plain = [node for node in drawn if EXTENSION not in node.get("extensions", {})]
+        instanced = [node for node in drawn if EXTENSION in node.get("extensions", {})]
+        assert len(plain) == 1  # the coping and every unit placed once, merged
+        assert instanced  # the vents
+        for node in instanced:
+            accessor = next(iter(node["extensions"][EXTENSION]["attributes"].values()))
+            assert document["accessors"][accessor]["count"] >= 2

@@ -348,6 +348,7 @@ def build_building(
     facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
     volumes = party_volumes(footprint, heights, roof, shared, tolerance, above)
+    on_roofs: dict[tuple[str, int, str], list[np.ndarray]] = {}  # plant: its placements
     posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
     for block_number, block in enumerate(volumes):
         wall_height = _wall_height(block)
@@ -426,18 +427,21 @@ def build_building(
                 parts.setdefault(_plain_material(spec), []).append(piece)
             seed = (pick, block_number, piece_number)
             for unit in plant(shape, block.eaves, still, seed) if dressed_top else []:
-                for own, mesh in UNITS[unit.kind].meshes:
+                for number, (own, _) in enumerate(UNITS[unit.kind].meshes):
                     name = _plain_material(spec) if own == WALL_NAME else own
-                    if instanced and len(mesh.faces) >= MIN_TRIANGLES:  # one mesh a city
-                        digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())
-                        instances.setdefault(digest, (name, mesh.copy(), []))[2].append(unit.matrix)
-                    else:
-                        parts.setdefault(name, []).append(mesh.copy().apply_transform(unit.matrix))
+                    on_roofs.setdefault((unit.kind, number, name), []).append(unit.matrix)
         bottom = trimesh.creation.extrude_polygon(block.part, 0.01)
         bottom.apply_translation((0, 0, block.base - 0.01))
         bottom.apply_transform(MAP_TO_WORLD)
         below = GROUND_NAME if block.base <= 0 else _plain_material(spec)
         parts.setdefault(below, []).append(bottom)
+    for (kind, number, name), placed in on_roofs.items():  # as a façade's parts (_parts)
+        mesh = UNITS[kind].meshes[number][1]
+        if instanced and len(placed) >= MIN_INSTANCES and len(mesh.faces) >= MIN_TRIANGLES:
+            digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())  # one mesh a city
+            instances.setdefault(digest, (name, mesh.copy(), []))[2].extend(placed)
+        else:
+            parts.setdefault(name, []).extend(mesh.copy().apply_transform(m) for m in placed)
     materials: dict[str, tuple[Material, Path | None]] = {}
     if fallback is not None:
         materials.update(_materials(fallback.spec, fallback.base_dir, looks, pick))
