@@ -133,7 +133,7 @@ def coping(
 ) -> trimesh.Trimesh:
     """The capping on the walls around a flat roof whose walls' top is ``top``: from
     COPING_OVER outside to COPING_IN inside the outline, no overhang along a ``party``
-    wall, none over the taller parts ``above`` the roof. In the glTF frame."""
+    wall, none over the taller parts ``above`` the roof. In the map frame."""
     outer = part.buffer(COPING_OVER, join_style="mitre")
     for a, b in party:  # no drip into the neighbour: cut back to the wall's face
         outer = outer.difference(_beyond(part, a, b))

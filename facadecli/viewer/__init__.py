@@ -333,7 +333,8 @@ function regionsPicture(data, columns, rows) {
   picture.needsUpdate = true;
   return picture;
 }
-uses.regions.value = regionsPicture(new Uint8Array([255, 0, 0, 0]), 1, 1);
+const allPaving = () => regionsPicture(new Uint8Array([255, 0, 0, 0]), 1, 1);
+uses.regions.value = allPaving();
 ground.material.onBeforeCompile = shader => {
   Object.assign(shader.uniforms, uses);
   shader.vertexShader = 'varying vec2 vGround;\\n' + shader.vertexShader.replace(
@@ -351,9 +352,12 @@ ground.material.onBeforeCompile = shader => {
       / max(share.r + share.g + share.b, 1e-3);`);
 };
 ground.material.customProgramCacheKey = () => 'ground-regions';
-function groundRegions(model, box) {
+function groundRegions(model, box, district) {  // a model after another: its own ground
+  uses.regions.value.dispose();
+  uses.regions.value = allPaving();
+  delete document.body.dataset.ground;
   const buildings = model.children.length;
-  if (buildings < 2 || buildings > 65535) return;  // as fitDistrictStreet: its plan
+  if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
   const {cell, columns, rows, near} = districtPlan(model, box);
   const margin = Math.ceil(GRASS_FROM / cell) + 2;  // its outer cells: grass
   const wide = columns + 2 * margin, deep = rows + 2 * margin;
@@ -895,7 +899,7 @@ function direction(angle, rise) {
 // model as first framed (not to where the camera is turned: a picture is the same each time)
 function light(model) {
   const {box, centre, radius, rise, points, district} = bounds(model);
-  if (district) groundRegions(model, box);
+  groundRegions(model, box, district);
   const fit = fitBox(points, centre, direction(SEEN_FROM, rise)).distance;
   const haze = fit + 2 * radius;
   scene.fog.near = haze; scene.fog.far = 4 * haze;
