@@ -597,3 +597,36 @@ def test_a_districts_street_view_looks_at_windows_from_a_distance(
     assert houses > 0.6 * sum(shares.values()), shares
     assert max(shares.values()) < 0.5, shares
     assert sum(street["open"]) > 0.5 * houses, street
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_districts_ground_has_streets_and_grass_and_a_hazy_horizon_from_35_degrees(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A district's ground by its distance to the nearest building: paving along the
+    walls, a kerb, asphalt between the blocks, grass far from every building (it was one
+    grey paving); seen from 35° up, the top of the picture is the horizon's haze, one
+    even colour, where it was ground up to the frame."""
+    import json
+    from html import unescape
+
+    from PIL import Image, ImageStat
+
+    manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
+    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
+    page = tmp_path / "city.html"
+    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
+    shot, dom = browse(tmp_path, page.as_uri() + "?bare&view=35,35")
+    found = re.search(r'data-ground="([^"]+)"', dom)
+    assert found, "the page reports no ground"
+    ground = json.loads(unescape(found.group(1)))
+    assert ground["paving"] > 0.2 and ground["asphalt"] > 0.2  # of the district's box
+    assert 0 < ground["kerb"] < 0.1 and ground["grass"] > 0.01
+    with Image.open(shot) as image:
+        top = image.convert("RGB").crop((0, 0, image.width, image.height // 30))
+        lower = image.convert("RGB").crop((0, image.height // 2, image.width, image.height))
+    assert max(ImageStat.Stat(top).stddev) < 2.0  # the haze, no ground's texture
+    pixels = list(zip(*(iter(lower.tobytes()),) * 3, strict=True))
+    green = sum(1 for r, g, b in pixels if g > r + 4 and g > b + 4) / len(pixels)
+    assert green > 0.05  # grass round the district

@@ -1,7 +1,8 @@
 """A whole building: a volume a part of its footprint (s3db.py: walls from their base to
 the eaves, the roof on them), every wall edge a façade facing outwards (the spec its wall
-rule gives), corner posts where two façades meet outside, the roof and the ground, as
-meshes in one scene (SPEC 5; DESIGN "Buildings and cities").
+rule gives), corner posts where two façades meet outside, the roof (a flat one with its
+coping and plant: rooftop.py) and the ground, as meshes in one scene (SPEC 5; DESIGN
+"Buildings and cities").
 
 The vertical axis of a spec is solved once per wall height, so floor lines meet at the
 corners; the horizontal axis once per (spec, rung of wall lengths) for the whole run
@@ -29,6 +30,7 @@ from facadecli.city.entrances import DOOR_MATERIAL, along_wall, with_doors
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, WallRule
 from facadecli.city.roofs import roof_meshes
+from facadecli.city.rooftop import METAL_NAME, ROOFLIGHT_NAME, UNITS, coping, plant
 from facadecli.city.s3db import (
     MIN_EDGE,
     POST,
@@ -82,6 +84,8 @@ FLAT_ROOFS = (
     FLAT_ROOF,
 )
 GROUND = Material(color="#808080", roughness=1.0)
+ROOF_METAL = LIBRARY["metal"]  # a flat roof's coping, plant and rooflights' kerbs (rooftop.py)
+ROOFLIGHT = LIBRARY["float-glass"]  # the rooflights' glazing
 DOOR = LIBRARY["timber"].model_copy(update={"color": "#5a3a22"})  # doors at entrances
 WALL_NAME, ROOF_NAME, GROUND_NAME = "wall", "roof", "ground"  # a spec may define them
 FLAT_ROOF_NAME = "flat_roof"
@@ -333,7 +337,10 @@ def build_building(
     walls. With ``instanced``, the parts a façade repeats are meshes of their own, each
     placed by a node per instance (:func:`.instance_nodes` makes them one node). A wall
     its façade does not fit (no layout for its height or its length) takes ``fallback``'s,
-    in the building's wall material (:func:`_worn`), before it is left plain."""
+    in the building's wall material (:func:`_worn`), before it is left plain. A flat
+    roof (not on posts) gets a coping on its walls and plant seeded by ``pick``
+    (rooftop.py): its units merged with the building's meshes of their material, or,
+    ``instanced``, placed as the façades' repeated parts are."""
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
@@ -341,8 +348,9 @@ def build_building(
     facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
     volumes = party_volumes(footprint, heights, roof, shared, tolerance, above)
+    on_roofs: dict[tuple[str, int, str], list[np.ndarray]] = {}  # plant: its placements
     posts_only = roof_only(footprint.properties)  # a carport: posts, no walls
-    for block in volumes:
+    for block_number, block in enumerate(volumes):
         wall_height = _wall_height(block)
         lift = trimesh.transformations.translation_matrix((0.0, block.base, 0.0))
         proud: dict[tuple[float, float], tuple[tuple[float, float], float, str]] = {}
@@ -403,7 +411,12 @@ def build_building(
             parts.setdefault(name, []).append(post)
         if posts_only:
             parts.setdefault(_plain_material(spec), []).extend(_posts(post_places(block)))
-        for shape, still in roof_outlines(block):
+        dressed_top = block.roof.type == "flat" and not posts_only  # a coping and plant
+        if dressed_top:
+            top = block.eaves + block.roof.parapet
+            cap = coping(block.part, top, block.still, block.above)
+            parts.setdefault(METAL_NAME, []).append(cap.apply_transform(MAP_TO_WORLD))
+        for piece_number, (shape, still) in enumerate(roof_outlines(block)):
             cover, infill = roof_meshes(shape, block.eaves, block.roof, still)
             cover.apply_transform(MAP_TO_WORLD)
             flat = block.roof.type == "flat" and ROOF_NAME not in spec.materials
@@ -412,11 +425,23 @@ def build_building(
             for piece in [] if posts_only else infill:  # a roof on posts has open gables
                 piece.apply_transform(MAP_TO_WORLD)
                 parts.setdefault(_plain_material(spec), []).append(piece)
+            seed = (pick, block_number, piece_number)
+            for unit in plant(shape, block.eaves, still, seed) if dressed_top else []:
+                for number, (own, _) in enumerate(UNITS[unit.kind].meshes):
+                    name = _plain_material(spec) if own == WALL_NAME else own
+                    on_roofs.setdefault((unit.kind, number, name), []).append(unit.matrix)
         bottom = trimesh.creation.extrude_polygon(block.part, 0.01)
         bottom.apply_translation((0, 0, block.base - 0.01))
         bottom.apply_transform(MAP_TO_WORLD)
         below = GROUND_NAME if block.base <= 0 else _plain_material(spec)
         parts.setdefault(below, []).append(bottom)
+    for (kind, number, name), placed in on_roofs.items():  # as a façade's parts (_parts)
+        mesh = UNITS[kind].meshes[number][1]
+        if instanced and len(placed) >= MIN_INSTANCES and len(mesh.faces) >= MIN_TRIANGLES:
+            digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())  # one mesh a city
+            instances.setdefault(digest, (name, mesh.copy(), []))[2].extend(placed)
+        else:
+            parts.setdefault(name, []).extend(mesh.copy().apply_transform(m) for m in placed)
     materials: dict[str, tuple[Material, Path | None]] = {}
     if fallback is not None:
         materials.update(_materials(fallback.spec, fallback.base_dir, looks, pick))
@@ -776,6 +801,8 @@ def _materials(
         (ROOF_NAME, ROOF),
         (FLAT_ROOF_NAME, flat_roof(pick)),
         (DOOR_MATERIAL, DOOR),
+        (METAL_NAME, ROOF_METAL),
+        (ROOFLIGHT_NAME, ROOFLIGHT),
     )
     for name, builtin in (*builtins, (GROUND_NAME, GROUND)):
         declared.setdefault(name, builtin)

@@ -15,7 +15,7 @@ back parallel): on a convex footprint those across the ridge direction (the long
 which the unweighted skeleton shows as triangles under one ridge point. So an L gets a
 cross gable with a valley, a T and a U likewise, a courtyard ring a ridge all round.
 
-- flat: a slab (the walls carry the parapet);
+- flat: a slab (the walls carry the parapet; rooftop.py caps them and sets plant on it);
 - shed: one plane, its low side facing ``direction`` (else across the main direction);
 - gable: the skeleton with weight 0 on the gable ends; half_hip: the same, the ends
   turning to weight 1 at two thirds of their height (hipped over the top third);

@@ -317,6 +317,74 @@ const ground = new THREE.Mesh(  // takes the shadows; large enough to reach the 
 ground.receiveShadow = true;
 ground.visible = false;
 scene.add(ground);
+// A district's ground reads as streets: by its distance to the nearest building (the
+// district's plan, districtPlan's near), paving up to PAVEMENT metres from a wall, a
+// granite kerb KERB wide, asphalt out to GRASS_FROM metres (a street is narrower than
+// twice that), grass beyond (gardens, open ground, the fields round the district). A
+// picture of the plan's cells and a margin round it (its edge all grass, which the ground
+// takes on to the haze) says how much of each a place is (red paving, green asphalt,
+// blue grass, alpha the kerb), and the ground's shader mixes them; a façade's is all paving.
+const PAVEMENT = 2.5, KERB = 0.2, GRASS_FROM = 8;
+const uses = {regions: {value: null}, regionsFrom: {value: new THREE.Vector2(0, 0)},
+              regionsSize: {value: new THREE.Vector2(1, 1)}};
+function regionsPicture(data, columns, rows) {
+  const picture = new THREE.DataTexture(data, columns, rows);
+  picture.magFilter = picture.minFilter = THREE.LinearFilter;
+  picture.needsUpdate = true;
+  return picture;
+}
+const allPaving = () => regionsPicture(new Uint8Array([255, 0, 0, 0]), 1, 1);
+uses.regions.value = allPaving();
+ground.material.onBeforeCompile = shader => {
+  Object.assign(shader.uniforms, uses);
+  shader.vertexShader = 'varying vec2 vGround;\\n' + shader.vertexShader.replace(
+    '#include <begin_vertex>',
+    '#include <begin_vertex>\\nvGround = (modelMatrix * vec4(position, 1.0)).xz;');
+  shader.fragmentShader = `uniform sampler2D regions; uniform vec2 regionsFrom, regionsSize;
+    varying vec2 vGround;\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
+    #include <map_fragment>
+    vec4 share = texture2D(regions, (vGround - regionsFrom) / regionsSize);
+    float speck = fract(sin(dot(floor(vGround * 5.0), vec2(12.9898, 78.233))) * 43758.5453);
+    vec3 asphalt = vec3(0.042, 0.042, 0.045) * (0.9 + 0.2 * speck);
+    vec3 grass = vec3(0.05, 0.075, 0.028) * (0.8 + 0.4 * speck);
+    vec3 paved = diffuseColor.rgb * mix(1.0, 1.5, share.a);
+    diffuseColor.rgb = (paved * share.r + asphalt * share.g + grass * share.b)
+      / max(share.r + share.g + share.b, 1e-3);`);
+};
+ground.material.customProgramCacheKey = () => 'ground-regions';
+function groundRegions(model, box, district) {  // a model after another: its own ground
+  uses.regions.value.dispose();
+  uses.regions.value = allPaving();
+  delete document.body.dataset.ground;
+  const buildings = model.children.length;
+  if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
+  const {cell, columns, rows, near} = districtPlan(model, box);
+  const margin = Math.ceil(GRASS_FROM / cell) + 2;  // its outer cells: grass
+  const wide = columns + 2 * margin, deep = rows + 2 * margin;
+  const data = new Uint8Array(wide * deep * 4), counts = [0, 0, 0, 0];
+  for (let row = 0; row < deep; row++) for (let column = 0; column < wide; column++) {
+    const x = Math.min(Math.max(column - margin, 0), columns - 1);
+    const y = Math.min(Math.max(row - margin, 0), rows - 1);
+    const out = Math.hypot(column - margin - x, row - margin - y);  // beyond the plan
+    const metres = (near[y * columns + x] + out) * cell;
+    const at = (row * wide + column) * 4;
+    if (metres < PAVEMENT + KERB) data[at] = 255; else if (metres < GRASS_FROM) data[at + 1] = 255;
+    else data[at + 2] = 255;
+    if (metres >= PAVEMENT && metres < PAVEMENT + KERB) data[at + 3] = 255;
+    if (row >= margin && row < margin + rows && column >= margin && column < margin + columns) {
+      counts[data[at + 3] ? 1 : data[at] ? 0 : data[at + 1] ? 2 : 3]++;  // within the plan
+    }
+  }
+  const share = count => Math.round(count / (columns * rows) * 1000) / 1000;
+  document.body.dataset.ground = JSON.stringify({
+    paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
+    grass: share(counts[3]), cell});
+  uses.regions.value.dispose();
+  uses.regions.value = regionsPicture(data, wide, deep);
+  // the picture's row 0 is the plan's, at the district's +z edge (districtPlan)
+  uses.regionsFrom.value.set(box.min.x - margin * cell, box.min.z + (rows + margin) * cell);
+  uses.regionsSize.value.set(wide * cell, -deep * cell);
+}
 const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 5000);
 const controls = new OrbitControls(camera, renderer.domElement);
 // Ambient occlusion (GTAO) between the scene's render and the output pass (tone mapping and
@@ -830,10 +898,25 @@ function direction(angle, rise) {
 // The ground, the haze, the sun's shadows and the ambient occlusion's reach, fitted to the
 // model as first framed (not to where the camera is turned: a picture is the same each time)
 function light(model) {
-  const {box, centre, radius, rise, points} = bounds(model);
+  const {box, centre, radius, rise, points, district} = bounds(model);
+  groundRegions(model, box, district);
   const fit = fitBox(points, centre, direction(SEEN_FROM, rise)).distance;
   const haze = fit + 2 * radius;
   scene.fog.near = haze; scene.fog.far = 4 * haze;
+  // a district seen from so high that the picture's top edge looks down at the ground
+  // (from 30° up, 10° down): the ground lost in the haze short of that edge, so the top of
+  // the picture is the horizon's haze, not ground to the frame; the haze is the ground's,
+  // the buildings stand clear of it
+  const topEdge = (or(up, rise) - camera.fov / 2) * Math.PI / 180;
+  if (district && topEdge > 0) {
+    const eye = centre.y - box.min.y + fit * Math.sin(or(up, rise) * Math.PI / 180);
+    const depth = eye / Math.sin(topEdge) * Math.cos(camera.fov * Math.PI / 360);
+    scene.fog.near = Math.min(scene.fog.near, 0.5 * depth);
+    scene.fog.far = Math.min(scene.fog.far, 0.85 * depth);
+    model.traverse(part => {
+      if (part.isMesh) for (const material of materialsOf(part)) material.fog = false;
+    });
+  }
   ground.position.set(centre.x, box.min.y - radius * 1e-4, centre.z);
   ground.scale.setScalar(4 * haze);
   // the circle's texture coordinates span its diameter: slabs SLAB metres a side
