@@ -293,3 +293,32 @@ def validates(glb: Path) -> None:
     )
     report = json.loads(result.stdout)
     assert (report["errors"], report["warnings"]) == (0, 0), report
+
+
+def _rooms_shown(glb: Path) -> tuple[int, set[tuple[int, int]]]:
+    """The merged city's materials named ``interior`` (how many) and the rooms of the
+    atlas their back plates show (each triangle's texture coordinates' centre, as a room
+    of the 4 x 4 atlas)."""
+    document, binary = read_glb(glb.read_bytes())
+    interiors = {k for k, m in enumerate(document["materials"]) if m["name"] == "interior"}
+    rooms: set[tuple[int, int]] = set()
+    for mesh in document["meshes"]:
+        for primitive in mesh["primitives"]:
+            if primitive["material"] not in interiors:
+                continue
+            material = document["materials"][primitive["material"]]
+            assert "baseColorTexture" in material["pbrMetallicRoughness"]
+            accessor = document["accessors"][primitive["attributes"]["TEXCOORD_0"]]
+            view = document["bufferViews"][accessor["bufferView"]]
+            start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+            uv = np.frombuffer(binary, np.float32, 2 * accessor["count"], start).reshape(-1, 2)
+            rooms |= {(int(u * 4), int(v * 4)) for u, v in uv}
+    return len(interiors), rooms
+
+
+def test_the_windows_of_a_city_show_many_rooms_from_one_material(city: Path) -> None:
+    """Behind the windows of the 50 buildings: one ``interior`` material for the city
+    (one picture, the atlas of rooms), and its back plates show every room of it."""
+    materials, rooms = _rooms_shown(city / "demo-district.glb")
+    assert materials == 1
+    assert len(rooms) == 16, rooms

@@ -63,7 +63,8 @@ def test_the_same_material_and_seed_draw_the_same_bytes(name: str) -> None:
         assert png(getattr(first, slot)) == png(getattr(again, slot))
     if name != "float-glass":  # glass is a flat colour: only its ripple moves with the seed
         assert png(first.base_colour) != png(other.base_colour)
-    assert png(first.normal) != png(other.normal)
+    if name != "rooms":  # rooms are a flat picture behind glass: only their colours move
+        assert png(first.normal) != png(other.normal)
 
 
 def _jump(image: np.ndarray) -> tuple[float, float]:

@@ -359,6 +359,35 @@ def test_glass_seen_at_35_degrees_mirrors_the_street_not_a_slate(tmp_path: Path)
     assert pane.stddev[0] > 5.8
 
 
+def _pane_spread(shot: Path) -> float:
+    """The spread (standard deviation of grey, 0..255) over the 3 x 3 m window of
+    :data:`PANE_SPEC` seen square on: 0.38..0.62 across, 0.3..0.7 up (the window spans
+    0.36..0.64 and 0.27..0.73 of the picture)."""
+    from PIL import Image, ImageStat
+
+    with Image.open(shot) as image:
+        grey = image.convert("L")
+        width, height = grey.size
+        box = (round(0.38 * width), round(0.3 * height), round(0.62 * width), round(0.7 * height))
+        return float(ImageStat.Stat(grey.crop(box)).stddev[0])
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_pane_shows_the_room_behind_it(tmp_path: Path) -> None:
+    """The window of :data:`PANE_SPEC` square on, behind it the dark recess (the built-in
+    interior) and then a room of the library's ``rooms``: through the glass, the room's
+    walls, floor and ceiling spread the pane's grey where the dark recess leaves only the
+    reflection (one deviation, headless Chromium with SwiftShader, one shot each: 12.6
+    with the dark recess, 20.3 with the room)."""
+    with_room = PANE_SPEC.replace("materials:\n", "materials:\n  interior: {library: rooms}\n")
+    spreads = []
+    for name, text in (("dark", PANE_SPEC), ("room", with_room)):
+        (tmp_path / name).mkdir()
+        spreads.append(_pane_spread(_shown(tmp_path / name, text, "?bare&view=0,0")[0]))
+    dark, room = spreads
+    assert room > 1.3 * dark, (dark, room)
+
+
 WALLS_SPEC = """
 version: 1
 name: walls

@@ -48,12 +48,14 @@ from facadecli.city.sides import facing, sides
 from facadecli.errors import InfeasibleError, SearchLimitError
 from facadecli.export.instancing import MIN_INSTANCES, MIN_TRIANGLES
 from facadecli.geometry.facade import (
+    ROOMS,
     facade_scene,
     look,
     material_names,
     metric_uv,
     pbr,
     plane_uv,
+    projection,
     see_through,
     tangent_space,
     texture_metres,
@@ -117,8 +119,9 @@ def solve_rung(spec: Spec, axis: str, canvas: float, variants: int = 1) -> tuple
 
 
 FacadeMeshes = tuple[tuple[str, np.ndarray, np.ndarray], ...]  # (material, vertices, faces)
-# a part a façade places again and again: its material, vertices, faces, and placements
-Part = tuple[str, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]
+# a part a façade places again and again: its material, vertices, faces, placements, and
+# its own texture coordinates (a window's room; None: laid in metres where it is used)
+Part = tuple[str, np.ndarray, np.ndarray, tuple[np.ndarray, ...], np.ndarray | None]
 PlacedParts = list[tuple[str, trimesh.Trimesh, list[np.ndarray]]]  # the same, on a wall
 Slot = tuple[str, str, int, int]  # a spec's cache key, an axis, a rung, how many variants
 
@@ -240,15 +243,15 @@ class AxisCache:
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.parts:
             scene = facade_scene(_facade(spec, horizontal, vertical), base_dir)
-            self.parts[slot] = _parts(scene, _stretchable(spec))
+            self.parts[slot] = _parts(scene, _stretchable(spec), _own_uv(spec))
         merged, parts = self.parts[slot]
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
         stretch = np.diag([*scale, 1.0])
         return (
             _scaled(merged, scale),
             [
-                (name, trimesh.Trimesh(points, faces, process=False), [stretch @ m for m in placed])
-                for name, points, faces, placed in parts
+                (name, _textured(points, faces, uv), [stretch @ m for m in placed])
+                for name, points, faces, placed, uv in parts
             ],
         )
 
@@ -344,7 +347,7 @@ def build_building(
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
-    instances: dict[tuple[str, bytes, bytes], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
+    instances: dict[tuple[str | bytes, ...], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
     facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
     volumes = party_volumes(footprint, heights, roof, shared, tolerance, above)
@@ -403,7 +406,9 @@ def build_building(
                 parts.setdefault(worn(name), []).append(mesh)
             for own, mesh, placed in repeated:
                 name = worn(own)
-                digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())
+                uv = getattr(mesh.visual, "uv", None)
+                shown = b"" if uv is None else np.asarray(uv).tobytes()  # a room: its own
+                digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes(), shown)
                 instances.setdefault(digest, (name, mesh, []))[2].extend(
                     placement @ m for m in placed
                 )
@@ -451,7 +456,7 @@ def build_building(
     for name in sorted(parts):
         builtin = BUILTIN_INTERIOR if name == INTERIOR_MATERIAL else Material()
         finished, folder = materials.get(name) or (builtin, None)  # the recesses stay dark
-        project = plane_uv if name in ROOFS else metric_uv
+        project = plane_uv if name in ROOFS else projection(finished)
         merged = _merged(parts[name], texture_metres(finished), project)
         if finished.library is not None:  # a normal map: normals and tangents with it
             merged = tangent_space(merged)
@@ -466,8 +471,9 @@ def build_building(
         metres = texture_metres(finished)
         if metres is None:
             mesh.visual = trimesh.visual.TextureVisuals()
-        else:  # texture coordinates in metres of the part's own frame
-            mesh = metric_uv(mesh, metres)
+        else:  # in metres of the part's own frame, unless it keeps its own (a room)
+            if getattr(mesh.visual, "uv", None) is None:
+                mesh = projection(finished)(mesh, metres)
             if finished.library is not None:
                 mesh = tangent_space(mesh)
         mesh = weld(mesh)
@@ -866,6 +872,20 @@ def _stretchable(spec: Spec) -> frozenset[str]:
     return frozenset(names | {INTERIOR_MATERIAL})
 
 
+def _own_uv(spec: Spec) -> frozenset[str]:
+    """The materials whose parts keep the texture coordinates the façade gave them: the
+    rooms behind windows (:func:`.room_uv`), one of the atlas a window."""
+    return frozenset(name for name in material_names(spec) if look(spec, name).library == ROOMS)
+
+
+def _textured(points: np.ndarray, faces: np.ndarray, uv: np.ndarray | None) -> trimesh.Trimesh:
+    """A part's mesh, with its own texture coordinates if it keeps them."""
+    mesh = trimesh.Trimesh(points, faces, process=False)
+    if uv is not None:
+        mesh.visual = trimesh.visual.TextureVisuals(uv=uv)
+    return mesh
+
+
 def _unit(mesh: trimesh.Trimesh) -> tuple[tuple[bytes, bytes], np.ndarray, np.ndarray]:
     """A small part as a unit mesh and the matrix that makes it the part again: its
     vertices moved and scaled into the unit cube (an axis it does not span kept as it
@@ -890,13 +910,17 @@ PART_DECIMALS = 5
 
 
 def _parts(
-    scene: trimesh.Scene, stretchable: frozenset[str] = frozenset()
+    scene: trimesh.Scene,
+    stretchable: frozenset[str] = frozenset(),
+    own_uv: frozenset[str] = frozenset(),
 ) -> tuple[FacadeMeshes, tuple[Part, ...]]:
     """A façade's meshes placed fewer than :data:`.MIN_INSTANCES` times or of fewer than
     :data:`.MIN_TRIANGLES` triangles, placed and merged per material, and the others
     each once with their placements, in the order of the scene's nodes. A small part in
     a ``stretchable`` material is a unit mesh (:func:`_unit`), one for all its sizes,
-    its placements scaling it: every pane of a glass, of any size, is one mesh."""
+    its placements scaling it: every pane of a glass, of any size, is one mesh. One in an
+    ``own_uv`` material keeps its texture coordinates (the room a recess shows): one
+    unit mesh for each room."""
     uses = Counter(scene.graph[node][1] for node in scene.graph.nodes_geometry)
     merged: dict[str, list[trimesh.Trimesh]] = {}
     parts: dict[Any, Part] = {}
@@ -906,21 +930,23 @@ def _parts(
         name = mesh.visual.material.name
         if len(mesh.faces) < MIN_TRIANGLES and name in stretchable:
             key, vertices, back = _unit(mesh)
-            unit = (name, *key)
+            uv = np.round(mesh.visual.uv, 6) + 0.0 if name in own_uv else None
+            unit = (name, *key, b"" if uv is None else uv.tobytes())
             if unit not in parts:
-                parts[unit] = (name, vertices, mesh.faces.copy(), ())
-            material, points, faces, placed = parts[unit]
+                parts[unit] = (name, vertices, mesh.faces.copy(), (), uv)
+            material, points, faces, placed, uv = parts[unit]
             placement = np.asarray(matrix, dtype=float) @ back
-            parts[unit] = (material, points, faces, (*placed, placement))
+            parts[unit] = (material, points, faces, (*placed, placement), uv)
             continue
         if uses[geometry] < MIN_INSTANCES or len(mesh.faces) < MIN_TRIANGLES:
             merged.setdefault(name, []).append(mesh.copy().apply_transform(matrix))
             continue
         if geometry not in parts:  # to 10 um: the same part built on two walls, equal bytes
             vertices = np.round(mesh.vertices, PART_DECIMALS) + 0.0  # no -0.0
-            parts[geometry] = (name, vertices, mesh.faces.copy(), ())
-        material, vertices, faces, placed = parts[geometry]
-        parts[geometry] = (material, vertices, faces, (*placed, np.asarray(matrix, dtype=float)))
+            parts[geometry] = (name, vertices, mesh.faces.copy(), (), None)
+        material, vertices, faces, placed, _ = parts[geometry]
+        matrix = np.asarray(matrix, dtype=float)
+        parts[geometry] = (material, vertices, faces, (*placed, matrix), None)
     walls = tuple(
         (name, joined.vertices.copy(), joined.faces.copy())
         for name, meshes in sorted(merged.items())

@@ -29,7 +29,7 @@ from facadecli.layout import (
 )
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.materials import images, resolve
-from facadecli.materials.textures import linear
+from facadecli.materials.textures import ROOM_REVEAL, ROOMS_GRID, linear
 from facadecli.spec.assets import load_mesh
 from facadecli.spec.model import Material, Spec
 
@@ -155,6 +155,110 @@ def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
     return flat
 
 
+ROOMS = "rooms"  # the library's interiors: an atlas of rooms, one a window (room_uv)
+
+
+def room_variant(points: np.ndarray, seed: int) -> np.ndarray:
+    """Which room of the atlas each of ``points`` (n x 3, metres) shows: a hash of the
+    point to the centimetre and the material's seed, so that neighbouring windows show
+    different rooms and the same model the same ones."""
+    cells = np.round(np.asarray(points, dtype=float).reshape(-1, 3) * 100).astype(np.int64)
+    mixed = np.full(len(cells), seed + 0x9E3779B97F4A7C15, dtype=np.uint64)
+    with np.errstate(over="ignore"):
+        for axis in range(3):
+            mixed ^= cells[:, axis].astype(np.uint64)
+            mixed *= np.uint64(0xBF58476D1CE4E5B9)
+            mixed ^= mixed >> np.uint64(31)
+    rooms: np.ndarray = (mixed % np.uint64(ROOMS_GRID * ROOMS_GRID)).astype(np.int64)
+    return rooms
+
+
+def room_uv(mesh: trimesh.Trimesh, seed: int = 0, room: int | None = None) -> trimesh.Trimesh:
+    """Texture coordinates that show one room of the interiors' atlas behind each
+    window: each connected piece of ``mesh`` (a recess: its back plate and reveals) is
+    mapped across its back plate, seen from the window (u level, left to right; v up),
+    onto one room of the atlas (``room``, else :func:`room_variant` of the piece's
+    centre); its reveals, square to the plate, take the room's rim (the inner reveal's
+    grey). Each face gets its own corners."""
+    points = np.asarray(mesh.vertices, dtype=float)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    pieces = _pieces(points, faces)
+    count = int(pieces.max(initial=-1)) + 1
+    corners = points[faces]  # (faces, 3, 3)
+    areas = np.asarray(mesh.area_faces, dtype=float)
+    facing = np.zeros((count, 3))
+    np.add.at(facing, pieces, np.asarray(mesh.face_normals) * areas[:, None])
+    centre = np.zeros((count, 3))
+    np.add.at(centre, pieces, corners.mean(axis=1) * areas[:, None])
+    weight = np.zeros(count)
+    np.add.at(weight, pieces, areas)
+    centre /= np.where(weight > 0, weight, 1.0)[:, None]
+    # the plate faces out of the window: the reveals' normals cancel in pairs
+    facing[:, 1] = 0.0
+    level = np.linalg.norm(facing, axis=1) < 1e-9
+    facing[level] = (0.0, 0.0, 1.0)
+    facing /= np.linalg.norm(facing, axis=1)[:, None]
+    along = np.stack([facing[:, 2], np.zeros(count), -facing[:, 0]], axis=1)  # up x facing
+    u = np.einsum("fcj,fj->fc", corners, along[pieces])
+    v = corners[:, :, 1]
+    low_u, high_u = np.full(count, np.inf), np.full(count, -np.inf)
+    low_v, high_v = np.full(count, np.inf), np.full(count, -np.inf)
+    np.minimum.at(low_u, pieces, u.min(axis=1))
+    np.maximum.at(high_u, pieces, u.max(axis=1))
+    np.minimum.at(low_v, pieces, v.min(axis=1))
+    np.maximum.at(high_v, pieces, v.max(axis=1))
+    span_u = np.maximum(high_u - low_u, 1e-9)[pieces, None]
+    span_v = np.maximum(high_v - low_v, 1e-9)[pieces, None]
+    across = (u - low_u[pieces, None]) / span_u
+    up = (v - low_v[pieces, None]) / span_v
+    chosen = room_variant(centre, seed) if room is None else np.full(count, room)
+    shown = chosen[pieces]
+    inset = 0.5 * ROOM_REVEAL  # the rim: inside the room's reveal, never its neighbour's
+    column, row = (shown % ROOMS_GRID)[:, None], (shown // ROOMS_GRID)[:, None]
+    across = (column + inset + (1 - 2 * inset) * across) / ROOMS_GRID
+    up = (row + inset + (1 - 2 * inset) * up) / ROOMS_GRID
+    flat = trimesh.Trimesh(
+        corners.reshape(-1, 3), np.arange(3 * len(faces)).reshape(-1, 3), process=False
+    )
+    flat.visual = trimesh.visual.TextureVisuals(
+        uv=np.stack([across.reshape(-1), up.reshape(-1)], axis=1)
+    )
+    return flat
+
+
+def _pieces(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """The connected piece each face belongs to (faces meeting at a corner, by position
+    to the micrometre), numbered in order of their first face."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    if len(faces) == 0:
+        return np.zeros(0, dtype=np.int64)
+    keys = np.round(points * 1e6).astype(np.int64)
+    _, corner = np.unique(keys, axis=0, return_inverse=True)
+    corner = corner.reshape(-1)[faces]  # (faces, 3): each corner's place
+    rows = np.repeat(np.arange(len(faces)), 3)
+    links = coo_matrix(
+        (np.ones(rows.size), (rows, len(faces) + corner.reshape(-1))),
+        shape=(len(faces) + int(corner.max()) + 1,) * 2,
+    )
+    _, labels = connected_components(links, directed=False)
+    labels = labels[: len(faces)]
+    _, first, renumbered = np.unique(labels, return_index=True, return_inverse=True)
+    order = np.argsort(np.argsort(first, kind="stable"), kind="stable")
+    pieces: np.ndarray = order[renumbered.reshape(-1)]
+    return pieces
+
+
+def projection(material: Material) -> Callable[[trimesh.Trimesh, float], trimesh.Trimesh]:
+    """How a material's texture is laid on a mesh: the rooms one a window
+    (:func:`room_uv`), any other texture in metres on each face's dominant plane
+    (:func:`metric_uv`)."""
+    if material.library == ROOMS:
+        return lambda mesh, _size: room_uv(mesh, material.seed)
+    return metric_uv
+
+
 def plane_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
     """Texture coordinates in metres (one texture copy per ``size`` metres) in each face's
     own plane: u level along it, v up its slope. A roof's tiles run along its eaves and
@@ -272,12 +376,16 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
     faces: dict[str, int] = {}  # triangles of each shared mesh
     total = 0  # triangles of the whole model (every node)
 
-    def dress(mesh: trimesh.Trimesh, material: str) -> trimesh.Trimesh:
-        """The mesh in a material (with texture coordinates in metres if it has a texture)."""
+    def dress(mesh: trimesh.Trimesh, material: str, room: int | None = None) -> trimesh.Trimesh:
+        """The mesh in a material (with texture coordinates in metres if it has a
+        texture; behind a window, the ``room`` of the atlas it shows)."""
         finished = look(spec, material)
         appearance = pbr(material, finished, base_dir)
         metres = texture_metres(finished)
-        if metres is not None:
+        if metres is not None and finished.library == ROOMS:
+            mesh = tangent_space(room_uv(mesh, finished.seed, room))
+            mesh.visual.material = appearance
+        elif metres is not None:
             mesh = metric_uv(mesh, metres)
             if finished.library is not None:  # a normal map: normals and tangents with it
                 mesh = tangent_space(mesh)
@@ -297,8 +405,20 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
         the mesh of an identical part already built."""
         nonlocal total
         cell = Cell.of(shape)
-        key = (shape.mesh, part, cell, material, shape.reflected_x, shape.reflected_y)
-        placement = trimesh.transformations.translation_matrix((shape.x0, shape.y0, shape.z1))
+        key: tuple[object, ...] = (
+            shape.mesh,
+            part,
+            cell,
+            material,
+            shape.reflected_x,
+            shape.reflected_y,
+        )
+        where = np.array([shape.x0, shape.y0, shape.z1])
+        placement = trimesh.transformations.translation_matrix(where)
+        room = None
+        if look(spec, material).library == ROOMS:  # a recess behind another room: its own
+            room = int(room_variant(where, look(spec, material).seed)[0])
+            key = (*key, room)
         parent = f"layer:{shape.layer}"
         if key in shared:
             existing = shared[key]
@@ -313,7 +433,7 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             shared[key] = None
             return
         _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
-        mesh = dress(mesh, material)
+        mesh = dress(mesh, material, room)
         name = f"{shape.mesh.replace('/', '_')}-{material}-{len(shared)}"
         shared[key] = name
         faces[name] = len(mesh.faces)

@@ -357,6 +357,93 @@ def _glass(n: int, tile: float, rng: np.random.Generator) -> Surface:
     return Surface(0.00015 * wave, colour, 0.0 * wave, np.zeros((n, n)))
 
 
+#: rooms a side of the interiors' atlas (:func:`_rooms`): 4 x 4, sixteen rooms
+ROOMS_GRID = 4
+#: the share of a room's picture (each side) that is the inner reveal around it
+ROOM_REVEAL = 0.04
+
+# a room's colours (linear light): back wall and side walls, floor, curtains and blinds
+_WALLS = ((0.55, 0.50, 0.42), (0.45, 0.45, 0.43), (0.50, 0.44, 0.34), (0.36, 0.40, 0.38))
+_FLOORS = ((0.22, 0.12, 0.06), (0.30, 0.20, 0.11), (0.12, 0.12, 0.12), (0.28, 0.25, 0.21))
+_CLOTHS = ((0.55, 0.52, 0.45), (0.35, 0.10, 0.08), (0.10, 0.16, 0.28), (0.62, 0.58, 0.50))
+
+
+def _room(m: int, rng: np.random.Generator) -> np.ndarray:
+    """One room as seen through a window, ``m`` pixels a side (row 0 the top): the back
+    wall in the middle, the ceiling, floor and side walls round it in one-point
+    perspective, each darker the further it is from the light; a piece of furniture
+    against the back wall; sometimes curtains at the sides or a blind half down; in some
+    the lights on (warmer and brighter, a lamp's glow under the ceiling); the inner
+    reveal (:data:`ROOM_REVEAL`) round it, in the dim grey a reveal's plaster has."""
+    centres = (np.arange(m) + 0.5) / m
+    s, t = np.meshgrid(centres, centres[::-1])  # 0..1 across, 0..1 up
+    a0 = float(rng.uniform(0.18, 0.32))  # the back wall's edges, as shares of the window
+    a1 = a0 + float(rng.uniform(0.4, 0.55))
+    b0 = float(rng.uniform(0.22, 0.32))
+    b1 = b0 + float(rng.uniform(0.4, 0.5))
+    wall = np.asarray(_WALLS[rng.integers(len(_WALLS))]) * rng.uniform(0.85, 1.1)
+    floor = np.asarray(_FLOORS[rng.integers(len(_FLOORS))])
+    # how far out of the back wall a pixel lies, towards each side: the largest names the
+    # surface it sees (left or right wall, floor, ceiling) and its depth (0 back, 1 window)
+    beyond = np.stack([(a0 - s) / a0, (s - a1) / (1 - a1), (b0 - t) / b0, (t - b1) / (1 - b1)])
+    side, depth = beyond.argmax(axis=0), np.clip(beyond.max(axis=0), 0.0, 1.0)
+    back = beyond.max(axis=0) <= 0
+    colour = np.empty((m, m, 3))
+    colour[...] = wall * (0.55 + 0.25 * depth)[..., None]  # side walls: lit near the window
+    ceiling = (side == 3) & ~back
+    colour[ceiling] = wall * 1.1 * (0.5 + 0.4 * depth[ceiling])[..., None]
+    below = (side == 2) & ~back
+    colour[below] = floor * (0.6 + 0.4 * depth[below])[..., None]
+    colour[back] = wall * 0.75
+    # furniture against the back wall: a sofa, a sideboard or a bookcase
+    x0 = float(rng.uniform(a0, (a0 + a1) / 2))
+    x1 = min(a1, x0 + float(rng.uniform(0.15, 0.35)))
+    top = b0 + (a1 - a0) * float(rng.choice([0.12, 0.2, 0.55]))
+    piece = (s > x0) & (s < x1) & (t > b0 - 0.03) & (t < top)
+    shade = np.asarray(_CLOTHS[rng.integers(len(_CLOTHS))]) * 0.45
+    colour[piece] = shade
+    if rng.uniform() < 0.5:  # a picture on the back wall
+        px = float(rng.uniform(a0 + 0.05, a1 - 0.15))
+        frame = (s > px) & (s < px + 0.1) & (t > b1 - 0.2) & (t < b1 - 0.08)
+        colour[frame] = np.asarray(_CLOTHS[rng.integers(len(_CLOTHS))]) * 0.8
+    lit = rng.uniform() < 0.3
+    if lit:  # the lights on: warmer, brighter, a lamp's glow under the ceiling
+        glow = np.exp(-(((s - (a0 + a1) / 2) / 0.25) ** 2 + ((t - b1) / 0.2) ** 2))
+        colour = colour * np.array([1.35, 1.2, 0.9]) + 0.5 * glow[..., None] * [1.0, 0.8, 0.5]
+    cover = rng.uniform()
+    if cover < 0.4:  # curtains drawn to the sides, in folds
+        cloth = np.asarray(_CLOTHS[rng.integers(len(_CLOTHS))])
+        width = float(rng.uniform(0.1, 0.22))
+        hung = (s < width) | (s > 1 - width)
+        folds = 0.75 + 0.25 * np.sin(2 * np.pi * s / 0.045) ** 2
+        colour[hung] = (cloth * (1.2 if lit else 1.0)) * folds[hung][..., None]
+    elif cover < 0.6:  # a blind let down part of the way, in slats
+        down = 1 - float(rng.uniform(0.2, 0.6))
+        slats = 0.8 + 0.2 * (np.mod(t / 0.035, 1.0) > 0.2)
+        blind = t > down
+        tone = np.asarray(_CLOTHS[3]) * (1.25 if lit else 1.0)
+        colour[blind] = tone * slats[blind][..., None]
+    # a room by day is darker than the street it looks onto: a lit one less so
+    colour = colour * (0.75 if lit else 0.35)
+    edge = np.minimum.reduce([s, 1 - s, t, 1 - t])
+    colour[edge < ROOM_REVEAL] = (0.16, 0.155, 0.145)
+    return colour
+
+
+def _rooms(n: int, tile: float, rng: np.random.Generator) -> Surface:
+    """The rooms behind a building's windows: an atlas of :data:`ROOMS_GRID` x
+    :data:`ROOMS_GRID` rooms (:func:`_room`), each window showing one of them (see
+    :func:`facadecli.geometry.facade.room_uv`). Flat: no relief, nothing occludes."""
+    m = n // ROOMS_GRID
+    colour = np.zeros((n, n, 3))
+    for k in range(ROOMS_GRID * ROOMS_GRID):
+        row, column = divmod(k, ROOMS_GRID)  # rows from the bottom, as texture v runs
+        top = n - (row + 1) * m
+        colour[top : top + m, column * m : (column + 1) * m] = _room(m, rng)
+    flat = np.zeros((n, n))
+    return Surface(flat, colour, flat, flat, cavities=flat)
+
+
 #: kind -> generator(resolution, tile metres, rng)
 GENERATORS: dict[str, Callable[[int, float, np.random.Generator], Surface]] = {
     "brick-stretcher": _bricks("stretcher"),
@@ -372,6 +459,7 @@ GENERATORS: dict[str, Callable[[int, float, np.random.Generator], Surface]] = {
     "glass": _glass,
     "gravel": _gravel,
     "membrane": _membrane,
+    "rooms": _rooms,
 }
 #: the kinds in the order their random streams are numbered: the first eleven in
 #: alphabetical order, the later ones as they came, so that a new kind changes no other
@@ -379,7 +467,7 @@ GENERATORS: dict[str, Callable[[int, float, np.random.Generator], Surface]] = {
 STREAMS = (
     *("ashlar", "brick-english", "brick-flemish", "brick-stretcher", "concrete", "glass"),
     *("metal", "render", "roof-tiles", "slate", "timber"),
-    *("gravel", "membrane"),
+    *("gravel", "membrane", "rooms"),
 )
 
 
