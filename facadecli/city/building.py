@@ -443,7 +443,7 @@ def build_building(
     for (kind, number, name), placed in on_roofs.items():  # as a façade's parts (_parts)
         mesh = UNITS[kind].meshes[number][1]
         if instanced and len(placed) >= MIN_INSTANCES and len(mesh.faces) >= MIN_TRIANGLES:
-            digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())  # one mesh a city
+            digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes(), b"")  # one a city
             instances.setdefault(digest, (name, mesh.copy(), []))[2].extend(placed)
         else:
             parts.setdefault(name, []).extend(mesh.copy().apply_transform(m) for m in placed)
