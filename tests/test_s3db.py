@@ -17,6 +17,7 @@ from shapely.geometry import Polygon
 from facadecli.city.folders import building_file
 from facadecli.city.footprints import Footprint
 from facadecli.city.manifest import Roof, load_city
+from facadecli.city.rooftop import METAL_NAME, ROOFLIGHT_NAME
 from facadecli.city.run import run_city
 from facadecli.city.s3db import (
     MIN_ROOF,
@@ -32,7 +33,7 @@ from facadecli.city.s3db import (
     tagged_heights,
     volume,
 )
-from facadecli.geometry.facade import linear_rgb
+from facadecli.geometry.facade import INTERIOR_MATERIAL, linear_rgb
 
 SPEC = """
 version: 1
@@ -148,6 +149,18 @@ def _model(tmp_path: Path, fid: str) -> trimesh.Scene:
     return trimesh.load(tmp_path / "out" / building_file(fid), force="scene")
 
 
+ON_ROOF = (METAL_NAME, ROOFLIGHT_NAME, INTERIOR_MATERIAL)  # coping, plant, rooflights' wells
+
+
+def _top(scene: trimesh.Scene) -> float:
+    """The top of a building's walls and roof (y is up): without what stands on a flat
+    roof (its coping and plant in the roof metal, the rooflights' glazing and wells; the
+    windows' recesses, in the interior's material too, are under the top), which
+    S3DB's height leaves out as it does antennas and other roof equipment."""
+    kept = [g for g in scene.geometry.values() if g.visual.material.name not in ON_ROOF]
+    return float(max(g.bounds[1][1] for g in kept))
+
+
 @pytest.fixture(scope="module")
 def district(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
     folder = tmp_path_factory.mktemp("tags")
@@ -185,7 +198,7 @@ def test_min_height_lifts_the_walls(district: tuple[Path, dict[str, Any]]) -> No
     folder, _ = district
     scene = _model(folder, "lifted")
     assert scene.bounds[0][1] == pytest.approx(5.0 - 0.01, abs=1e-3)  # its floor slab
-    assert scene.bounds[1][1] == pytest.approx(10.0, abs=1e-3)
+    assert _top(scene) == pytest.approx(10.0, abs=1e-3)
     assert "lifted/ground" not in scene.geometry  # nothing on the ground
 
 
@@ -195,8 +208,8 @@ def test_parts_replace_their_outline(district: tuple[Path, dict[str, Any]]) -> N
     assert "outline" not in built and {"low", "tower"} <= built
     assert {"id": "outline", "parts": ["low", "tower"], "kept_m2": 0.0} in report["replaced"]
     assert report["summary"]["replaced"] == 1
-    assert _model(folder, "tower").bounds[1][1] == pytest.approx(15.0, abs=1e-3)
-    assert _model(folder, "low").bounds[1][1] == pytest.approx(6.0, abs=1e-3)
+    assert _top(_model(folder, "tower")) == pytest.approx(15.0, abs=1e-3)
+    assert _top(_model(folder, "low")) == pytest.approx(6.0, abs=1e-3)
 
 
 def test_what_parts_leave_of_their_outline_is_built(
@@ -205,14 +218,15 @@ def test_what_parts_leave_of_their_outline_is_built(
     folder, report = district
     wing = _model(folder, "station").bounds
     assert wing[0][0] == pytest.approx(10.0, abs=0.3) and wing[1][0] == pytest.approx(20.0, abs=0.3)
-    assert wing[1][1] == pytest.approx(9.0, abs=1e-3)  # the outline's own height
-    assert _model(folder, "hall").bounds[1][1] == pytest.approx(15.0, abs=1e-3)
+    top = _top(_model(folder, "station"))
+    assert top == pytest.approx(9.0, abs=1e-3)  # the outline's own height
+    assert _top(_model(folder, "hall")) == pytest.approx(15.0, abs=1e-3)
     entries = {r["id"]: r for r in report["replaced"]}
     assert entries["station"] == {"id": "station", "parts": ["hall"], "kept_m2": 100.0}
     assert entries["podium"]["kept_m2"] == 120.0  # the storeys stand on it: all of it
     assert report["summary"]["trimmed"] == 2
-    podium, storeys = _model(folder, "podium").bounds, _model(folder, "storeys").bounds
-    assert podium[1][1] == pytest.approx(6.0, abs=1e-3)  # 2 levels of 3 m, flat
+    storeys = _model(folder, "storeys").bounds
+    assert _top(_model(folder, "podium")) == pytest.approx(6.0, abs=1e-3)  # 2 levels of 3 m
     assert storeys[0][1] == pytest.approx(6.0 - 0.01, abs=1e-3)  # on the podium's roof
     assert _entry(report, "storeys")["party_walls"] == 0  # walls above the podium's
     assert _entry(report, "storeys")["facades"] == 4
@@ -276,7 +290,7 @@ def test_party_walls_of_a_terrace_are_blind(district: tuple[Path, dict[str, Any]
 def test_heights_from_any_property_with_a_scale(district: tuple[Path, dict[str, Any]]) -> None:
     folder, report = district
     assert _entry(report, "dataset")["height"] == pytest.approx(18.0)
-    assert _model(folder, "dataset").bounds[1][1] == pytest.approx(18.0, abs=1e-3)
+    assert _top(_model(folder, "dataset")) == pytest.approx(18.0, abs=1e-3)
 
 
 def test_colours_spec_keeps_the_spec_materials(tmp_path: Path) -> None:
