@@ -19,8 +19,9 @@ from facadecli.grammar.model import Options, Progress, no_progress
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
 from facadecli.infer.bays import FEW_BAYS, Bays, find_bays, in_bays, inside
+from facadecli.infer.floors import by_floors
 from facadecli.infer.layers import BAND, Grid, grids, to_edges
-from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
+from facadecli.infer.spec_text import Spread, floor_run, ident, layer_names, spec_text
 from facadecli.infer.structure import structured
 from facadecli.layout import Layout
 from facadecli.spec.model import Spec
@@ -67,16 +68,15 @@ def infer(
     progress("finding the bays and the grids of each label")
     bays = find_bays(regular, tidied.raw)
     if isinstance(bays, Bays):
-        found = [
-            to_edges(grid, regular.width, regular.height)
-            for grid in grids(bays.layout, apart=bays.apart)
-        ]
-        if any(inside(bays, g) and not g.apart and not in_bays(bays, g) for g in found):
+        found = _cut(bays.layout, bays.apart, True)
+        if _unlike(bays, found):
+            found = _cut(bays.layout, bays.apart)
+        if _unlike(bays, found):
             bays = "a label's elements stand unlike in the bays of a kind"
         else:
             regular = bays.layout
     if not isinstance(bays, Bays):
-        found = [to_edges(grid, regular.width, regular.height) for grid in grids(regular)]
+        found = _cut(regular, frozenset(), True)
     spread = size_spread(regular, tidied.snapped)
     text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread, bays)
     tiling = tile(regular, tolerance=0.0)
@@ -85,6 +85,24 @@ def infer(
     return Inference(
         path.name, regular, tiling, found, text, raw=tidied.raw, bays=note, unshared=unshared
     )
+
+
+def _cut(layout: LabelledLayout, apart: frozenset[int], by_floor: bool = False) -> list[Grid]:
+    """The layout's grids (``layers.grids``; ``apart``: the rectangles off the bays), with
+    bands reaching the façade's edges; ``by_floor``: each label's re-cut by the openings'
+    floors where they have a run (``floors.by_floors``), so that what stands alike on every
+    floor is one layer that follows them. Where that leaves a layer unlike in the bays of
+    a kind (its columns a subset of a kind's bays), the bays take the grids as cut."""
+    found = grids(layout, apart=apart)
+    run = floor_run(found, layout.height) if by_floor else None
+    if run is not None:
+        found = by_floors(found, run[1])
+    return [to_edges(grid, layout.width, layout.height) for grid in found]
+
+
+def _unlike(bays: Bays, found: list[Grid]) -> bool:
+    """Whether a layer standing in the bays shows unlike in the bays of a kind."""
+    return any(inside(bays, g) and not g.apart and not in_bays(bays, g) for g in found)
 
 
 def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:

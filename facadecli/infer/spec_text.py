@@ -272,7 +272,7 @@ def spec_text(
         elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
     unique = {elements[label][0].prefix for label in UNIQUE if label in elements}
     top = floors_top(found)
-    floors = _floor_run(found, height)
+    floors = floor_run(found, height)
     tops = top_floors(found, width, height)
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
     framed = frames(found) if shared is None else [None] * len(found)
@@ -485,7 +485,10 @@ def spec_text(
         mesh, thickness = MESHES.get(grid.label, DEFAULT_MESH)
         rows = ", ".join(f"{_number(a)}-{_number(b)}" for a, b in grid.rows)
         shown_x = sorted({elements[grid.label][0].of(b - a) for a, b in grid.columns})
-        shown_y = sorted({elements[grid.label][1].of(b - a) for a, b in grid.rows})
+        # the element symbols its y word writes (a layer on the floors writes each floor of
+        # the run as its last, a row within ``floors.ALIKE`` of it by the last's symbol)
+        written = set(re.findall(r"\w+", y))
+        shown_y = sorted(n for n in _names(elements[grid.label][1]) if n in written)
         out += [
             f"  # {grid.elements} {grid.label} of the input: {len(grid.columns)} columns, "
             f"rows at y = {rows}",
@@ -585,7 +588,7 @@ def _floors_above(
     return " ".join([*symbols[:-1], run, symbols[-1]]), gap
 
 
-def _floor_run(found: list[Grid], height: float) -> tuple[int, Floors] | None:
+def floor_run(found: list[Grid], height: float) -> tuple[int, Floors] | None:
     """The openings' run of floors (``infer.floors``), with the index of the grid whose y
     word writes it: the run its word gets (``_longest_run``, of an element and a gap, not
     mirrored), or None (no run: the top floors repeat upwards instead, ``_floors_above``)."""
