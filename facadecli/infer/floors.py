@@ -55,11 +55,14 @@ Letter = tuple[str, float]  # ("margin" | "gap" | "element", size)
 class Floors:
     """The openings' run of floors: ``copies`` floors (the counter's value at the input's
     size) at ``pitch``, the cut over the last ``cut`` (mid-wall), each floor from the cut
-    under it to the one over it."""
+    under it to the one over it; ``alike``: the share of an element's size its edges on
+    one floor of the run may be off where they are on the last (``ALIKE``; 0: to
+    ``EPS``)."""
 
     cut: float
     pitch: float
     copies: int
+    alike: float = ALIKE
 
     def cuts(self) -> list[float]:
         """The cuts bottom up: under the run's first floor, ..., over its last."""
@@ -102,10 +105,12 @@ def follows(rows: tuple[Span, ...], floors: Floors) -> bool:
     if any(a < c - EPS and b > c + EPS for a, b in rows for c in cuts):
         return False
     shown = [_on(rows, cuts[k], cuts[k + 1]) for k in range(floors.copies)]
-    if any(not _alike(s, shown[-1]) for s in shown):
+    if any(not _alike(s, shown[-1], floors.alike) for s in shown):
         return False
     starts = _starts(rows, floors)
-    return not any(a < _over(starts[-1], (a, b)) and b > cuts[-1] + EPS for a, b in rows)
+    return not any(
+        a < _over(starts[-1], (a, b), floors.alike) and b > cuts[-1] + EPS for a, b in rows
+    )
 
 
 def on_run(rows: tuple[Span, ...], floors: Floors) -> bool:
@@ -119,24 +124,24 @@ def _on(rows: tuple[Span, ...], low: float, high: float) -> tuple[Span, ...]:
     return tuple((a - low, b - low) for a, b in rows if a >= low - EPS and b <= high + EPS)
 
 
-def _alike(rows: tuple[Span, ...], reference: tuple[Span, ...]) -> bool:
-    """As many rows as ``reference``, each within ``ALIKE`` of its size of its own."""
+def _alike(rows: tuple[Span, ...], reference: tuple[Span, ...], alike: float) -> bool:
+    """As many rows as ``reference``, each within ``alike`` of its size of its own."""
     return len(rows) == len(reference) and all(
-        _near(row, own) for row, own in zip(rows, reference, strict=True)
+        _near(row, own, alike) for row, own in zip(rows, reference, strict=True)
     )
 
 
-def _near(row: Span, own: Span) -> bool:
-    """``row`` within ``ALIKE`` of the size of ``own`` of it, at both ends."""
-    reach = ALIKE * (own[1] - own[0]) + EPS
+def _near(row: Span, own: Span, alike: float) -> bool:
+    """``row`` within ``alike`` of the size of ``own`` of it, at both ends."""
+    reach = alike * (own[1] - own[0]) + EPS
     return abs(row[0] - own[0]) <= reach and abs(row[1] - own[1]) <= reach
 
 
-def _over(start: float, row: Span) -> float:
+def _over(start: float, row: Span, alike: float) -> float:
     """Where ``row`` counts as over the run whose floor over it starts at ``start``: from
-    ``ALIKE`` of its size under that (a top floor's sill drawn a millimetre under the
+    ``alike`` of its size under that (a top floor's sill drawn a millimetre under the
     floors' pitch stands on it, written from ``start``)."""
-    return start - ALIKE * (row[1] - row[0]) - EPS
+    return start - alike * (row[1] - row[0]) - EPS
 
 
 def by_floors(found: list[Grid], floors: Floors) -> list[Grid]:
@@ -162,11 +167,11 @@ def by_floors(found: list[Grid], floors: Floors) -> list[Grid]:
             continue
         seen.add(key)
         mine = [g for g in found if (g.label, g.apart) == key]
-        out.extend(_recut(mine, cuts) or mine)
+        out.extend(_recut(mine, cuts, floors.alike) or mine)
     return out
 
 
-def _recut(mine: list[Grid], cuts: list[float]) -> list[Grid] | None:
+def _recut(mine: list[Grid], cuts: list[float], alike: float) -> list[Grid] | None:
     """A label's grids (all apart or none) re-cut by the floors between ``cuts`` (see
     ``by_floors``): the grids of what stands alike on every floor, and the grids as they
     were less those elements (a grid left a part of itself is cut again); None where
@@ -177,21 +182,21 @@ def _recut(mine: list[Grid], cuts: list[float]) -> list[Grid] | None:
         [(r, c) for r, c in spans if r[0] >= low - EPS and r[1] <= high + EPS]
         for low, high in itertools.pairwise(cuts)
     ]
-    alike: dict[tuple[Span, ...], list[Span]] = {}  # its row on each floor -> columns
+    same: dict[tuple[Span, ...], list[Span]] = {}  # its row on each floor -> columns
     for row, column in on[-1]:
         rows = []
         for k, elements in enumerate(on):
             shift = cuts[k] - cuts[-2]
             own = (row[0] + shift, row[1] + shift)
-            hit = next((r for r, c in elements if c == column and _near(r, own)), None)
+            hit = next((r for r, c in elements if c == column and _near(r, own, alike)), None)
             if hit is None:
                 break
             rows.append(hit)
         else:
-            alike.setdefault(tuple(rows), []).append(column)
+            same.setdefault(tuple(rows), []).append(column)
     taken: set[tuple[Span, Span]] = set()
     found: list[Grid] = []
-    for floor_rows, columns in alike.items():
+    for floor_rows, columns in same.items():
         if any(b[0] < a[1] - EPS for a, b in itertools.pairwise(sorted(columns))):
             continue  # overlapping columns: not one grid
         kept = list(floor_rows)
@@ -244,7 +249,11 @@ def floor_letters(
         "gap",
     )
     over = _letters(
-        [r for r in rows if r[0] >= _over(starts[-1], r)], starts[-1], height, "gap", "margin"
+        [r for r in rows if r[0] >= _over(starts[-1], r, floors.alike)],
+        starts[-1],
+        height,
+        "gap",
+        "margin",
     )
     return under, floor, over
 
