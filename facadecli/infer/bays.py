@@ -367,7 +367,7 @@ def _followed(
     def holds(count: int) -> bool:
         placed = _rowed(layout, after, apart, moves, count)
         now = LabelledLayout(layout.width, layout.height, tuple(placed))
-        return not _new_overlaps(layout.rects, placed) and _kept(was, fidelity(drawn, now))
+        return not _new_overlaps(layout.rects, placed) and kept(was, fidelity(drawn, now))
 
     if holds(len(moves)):
         return len(moves)
@@ -1109,12 +1109,12 @@ def _faithful(drawn: LabelledLayout, before: LabelledLayout, after: LabelledLayo
     """The layout with its bays on their kinds' shapes (``after``) is as faithful to the
     drawing as the structure's (``before``): its mean IoU per label within ``KEEP``, no
     element more lost or fused (``grammar.fidelity``)."""
-    return _kept(fidelity(drawn, before), fidelity(drawn, after))
+    return kept(fidelity(drawn, before), fidelity(drawn, after))
 
 
-def _kept(was: Fidelity, now: Fidelity) -> bool:
-    """``now`` within ``KEEP`` of ``was``'s mean IoU, no element more lost or fused."""
-    return now.iou_mean >= was.iou_mean - KEEP and now.lost <= was.lost and now.fused <= was.fused
+def kept(was: Fidelity, now: Fidelity, keep: float = KEEP) -> bool:
+    """``now`` within ``keep`` of ``was``'s mean IoU, no element more lost or fused."""
+    return now.iou_mean >= was.iou_mean - keep and now.lost <= was.lost and now.fused <= was.fused
 
 
 def _fair(drawn: LabelledLayout, before: LabelledLayout, after: LabelledLayout) -> bool:

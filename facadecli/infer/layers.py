@@ -63,9 +63,16 @@ def grids(
                     if r.label == label and (k in apart) == own
                 }
             )
-            while spans:
-                taken, spans = _grid_rows(spans)
-                found.extend(_by_columns(label, taken, own))
+            found.extend(cut(label, spans, own))
+    return found
+
+
+def cut(label: str, spans: list[tuple[Span, Span]], apart: bool = False) -> list[Grid]:
+    """A label's elements (``(row, column)`` spans, sorted) as grids (see the module)."""
+    found: list[Grid] = []
+    while spans:
+        taken, spans = _grid_rows(spans)
+        found.extend(_by_columns(label, taken, apart))
     return found
 
 

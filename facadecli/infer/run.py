@@ -15,17 +15,21 @@ from facadecli.errors import FacadeError, SpecError
 from facadecli.grammar.deadline import Deadline
 from facadecli.grammar.fidelity import Fidelity, fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
-from facadecli.grammar.model import Options, Progress, no_progress
+from facadecli.grammar.model import Options, Progress, Tidied, no_progress
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import Tiling, tile
-from facadecli.infer.bays import FEW_BAYS, Bays, find_bays, in_bays, inside
+from facadecli.infer.bays import FEW_BAYS, Bays, find_bays, in_bays, inside, kept
+from facadecli.infer.floors import ALIKE, by_floors
 from facadecli.infer.layers import BAND, Grid, grids, to_edges
-from facadecli.infer.spec_text import Spread, ident, layer_names, spec_text
+from facadecli.infer.spec_text import Spread, floor_run, ident, layer_names, spec_text
 from facadecli.infer.structure import structured
 from facadecli.layout import Layout
 from facadecli.spec.model import Spec
 
 WIDTHS = (0.7, 1.5)  # other widths the spec must solve at, as shares of the input's
+RECUT_KEEP = 0.001  # of the mean IoU against the annotation at 1x: the most the grids'
+# re-cut by floor may lose (a layer on the floors writes every floor as its last, so a
+# floor drawn off it moves; a counter's tie may solve otherwise), else they stay as cut
 
 
 @dataclass
@@ -66,25 +70,91 @@ def infer(
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
     progress("finding the bays and the grids of each label")
     bays = find_bays(regular, tidied.raw)
+    cut = _layered(regular, bays, by_floor=True)
+    before = _layered(regular, bays, by_floor=False)
+    chosen, was = _inference(path, name, tidied, *cut), _inference(path, name, tidied, *before)
+    if chosen.text != was.text:  # the re-cut by floor is kept only as faithful at 1x
+        progress("checking the grids cut by floor against the annotation")
+        now_fidelity, was_fidelity = at_input_size(chosen), at_input_size(was)
+        if was_fidelity is not None and (
+            now_fidelity is None or not kept(was_fidelity, now_fidelity, RECUT_KEEP)
+        ):
+            chosen = was
+    return chosen
+
+
+def _layered(
+    regular: LabelledLayout, bays: Bays | str, by_floor: bool
+) -> tuple[LabelledLayout, list[Grid], Bays | str, float]:
+    """The layout the spec is written from, its grids and its bays (or why they are not
+    shared): the bays' layout and grids where every layer standing in the bays shows alike
+    in the bays of a kind, else the structure's; ``by_floor``: the grids re-cut by floor
+    (``_cut``), or, where that leaves a layer unlike in the bays, as cut before; and how
+    far a layer's floors may be off its last to follow the openings' (``floors.Floors``:
+    ``ALIKE`` by floor, else to ``floors.EPS``)."""
+    alike = ALIKE if by_floor else 0.0
     if isinstance(bays, Bays):
-        found = [
-            to_edges(grid, regular.width, regular.height)
-            for grid in grids(bays.layout, apart=bays.apart)
-        ]
-        if any(inside(bays, g) and not g.apart and not in_bays(bays, g) for g in found):
-            bays = "a label's elements stand unlike in the bays of a kind"
-        else:
-            regular = bays.layout
-    if not isinstance(bays, Bays):
-        found = [to_edges(grid, regular.width, regular.height) for grid in grids(regular)]
+        found = _cut(bays.layout, bays.apart, by_floor)
+        if by_floor and _unlike(bays, found):
+            found = _cut(bays.layout, bays.apart)
+        if not _unlike(bays, found):
+            return bays.layout, found, bays, alike
+        bays = "a label's elements stand unlike in the bays of a kind"
+    return regular, _cut(regular, frozenset(), by_floor), bays, alike
+
+
+def _inference(
+    path: Path,
+    name: str,
+    tidied: Tidied,
+    regular: LabelledLayout,
+    found: list[Grid],
+    bays: Bays | str,
+    alike: float,
+) -> Inference:
+    """The spec written from ``regular``'s grids ``found`` (``bays``: see ``_layered``)."""
     spread = size_spread(regular, tidied.snapped)
-    text = spec_text(ident(name), regular.width, regular.height, found, path.name, spread, bays)
+    text = spec_text(
+        ident(name), regular.width, regular.height, found, path.name, spread, bays, alike
+    )
     tiling = tile(regular, tolerance=0.0)
     note = bays.describe() if isinstance(bays, Bays) else f"not shared: {bays}"
     unshared = isinstance(bays, str) and bays != FEW_BAYS
     return Inference(
         path.name, regular, tiling, found, text, raw=tidied.raw, bays=note, unshared=unshared
     )
+
+
+def at_input_size(inference: Inference) -> Fidelity | None:
+    """The spec solved at the input's size against the annotation (``grammar.fidelity``),
+    or None where it does not solve there."""
+    from facadecli.solve import solve
+    from facadecli.spec import parse_spec
+
+    spec = parse_spec(inference.text, inference.source)
+    try:
+        layout = solve(spec)
+    except FacadeError:
+        return None
+    return fidelity(inference.raw or inference.layout, solved_layout(layout, spec, inference))
+
+
+def _cut(layout: LabelledLayout, apart: frozenset[int], by_floor: bool = False) -> list[Grid]:
+    """The layout's grids (``layers.grids``; ``apart``: the rectangles off the bays), with
+    bands reaching the façade's edges; ``by_floor``: each label's re-cut by the openings'
+    floors where they have a run (``floors.by_floors``), so that what stands alike on every
+    floor is one layer that follows them. Where that leaves a layer unlike in the bays of
+    a kind (its columns a subset of a kind's bays), the bays take the grids as cut."""
+    found = grids(layout, apart=apart)
+    run = floor_run(found, layout.height) if by_floor else None
+    if run is not None:
+        found = by_floors(found, run[1])
+    return [to_edges(grid, layout.width, layout.height) for grid in found]
+
+
+def _unlike(bays: Bays, found: list[Grid]) -> bool:
+    """Whether a layer standing in the bays shows unlike in the bays of a kind."""
+    return any(inside(bays, g) and not g.apart and not in_bays(bays, g) for g in found)
 
 
 def size_spread(regular: LabelledLayout, snapped: LabelledLayout) -> Spread:

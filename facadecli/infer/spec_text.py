@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 from facadecli.grammar.palette import label_colour
 from facadecli.infer.bays import WALL, Bays, in_bays, segment
 from facadecli.infer.floors import (
+    ALIKE,
     Floors,
     floor_letters,
     floors_grid,
@@ -256,12 +257,14 @@ def spec_text(
     source: str,
     spread: Spread | None = None,
     bays: Bays | str | None = None,
+    alike: float = ALIKE,
 ) -> str:
     """The spec (see the module): the sizes a line per label and a line per layer, and each
     layer in two lines under the comment that says where it came from. ``spread``: the
     range the input's elements of a label's size span (see ``_size``). ``bays``: the
     façade's bays (``infer.bays``), whose one sequence the x word of every layer standing
-    in them follows; or why there are none (said in a comment)."""
+    in them follows; or why there are none (said in a comment). ``alike``: how far a
+    layer's floors may be off its last to follow the openings' (``floors.Floors``)."""
     counters = _Counters()
     shared = bays if isinstance(bays, Bays) else None
     bay_gaps = [_Symbols(f"bay{k + 1}_g") for k in range(len(shared.widths) if shared else 0)]
@@ -291,7 +294,7 @@ def spec_text(
     widths = _width_tables(found, framed, names, elements)
     unique = {t.prefix for g, t in zip(found, widths, strict=True) if g.label in UNIQUE}
     top = floors_top(found)
-    floors = _floor_run(found, height)
+    floors = floor_run(found, height, alike)
     tops = top_floors(found, width, height)
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
     # where a layer's top floor repeats upwards with nothing on the run's floors (its
@@ -511,7 +514,10 @@ def spec_text(
         mesh, thickness = MESHES.get(grid.label, DEFAULT_MESH)
         rows = ", ".join(f"{_number(a)}-{_number(b)}" for a, b in grid.rows)
         shown_x = sorted({widths[k - 1].of(b - a) for a, b in grid.columns})
-        shown_y = sorted({elements[grid.label][1].of(b - a) for a, b in grid.rows})
+        # the element symbols its y word writes (a layer on the floors writes each floor of
+        # the run as its last, a row within ``floors.ALIKE`` of it by the last's symbol)
+        written = set(re.findall(r"\w+", y))
+        shown_y = sorted(n for n in _names(elements[grid.label][1]) if n in written)
         out += [
             f"  # {grid.elements} {grid.label} of the input: {len(grid.columns)} columns, "
             f"rows at y = {rows}",
@@ -611,10 +617,11 @@ def _floors_above(
     return " ".join([*symbols[:-1], run, symbols[-1]]), gap
 
 
-def _floor_run(found: list[Grid], height: float) -> tuple[int, Floors] | None:
-    """The openings' run of floors (``infer.floors``), with the index of the grid whose y
-    word writes it: the run its word gets (``_longest_run``, of an element and a gap, not
-    mirrored), or None (no run: the top floors repeat upwards instead, ``_floors_above``)."""
+def floor_run(found: list[Grid], height: float, alike: float = ALIKE) -> tuple[int, Floors] | None:
+    """The openings' run of floors (``infer.floors``; ``alike``: ``Floors``'), with the
+    index of the grid whose y word writes it: the run its word gets (``_longest_run``, of
+    an element and a gap, not mirrored), or None (no run: the top floors repeat upwards
+    instead, ``_floors_above``)."""
     k = floors_grid(found)
     if k is None or found[k].label in UNIQUE:
         return None
@@ -632,7 +639,7 @@ def _floor_run(found: list[Grid], height: float) -> tuple[int, Floors] | None:
     letters = [(kinds[symbol], size) for symbol, size in tokens[start : start + unit]]
     pitch = sum(size for _, size in letters)
     end = sum(size for _, size in tokens[:start]) + copies * pitch
-    return k, Floors(mid_wall(end, letters, pitch), pitch, copies)
+    return k, Floors(mid_wall(end, letters, pitch), pitch, copies, alike)
 
 
 def _floor_word(
