@@ -5,10 +5,13 @@ browser where one is installed."""
 from __future__ import annotations
 
 import base64
+import json
 import re
 import shutil
 import sys
+from html import unescape
 from pathlib import Path
+from typing import Any
 from urllib.parse import quote
 
 import pytest
@@ -39,6 +42,20 @@ def _shown(tmp_path: Path, text: str, query: str) -> tuple[Path, str]:
     layout = solve(load_spec(spec))
     (path,) = write_outputs(layout, tmp_path, ["html"], OutputOptions())
     return browse(tmp_path, path.as_uri() + query)
+
+
+def _district_shown(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, manifest: Path, query: str, shows: str
+) -> tuple[Path, Any]:
+    """A city built from ``manifest`` and its page in the browser with ``query`` (its
+    view): the screenshot and what the page reports in its ``data-<shows>`` attribute."""
+    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
+    page = tmp_path / "city.html"
+    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
+    shot, dom = browse(tmp_path, page.as_uri() + query)
+    found = re.search(rf'data-{shows}="([^"]+)"', dom)
+    assert found, f"the page reports no {shows}"
+    return shot, json.loads(unescape(found.group(1)))
 
 
 def test_the_page_holds_everything_it_shows(tmp_path: Path) -> None:
@@ -501,19 +518,12 @@ def test_a_districts_street_view_stands_in_a_street_among_its_buildings(
     (the old street view stood back until the whole district was in view: a row of houses
     on the horizon under a sky filling half the picture)."""
     import json
-    from html import unescape
 
     from PIL import Image
     from shapely.geometry import Point, shape
 
     manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
-    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
-    page = tmp_path / "city.html"
-    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
-    shot, dom = browse(tmp_path, page.as_uri() + "?bare&view=street")
-    found = re.search(r'data-street="([^"]+)"', dom)
-    assert found, "the page reports no street view"
-    street = json.loads(unescape(found.group(1)))
+    shot, street = _district_shown(capsys, tmp_path, manifest, "?bare&view=street", "street")
     georef = json.loads((tmp_path / "city" / "demo-district.georef.json").read_text())
     features = json.loads((tmp_path / "demo" / "footprints.geojson").read_text())["features"]
     footprints = {f["properties"]["osm_id"]: shape(f["geometry"]) for f in features}
@@ -608,17 +618,9 @@ def test_a_districts_street_view_looks_at_windows_from_a_distance(
     buildings' share of the picture, their walls seen are windowed), at least two of them,
     none filling more than half of the picture. The old view, scored by the share of the
     picture alone, stood in the blank street."""
-    import json
-    from html import unescape
 
     manifest, windowed = _windows_and_blank_walls(tmp_path / "district")
-    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
-    page = tmp_path / "city.html"
-    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
-    _shot, dom = browse(tmp_path, page.as_uri() + "?bare&view=street")
-    found = re.search(r'data-street="([^"]+)"', dom)
-    assert found, "the page reports no street view"
-    street = json.loads(unescape(found.group(1)))
+    _shot, street = _district_shown(capsys, tmp_path, manifest, "?bare&view=street", "street")
     seen = set(street["seen"])
     assert len(seen & windowed) >= 2 and len(seen - windowed) <= len(seen & windowed), seen
     shares = dict(zip(street["seen"], street["shares"], strict=True))
@@ -637,19 +639,11 @@ def test_a_districts_ground_has_streets_and_grass_and_a_hazy_horizon_from_35_deg
     walls, a kerb, asphalt between the blocks, grass far from every building (it was one
     grey paving); seen from 35° up, the top of the picture is the horizon's haze, one
     even colour, where it was ground up to the frame."""
-    import json
-    from html import unescape
 
     from PIL import Image, ImageStat
 
     manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
-    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
-    page = tmp_path / "city.html"
-    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
-    shot, dom = browse(tmp_path, page.as_uri() + "?bare&view=35,35")
-    found = re.search(r'data-ground="([^"]+)"', dom)
-    assert found, "the page reports no ground"
-    ground = json.loads(unescape(found.group(1)))
+    shot, ground = _district_shown(capsys, tmp_path, manifest, "?bare&view=35,35", "ground")
     assert ground["paving"] > 0.2 and ground["asphalt"] > 0.2  # of the district's box
     assert 0 < ground["kerb"] < 0.1 and ground["grass"] > 0.01
     with Image.open(shot) as image:
