@@ -270,7 +270,7 @@ class _Outline:
         self.convex = len(self.local) == 1 and bool(
             (_cross(self.direction[prv], self.direction) >= -1e-9).all()
         )
-        centre, main, normal = _axes(part)
+        centre, main, normal = roof_axes(part)
         self.centre, self.main, self.normal = centre - self.origin, main, normal
         self.still = _still(self.exact, self.direction, self.next, fixed)
         if len(self.still) == self.count:
@@ -1177,7 +1177,7 @@ def _north(normal: np.ndarray) -> np.ndarray:
     return normal if normal[0] > 0 else -normal
 
 
-def _axes(part: Polygon) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def roof_axes(part: Polygon) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Centre, main direction (the long side of the minimum rotated rectangle) and its
     normal; the direction points east-ish (north for a north-south building)."""
     corners = np.array(part.minimum_rotated_rectangle.exterior.coords)[:4]

@@ -31,8 +31,7 @@ from shapely.geometry import LineString, MultiPolygon, Point, Polygon
 from shapely.ops import unary_union
 from shapely.prepared import prep
 
-from facadecli.city.roofs import Segment
-from facadecli.city.roofs import _axes as roof_axes  # the roofs' main direction, shared
+from facadecli.city.roofs import Segment, roof_axes  # the roofs' main direction, shared
 
 COPING_HEIGHT = 0.08  # metres: the capping's thickness
 COPING_OVER = 0.05  # metres: how far it overhangs the outer face of a wall
