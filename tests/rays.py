@@ -6,6 +6,7 @@ import math
 from collections import defaultdict
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -153,6 +154,22 @@ def _buildings(scene: trimesh.Scene, see_through: set[str]) -> dict[str, list[np
     return found
 
 
+def _beyond_the_rooms(plan: Any) -> Any:
+    """The part of a building's plan deeper in than the rooms behind its windows reach:
+    :data:`.ROOM_DEPTH` and 10 cm; in a narrow building, whose rooms reach half way in
+    at most (:func:`.room_reach`), the middle: 98% of the way to its deepest point."""
+    from facadecli.geometry.primitives import ROOM_DEPTH
+
+    inner = plan.buffer(-(ROOM_DEPTH + 0.1))
+    if not inner.is_empty:
+        return inner
+    low, high = 0.0, ROOM_DEPTH + 0.1  # the deepest point: bisected
+    for _ in range(20):
+        middle = (low + high) / 2
+        low, high = (middle, high) if not plan.buffer(-middle).is_empty else (low, middle)
+    return plan.buffer(-0.98 * low)
+
+
 def city_leaks(glb: Path) -> tuple[int, list[tuple[str, list[float], list[list[float]]]]]:
     """From eight directions 35° above the horizon, rays aimed at points inside each
     building of a merged city (a metre in from its footprint, 1 m up and at 40% of its
@@ -179,7 +196,7 @@ def city_leaks(glb: Path) -> tuple[int, list[tuple[str, list[float], list[list[f
         low, high = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
         ground = [t for t in triangles if np.ptp(t[:, 1]) < 1e-6 and t[0, 1] <= low[1] + 0.02]
         plan = unary_union([Polygon(t[:, [0, 2]]) for t in ground if Polygon(t[:, [0, 2]]).area])
-        inner = plan.buffer(-1.0)  # deeper than any window recess reaches
+        inner = _beyond_the_rooms(plan)
         assert not inner.is_empty, name
         x0, z0, x1, z1 = inner.bounds
         points = [

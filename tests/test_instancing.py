@@ -207,3 +207,27 @@ def test_3d_tiles_see_instanced_buildings_where_they_are(towns: dict[bool, Path]
     assert [p.name for p in plain] == [p.name for p in instanced]
     assert np.allclose(_glb_boxes(plain), _glb_boxes(instanced), atol=1e-3)
     assert [_glb_triangles(p) for p in plain] == [_glb_triangles(p) for p in instanced]
+
+
+def test_a_part_a_building_places_once_is_merged_with_its_material(
+    towns: dict[bool, Path],
+) -> None:
+    """The rule the rooftop units follow holds for a façade's parts too: a part placed
+    once on a building (a room shown in a single window) is merged with the building's
+    mesh of its material, not a node and a draw call of its own; so each material of a
+    building is drawn by one plain node at most, and each instanced node places its
+    mesh twice or more (32 buildings of the 50-building block drew a lone room apart)."""
+    for glb in sorted((towns[True] / "buildings").rglob("*.glb")):
+        document, _ = read_glb(glb.read_bytes())
+        plain: Counter[int] = Counter()
+        for node in document["nodes"]:
+            if "mesh" not in node:
+                continue
+            if EXTENSION in node.get("extensions", {}):
+                accessor = next(iter(node["extensions"][EXTENSION]["attributes"].values()))
+                assert document["accessors"][accessor]["count"] >= 2, glb.name
+                continue
+            for primitive in document["meshes"][node["mesh"]]["primitives"]:
+                plain[primitive["material"]] += 1
+        twice = {document["materials"][k]["name"]: n for k, n in plain.items() if n > 1}
+        assert not twice, (glb.name, twice)

@@ -1,6 +1,8 @@
-"""A room behind every pane (issue 35): each window's recess shows one room of the
-library's ``rooms`` atlas on its back plate, varied from window to window by its place,
-from one material and one picture; the same model gives the same bytes."""
+"""A room behind every pane (issue 35): behind each window a room box as deep as the
+wall leaves room, showing one room of the library's ``rooms`` atlas on its back wall,
+side walls, floor and ceiling at the room's own proportions, varied from window to
+window by its place, from one material and one picture; the same model gives the same
+bytes."""
 
 from __future__ import annotations
 
@@ -11,90 +13,165 @@ import pytest
 import trimesh
 
 from facadecli import load_spec, solve
-from facadecli.geometry.facade import facade_scene, room_uv, room_variant
+from facadecli.geometry.facade import HEAD_ROOM, facade_scene, room_uv, room_variant
+from facadecli.geometry.primitives import RECESS_DEPTH, ROOM_DEPTH, recess
 from facadecli.materials import LIBRARY, images
-from facadecli.materials.textures import ROOMS_GRID
+from facadecli.materials.textures import (
+    ROOM_BACK,
+    ROOM_HEIGHT,
+    ROOM_REVEAL,
+    ROOM_WIDTH,
+    ROOMS_GRID,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "specs").glob("*.yaml"))
 
 
-def _plates(scene: trimesh.Scene) -> list[tuple[trimesh.Trimesh, np.ndarray]]:
-    """Every recess of a façade scene (the ``/recess`` nodes): its mesh and the texture
-    coordinates of its back plate's corners (the faces facing the window, +z)."""
-    found = []
-    for node in scene.graph.nodes_geometry:
-        if not node.endswith("/recess"):
-            continue
-        mesh = scene.geometry[scene.graph[node][1]]
-        facing = np.asarray(mesh.face_normals)[:, 2] > 0.99
-        uv = np.asarray(mesh.visual.uv)[mesh.faces[facing]].reshape(-1, 2)
-        found.append((mesh, uv))
-    return found
+def _rooms(scene: trimesh.Scene) -> list[tuple[str, trimesh.Trimesh]]:
+    """Every room box of a façade scene (the ``/recess`` nodes): its node and mesh."""
+    return [
+        (node, scene.geometry[scene.graph[node][1]])
+        for node in sorted(scene.graph.nodes_geometry)
+        if node.endswith("/recess")
+    ]
 
 
 def _luminance(image: object, uv: np.ndarray) -> np.ndarray:
-    """The luminance (0..1, of the sRGB values) of a picture's pixels inside the box the
-    texture coordinates ``uv`` span (v up, as trimesh keeps it)."""
+    """The luminance (0..1, of the sRGB values) of a picture's pixels at the texture
+    coordinates ``uv`` (v up, as trimesh keeps it)."""
     pixels = np.asarray(image, dtype=float) / 255.0
     n = pixels.shape[0]
-    (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
-    columns = slice(int(u0 * n), max(int(u0 * n) + 1, int(u1 * n)))
-    rows = slice(int((1 - v1) * n), max(int((1 - v1) * n) + 1, int((1 - v0) * n)))
-    part = pixels[rows, columns]
-    luminance: np.ndarray = part @ np.array([0.2126, 0.7152, 0.0722])
+    columns = np.clip((uv[:, 0] * n).astype(int), 0, n - 1)
+    rows = np.clip(((1 - uv[:, 1]) * n).astype(int), 0, n - 1)
+    luminance: np.ndarray = pixels[rows, columns] @ np.array([0.2126, 0.7152, 0.0722])
     return luminance
+
+
+def _seen(mesh: trimesh.Trimesh) -> np.ndarray:
+    """Texture coordinates all over a mesh's faces: 15 points of each (barycentric)."""
+    steps = [(a, b) for a in range(5) for b in range(5 - a)]
+    weights = np.array([(a, b, 4 - a - b) for a, b in steps], dtype=float) / 4
+    corners = np.asarray(mesh.visual.uv)[mesh.faces]  # (faces, 3, 2)
+    found: np.ndarray = np.einsum("wc,fcj->fwj", weights, corners).reshape(-1, 2)
+    return found
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_every_window_of_the_examples_shows_a_room(path: Path) -> None:
-    """Behind every pane of every example is a back plate in a base-colour texture, and
-    what its texture coordinates show is a room, not a plain dark plate: a back wall
-    lighter than its floor and its rim, so its luminance spreads (one deviation, over
-    the plate: 0.039 to 0.15 on the examples; the dark render the recesses wore before
-    spread 0.0034 over its whole picture). The rooms vary: a façade of four windows or
-    more shows four different rooms or more."""
+    """Behind every pane of every example is a room box in a base-colour texture, all of
+    it in one room of the atlas, and what it shows is a room, not a plain dark box: back
+    wall, side walls, floor and ceiling of other tones, so its luminance spreads (one
+    deviation over its faces: 0.021 to 0.18 on the examples; the dark render the recesses
+    wore before spread 0.0034 over its whole picture). The rooms vary: a façade of four
+    windows or more shows four different rooms or more."""
     scene = facade_scene(solve(load_spec(path)), path.parent)
-    plates = _plates(scene)
-    assert plates, "no recess"
+    rooms = _rooms(scene)
+    assert rooms, "no recess"
     shown = set()
-    for mesh, uv in plates:
+    for node, mesh in rooms:
         picture = mesh.visual.material.baseColorTexture
         assert picture is not None
+        uv = _seen(mesh)
+        cell = np.floor(uv * ROOMS_GRID)
+        assert (cell == cell[0]).all(), node  # one room's picture
         spread = float(_luminance(picture, uv).std())
-        assert spread > 0.03, (path.stem, spread)
-        shown.add(tuple(np.floor(uv.mean(axis=0) * ROOMS_GRID).astype(int)))
-    windows = len({id(mesh) for mesh, _ in plates})
+        assert spread > 0.015, (path.stem, node, spread)
+        shown.add(tuple(cell[0].astype(int)))
+    windows = len({id(mesh) for _, mesh in rooms})
     assert len(shown) >= min(4, windows), (len(shown), windows)
 
 
-def test_a_recess_maps_its_plate_across_one_room_and_its_reveals_onto_the_rim() -> None:
-    """:func:`room_uv` on two recesses side by side: each back plate spans one room of
-    the atlas from its left to its right (u rises along the wall, seen from outside), its
-    reveals lie on that room's rim; a room asked for is the one shown."""
-    from facadecli.geometry.primitives import recess
+def _box(x0: float, y0: float, wide: float, high: float) -> trimesh.Trimesh:
+    """A room box 1 m deep behind a pane ``wide`` x ``high`` with its foot at (x0, y0)."""
+    glass = trimesh.creation.box(bounds=[(x0, y0, -0.01), (x0 + wide, y0 + high, 0)])
+    return recess(glass, 1.0)
 
-    left = recess(trimesh.creation.box(bounds=[(0, 0, -0.01), (1, 2, 0)]))
-    right = recess(trimesh.creation.box(bounds=[(3, 0, -0.01), (4, 2, 0)]))
-    both = trimesh.util.concatenate([left, right])
+
+@pytest.mark.parametrize("wide, high", [(1.0, 2.4), (2.4, 1.0), (1.0, 1.5), (4.0, 3.5)])
+def test_a_room_keeps_its_proportions_behind_a_window_of_any_shape(
+    wide: float, high: float
+) -> None:
+    """:func:`room_uv` shows a room at its own proportions (a tall window stretched it
+    upright before, a wide one squashed it): the back plate spans as many metres of the
+    room's back wall across as up for each metre of window, the window's own size when the
+    wall is larger (its head :data:`HEAD_ROOM` under the ceiling, centred across), the
+    whole wall in the side it overflows when it is not."""
+    mapped = room_uv(_box(3.0, 7.0, wide, high), seed=2, room=5)
+    uv = np.asarray(mapped.visual.uv).reshape(-1, 3, 2)
+    normals = np.asarray(mapped.face_normals)
+    plate = uv[normals[:, 2] > 0.99].reshape(-1, 2) * ROOMS_GRID - (1, 1)  # room 5: (1, 1)
+    a0, a1, b0, b1 = ROOM_BACK
+    across = np.ptp(plate[:, 0]) / (a1 - a0) * ROOM_WIDTH  # metres of wall shown
+    up = np.ptp(plate[:, 1]) / (b1 - b0) * ROOM_HEIGHT
+    assert across / wide == pytest.approx(up / high, rel=1e-6)  # never stretched
+    assert across <= ROOM_WIDTH + 1e-9 and up <= ROOM_HEIGHT + 1e-9
+    if wide <= ROOM_WIDTH and high <= ROOM_HEIGHT - HEAD_ROOM:
+        assert (across, up) == pytest.approx((wide, high))
+        top = b0 + (b1 - b0) * (ROOM_HEIGHT - HEAD_ROOM) / ROOM_HEIGHT
+        assert plate[:, 1].max() == pytest.approx(top)
+        assert plate[:, 0].mean() == pytest.approx((a0 + a1) / 2)
+    else:
+        assert max(across / ROOM_WIDTH, up / ROOM_HEIGHT) == pytest.approx(1.0)
+
+
+def test_a_room_boxs_sides_show_its_walls_floor_and_ceiling_from_the_window_in() -> None:
+    """The box's sides lie on the picture's bands round the back wall: the left wall
+    (facing right) on the left band, from the picture's edge at the window to the back
+    wall's edge at the back, the right wall, floor and ceiling likewise; two boxes side
+    by side show their own rooms, the one asked for when asked."""
+    both = trimesh.util.concatenate([_box(0.0, 0.0, 1.0, 2.0), _box(3.0, 0.0, 1.0, 2.0)])
+    a0, a1, b0, b1 = ROOM_BACK
     for room in (None, 6):
         mapped = room_uv(both, seed=5, room=room)
         uv = np.asarray(mapped.visual.uv).reshape(-1, 3, 2)
         corners = np.asarray(mapped.vertices).reshape(-1, 3, 3)
+        normals = np.asarray(mapped.face_normals)
         for piece in range(2):
             faces = slice(10 * piece, 10 * piece + 10)
             cell = np.floor(uv[faces].mean(axis=(0, 1)) * ROOMS_GRID)
             if room is not None:
                 assert tuple(cell) == (room % ROOMS_GRID, room // ROOMS_GRID)
             inside = uv[faces] * ROOMS_GRID - cell
-            assert inside.min() > 0 and inside.max() < 1  # within one room's square
-            plate = inside[:2].reshape(-1, 2)  # the back plate: the first quad
-            xs = corners[faces][:2].reshape(-1, 3)[:, 0]
-            assert np.corrcoef(xs, plate[:, 0])[0, 1] > 0.99  # u along the wall
-            assert np.ptp(plate[:, 0]) > 0.9 and np.ptp(plate[:, 1]) > 0.9  # the whole room
-            rim = inside[2:].reshape(-1, 2)  # the reveals: on the room's edge
-            edges = np.minimum(np.abs(rim - 0.02), np.abs(rim - 0.98))
-            assert (edges.min(axis=1) < 1e-6).all(), rim
+            deep = -corners[faces][:, :, 2]  # 0 at the glass, 1.01 at the back
+            sides = {
+                "left": (normals[faces, 0] > 0.99, 0, (ROOM_REVEAL, a0)),
+                "right": (normals[faces, 0] < -0.99, 0, (1 - ROOM_REVEAL, a1)),
+                "floor": (normals[faces, 1] > 0.99, 1, (ROOM_REVEAL, b0)),
+                "ceiling": (normals[faces, 1] < -0.99, 1, (1 - ROOM_REVEAL, b1)),
+            }
+            for name, (chosen, axis, (window, back)) in sides.items():
+                assert chosen.sum() == 2, name
+                shown = inside[chosen][:, :, axis].reshape(-1)
+                depth = deep[chosen].reshape(-1)
+                expected = window + (back - window) * (depth - 0.01) / 1.0
+                assert np.allclose(shown, expected, atol=1e-9), name
+
+
+def test_rooms_are_deep_where_the_wall_leaves_room_and_stop_short_of_its_ends() -> None:
+    """The townhouse's rooms: those of windows a room's depth or more from the façade's
+    ends are :data:`ROOM_DEPTH` deep behind their glass (a recess was 12 cm); none
+    reaches further behind the façade than its window stands from the nearer end (where
+    a room of the other façade of a corner would be); a spec without the rooms keeps
+    the 12 cm recess."""
+    path = ROOT / "specs" / "townhouse.yaml"
+    layout = solve(load_spec(path))
+    scene = facade_scene(layout, path.parent)
+    depths = []
+    for node, mesh in _rooms(scene):
+        matrix, _ = scene.graph[node]
+        (x0, _, z0), (x1, _, z1) = trimesh.transform_points(mesh.bounds, matrix)
+        depths.append(round(z1 - z0, 6))
+        assert -z0 <= min(x0, layout.width - x1) + 1e-6, node
+    assert max(depths) == pytest.approx(ROOM_DEPTH)
+    assert np.mean(np.isclose(depths, ROOM_DEPTH)) >= 0.5  # the outer windows: 0.5 m
+    plain = load_spec(path)
+    plain = plain.model_copy(
+        update={"materials": {k: v for k, v in plain.materials.items() if k != "interior"}}
+    )
+    scene = facade_scene(solve(plain), path.parent)
+    for _, mesh in _rooms(scene):
+        assert np.ptp(mesh.vertices[:, 2]) == pytest.approx(RECESS_DEPTH, abs=1e-9)
 
 
 def test_neighbouring_windows_show_different_rooms() -> None:
@@ -123,3 +200,35 @@ def test_the_rooms_are_one_picture_of_sixteen_different_rooms() -> None:
         assert (room[0] == room[0, 0]).all() and (room[:, 0] == room[0, 0]).all()  # the rim
         for other in rooms[k + 1 :]:
             assert np.abs(room - other).mean() > 5
+
+
+L_SHAPE = [(0, 0), (12, 0), (12, 2), (2, 2), (2, 10), (0, 10)]  # an arm 2 m across
+
+
+@pytest.mark.parametrize(
+    "outline, wall, deep",
+    [
+        ([(0, 0), (12, 0), (12, 10), (0, 10)], ((0, 0), (12, 0)), 10.0),
+        ([(0, 0), (12, 0), (12, 2.4), (0, 2.4)], ((0, 0), (12, 0)), 2.4),
+        ([(0, 0), (12, 0), (12, 1.7), (0, 1.7)], ((0, 0), (12, 0)), 1.7),  # Delft's least
+        (L_SHAPE, ((2, 2), (2, 10)), 2.0),  # the arm's wall
+        (L_SHAPE, ((0, 0), (12, 0)), 2.0),  # the long wall the arm stands on
+    ],
+)
+def test_a_room_reaches_no_further_than_half_its_building_behind_its_wall(
+    outline: list[tuple[float, float]],
+    wall: tuple[tuple[float, float], tuple[float, float]],
+    deep: float,
+) -> None:
+    """:func:`.room_reach` (the wall from ``a`` to ``b``, the building on its left):
+    behind a wall of a deep building a room is :data:`ROOM_DEPTH` deep; behind one of a
+    narrow building (or of an L's narrow arm) no deeper than half the building less
+    5 cm, so that the rooms behind its facing walls stay apart and never come out at the
+    far side (Delft's footprints are from 1.7 m across); within a step (0.2 m) of that."""
+    from shapely.geometry import Polygon
+
+    from facadecli.city.building import room_reach
+
+    found = room_reach(Polygon(outline), *wall)
+    assert found <= min(ROOM_DEPTH, (deep - 0.1) / 2) + 1e-9
+    assert found >= min(ROOM_DEPTH, (deep - 0.1) / 2) - 0.2 - 1e-9

@@ -119,10 +119,12 @@ def solve_rung(spec: Spec, axis: str, canvas: float, variants: int = 1) -> tuple
 
 
 FacadeMeshes = tuple[tuple[str, np.ndarray, np.ndarray], ...]  # (material, vertices, faces)
-# a part a façade places again and again: its material, vertices, faces, placements, and
-# its own texture coordinates (a window's room; None: laid in metres where it is used)
-Part = tuple[str, np.ndarray, np.ndarray, tuple[np.ndarray, ...], np.ndarray | None]
+# a part a façade places again and again: its material, vertices, faces, placements
+Part = tuple[str, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]
 PlacedParts = list[tuple[str, trimesh.Trimesh, list[np.ndarray]]]  # the same, on a wall
+# a building's parts to instance: (material, vertices, faces) -> the material, the mesh
+# and its placements
+Instances = dict[tuple[str | bytes, ...], tuple[str, trimesh.Trimesh, list[np.ndarray]]]
 Slot = tuple[str, str, int, int]  # a spec's cache key, an axis, a rung, how many variants
 
 
@@ -243,15 +245,15 @@ class AxisCache:
         slot = (key, rung(width), rung(height), x, y)
         if slot not in self.parts:
             scene = facade_scene(_facade(spec, horizontal, vertical), base_dir)
-            self.parts[slot] = _parts(scene, _stretchable(spec), _own_uv(spec))
+            self.parts[slot] = _parts(scene, _stretchable(spec))
         merged, parts = self.parts[slot]
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
         stretch = np.diag([*scale, 1.0])
         return (
             _scaled(merged, scale),
             [
-                (name, _textured(points, faces, uv), [stretch @ m for m in placed])
-                for name, points, faces, placed, uv in parts
+                (name, trimesh.Trimesh(points, faces, process=False), [stretch @ m for m in placed])
+                for name, points, faces, placed in parts
             ],
         )
 
@@ -347,7 +349,7 @@ def build_building(
     main = Facade(spec, spec_key, base_dir)
     scene = trimesh.Scene()
     parts: dict[str, list[trimesh.Trimesh]] = {}
-    instances: dict[tuple[str | bytes, ...], tuple[str, trimesh.Trimesh, list[np.ndarray]]] = {}
+    instances: Instances = {}
     facades = plain = party = entrances = 0
     reasons: dict[str, int] = {}
     volumes = party_volumes(footprint, heights, roof, shared, tolerance, above)
@@ -394,6 +396,8 @@ def build_building(
                 reasons[reason] = reasons.get(reason, 0) + 1
                 continue
             facades += 1
+            behind = room_reach(block.part, a, b)
+            meshes = [(n, _within(m, behind) if n == INTERIOR_MATERIAL else m) for n, m in meshes]
             out = max(float(mesh.vertices[:, 2].max(initial=0.0)) for _, mesh in meshes)
             for _, mesh, placed in repeated:  # how far they stand out, on the wall
                 corners = trimesh.bounds.corners(mesh.bounds)
@@ -406,9 +410,7 @@ def build_building(
                 parts.setdefault(worn(name), []).append(mesh)
             for own, mesh, placed in repeated:
                 name = worn(own)
-                uv = getattr(mesh.visual, "uv", None)
-                shown = b"" if uv is None else np.asarray(uv).tobytes()  # a room: its own
-                digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes(), shown)
+                digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())
                 instances.setdefault(digest, (name, mesh, []))[2].extend(
                     placement @ m for m in placed
                 )
@@ -442,11 +444,12 @@ def build_building(
         parts.setdefault(below, []).append(bottom)
     for (kind, number, name), placed in on_roofs.items():  # as a façade's parts (_parts)
         mesh = UNITS[kind].meshes[number][1]
-        if instanced and len(placed) >= MIN_INSTANCES and len(mesh.faces) >= MIN_TRIANGLES:
-            digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes(), b"")  # one a city
+        if instanced and len(mesh.faces) >= MIN_TRIANGLES:
+            digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())  # one a city
             instances.setdefault(digest, (name, mesh.copy(), []))[2].extend(placed)
         else:
             parts.setdefault(name, []).extend(mesh.copy().apply_transform(m) for m in placed)
+    instances = placed_often(instances, parts)
     materials: dict[str, tuple[Material, Path | None]] = {}
     if fallback is not None:
         materials.update(_materials(fallback.spec, fallback.base_dir, looks, pick))
@@ -471,9 +474,8 @@ def build_building(
         metres = texture_metres(finished)
         if metres is None:
             mesh.visual = trimesh.visual.TextureVisuals()
-        else:  # in metres of the part's own frame, unless it keeps its own (a room)
-            if getattr(mesh.visual, "uv", None) is None:
-                mesh = projection(finished)(mesh, metres)
+        else:  # in metres of the part's own frame
+            mesh = projection(finished)(mesh, metres)
             if finished.library is not None:
                 mesh = tangent_space(mesh)
         mesh = weld(mesh)
@@ -498,6 +500,60 @@ def build_building(
         dict(sorted(reasons.items())),
         entrances,
     )
+
+
+def placed_often(instances: Instances, parts: dict[str, list[trimesh.Trimesh]]) -> Instances:
+    """The parts a building places :data:`.MIN_INSTANCES` times or more, to be instanced;
+    those it places fewer times (a plant unit alone on its roof, the panes of a size one
+    window has) are put in place and merged with the building's meshes of their
+    material (into ``parts``): a node of their own would cost a draw call that a merged
+    mesh does not."""
+    often: Instances = {}
+    for digest, (name, mesh, placed) in instances.items():
+        if len(placed) >= MIN_INSTANCES:
+            often[digest] = (name, mesh, placed)
+        else:
+            parts.setdefault(name, []).extend(mesh.copy().apply_transform(m) for m in placed)
+    return often
+
+
+ROOM_STEPS = (1.2, 1.0, 0.8, 0.6, 0.4)  # metres a room behind a wall may reach, tried
+ROOM_GAP = 0.1  # metres at the least between rooms behind facing walls
+
+
+def room_reach(part: Polygon, a: tuple[float, float], b: tuple[float, float]) -> float:
+    """How far behind the wall from ``a`` to ``b`` (outwards on its right) the rooms
+    behind its windows may reach: the deepest of :data:`ROOM_STEPS` such that the
+    building is twice as deep behind the wall (less its ends, which the rooms near a
+    corner do not reach: :func:`.room_depth`) and :data:`ROOM_GAP` more, so that rooms
+    behind facing walls of a narrow building stay apart and never come out at its far
+    side; the least step where none fits."""
+    length = math.dist(a, b)
+    dx, dy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+    inside = part.buffer(1e-6)
+    for reach in ROOM_STEPS:
+        end = min(2 * reach, length / 2 - 1e-3)
+        start = (a[0] + dx * end, a[1] + dy * end)
+        stop = (b[0] - dx * end, b[1] - dy * end)
+        deep = (-dy * (2 * reach + ROOM_GAP), dx * (2 * reach + ROOM_GAP))  # inwards: left
+        strip = Polygon(
+            [
+                start,
+                stop,
+                (stop[0] + deep[0], stop[1] + deep[1]),
+                (start[0] + deep[0], start[1] + deep[1]),
+            ]
+        )
+        if inside.contains(strip):
+            return reach
+    return ROOM_STEPS[-1]
+
+
+def _within(mesh: trimesh.Trimesh, reach: float) -> trimesh.Trimesh:
+    """A wall's rooms (in its frame: z out of the wall) cut back to ``reach`` behind it."""
+    points = mesh.vertices.copy()
+    points[:, 2] = np.maximum(points[:, 2], -reach)
+    return trimesh.Trimesh(points, mesh.faces, process=False)
 
 
 def building_solids(
@@ -866,24 +922,18 @@ def _merged_facade(layout: Layout, base_dir: Path | None) -> FacadeMeshes:
 def _stretchable(spec: Spec) -> frozenset[str]:
     """The materials whose small parts may be stretched to any size (:func:`_unit`): the
     see-through ones (panes: a faint ripple, stretched, still reads as float glass) and
-    the interior behind them (dark, plain). A visible texture (brick, stone, timber)
-    would be stretched with its part: those parts stay a mesh a size."""
+    the dark interior behind them (plain). A visible texture (brick, stone, timber)
+    would be stretched with its part: those parts stay a mesh a size. The rooms behind
+    windows (a ``rooms`` interior) are not: a room box shows as much of its room as its
+    window is large (:func:`.room_uv`), so a unit mesh would be one a room, size and
+    depth, most of them placed once or twice (on the 50-building block, 1,010 instanced
+    meshes and 1,317 draw calls where 191 and 512 were); they are merged with their
+    building's interior as a façade's small parts are, ten triangles a window and no
+    draw call of their own."""
     names = {name for name in material_names(spec) if see_through(spec, name)}
-    return frozenset(names | {INTERIOR_MATERIAL})
-
-
-def _own_uv(spec: Spec) -> frozenset[str]:
-    """The materials whose parts keep the texture coordinates the façade gave them: the
-    rooms behind windows (:func:`.room_uv`), one of the atlas a window."""
-    return frozenset(name for name in material_names(spec) if look(spec, name).library == ROOMS)
-
-
-def _textured(points: np.ndarray, faces: np.ndarray, uv: np.ndarray | None) -> trimesh.Trimesh:
-    """A part's mesh, with its own texture coordinates if it keeps them."""
-    mesh = trimesh.Trimesh(points, faces, process=False)
-    if uv is not None:
-        mesh.visual = trimesh.visual.TextureVisuals(uv=uv)
-    return mesh
+    if look(spec, INTERIOR_MATERIAL).library != ROOMS:
+        names.add(INTERIOR_MATERIAL)
+    return frozenset(names)
 
 
 def _unit(mesh: trimesh.Trimesh) -> tuple[tuple[bytes, bytes], np.ndarray, np.ndarray]:
@@ -910,17 +960,13 @@ PART_DECIMALS = 5
 
 
 def _parts(
-    scene: trimesh.Scene,
-    stretchable: frozenset[str] = frozenset(),
-    own_uv: frozenset[str] = frozenset(),
+    scene: trimesh.Scene, stretchable: frozenset[str] = frozenset()
 ) -> tuple[FacadeMeshes, tuple[Part, ...]]:
     """A façade's meshes placed fewer than :data:`.MIN_INSTANCES` times or of fewer than
     :data:`.MIN_TRIANGLES` triangles, placed and merged per material, and the others
     each once with their placements, in the order of the scene's nodes. A small part in
     a ``stretchable`` material is a unit mesh (:func:`_unit`), one for all its sizes,
-    its placements scaling it: every pane of a glass, of any size, is one mesh. One in an
-    ``own_uv`` material keeps its texture coordinates (the room a recess shows): one
-    unit mesh for each room."""
+    its placements scaling it: every pane of a glass, of any size, is one mesh."""
     uses = Counter(scene.graph[node][1] for node in scene.graph.nodes_geometry)
     merged: dict[str, list[trimesh.Trimesh]] = {}
     parts: dict[Any, Part] = {}
@@ -930,23 +976,22 @@ def _parts(
         name = mesh.visual.material.name
         if len(mesh.faces) < MIN_TRIANGLES and name in stretchable:
             key, vertices, back = _unit(mesh)
-            uv = np.round(mesh.visual.uv, 6) + 0.0 if name in own_uv else None
-            unit = (name, *key, b"" if uv is None else uv.tobytes())
+            unit = (name, *key)
             if unit not in parts:
-                parts[unit] = (name, vertices, mesh.faces.copy(), (), uv)
-            material, points, faces, placed, uv = parts[unit]
+                parts[unit] = (name, vertices, mesh.faces.copy(), ())
+            material, points, faces, placed = parts[unit]
             placement = np.asarray(matrix, dtype=float) @ back
-            parts[unit] = (material, points, faces, (*placed, placement), uv)
+            parts[unit] = (material, points, faces, (*placed, placement))
             continue
         if uses[geometry] < MIN_INSTANCES or len(mesh.faces) < MIN_TRIANGLES:
             merged.setdefault(name, []).append(mesh.copy().apply_transform(matrix))
             continue
         if geometry not in parts:  # to 10 um: the same part built on two walls, equal bytes
             vertices = np.round(mesh.vertices, PART_DECIMALS) + 0.0  # no -0.0
-            parts[geometry] = (name, vertices, mesh.faces.copy(), (), None)
-        material, vertices, faces, placed, _ = parts[geometry]
+            parts[geometry] = (name, vertices, mesh.faces.copy(), ())
+        material, vertices, faces, placed = parts[geometry]
         matrix = np.asarray(matrix, dtype=float)
-        parts[geometry] = (material, vertices, faces, (*placed, matrix), None)
+        parts[geometry] = (material, vertices, faces, (*placed, matrix))
     walls = tuple(
         (name, joined.vertices.copy(), joined.faces.copy())
         for name, meshes in sorted(merged.items())

@@ -7,6 +7,7 @@ along the façade, y up, z towards the viewer (SPEC 2.1), metres: glTF's own fra
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import lru_cache, partial
 from pathlib import Path
@@ -16,7 +17,16 @@ import trimesh
 from trimesh.visual.material import PBRMaterial
 
 from facadecli.errors import SpecError
-from facadecli.geometry.primitives import GLAZED, PANES, PRIMITIVES, Cell, asset, recess
+from facadecli.geometry.primitives import (
+    GLAZED,
+    PANES,
+    PRIMITIVES,
+    RECESS_DEPTH,
+    ROOM_DEPTH,
+    Cell,
+    asset,
+    recess,
+)
 from facadecli.geometry.runs import built
 from facadecli.geometry.walls import wall_mesh
 from facadecli.layout import (
@@ -29,7 +39,14 @@ from facadecli.layout import (
 )
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.materials import images, resolve
-from facadecli.materials.textures import ROOM_REVEAL, ROOMS_GRID, linear
+from facadecli.materials.textures import (
+    ROOM_BACK,
+    ROOM_HEIGHT,
+    ROOM_REVEAL,
+    ROOM_WIDTH,
+    ROOMS_GRID,
+    linear,
+)
 from facadecli.spec.assets import load_mesh
 from facadecli.spec.model import Material, Spec
 
@@ -174,26 +191,30 @@ def room_variant(points: np.ndarray, seed: int) -> np.ndarray:
 
 
 def room_uv(mesh: trimesh.Trimesh, seed: int = 0, room: int | None = None) -> trimesh.Trimesh:
-    """Texture coordinates that show one room of the interiors' atlas behind each
-    window: each connected piece of ``mesh`` (a recess: its back plate and reveals) is
-    mapped across its back plate, seen from the window (u level, left to right; v up),
-    onto one room of the atlas (``room``, else :func:`room_variant` of the piece's
-    centre); its reveals, square to the plate, take the room's rim (the inner reveal's
-    grey). Each face gets its own corners."""
+    """Texture coordinates that lay one room of the interiors' atlas on each room box
+    behind a window: each connected piece of ``mesh`` (a box, :func:`.recess`: its back
+    plate and four sides, open to the window) shows one room (``room``, else
+    :func:`room_variant` of the piece's centre). Its back plate shows a piece of the
+    room's back wall at the room's own scale (:func:`room_crop`: a window of any shape
+    sees the room unstretched), its sides the room's side walls, floor and ceiling (the
+    picture's bands round the back wall, from the window's edge at the picture's edge to
+    the back wall), at the heights and across the widths the back plate shows. Each face
+    gets its own corners."""
     points = np.asarray(mesh.vertices, dtype=float)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     pieces = _pieces(points, faces)
     count = int(pieces.max(initial=-1)) + 1
     corners = points[faces]  # (faces, 3, 3)
     areas = np.asarray(mesh.area_faces, dtype=float)
+    normals = np.asarray(mesh.face_normals, dtype=float)
     facing = np.zeros((count, 3))
-    np.add.at(facing, pieces, np.asarray(mesh.face_normals) * areas[:, None])
+    np.add.at(facing, pieces, normals * areas[:, None])
     centre = np.zeros((count, 3))
     np.add.at(centre, pieces, corners.mean(axis=1) * areas[:, None])
     weight = np.zeros(count)
     np.add.at(weight, pieces, areas)
     centre /= np.where(weight > 0, weight, 1.0)[:, None]
-    # the plate faces out of the window: the reveals' normals cancel in pairs
+    # the plate faces out of the window: the sides' normals cancel in pairs
     facing[:, 1] = 0.0
     level = np.linalg.norm(facing, axis=1) < 1e-9
     facing[level] = (0.0, 0.0, 1.0)
@@ -201,29 +222,82 @@ def room_uv(mesh: trimesh.Trimesh, seed: int = 0, room: int | None = None) -> tr
     along = np.stack([facing[:, 2], np.zeros(count), -facing[:, 0]], axis=1)  # up x facing
     u = np.einsum("fcj,fj->fc", corners, along[pieces])
     v = corners[:, :, 1]
-    low_u, high_u = np.full(count, np.inf), np.full(count, -np.inf)
-    low_v, high_v = np.full(count, np.inf), np.full(count, -np.inf)
-    np.minimum.at(low_u, pieces, u.min(axis=1))
-    np.maximum.at(high_u, pieces, u.max(axis=1))
-    np.minimum.at(low_v, pieces, v.min(axis=1))
-    np.maximum.at(high_v, pieces, v.max(axis=1))
-    span_u = np.maximum(high_u - low_u, 1e-9)[pieces, None]
-    span_v = np.maximum(high_v - low_v, 1e-9)[pieces, None]
-    across = (u - low_u[pieces, None]) / span_u
-    up = (v - low_v[pieces, None]) / span_v
+    w = np.einsum("fcj,fj->fc", corners, facing[pieces])  # out of the room, to the window
+    low_u, high_u = _spans(u, pieces, count)
+    low_v, high_v = _spans(v, pieces, count)
+    low_w, high_w = _spans(w, pieces, count)
+    shown, up = room_crop(high_u - low_u, high_v - low_v)  # metres of wall shown, its foot
+    scale = (high_u - low_u) / np.maximum(shown[:, 0], 1e-9)  # window metres a wall metre
+    a0, a1, b0, b1 = ROOM_BACK
+    # where each corner lies on the room's back wall (metres: across from its left, up
+    # from its floor) and how deep in (0 at the window, 1 at the back wall)
+    x = (ROOM_WIDTH - shown[:, 0])[pieces, None] / 2 + (u - low_u[pieces, None]) / scale[
+        pieces, None
+    ]
+    y = up[pieces, None] + (v - low_v[pieces, None]) / scale[pieces, None]
+    deep = (high_w[pieces, None] - w) / np.maximum(high_w - low_w, 1e-9)[pieces, None]
+    across = a0 + (a1 - a0) * x / ROOM_WIDTH
+    upward = b0 + (b1 - b0) * y / ROOM_HEIGHT
+    rim = ROOM_REVEAL
+    side = _side(normals, facing[pieces], along[pieces])
+    left, right, floor, ceiling = (side == k for k in range(4))
+    across[left] = (rim + (a0 - rim) * deep)[left]
+    across[right] = (1 - rim - (1 - rim - a1) * deep)[right]
+    upward[floor] = (rim + (b0 - rim) * deep)[floor]
+    upward[ceiling] = (1 - rim - (1 - rim - b1) * deep)[ceiling]
     chosen = room_variant(centre, seed) if room is None else np.full(count, room)
-    shown = chosen[pieces]
-    inset = 0.5 * ROOM_REVEAL  # the rim: inside the room's reveal, never its neighbour's
-    column, row = (shown % ROOMS_GRID)[:, None], (shown // ROOMS_GRID)[:, None]
-    across = (column + inset + (1 - 2 * inset) * across) / ROOMS_GRID
-    up = (row + inset + (1 - 2 * inset) * up) / ROOMS_GRID
+    number = chosen[pieces]
+    column, row = (number % ROOMS_GRID)[:, None], (number // ROOMS_GRID)[:, None]
+    inside = (rim / 2, 1 - rim / 2)  # never a neighbouring room's picture
+    across = (column + np.clip(across, *inside)) / ROOMS_GRID
+    upward = (row + np.clip(upward, *inside)) / ROOMS_GRID
     flat = trimesh.Trimesh(
         corners.reshape(-1, 3), np.arange(3 * len(faces)).reshape(-1, 3), process=False
     )
     flat.visual = trimesh.visual.TextureVisuals(
-        uv=np.stack([across.reshape(-1), up.reshape(-1)], axis=1)
+        uv=np.stack([across.reshape(-1), upward.reshape(-1)], axis=1)
     )
     return flat
+
+
+def room_crop(wide: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """What a window ``wide`` x ``high`` metres (arrays) shows of a room's back wall
+    (:data:`ROOM_WIDTH` x :data:`ROOM_HEIGHT`): (n, 2) metres across and up, and the
+    metres from the floor to its foot. A window shows as much wall as it is large, its
+    head :data:`HEAD_ROOM` under the ceiling (or less, when it is taller), centred across;
+    one larger than the wall shows the whole wall in the side it overflows and less in
+    the other, so the room keeps its proportions and is never stretched."""
+    wide, high = np.asarray(wide, dtype=float), np.asarray(high, dtype=float)
+    over = np.maximum.reduce([np.ones_like(wide), wide / ROOM_WIDTH, high / ROOM_HEIGHT])
+    shown = np.stack([wide / over, high / over], axis=1)
+    head = np.maximum(shown[:, 1], ROOM_HEIGHT - HEAD_ROOM)
+    return shown, head - shown[:, 1]
+
+
+#: metres from the head of a window to the ceiling of the room behind it
+HEAD_ROOM = 0.3
+
+
+def _spans(values: np.ndarray, pieces: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The least and greatest of each piece's ``values`` (faces x 3 corners)."""
+    low, high = np.full(count, np.inf), np.full(count, -np.inf)
+    np.minimum.at(low, pieces, values.min(axis=1))
+    np.maximum.at(high, pieces, values.max(axis=1))
+    return low, high
+
+
+def _side(normals: np.ndarray, facing: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """Which of a room box's faces each is, by its normal: 0 the left wall (facing right,
+    along the wall), 1 the right, 2 the floor (facing up), 3 the ceiling, 4 the back."""
+    across = np.einsum("ij,ij->i", normals, along)
+    side = np.full(len(normals), 4)
+    side[across > 0.5] = 0
+    side[across < -0.5] = 1
+    side[normals[:, 1] > 0.5] = 2
+    side[normals[:, 1] < -0.5] = 3
+    back = np.einsum("ij,ij->i", normals, facing) > 0.5
+    side[back] = 4
+    return side
 
 
 def _pieces(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -462,15 +536,17 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             cell = Cell.of(shape)
             build = partial(_build, shape, cell, base_dir, assets)
             place(shape, "", shape.material, build, node)
+            deep = room_depth(layout, shape)
             if shape.mesh in GLAZED and see_through(spec, shape.material):
-                place(shape, "recess", INTERIOR_MATERIAL, partial(_recess, build), f"{node}/recess")
+                behind = partial(_recess, build, deep)
+                place(shape, f"recess {deep:g}", INTERIOR_MATERIAL, behind, f"{node}/recess")
             pane = PANES.get(shape.mesh)
             if pane is not None:
                 glass = shape.look.pane_material if shape.look else PANE_MATERIAL
                 place(shape, "pane", glass, partial(pane, cell), f"{node}/pane")
                 if see_through(spec, glass):
-                    back = partial(_recess, partial(pane, cell))
-                    place(shape, "pane-recess", INTERIOR_MATERIAL, back, f"{node}/recess")
+                    back = partial(_recess, partial(pane, cell), deep)
+                    place(shape, f"pane-recess {deep:g}", INTERIOR_MATERIAL, back, f"{node}/recess")
         for (material, z0, z1), cells in walls.items():  # one mesh each: no seams
             mesh = dress(wall_mesh(cells, z0, z1), material)
             name = f"walls-{layer.name}-{material}-{count}"
@@ -491,10 +567,25 @@ def see_through(spec: Spec, name: str) -> bool:
     return material.opacity < 1.0 or material.transmission > 0.0
 
 
-def _recess(glass: Callable[[], trimesh.Trimesh | None]) -> trimesh.Trimesh | None:
-    """The dark recess behind the glass a builder makes (none when it makes none)."""
+def _recess(glass: Callable[[], trimesh.Trimesh | None], depth: float) -> trimesh.Trimesh | None:
+    """The recess ``depth`` deep behind the glass a builder makes (none when it makes none)."""
     mesh = glass()
-    return None if mesh is None else recess(mesh)
+    return None if mesh is None else recess(mesh, depth)
+
+
+def room_depth(layout: Layout, shape: Shape) -> float:
+    """How deep the recess behind a shape's glass is: :data:`.RECESS_DEPTH` (a dark
+    recess), or with a ``rooms`` interior a room :data:`.ROOM_DEPTH` deep where the wall
+    leaves room. A room reaches no further behind the façade's plane than its window
+    stands from the nearer end of the façade, so that at a building's corner it meets
+    no room of the other façade (whose windows stand as far from the corner as its
+    rooms reach in); it keeps :data:`.RECESS_DEPTH` at the least, and is a whole number
+    of decimetres, so that the windows of a façade share a few room boxes."""
+    if look(layout.spec, INTERIOR_MATERIAL).library != ROOMS:
+        return RECESS_DEPTH
+    free = min(shape.x0, layout.width - shape.x1) + shape.z0  # z0: the shape's back
+    deep = math.floor(min(ROOM_DEPTH, free) * 10 + 1e-9) / 10
+    return max(RECESS_DEPTH, deep)
 
 
 def _builtin(material: str) -> Material:

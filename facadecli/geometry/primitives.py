@@ -29,6 +29,9 @@ from facadecli.geometry.cell import (
 __all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset", "recess"]
 
 RECESS_DEPTH = 0.12  # metres from the back of a window's glass to the plate behind it
+# metres from the back of a window's glass to the back wall of the room behind it (a
+# ``rooms`` interior), where the wall leaves room (:func:`.facade.room_depth`)
+ROOM_DEPTH = 1.2
 
 
 def _block(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> trimesh.Trimesh:
@@ -336,15 +339,17 @@ def shutter(cell: Cell) -> trimesh.Trimesh:
     return trimesh.util.concatenate(parts)
 
 
-def recess(glass: trimesh.Trimesh) -> trimesh.Trimesh:
+def recess(glass: trimesh.Trimesh, depth: float = RECESS_DEPTH) -> trimesh.Trimesh:
     """The dark recess behind a window's glass (in the glass's frame), open towards the
-    glass: a back plate :data:`RECESS_DEPTH` behind the back of the glass, as large as the
-    glass seen head-on, and four reveals from it up to the glass, each a quad facing into
-    the opening (five quads, ten triangles, eight corners). A ray that passes the glass
-    meets the front of one of them, so the street behind a façade never shows through its
-    windows; nothing faces away from the window, where no one can see it."""
+    glass: a back plate ``depth`` behind the back of the glass, as large as the glass seen
+    head-on, and four reveals from it up to the glass, each a quad facing into the
+    opening (five quads, ten triangles, eight corners). A ray that passes the glass meets
+    the front of one of them, so the street behind a façade never shows through its
+    windows; nothing faces away from the window, where no one can see it. A room
+    (:data:`ROOM_DEPTH` deep) is the same box, its reveals the room's side walls, floor
+    and ceiling."""
     (x0, y0, z0), (x1, y1, _) = glass.bounds
-    back = z0 - RECESS_DEPTH
+    back = z0 - depth
     corners = np.array(
         [(x, y, z) for z in (back, z0) for y in (y0, y1) for x in (x0, x1)], dtype=float
     )  # 0-3 the back plate's corners, 4-7 the opening's (x fastest, then y)

@@ -64,7 +64,7 @@ LIBRARY: dict[str, Material] = {
     "metal": _entry("metal", "#a3a7ab", 0.35, metallic=1.0),
     "roof-tiles": _entry("roof-tiles", "#a4553b", 0.75),
     "slate": _entry("slate", "#464b53", 0.6),
-    "float-glass": _entry("float-glass", "#dde6e4", 0.04, opacity=0.35, transmission=0.9, ior=1.52),
+    "float-glass": _entry("float-glass", "#dde6e4", 0.04, opacity=0.35, transmission=1.0, ior=1.52),
     "gravel": _entry("gravel", "#9a958c", 0.95),
     "membrane": _entry("membrane", "#3f4042", 0.8),  # bitumen felt; lighter: a single-ply sheet
     "rooms": _entry("rooms", "#ffffff", 0.9),  # the colour dims or tints every room

@@ -33,6 +33,9 @@ class Surface:
     # the relief ambient occlusion reads (None: ``height``): the joints between units, not
     # the grain of their faces, whose pits are too shallow for their width to shade
     cavities: Field | None = None
+    # the ambient occlusion itself, 0..1 (None: from ``cavities``, :func:`occlusion`): a
+    # room's, which sees the sky through its window alone
+    occlusion: Field | None = None
 
 
 @dataclass(frozen=True)
@@ -359,32 +362,48 @@ def _glass(n: int, tile: float, rng: np.random.Generator) -> Surface:
 
 #: rooms a side of the interiors' atlas (:func:`_rooms`): 4 x 4, sixteen rooms
 ROOMS_GRID = 4
-#: the share of a room's picture (each side) that is the inner reveal around it
+#: the share of a room's picture (each side) that is the inner reveal around it: a
+#: gutter no window's room reads, so that no room bleeds into its neighbour
 ROOM_REVEAL = 0.04
+#: where a room's back wall lies in its picture, as shares of it (left, right, bottom,
+#: top; the same in every room): round it, the left and right walls, the floor and the
+#: ceiling, each a band from the picture's edge (at the window) to the back wall
+ROOM_BACK = (0.25, 0.75, 0.28, 0.74)
+#: metres from a room's floor to its ceiling: the back wall's height in the picture
+ROOM_HEIGHT = 2.7
+#: metres across the back wall (its picture's pixels are square)
+ROOM_WIDTH = ROOM_HEIGHT * (ROOM_BACK[1] - ROOM_BACK[0]) / (ROOM_BACK[3] - ROOM_BACK[2])
 
 # a room's colours (linear light): back wall and side walls, floor, curtains and blinds
-_WALLS = ((0.55, 0.50, 0.42), (0.45, 0.45, 0.43), (0.50, 0.44, 0.34), (0.36, 0.40, 0.38))
-_FLOORS = ((0.22, 0.12, 0.06), (0.30, 0.20, 0.11), (0.12, 0.12, 0.12), (0.28, 0.25, 0.21))
+_WALLS = (
+    *((0.55, 0.50, 0.42), (0.45, 0.45, 0.43), (0.50, 0.44, 0.34), (0.36, 0.40, 0.38)),
+    *((0.62, 0.60, 0.56), (0.42, 0.30, 0.26), (0.30, 0.36, 0.44)),
+)
+_FLOORS = (
+    *((0.22, 0.12, 0.06), (0.30, 0.20, 0.11), (0.12, 0.12, 0.12), (0.28, 0.25, 0.21)),
+    *((0.40, 0.30, 0.18), (0.18, 0.20, 0.24)),
+)
 _CLOTHS = ((0.55, 0.52, 0.45), (0.35, 0.10, 0.08), (0.10, 0.16, 0.28), (0.62, 0.58, 0.50))
 
 
-def _room(m: int, rng: np.random.Generator) -> np.ndarray:
-    """One room as seen through a window, ``m`` pixels a side (row 0 the top): the back
-    wall in the middle, the ceiling, floor and side walls round it in one-point
-    perspective, each darker the further it is from the light; a piece of furniture
-    against the back wall; sometimes curtains at the sides or a blind half down; in some
-    the lights on (warmer and brighter, a lamp's glow under the ceiling); the inner
-    reveal (:data:`ROOM_REVEAL`) round it, in the dim grey a reveal's plaster has."""
+def _room(m: int, rng: np.random.Generator) -> tuple[np.ndarray, Field]:
+    """One room, ``m`` pixels a side (row 0 the top), drawn as a room box's faces lie on
+    it (:data:`ROOM_BACK`): the back wall in the middle, the side walls, floor and
+    ceiling as bands round it, each from the window (the picture's edge) to the back
+    wall, lit near the window and darker deeper in; a piece of furniture against the back
+    wall, sometimes a picture on it; sometimes curtains hung at the window (on the side
+    walls next to it); in some the lights on (warmer and brighter, a lamp's glow under the
+    ceiling); the inner reveal (:data:`ROOM_REVEAL`) round it, in the dim grey a reveal's
+    plaster has. With its ambient occlusion: a room sees the sky through its window
+    alone, the less the deeper in (0.7 at the window to 0.3 at the back wall)."""
     centres = (np.arange(m) + 0.5) / m
     s, t = np.meshgrid(centres, centres[::-1])  # 0..1 across, 0..1 up
-    a0 = float(rng.uniform(0.18, 0.32))  # the back wall's edges, as shares of the window
-    a1 = a0 + float(rng.uniform(0.4, 0.55))
-    b0 = float(rng.uniform(0.22, 0.32))
-    b1 = b0 + float(rng.uniform(0.4, 0.5))
-    wall = np.asarray(_WALLS[rng.integers(len(_WALLS))]) * rng.uniform(0.85, 1.1)
-    floor = np.asarray(_FLOORS[rng.integers(len(_FLOORS))])
+    a0, a1, b0, b1 = ROOM_BACK
+    tint = 1 + rng.uniform(-0.08, 0.08, 3)  # no two rooms painted quite alike
+    wall = np.asarray(_WALLS[rng.integers(len(_WALLS))]) * rng.uniform(0.8, 1.15) * tint
+    floor = np.asarray(_FLOORS[rng.integers(len(_FLOORS))]) * rng.uniform(0.8, 1.2)
     # how far out of the back wall a pixel lies, towards each side: the largest names the
-    # surface it sees (left or right wall, floor, ceiling) and its depth (0 back, 1 window)
+    # surface it shows (left or right wall, floor, ceiling) and its depth (0 back, 1 window)
     beyond = np.stack([(a0 - s) / a0, (s - a1) / (1 - a1), (b0 - t) / b0, (t - b1) / (1 - b1)])
     side, depth = beyond.argmax(axis=0), np.clip(beyond.max(axis=0), 0.0, 1.0)
     back = beyond.max(axis=0) <= 0
@@ -393,55 +412,61 @@ def _room(m: int, rng: np.random.Generator) -> np.ndarray:
     ceiling = (side == 3) & ~back
     colour[ceiling] = wall * 1.1 * (0.5 + 0.4 * depth[ceiling])[..., None]
     below = (side == 2) & ~back
-    colour[below] = floor * (0.6 + 0.4 * depth[below])[..., None]
+    boards = 0.9 + 0.1 * (np.mod(s * 23.0, 1.0) > 0.08)  # floorboards, running in
+    colour[below] = floor * ((0.6 + 0.4 * depth) * boards)[below][..., None]
     colour[back] = wall * 0.75
-    # furniture against the back wall: a sofa, a sideboard or a bookcase
-    x0 = float(rng.uniform(a0, (a0 + a1) / 2))
-    x1 = min(a1, x0 + float(rng.uniform(0.15, 0.35)))
-    top = b0 + (a1 - a0) * float(rng.choice([0.12, 0.2, 0.55]))
-    piece = (s > x0) & (s < x1) & (t > b0 - 0.03) & (t < top)
+    if rng.uniform() < 0.4:  # a doorway in the back wall, 0.9 x 2.1 m, to a darker room
+        door = float(rng.choice([a0 + 0.04, a1 - 0.04 - 0.9 / ROOM_WIDTH * (a1 - a0)]))
+        wide, tall = 0.9 / ROOM_WIDTH * (a1 - a0), 2.1 / ROOM_HEIGHT * (b1 - b0)
+        colour[(s > door) & (s < door + wide) & (t > b0) & (t < b0 + tall)] = wall * 0.3
+    if rng.uniform() < 0.5:  # a rug on the floor
+        rug = np.asarray(_CLOTHS[rng.integers(len(_CLOTHS))]) * 0.6
+        lies = below & (depth > 0.2) & (depth < 0.75) & (s > a0 + 0.05) & (s < a1 - 0.05)
+        colour[lies] = rug
+    # furniture against the back wall: a sideboard, a dresser or a bookcase (metres up)
+    x0 = float(rng.uniform(a0 + 0.02, (a0 + a1) / 2))
+    x1 = min(a1 - 0.02, x0 + float(rng.uniform(0.15, 0.3)))
+    high = float(rng.choice([0.9, 1.3, 1.9])) / ROOM_HEIGHT * (b1 - b0)
+    piece = (s > x0) & (s < x1) & (t > b0) & (t < b0 + high)
     shade = np.asarray(_CLOTHS[rng.integers(len(_CLOTHS))]) * 0.45
-    colour[piece] = shade
-    if rng.uniform() < 0.5:  # a picture on the back wall
+    colour[piece] = shade * (0.8 + 0.2 * (np.mod((t - b0) / 0.06, 1.0) > 0.15))[piece][..., None]
+    if rng.uniform() < 0.6:  # a picture on the back wall, at eye height and above
         px = float(rng.uniform(a0 + 0.05, a1 - 0.15))
-        frame = (s > px) & (s < px + 0.1) & (t > b1 - 0.2) & (t < b1 - 0.08)
+        frame = (s > px) & (s < px + 0.1) & (t > b1 - 0.2) & (t < b1 - 0.1)
         colour[frame] = np.asarray(_CLOTHS[rng.integers(len(_CLOTHS))]) * 0.8
     lit = rng.uniform() < 0.3
     if lit:  # the lights on: warmer, brighter, a lamp's glow under the ceiling
         glow = np.exp(-(((s - (a0 + a1) / 2) / 0.25) ** 2 + ((t - b1) / 0.2) ** 2))
         colour = colour * np.array([1.35, 1.2, 0.9]) + 0.5 * glow[..., None] * [1.0, 0.8, 0.5]
-    cover = rng.uniform()
-    if cover < 0.4:  # curtains drawn to the sides, in folds
+    if rng.uniform() < 0.45:  # curtains hung at the window, in folds, on the side walls
         cloth = np.asarray(_CLOTHS[rng.integers(len(_CLOTHS))])
-        width = float(rng.uniform(0.1, 0.22))
-        hung = (s < width) | (s > 1 - width)
-        folds = 0.75 + 0.25 * np.sin(2 * np.pi * s / 0.045) ** 2
+        width = float(rng.uniform(0.3, 0.6))  # of the side walls' depth
+        hung = ((side <= 1) & ~back & (depth > 1 - width)) & (t > b0) & (t < b1)
+        folds = 0.75 + 0.25 * np.sin(2 * np.pi * depth / 0.12) ** 2
         colour[hung] = (cloth * (1.2 if lit else 1.0)) * folds[hung][..., None]
-    elif cover < 0.6:  # a blind let down part of the way, in slats
-        down = 1 - float(rng.uniform(0.2, 0.6))
-        slats = 0.8 + 0.2 * (np.mod(t / 0.035, 1.0) > 0.2)
-        blind = t > down
-        tone = np.asarray(_CLOTHS[3]) * (1.25 if lit else 1.0)
-        colour[blind] = tone * slats[blind][..., None]
     # a room by day is darker than the street it looks onto: a lit one less so
-    colour = colour * (0.75 if lit else 0.35)
+    colour = colour * (0.65 if lit else 0.35)
     edge = np.minimum.reduce([s, 1 - s, t, 1 - t])
     colour[edge < ROOM_REVEAL] = (0.16, 0.155, 0.145)
-    return colour
+    open_sky: Field = np.where(back, 0.3, 0.3 + 0.4 * depth)
+    return colour, open_sky
 
 
 def _rooms(n: int, tile: float, rng: np.random.Generator) -> Surface:
     """The rooms behind a building's windows: an atlas of :data:`ROOMS_GRID` x
-    :data:`ROOMS_GRID` rooms (:func:`_room`), each window showing one of them (see
-    :func:`facadecli.geometry.facade.room_uv`). Flat: no relief, nothing occludes."""
+    :data:`ROOMS_GRID` rooms (:func:`_room`), each window's room box showing one of them
+    (see :func:`facadecli.geometry.facade.room_uv`). Flat: no relief; occluded as a
+    room is from the sky."""
     m = n // ROOMS_GRID
     colour = np.zeros((n, n, 3))
+    shade = np.ones((n, n))
     for k in range(ROOMS_GRID * ROOMS_GRID):
         row, column = divmod(k, ROOMS_GRID)  # rows from the bottom, as texture v runs
         top = n - (row + 1) * m
-        colour[top : top + m, column * m : (column + 1) * m] = _room(m, rng)
+        cell = slice(top, top + m), slice(column * m, (column + 1) * m)
+        colour[cell], shade[cell] = _room(m, rng)
     flat = np.zeros((n, n))
-    return Surface(flat, colour, flat, flat, cavities=flat)
+    return Surface(flat, colour, flat, flat, cavities=flat, occlusion=shade)
 
 
 #: kind -> generator(resolution, tile metres, rng)
@@ -532,10 +557,11 @@ def texture_set(
     rough = np.clip(roughness + surface.roughness, 0.02, 1.0)
     metal = np.clip(metallic * surface.metal, 0.0, 1.0) if metallic > 0 else surface.metal * 0
     cavities = surface.height if surface.cavities is None else surface.cavities
+    ambient = occlusion(cavities, tile) if surface.occlusion is None else surface.occlusion
     # occlusion and roughness in steps of 1/32 and 1/64: finer steps cannot be seen, and
     # would double the image's size
     orm = np.stack(
-        [np.round(occlusion(cavities, tile) * 32) / 32, np.round(rough * 64) / 64, metal],
+        [np.round(ambient * 32) / 32, np.round(rough * 64) / 64, metal],
         axis=-1,
     )
     normal = normal_map(surface.height, tile) * 0.5 + 0.5
