@@ -35,6 +35,10 @@ PICTURES: dict[str, tuple[str, str, str]] = {
     "terraced-house": ("terraced-house", "model", "35,10"),
     "townhouse": ("townhouse", "model", "35,10"),
     "townhouse-street": ("townhouse", "model", "street,25"),
+    # the rooms behind the windows close up: 30° round and 5° up, five times closer than
+    # the whole façade; and from below, as from the street, 40° round and 12° down
+    "townhouse-rooms-depth": ("townhouse", "model", "30,5,5,0.6,0.45,0.9"),
+    "townhouse-rooms-street": ("townhouse", "model", "40,-12,2.4,0.5,0.35,0.9"),
     "parts": ("parts", "model", "35,10,1.1,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
 }
