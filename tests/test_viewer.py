@@ -361,8 +361,10 @@ def test_glass_seen_at_35_degrees_mirrors_the_street_not_a_slate(tmp_path: Path)
     windows), at the reflectance of a double-glazed unit, so it is lighter than a dark
     slate and shows something. Measured on the pane's middle (0.33..0.45 across,
     0.32..0.6 up): mean grey 66.3, spread (standard deviation) 4.3 when the environment
-    held plain paving there and the glass reflected one face's 4%; 83.5 and 7.4 now
-    (square on, 0.42..0.58: 65.7 and 7.1 before, 88.2 and 12.0 now)."""
+    held plain paving there and the glass reflected one face's 4%; 83.5 and 7.4 with
+    the reflection (square on, 0.42..0.58: 65.7 and 7.1 before, 88.2 and 12.0); 66.9
+    since glass transmits all it does not reflect (transmission 1: no white veil of
+    diffuse light over the room), its spread telling the reflection from a slate."""
     from PIL import Image, ImageStat
 
     shot, dom = _shown(tmp_path, PANE_SPEC, "?bare&view=35,10")
@@ -372,8 +374,8 @@ def test_glass_seen_at_35_degrees_mirrors_the_street_not_a_slate(tmp_path: Path)
         width, height = grey.size
         box = (round(0.33 * width), round(0.32 * height), round(0.45 * width), round(0.6 * height))
         pane = ImageStat.Stat(grey.crop(box))
-    assert 75 < pane.mean[0] < 170
-    assert pane.stddev[0] > 5.8
+    assert 55 < pane.mean[0] < 170, pane.mean[0]
+    assert pane.stddev[0] > 5.8, pane.stddev[0]
 
 
 def _pane_spread(shot: Path) -> float:
@@ -393,16 +395,19 @@ def _pane_spread(shot: Path) -> float:
 def test_a_pane_shows_the_room_behind_it(tmp_path: Path) -> None:
     """The window of :data:`PANE_SPEC` square on, behind it the dark recess (the built-in
     interior) and then a room of the library's ``rooms``: through the glass, the room's
-    walls, floor and ceiling spread the pane's grey where the dark recess leaves only the
-    reflection (one deviation, headless Chromium with SwiftShader, one shot each: 12.6
-    with the dark recess, 20.3 with the room)."""
+    back wall (1.2 m back) lifts the pane's grey over the dark recess's. Mean grey over
+    the pane, headless Chromium with SwiftShader, one shot each: 80.0 with the dark
+    recess, 110.9 with the room. (Its spread told them apart while the room was a
+    perspective picture on the plate, 12.6 and 20.3; a room box seen square on shows
+    its back wall, and the spread is the reflection's: 17.7 and 17.4.)"""
     with_room = PANE_SPEC.replace("materials:\n", "materials:\n  interior: {library: rooms}\n")
     spreads = []
     for name, text in (("dark", PANE_SPEC), ("room", with_room)):
         (tmp_path / name).mkdir()
-        spreads.append(_pane_spread(_shown(tmp_path / name, text, "?bare&view=0,0")[0]))
+        shot = _shown(tmp_path / name, text, "?bare&view=0,0")[0]
+        spreads.append(_mean_grey(shot, (0.38, 0.3, 0.62, 0.7)))
     dark, room = spreads
-    assert room > 1.3 * dark, (dark, room)
+    assert room > dark + 15, (dark, room)
 
 
 WALLS_SPEC = """
