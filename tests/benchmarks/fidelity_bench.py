@@ -9,11 +9,12 @@ raw annotation, rasterised at 2.5 cm with CMP's z-order: mean IoU of the labels,
 elements, lost and fused (output elements covering two or more), for the spec solved at the
 input's size and for the grammar derived at it. Skips, saying so, when the data is not there.
 
-``--stages [--seeds A-B] [--cmp]``: where infer's 1x fidelity goes, stage by stage (mean
+``--stages [--seeds A-B] [--defects] [--cmp]``: where infer's 1x fidelity goes, stage by stage (mean
 per-label IoU against the annotation of the snapped, the regularised, the structured
 layout and the spec solved, and the labels that lose most), beside the snapping noise
 floor: the annotation's edges snapped (``tiling.snap_and_count``) at 0.5% and 1% of the
-façade and nothing else, on the generated family (seeds 1-24 unless given) or CMP.
+façade and nothing else, on the generated family (seeds 1-24 unless given; ``--defects``:
+with its defects) or CMP.
 """
 
 from __future__ import annotations
@@ -156,7 +157,7 @@ def stages() -> None:
             paths = []
             for seed in seeds:
                 paths.append(Path(folder) / f"family-{seed}.xml")
-                paths[-1].write_text(cmp_xml(family(seed)[0]))
+                paths[-1].write_text(cmp_xml(family(seed, "--defects" in sys.argv)[0]))
         for path in paths:
             tidied = tidy_layout(path, options, Deadline())
             inferred = infer(path, path.stem, options)
