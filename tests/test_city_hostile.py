@@ -322,6 +322,7 @@ def test_a_run_cleans_what_a_killed_run_left_and_nothing_else(
         (out, ".town.glb.", ".tmp"),
         (out, ".town.city.json.", ".objects"),
         (out, ".town.city.json.", ".vertices"),
+        (out, ".town.city.json.", ".ids"),
         (out, ".town.report.json.", ".tmp"),
         (out / "buildings", ".b0.glb.", ".tmp"),  # where runs before the shards wrote
         (out / "buildings" / shard("b0"), ".b0.glb.", ".tmp"),

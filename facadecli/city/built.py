@@ -83,6 +83,6 @@ class BuiltCity:
 
     def features(self) -> Iterator[dict[str, Any]]:
         """The CityJSON features of the buildings built, an outline's parts as one."""
-        ids = [task.footprint.id for task in self.ok()]
+        ids = (task.footprint.id for task in self.ok())  # a pass: none held
         found = outlines(self.found.footprints, self.replaced, ids)
         return grouped((feature(task) for task in self.ok()), found)

@@ -23,12 +23,14 @@ same bytes. Key order is fixed by construction, so the same input gives the same
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import itertools
 import json
 import math
 import os
 import shutil
 import tempfile
+from array import array
 from collections import Counter, deque
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -195,14 +197,14 @@ def building_with_parts(outline: Outline, features: Sequence[dict[str, Any]]) ->
 
 
 def outlines(
-    footprints: Iterable[Footprint], replaced: dict[str, list[str]], written: Sequence[str]
+    footprints: Iterable[Footprint], replaced: dict[str, list[str]], written: Iterable[str]
 ) -> list[Outline]:
     """The outlines with parts (``replaced``: outline id -> its parts' ids, a part in
     several outlines belonging to the first by id) of which a part is among the
-    features ``written`` (ids, in their order): their typed tags, and their members in
-    that order."""
+    features ``written`` (ids, in their order, taken as they come: only the places of
+    outlines and parts are kept): their typed tags, and their members in that order."""
     parent = outline_of(replaced)
-    order = {key: index for index, key in enumerate(written)}
+    order = {key: index for index, key in enumerate(written) if key in parent or key in replaced}
     by_id = {footprint.id: footprint for footprint in footprints}
     found = []
     for key in sorted(replaced):
@@ -332,13 +334,14 @@ class CityJSONWriter:
     def __init__(self, path: str | Path, crs: str, origin: tuple[float, float], name: str):
         self.path = Path(path)
         self.header = cityjson_header(crs, origin, name)
-        self._ids: set[str] = set()
+        self._objects_written = 0
         self._count = 0
         self._extent = _Extent()
         self._stack = contextlib.ExitStack()
         try:
             self._objects = self._spool(".objects")
             self._vertices = self._spool(".vertices")
+            self._ids = Ids(self._spool(".ids"))
         except BaseException:
             self._stack.close()
             raise
@@ -352,12 +355,12 @@ class CityJSONWriter:
         return self._stack.enter_context(os.fdopen(fd, "w+b"))
 
     def add(self, feature: dict[str, Any]) -> None:
-        """Append one building's feature; ValueError for an id already written."""
+        """Append one building's feature (two CityObjects with one id are refused when
+        the document is assembled: :meth:`close`)."""
         for key, value in feature["CityObjects"].items():
-            if key in self._ids:
-                raise ValueError(f"two CityObjects with the id '{key}'")
             self._ids.add(key)
-            self._objects.write(b"," if len(self._ids) > 1 else b"")
+            self._objects.write(b"," if self._objects_written else b"")
+            self._objects_written += 1
             self._objects.write(cityjson_bytes({key: _shifted(value, self._count)})[1:-1])
         for point in feature["vertices"]:
             self._vertices.write(b"," if self._count else b"")
@@ -366,8 +369,12 @@ class CityJSONWriter:
         self._extent.add(feature["vertices"])
 
     def close(self) -> None:
-        """Assemble the document into ``path`` and remove the temporary files."""
+        """Assemble the document into ``path`` and remove the temporary files; ValueError
+        (and no document) for two CityObjects with one id, the first such id named."""
         try:
+            twice = self._ids.repeated()
+            if twice is not None:
+                raise ValueError(f"two CityObjects with the id '{twice}'")
             header = dict(self.header)
             header["metadata"] = self._extent.metadata(header)
             head = cityjson_bytes(header)[:-1]
@@ -384,7 +391,7 @@ class CityJSONWriter:
     def _copy(spool: BinaryIO, out: BinaryIO) -> None:
         spool.flush()
         spool.seek(0)
-        shutil.copyfileobj(spool, out, 1 << 20)
+        shutil.copyfileobj(spool, out, 1 << 16)
 
     def __enter__(self) -> CityJSONWriter:
         return self
@@ -399,6 +406,45 @@ class CityJSONWriter:
             self.close()
         else:
             self._stack.close()
+
+
+class Ids:
+    """The CityObject ids of a streamed document, to find one written twice in flat
+    memory: each id is kept as an 8-byte digest (where a set of the ids takes a hundred
+    bytes an id) and as a line of ``spool`` (a temporary file), read again only for the
+    few digests that repeat, to tell a repeated id from two ids sharing a digest."""
+
+    def __init__(self, spool: BinaryIO):
+        self._spool = spool
+        self._digests = array("Q")
+
+    def add(self, key: str) -> None:
+        self._digests.append(_digest(key))
+        self._spool.write(json.dumps(key).encode("ascii") + b"\n")
+
+    def repeated(self) -> str | None:
+        """The first id (in the order added) added before, None when each came once."""
+        ordered = np.frombuffer(self._digests, dtype=np.uint64)
+        ordered.sort()  # in place: the digests are not needed in their order
+        shared = set(ordered[1:][ordered[1:] == ordered[:-1]].tolist())
+        if not shared:
+            return None
+        self._spool.flush()
+        self._spool.seek(0)
+        seen: set[str] = set()
+        for line in self._spool:
+            key: str = json.loads(line)
+            if _digest(key) in shared:
+                if key in seen:
+                    return key
+                seen.add(key)
+        return None
+
+
+def _digest(key: str) -> int:
+    return int.from_bytes(
+        hashlib.blake2b(key.encode("utf-8", "surrogatepass"), digest_size=8).digest(), "big"
+    )
 
 
 def _unlink(name: str) -> None:

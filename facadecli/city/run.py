@@ -666,7 +666,7 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
     plain = re.escape(name)
     patterns = {
         outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda)"
-        rf"{_RANDOM}(?:tmp|bin|objects|vertices)",
+        rf"{_RANDOM}(?:tmp|bin|objects|vertices|ids)",
         outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
         outdir / TILESET_FOLDER: rf"\.tileset\.json{_RANDOM}tmp",

@@ -34,11 +34,12 @@ are removed. The same buildings give the same bytes.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import math
 import os
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -50,7 +51,7 @@ import trimesh
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.lods import dressed, feature_of, lod_meshes, roof_depth
 from facadecli.errors import SpecError
-from facadecli.export.atomic import write_atomic
+from facadecli.export.atomic import atomic_output, write_atomic
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.instancing import EXTENSION, node_matrix, placements
@@ -137,7 +138,10 @@ class Square:
     lods: tuple[int, ...] = ()  # the levels of detail of its tiles, coarse first
     left: int = 0  # its buildings not done yet
     tiles: list[dict[str, Any]] = field(default_factory=list)  # its chain, coarse first
-    box: Box | None = None  # of its content and its children's
+    box: Box | None = None  # of its content; and its children's, once spanned (_span)
+    # the largest of its children's errors, once spanned; None when none of its
+    # buildings was built
+    below: float | None = None
 
 
 Centroids = Sequence[tuple[str, tuple[float, float]]]  # building ids and their centroids
@@ -274,23 +278,35 @@ class TilesetWriter:
 
     def close(self, name: str) -> dict[str, Any]:
         """Write ``tileset.json`` (and remove tiles an earlier run left that it does not
-        name); returns what the report says of the tiles."""
-        root = self._tile(self.root, covered=False)
-        if root is not None:
-            _lift(root, None)
-        if root is None:  # no building built: an empty tileset, placed all the same
-            root = {"boundingVolume": {"box": _box((0.0, 0.0, 0.0, 1.0, 1.0, 1.0))}}
-            root.update(geometricError=0.0, refine="REPLACE")
-        root = {"transform": ecef_transform(self.georef), **root}
+        name); returns what the report says of the tiles. The file is written as its
+        text is made, a tile at a time from the squares' spans (:meth:`_span`): no tile's
+        JSON is held but those on the way from the root to the one written."""
+        top = self._span(self.root, covered=False)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self._remove_stale()
+        transform = {"transform": ecef_transform(self.georef)}
+        if top is None:  # no building built: an empty tileset, placed all the same
+            empty: dict[str, Any] = {
+                **transform,
+                "boundingVolume": {"box": _box((0.0, 0.0, 0.0, 1.0, 1.0, 1.0))},
+                "geometricError": 0.0,
+                "refine": "REPLACE",
+            }
+            root = functools.partial(_spliced, empty, None)
+            error = 0.0
+        else:
+            root = functools.partial(self._tile, self.root, False, None, transform)
+            error = top[1]
         tileset = {
             "asset": {"version": "1.1", "generator": "facadecli"},
             "extras": {"name": name, "georeference": georeference(self.georef)},
-            "geometricError": root["geometricError"],
-            "root": root,
+            "geometricError": error,
+            "root": _MARK,
         }
-        self.folder.mkdir(parents=True, exist_ok=True)
-        self._remove_stale()
-        write_atomic(self.folder / "tileset.json", json.dumps(tileset, indent=1) + "\n")
+        with atomic_output(self.folder / "tileset.json") as out:
+            for chunk in _batched(_spliced(tileset, root, 0)):
+                out.write(chunk)
+            out.write(b"\n")
         return {
             "tileset": f"{FOLDER}/tileset.json",
             "lods": list(self.lods),
@@ -299,45 +315,72 @@ class TilesetWriter:
             "bytes": {f"lod{k}": v for k, v in self.bytes.items()},
         }
 
-    def _tile(self, square: Square, covered: bool) -> dict[str, Any] | None:
-        """The square's tile: its chain of content, coarse first, each the only child of
-        the one before, its children's tiles under the last; or, without content, a tile
-        holding its children's. None when none of its buildings was built. ``covered``:
-        a square above has content."""
+    def _span(self, square: Square, covered: bool) -> tuple[Box, float] | None:
+        """The square's tile as its parent sees it: its box (as written, widened) and
+        its geometric error, before :meth:`_tile` raises an error under content; None
+        when none of its buildings was built. What :meth:`_tile` needs again is kept in
+        the square, in place of what it held (``box``: its content's and its children's
+        now; ``below``: their largest error). ``covered``: a square above has content."""
         below = covered or bool(square.tiles)
-        children = [t for child in square.children if (t := self._tile(child, below))]
-        if not children and not square.tiles:
+        found = [span for child in square.children if (span := self._span(child, below))]
+        square.below = None
+        if not found and not square.tiles:
             return None
-        boxes = [_unbox(tile["boundingVolume"]["box"]) for tile in children]
-        box = _union([*boxes, *([square.box] if square.box is not None else [])])
-        error = max((t["geometricError"] for t in children), default=0.0)
-        if not square.tiles:  # no content: all of it missing, unless a square above has
-            # content (then its error is raised to that one's, by _lift)
-            if not covered:
-                lo, hi = np.array(box[:3]), np.array(box[3:])
-                error = max(float(np.linalg.norm(hi - lo)), 2 * error)
-            return {
-                "boundingVolume": {"box": _box(box)},
-                "geometricError": round(error, 3),
-                "refine": "REPLACE",
-                "children": children,
-            }
-        tile: dict[str, Any] = {}
-        for entry in reversed(square.tiles):
-            error = max(error, entry["error"])  # at least what the finer tiles get wrong
-            above: dict[str, Any] = {
-                "boundingVolume": {"box": _box(box)},
-                "geometricError": round(error, 3),
+        own = [square.box] if square.box is not None else []
+        square.box = _union([*(box for box, _ in found), *own])
+        square.below = max((error for _, error in found), default=0.0)
+        return _unbox(_box(square.box)), _errors(square, covered)[0]
+
+    def _tile(
+        self,
+        square: Square,
+        covered: bool,
+        ceiling: float | None,
+        first: dict[str, Any],
+        depth: int,
+    ) -> Iterator[str]:
+        """The JSON text of the square's tile at ``depth`` (json.dumps' indent of one):
+        its chain of content, coarse first, each the only child of the one before, its
+        children's tiles under the last; or, without content, a tile holding its
+        children's. A tile without content under one with content (``ceiling``, its
+        error) takes that one's error: a viewer that refined it goes on through it to the
+        content below (with a smaller error it would stop there, and draw nothing).
+        ``first``: keys the tile starts with (the root's transform)."""
+        assert square.box is not None
+        box = _box(square.box)
+        below = covered or bool(square.tiles)
+        shown = [child for child in square.children if child.below is not None]
+        errors = _errors(square, covered)
+        if not square.tiles:
+            error = errors[0] if ceiling is None else ceiling
+            tile = {**first, "boundingVolume": {"box": box}, "geometricError": error}
+            tile.update(refine="REPLACE", children=_MARK)
+            yield from _spliced(tile, self._children(shown, below, ceiling), depth)
+            return
+        chain = [
+            {
+                **(first if number == 0 else {}),
+                "boundingVolume": {"box": box},
+                "geometricError": error,
                 "refine": "REPLACE",
                 "content": {"uri": entry["uri"]},
+                **({"children": _MARK} if number + 1 < len(errors) or shown else {}),
             }
-            if children:
-                above["children"] = children
-            children, tile = [above], above
-        return tile
+            for number, (entry, error) in enumerate(zip(square.tiles, errors, strict=True))
+        ]
+        last = chain[-1]
+        finest = self._children(shown, below, last["geometricError"]) if shown else None
+        yield from _chained(chain, finest, depth)
+
+    def _children(
+        self, squares: list[Square], covered: bool, ceiling: float | None
+    ) -> Callable[[int], Iterator[str]]:
+        """The JSON list of the squares' tiles, at the depth it is given."""
+        tiles = [functools.partial(self._tile, child, covered, ceiling, {}) for child in squares]
+        return functools.partial(_listed, tiles)
 
     def _remove_stale(self) -> None:
-        for folder, _, files in sorted(os.walk(self.folder)):
+        for folder, _, files in os.walk(self.folder):  # a folder at a time, none held
             for file in files:
                 path = Path(folder) / file
                 if TILE_FILE.fullmatch(file) and path not in self.written:
@@ -345,15 +388,76 @@ class TilesetWriter:
                         path.unlink()
 
 
-def _lift(tile: dict[str, Any], ceiling: float | None) -> None:
-    """Content-less tiles under a tile with content take that tile's error: a viewer
-    that refined it goes on through them to the content below (with a smaller error it
-    would stop at them, and draw nothing there)."""
-    if "content" not in tile and ceiling is not None:
-        tile["geometricError"] = ceiling
-    below = tile["geometricError"] if "content" in tile else ceiling
-    for child in tile.get("children", []):
-        _lift(child, below)
+_MARK = "\0tiles\0"  # where a tile's children's JSON goes in its own (:func:`_spliced`)
+Text = Callable[[int], Iterator[str]]  # JSON text at a depth: a tile, a list of them
+
+
+def _errors(square: Square, covered: bool) -> list[float]:
+    """The geometric errors of the square's tiles (its chain, coarse first; or its one
+    tile without content) before a tile above with content raises the latter's: each at
+    least its children's (``below``); without content, all of it missing (the diagonal
+    of its box, at least twice its children's) unless ``covered``."""
+    assert square.box is not None and square.below is not None
+    box, error = square.box, square.below
+    if not square.tiles:
+        if not covered:
+            lo, hi = np.array(box[:3]), np.array(box[3:])
+            error = max(float(np.linalg.norm(hi - lo)), 2 * error)
+        return [round(error, 3)]
+    errors = []
+    for entry in reversed(square.tiles):
+        error = max(error, entry["error"])  # at least what the finer tiles get wrong
+        errors.append(round(error, 3))
+    return errors[::-1]
+
+
+def _chained(chain: list[dict[str, Any]], finest: Text | None, depth: int) -> Iterator[str]:
+    """A square's chain of tiles at ``depth``, each the only child of the one before,
+    ``finest`` (its children's tiles) under the last."""
+    if len(chain) == 1:
+        yield from _spliced(chain[0], finest, depth)
+        return
+    rest = functools.partial(_chained, chain[1:], finest)
+    yield from _spliced(chain[0], functools.partial(_listed, [rest]), depth)
+
+
+def _spliced(value: dict[str, Any], inner: Text | None, depth: int) -> Iterator[str]:
+    """``value``'s text as ``json.dumps(..., indent=1)`` writes it at ``depth``, with the
+    text ``inner`` makes where it holds _MARK (one place at most)."""
+    text = json.dumps(value, indent=1).replace("\n", "\n" + " " * depth)
+    if inner is None:
+        yield text
+        return
+    before, after = text.split(json.dumps(_MARK), 1)
+    yield before
+    yield from inner(depth + 1)
+    yield after
+
+
+def _listed(items: Sequence[Text], depth: int) -> Iterator[str]:
+    """A JSON list of ``items`` at ``depth`` (json.dumps' indent of one)."""
+    if not items:
+        yield "[]"
+        return
+    inside = "\n" + " " * (depth + 1)
+    for number, item in enumerate(items):
+        yield ("[" if number == 0 else ",") + inside
+        yield from item(depth + 1)
+    yield "\n" + " " * depth + "]"
+
+
+def _batched(chunks: Iterable[str], size: int = 1 << 16) -> Iterator[bytes]:
+    """The text's pieces as UTF-8 bytes, gathered into writes of about ``size``."""
+    held: list[str] = []
+    length = 0
+    for chunk in chunks:
+        held.append(chunk)
+        length += len(chunk)
+        if length >= size:
+            yield "".join(held).encode("utf-8")
+            held, length = [], 0
+    if held:
+        yield "".join(held).encode("utf-8")
 
 
 def _lod_scene(

@@ -29,6 +29,12 @@ building before and after the C heap's freed memory is given back to the system
 (glibc's ``malloc_trim``): what is freed but not returned, not held. Tracing slows the
 client and its bookkeeping is in the resident figures: compare traced runs with traced.
 
+The final step, from the last building to the report written, is traced in every run
+(:class:`FinalStep`): the client's resident peak over it (sampled from ``/proc``), and
+each writer's (merged models, 3D Tiles, USD, CityJSON, report): its resident peak and
+the peak of Python's allocations made while it writes (tracemalloc, from the last
+building on). A run whose buildings were all kept by ``--resume`` traces it too.
+
 A run of 100,000 buildings takes about an hour of a quiet 2-core machine. With
 ``FACADE_BENCH_DIR`` the town and its output are kept in that folder, not a temporary
 one, so a run that is stopped (Ctrl-C, ``kill``, the end of a working day) goes on where
@@ -56,8 +62,11 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import tracemalloc
+from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -103,6 +112,92 @@ def _resident_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
+class FinalStep:
+    """The memory of a run's final step, from its last building to its report written
+    (the merged models, 3D Tiles, USD stage, CityJSON and report): the client's resident
+    peak over it (``/proc``, sampled every SAMPLE seconds by a thread), and, for each of
+    the writers of ``CITY_WRITERS`` and the report, the peak of Python's allocations made
+    while it writes (tracemalloc, started at the last building: what the writer holds at
+    once, not what the run held before it), and its resident peak."""
+
+    SAMPLE = 0.02
+
+    def __init__(self) -> None:
+        self.started = False
+        self.rows: dict[str, dict[str, float]] = {}
+        self.high = self.overall = self.at_start = self.base = 0.0
+        self.stopping = threading.Event()
+        self.thread = threading.Thread(target=self._sample, daemon=True)
+
+    def _sample(self) -> None:
+        while not self.stopping.wait(self.SAMPLE):
+            resident = _resident_mib()
+            self.high, self.overall = max(self.high, resident), max(self.overall, resident)
+
+    def watch(self) -> None:
+        """Each city writer measured while it writes, and the report with them."""
+        from facadecli.city.report import CityReport
+        from facadecli.export import CITY_WRITERS
+
+        for name, writer in list(CITY_WRITERS.items()):
+            CITY_WRITERS[name] = replace(writer, write=self._measured(name, writer.write))
+        CityReport.chunks = self._measured_chunks(CityReport.chunks)  # type: ignore[method-assign]
+
+    def _measured(self, name: str, write: Any) -> Any:
+        def measured(built: Any) -> Any:
+            if not self.started:  # every building kept by --resume: none ended here
+                self.start()
+            self._begin()
+            try:
+                return write(built)
+            finally:
+                self._end(name)
+
+        return measured
+
+    def _measured_chunks(self, chunks: Any) -> Any:
+        final = self
+
+        def measured(report: Any) -> Iterator[str]:
+            final._begin()
+            try:
+                yield from chunks(report)
+            finally:
+                final._end("report")
+
+        return measured
+
+    def _begin(self) -> None:
+        if self.started:
+            tracemalloc.reset_peak()
+            self.base = tracemalloc.get_traced_memory()[0]
+            self.high = _resident_mib()
+
+    def _end(self, name: str) -> None:
+        if self.started:
+            peak = tracemalloc.get_traced_memory()[1] - self.base
+            self.high = max(self.high, _resident_mib())
+            self.rows[name] = {"traced_peak": peak, "resident_peak_mib": self.high}
+            self.overall = max(self.overall, self.high)
+
+    def start(self) -> None:
+        """At the last building: the final step begins."""
+        if not tracemalloc.is_tracing():
+            tracemalloc.start()
+        self.started = True
+        self.overall = self.high = _resident_mib()
+        self.at_start = self.overall
+        self.thread.start()
+
+    def stop(self) -> dict[str, Any]:
+        if not self.started:
+            return {}
+        self.stopping.set()
+        self.thread.join()
+        self.overall = max(self.overall, _resident_mib())
+        return {"at_start_mib": self.at_start, "peak_mib": self.overall, "writers": self.rows}
+
+
 def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
     """A city run in this process; its resource use written to ``figures``: its peak, and
     its resident memory when the first building ends (read, planned, the axes solved) and
@@ -133,8 +228,11 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
             resident["all_built_mib"] = _resident_mib()
             if TRACED:
                 resident["all_built_returned_mib"] = _returned_mib()
+            final.start()
 
     lods = parse_lods(os.environ.get("FACADE_BENCH_LODS", "1,2,3"))
+    final = FinalStep()
+    final.watch()
     resume = out.exists()  # a stopped run's output (FACADE_BENCH_DIR): go on from there
     report = run_city(
         load_city(manifest),
@@ -145,6 +243,7 @@ def client(manifest: Path, out: Path, jobs: int, figures: Path) -> None:
         merged_lod=max(lods),  # FACADE_BENCH_LODS=1: blocks alone, no façade solved
         resume=resume,
     )
+    resident["final"] = final.stop()
     own = resource.getrusage(resource.RUSAGE_SELF)
     workers = resource.getrusage(resource.RUSAGE_CHILDREN)
     summary = report["summary"]
@@ -258,6 +357,23 @@ def _traced_lines(row: dict[str, Any], count: int) -> list[str]:
     return lines
 
 
+def _final_lines(final: dict[str, Any], count: int) -> list[str]:
+    """What :class:`FinalStep` found: the final step's resident peak, each writer's."""
+    if not final:
+        return []
+    lines = [
+        f"  final step: resident {final['at_start_mib']:.0f} MiB at its start, peak "
+        f"{final['peak_mib']:.0f} MiB (+{final['peak_mib'] - final['at_start_mib']:.0f})"
+    ]
+    for name, row in final["writers"].items():
+        lines.append(
+            f"    {name}: traced peak {row['traced_peak'] / 2**20:.1f} MiB "
+            f"({row['traced_peak'] / count:.0f} B a building), resident peak "
+            f"{row['resident_peak_mib']:.0f} MiB"
+        )
+    return lines
+
+
 def _size(path: Path) -> int:
     if path.is_file():
         return path.stat().st_size
@@ -338,6 +454,7 @@ def _figures(
         f"  client memory: {last.get('first_built_mib', 0):.0f} MiB at the first building "
         f"built, {last.get('all_built_mib', 0):.0f} MiB at the last",
         *_traced_lines(last, count),
+        *_final_lines(last.get("final", {}), count),
         "  outputs: "
         + ", ".join(f"{key} {size / 2**20:.1f} MiB" for key, size in sizes.items() if size),
     ]
