@@ -504,7 +504,8 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   placeStreetParts(treesAt, dashes, place);
   document.body.dataset.ground = JSON.stringify({
     paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
-    grass: share(counts[3]), cell, trees: treesAt.map(at => place(at).map(v => +v.toFixed(2))),
+    grass: share(counts[3]), cell, area: +(columns * rows * cell * cell).toFixed(1),
+    trees: treesAt.map(at => place(at).map(v => +v.toFixed(2))),
     dashes: dashes.length});
   uses.regions.value.dispose();
   uses.regions.value = regionsPicture(data, wide, deep);
