@@ -287,6 +287,7 @@ scene.environment = daylight.environment;
 // as the horizon drops, so the top of such a picture is sky (pale at the haze, bluer
 // above), where it was the haze below the sky's horizon.
 const SKY_STRETCH = 3;
+let lowHorizon = false;  // a district seen from above (light); a façade's is at eye level
 const backdrop = new THREE.Scene();
 const dome = new THREE.Mesh(new THREE.SphereGeometry(1, 64, 32), new THREE.ShaderMaterial({
   uniforms: {sky: {value: daylight.backdrop}, horizon: {value: 0}, stretch: {value: 1}},
@@ -316,7 +317,8 @@ function placeBackdrop() {
   dome.scale.setScalar((camera.near + camera.far) / 2);
   dome.updateMatrixWorld();
   const high = Math.max(camera.position.y - ground.position.y, 0);
-  const horizon = -Math.asin(Math.min(1, high / Math.max(scene.fog.far, 1e-6)));
+  const horizon = !lowHorizon ? 0
+    : -Math.asin(Math.min(1, high / Math.max(scene.fog.far, 1e-6)));
   dome.material.uniforms.horizon.value = horizon;
   dome.material.uniforms.stretch.value =
     1 + (SKY_STRETCH - 1) * THREE.MathUtils.smoothstep(-horizon, 0.01, 0.1);
@@ -1032,7 +1034,8 @@ function light(model) {
   // to the frame; but not short of the district's far corners (its buildings stand on
   // their streets, clear of the haze, the sky over them)
   const topEdge = (or(up, rise) - camera.fov / 2) * Math.PI / 180;
-  if (district && topEdge > 0) {
+  lowHorizon = district && topEdge > 0;
+  if (lowHorizon) {
     const seen = direction(or(around, SEEN_FROM), or(up, rise));
     const framed = fitBox(points, centre, seen, SKY_BAND);
     const eyeAt = framed.aim.clone().addScaledVector(seen, framed.distance);

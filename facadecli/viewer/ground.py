@@ -15,6 +15,9 @@ from __future__ import annotations
 #   street runs on ROOM metres past it (a wide street or the town's edge), then a kerb
 #   KERB wide, then asphalt; the land round the district is such a street, to the haze;
 # - a yard has a path YARD_PATH wide along its walls, then grass;
+# - a street's asphalt reaches ROAD_HALF[1] metres from the walls at most (the middle of
+#   a street 24 m wide); open ground farther out is a paved square (a green by distance
+#   alone, among the buildings, drew slivers of lawn along the plan's rows and columns);
 # - a tree every TREE_EVERY metres or more along the wide pavements, TREE_LINE metres from
 #   the walls; a dash DASH metres long every DASH_EVERY metres along a street's centre (the
 #   ridge of the distance to its walls), where the street is ROAD_HALF metres from its walls.
@@ -117,7 +120,8 @@ function groundKinds(building, columns, rows, cell) {
       wide[at] = roomy(near, columns, rows, cell, at) ? 1 : 0;
     }
     const kerb = wide[at] ? WIDE_PAVEMENT : PAVEMENT;
-    kinds[at] = metres < kerb ? 1 : metres < kerb + KERB ? 2 : 3;
+    // past the middle of the widest street: a paved square
+    kinds[at] = metres < kerb ? 1 : metres < kerb + KERB ? 2 : metres <= ROAD_HALF[1] ? 3 : 1;
   }
   return {kinds, near, street, wide};
 }
