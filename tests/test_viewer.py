@@ -483,7 +483,7 @@ def test_a_lit_wall_keeps_its_colours_hue_and_saturation(tmp_path: Path) -> None
 def test_the_page_lights_the_model_by_the_sky_it_shows() -> None:
     """One sky is the backdrop and, prefiltered, the light and what glass mirrors; the sun
     that casts the shadows shines from the direction of the sky's sun (its disc and glow)."""
-    assert "scene.background = daylight.backdrop;" in VIEWER
+    assert "uniforms: {sky: {value: daylight.backdrop}" in VIEWER  # the backdrop's dome
     assert "scene.environment = daylight.environment;" in VIEWER
     assert VIEWER.count("sunDirection") >= 4  # the disc, the glow, the clouds' light, the sun
 
@@ -635,26 +635,106 @@ def test_a_districts_street_view_looks_at_windows_from_a_distance(
     assert sum(street["open"]) > 0.5 * houses, street
 
 
-@pytest.mark.slow
-@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-def test_a_districts_ground_has_streets_and_grass_and_a_hazy_horizon_from_35_degrees(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
-) -> None:
-    """A district's ground by its distance to the nearest building: paving along the
-    walls, a kerb, asphalt between the blocks, grass far from every building (it was one
-    grey paving); seen from 35° up, the top of the picture is the horizon's haze, one
-    even colour, where it was ground up to the frame."""
-
+def _sky_at_the_top(shot: Path) -> tuple[float, float]:
+    """The mean blue less red at the top of a screenshot (a thirtieth of its height), and
+    the share of the picture's lower half that is asphalt (darker than 70 of 255)."""
     from PIL import Image, ImageStat
 
+    with Image.open(shot) as image:
+        rgb = image.convert("RGB")
+        top = rgb.crop((0, 0, rgb.width, rgb.height // 30))
+        lower = rgb.convert("L").crop((0, rgb.height // 2, rgb.width, rgb.height))
+    red, _green, blue = ImageStat.Stat(top).mean
+    dark = sum(1 for value in lower.tobytes() if value < 70) / (lower.width * lower.height)
+    return blue - red, dark
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_districts_ground_has_streets_trees_and_a_sky_over_the_haze_from_35_degrees(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The demo district's ground: paving along the walls, a kerb, asphalt between the
+    blocks, no grass (every lot reaches a street; it was a lawn past the outer streets),
+    street trees and centre-line dashes; seen from 35° up, the top of the picture is the
+    sky's blue over the haze, where it was the haze's cream (blue less red about -13)."""
     manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
     shot, ground = _district_shown(capsys, tmp_path, manifest, "?bare&view=35,35", "ground")
-    assert ground["paving"] > 0.2 and ground["asphalt"] > 0.2  # of the district's box
-    assert 0 < ground["kerb"] < 0.1 and ground["grass"] > 0.01
-    with Image.open(shot) as image:
-        top = image.convert("RGB").crop((0, 0, image.width, image.height // 30))
-        lower = image.convert("RGB").crop((0, image.height // 2, image.width, image.height))
-    assert max(ImageStat.Stat(top).stddev) < 2.0  # the haze, no ground's texture
-    pixels = list(zip(*(iter(lower.tobytes()),) * 3, strict=True))
-    green = sum(1 for r, g, b in pixels if g > r + 4 and g > b + 4) / len(pixels)
-    assert green > 0.05  # grass round the district
+    assert ground["paving"] > 0.1 and ground["asphalt"] > 0.3  # of the district's box
+    assert 0 < ground["kerb"] < 0.1 and ground["grass"] < 0.01
+    assert len(ground["trees"]) >= 10 and ground["dashes"] >= 10
+    blue, asphalt = _sky_at_the_top(shot)
+    assert blue > 4  # the sky over the horizon
+    assert asphalt > 0.2  # the streets round the district
+
+
+def _courtyard_block(folder: Path) -> tuple[Path, list[Any], Any]:
+    """Generated footprints (metres, a projected CRS) of blank-walled buildings: a closed
+    perimeter block 44 m square round a 20 m courtyard, a bar 16 m south of it across a
+    street, and a lone building 40 m east across an open square. Returns the manifest,
+    the footprints (shapely) and the courtyard."""
+    from shapely.geometry import box
+
+    bars = {
+        "north": (0, 32, 44, 44), "south": (0, 0, 44, 12), "west": (0, 12, 12, 32),
+        "east": (32, 12, 44, 32), "across": (0, -28, 44, -16), "lone": (84, 0, 96, 12),
+    }  # fmt: skip
+    features = [
+        {
+            "type": "Feature",
+            "properties": {"osm_id": f"way/{key}", "building": "shed"},
+            "geometry": {
+                "type": "Polygon",
+                "coordinates": [
+                    [
+                        [100000 + x, 400000 + y]
+                        for x, y in ((x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0))
+                    ]
+                ],
+            },
+        }
+        for key, (x0, y0, x1, y1) in bars.items()
+    ]
+    folder.mkdir()
+    (folder / "footprints.geojson").write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}},
+                "features": features,
+            }
+        )
+    )
+    (folder / "blank.yaml").write_text(BLANK_SPEC)
+    manifest = folder / "district.yaml"
+    manifest.write_text(
+        "version: 1\nname: courtyard\nfootprints: footprints.geojson\n"
+        "defaults: {facade: blank.yaml, height: 9.0, floor_height: 3.0, roof: {type: flat}}\n"
+    )
+    footprints = [box(100000 + x0, 400000 + y0, 100000 + x1, 400000 + y1)
+                  for x0, y0, x1, y1 in bars.values()]  # fmt: skip
+    return manifest, footprints, box(100012, 400012, 100032, 400032)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
+def test_a_districts_grass_is_its_courtyard_and_its_trees_stand_on_pavements(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The ground by what each place is: the closed block's courtyard, which no street
+    reaches, is grass inside a 1 m path (18 m square, 324 m²); the open square and the
+    street are paved and asphalt, not grass (by the distance to the nearest building alone
+    the square was grass, over 1,000 m²); street trees stand on the pavements, at least
+    3 m from every wall and none in the courtyard; dashes run down the 16 m street."""
+    from shapely.geometry import Point
+
+    manifest, footprints, courtyard = _courtyard_block(tmp_path / "district")
+    _shot, ground = _district_shown(capsys, tmp_path, manifest, "?bare&view=35,35", "ground")
+    assert abs(ground["grass"] * ground["area"] - 324) < 30, ground
+    assert ground["asphalt"] > 0.15 and ground["paving"] > 0.3  # the square is paved
+    georef = json.loads((tmp_path / "city" / "courtyard.georef.json").read_text())
+    trees = [Point(georef["origin"][0] + x, georef["origin"][1] - z) for x, _, z in ground["trees"]]
+    assert len(trees) >= 8
+    assert all(min(f.distance(tree) for f in footprints) > 3.0 for tree in trees)
+    assert not any(courtyard.contains(tree) for tree in trees)
+    assert ground["dashes"] >= 3

@@ -17,6 +17,8 @@ from functools import cache
 from html import escape
 from importlib import resources
 
+from facadecli.viewer.ground import GROUND
+
 THREE_VERSION = "0.162.0"
 # specifier -> bundled file
 MODULES = {
@@ -276,8 +278,51 @@ function sky() {
 }
 const scene = new THREE.Scene();
 const daylight = sky();
-scene.background = daylight.backdrop;
 scene.environment = daylight.environment;
+// The backdrop: the sky's picture on a dome round the eye, drawn before the scene (a scene
+// of its own, out of the ambient occlusion's depth). Its horizon is where the ground is
+// lost in the haze (fog.far away): at eye level for an eye on the street, below it for an
+// eye high over a district, which at 30-35 degrees up looks down at its picture's top.
+// Above that horizon the sky's gradient, its elevations stretched up to SKY_STRETCH times
+// as the horizon drops, so the top of such a picture is sky (pale at the haze, bluer
+// above), where it was the haze below the sky's horizon.
+const SKY_STRETCH = 3;
+let lowHorizon = false;  // a district seen from above (light); a façade's is at eye level
+const backdrop = new THREE.Scene();
+const dome = new THREE.Mesh(new THREE.SphereGeometry(1, 64, 32), new THREE.ShaderMaterial({
+  uniforms: {sky: {value: daylight.backdrop}, horizon: {value: 0}, stretch: {value: 1}},
+  vertexShader: `varying vec3 vDirection;
+    void main() {
+      vDirection = position;
+      gl_Position = (projectionMatrix * modelViewMatrix * vec4(position, 1.0)).xyww;
+    }`,
+  fragmentShader: `uniform sampler2D sky; uniform float horizon, stretch;
+    varying vec3 vDirection;
+    #include <common>
+    void main() {
+      vec3 d = normalize(vDirection);
+      float up = (asin(clamp(d.y, -1.0, 1.0)) - horizon) * stretch;
+      vec2 uv = vec2(atan(d.z, d.x) * RECIPROCAL_PI2 + 0.5,
+                     clamp(up, -0.5 * PI, 0.5 * PI) * RECIPROCAL_PI + 0.5);
+      gl_FragColor = vec4(texture2D(sky, uv).rgb, 1.0);
+      #include <tonemapping_fragment>
+      #include <colorspace_fragment>
+    }`,
+  side: THREE.BackSide, depthTest: false, depthWrite: false}));
+dome.frustumCulled = false;
+backdrop.add(dome);
+// the dome round the camera, its horizon where the ground (at ground.position) fades out
+function placeBackdrop() {
+  dome.position.copy(camera.position);
+  dome.scale.setScalar((camera.near + camera.far) / 2);
+  dome.updateMatrixWorld();
+  const high = Math.max(camera.position.y - ground.position.y, 0);
+  const horizon = !lowHorizon ? 0
+    : -Math.asin(Math.min(1, high / Math.max(scene.fog.far, 1e-6)));
+  dome.material.uniforms.horizon.value = horizon;
+  dome.material.uniforms.stretch.value =
+    1 + (SKY_STRETCH - 1) * THREE.MathUtils.smoothstep(-horizon, 0.01, 0.1);
+}
 // placed by frame(): the model clear, the ground fading out into the horizon's haze
 scene.fog = new THREE.Fog(daylight.haze, 1, 2);
 const sun = new THREE.DirectionalLight(0xffffff, 3.4);  // white, as the sky's light is
@@ -317,14 +362,14 @@ const ground = new THREE.Mesh(  // takes the shadows; large enough to reach the 
 ground.receiveShadow = true;
 ground.visible = false;
 scene.add(ground);
-// A district's ground reads as streets: by its distance to the nearest building (the
-// district's plan, districtPlan's near), paving up to PAVEMENT metres from a wall, a
-// granite kerb KERB wide, asphalt out to GRASS_FROM metres (a street is narrower than
-// twice that), grass beyond (gardens, open ground, the fields round the district). A
-// picture of the plan's cells and a margin round it (its edge all grass, which the ground
-// takes on to the haze) says how much of each a place is (red paving, green asphalt,
-// blue grass, alpha the kerb), and the ground's shader mixes them; a façade's is all paving.
-const PAVEMENT = 2.5, KERB = 0.2, GRASS_FROM = 8;
+// A district's ground reads as a town's (facadecli.viewer.ground's GROUND): streets where
+// its open ground reaches the town round it (a pavement along the walls, a kerb, asphalt,
+// the land round the district a street too, to the haze), a path and grass in the yards
+// the streets do not reach, street trees on the wide pavements and dashes down the middle
+// of the streets. A picture of the plan's cells and a margin round it says how much of
+// each a place is (red paving, green asphalt, blue grass, alpha the kerb), and the
+// ground's shader mixes them; a façade's is all paving.
+const TOWN_PAVED = 40;  // metres past the plan's margin where the town is paved
 const uses = {regions: {value: null}, regionsFrom: {value: new THREE.Vector2(0, 0)},
               regionsSize: {value: new THREE.Vector2(1, 1)}};
 function regionsPicture(data, columns, rows) {
@@ -341,9 +386,15 @@ ground.material.onBeforeCompile = shader => {
     '#include <begin_vertex>',
     '#include <begin_vertex>\\nvGround = (modelMatrix * vec4(position, 1.0)).xz;');
   shader.fragmentShader = `uniform sampler2D regions; uniform vec2 regionsFrom, regionsSize;
+    #define TOWN_PAVED ${TOWN_PAVED.toFixed(1)}
     varying vec2 vGround;\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
     #include <map_fragment>
-    vec4 share = texture2D(regions, (vGround - regionsFrom) / regionsSize);
+    vec2 inPlan = (vGround - regionsFrom) / regionsSize;
+    vec4 share = texture2D(regions, inPlan);
+    // past the plan's margin the town's streets give way to its paved squares, out to
+    // the haze: the district stands in a town, not in a field or on a car park
+    vec2 past = (inPlan - clamp(inPlan, 0.0, 1.0)) * regionsSize;
+    share = mix(share, vec4(1.0, 0.0, 0.0, 0.0), smoothstep(0.0, TOWN_PAVED, length(past)));
     float speck = fract(sin(dot(floor(vGround * 5.0), vec2(12.9898, 78.233))) * 43758.5453);
     vec3 asphalt = vec3(0.042, 0.042, 0.045) * (0.9 + 0.2 * speck);
     vec3 grass = vec3(0.05, 0.075, 0.028) * (0.8 + 0.4 * speck);
@@ -352,33 +403,112 @@ ground.material.onBeforeCompile = shader => {
       / max(share.r + share.g + share.b, 1e-3);`);
 };
 ground.material.customProgramCacheKey = () => 'ground-regions';
+// The ground and what stands on it end where the haze has swallowed them (fog.far away),
+// so the sky's backdrop, its horizon there (placeBackdrop), shows over them
+function endsInHaze(material, more = shader => shader) {
+  material.onBeforeCompile = shader => {
+    more(shader);
+    shader.fragmentShader = shader.fragmentShader.replace('#include <fog_fragment>',
+      '#include <fog_fragment>\\n#ifdef USE_FOG\\nif (vFogDepth > fogFar) discard;\\n#endif');
+  };
+}
+endsInHaze(ground.material, ground.material.onBeforeCompile);
+// The street trees (a trunk and a crown, each one instanced mesh: two draw calls whatever
+// their number) and the centre-line dashes (one more), seeded: the same each time
+const TREE_TRUNK = 2.6;
+const trees = {
+  trunks: new THREE.InstancedMesh(
+    new THREE.CylinderGeometry(0.12, 0.17, TREE_TRUNK, 7).translate(0, TREE_TRUNK / 2, 0),
+    new THREE.MeshStandardMaterial({color: 0x4a3a2c, roughness: 0.95}), 1),
+  crowns: new THREE.InstancedMesh(
+    new THREE.IcosahedronGeometry(1, 1),
+    new THREE.MeshStandardMaterial({color: 0xffffff, roughness: 0.9, flatShading: true}), 1),
+  dashes: new THREE.InstancedMesh(
+    new THREE.PlaneGeometry(1, 1).rotateX(-Math.PI / 2),
+    new THREE.MeshStandardMaterial({color: 0xd8d6cc, roughness: 0.8, polygonOffset: true,
+                                    polygonOffsetFactor: -2, polygonOffsetUnits: -2}), 1),
+};
+for (const part of Object.values(trees)) {
+  endsInHaze(part.material);
+  part.count = 0; part.frustumCulled = false; part.receiveShadow = true;
+  scene.add(part);
+}
+trees.trunks.castShadow = trees.crowns.castShadow = true;
+const CROWN_GREENS = [0x3f5e2a, 0x4d6b30, 0x35522a, 0x56703a].map(c => new THREE.Color(c));
+function placeStreetParts(cells, dashes, place) {
+  const random = seeded(13), matrix = new THREE.Matrix4(), turn = new THREE.Quaternion();
+  const up = new THREE.Vector3(0, 1, 0), size = new THREE.Vector3(), at = new THREE.Vector3();
+  const grow = (mesh, count) => {
+    if (mesh.instanceMatrix.count >= count) return mesh;
+    const bigger = new THREE.InstancedMesh(mesh.geometry, mesh.material, count);
+    bigger.castShadow = mesh.castShadow; bigger.receiveShadow = true;
+    bigger.frustumCulled = false;
+    scene.remove(mesh); mesh.dispose(); scene.add(bigger);
+    return bigger;
+  };
+  trees.trunks = grow(trees.trunks, cells.length);
+  trees.crowns = grow(trees.crowns, cells.length);
+  trees.dashes = grow(trees.dashes, dashes.length);
+  cells.forEach((cell, index) => {
+    const [x, y, z] = place(cell);
+    const radius = 1.5 + 0.6 * random(), tall = 1.1 + 0.35 * random();
+    const height = 0.85 + 0.3 * random();
+    turn.setFromAxisAngle(up, random() * 2 * Math.PI);
+    matrix.compose(at.set(x, y, z), turn, size.set(1, height, 1));
+    trees.trunks.setMatrixAt(index, matrix);
+    matrix.compose(at.set(x, y + TREE_TRUNK * height + radius * tall * 0.7, z), turn,
+                   size.set(radius, radius * tall, radius));
+    trees.crowns.setMatrixAt(index, matrix);
+    trees.crowns.setColorAt(index, CROWN_GREENS[(random() * CROWN_GREENS.length) | 0]);
+  });
+  dashes.forEach(([cell, across, down], index) => {
+    const [x, y, z] = place(cell);
+    turn.setFromAxisAngle(up, Math.atan2(down, across));  // rows run to -z
+    matrix.compose(at.set(x, y, z), turn, size.set(DASH, 1, 0.12));
+    trees.dashes.setMatrixAt(index, matrix);
+  });
+  trees.trunks.count = trees.crowns.count = cells.length;
+  trees.dashes.count = dashes.length;
+  for (const part of Object.values(trees)) {
+    part.instanceMatrix.needsUpdate = true;
+    if (part.instanceColor) part.instanceColor.needsUpdate = true;
+  }
+}
 function groundRegions(model, box, district) {  // a model after another: its own ground
   uses.regions.value.dispose();
   uses.regions.value = allPaving();
   delete document.body.dataset.ground;
+  placeStreetParts([], [], null);
   const buildings = model.children.length;
   if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
-  const {cell, columns, rows, near} = districtPlan(model, box);
-  const margin = Math.ceil(GRASS_FROM / cell) + 2;  // its outer cells: grass
+  const {cell, columns, rows, building} = districtPlan(model, box);
+  const margin = Math.ceil(GROUND_MARGIN / cell);  // the town round the district
   const wide = columns + 2 * margin, deep = rows + 2 * margin;
+  const built = new Uint8Array(wide * deep);
+  for (let row = 0; row < rows; row++) for (let column = 0; column < columns; column++) {
+    if (building[row * columns + column]) built[(row + margin) * wide + column + margin] = 1;
+  }
+  const plan = groundKinds(built, wide, deep, cell);
   const data = new Uint8Array(wide * deep * 4), counts = [0, 0, 0, 0];
+  const channel = [0, 0, 3, 1, 2];  // building (as paving), pavement, kerb, asphalt, grass
   for (let row = 0; row < deep; row++) for (let column = 0; column < wide; column++) {
-    const x = Math.min(Math.max(column - margin, 0), columns - 1);
-    const y = Math.min(Math.max(row - margin, 0), rows - 1);
-    const out = Math.hypot(column - margin - x, row - margin - y);  // beyond the plan
-    const metres = (near[y * columns + x] + out) * cell;
-    const at = (row * wide + column) * 4;
-    if (metres < PAVEMENT + KERB) data[at] = 255; else if (metres < GRASS_FROM) data[at + 1] = 255;
-    else data[at + 2] = 255;
-    if (metres >= PAVEMENT && metres < PAVEMENT + KERB) data[at + 3] = 255;
-    if (row >= margin && row < margin + rows && column >= margin && column < margin + columns) {
-      counts[data[at + 3] ? 1 : data[at] ? 0 : data[at + 1] ? 2 : 3]++;  // within the plan
-    }
+    const at = row * wide + column, kind = plan.kinds[at];
+    data[at * 4 + channel[kind]] = 255;
+    if (kind === 2) data[at * 4] = 255;  // a kerb is paving, lighter
+    if (kind && row >= margin && row < margin + rows && column >= margin
+        && column < margin + columns) counts[kind - 1]++;  // within the plan
   }
   const share = count => Math.round(count / (columns * rows) * 1000) / 1000;
+  const x = column => box.min.x + (column - margin + 0.5) * cell;
+  const z = row => box.min.z + (rows + margin - row - 0.5) * cell;
+  const place = at => [x(at % wide), box.min.y, z(Math.floor(at / wide))];
+  const treesAt = treeCells(plan, wide, cell), dashes = dashCells(plan, wide, deep, cell);
+  placeStreetParts(treesAt, dashes, place);
   document.body.dataset.ground = JSON.stringify({
     paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
-    grass: share(counts[3]), cell});
+    grass: share(counts[3]), cell, area: +(columns * rows * cell * cell).toFixed(1),
+    trees: treesAt.map(at => place(at).map(v => +v.toFixed(2))),
+    dashes: dashes.length});
   uses.regions.value.dispose();
   uses.regions.value = regionsPicture(data, wide, deep);
   // the picture's row 0 is the plan's, at the district's +z edge (districtPlan)
@@ -411,7 +541,10 @@ let composer = null, occlusion = null;
 if (renderer.capabilities.isWebGL2) {
   const target = new THREE.WebGLRenderTarget(1, 1, {type: THREE.HalfFloatType, samples: 4});
   composer = new EffectComposer(renderer, target);
-  composer.addPass(new RenderPass(scene, camera));
+  composer.addPass(new RenderPass(backdrop, camera));
+  const drawn = new RenderPass(scene, camera);
+  drawn.clear = false;  // over the backdrop (which writes no depth)
+  composer.addPass(drawn);
   occlusion = new SteadyGTAOPass(scene, camera, 1, 1);
   occlusion.updateGtaoMaterial({samples: 16, distanceExponent: 1, thickness: 1, scale: 1});
   occlusion.updatePdMaterial(
@@ -431,7 +564,12 @@ function redraw() {
   requestAnimationFrame(() => {
     drawing = false;
     controls.update();
-    if (composer) composer.render(); else renderer.render(scene, camera);
+    placeBackdrop();
+    if (composer) { composer.render(); return; }
+    renderer.render(backdrop, camera);
+    renderer.autoClear = false;
+    renderer.render(scene, camera);
+    renderer.autoClear = true;
   });
 }
 controls.addEventListener('change', redraw);
@@ -516,8 +654,11 @@ function halfTangents() {
 // at (where its axis passes the centre's depth), the camera's distance from it, the
 // distance at which the points' picture would fill the view's height (high), and whether
 // it does (filled; else its width binds, and the view has room above and below it).
-function fitBox(points, centre, seen) {
+// headroom: the share of the view's height kept clear at its top (a district seen from
+// above: the sky over its horizon, see light)
+function fitBox(points, centre, seen, headroom = 0) {
   const [tanH, tanV] = halfTangents();
+  const tanTop = tanV * (1 - 2 * headroom);
   const forward = seen.clone().negate();
   const right = forward.clone().cross(new THREE.Vector3(0, 1, 0)).normalize();
   const upward = right.clone().cross(forward);
@@ -527,13 +668,13 @@ function fitBox(points, centre, seen) {
     offset.subVectors(point, centre);
     const x = offset.dot(right), y = offset.dot(upward), z = offset.dot(forward);
     rightmost = Math.max(rightmost, x - tanH * z); leftmost = Math.max(leftmost, -x - tanH * z);
-    top = Math.max(top, y - tanV * z); bottom = Math.max(bottom, -y - tanV * z);
+    top = Math.max(top, y - tanTop * z); bottom = Math.max(bottom, -y - tanV * z);
   }
-  const wide = (rightmost + leftmost) / (2 * tanH), high = (top + bottom) / (2 * tanV);
+  const wide = (rightmost + leftmost) / (2 * tanH), high = (top + bottom) / (tanTop + tanV);
+  const distance = Math.max(wide, high, 0.01);
   const aim = centre.clone().addScaledVector(right, (rightmost - leftmost) / 2)
-    .addScaledVector(upward, (top - bottom) / 2);
-  return {aim, distance: Math.max(wide, high, 0.01), high: Math.max(high, 0.01),
-          filled: high >= wide};
+    .addScaledVector(upward, (top - bottom + (tanV - tanTop) * distance) / 2);
+  return {aim, distance, high: Math.max(high, 0.01), filled: high >= wide};
 }
 // A person's eye above the ground, for the street-level view
 const EYE = 1.6;
@@ -729,24 +870,7 @@ function districtPlan(model, box) {
     building[at] = pixels[at * 4] * 256 + pixels[at * 4 + 1];
     height[at] = pixels[at * 4 + 2] / 255 * high;
   }
-  // each cell's distance to the nearest building, in cells (a two-pass chamfer, 1 and sqrt 2)
-  const near = new Float32Array(columns * rows).fill(Infinity);
-  for (let at = 0; at < columns * rows; at++) if (building[at]) near[at] = 0;
-  const pass = (from, to, step) => {
-    for (let row = from; row !== to; row += step) {
-      for (let column = step > 0 ? 0 : columns - 1; column >= 0 && column < columns;
-           column += step) {
-        const at = row * columns + column;
-        for (const [dx, dy, cost] of [[-step, 0, 1], [0, -step, 1], [-step, -step, Math.SQRT2],
-                                      [step, -step, Math.SQRT2]]) {
-          const x = column + dx, y = row + dy;
-          if (x < 0 || x >= columns || y < 0 || y >= rows) continue;
-          near[at] = Math.min(near[at], near[y * columns + x] + cost);
-        }
-      }
-    }
-  };
-  pass(0, rows, 1); pass(rows - 1, -1, -1);
+  const near = distanceField(building, columns, rows);  // in cells, Euclidean
   const openings = planOpenings(model, box, cell, columns, rows);
   return {cell, columns, rows, building, height, near, openings,
           x: column => box.min.x + (column + 0.5) * cell,
@@ -869,6 +993,7 @@ function fitSun(box, centre, radius) {
 }
 const SEEN_FROM = 35;  // degrees round from the front, unless ?view says otherwise
 const DISTRICT_RISE = 30;  // degrees up a district is seen from (a façade from 8.5)
+const SKY_BAND = 0.1;  // of a district's picture seen from above: sky at its top
 // What the camera frames (points): a model's box's eight corners; a district's, those of
 // each of its buildings' boxes (up to FRAMED_BUILDINGS of them), which hug the buildings
 // (the district's box has corners in the air over low houses, and framing those left the
@@ -904,15 +1029,26 @@ function light(model) {
   const haze = fit + 2 * radius;
   scene.fog.near = haze; scene.fog.far = 4 * haze;
   // a district seen from so high that the picture's top edge looks down at the ground
-  // (from 30° up, 10° down): the ground lost in the haze short of that edge, so the top of
-  // the picture is the horizon's haze, not ground to the frame; the haze is the ground's,
-  // the buildings stand clear of it
+  // (from 30° up, 10° down): the ground lost in the haze SKY_BAND of the picture's height
+  // under its top, so the top is sky over the haze's horizon (placeBackdrop), not ground
+  // to the frame; but not short of the district's far corners (its buildings stand on
+  // their streets, clear of the haze, the sky over them)
   const topEdge = (or(up, rise) - camera.fov / 2) * Math.PI / 180;
-  if (district && topEdge > 0) {
-    const eye = centre.y - box.min.y + fit * Math.sin(or(up, rise) * Math.PI / 180);
-    const depth = eye / Math.sin(topEdge) * Math.cos(camera.fov * Math.PI / 360);
-    scene.fog.near = Math.min(scene.fog.near, 0.5 * depth);
-    scene.fog.far = Math.min(scene.fog.far, 0.85 * depth);
+  lowHorizon = district && topEdge > 0;
+  if (lowHorizon) {
+    const seen = direction(or(around, SEEN_FROM), or(up, rise));
+    const framed = fitBox(points, centre, seen, SKY_BAND);
+    const eyeAt = framed.aim.clone().addScaledVector(seen, framed.distance);
+    const eye = eyeAt.y - box.min.y;
+    const fov = camera.fov * Math.PI / 180, fade = topEdge + SKY_BAND * fov;
+    const depth = eye / Math.sin(fade) * Math.cos(fov / 2 - SKY_BAND * fov);
+    let farthest = 0;  // the depth of the district's farthest corner on the ground
+    for (const corner of corners(box)) {
+      if (corner.y !== box.min.y) continue;
+      farthest = Math.max(farthest, eyeAt.clone().sub(corner).dot(seen));
+    }
+    scene.fog.far = Math.min(scene.fog.far, Math.max(depth, 1.1 * farthest));
+    scene.fog.near = Math.min(scene.fog.near, Math.max(0.6 * scene.fog.far, 0.9 * farthest));
     model.traverse(part => {
       if (part.isMesh) for (const material of materialsOf(part)) material.fog = false;
     });
@@ -954,8 +1090,11 @@ function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a 
     target = fit.aim; distance = fit.distance;
     camera.position.copy(fit.position);
   } else {
-    const seen = direction(or(around, SEEN_FROM), districtRise(points, centre, district, rise));
-    const fit = fitBox(points, centre, seen);
+    const elevation = districtRise(points, centre, district, rise);
+    const seen = direction(or(around, SEEN_FROM), elevation);
+    // from above, the sky over the district's horizon at the picture's top
+    const fit = fitBox(points, centre, seen,
+                       district && elevation > camera.fov / 2 ? SKY_BAND : 0);
     target = fit.aim;
     if (Number.isFinite(atX)) target.x = box.min.x + atX * size.x;
     if (Number.isFinite(atY)) target.y = box.min.y + atY * size.y;
@@ -994,6 +1133,7 @@ function show(id, keep = false) {  // keep: the camera where the user turned it,
 resize();
 window.facadeShow = show;  // for a page's own scripts (facade watch swaps the model)
 """
+VIEWER += GROUND  # the ground under a district (facadecli.viewer.ground)
 
 STYLE = (
     "body{margin:0;font-family:sans-serif;display:flex;height:100vh;background:#f4f4f4}"

@@ -1,0 +1,199 @@
+"""The ground under a district in the viewer, as a town has it: what each place of the
+district's plan is (a street, a pavement, a kerb, a back yard), the street trees and the
+road's centre-line dashes. Pure functions over the plan's grid (JavaScript, part of
+:data:`facadecli.viewer.VIEWER`); the page draws what they return."""
+
+from __future__ import annotations
+
+# The rules (docs/reference/materials.md, "The ground under a district"):
+# - every distance is Euclidean (distanceField), so a pavement rounds a building's corner;
+# - a place is street if it is reached from the town round the district (the plan's edge)
+#   through open ground at least PASSAGE metres from every building (a gap narrower than
+#   twice that, between two houses, is not a street), or lies within PASSAGE of such a
+#   place; elsewhere it is a yard (a courtyard, a back garden, a gap between houses);
+# - a street has a pavement PAVEMENT metres wide along its walls, WIDE_PAVEMENT where the
+#   street runs on ROOM metres past it (a wide street or the town's edge), then a kerb
+#   KERB wide, then asphalt; the land round the district is such a street, to the haze;
+# - a yard has a path YARD_PATH wide along its walls, then grass;
+# - a street's asphalt reaches ROAD_HALF[1] metres from the walls at most (the middle of
+#   a street 24 m wide); open ground farther out is a paved square (a green by distance
+#   alone, among the buildings, drew slivers of lawn along the plan's rows and columns);
+# - a tree every TREE_EVERY metres or more along the wide pavements, TREE_LINE metres from
+#   the walls; a dash DASH metres long every DASH_EVERY metres along a street's centre (the
+#   ridge of the distance to its walls), where the street is ROAD_HALF metres from its walls.
+GROUND = """
+const PAVEMENT = 2.5, WIDE_PAVEMENT = 4.5, KERB = 0.2, PASSAGE = 3, YARD_PATH = 1;
+const ROOM = 6, GROUND_MARGIN = 14;
+const TREE_LINE = 3.4, TREE_EVERY = 9, DASH = 3, DASH_EVERY = 7.5, ROAD_HALF = [3.5, 12];
+// The exact Euclidean distance of each cell of a grid (row by row, ``columns`` a row) to
+// the nearest cell set in ``seeds``, in cells: the lower envelope of parabolas
+// (Felzenszwalb and Huttenlocher), down each column, then along each row. A chamfer (steps
+// of 1 and the square root of 2) drew octagons round a building's corner.
+function distanceField(seeds, columns, rows) {
+  const FAR = 1e20, squared = new Float64Array(columns * rows);
+  for (let at = 0; at < columns * rows; at++) squared[at] = seeds[at] ? 0 : FAR;
+  const size = Math.max(columns, rows);
+  const f = new Float64Array(size), lowest = new Int32Array(size);
+  const from = new Float64Array(size + 1);
+  const line = (start, step, count) => {
+    for (let i = 0; i < count; i++) f[i] = squared[start + i * step];
+    let k = 0;
+    lowest[0] = 0; from[0] = -Infinity; from[1] = Infinity;
+    for (let q = 1; q < count; q++) {
+      let s;
+      for (;;) {
+        const p = lowest[k];
+        s = (f[q] + q * q - f[p] - p * p) / (2 * (q - p));
+        if (s > from[k]) break;
+        k--;
+      }
+      k++; lowest[k] = q; from[k] = s; from[k + 1] = Infinity;
+    }
+    k = 0;
+    for (let q = 0; q < count; q++) {
+      while (from[k + 1] < q) k++;
+      const p = lowest[k];
+      squared[start + q * step] = (q - p) * (q - p) + f[p];
+    }
+  };
+  for (let column = 0; column < columns; column++) line(column, columns, rows);
+  for (let row = 0; row < rows; row++) line(row * columns, 1, columns);
+  const distance = new Float32Array(columns * rows);
+  for (let at = 0; at < columns * rows; at++) distance[at] = Math.sqrt(squared[at]);
+  return distance;
+}
+// The cells reached from the grid's edge through cells whose ``near`` is at least ``least``
+// (four neighbours a cell): the open ground a street runs through.
+function reachedFromEdge(near, columns, rows, least) {
+  const reached = new Uint8Array(columns * rows), queue = new Int32Array(columns * rows);
+  let head = 0, tail = 0;
+  const visit = at => {
+    if (!reached[at] && near[at] >= least) { reached[at] = 1; queue[tail++] = at; }
+  };
+  for (let column = 0; column < columns; column++) {
+    visit(column); visit((rows - 1) * columns + column);
+  }
+  for (let row = 0; row < rows; row++) { visit(row * columns); visit(row * columns + columns - 1); }
+  while (head < tail) {
+    const at = queue[head++], column = at % columns;
+    if (column > 0) visit(at - 1);
+    if (column < columns - 1) visit(at + 1);
+    if (at >= columns) visit(at - columns);
+    if (at < (rows - 1) * columns) visit(at + columns);
+  }
+  return reached;
+}
+// Whether the street at ``at`` runs on ROOM metres past it, away from its nearest wall
+// (the way the distance grows): a wide street, or the open town round the district
+function roomy(near, columns, rows, cell, at) {
+  const column = at % columns, row = (at - column) / columns;
+  const value = (c, r) => c < 0 || c >= columns || r < 0 || r >= rows ? Infinity
+    : near[r * columns + c];
+  let dx = value(column + 2, row) - value(column - 2, row);
+  let dy = value(column, row + 2) - value(column, row - 2);
+  if (!Number.isFinite(dx) || !Number.isFinite(dy)) return true;  // at the grid's edge
+  const length = Math.hypot(dx, dy);
+  if (length < 1e-6) return false;  // on a ridge: the middle of a street
+  dx /= length; dy /= length;
+  const probe = ROOM / cell;
+  const there = value(Math.round(column + dx * probe), Math.round(row + dy * probe));
+  return there * cell >= near[at] * cell + ROOM - 1.5;
+}
+// What each cell of a grid is, the buildings' cells set in ``building``: 0 building,
+// 1 pavement (a path, in a yard), 2 kerb, 3 asphalt, 4 grass; and the distance to the
+// nearest building (metres), whether each is street, and whether its pavement is wide
+function groundKinds(building, columns, rows, cell) {
+  const near = distanceField(building, columns, rows);
+  const reached = reachedFromEdge(near, columns, rows, PASSAGE / cell);
+  const toStreet = distanceField(reached, columns, rows);
+  const kinds = new Uint8Array(columns * rows), street = new Uint8Array(columns * rows);
+  const wide = new Uint8Array(columns * rows);
+  for (let at = 0; at < columns * rows; at++) {
+    if (building[at]) continue;
+    const metres = near[at] * cell;
+    if (toStreet[at] * cell > PASSAGE + cell) {
+      kinds[at] = metres < YARD_PATH ? 1 : 4;
+      continue;
+    }
+    street[at] = 1;
+    if (metres >= PAVEMENT && metres < WIDE_PAVEMENT + KERB) {
+      wide[at] = roomy(near, columns, rows, cell, at) ? 1 : 0;
+    }
+    const kerb = wide[at] ? WIDE_PAVEMENT : PAVEMENT;
+    // past the middle of the widest street: a paved square
+    kinds[at] = metres < kerb ? 1 : metres < kerb + KERB ? 2 : metres <= ROAD_HALF[1] ? 3 : 1;
+  }
+  return {kinds, near, street, wide};
+}
+// Cells at least ``every`` metres apart, the first of each crowd in the grid's order (the
+// same each time): a coarse grid of buckets ``every`` wide keeps the test local
+function spaced(candidates, columns, cell, every) {
+  const buckets = new Map(), chosen = [], span = every / cell;
+  for (const at of candidates) {
+    const column = at % columns, row = (at - column) / columns;
+    const bx = Math.floor(column / span), by = Math.floor(row / span);
+    let clear = true;
+    for (let x = bx - 1; x <= bx + 1 && clear; x++) for (let y = by - 1; y <= by + 1; y++) {
+      for (const other of buckets.get(x + ',' + y) || []) {
+        const otherColumn = other % columns, otherRow = (other - otherColumn) / columns;
+        if (Math.hypot(otherColumn - column, otherRow - row) < span) { clear = false; break; }
+      }
+      if (!clear) break;
+    }
+    if (!clear) continue;
+    chosen.push(at);
+    const key = bx + ',' + by;
+    buckets.set(key, [...(buckets.get(key) || []), at]);
+  }
+  return chosen;
+}
+// The street trees: cells on a wide pavement TREE_LINE metres (within a cell) from the walls,
+// TREE_EVERY apart
+function treeCells(ground, columns, cell) {
+  const {kinds, near, wide} = ground, candidates = [];
+  for (let at = 0; at < kinds.length; at++) {
+    if (kinds[at] === 1 && wide[at] && Math.abs(near[at] * cell - TREE_LINE) <= 0.75 * cell) {
+      candidates.push(at);
+    }
+  }
+  return spaced(candidates, columns, cell, TREE_EVERY);
+}
+// The road's centre-line dashes: on a street's ridge (the distance to its walls highest
+// across it, in one of four directions), ROAD_HALF metres from its walls, DASH_EVERY
+// apart, each along the ridge's cells within DASH metres (their principal axis), where
+// those lie along a line (not at a crossing) -> [[cell, along x, along rows], ...]
+function dashCells(ground, columns, rows, cell) {
+  const {kinds, near, street} = ground, k = 2, ridge = new Uint8Array(kinds.length);
+  const candidates = [];
+  for (let row = k; row < rows - k; row++) for (let column = k; column < columns - k; column++) {
+    const at = row * columns + column, metres = near[at] * cell;
+    if (!street[at] || kinds[at] !== 3 || metres < ROAD_HALF[0] || metres > ROAD_HALF[1]) continue;
+    for (const [dx, dy] of [[1, 0], [0, 1], [1, 1], [1, -1]]) {
+      const a = near[at - dy * k * columns - dx * k], b = near[at + dy * k * columns + dx * k];
+      if (near[at] >= a && near[at] >= b && near[at] - (a + b) / 2 >= 0.5 * k) {
+        ridge[at] = 1; candidates.push(at); break;
+      }
+    }
+  }
+  const dashes = [], reach = Math.round(DASH / cell);
+  for (const at of spaced(candidates, columns, cell, DASH_EVERY)) {
+    const column = at % columns, row = (at - column) / columns;
+    let n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    for (let y = Math.max(0, row - reach); y <= Math.min(rows - 1, row + reach); y++) {
+      for (let x = Math.max(0, column - reach); x <= Math.min(columns - 1, column + reach); x++) {
+        if (!ridge[y * columns + x] || Math.hypot(x - column, y - row) > reach) continue;
+        n++; sx += x; sy += y; sxx += x * x; syy += y * y; sxy += x * y;
+      }
+    }
+    if (n < reach) continue;  // a speck of ridge, not a street's
+    const cxx = sxx / n - (sx / n) ** 2, cyy = syy / n - (sy / n) ** 2;
+    const cxy = sxy / n - (sx / n) * (sy / n);
+    const spread = Math.sqrt(((cxx - cyy) / 2) ** 2 + cxy * cxy), mean = (cxx + cyy) / 2;
+    const along = mean + spread, across = mean - spread;
+    if (across * 6 > along) continue;  // no line: a crossing or a square
+    const angle = 0.5 * Math.atan2(2 * cxy, cxx - cyy);
+    dashes.push([at, Math.cos(angle), Math.sin(angle)]);
+  }
+  return dashes;
+}
+"""
