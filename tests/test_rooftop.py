@@ -27,6 +27,7 @@ from facadecli.city.rooftop import (
     EDGE_CLEAR,
     GRID,
     HOUSING_AREA,
+    KINDS,
     METAL_NAME,
     PARTY_CLEAR,
     UNITS,
@@ -77,7 +78,7 @@ def test_plant_stays_inside_the_parapet_clear_of_party_walls_and_of_each_other()
         inside = part.buffer(-EDGE_CLEAR + TOLERANCE, join_style="mitre")
         for unit in units:
             # where its meshes are, not only the outline it was placed by
-            points = np.vstack([_map_points(m, unit.matrix) for _, m in UNITS[unit.kind].meshes])
+            points = np.vstack([_map_points(m, unit.matrix) for _, m in UNITS[unit.shape].meshes])
             plan = Polygon(points[:, :2]).convex_hull
             assert plan.difference(unit.outline.buffer(TOLERANCE)).area < 1e-9
             assert inside.contains(unit.outline), (number, unit.kind)
@@ -100,7 +101,28 @@ def test_plant_grows_with_the_roof_and_only_large_roofs_get_a_housing() -> None:
         assert on_large.count("housing") == 1
         assert len(on_large) > len(on_small) >= 1
     kinds = {u.kind for seed in range(20) for u in plant(large, 9.0, [], (seed, 0, 0))}
-    assert kinds == set(UNITS)  # each kind turns up: rooflights on some roofs
+    assert kinds == set(KINDS)  # each kind turns up: rooflights on some roofs
+
+
+def test_each_kind_comes_in_several_shapes_over_a_family_of_roofs() -> None:
+    """Over the generated family, every shape of every kind turns up (so a kind is not one
+    shape everywhere), each on a roof it is meant for and where its outline says."""
+    seen: dict[str, set[str]] = {kind: set() for kind in KINDS}
+    for number, (part, party) in enumerate(_family(count=120, seed=11)):
+        for unit in plant(part, 12.0, party, (number, 0, 0)):
+            shape = UNITS[unit.shape]
+            assert shape.kind == unit.kind
+            assert part.area >= shape.from_area  # the largest housings on the largest roofs
+            length, width = shape.size
+            assert unit.outline.area == pytest.approx(length * width)
+            seen[unit.kind].add(unit.shape)
+    for kind in KINDS:
+        assert seen[kind] == {n for n, u in UNITS.items() if u.kind == kind}, kind
+        assert len(seen[kind]) >= 3, kind
+    sizes = {u.kind: set() for u in UNITS.values()}
+    for unit in UNITS.values():
+        sizes[unit.kind].add(tuple(round(v, 3) for v in unit.size))
+    assert all(len(found) == 3 for found in sizes.values())  # each shape its own plan
 
 
 def test_the_same_seed_places_the_same_plant_and_another_seed_other_plant() -> None:

@@ -434,16 +434,16 @@ def build_building(
                 parts.setdefault(_plain_material(spec), []).append(piece)
             seed = (pick, block_number, piece_number)
             for unit in plant(shape, block.eaves, still, seed) if dressed_top else []:
-                for number, (own, _) in enumerate(UNITS[unit.kind].meshes):
+                for number, (own, _) in enumerate(UNITS[unit.shape].meshes):
                     name = _plain_material(spec) if own == WALL_NAME else own
-                    on_roofs.setdefault((unit.kind, number, name), []).append(unit.matrix)
+                    on_roofs.setdefault((unit.shape, number, name), []).append(unit.matrix)
         bottom = trimesh.creation.extrude_polygon(block.part, 0.01)
         bottom.apply_translation((0, 0, block.base - 0.01))
         bottom.apply_transform(MAP_TO_WORLD)
         below = GROUND_NAME if block.base <= 0 else _plain_material(spec)
         parts.setdefault(below, []).append(bottom)
-    for (kind, number, name), placed in on_roofs.items():  # as a façade's parts (_parts)
-        mesh = UNITS[kind].meshes[number][1]
+    for (shape, number, name), placed in on_roofs.items():  # as a façade's parts (_parts)
+        mesh = UNITS[shape].meshes[number][1]
         if instanced and len(mesh.faces) >= MIN_TRIANGLES:
             digest = (name, mesh.vertices.tobytes(), mesh.faces.tobytes())  # one a city
             instances.setdefault(digest, (name, mesh.copy(), []))[2].extend(placed)

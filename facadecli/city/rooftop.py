@@ -12,8 +12,11 @@
   and the taller parts on it, square to the roof's main direction. What does not fit
   is left out.
 
-Every unit of a kind is one shape (sizes in metres, fixed), so a city's units are one
-mesh each, placed again and again (instanced across the buildings with ``--instance``).
+Each kind has a few shapes (sizes in metres, fixed: three condensers, one with two
+fans; three vents; three housings, the largest on roofs of twice HOUSING_AREA; three
+rooflights), one picked by the seed for each unit, so roofs differ while a city's
+units are still one mesh a shape, placed again and again (instanced across the
+buildings with ``--instance``).
 Units and placements are in the glTF frame (x east, y up, z south), the coping and
 the outlines in the map frame (x east, y north, z up).
 """
@@ -50,12 +53,16 @@ ROOFLIGHT_NAME = "rooflight"  # the rooflights' glazing
 
 @dataclass(frozen=True)
 class Unit:
-    """A kind of plant: its meshes by material (``wall``: the building's plain wall
-    material; ``interior``: the dark of a window's recess), in its own frame (glTF's;
-    its base's centre at the origin, its length along x)."""
+    """One shape of a kind of plant (``name``: the shape, ``kind``: what it is): its
+    meshes by material (``wall``: the building's plain wall material; ``interior``: the
+    dark of a window's recess), in its own frame (glTF's; its base's centre at the
+    origin, its length along x). ``from_area``: the least roof (square metres) it goes
+    on."""
 
+    name: str
     kind: str
     meshes: tuple[tuple[str, trimesh.Trimesh], ...]
+    from_area: float = 0.0
 
     @property
     def size(self) -> tuple[float, float]:
@@ -71,10 +78,12 @@ def _box(size: tuple[float, float, float], centre: tuple[float, float, float]) -
     return found
 
 
-def _cylinder(radius: float, height: float, base: float, sections: int) -> trimesh.Trimesh:
+def _cylinder(
+    radius: float, height: float, base: float, sections: int, x: float = 0.0
+) -> trimesh.Trimesh:
     found = trimesh.creation.cylinder(radius=radius, height=height, sections=sections)
     found.apply_transform(trimesh.transformations.rotation_matrix(-math.pi / 2, (1, 0, 0)))
-    found.apply_translation((0.0, base + height / 2, 0.0))
+    found.apply_translation((x, base + height / 2, 0.0))
     return found
 
 
@@ -84,45 +93,90 @@ def _joined(*meshes: trimesh.Trimesh) -> trimesh.Trimesh:
     return found
 
 
-def _units() -> dict[str, Unit]:
-    # an air-conditioning unit: a casing with its fan's shroud on top
-    condenser = _joined(_box((1.6, 1.0, 1.0), (0.0, 0.5, 0.0)), _cylinder(0.38, 0.12, 1.0, 12))
-    # a mushroom vent: a stem and its cap
-    vent = _joined(_cylinder(0.11, 0.55, 0.0, 8), _cylinder(0.24, 0.1, 0.55, 8))
-    # a stair or lift housing: a box of the wall's material, a capping and a metal door
-    housing = _box((3.0, 2.6, 2.4), (0.0, 1.3, 0.0))
-    capping = _box((3.1, COPING_HEIGHT, 2.5), (0.0, 2.6 + COPING_HEIGHT / 2, 0.0))
-    door = _box((0.9, 2.05, 0.04), (0.6, 1.025, 1.22))
-    # a rooflight: a kerb, the dark well under it, a low glazed pyramid over it
-    kerb = _box((1.2, 0.3, 1.8), (0.0, 0.15, 0.0))
-    well = _box((1.0, 0.005, 1.6), (0.0, 0.3025, 0.0))
-    apex = ((0.0, 0.45, -0.3), (0.0, 0.45, 0.3))  # a hipped ridge along it
-    corners = ((-0.6, 0.3, -0.9), (0.6, 0.3, -0.9), (0.6, 0.3, 0.9), (-0.6, 0.3, 0.9))
+def _condenser(name: str, size: tuple[float, float, float], fans: int, radius: float) -> Unit:
+    """An air-conditioning unit: a casing ``size`` (length, height, width) with ``fans``
+    fans' shrouds of ``radius`` in a row on top."""
+    length, height, _ = size
+    pitch = length / fans
+    shrouds = [
+        _cylinder(radius, 0.12, height, 12, x=-length / 2 + pitch * (k + 0.5)) for k in range(fans)
+    ]
+    casing = _joined(_box(size, (0.0, height / 2, 0.0)), *shrouds)
+    return Unit(name, "condenser", ((METAL_NAME, casing),))
+
+
+def _vent(name: str, stem: float, height: float, cap: float) -> Unit:
+    """A mushroom vent: a stem of radius ``stem``, ``height`` high, and its cap."""
+    found = _joined(_cylinder(stem, height, 0.0, 8), _cylinder(cap, 0.1, height, 8))
+    return Unit(name, "vent", ((METAL_NAME, found),))
+
+
+def _housing(name: str, size: tuple[float, float, float], from_area: float) -> Unit:
+    """A stair or lift housing ``size`` (length, height, width): a box of the wall's
+    material, a capping and a metal door near one end of its long side."""
+    length, height, width = size
+    housing = _box(size, (0.0, height / 2, 0.0))
+    capping = _box(
+        (length + 0.1, COPING_HEIGHT, width + 0.1), (0.0, height + COPING_HEIGHT / 2, 0.0)
+    )
+    door = _box((0.9, 2.05, 0.04), (length / 2 - 0.9, 1.025, width / 2 + 0.02))
+    meshes = (("wall", housing), (METAL_NAME, _joined(capping, door)))
+    return Unit(name, "housing", meshes, from_area)
+
+
+def _rooflight(name: str, length: float, width: float) -> Unit:
+    """A rooflight ``length`` by ``width`` (the longer along z): a kerb, the dark well
+    under it, a low glazed pyramid over it, hipped along a ridge."""
+    kerb = _box((length, 0.3, width), (0.0, 0.15, 0.0))
+    well = _box((length - 0.2, 0.005, width - 0.2), (0.0, 0.3025, 0.0))
+    ridge = (width - length) / 2
+    apex = ((0.0, 0.45, -ridge), (0.0, 0.45, ridge))
+    x, z = length / 2, width / 2
+    corners = ((-x, 0.3, -z), (x, 0.3, -z), (x, 0.3, z), (-x, 0.3, z))
     glazing = trimesh.Trimesh(
         [*corners, *apex],
         [[0, 4, 1], [1, 4, 5], [1, 5, 2], [2, 5, 3], [3, 5, 4], [3, 4, 0]],
         process=False,
     )
-    return {
-        "housing": Unit("housing", (("wall", housing), (METAL_NAME, _joined(capping, door)))),
-        "condenser": Unit("condenser", ((METAL_NAME, condenser),)),
-        "rooflight": Unit(
-            "rooflight",
-            ((METAL_NAME, kerb), ("interior", well), (ROOFLIGHT_NAME, glazing)),
-        ),
-        "vent": Unit("vent", ((METAL_NAME, vent),)),
-    }
+    meshes = ((METAL_NAME, kerb), ("interior", well), (ROOFLIGHT_NAME, glazing))
+    return Unit(name, "rooflight", meshes)
 
 
-UNITS = _units()
+def _units() -> dict[str, Unit]:
+    found = [
+        _housing("housing", (3.0, 2.6, 2.4), HOUSING_AREA),  # a stair
+        _housing("housing-lift", (2.4, 3.2, 2.2), HOUSING_AREA),  # a lift's overrun
+        _housing("housing-stair-lift", (4.4, 3.0, 2.6), 2 * HOUSING_AREA),  # both
+        _condenser("condenser", (1.6, 1.0, 1.0), 1, 0.38),
+        _condenser("condenser-small", (1.0, 0.7, 0.8), 1, 0.3),
+        _condenser("condenser-twin", (2.4, 1.1, 1.1), 2, 0.4),  # two fans
+        _rooflight("rooflight", 1.2, 1.8),
+        _rooflight("rooflight-small", 0.9, 1.2),
+        _rooflight("rooflight-long", 1.5, 2.7),
+        _vent("vent", 0.11, 0.55, 0.24),
+        _vent("vent-tall", 0.08, 0.9, 0.18),
+        _vent("vent-wide", 0.16, 0.4, 0.32),
+    ]
+    return {unit.name: unit for unit in found}
+
+
+UNITS = _units()  # every shape, by its name
+KINDS = tuple(dict.fromkeys(unit.kind for unit in UNITS.values()))  # housing, condenser, ...
+
+
+def shapes(kind: str, area: float) -> tuple[Unit, ...]:
+    """The shapes of ``kind`` that go on a roof of ``area`` square metres."""
+    return tuple(u for u in UNITS.values() if u.kind == kind and u.from_area <= area)
 
 
 @dataclass(frozen=True)
 class Placed:
-    """A unit on a roof: its kind, its plan (a rectangle, map frame), and its placement
-    (the glTF frame: a turn about the vertical, then a translation)."""
+    """A unit on a roof: its kind, its shape (a name in UNITS), its plan (a rectangle,
+    map frame), and its placement (the glTF frame: a turn about the vertical, then a
+    translation)."""
 
     kind: str
+    shape: str
     outline: Polygon
     matrix: np.ndarray
 
@@ -208,7 +262,9 @@ def plant(
     placed: list[Placed] = []
     taken: list[Polygon] = []
     for kind in wanted:
-        length, width = UNITS[kind].size
+        choice = shapes(kind, float(roof.area))
+        unit = choice[int(rng.integers(0, len(choice)))]  # one of its shapes, by the seed
+        length, width = unit.size
         for _ in range(TRIES):
             turn = angle + (math.pi / 2 if rng.random() < 0.5 else 0.0)
             x = float(rng.uniform(low_x, high_x))
@@ -219,7 +275,7 @@ def plant(
             if any(outline.distance(other) < CLEAR for other in taken):
                 continue
             taken.append(outline)
-            placed.append(Placed(kind, outline, _placement(x, y, eaves, turn)))
+            placed.append(Placed(kind, unit.name, outline, _placement(x, y, eaves, turn)))
             break
     return placed
 
