@@ -445,10 +445,10 @@ def _room(m: int, rng: np.random.Generator) -> tuple[np.ndarray, Field]:
         folds = 0.75 + 0.25 * np.sin(2 * np.pi * depth / 0.12) ** 2
         colour[hung] = (cloth * (1.2 if lit else 1.0)) * folds[hung][..., None]
     # a room by day is darker than the street it looks onto: a lit one less so
-    colour = colour * (0.65 if lit else 0.35)
+    colour = colour * (1.0 if lit else 0.75)
     edge = np.minimum.reduce([s, 1 - s, t, 1 - t])
     colour[edge < ROOM_REVEAL] = (0.16, 0.155, 0.145)
-    open_sky: Field = np.where(back, 0.55, 0.55 + 0.35 * depth)
+    open_sky: Field = np.where(back, 0.8, 0.8 + 0.15 * depth)
     return colour, open_sky
 
 
