@@ -61,7 +61,6 @@ from facadecli.geometry.facade import (
     texture_metres,
     weld,
 )
-from facadecli.geometry.primitives import ROOM_DEPTH
 from facadecli.layout import (
     BUILTIN_INTERIOR,
     DEFAULT_MATERIAL,
@@ -190,7 +189,7 @@ class AxisCache:
         base_dir: Path | None,
         variants: int = 1,
         pick: int = 0,
-        behind: float = ROOM_DEPTH,
+        behind: float = math.inf,
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """The façade of a wall ``width`` x ``height`` in its own frame (x along, y up, z
         out), one mesh per material, its rooms reaching ``behind`` the wall at the most
@@ -216,7 +215,7 @@ class AxisCache:
         doors: Sequence[float],
         variants: int = 1,
         pick: int = 0,
-        behind: float = ROOM_DEPTH,
+        behind: float = math.inf,
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """:meth:`facade` with a door at each of ``doors`` (metres along the wall, where
         entrances are: :func:`.with_doors`); a wall's own, so not kept."""
@@ -238,7 +237,7 @@ class AxisCache:
         base_dir: Path | None,
         variants: int = 1,
         pick: int = 0,
-        behind: float = ROOM_DEPTH,
+        behind: float = math.inf,
     ) -> tuple[list[tuple[str, trimesh.Trimesh]], PlacedParts] | None:
         """:meth:`facade`, with the parts it places :data:`.MIN_INSTANCES` times or more
         apart, those of :data:`.MIN_TRIANGLES` triangles or more (each in its own frame,
@@ -906,9 +905,7 @@ def _merged(
     return merged
 
 
-def _merged_facade(
-    layout: Layout, base_dir: Path | None, behind: float = ROOM_DEPTH
-) -> FacadeMeshes:
+def _merged_facade(layout: Layout, base_dir: Path | None, behind: float = math.inf) -> FacadeMeshes:
     """A façade's meshes placed and merged per material (its rooms reaching ``behind``
     the wall at the most)."""
     merged: dict[str, list[trimesh.Trimesh]] = {}

@@ -7,6 +7,7 @@ along the façade, y up, z towards the viewer (SPEC 2.1), metres: glTF's own fra
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from functools import lru_cache, partial
 from pathlib import Path
@@ -21,7 +22,6 @@ from facadecli.geometry.primitives import (
     PANES,
     PRIMITIVES,
     RECESS_DEPTH,
-    ROOM_DEPTH,
     Cell,
     asset,
     open_box,
@@ -436,7 +436,7 @@ def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
 
 
 def facade_scene(
-    layout: Layout, base_dir: Path | None = None, behind: float = ROOM_DEPTH
+    layout: Layout, base_dir: Path | None = None, behind: float = math.inf
 ) -> trimesh.Scene:
     """The visible shapes of a layout as a scene (hidden ones are culled). A frame or an
     arch is two meshes: its bars in the shape's material and its pane in the pane's. The
@@ -446,7 +446,8 @@ def facade_scene(
     or panel of a see-through material, a closed dark recess (:func:`.recess`) in the
     ``interior`` material, so that no view through a window passes through the model;
     with a ``rooms`` interior, one room box a window instead, as :func:`.rooms.rooms`
-    decides them (``behind``: metres of building behind the wall a room may reach)."""
+    decides them (``behind``: metres behind the façade's plane a room may reach, the
+    building behind the wall; a façade alone has nothing behind it)."""
     spec = layout.spec
     assets: dict[str, trimesh.Trimesh] = {}
     scene = trimesh.Scene()
@@ -623,7 +624,7 @@ def _backed(
     a see-through box or panel, its glass; ``"pane"``: a frame's, an arch's or a door's
     pane in a see-through material), in the order :func:`facade_scene` places them: what
     the glass of each covers seen head-on (as its mesh is built and mirrored in its
-    cell), and the back of that glass."""
+    cell), the back of that glass, and a door's threshold (its room's floor)."""
     spec = layout.spec
     found: dict[tuple[int, str], Opening] = {}
     enabled = {layer.name for layer in spec.layers if layer.enabled}
@@ -644,8 +645,9 @@ def _backed(
                 continue
             _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
             (x0, y0, z0), (x1, y1, _) = mesh.bounds
+            threshold = shape.y0 if shape.mesh == "door" else None  # the storey's floor
             found[(id(shape), part)] = Opening(
-                shape.x0 + x0, shape.x0 + x1, shape.y0 + y0, shape.y0 + y1, shape.z1 + z0
+                shape.x0 + x0, shape.x0 + x1, shape.y0 + y0, shape.y0 + y1, shape.z1 + z0, threshold
             )
     return found
 

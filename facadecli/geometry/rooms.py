@@ -2,10 +2,11 @@
 place: :func:`rooms` takes the openings of a façade (each window's glass seen head-on),
 the façade's size and the space behind it, and gives each window one room box, as a
 room is: wider than its window (out to about its bay), its floor the storey's floor
-(:data:`BELOW_SILL` under the sill), its ceiling the storey's ceiling (:data:`ABOVE_HEAD`
-over the head), as deep as the façade's ends and the building behind the wall leave
-room. No two rooms meet: where two would, they are cut apart between their windows.
-Coordinates are the façade's (x along, y up, z out of the wall, metres).
+(:data:`BELOW_SILL` under the sill, or a door's threshold), its ceiling the storey's
+ceiling (:data:`ABOVE_HEAD` over the head), as deep as the façade's ends and the
+building behind the wall leave room. No two rooms meet: where two would, they are cut
+apart between their windows. Coordinates are the façade's (x along, y up, z out of the
+wall, metres).
 """
 
 from __future__ import annotations
@@ -30,13 +31,15 @@ ROOM_GAP = 0.1
 @dataclass(frozen=True)
 class Opening:
     """A window's glass seen head-on: across (x0, x1) and up (y0, y1), and ``back``, the
-    z of the back of its glass (where its room begins)."""
+    z of the back of its glass (where its room begins); ``floor``, the storey's floor
+    where the façade says it (a door's threshold), else None (:data:`BELOW_SILL`)."""
 
     x0: float
     x1: float
     y0: float
     y1: float
     back: float
+    floor: float | None = None
 
 
 @dataclass(frozen=True)
@@ -53,7 +56,7 @@ class Room:
 
 
 def rooms(
-    openings: Sequence[Opening], width: float, height: float, behind: float = ROOM_DEPTH
+    openings: Sequence[Opening], width: float, height: float, behind: float = math.inf
 ) -> list[Room | None]:
     """The room behind each of ``openings`` of a façade ``width`` x ``height``, or None
     for one whose window shares its room with an earlier opening (a frame's pane in
@@ -63,8 +66,9 @@ def rooms(
     Each room is first as large as a room is round its window (:data:`BEYOND_JAMB` each
     side, :data:`BELOW_SILL` and :data:`ABOVE_HEAD`), within the façade; where two
     rooms would meet, both are cut back to :data:`ROOM_GAP` apart (:func:`_apart`) on the
-    axis where their windows stand furthest apart. Its depth is
-    :func:`room_depth`: ``behind`` (the space behind the wall) at the most."""
+    axis where their windows stand furthest apart. Its depth is :func:`room_depth`: no
+    further than ``behind`` the façade's plane (the space behind the wall; a façade alone
+    has nothing behind it)."""
     windows = _windows(openings)
     spans = [_round(window, width, height) for window, _ in windows]
     pairs = [(i, j) for i in range(len(windows)) for j in range(i + 1, len(windows))]
@@ -81,15 +85,16 @@ def rooms(
     return found
 
 
-def room_depth(window: Opening, width: float, behind: float = ROOM_DEPTH) -> float:
-    """How deep a window's room is behind its glass: :data:`ROOM_DEPTH`, no more than
-    ``behind`` (the space behind the wall: in a city, half the building behind it) and no
-    further behind the façade's plane than the window stands from the façade's nearer end
+def room_depth(window: Opening, width: float, behind: float = math.inf) -> float:
+    """How deep a window's room is behind its glass: :data:`ROOM_DEPTH`, reaching no
+    further than ``behind`` the façade's plane (the space behind the wall: in a city, half
+    the building behind it, :func:`.room_reach`) nor further behind the façade's plane
+    than the window stands from the façade's nearer end
     (so that at a building's corner it meets no room of the other façade, whose windows
     stand as far from the corner as its rooms reach in); whole decimetres, so that the
     windows of a façade share a few depths, and :data:`RECESS_DEPTH` at the least."""
-    free = min(window.x0, width - window.x1) + window.back
-    deep = math.floor(min(ROOM_DEPTH, behind, free) * 10 + 1e-9) / 10
+    free = min(window.x0, width - window.x1, behind) + window.back  # back: under 0
+    deep = math.floor(min(ROOM_DEPTH, free) * 10 + 1e-9) / 10
     return max(RECESS_DEPTH, deep)
 
 
@@ -108,12 +113,14 @@ def _windows(openings: Sequence[Opening]) -> list[tuple[Opening, int]]:
             for j in range(i + 1, len(groups)):
                 a, b = groups[i][1], groups[j][1]
                 if _gap(a, b) < ROOM_GAP:
+                    floors = [f for f in (a.floor, b.floor) if f is not None]
                     joined = Opening(
                         min(a.x0, b.x0),
                         max(a.x1, b.x1),
                         min(a.y0, b.y0),
                         max(a.y1, b.y1),
                         min(a.back, b.back),
+                        min(floors) if floors else None,
                     )
                     groups[i] = (groups[i][0] + groups[j][0], joined)
                     del groups[j]
@@ -131,10 +138,11 @@ def _gap(a: Opening, b: Opening) -> float:
 
 def _round(window: Opening, width: float, height: float) -> Span:
     """The room a window would have alone, within the façade."""
+    floor = window.y0 - BELOW_SILL if window.floor is None else window.floor
     return (
         min(window.x0, max(0.0, window.x0 - BEYOND_JAMB)),
         max(window.x1, min(width, window.x1 + BEYOND_JAMB)),
-        min(window.y0, max(0.0, window.y0 - BELOW_SILL)),
+        min(window.y0, max(0.0, floor)),
         max(window.y1, min(height, window.y1 + ABOVE_HEAD)),
     )
 
