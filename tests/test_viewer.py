@@ -397,9 +397,10 @@ def test_a_pane_shows_the_room_behind_it(tmp_path: Path) -> None:
     interior) and then a room of the library's ``rooms``: through the glass, the room's
     back wall (1.2 m back) lifts the pane's grey over the dark recess's. Mean grey over
     the pane, headless Chromium with SwiftShader, one shot each: 80.0 with the dark
-    recess, 110.9 with the room. (Its spread told them apart while the room was a
-    perspective picture on the plate, 12.6 and 20.3; a room box seen square on shows
-    its back wall, and the spread is the reflection's: 17.7 and 17.4.)"""
+    recess, 110.9 with the room (140.4 since the rooms are brighter by day). (Its
+    spread told them apart while the room was a perspective picture on the plate, 12.6
+    and 20.3; a room box seen square on shows its back wall, and the spread is the
+    reflection's: 17.7 and 17.4.)"""
     with_room = PANE_SPEC.replace("materials:\n", "materials:\n  interior: {library: rooms}\n")
     spreads = []
     for name, text in (("dark", PANE_SPEC), ("room", with_room)):
