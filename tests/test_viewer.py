@@ -722,16 +722,17 @@ def test_a_districts_grass_is_its_courtyard_and_its_trees_stand_on_pavements(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
     """The ground by what each place is: the closed block's courtyard, which no street
-    reaches, is grass inside a 1 m path (18 m square, 324 m²); the open square and the
-    street are paved and asphalt, not grass (by the distance to the nearest building alone
-    the square was grass, over 1,000 m²); street trees stand on the pavements, at least
-    3 m from every wall and none in the courtyard; dashes run down the 16 m street."""
+    reaches, is grass inside a 1 m path (18 m square, 324 m²); the street between the
+    block and the bar is asphalt; the 40 m gap to the lone building, open to the north and
+    south, no walls closing it in, is lawn, not a paved square (about 2,500 m² more
+    grass); street trees stand on the pavements, at least 3 m from every wall and none in
+    the courtyard; dashes run down the 16 m street."""
     from shapely.geometry import Point
 
     manifest, footprints, courtyard = _courtyard_block(tmp_path / "district")
     _shot, ground = _district_shown(capsys, tmp_path, manifest, "?bare&view=35,35", "ground")
-    assert abs(ground["grass"] * ground["area"] - 324) < 30, ground
-    assert ground["asphalt"] > 0.15 and ground["paving"] > 0.3  # the square is paved
+    assert 2000 < ground["grass"] * ground["area"] < 3500, ground
+    assert ground["asphalt"] > 0.12 and ground["paving"] > 0.05  # streets round the block
     georef = json.loads((tmp_path / "city" / "courtyard.georef.json").read_text())
     trees = [Point(georef["origin"][0] + x, georef["origin"][1] - z) for x, _, z in ground["trees"]]
     assert len(trees) >= 8

@@ -73,6 +73,7 @@ import {RenderPass} from 'three/addons/postprocessing/RenderPass.js';
 import {GTAOPass} from 'three/addons/postprocessing/GTAOPass.js';
 import {OutputPass} from 'three/addons/postprocessing/OutputPass.js';
 import {SimplexNoise} from 'three/addons/math/SimplexNoise.js';
+import {mergeGeometries} from 'three/addons/utils/BufferGeometryUtils.js';
 const view = document.getElementById('model');
 const status = document.getElementById('status');
 // the sky's light is 2.4 times the houses' (below): at 0.55 a sunlit wall is about as light
@@ -414,8 +415,20 @@ function endsInHaze(material, more = shader => shader) {
 }
 endsInHaze(ground.material, ground.material.onBeforeCompile);
 // The street trees (a trunk and a crown, each one instanced mesh: two draw calls whatever
-// their number) and the centre-line dashes (one more), seeded: the same each time
+// their number), the centre-line dashes and the street lamps (one more each), seeded: the
+// same each time
 const TREE_TRUNK = 2.6;
+// A street lamp of painted steel, LAMP_HIGH metres, one mesh (one draw call for them all):
+// a tapering pole, an arm reaching LAMP_ARM metres over the road (+x), a flat lantern
+const LAMP_HIGH = 5.6, LAMP_ARM = 1.1;
+function lampShape() {
+  const pole = new THREE.CylinderGeometry(0.05, 0.08, LAMP_HIGH, 8).translate(0, LAMP_HIGH / 2, 0);
+  const arm = new THREE.BoxGeometry(LAMP_ARM, 0.06, 0.06)
+    .translate(LAMP_ARM / 2, LAMP_HIGH - 0.05, 0);
+  const lantern = new THREE.BoxGeometry(0.55, 0.12, 0.26)
+    .translate(LAMP_ARM - 0.05, LAMP_HIGH - 0.12, 0);
+  return mergeGeometries([pole, arm, lantern].map(part => part.toNonIndexed()));
+}
 const trees = {
   trunks: new THREE.InstancedMesh(
     new THREE.CylinderGeometry(0.12, 0.17, TREE_TRUNK, 7).translate(0, TREE_TRUNK / 2, 0),
@@ -427,15 +440,17 @@ const trees = {
     new THREE.PlaneGeometry(1, 1).rotateX(-Math.PI / 2),
     new THREE.MeshStandardMaterial({color: 0xd8d6cc, roughness: 0.8, polygonOffset: true,
                                     polygonOffsetFactor: -2, polygonOffsetUnits: -2}), 1),
+  lamps: new THREE.InstancedMesh(lampShape(), new THREE.MeshStandardMaterial(
+    {color: 0x3b3f42, roughness: 0.55, metalness: 0.6}), 1),
 };
 for (const part of Object.values(trees)) {
   endsInHaze(part.material);
   part.count = 0; part.frustumCulled = false; part.receiveShadow = true;
   scene.add(part);
 }
-trees.trunks.castShadow = trees.crowns.castShadow = true;
+trees.trunks.castShadow = trees.crowns.castShadow = trees.lamps.castShadow = true;
 const CROWN_GREENS = [0x3f5e2a, 0x4d6b30, 0x35522a, 0x56703a].map(c => new THREE.Color(c));
-function placeStreetParts(cells, dashes, place) {
+function placeStreetParts(cells, dashes, lamps, place) {
   const random = seeded(13), matrix = new THREE.Matrix4(), turn = new THREE.Quaternion();
   const up = new THREE.Vector3(0, 1, 0), size = new THREE.Vector3(), at = new THREE.Vector3();
   const grow = (mesh, count) => {
@@ -449,6 +464,7 @@ function placeStreetParts(cells, dashes, place) {
   trees.trunks = grow(trees.trunks, cells.length);
   trees.crowns = grow(trees.crowns, cells.length);
   trees.dashes = grow(trees.dashes, dashes.length);
+  trees.lamps = grow(trees.lamps, lamps.length);
   cells.forEach((cell, index) => {
     const [x, y, z] = place(cell);
     const radius = 1.5 + 0.6 * random(), tall = 1.1 + 0.35 * random();
@@ -467,8 +483,15 @@ function placeStreetParts(cells, dashes, place) {
     matrix.compose(at.set(x, y, z), turn, size.set(DASH, 1, 0.12));
     trees.dashes.setMatrixAt(index, matrix);
   });
+  lamps.forEach(([cell, across, down], index) => {
+    const [x, y, z] = place(cell);
+    turn.setFromAxisAngle(up, Math.atan2(down, across));  // the arm over the road
+    matrix.compose(at.set(x, y, z), turn, size.set(1, 1, 1));
+    trees.lamps.setMatrixAt(index, matrix);
+  });
   trees.trunks.count = trees.crowns.count = cells.length;
   trees.dashes.count = dashes.length;
+  trees.lamps.count = lamps.length;
   for (const part of Object.values(trees)) {
     part.instanceMatrix.needsUpdate = true;
     if (part.instanceColor) part.instanceColor.needsUpdate = true;
@@ -478,7 +501,7 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   uses.regions.value.dispose();
   uses.regions.value = allPaving();
   delete document.body.dataset.ground;
-  placeStreetParts([], [], null);
+  placeStreetParts([], [], [], null);
   const buildings = model.children.length;
   if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
   const {cell, columns, rows, building} = districtPlan(model, box);
@@ -503,12 +526,13 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   const z = row => box.min.z + (rows + margin - row - 0.5) * cell;
   const place = at => [x(at % wide), box.min.y, z(Math.floor(at / wide))];
   const treesAt = treeCells(plan, wide, cell), dashes = dashCells(plan, wide, deep, cell);
-  placeStreetParts(treesAt, dashes, place);
+  const lamps = lampCells(plan, wide, deep, cell, treesAt);
+  placeStreetParts(treesAt, dashes, lamps, place);
   document.body.dataset.ground = JSON.stringify({
     paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
     grass: share(counts[3]), cell, area: +(columns * rows * cell * cell).toFixed(1),
     trees: treesAt.map(at => place(at).map(v => +v.toFixed(2))),
-    dashes: dashes.length});
+    dashes: dashes.length, lamps: lamps.map(([at]) => place(at).map(v => +v.toFixed(2)))});
   uses.regions.value.dispose();
   uses.regions.value = regionsPicture(data, wide, deep);
   // the picture's row 0 is the plan's, at the district's +z edge (districtPlan)
