@@ -174,3 +174,21 @@ def test_street_lamps_stand_on_the_pavements_30_m_apart_their_arms_over_the_road
     for index, (x, y, *_) in enumerate(ground.lamps):
         for other in ground.lamps[index + 1 :]:
             assert np.hypot(other[0] - x, other[1] - y) >= 30 - CELL
+
+
+@pytest.mark.parametrize("seed", [7, 8, 9])
+def test_centre_line_dashes_stop_before_each_junction(seed: int) -> None:
+    """Dashes run down the middle of every street between junctions and stop before each
+    junction (the square where two streets cross): none reaches into it (they crossed
+    it where the crossing's middle ran straight for a dash's length)."""
+    from shapely.geometry import LineString, box
+
+    buildings, junctions, _ = _blocks(seed, 16)
+    ground = _ground(buildings)
+    crossings = [box(*junction) for junction in junctions]
+    assert len(ground.dashes) >= 12
+    for x, y, along_x, along_y in ground.dashes:
+        half = 1.5  # a dash is 3 m long
+        dash = LineString([(x - half * along_x, y - half * along_y),
+                           (x + half * along_x, y + half * along_y)])  # fmt: skip
+        assert not any(dash.intersects(crossing) for crossing in crossings), (x, y)

@@ -211,10 +211,32 @@ function treeCells(ground, columns, cell) {
   }
   return spaced(candidates, columns, cell, TREE_EVERY);
 }
+// Whether a dash at ``at`` along ``angle`` stops DASH_STOP metres short of any junction:
+// within the street's half width, half a dash and DASH_STOP of it, no ridge cell off its
+// line by more than JUNCTION_BAND metres (the middle of a street meeting it) and no place
+// farther than ROAD_HALF[1] from the walls (a square or open land it opens into)
+const DASH_STOP = 1.5, JUNCTION_BAND = 1.5;
+function clearOfJunctions(ground, ridge, columns, rows, cell, at, angle) {
+  const {near} = ground, column = at % columns, row = (at - column) / columns;
+  const reach = near[at] + (DASH / 2 + DASH_STOP) / cell, band = Math.max(2, JUNCTION_BAND / cell);
+  const acrossX = -Math.sin(angle), acrossY = Math.cos(angle), open = ROAD_HALF[1] / cell;
+  const r = Math.ceil(reach);
+  for (let y = Math.max(0, row - r); y <= Math.min(rows - 1, row + r); y++) {
+    for (let x = Math.max(0, column - r); x <= Math.min(columns - 1, column + r); x++) {
+      if (Math.hypot(x - column, y - row) > reach) continue;
+      const there = y * columns + x;
+      if (near[there] > open) return false;
+      const off = Math.abs((x - column) * acrossX + (y - row) * acrossY);
+      if (ridge[there] && off > band) return false;
+    }
+  }
+  return true;
+}
 // The road's centre-line dashes: on a street's ridge (the distance to its walls highest
 // across it, in one of four directions), ROAD_HALF metres from its walls, DASH_EVERY
 // apart, each along the ridge's cells within DASH metres (their principal axis), where
-// those lie along a line (not at a crossing) -> [[cell, along x, along rows], ...]
+// those lie along a line, stopping short of junctions (clearOfJunctions)
+// -> [[cell, along x, along rows], ...]
 function dashCells(ground, columns, rows, cell) {
   const {kinds, near, street} = ground, k = 2, ridge = new Uint8Array(kinds.length);
   const candidates = [];
@@ -245,6 +267,7 @@ function dashCells(ground, columns, rows, cell) {
     const along = mean + spread, across = mean - spread;
     if (across * 6 > along) continue;  // no line: a crossing or a square
     const angle = 0.5 * Math.atan2(2 * cxy, cxx - cyy);
+    if (!clearOfJunctions(ground, ridge, columns, rows, cell, at, angle)) continue;
     dashes.push([at, Math.cos(angle), Math.sin(angle)]);
   }
   return dashes;
