@@ -48,14 +48,17 @@ class Ground:
     lamps: list[tuple[float, float, float, float]]
     trees: list[tuple[float, float]]
 
+    def inner(self) -> np.ndarray:
+        """The plan's cells, not the town's margin round it."""
+        return self.kinds[_cells(MARGIN) : -_cells(MARGIN), _cells(MARGIN) : -_cells(MARGIN)]
+
     def share(self, kind: int) -> float:
-        """Of the plan's open ground (not the town's margin round it)."""
-        inner = self.kinds[_cells(MARGIN) : -_cells(MARGIN), _cells(MARGIN) : -_cells(MARGIN)]
-        return float((inner == kind).sum() / (inner != BUILDING).sum())
+        """Of the plan's open ground."""
+        return float((self.inner() == kind).sum() / (self.inner() != BUILDING).sum())
 
     def area(self, kind: int) -> float:
-        """m² of the plan and the town's margin round it."""
-        return float((self.kinds == kind).sum() * CELL * CELL)
+        """m² of the plan."""
+        return float((self.inner() == kind).sum() * CELL * CELL)
 
 
 def _cells(metres: float) -> int:

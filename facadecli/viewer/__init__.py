@@ -370,9 +370,15 @@ scene.add(ground);
 // of the streets. A picture of the plan's cells and a margin round it says how much of
 // each a place is (red paving, green asphalt, blue grass, alpha the kerb), and the
 // ground's shader mixes them; a façade's is all paving.
-const TOWN_PAVED = 40;  // metres past the plan's margin where the town is paved
+// Past the plan's margin the land round the district is, within TOWN_PAVED metres, what
+// most of the district's open ground is (``town``: paving, or grass for a town of lawns),
+// and the ground fades into the horizon's haze from ``hazeFrom`` metres from the eye to
+// the fog's far end (light), so no edge or band shows where the plan ends.
+const TOWN_PAVED = 20, TOWN_EDGE = 6;
+const PAVED = new THREE.Vector4(1, 0, 0, 0), LAWNS = new THREE.Vector4(0, 0, 1, 0);
 const uses = {regions: {value: null}, regionsFrom: {value: new THREE.Vector2(0, 0)},
-              regionsSize: {value: new THREE.Vector2(1, 1)}};
+              regionsSize: {value: new THREE.Vector2(1, 1)}, town: {value: PAVED.clone()},
+              hazeFrom: {value: 1}};
 function regionsPicture(data, columns, rows) {
   const picture = new THREE.DataTexture(data, columns, rows);
   picture.magFilter = picture.minFilter = THREE.LinearFilter;
@@ -387,15 +393,21 @@ ground.material.onBeforeCompile = shader => {
     '#include <begin_vertex>',
     '#include <begin_vertex>\\nvGround = (modelMatrix * vec4(position, 1.0)).xz;');
   shader.fragmentShader = `uniform sampler2D regions; uniform vec2 regionsFrom, regionsSize;
+    uniform vec4 town; uniform float hazeFrom;
     #define TOWN_PAVED ${TOWN_PAVED.toFixed(1)}
+    #define TOWN_EDGE ${TOWN_EDGE.toFixed(1)}
     varying vec2 vGround;\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
     #include <map_fragment>
     vec2 inPlan = (vGround - regionsFrom) / regionsSize;
     vec4 share = texture2D(regions, inPlan);
-    // past the plan's margin the town's streets give way to its paved squares, out to
-    // the haze: the district stands in a town, not in a field or on a car park
+    // past the plan's margin the town's streets give way to what most of the district's
+    // open ground is (its squares, or its lawns), out to the haze
+    // (from TOWN_EDGE metres inside the margin's edge: the picture's edge, clamped, drew
+    // streaks past it)
     vec2 past = (inPlan - clamp(inPlan, 0.0, 1.0)) * regionsSize;
-    share = mix(share, vec4(1.0, 0.0, 0.0, 0.0), smoothstep(0.0, TOWN_PAVED, length(past)));
+    vec2 inside = min(inPlan, 1.0 - inPlan) * abs(regionsSize);
+    float beyond = length(past) > 0.0 ? length(past) : -min(inside.x, inside.y);
+    share = mix(share, town, smoothstep(-TOWN_EDGE, TOWN_PAVED, beyond));
     float speck = fract(sin(dot(floor(vGround * 5.0), vec2(12.9898, 78.233))) * 43758.5453);
     vec3 asphalt = vec3(0.042, 0.042, 0.045) * (0.9 + 0.2 * speck);
     vec3 grass = vec3(0.05, 0.075, 0.028) * (0.8 + 0.4 * speck);
@@ -404,6 +416,18 @@ ground.material.onBeforeCompile = shader => {
       / max(share.r + share.g + share.b, 1e-3);`);
 };
 ground.material.customProgramCacheKey = () => 'ground-regions';
+{
+  const regions = ground.material.onBeforeCompile;
+  ground.material.onBeforeCompile = shader => {  // the ground fades into the haze
+    regions(shader);
+    shader.fragmentShader = shader.fragmentShader.replace('#include <fog_fragment>', `
+      #include <fog_fragment>
+      #ifdef USE_FOG
+      float hazed = clamp((vFogDepth - hazeFrom) / max(fogFar - hazeFrom, 1e-3), 0.0, 1.0);
+      gl_FragColor.rgb = mix(gl_FragColor.rgb, fogColor, hazed * hazed);
+      #endif`);
+  };
+}
 // The ground and what stands on it end where the haze has swallowed them (fog.far away),
 // so the sky's backdrop, its horizon there (placeBackdrop), shows over them
 function endsInHaze(material, more = shader => shader) {
@@ -500,6 +524,7 @@ function placeStreetParts(cells, dashes, lamps, place) {
 function groundRegions(model, box, district) {  // a model after another: its own ground
   uses.regions.value.dispose();
   uses.regions.value = allPaving();
+  uses.town.value.copy(PAVED);
   delete document.body.dataset.ground;
   placeStreetParts([], [], [], null);
   const buildings = model.children.length;
@@ -538,6 +563,7 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   // the picture's row 0 is the plan's, at the district's +z edge (districtPlan)
   uses.regionsFrom.value.set(box.min.x - margin * cell, box.min.z + (rows + margin) * cell);
   uses.regionsSize.value.set(wide * cell, -deep * cell);
+  uses.town.value.copy(counts[3] > counts[0] + counts[2] ? LAWNS : PAVED);
 }
 const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 5000);
 const controls = new OrbitControls(camera, renderer.domElement);
@@ -1077,6 +1103,8 @@ function light(model) {
       if (part.isMesh) for (const material of materialsOf(part)) material.fog = false;
     });
   }
+  // a district's ground fades from the distance of its middle: a façade's in the fog alone
+  uses.hazeFrom.value = district ? Math.min(scene.fog.near, fit) : scene.fog.far;
   ground.position.set(centre.x, box.min.y - radius * 1e-4, centre.z);
   ground.scale.setScalar(4 * haze);
   // the circle's texture coordinates span its diameter: slabs SLAB metres a side

@@ -110,11 +110,11 @@ function roomy(near, columns, rows, cell, at) {
 }
 // How closed in by walls each place is, 0..1: of RAYS_AROUND rays from it, evenly round,
 // the share that meets a building within SQUARE_REACH metres, of those that do not leave
-// the plan first (what lies past the district is unknown; a place all of whose rays leave
-// it counts as closed in). Each ray marches along the distance field (``near``, cells), a
-// step as long as the way is clear: a few steps a ray. Taken every ENCLOSURE_STEP metres
-// and interpolated between, so a boundary between square and lawn runs smooth, not in
-// the rays' jagged fans.
+// the plan first (what lies past the district is unknown), or of half the rays where
+// more leave (a few rays left drew streaks of square along their directions). Each ray
+// marches along the distance field (``near``, cells), a step as long as the way is clear:
+// a few steps a ray. Taken every ENCLOSURE_STEP metres and interpolated between, so a
+// boundary between square and lawn runs smooth, not in the rays' jagged fans.
 const ENCLOSURE_STEP = 4;
 function enclosureField(near, columns, rows, cell) {
   const reach = SQUARE_REACH / cell, step = Math.max(1, Math.round(ENCLOSURE_STEP / cell));
@@ -136,7 +136,7 @@ function enclosureField(near, columns, rows, cell) {
         along += Math.max(1, clear - 1);
       }
     }
-    coarse[j * across + i] = out < RAYS_AROUND ? walls / (RAYS_AROUND - out) : 1;
+    coarse[j * across + i] = walls / Math.max(RAYS_AROUND - out, RAYS_AROUND / 2);
   }
   return at => {  // bilinear between the four places taken round ``at``
     const column = at % columns, row = (at - column) / columns;
