@@ -663,6 +663,7 @@ def test_a_districts_ground_has_streets_trees_and_a_sky_over_the_haze_from_35_de
     assert ground["paving"] > 0.1 and ground["asphalt"] > 0.3  # of the district's box
     assert 0 < ground["kerb"] < 0.1 and ground["grass"] < 0.01
     assert len(ground["trees"]) >= 10 and ground["dashes"] >= 10
+    assert len(ground["lamps"]) >= 5  # street lamps along the roads
     blue, asphalt = _sky_at_the_top(shot)
     assert blue > 4  # the sky over the horizon
     assert asphalt > 0.2  # the streets round the district
