@@ -4,7 +4,8 @@ library's sqlite3 and shapely: no GDAL.
 
 The first feature table (by name) is read; each row becomes a GeoJSON feature (its id the
 row's primary key, its properties the other columns, blobs left out), so the footprints
-are checked exactly as a GeoJSON file's are. The table's CRS comes from
+are checked exactly as a GeoJSON file's are; the rows are read one at a time as the
+survey walks them (:class:`Rows`), never the whole table at once. The table's CRS comes from
 ``gpkg_spatial_ref_sys`` (an EPSG code, else the WKT definition). A file that is not a
 GeoPackage, or has no feature table or no CRS, is a SpecError (exit 2); a row whose
 geometry cannot be read is a feature the caller rejects with its reason.
