@@ -16,7 +16,7 @@ import os
 import re
 import stat
 from array import array
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -82,7 +82,7 @@ class Places:
 @dataclass(frozen=True)
 class GeoJSON:
     file: str
-    features: Sequence[Any]  # as read: each may be anything
+    features: Iterable[Any]  # as read, each may be anything: walked once, in the file's order
     crs: pyproj.CRS
     places: Places
     reasons: Mapping[int, str] = field(default_factory=dict)  # index -> why it has no geometry
