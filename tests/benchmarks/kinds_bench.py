@@ -83,7 +83,7 @@ def outcome(
         now = fidelity(drawn, found.layout)
         gate = (
             "kept"
-            if bays._kept(was, now)
+            if bays.kept(was, now)
             else "fair"
             if bays._fair(drawn, layout, found.layout)
             else "refused"
