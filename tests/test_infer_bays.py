@@ -616,3 +616,59 @@ def test_bays_drawn_once_drop_and_gain_in_mirrored_pairs(tmp_path: Path) -> None
         assert _mirrored(rects, inference.layout.width * share)
         assert all(any(abs((r.x1 - r.x0) / w - 1) <= 0.15 for w in widths) for r in windows)
         assert sum(r.label == "door" for r in rects) == 1
+
+
+def _bays_each_unlike(seed: int) -> list[tuple[str, float, float, float, float]]:
+    """Family seed ``seed`` with each bay's windows and sills drawn wider or narrower
+    about their centres, by a share of their own that no other bay shares (0.7-1.4):
+    every bay a kind of its own, as on most CMP samples."""
+    boxes, _ = family(seed)
+    centres = sorted({round((b[1] + b[3]) / 2, 2) for b in boxes if b[0] == "window"})
+    columns: list[float] = []
+    for c in centres:
+        if not columns or c - columns[-1] > 0.02:
+            columns.append(c)
+    scales = (1.0, 1.3, 0.85, 1.15, 0.7, 1.4, 0.95, 1.22, 0.78)
+    out = []
+    for label, x0, y0, x1, y1 in boxes:
+        if label in ("window", "sill"):
+            centre = (x0 + x1) / 2
+            bay = min(range(len(columns)), key=lambda k: abs(columns[k] - centre))
+            half = (x1 - x0) * scales[bay] / 2
+            x0, x1 = centre - half, centre + half
+        out.append((label, x0, y0, x1, y1))
+    return out
+
+
+def test_bays_drawn_once_solve_at_their_drawn_counts_at_1x(tmp_path: Path) -> None:
+    """Seed 13 (five bays of four floors, the door under the second's windows) with
+    every bay drawn unlike the others (``ABCDE``): the three inner bays are on counters
+    at one where drawn. The structure leaves one sill a fifth of a millimetre in from
+    its bay's edge; written as a gap, that sliver is under the solver's least letter (a
+    millimetre), so the drawn counts had no layout and the solver took others at the
+    input's size (before: no end bays, the narrowest bay four times, the door's column
+    moved). Now the element meets the edge: solved at 1x every counter of bays is at
+    its drawn count and the columns are the drawing's; narrower the façade drops bays,
+    wider it gains them, every window at a drawn width (within 15%), one door."""
+    path = tmp_path / "unlike-13.xml"
+    boxes = _bays_each_unlike(13)
+    path.write_text(cmp_xml(boxes))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    assert inference.bays.startswith("5 bays of 5 kinds (ABCDE)"), inference.bays
+    spec = parse_spec(inference.text, path.stem)
+    raw = list((inference.raw or inference.layout).rects)
+    widths = [r.x1 - r.x0 for r in raw if r.label == "window"]
+    layout = solve(spec)
+    assert {n: v for n, v in layout.counters.items() if n.startswith("bays")} == {
+        "bays1": 1,
+        "bays2": 1,
+        "bays3": 1,
+    }
+    assert _columns(list(solved_layout(layout, spec, inference).rects)) == _columns(raw)
+    for share in (0.7, 2.0):
+        rects = _solved(inference, spec, share)
+        columns = len(_columns(rects))
+        assert columns < len(_columns(raw)) if share < 1 else columns > len(_columns(raw))
+        windows = [r for r in rects if r.label == "window"]
+        assert all(any(abs((r.x1 - r.x0) / w - 1) <= 0.15 for w in widths) for r in windows)
+        assert sum(r.label == "door" for r in rects) == 1

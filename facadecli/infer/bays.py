@@ -82,6 +82,7 @@ from facadecli.grammar.fidelity import Fidelity, fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
 from facadecli.infer.structure import SHARE, beyond_limits
+from facadecli.solver.sizing import MIN_SIZE
 
 ALIKE = 0.05  # of the bay's width: elements this close are the same in two bays
 COUNTERS = 2  # the most counters of runs of bays
@@ -92,6 +93,7 @@ COLUMN = 0.01  # m: a kind's elements of a label and size this close stand in on
 MARGIN = 0.005  # of the façade's width: what an end bay leaves of the margin beyond it
 DIGITS = 4  # of a metre: a kind's shape is rounded to this, so every word adds up alike
 ROUNDING = 1e-4  # m: the most rounding to DIGITS moves an edge, with float noise
+SLIVER = MIN_SIZE  # m: an element this near a bay's edge or another's meets it (``_unslivered``)
 CENTRED = 1e3  # the weight of a mirrored façade's bays standing in its middle
 SETTLE = 1e-3  # the weight of a kind's width and centres as first read, against the elements'
 AXIS = 0.01  # of the façade's width: an opening this close to another's reflection mirrors it
@@ -761,15 +763,46 @@ def _as_placed(
     the façade's shared sizes within ``ALIKE`` of a bay (``_shapes``), the fidelity gate
     refused CMP's b0003, b0004, b0007 and b0008; the structure's sizes and rows are
     already shared ones."""
-    shapes = []
-    for mine in slots:
-        shape: list[Slot] = []
-        for label, centre, size, y0, y1 in mine:
-            low, high = round(centre - size / 2, DIGITS), round(centre + size / 2, DIGITS)
-            shape.append((label, (low + high) / 2, round(high - low, DIGITS), y0, y1))
-        shapes.append(shape)
     widths = tuple(round(b - a, DIGITS) for a, b in spans)
+    shapes = []
+    for mine, width in zip(slots, widths, strict=True):
+        edges = [
+            (round(centre - size / 2, DIGITS), round(centre + size / 2, DIGITS))
+            for _, centre, size, _, _ in mine
+        ]
+        edges = _unslivered(edges, width)
+        shapes.append(
+            [
+                (label, (low + high) / 2, round(high - low, DIGITS), y0, y1)
+                for (label, _, _, y0, y1), (low, high) in zip(mine, edges, strict=True)
+            ]
+        )
     return round(spans[0][0], DIGITS), widths, shapes
+
+
+def _unslivered(edges: list[Span], width: float) -> list[Span]:
+    """A bay's elements (edges in its frame, rounded to ``DIGITS``), each moved (its
+    size kept) by less than ``SLIVER`` onto the bay's edge or another element's edge
+    where it stands nearer than that to one: a gap that narrow is no gap the solver can
+    make (its least letter, ``solver.sizing.MIN_SIZE``), so a bay on a counter holding
+    one (an element drawn a fifth of a millimetre in from the bay's edge: CMP's b0003
+    and b0008) gave a spec that cannot solve at the drawn counts, and the solver took
+    other counts at the input's size. The first in the order of their left edges settle
+    first; the later ones snap to them."""
+    placed: list[Span] = []
+    order = sorted(range(len(edges)), key=lambda k: edges[k])
+    out = list(edges)
+    for k in order:
+        low, high = out[k]
+        targets = [0.0, width, *(e for j in placed for e in out[j])]
+        shift = min(
+            (t - e for e in (low, high) for t in targets if 1e-9 < abs(t - e) < SLIVER),
+            key=abs,
+            default=0.0,
+        )
+        out[k] = (round(low + shift, DIGITS), round(high + shift, DIGITS))
+        placed.append(k)
+    return out
 
 
 def _sized(slot: Slot) -> tuple[float, float, float, float]:
