@@ -791,7 +791,7 @@ def _unslivered(edges: list[Span], width: float) -> list[Span]:
     and b0008) gave a spec that cannot solve at the drawn counts, and the solver took
     other counts at the input's size. The first in the order of their left edges settle
     first; the later ones snap to them."""
-    placed: list[Span] = []
+    placed: list[int] = []
     order = sorted(range(len(edges)), key=lambda k: edges[k])
     out = list(edges)
     for k in order:
