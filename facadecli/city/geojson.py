@@ -142,6 +142,18 @@ def _text(path: Path) -> str:
     return decode_utf8(raw, str(path), "save the GeoJSON as UTF-8 (RFC 7946)")
 
 
+def changed_while_read(file: str) -> SpecError:
+    """The error of a footprints file whose features, read again a feature at a time,
+    are not those its first pass counted (GeoJSON, GeoPackage, Shapefile, FlatGeobuf)."""
+    return SpecError.at(
+        file,
+        None,
+        None,
+        "the footprints file changed while it was read",
+        "run again once the file is written",
+    )
+
+
 def too_long(path: Path) -> SpecError:
     """The error of a footprints file past the limit of a file read whole."""
     return SpecError.at(
@@ -219,13 +231,7 @@ class Features(Sequence[Any]):
         except (OSError, _NotStreamed, _TooLong, json.JSONDecodeError, ValueError):
             found = -1  # UnicodeDecodeError is a ValueError
         if found != self.length:
-            raise SpecError.at(
-                str(self.path),
-                None,
-                None,
-                "the footprints file changed while it was read",
-                "run again once the file is written",
-            )
+            raise changed_while_read(str(self.path))
 
     @overload
     def __getitem__(self, index: int) -> Any: ...

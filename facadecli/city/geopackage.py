@@ -31,7 +31,13 @@ import pyproj.exceptions
 import shapely
 import shapely.errors
 
-from facadecli.city.geojson import GeoJSON, NoPlaces, printable, too_long
+from facadecli.city.geojson import (
+    GeoJSON,
+    NoPlaces,
+    changed_while_read,
+    printable,
+    too_long,
+)
 from facadecli.errors import SpecError
 from facadecli.limits import (
     GEOJSON_BYTES_MAX,
@@ -166,13 +172,7 @@ class Rows(Iterable[dict[str, Any]]):
         except sqlite3.Error as error:
             raise _refused(error, budget, self.steps[0], size, file) from None
         if found != self.count:
-            raise SpecError.at(
-                file,
-                None,
-                None,
-                "the footprints file changed while it was read",
-                "run again once the file is written",
-            )
+            raise changed_while_read(file)
 
 
 def _crs(db: sqlite3.Connection, srs: Any, file: str) -> pyproj.CRS:

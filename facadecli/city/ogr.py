@@ -22,7 +22,7 @@ import pyproj.exceptions
 import shapely
 import shapely.errors
 
-from facadecli.city.geojson import GeoJSON, NoPlaces, too_long
+from facadecli.city.geojson import GeoJSON, NoPlaces, changed_while_read, too_long
 from facadecli.errors import SpecError
 from facadecli.limits import GEOJSON_BYTES_MAX
 
@@ -98,13 +98,7 @@ class Records(Iterable[dict[str, Any]]):
                 )
             del meta, ids, geometries, columns
         if found != self.count:
-            raise SpecError.at(
-                file,
-                None,
-                None,
-                "the footprints file changed while it was read",
-                "run again once the file is written",
-            )
+            raise changed_while_read(file)
 
 
 def _feature(fid: int, properties: dict[str, Any], blob: Any) -> dict[str, Any]:
