@@ -186,3 +186,36 @@ def test_contradicting_bounds_are_only_claimed_where_the_qp_finds_no_layout() ->
                 claimed += 1
                 assert sized is None, (seed, trial)
     assert claimed >= 20 and feasible >= 40, (claimed, feasible)
+
+
+# -- Clarabel's matrices, made from the nonzeros alone -----------------------------------
+def _dense(matrix: sizing._Csc) -> np.ndarray:
+    made = np.zeros(matrix.shape)
+    for j in range(matrix.shape[1]):
+        cut = slice(matrix.indptr[j], matrix.indptr[j + 1])
+        made[matrix.indices[cut], j] = matrix.data[cut]
+    return made
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_qp_solver_is_given_the_dense_constraints_nonzeros_in_canonical_order(
+    seed: int,
+) -> None:
+    """Clarabel's constraint matrix, made from the equalities' nonzeros and the bounds
+    (not from a dense matrix of them, tens of millions of entries on a long façade), is
+    the dense ``[E; -I_lower; I_upper]``: the same entries, column by column with the rows
+    in order (canonical), so Clarabel is given the same problem, value for value."""
+    rng = np.random.default_rng(seed)
+    e, d = random_system(seed, rows=10 + seed, variables=14)
+    n = e.shape[1]
+    made = bounded(e, d, np.where(rng.random(n) < 0.6, 0.0, -np.inf), np.full(n, np.inf))
+    made.upper = np.where(rng.random(n) < 0.3, 5.0, np.inf)
+    low, high = np.flatnonzero(np.isfinite(made.lower)), np.flatnonzero(np.isfinite(made.upper))
+    matrix = sizing._constraints(made, low, high)
+    expected = np.vstack([e, -np.eye(n)[low], np.eye(n)[high]])
+    assert matrix.shape == expected.shape
+    assert np.array_equal(_dense(matrix), expected)
+    assert matrix.nnz == np.count_nonzero(expected)
+    for j in range(n):  # rows in order within each column: canonical
+        rows = matrix.indices[matrix.indptr[j] : matrix.indptr[j + 1]]
+        assert (np.diff(rows) > 0).all()
