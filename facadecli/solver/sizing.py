@@ -207,6 +207,30 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
     )
 
 
+# what a program is made of: the canvas, and each group's name, rows and entries
+AlignedKey = tuple[float, tuple[tuple[str, tuple[object, ...], tuple[object, ...]], ...]]
+Sized = dict[AlignedKey, tuple[Program, "Sizing | None"]]
+
+
+def sized_alignments(
+    spec: Spec, groups: Mapping[str, Alignment], canvas: float, known: Sized | None = None
+) -> tuple[Program, Sizing | None]:
+    """The alignments' program (:func:`build_program`) and its optimum
+    (:func:`search_solve`); remembered in ``known`` (one spec's: the caller keeps it for
+    one axis solve) by what the program is made of, each group's rows and entries and the
+    canvas, so that constructions laid from other sizes that cut the rows into the same
+    columns are sized once. The same program, so the same answer."""
+    if known is None:
+        program = build_program(spec, groups, canvas)
+        return program, search_solve(program)
+    key = (canvas, tuple((name, a.rows, a.entries) for name, a in sorted(groups.items())))
+    found = known.get(key)
+    if found is None:
+        program = build_program(spec, groups, canvas)
+        found = known[key] = (program, search_solve(program))
+    return found
+
+
 def _difference(a: Mapping[int, float], b: Mapping[int, float]) -> tuple[tuple[int, float], ...]:
     """The row ``a - b``: its nonzero coefficients, by variable."""
     merged = dict(a)
