@@ -219,3 +219,54 @@ def test_the_qp_solver_is_given_the_dense_constraints_nonzeros_in_canonical_orde
     for j in range(n):  # rows in order within each column: canonical
         rows = matrix.indices[matrix.indptr[j] : matrix.indptr[j + 1]]
         assert (np.diff(rows) > 0).all()
+
+
+# -- alignments sized once per axis solve -----------------------------------------------
+def _solved(text: str, width: float) -> tuple[object, ...]:
+    from facadecli import parse_spec, retarget, solve
+
+    layout = solve(retarget(parse_spec(text, "generated"), width=width))
+    return (
+        layout.shapes,
+        dict(layout.x.letters),
+        dict(layout.y.letters),
+        layout.x.objective,
+        layout.x.proven,
+        layout.warnings,
+    )
+
+
+@pytest.mark.parametrize(
+    ("layers", "bays", "stretch"), [(6, 3, 1.07), (10, 5, 0.83), (14, 4, 1.31)]
+)
+def test_alignments_sized_once_give_the_layouts_sized_anew_with_fewer_programs(
+    monkeypatch: pytest.MonkeyPatch, layers: int, bays: int, stretch: float
+) -> None:
+    """The constructions remember the alignments they sized (``sizing.sized_alignments``,
+    by each group's rows and entries): generated façades at a width their words do not
+    fill solve to the same layouts, byte for byte, as when every construction builds and
+    solves its program anew, with fewer programs built (the work saved)."""
+    from tests.benchmarks.generated import generated_spec
+
+    text = generated_spec(layers=layers, bays=bays)
+    width = round((1.0 + bays * 2.4) * stretch, 2)
+    built = [0]
+    build = sizing.build_program
+
+    def counted(*args: object, **kwargs: object) -> sizing.Program:
+        built[0] += 1
+        return build(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(sizing, "build_program", counted)
+    remembered = _solved(text, width)
+    with_memory = built[0]
+    sized = sizing.sized_alignments
+    monkeypatch.setattr(
+        sizing,
+        "sized_alignments",
+        lambda spec, groups, canvas, known=None: sized(spec, groups, canvas),
+    )
+    built[0] = 0
+    anew = _solved(text, width)
+    assert remembered == anew
+    assert with_memory < built[0], (with_memory, built[0])
