@@ -385,6 +385,19 @@ function regionsPicture(data, columns, rows) {
   picture.needsUpdate = true;
   return picture;
 }
+// A lawn's edge, soft and ragged (a verge, not a line ruled at the plan's cell): its
+// share of grass the mean of four places LAWN_BLUR metres round, each moved by a smooth
+// wobble up to LAWN_WOBBLE metres (the same at a place each time)
+const LAWN_BLUR = 0.6, LAWN_WOBBLE = 0.35;
+const LAWN_EDGE = `
+  float lawnAt(vec2 place) { return texture2D(regions, (place - regionsFrom) / regionsSize).b; }
+  float lawnEdge(vec2 place) {
+    vec2 moved = place + ${LAWN_WOBBLE.toFixed(2)} * vec2(
+      sin(place.x * 1.9 + 2.0 * sin(place.y * 0.7)), sin(place.y * 2.3 + 2.0 * sin(place.x * 0.6)));
+    float blur = ${LAWN_BLUR.toFixed(2)};
+    return 0.25 * (lawnAt(moved + vec2(blur, 0.0)) + lawnAt(moved - vec2(blur, 0.0))
+                   + lawnAt(moved + vec2(0.0, blur)) + lawnAt(moved - vec2(0.0, blur)));
+  }`;
 const allPaving = () => regionsPicture(new Uint8Array([255, 0, 0, 0]), 1, 1);
 uses.regions.value = allPaving();
 ground.material.onBeforeCompile = shader => {
@@ -396,10 +409,12 @@ ground.material.onBeforeCompile = shader => {
     uniform vec4 town; uniform float hazeFrom;
     #define TOWN_PAVED ${TOWN_PAVED.toFixed(1)}
     #define TOWN_EDGE ${TOWN_EDGE.toFixed(1)}
-    varying vec2 vGround;\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
+    varying vec2 vGround;
+    ${LAWN_EDGE}\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
     #include <map_fragment>
     vec2 inPlan = (vGround - regionsFrom) / regionsSize;
     vec4 share = texture2D(regions, inPlan);
+    share.b = lawnEdge(vGround);
     // past the plan's margin the town's streets give way to what most of the district's
     // open ground is (its squares, or its lawns), out to the haze
     // (from TOWN_EDGE metres inside the margin's edge: the picture's edge, clamped, drew
@@ -521,12 +536,55 @@ function placeStreetParts(cells, dashes, lamps, place) {
     if (part.instanceColor) part.instanceColor.needsUpdate = true;
   }
 }
+// The benches (street furniture, one instanced mesh: one draw call whatever their
+// number, no randomness): a seat of timber slats BENCH_SEAT metres up on two cast-iron
+// ends, a back rest leaning back; the seat's front faces +x, the way benchCells gives
+const BENCH_LONG = 1.8, BENCH_SEAT = 0.45;
+function benchShape() {
+  const slat = (deep, high, x, y, lean = 0) => new THREE.BoxGeometry(deep, high, BENCH_LONG)
+    .rotateZ(lean).translate(x, y, 0);
+  const parts = [slat(0.14, 0.04, 0.13, BENCH_SEAT), slat(0.14, 0.04, -0.02, BENCH_SEAT),
+                 slat(0.04, 0.14, -0.14, BENCH_SEAT + 0.2, 0.2),
+                 slat(0.04, 0.14, -0.17, BENCH_SEAT + 0.38, 0.2)];
+  const timber = mergeGeometries(parts.map(part => part.toNonIndexed()));
+  const ends = [-1, 1].map(side => new THREE.BoxGeometry(0.42, BENCH_SEAT, 0.06)
+    .translate(0.02, BENCH_SEAT / 2, side * (BENCH_LONG / 2 - 0.15)).toNonIndexed());
+  const iron = mergeGeometries(ends);
+  // one mesh, two materials (groups): timber, then the iron ends
+  return mergeGeometries([timber, iron], true);
+}
+let benches = new THREE.InstancedMesh(benchShape(), [
+  new THREE.MeshStandardMaterial({color: 0x8a6240, roughness: 0.8}),
+  new THREE.MeshStandardMaterial({color: 0x2b2e2f, roughness: 0.5, metalness: 0.6})], 1);
+for (const material of benches.material) endsInHaze(material);
+benches.count = 0; benches.frustumCulled = false;
+benches.castShadow = benches.receiveShadow = true;
+scene.add(benches);
+function placeBenches(cells, place) {
+  if (benches.instanceMatrix.count < cells.length) {  // grown: a mesh with room for them
+    const bigger = new THREE.InstancedMesh(benches.geometry, benches.material, cells.length);
+    bigger.frustumCulled = false; bigger.castShadow = bigger.receiveShadow = true;
+    scene.remove(benches); benches.dispose(); scene.add(bigger);
+    benches = bigger;
+  }
+  const matrix = new THREE.Matrix4(), turn = new THREE.Quaternion();
+  const up = new THREE.Vector3(0, 1, 0), at = new THREE.Vector3();
+  const size = new THREE.Vector3(1, 1, 1);
+  cells.forEach(([cell, across, down], index) => {
+    const [x, y, z] = place(cell);
+    turn.setFromAxisAngle(up, Math.atan2(down, across));  // rows run to -z, as the lamps
+    benches.setMatrixAt(index, matrix.compose(at.set(x, y, z), turn, size));
+  });
+  benches.count = cells.length;
+  benches.instanceMatrix.needsUpdate = true;
+}
 function groundRegions(model, box, district) {  // a model after another: its own ground
   uses.regions.value.dispose();
   uses.regions.value = allPaving();
   uses.town.value.copy(PAVED);
   delete document.body.dataset.ground;
   placeStreetParts([], [], [], null);
+  placeBenches([], null);
   const buildings = model.children.length;
   if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
   const {cell, columns, rows, building} = districtPlan(model, box);
@@ -553,11 +611,14 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   const treesAt = treeCells(plan, wide, cell), dashes = dashCells(plan, wide, deep, cell);
   const lamps = lampCells(plan, wide, deep, cell, treesAt);
   placeStreetParts(treesAt, dashes, lamps, place);
+  const benchesAt = benchCells(plan, wide, deep, cell, [...treesAt, ...lamps.map(([at]) => at)]);
+  placeBenches(benchesAt, place);
   document.body.dataset.ground = JSON.stringify({
     paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
     grass: share(counts[3]), cell, area: +(columns * rows * cell * cell).toFixed(1),
     trees: treesAt.map(at => place(at).map(v => +v.toFixed(2))),
-    dashes: dashes.length, lamps: lamps.map(([at]) => place(at).map(v => +v.toFixed(2)))});
+    dashes: dashes.length, lamps: lamps.map(([at]) => place(at).map(v => +v.toFixed(2))),
+    benches: benchesAt.map(([at]) => place(at).map(v => +v.toFixed(2)))});
   uses.regions.value.dispose();
   uses.regions.value = regionsPicture(data, wide, deep);
   // the picture's row 0 is the plan's, at the district's +z edge (districtPlan)
