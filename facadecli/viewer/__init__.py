@@ -387,16 +387,29 @@ function regionsPicture(data, columns, rows) {
 }
 // A lawn's edge, soft and ragged (a verge, not a line ruled at the plan's cell): its
 // share of grass the mean of four places LAWN_BLUR metres round, each moved by a smooth
-// wobble up to LAWN_WOBBLE metres (the same at a place each time)
-const LAWN_BLUR = 0.6, LAWN_WOBBLE = 0.35;
+// noise up to LAWN_WOBBLE metres, eased; and the grass's tone, smooth noise at two
+// scales (blades and patches), not squares of 0.2 m, which drew a staircase along every
+// lawn's edge. The same at a place each time.
+const LAWN_BLUR = 0.5, LAWN_WOBBLE = 0.45;
 const LAWN_EDGE = `
+  float lawnHash(vec2 p) { return fract(sin(dot(p, vec2(12.9898, 78.233))) * 43758.5453); }
+  float lawnNoise(vec2 p) {
+    vec2 i = floor(p), f = fract(p);
+    f = f * f * (3.0 - 2.0 * f);
+    return mix(mix(lawnHash(i), lawnHash(i + vec2(1.0, 0.0)), f.x),
+               mix(lawnHash(i + vec2(0.0, 1.0)), lawnHash(i + vec2(1.0, 1.0)), f.x), f.y);
+  }
   float lawnAt(vec2 place) { return texture2D(regions, (place - regionsFrom) / regionsSize).b; }
   float lawnEdge(vec2 place) {
-    vec2 moved = place + ${LAWN_WOBBLE.toFixed(2)} * vec2(
-      sin(place.x * 1.9 + 2.0 * sin(place.y * 0.7)), sin(place.y * 2.3 + 2.0 * sin(place.x * 0.6)));
+    vec2 moved = place + ${(2 * LAWN_WOBBLE).toFixed(2)} * (vec2(
+      lawnNoise(place * 1.3), lawnNoise(place * 1.3 + 17.0)) - 0.5);
     float blur = ${LAWN_BLUR.toFixed(2)};
-    return 0.25 * (lawnAt(moved + vec2(blur, 0.0)) + lawnAt(moved - vec2(blur, 0.0))
-                   + lawnAt(moved + vec2(0.0, blur)) + lawnAt(moved - vec2(0.0, blur)));
+    float share = 0.25 * (lawnAt(moved + vec2(blur, 0.0)) + lawnAt(moved - vec2(blur, 0.0))
+                          + lawnAt(moved + vec2(0.0, blur)) + lawnAt(moved - vec2(0.0, blur)));
+    return smoothstep(0.15, 0.85, share);
+  }
+  float lawnTone(vec2 place) {
+    return 0.72 + 0.32 * lawnNoise(place * 7.0) + 0.24 * lawnNoise(place * 0.35);
   }`;
 const allPaving = () => regionsPicture(new Uint8Array([255, 0, 0, 0]), 1, 1);
 uses.regions.value = allPaving();
@@ -425,7 +438,7 @@ ground.material.onBeforeCompile = shader => {
     share = mix(share, town, smoothstep(-TOWN_EDGE, TOWN_PAVED, beyond));
     float speck = fract(sin(dot(floor(vGround * 5.0), vec2(12.9898, 78.233))) * 43758.5453);
     vec3 asphalt = vec3(0.042, 0.042, 0.045) * (0.9 + 0.2 * speck);
-    vec3 grass = vec3(0.05, 0.075, 0.028) * (0.8 + 0.4 * speck);
+    vec3 grass = vec3(0.05, 0.075, 0.028) * lawnTone(vGround);
     vec3 paved = diffuseColor.rgb * mix(1.0, 1.5, share.a);
     diffuseColor.rgb = (paved * share.r + asphalt * share.g + grass * share.b)
       / max(share.r + share.g + share.b, 1e-3);`);
