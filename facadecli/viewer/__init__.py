@@ -156,15 +156,16 @@ function cloudiness(direction) {  // 0 (clear) .. 1 (thick cloud) in a direction
 // a little cool: the white balance (below) warms the whole sky as it cancels its blue
 const CLOUD_TOP = new THREE.Color(0xeef3ff), CLOUD_BASE = new THREE.Color(0xa9b4c6);
 const GLOW = new THREE.Color(0xfff1dc);
-function skyRadiance(direction, colour) {
+function cloudShade(direction, cloud, shade) {  // a cloud's colour, lit from the sun's side
+  const lit = 0.9 + 0.3 * Math.max(0, direction.dot(sunDirection));
+  return shade.copy(CLOUD_BASE).lerp(CLOUD_TOP, 1 - cloud * 0.6)
+    .multiplyScalar(SKY_LIGHT * 1.35 * lit);
+}
+function skyRadiance(direction, colour, clouds = true) {
   const y = Math.max(direction.y, 0);
   colour.copy(HORIZON).lerp(ZENITH, Math.pow(y, 0.6)).multiplyScalar(SKY_LIGHT);
-  const cloud = cloudiness(direction);
-  if (cloud > 0) {  // lit from the sun's side: brighter towards it
-    const lit = 0.9 + 0.3 * Math.max(0, direction.dot(sunDirection));
-    const shade = CLOUD_BASE.clone().lerp(CLOUD_TOP, 1 - cloud * 0.6);
-    colour.lerp(shade.multiplyScalar(SKY_LIGHT * 1.35 * lit), cloud);
-  }
+  const cloud = clouds ? cloudiness(direction) : 0;
+  if (cloud > 0) colour.lerp(cloudShade(direction, cloud, new THREE.Color()), cloud);
   const towards = Math.max(0, direction.dot(sunDirection));
   colour.add(GLOW.clone().multiplyScalar(2.5 * Math.pow(towards, 24)));
   if (towards > SUN_DISC) colour.add(GLOW.clone().multiplyScalar(40));
@@ -179,7 +180,7 @@ function skyRadiance(direction, colour) {
 // mirrors is here, 5-15° below the horizon: it was paving as bright as the haze, the
 // same grey all over, so a pane showed nothing but a dark slate.
 const FRONTS = 0.26, WINDOWS = 0.5, SUNLIT = 2;
-function skyPicture(width, height, below, skyline) {
+function skyPicture(width, height, below, skyline, clouds = true) {
   const data = new Float32Array(width * height * 4);
   const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
   const horizon = HORIZON.clone().multiplyScalar(SKY_LIGHT);
@@ -192,7 +193,7 @@ function skyPicture(width, height, below, skyline) {
                     Math.sin(azimuth) * Math.cos(elevation));
       if (skyline) while (skyline[block][1] <= u) block++;
       if (y >= 0) {
-        skyRadiance(direction, colour);
+        skyRadiance(direction, colour, clouds);
         if (skyline) {
           const [, , top, tone, light] = skyline[block];
           if (y < top) {  // a house far off: lit by the sky, half lost in the haze
@@ -274,8 +275,30 @@ function sky() {
   const haze = HORIZON.clone().multiplyScalar(SKY_LIGHT);
   haze.setRGB(haze.r * gains[0], haze.g * gains[1], haze.b * gains[2]);
   const backdrop = equirectangular(
-    balanced(skyPicture(2048, 1024, () => {}, null), gains), 2048, 1024);  // haze below
-  return {environment, backdrop, haze};
+    balanced(skyPicture(1024, 512, () => {}, null, false), gains), 1024, 512);  // haze below
+  const clouds = equirectangular(balanced(cloudPicture(2048, 1024), gains), 2048, 1024);
+  return {environment, backdrop, clouds, haze};
+}
+// The backdrop's clouds apart from its clear sky, an equirectangular picture as
+// skyPicture's: each cloud's colour and, as alpha, how thick it is (0 clear), so the
+// backdrop lays them over the sky at elevations of their own (placeBackdrop)
+function cloudPicture(width, height) {
+  const data = new Float32Array(width * height * 4);
+  const direction = new THREE.Vector3(), shade = new THREE.Color();
+  for (let row = height / 2; row < height; row++) {
+    const elevation = ((row + 0.5) / height - 0.5) * Math.PI, y = Math.sin(elevation);
+    for (let column = 0; column < width; column++) {
+      const azimuth = ((column + 0.5) / width - 0.5) * 2 * Math.PI;
+      direction.set(Math.cos(azimuth) * Math.cos(elevation), y,
+                    Math.sin(azimuth) * Math.cos(elevation));
+      const cloud = cloudiness(direction);
+      if (cloud <= 0) continue;
+      cloudShade(direction, cloud, shade);
+      const at = (row * width + column) * 4;
+      data[at] = shade.r; data[at + 1] = shade.g; data[at + 2] = shade.b; data[at + 3] = cloud;
+    }
+  }
+  return data;
 }
 const scene = new THREE.Scene();
 const daylight = sky();
@@ -286,26 +309,35 @@ scene.environment = daylight.environment;
 // eye high over a district, which at 30-35 degrees up looks down at its picture's top.
 // Above that horizon the sky's gradient, its elevations stretched up to SKY_STRETCH times
 // as the horizon drops, so the top of such a picture is sky (pale at the haze, bluer
-// above), where it was the haze below the sky's horizon.
-const SKY_STRETCH = 3;
+// above), where it was the haze below the sky's horizon. The clouds are not stretched
+// (three times flatter, they read as streaks over a district): over a lowered horizon
+// they are those up to CLOUD_LIFT radians higher in the sky, as an eye over the town
+// sees them, fading in over CLOUD_FADE radians above the haze.
+const SKY_STRETCH = 3, CLOUD_LIFT = 0.25, CLOUD_FADE = 0.08;
 let lowHorizon = false;  // a district seen from above (light); a façade's is at eye level
 const backdrop = new THREE.Scene();
 const dome = new THREE.Mesh(new THREE.SphereGeometry(1, 64, 32), new THREE.ShaderMaterial({
-  uniforms: {sky: {value: daylight.backdrop}, horizon: {value: 0}, stretch: {value: 1}},
+  uniforms: {sky: {value: daylight.backdrop}, clouds: {value: daylight.clouds},
+             horizon: {value: 0}, stretch: {value: 1}, lift: {value: 0}},
   vertexShader: `varying vec3 vDirection;
     void main() {
       vDirection = position;
       gl_Position = (projectionMatrix * modelViewMatrix * vec4(position, 1.0)).xyww;
     }`,
-  fragmentShader: `uniform sampler2D sky; uniform float horizon, stretch;
+  fragmentShader: `uniform sampler2D sky, clouds; uniform float horizon, stretch, lift;
     varying vec3 vDirection;
     #include <common>
+    vec2 equirectangular(float around, float up) {
+      return vec2(around, clamp(up, -0.5 * PI, 0.5 * PI) * RECIPROCAL_PI + 0.5);
+    }
     void main() {
       vec3 d = normalize(vDirection);
-      float up = (asin(clamp(d.y, -1.0, 1.0)) - horizon) * stretch;
-      vec2 uv = vec2(atan(d.z, d.x) * RECIPROCAL_PI2 + 0.5,
-                     clamp(up, -0.5 * PI, 0.5 * PI) * RECIPROCAL_PI + 0.5);
-      gl_FragColor = vec4(texture2D(sky, uv).rgb, 1.0);
+      float above = asin(clamp(d.y, -1.0, 1.0)) - horizon;
+      float around = atan(d.z, d.x) * RECIPROCAL_PI2 + 0.5;
+      vec3 colour = texture2D(sky, equirectangular(around, above * stretch)).rgb;
+      vec4 cloud = texture2D(clouds, equirectangular(around, above + lift));
+      float fade = lift > 0.0 ? smoothstep(0.0, ${CLOUD_FADE.toFixed(2)}, above) : 1.0;
+      gl_FragColor = vec4(mix(colour, cloud.rgb, cloud.a * fade), 1.0);
       #include <tonemapping_fragment>
       #include <colorspace_fragment>
     }`,
@@ -321,8 +353,9 @@ function placeBackdrop() {
   const horizon = !lowHorizon ? 0
     : -Math.asin(Math.min(1, high / Math.max(scene.fog.far, 1e-6)));
   dome.material.uniforms.horizon.value = horizon;
-  dome.material.uniforms.stretch.value =
-    1 + (SKY_STRETCH - 1) * THREE.MathUtils.smoothstep(-horizon, 0.01, 0.1);
+  const lowered = THREE.MathUtils.smoothstep(-horizon, 0.01, 0.1);
+  dome.material.uniforms.stretch.value = 1 + (SKY_STRETCH - 1) * lowered;
+  dome.material.uniforms.lift.value = CLOUD_LIFT * lowered;
 }
 // placed by frame(): the model clear, the ground fading out into the horizon's haze
 scene.fog = new THREE.Fog(daylight.haze, 1, 2);
