@@ -499,6 +499,21 @@ function endsInHaze(material, more = shader => shader) {
   };
 }
 endsInHaze(ground.material, ground.material.onBeforeCompile);
+// What stands on a district's ground (trees, dashes, lamps, benches) fades into the haze
+// as the ground under it does: with the fog alone, the trees on a lawn far off stood
+// out of the hazed ground as pale ghosts over the horizon
+function fadesWithGround(material) {
+  endsInHaze(material, shader => {
+    shader.uniforms.hazeFrom = uses.hazeFrom;
+    shader.fragmentShader = 'uniform float hazeFrom;\\n' + shader.fragmentShader.replace(
+      '#include <fog_fragment>', `#include <fog_fragment>
+      #ifdef USE_FOG
+      float hazed = clamp((vFogDepth - hazeFrom) / max(fogFar - hazeFrom, 1e-3), 0.0, 1.0);
+      gl_FragColor.rgb = mix(gl_FragColor.rgb, fogColor, hazed * hazed);
+      #endif`);
+  });
+  material.customProgramCacheKey = () => 'fades-with-ground';
+}
 // The street trees (a trunk and a crown, each one instanced mesh: two draw calls whatever
 // their number), the centre-line dashes and the street lamps (one more each), seeded: the
 // same each time
@@ -529,7 +544,7 @@ const trees = {
     {color: 0x3b3f42, roughness: 0.55, metalness: 0.6}), 1),
 };
 for (const part of Object.values(trees)) {
-  endsInHaze(part.material);
+  fadesWithGround(part.material);
   part.count = 0; part.frustumCulled = false; part.receiveShadow = true;
   scene.add(part);
 }
@@ -602,7 +617,7 @@ function benchShape() {
 let benches = new THREE.InstancedMesh(benchShape(), [
   new THREE.MeshStandardMaterial({color: 0x8a6240, roughness: 0.8}),
   new THREE.MeshStandardMaterial({color: 0x2b2e2f, roughness: 0.5, metalness: 0.6})], 1);
-for (const material of benches.material) endsInHaze(material);
+for (const material of benches.material) fadesWithGround(material);
 benches.count = 0; benches.frustumCulled = false;
 benches.castShadow = benches.receiveShadow = true;
 scene.add(benches);
@@ -766,6 +781,13 @@ const isGlass = material => material.transmission > 0;
 // the 4% of one face, which left every pane a dark slate. The glb keeps its glass's ior;
 // the viewer scales its F0 colour to the unit's reflectance.
 const GLAZING_REFLECTANCE = 0.15;
+// What a pane mirrors of the sky and the street, dimmed to GLASS_REFLECTION of the
+// environment's light: the sky is 2.4 times as bright as what it lights, so at street
+// level, where Fresnel raises the reflection towards the glancing angle, the mirrored
+// sky veiled the room behind a ground-floor window (a photographer's polariser does
+// the same). Mean grey of a 3 x 3 m pane with a room behind it, headless Chromium:
+// see docs/how-to/preview.md.
+const GLASS_REFLECTION = 0.6;
 const fresnelAtNormal = ior => ((ior - 1) / (ior + 1)) ** 2;
 const materialsOf = part => Array.isArray(part.material) ? part.material : [part.material];
 function castsShadows(model) {
@@ -777,6 +799,7 @@ function castsShadows(model) {
     for (const material of materials.filter(isGlass)) {
       material.transparent = false; material.opacity = 1; material.depthWrite = true;
       material.specularColor.setScalar(GLAZING_REFLECTANCE / fresnelAtNormal(material.ior));
+      material.envMapIntensity = GLASS_REFLECTION;
     }
   });
 }
