@@ -781,13 +781,6 @@ const isGlass = material => material.transmission > 0;
 // the 4% of one face, which left every pane a dark slate. The glb keeps its glass's ior;
 // the viewer scales its F0 colour to the unit's reflectance.
 const GLAZING_REFLECTANCE = 0.15;
-// What a pane mirrors of the sky and the street, dimmed to GLASS_REFLECTION of the
-// environment's light: the sky is 2.4 times as bright as what it lights, so at street
-// level, where Fresnel raises the reflection towards the glancing angle, the mirrored
-// sky veiled the room behind a ground-floor window (a photographer's polariser does
-// the same). Mean grey of a 3 x 3 m pane with a room behind it, headless Chromium:
-// see docs/how-to/preview.md.
-const GLASS_REFLECTION = 0.6;
 const fresnelAtNormal = ior => ((ior - 1) / (ior + 1)) ** 2;
 const materialsOf = part => Array.isArray(part.material) ? part.material : [part.material];
 function castsShadows(model) {
@@ -799,7 +792,6 @@ function castsShadows(model) {
     for (const material of materials.filter(isGlass)) {
       material.transparent = false; material.opacity = 1; material.depthWrite = true;
       material.specularColor.setScalar(GLAZING_REFLECTANCE / fresnelAtNormal(material.ior));
-      material.envMapIntensity = GLASS_REFLECTION;
     }
   });
 }
