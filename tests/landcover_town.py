@@ -1,5 +1,5 @@
 """A small district with its land cover, written by the tests as OSM (XML or PBF) and as
-GeoJSON, seeded sizes with known answers: a row of houses along a street, a park west of
+GeoJSON, seeded sizes with known answers: two rows of houses along a street, a park west of
 them with a pond in it (a multipolygon with an island), a riverbank south of the street, a
 wood north reaching far past the district (clipped), a car park east, a railway yard (a
 land use of no kind drawn: warned) and the town's residential land use round it all.
@@ -22,6 +22,7 @@ METRE_LAT = 1 / 111_320
 METRE_LON = 1 / (111_320 * math.cos(math.radians(ORIGIN[1])))
 
 Ring = list[tuple[float, float]]
+STREET = 16.0  # metres between the two rows of houses
 
 
 def box(x: float, y: float, w: float, d: float) -> Ring:
@@ -58,11 +59,13 @@ def town(seed: int) -> Town:
     deep = chance.uniform(9, 13)
     buildings = []
     x = 0.0
-    for k in range(houses):
-        tags = {"building": "house", "building:levels": str(chance.randint(2, 4))}
-        buildings.append(Area("way", 100 + k, box(x, 0, wide[k], deep), tags))
+    for k in range(houses):  # a row each side of a street STREET wide
+        for side, y in ((0, 0.0), (1, -STREET - deep)):
+            tags = {"building": "house", "building:levels": str(chance.randint(2, 4))}
+            buildings.append(Area("way", 100 + 20 * side + k, box(x, y, wide[k], deep), tags))
         x += wide[k] + chance.uniform(2, 6)
     east = x
+    south = -STREET - deep  # the south row's back
     # a multi-storey car park: a building, whatever its amenity
     buildings.append(
         Area("way", 150, box(east, 0, 20, 16), {"building": "yes", "amenity": "parking"})
@@ -79,10 +82,15 @@ def town(seed: int) -> Town:
             {"type": "multipolygon", "natural": "water"},
             (box(-park_w + 2 + pond - 2, 5 + pond / 2 - 2, 4, 4),),
         ),
-        Area("way", 400, box(-park_w - 8, -40, park_w + east + 16, 18), {"waterway": "riverbank"}),
+        Area(
+            "way",
+            400,
+            box(-park_w - 8, south - 30, park_w + east + 40, 18),
+            {"waterway": "riverbank"},
+        ),
         Area("way", 500, box(-20, deep + 16, 60, 400), {"landuse": "forest"}),
         Area("way", 600, box(east + 6, 0, 24, 30), {"amenity": "parking"}),
-        Area("way", 700, box(east + 6, -60, 30, 10), {"landuse": "railway"}),
+        Area("way", 700, box(east + 6, south - 60, 30, 10), {"landuse": "railway"}),
         Area("way", 800, box(-300, -300, 600, 600), {"landuse": "residential"}),
     ]
     xs = [p[0] for b in buildings for p in b.outer]
@@ -97,6 +105,7 @@ def _lon_lat(point: tuple[float, float]) -> tuple[float, float]:
 def write_osm(path: Path, district: Town) -> Path:
     """The district as an extract (``.osm`` or ``.osm.pbf``, by its name), sorted: nodes,
     ways, relations; a multipolygon's rings are untagged ways."""
+    path.unlink(missing_ok=True)
     writer = osmium.SimpleWriter(str(path))
     node = 0
     ways: list[Way] = []
