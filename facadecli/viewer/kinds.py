@@ -1,7 +1,8 @@
 """Whether a file is what its name says, before a page inlines it: a ``.glb`` is glTF 2.0
 binary with a JSON chunk that parses, an ``.svg`` is XML whose root is ``<svg>`` with no
 document type (so no entity of any kind, inside or outside), a ``.png`` starts with the
-PNG signature, a ``.geojson`` is a JSON FeatureCollection. Each check returns why the bytes are not of their kind, or None."""
+PNG signature, a ``.geojson`` is a JSON FeatureCollection. Each check returns why the
+bytes are not of their kind, or None."""
 
 from __future__ import annotations
 

@@ -228,7 +228,9 @@ function coverCounts(covered, wide, margin, rows, columns) {
       if (code) shares[COVER_KINDS[code - 1]]++;
     }
   }
-  for (const kind of COVER_KINDS) shares[kind] = Math.round(shares[kind] / (columns * rows) * 1000) / 1000;
+  for (const kind of COVER_KINDS) {
+    shares[kind] = Math.round(shares[kind] / (columns * rows) * 1000) / 1000;
+  }
   return {shares, trees: covered.trees.length, meshes: coverParts.children.length};
 }
 """
