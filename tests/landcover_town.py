@@ -74,7 +74,7 @@ def town(seed: int) -> Town:
     park_w, park_d = chance.uniform(30, 45), chance.uniform(25, 35)
     pond = chance.uniform(8, 12)
     cover = [
-        Area("way", 200, box(-park_w - 8, 0, park_w, park_d), {"leisure": "park"}),
+        Area("way", 200, box(-park_w - 2, 0, park_w, park_d), {"leisure": "park"}),
         Area(
             "relation",
             300,
@@ -98,7 +98,7 @@ def town(seed: int) -> Town:
     return Town(buildings, cover, (min(xs), min(ys), max(xs), max(ys)))
 
 
-def _lon_lat(point: tuple[float, float]) -> tuple[float, float]:
+def lon_lat(point: tuple[float, float]) -> tuple[float, float]:
     return ORIGIN[0] + point[0] * METRE_LON, ORIGIN[1] + point[1] * METRE_LAT
 
 
@@ -118,7 +118,7 @@ def write_osm(path: Path, district: Town) -> Path:
             ids = []
             for point in ring:
                 node += 1
-                writer.add_node(Node(id=node, location=_lon_lat(point)))
+                writer.add_node(Node(id=node, location=lon_lat(point)))
                 ids.append(node)
             refs.append([*ids, ids[0]])
         if area.kind == "way":
@@ -142,7 +142,7 @@ def write_geojson(path: Path, district: Town) -> Path:
     """The district as a GeoJSON FeatureCollection (lon/lat), tags as properties."""
     features = []
     for area in district.areas:
-        rings = [[list(_lon_lat(p)) for p in [*r, r[0]]] for r in (area.outer, *area.holes)]
+        rings = [[list(lon_lat(p)) for p in [*r, r[0]]] for r in (area.outer, *area.holes)]
         tags = {k: v for k, v in area.tags.items() if k != "type"}
         features.append(
             {
