@@ -154,3 +154,9 @@ def write_geojson(path: Path, district: Town) -> Path:
         )
     path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
     return path
+
+
+if __name__ == "__main__":  # the sample: python -m tests.landcover_town samples/park-town.osm
+    import sys
+
+    write_osm(Path(sys.argv[1]), town(1))

@@ -127,7 +127,9 @@ def test_a_city_writes_its_land_cover_georeferenced_and_the_same_bytes_each_run(
     found = read_footprints(source)
     local = {a.id: sum(p.area for p in a.parts) for a in found.ground}
     for feature in ground["features"]:
-        assert shape(feature["geometry"]).area == pytest.approx(local[feature["id"]], rel=1e-3)  # to cm
+        assert shape(feature["geometry"]).area == pytest.approx(
+            local[feature["id"]], rel=1e-3
+        )  # to cm
     _city(capsys, source, tmp_path / "b")
     assert (tmp_path / "b" / "t.ground.geojson").read_bytes() == written
 
@@ -177,3 +179,10 @@ def test_the_viewer_draws_the_land_cover_with_trees_in_the_wood_and_none_on_wate
     )
     trees = [shapely.Point(origin[0] + x, origin[1] - z) for x, _, z in ground["trees"]]
     assert trees and not any(mapped.contains(tree) for tree in trees)
+
+
+def test_the_sample_is_the_district_the_tests_write(tmp_path: Path) -> None:
+    """samples/park-town.osm is written by ``python -m tests.landcover_town``, never by
+    hand: the same bytes as the district of seed 1."""
+    sample = Path(__file__).resolve().parents[1] / "samples" / "park-town.osm"
+    assert sample.read_bytes() == write_osm(tmp_path / "p.osm", town(1)).read_bytes()
