@@ -85,10 +85,13 @@ def test_a_multipolygons_hole_is_kept_and_the_wood_clipped_to_the_district(
 
 
 def test_the_tags_that_make_land_cover() -> None:
-    """A building key wins; a polygon with no cover key is a footprint (GeoJSON exports of
-    buildings carry no tag); later kinds win (a pond tagged leisure=park too is water)."""
+    """A building key wins; a polygon of another format than OSM with no cover key, or
+    only an amenity or leisure of no kind drawn, is a footprint (exports of buildings
+    often carry no building tag); later kinds win (a pond tagged leisure=park is water)."""
     assert not is_cover({"building": "yes", "leisure": "park"})
     assert not is_cover({"measuredHeight": 9.5}) and not is_cover({})
+    assert not is_cover({"amenity": "school"}) and not is_cover({"leisure": "sports_centre"})
+    assert is_cover({"landuse": "residential"})  # the town's land use, counted
     assert is_cover({"landuse": "railway"}) and cover_kind({"landuse": "railway"}) is None
     assert cover_kind({"leisure": "park", "natural": "water"}) == "water"
     assert cover_kind({"landuse": "residential"}) == "built_up"

@@ -33,7 +33,15 @@ from shapely.geometry.polygon import orient
 from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
 from facadecli.city.geopackage import read_geopackage
 from facadecli.city.georef import utm_epsg
-from facadecli.city.landcover import Area, clipped, cover_kind, district_box, ignored_tag, is_cover
+from facadecli.city.landcover import (
+    LAND_COVER,
+    Area,
+    clipped,
+    cover_kind,
+    district_box,
+    ignored_tag,
+    is_cover,
+)
 from facadecli.city.ogr import is_ogr, read_ogr
 from facadecli.city.osm import is_osm, read_osm
 from facadecli.city.packed import Spooled
@@ -343,7 +351,7 @@ def survey(path: Path, bbox: BBox | None = None, names: Names | None = None) -> 
         if isinstance(read, str):
             rejected.append(_rejected(document, index, fid, read))
             continue
-        if is_cover(read[0]):
+        if feature.get(LAND_COVER) is True or is_cover(read[0]):
             kind = cover_kind(read[0])
             if kind is None:
                 ignored.append(_rejected(document, index, fid, ignored_tag(read[0])))

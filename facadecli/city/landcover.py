@@ -3,14 +3,16 @@ maps on its ground, read beside its buildings and written beside the city's mode
 ``<name>.ground.geojson`` (docs/reference/city.md, "Land cover"), which the viewer draws.
 
 A feature is land cover when it has no ``building`` or ``building:part`` tag and one of
-the keys of :data:`COVER_KEYS`; its kind is the first rule of :data:`KINDS` its tags
-meet. Land use that is the built town itself (``landuse=residential``, ``retail`` ...,
-:data:`BUILT_UP`) is left to the footprint rules of the viewer, and counted; any other
-value of those keys is a kind not drawn here: a warning (``<key> '<value>' is not a land
-cover drawn here: ignored``), counted in the report's ``warnings_by_tag`` as ignored tags
-are. The areas are clipped to the district (the buildings' extent and
-:data:`DISTRICT_MARGIN` metres round it) and written in the order of their kind, then
-their feature's place in the file: the same input gives the same bytes.
+the keys of :data:`COVER_KEYS` (an OSM area), or a kind drawn here or a key of
+:data:`NEVER_BUILDINGS` (a feature of another format: :func:`is_cover`); its kind is the
+first rule of :data:`KINDS` its tags meet. Land use that is the built town itself
+(``landuse=residential``, ``retail`` ..., :data:`BUILT_UP`) is left to the footprint
+rules of the viewer, and counted; any other value of those keys is a kind not drawn
+here: a warning (``<key> '<value>' is not a land cover drawn here: ignored``), counted in
+the report's ``warnings_by_tag`` as ignored tags are. The areas are clipped to the
+district (the buildings' extent and :data:`DISTRICT_MARGIN` metres round it) and written
+in the order of their kind, then their feature's place in the file: the same input gives
+the same bytes.
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ from facadecli.export.atomic import atomic_output
 
 COVER_KEYS = ("leisure", "landuse", "natural", "waterway", "amenity")
 BUILDING_KEYS = ("building", "building:part")
+NEVER_BUILDINGS = ("landuse", "natural", "waterway")  # keys no building carries alone
+LAND_COVER = "land_cover"  # a feature's member: an OSM area not tagged as a building
 DISTRICT_MARGIN = 50.0  # metres of land cover kept round the buildings' extent
 MIN_AREA = 1.0  # m²: a smaller piece left by clipping is a sliver
 DIGITS = 2  # centimetres: the coordinates written
@@ -61,12 +65,18 @@ UNKNOWN = "is not a land cover drawn here: ignored"
 
 
 def is_cover(properties: Mapping[str, Any]) -> bool:
-    """Whether a feature is land cover rather than a footprint: no building key, one of
-    :data:`COVER_KEYS` (a polygon with neither is a footprint, as GeoJSON exports of
-    buildings often carry no tag at all)."""
+    """Whether a feature of a GeoJSON, GeoPackage, Shapefile or FlatGeobuf file is land
+    cover rather than a footprint: no building key, and a kind drawn here, or a
+    ``landuse``, ``natural`` or ``waterway`` key (no building is tagged with those alone).
+    A polygon tagged otherwise stays a footprint, as before: exports of buildings often
+    carry no building tag (``amenity=school``, ``leisure=sports_centre``, none at all).
+    An OSM extract's areas are told apart by their building key alone (osm.py:
+    :data:`LAND_COVER` marks the others)."""
     if any(key in properties for key in BUILDING_KEYS):
         return False
-    return any(isinstance(properties.get(key), str) for key in COVER_KEYS)
+    if any(isinstance(properties.get(key), str) for key in NEVER_BUILDINGS):
+        return True
+    return cover_kind(properties) not in (None, "built_up")
 
 
 def cover_kind(properties: Mapping[str, Any]) -> str | None:

@@ -34,7 +34,7 @@ from typing import Any
 import pyproj
 
 from facadecli.city.geojson import GeoJSON, NoPlaces
-from facadecli.city.landcover import COVER_KEYS
+from facadecli.city.landcover import COVER_KEYS, LAND_COVER
 from facadecli.city.osmxml import ELEMENTS, KEYS, Places, check_xml
 from facadecli.errors import SpecError
 from facadecli.limits import OSM_ID_MAX, OSM_TEXT_CHARS_MAX
@@ -244,6 +244,7 @@ class Buildings(Iterable[dict[str, Any]]):
             return  # an old-style multipolygon's untagged ring, or an entrance way
         feature = self._feature(kind, oid, tags)
         feature["geometry"] = geometry
+        feature[LAND_COVER] = True  # not a footprint, whatever its tags (survey())
         yield feature
 
     def _undrawn(self, found: _Pass) -> Iterator[dict[str, Any]]:
