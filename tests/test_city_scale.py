@@ -207,7 +207,8 @@ def test_a_city_is_ended_by_the_writers_of_the_registry(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The merged model, 3D Tiles, USD stage, CityJSON and land cover are written by
-    CITY_WRITERS, in that order; a writer the disk refuses is exit 1 naming its output, the buildings kept."""
+    CITY_WRITERS, in that order; a writer the disk refuses is exit 1 naming its output,
+    the buildings kept."""
     manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(2)])
     assert list(CITY_WRITERS) == ["glb", "3dtiles", "usd", "cityjson", "ground"]
     called: list[str] = []
