@@ -206,10 +206,11 @@ def test_the_report_is_a_typed_object_read_as_its_json_document(tmp_path: Path) 
 def test_a_city_is_ended_by_the_writers_of_the_registry(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The merged model, 3D Tiles, USD stage and CityJSON are written by CITY_WRITERS, in
-    that order; a writer the disk refuses is exit 1 naming its output, the buildings kept."""
+    """The merged model, 3D Tiles, USD stage, CityJSON and land cover are written by
+    CITY_WRITERS, in that order; a writer the disk refuses is exit 1 naming its output,
+    the buildings kept."""
     manifest = town(tmp_path, [square(f"h{i}", x=12.0 * i) for i in range(2)])
-    assert list(CITY_WRITERS) == ["glb", "3dtiles", "usd", "cityjson"]
+    assert list(CITY_WRITERS) == ["glb", "3dtiles", "usd", "cityjson", "ground"]
     called: list[str] = []
     for name, writer in CITY_WRITERS.items():
 
@@ -221,12 +222,12 @@ def test_a_city_is_ended_by_the_writers_of_the_registry(
         monkeypatch.setitem(CITY_WRITERS, name, dataclasses.replace(writer, write=spy))
     code, _, err = city(capsys, manifest, "--usd", "--3dtiles")
     assert code == 0, err
-    assert called == ["glb", "3dtiles", "usd", "cityjson"]
+    assert called == ["glb", "3dtiles", "usd", "cityjson", "ground"]
     models = json.loads((tmp_path / "out" / "town.report.json").read_text())["models"]
     assert models["usd"] == "town.usda" and models["3dtiles"]["tileset"] == "3dtiles/tileset.json"
     called.clear()
     assert city(capsys, manifest)[0] == 0
-    assert called == ["glb", "cityjson"]  # no --usd, no --3dtiles
+    assert called == ["glb", "cityjson", "ground"]  # no --usd, no --3dtiles
 
     def full(built: BuiltCity) -> Any:
         raise OSError(errno.ENOSPC, "No space left on device")

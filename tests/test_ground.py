@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from facadecli.viewer.ground import GROUND
+from facadecli.viewer.landcover import COVER
 
 pytestmark = pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed")
 
@@ -300,3 +301,94 @@ def test_benches_stand_on_paving_at_a_lawns_edge_facing_it(seed: int) -> None:
     for index, (x, y, *_) in enumerate(ground.benches):
         for other in ground.benches[index + 1 :]:
             assert np.hypot(other[0] - x, other[1] - y) >= 40 - CELL
+# The land cover on the plan (facadecli.viewer.landcover's COVER, after GROUND's besideKind)
+COVER_DRIVER = """
+const plan = JSON.parse(require('fs').readFileSync(0, 'utf8'));
+const cover = coverCells(plan.polygons, plan.columns, plan.rows);
+const trees = coverTreeCells(cover, Float32Array.from(plan.near), plan.columns, plan.rows,
+                             plan.cell);
+console.log(JSON.stringify({cover: Array.from(cover), trees}));
+"""
+WOOD, PARK, WATER = 1, 3, 7  # COVER_KINDS' codes
+
+
+def _cover(
+    polygons: list[dict[str, Any]], columns: int, rows: int, near: np.ndarray | None = None
+) -> tuple[np.ndarray, list[int]]:
+    """COVER over a plan of ``columns`` x ``rows`` cells of CELL metres: each cell's kind
+    (rows from the top), and the trees' cells; ``near``: the distance to the buildings in
+    cells (none: far from any)."""
+    far = np.full(columns * rows, 1e9) if near is None else near.ravel()
+    plan = {"polygons": polygons, "columns": columns, "rows": rows, "cell": CELL}
+    done = subprocess.run(
+        ["node", "-e", GROUND + COVER + COVER_DRIVER],
+        input=json.dumps({**plan, "near": far.tolist()}),
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+    )
+    found: dict[str, Any] = json.loads(done.stdout)
+    return np.array(found["cover"], dtype=np.uint8).reshape(rows, columns), found["trees"]
+
+
+def _square(x0: float, y0: float, x1: float, y1: float) -> list[list[float]]:
+    return [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_ponds_island_is_the_park_round_it_and_water_lies_over_the_park(seed: int) -> None:
+    """Scanlines fill what each polygon holds (a ring's hole not), a later kind over an
+    earlier one whatever the order given: the pond's cells are its area less its island,
+    the island is the park's, nothing outside the park is covered."""
+    chance = random.Random(seed)
+    x0, y0 = chance.uniform(5, 15), chance.uniform(5, 15)
+    w, d = chance.uniform(100, 160), chance.uniform(100, 160)  # cells
+    px, py, pw = x0 + chance.uniform(10, 30), y0 + chance.uniform(10, 30), chance.uniform(30, 50)
+    island = _square(px + pw / 2 - 5, py + pw / 2 - 5, px + pw / 2 + 5, py + pw / 2 + 5)
+    polygons = [
+        {"kind": "water", "rings": [_square(px, py, px + pw, py + pw), island]},
+        {"kind": "park", "rings": [_square(x0, y0, x0 + w, y0 + d)]},
+        {"kind": "moor", "rings": [_square(0, 0, 200, 200)]},  # no kind drawn: left out
+    ]
+    cover, _ = _cover(polygons, 200, 200)
+    water = int((cover == WATER).sum())
+    assert water == pytest.approx(pw * pw - 100, abs=4 * pw)  # within a cell of the edges
+    assert cover[int(py + pw / 2), int(px + pw / 2)] == PARK  # the island
+    assert int((cover > 0).sum()) == pytest.approx(w * d, abs=2 * (w + d) + 4)
+    assert cover[int(y0 + d) + 2, int(x0 + w) + 2] == 0
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_trees_stand_in_woods_and_parks_never_on_water_nor_by_a_building(seed: int) -> None:
+    """A wood (west half) has a tree about every WOOD_EVERY (4.5 m), the park (east half)
+    fewer; none on the pond or within TREE_CLEAR (2.5 m) of it, none within 2.5 m of the
+    house standing in the wood; seeded lattice: the same trees each time."""
+    chance = random.Random(seed)
+    columns = rows = 240  # 120 m
+    middle = chance.uniform(100, 140)
+    pond = [chance.uniform(150, 170), chance.uniform(60, 120)]
+    house = (chance.uniform(20, 60), chance.uniform(20, 60))  # 16 x 16 cells
+    polygons = [
+        {"kind": "wood", "rings": [_square(0, 0, middle, rows)]},
+        {"kind": "park", "rings": [_square(middle, 0, columns, rows)]},
+        {"kind": "water", "rings": [_square(pond[0], pond[1], pond[0] + 40, pond[1] + 40)]},
+    ]
+    ys, xs = np.mgrid[0:rows, 0:columns] + 0.5
+    dx = np.maximum(np.maximum(house[0] - xs, xs - house[0] - 16), 0)
+    dy = np.maximum(np.maximum(house[1] - ys, ys - house[1] - 16), 0)
+    near = np.hypot(dx, dy)
+    cover, trees = _cover(polygons, columns, rows, near)
+    assert trees == _cover(polygons, columns, rows, near)[1]
+    kinds = [int(cover.ravel()[at]) for at in trees]
+    assert set(kinds) <= {WOOD, PARK}
+    in_wood = kinds.count(WOOD) / ((middle * rows - 256) * CELL * CELL)
+    in_park = kinds.count(PARK) / (((columns - middle) * rows - 1600) * CELL * CELL)
+    assert in_wood == pytest.approx(1 / 4.5**2, rel=0.35)
+    assert in_park < in_wood / 4
+    water_rows, water_columns = np.nonzero(cover == WATER)
+    for at in trees:
+        row, column = divmod(at, columns)
+        nearest = np.hypot(water_rows - row, water_columns - column).min() * CELL
+        assert nearest >= 2.5
+        assert near[row, column] * CELL >= 2.5

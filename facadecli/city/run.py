@@ -70,6 +70,7 @@ from facadecli.city.footprints import (
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.heap import EVERY, give_back
+from facadecli.city.landcover import kind_counts
 from facadecli.city.lods import feature_scene
 from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.packed import Packed, Picked, Points, Spooled
@@ -647,6 +648,7 @@ def check_output(outdir: Path, name: str) -> None:
         outdir / f"{name}.tiles.json",
         outdir / f"{name}.georef.json",
         outdir / f"{name}.report.jsonl",
+        outdir / f"{name}.ground.geojson",
     ):
         if os.path.isdir(output):
             problem = f"'{output}' is a folder, where an output file goes"
@@ -665,7 +667,7 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
     regular files named as this tool names them, beside the outputs it writes."""
     plain = re.escape(name)
     patterns = {
-        outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda)"
+        outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda|ground\.geojson)"
         rf"{_RANDOM}(?:tmp|bin|objects|vertices|ids)",
         outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
@@ -1039,7 +1041,7 @@ def _build(
         instanced,
     )
     _prune_pictures(outdir)
-    formats = ["glb", "3dtiles", "usd", "cityjson"]  # CITY_WRITERS' order: the report's too
+    formats = ["glb", "3dtiles", "usd", "cityjson", "ground"]  # CITY_WRITERS' order: the report's
     asked = {"3dtiles": tileset is not None, "usd": usd}
     models: dict[str, Any] = {}
     for name in (name for name in formats if asked.get(name, True)):
@@ -1051,7 +1053,7 @@ def _build(
         georeference(georef),
         entries,
         [_rejected(r) for r in found.rejected],
-        [_warning(w) for w in found.warnings if w.id in order],
+        [_warning(w) for w in (*(w for w in found.warnings if w.id in order), *found.ignored)],
         [{"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())],
         models,
         _summary(tally, found, kept, order, straight, time.perf_counter() - started),
@@ -1119,7 +1121,7 @@ def _summary(
     seconds: float,
 ) -> Summary:
     """The report's summary of a run: ``tally`` of its buildings, what was read."""
-    warned = [w for w in found.warnings if w.id in order]
+    warned = [w for w in found.warnings if w.id in order] + list(found.ignored)
     return Summary(
         buildings=len(order),
         ok=tally.ok,
@@ -1134,6 +1136,7 @@ def _summary(
         collinear_nodes_merged=straight.nodes if straight else 0,
         warnings_by_tag=dict(sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())),
         seconds=round(seconds, 2),
+        ground=kind_counts(found.ground, found.built_up),
     )
 
 

@@ -18,6 +18,7 @@ from html import escape
 from importlib import resources
 
 from facadecli.viewer.ground import GROUND
+from facadecli.viewer.landcover import COVER, COVER_DRAWN
 
 THREE_VERSION = "0.162.0"
 # specifier -> bundled file
@@ -646,6 +647,8 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   delete document.body.dataset.ground;
   placeStreetParts([], [], [], null);
   placeBenches([], null);
+  placeLandCover([], 0);  // the land cover mapped (facadecli.viewer.landcover)
+  delete document.body.dataset.cover;
   const buildings = model.children.length;
   if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
   const {cell, columns, rows, building} = districtPlan(model, box);
@@ -669,11 +672,19 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   const x = column => box.min.x + (column - margin + 0.5) * cell;
   const z = row => box.min.z + (rows + margin - row - 0.5) * cell;
   const place = at => [x(at % wide), box.min.y, z(Math.floor(at / wide))];
-  const treesAt = treeCells(plan, wide, cell), dashes = dashCells(plan, wide, deep, cell);
-  const lamps = lampCells(plan, wide, deep, cell, treesAt);
-  placeStreetParts(treesAt, dashes, lamps, place);
-  const benchesAt = benchCells(plan, wide, deep, cell, [...treesAt, ...lamps.map(([at]) => at)]);
+  const covered = coverPlan(plan, box.min.x - margin * cell, box.min.z + (rows + margin) * cell,
+                            wide, deep, cell);  // what OSM maps there: the rules fill the rest
+  const treesAt = treeCells(plan, wide, cell).filter(covered.open);
+  const dashes = dashCells(plan, wide, deep, cell).filter(([at]) => covered.open(at));
+  const lamps = lampCells(plan, wide, deep, cell, treesAt).filter(([at]) => covered.open(at));
+  const trees = [...treesAt, ...covered.trees.map((_, k) => -1 - k)];  // theirs below 0
+  placeStreetParts(trees, dashes, lamps, at => at >= 0 ? place(at)
+    : [covered.trees[-1 - at][0], box.min.y, covered.trees[-1 - at][1]]);
+  const benchesAt = benchCells(plan, wide, deep, cell, [...treesAt, ...lamps.map(([at]) => at)])
+    .filter(([at]) => covered.open(at));
   placeBenches(benchesAt, place);
+  placeLandCover(covered.polygons, box.min.y);
+  document.body.dataset.cover = JSON.stringify(coverCounts(covered, wide, margin, rows, columns));
   document.body.dataset.ground = JSON.stringify({
     paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
     grass: share(counts[3]), cell, area: +(columns * rows * cell * cell).toFixed(1),
@@ -1175,7 +1186,8 @@ function bounds(model) {
   const box = new THREE.Box3().setFromObject(model);
   if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(10, 10, 10));
   const size = box.getSize(new THREE.Vector3());
-  const district = Math.min(size.x, size.z) > 2 * size.y;  // wider and deeper than tall
+  // wider and deeper than tall, or with the land cover of a city round it
+  const district = Math.min(size.x, size.z) > 2 * size.y || Boolean(landCover);
   let points = corners(box);
   if (district && model.children.length <= FRAMED_BUILDINGS) {
     points = [];
@@ -1296,6 +1308,7 @@ function show(id, keep = false) {  // keep: the camera where the user turned it,
     shown = gltf.scene;
     castsShadows(shown);
     scene.add(shown);
+    landCover = landCoverOf(id);  // drawn by light() (groundRegions)
     light(shown);
     if (!(keep && moved)) frame(shown);
     status.textContent = 'drag to orbit, scroll to zoom';
@@ -1308,6 +1321,7 @@ resize();
 window.facadeShow = show;  // for a page's own scripts (facade watch swaps the model)
 """
 VIEWER += GROUND  # the ground under a district (facadecli.viewer.ground)
+VIEWER += COVER + COVER_DRAWN  # the land cover on it (facadecli.viewer.landcover)
 
 STYLE = (
     "body{margin:0;font-family:sans-serif;display:flex;height:100vh;background:#f4f4f4}"
