@@ -301,6 +301,8 @@ def test_benches_stand_on_paving_at_a_lawns_edge_facing_it(seed: int) -> None:
     for index, (x, y, *_) in enumerate(ground.benches):
         for other in ground.benches[index + 1 :]:
             assert np.hypot(other[0] - x, other[1] - y) >= 40 - CELL
+
+
 # The land cover on the plan (facadecli.viewer.landcover's COVER, after GROUND's besideKind)
 COVER_DRIVER = """
 const plan = JSON.parse(require('fs').readFileSync(0, 'utf8'));
