@@ -196,25 +196,24 @@ def read_models(
         except _Skip as skip:
             raise _Skip(f"its texture picture {unquote(uri)}: {skip}") from None
 
+    def optional(path: Path | None) -> bytes | None:
+        """A file beside a model's glb (its SVG, its ground), if it has one and it reads;
+        one that does not is skipped, the model kept."""
+        if path is None:
+            return None
+        try:
+            return read(path)
+        except _Skip as skip:
+            skipped.append(Skipped(path, str(skip)))
+            return None
+
     for model in models:
         try:  # a city's glb names the pictures of its run's textures/: the page holds them
             glb = embedded(read(model.glb), partial(picture, model))
         except _Skip as skip:
             skipped.append(Skipped(model.glb, str(skip)))
             continue
-        svg = None
-        if model.svg is not None:
-            try:
-                svg = read(model.svg)
-            except _Skip as skip:
-                skipped.append(Skipped(model.svg, str(skip)))
-        ground = None
-        if model.ground is not None:
-            try:
-                ground = read(model.ground)
-            except _Skip as skip:
-                skipped.append(Skipped(model.ground, str(skip)))
-        loaded.append(Loaded(model, glb, svg, ground))
+        loaded.append(Loaded(model, glb, optional(model.svg), optional(model.ground)))
     return loaded, skipped
 
 
