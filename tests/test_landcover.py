@@ -99,9 +99,10 @@ def test_the_tags_that_make_land_cover() -> None:
 
 
 def _city(capsys: pytest.CaptureFixture[str], source: Path, out: Path) -> dict:
-    code, _, err = facade(capsys, "city", source, "-o", out, "-j", "1")
+    code, said, err = facade(capsys, "city", source, "-o", out, "-j", "1")
     assert code == 0, err
     assert "landuse 'railway' is not a land cover drawn here: ignored" in err
+    assert said.rstrip().endswith(f"{out}/t.report.json, {out}/t.ground.geojson")  # named
     return json.loads((out / "t.report.json").read_text())
 
 
