@@ -27,8 +27,7 @@ import numpy as np
 import pyproj
 import shapely
 import shapely.affinity
-from shapely.geometry import MultiPolygon, Polygon
-from shapely.geometry.polygon import orient
+from shapely.geometry import Polygon
 
 from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
 from facadecli.city.geopackage import read_geopackage
@@ -41,6 +40,7 @@ from facadecli.city.landcover import (
     district_box,
     ignored_tag,
     is_cover,
+    oriented_parts,
 )
 from facadecli.city.ogr import is_ogr, read_ogr
 from facadecli.city.osm import is_osm, read_osm
@@ -462,7 +462,7 @@ def _footprint(fid: str, properties: dict[str, Any], local: Any) -> Footprint | 
     if not local.is_valid:
         local = shapely.make_valid(local)
         repaired = True
-    parts = tuple(orient(part, sign=1.0) for part in _polygons(local) if part.area >= MIN_AREA)
+    parts = oriented_parts(local, MIN_AREA)
     if not parts:
         return "no part of at least 1 m² (degenerate footprint)"
     parts, simplified = _simplify(parts)
@@ -484,9 +484,7 @@ def _simplify(parts: tuple[Polygon, ...]) -> tuple[tuple[Polygon, ...], Simplifi
     tolerance = SIMPLIFY_TOLERANCE
     while True:
         simpler = [part.simplify(tolerance, preserve_topology=True) for part in parts]
-        kept = tuple(
-            orient(p, sign=1.0) for s in simpler for p in _polygons(s) if p.area >= MIN_AREA
-        )
+        kept = tuple(p for s in simpler for p in oriented_parts(s, MIN_AREA))
         if kept and (_vertices(kept) <= MAX_VERTICES or tolerance * 2 > MAX_TOLERANCE):
             return kept, Simplified(before, _vertices(kept), tolerance)
         if not kept:  # simplified away: keep the outline as it is
@@ -538,16 +536,6 @@ def _nothing_usable(document: GeoJSON, rejected: list[Rejected]) -> SpecError:
         )
     )
     return SpecError(problems)
-
-
-def _polygons(geometry: Any) -> list[Polygon]:
-    if isinstance(geometry, Polygon):
-        return [geometry]
-    if isinstance(geometry, MultiPolygon):
-        return list(geometry.geoms)
-    if hasattr(geometry, "geoms"):  # a collection from make_valid: keep its polygons
-        return [p for g in geometry.geoms for p in _polygons(g)]
-    return []
 
 
 def _projected(source: pyproj.CRS, middles: Sequence[float]) -> pyproj.CRS:

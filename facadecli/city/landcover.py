@@ -127,8 +127,15 @@ def clipped(kind: str, fid: str, index: int, local: Any, box: tuple[float, ...])
     if not local.is_valid:
         local = shapely.make_valid(local)
     inside = shapely.clip_by_rect(local, *box)
-    parts = tuple(orient(part, sign=1.0) for part in _polygons(inside) if part.area >= MIN_AREA)
+    parts = oriented_parts(inside)
     return Area(kind, fid, index, parts) if parts else None
+
+
+def oriented_parts(geometry: Any, least: float = MIN_AREA) -> tuple[Polygon, ...]:
+    """The polygons of a geometry (a polygon, a multipolygon, or the collection
+    ``make_valid`` gives) of at least ``least`` m², outer rings counter-clockwise: the
+    parts of a footprint (footprints.py) and of a land-cover area alike."""
+    return tuple(orient(p, sign=1.0) for p in _polygons(geometry) if p.area >= least)
 
 
 def _polygons(geometry: Any) -> list[Polygon]:
