@@ -15,7 +15,6 @@ and the rest of the USD world, written without USD's own library.
 
 from __future__ import annotations
 
-import hashlib
 import re
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -23,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from facadecli.city.folders import id_digest
 from facadecli.export.atomic import write_atomic
 from facadecli.export.obj import ordered_nodes
 from facadecli.export.texture_store import TextureStore
@@ -300,6 +300,5 @@ def building_prim(stem: str) -> str:
     list of the names given is needed to keep them apart."""
     name = usd_name(stem)
     if "~" not in stem and ("." in stem or "-" in stem or HASHED.fullmatch(name)):
-        digest = hashlib.sha256(stem.encode("utf-8", "surrogatepass")).hexdigest()
-        name += "_" + digest[:16]
+        name += "_" + id_digest(stem)[:16]
     return name
