@@ -1410,9 +1410,12 @@ def _finish(
     tie: float,
 ) -> AxisLayout:
     """The placed letters of a chosen candidate, with the warnings a user should see;
-    ``lower``: the best lower bound found on its objective."""
+    ``lower``: the best lower bound found on its objective. It is proven when the bound
+    reaches its objective as sized exactly or as the searches sized it (the same program:
+    on a large objective, two QP solvers' optima differ by their precision, 1e-8 of it,
+    more than the noise of the canvas, ``tie``)."""
     warnings = []
-    proven = lower >= final.objective - tie
+    proven = lower >= min(final.objective, choice.estimate.objective) - tie
     if not proven:
         warnings.append(
             f"{axis}: the layout is not proven optimal: its objective is {final.objective:.6g} "
