@@ -144,3 +144,32 @@ layers:
     assert unseen.repeat_step(uses["twice"], spec) == pytest.approx(0.5 + 0.75)
     assert unseen.repeat_step(uses["nested"], spec) == pytest.approx(1.0)
     assert unseen.repeat_step(uses["inside"], spec) == float("inf")
+
+
+CAPPED = """
+version: 1
+name: capped
+canvas: {width: 8.0, height: 3.0}
+symbol_defaults: {opaque: true}
+symbols: {W0: 10.0, H: 3.0, A: 0.4, B: 0.5, C: 0.6, l: 3.0, u: 2.0, r: 5.0}
+patterns:
+  tiles: (A)^* (B)^* (C)^*
+layers:
+  - {name: wall, x: W0, y: H}
+  - {name: tiles, x: tiles, y: H}
+  - {name: one, x: l u r, y: H, groups: {x: one}, visible: {x: [u]}}
+"""
+
+
+def test_a_capped_candidate_space_is_bounded_by_the_rows_every_candidate_has() -> None:
+    """The tiles make more than 4,000 words within twice the canvas, so candidates are left
+    unmade by the cap; the wall and the one-off layer shrink in every one of them (by 2 m:
+    4 m² and 3 x (2/3)² m²), and the tiles fit the canvas exactly. On main the bound was 0."""
+    spec = parse_spec(CAPPED, "capped.yaml")
+    uses = pattern_uses(spec, axis_words(spec, "x"))
+    space = CandidateSpace.of(spec, uses, spec.canvas.width)
+    assert space is not None and space.truncated
+    layout = solve(spec)
+    assert layout.x.objective == pytest.approx(4.0 + 4.0 / 3.0)
+    assert layout.x.proven
+    assert layout.x.bound == pytest.approx(layout.x.objective)
