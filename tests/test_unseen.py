@@ -173,3 +173,31 @@ def test_a_capped_candidate_space_is_bounded_by_the_rows_every_candidate_has() -
     assert layout.x.objective == pytest.approx(4.0 + 4.0 / 3.0)
     assert layout.x.proven
     assert layout.x.bound == pytest.approx(layout.x.objective)
+
+
+def _branch_beyond_the_reach() -> str:
+    """A row whose long branch (20 symbols of 0.9 m, 18 m) has no word within twice the
+    8.5 m canvas, and is its best layout (shrunk, 4.51 m²); its short branch's words
+    (a soft A, hard 5 m B's) cost 6.25 m² at best, and those near the reach cannot fit."""
+    longs = [f"L{i}" for i in range(20)]
+    symbols = ", ".join(f"{name}: 0.9" for name in longs)
+    return f"""
+version: 1
+name: branches
+canvas: {{width: 8.5, height: 3.0}}
+symbol_defaults: {{opaque: true}}
+symbols: {{{symbols}, A: 1.0, B: {{size: 5.0, min: 5.0, max: 5.0}}, H: 3.0}}
+patterns:
+  row: ({" ".join(longs)} | A) (B)^*
+layers:
+  - {{name: row, x: row, y: H}}
+"""
+
+
+def test_a_branch_beyond_the_reach_is_not_bounded_by_the_other_branch() -> None:
+    """Taking repeats away keeps a word's branch, so the band of words near the reach says
+    nothing of a branch with no word within it: the answer is the long branch's layout, or
+    it is not proven (a bound from the band alone would prove the short branch's 6.25)."""
+    layout = solve(parse_spec(_branch_beyond_the_reach(), "branches.yaml"))
+    shrunk = (18.0 - 8.5) ** 2 / 20  # the long branch: 20 symbols shrink 9.5 m together
+    assert layout.x.objective <= shrunk + 1e-6 or (not layout.x.proven and layout.x.bound < shrunk)

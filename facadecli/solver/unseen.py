@@ -13,7 +13,9 @@ over 4) is not:
   least its ``min``) costs no more than shrinking a longer word's. A word longer than the
   reach, less one repeat at a time, comes down to a word no longer than the reach but
   longer than it less the most one repeat takes away (the *band*): every unseen word costs
-  at least the least of the band's words, which are all made.
+  at least the least of the band's words, which are all made. Only for a pattern without
+  alternations: a word keeps its branches, and a branch may have no word within the reach
+  (then only the core bounds).
 
 The objective sums over symbols, so what the core's symbols deviate and what a band word's
 other symbols must shrink add up: the bound is the core's plus the least band word's."""
@@ -25,7 +27,7 @@ from collections import Counter
 from collections.abc import Sequence
 from typing import NamedTuple
 
-from facadecli.patterns.ast import Alt, Fixed, Named, Node, Seq, Sym
+from facadecli.patterns.ast import Alt, Fixed, Named, Node, Seq, Sym, walk
 from facadecli.patterns.words import Word
 from facadecli.solver import construct
 from facadecli.solver.budgets import NEAR
@@ -67,6 +69,9 @@ def unseen_bounds(
         words = space.words[use.key]
         if not any(item.length <= reach for item in words):
             return Unseen(every, max(every, space.beyond))  # its words start beyond the reach
+        if not descends(use):
+            least = 0.0  # a word beyond the reach may have no made word under it
+            break
         step = repeat_step(use, spec)
         band = [item for item in words if reach - step < item.length <= reach]
         shrunk = (_shrink(spec, item.word, taken, canvas) for item in band)
@@ -105,6 +110,15 @@ def _gives_way(uses: Sequence[PatternUse], full: frozenset[int]) -> construct.Gi
         return any(other > row.highest and other in full for other in layers[group])
 
     return gives_way
+
+
+def descends(use: PatternUse) -> bool:
+    """Whether every word of the pattern comes down, one repeat at a time, to its shortest:
+    no alternation (a word keeps its branches as its repeats go, and a branch whose
+    shortest word is beyond the reach has no made word under it) and no contents."""
+    return not use.pattern.contents and not any(
+        isinstance(node, Alt) for node in walk(use.pattern.root)
+    )
 
 
 def repeat_step(use: PatternUse, spec: Spec) -> float:
