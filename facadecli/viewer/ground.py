@@ -99,14 +99,17 @@ function reachedFromEdge(near, columns, rows, least) {
     visit(column); visit((rows - 1) * columns + column);
   }
   for (let row = 0; row < rows; row++) { visit(row * columns); visit(row * columns + columns - 1); }
-  while (head < tail) {
-    const at = queue[head++], column = at % columns;
-    if (column > 0) visit(at - 1);
-    if (column < columns - 1) visit(at + 1);
-    if (at >= columns) visit(at - columns);
-    if (at < (rows - 1) * columns) visit(at + columns);
-  }
+  while (head < tail) besideEach(queue[head++], columns, rows, visit);
   return reached;
+}
+// Calls visit with each of the (up to) four cells beside the cell at, on a grid of
+// columns x rows: the step of every flood over the grid.
+function besideEach(at, columns, rows, visit) {
+  const column = at % columns;
+  if (column > 0) visit(at - 1);
+  if (column < columns - 1) visit(at + 1);
+  if (at >= columns) visit(at - columns);
+  if (at < (rows - 1) * columns) visit(at + columns);
 }
 // Whether the street at ``at`` runs on ROOM metres past it, away from its nearest wall
 // (the way the distance grows): a wide street, or the open town round the district
@@ -176,13 +179,7 @@ function buildingPieces(building, columns, rows) {
     let head = 0, tail = 0;
     const visit = at => { if (building[at] && !piece[at]) { piece[at] = id; queue[tail++] = at; } };
     visit(start);
-    while (head < tail) {
-      const at = queue[head++], column = at % columns;
-      if (column > 0) visit(at - 1);
-      if (column < columns - 1) visit(at + 1);
-      if (at >= columns) visit(at - columns);
-      if (at < (rows - 1) * columns) visit(at + columns);
-    }
+    while (head < tail) besideEach(queue[head++], columns, rows, visit);
     areas.push(tail);
   }
   return {piece, areas};
