@@ -487,6 +487,9 @@ def test_clusters_of_houses_far_apart_are_joined_by_one_network_of_streets(seed:
     assert sum(reached) >= 0.9 * len(houses), reached
 
 
+ROUND = 7.0  # metres: the circle round a road's cell that tells an end (_road_ends)
+
+
 def _road_ends(ground: Ground) -> list[tuple[int, int, float]]:
     """The ends of the roads: cells of a road's core (asphalt 2 m or more from its edge)
     round which a circle of ROUND metres meets the core in one arc alone (along a road
@@ -498,7 +501,6 @@ def _road_ends(ground: Ground) -> list[tuple[int, int, float]]:
     asphalt = ground.kinds == ASPHALT
     width = distance_transform_edt(asphalt) * CELL
     core = width >= 2
-    rows, columns = core.shape
     angles = np.linspace(0, 2 * np.pi, 72, endpoint=False)
     reach = _cells(ROUND)
     ends = []
@@ -512,9 +514,6 @@ def _road_ends(ground: Ground) -> list[tuple[int, int, float]]:
             near = width[row - reach : row + reach + 1, column - reach : column + reach + 1]
             ends.append((int(row), int(column), float(near.max())))
     return ends
-
-
-ROUND = 7.0  # metres: the circle round a road's cell that tells an end (_road_ends)
 
 
 @pytest.mark.parametrize("seed", [25, 26, 27])
