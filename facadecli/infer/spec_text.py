@@ -102,13 +102,26 @@ class _Symbols:
 
     prefix: str
     sizes: dict[float, str] = field(default_factory=dict)
+    keys: dict[float, float] = field(default_factory=dict)  # each size seen: its symbol's
 
     def of(self, size: float) -> str:
+        """The symbol of ``size``: that of a size already named within ``10**-SIZE_KEY``
+        of it, else a new one. Rounding alone splits sizes a float's noise apart that
+        fall either side of a rounding boundary (family seed 3's windows, 0.8346675 m
+        each as the structure put them, became two height symbols of one size)."""
         key = round(size, SIZE_KEY)
-        name = self.sizes.get(key)
+        known = self.keys.get(key)
+        if known is None:
+            known = next((k for k in self.sizes if abs(k - size) < 10**-SIZE_KEY), key)
+            self.keys[key] = known
+        name = self.sizes.get(known)
         if name is None:
-            name = self.sizes[key] = f"{self.prefix}{len(self.sizes) + 1}"
+            name = self.sizes[known] = f"{self.prefix}{len(self.sizes) + 1}"
         return name
+
+    def seen(self, size: float) -> list[float]:
+        """The sizes seen (rounded to ``SIZE_KEY``) that ``size``'s symbol names."""
+        return [k for k, known in self.keys.items() if known == size]
 
 
 @dataclass
@@ -448,7 +461,7 @@ def spec_text(
                 symbol,
                 _size(
                     size,
-                    None if symbol in stretched else spread.get((axis, label, size)),
+                    None if symbol in stretched else _spread_of(spread, axis, label, table, size),
                     symbol in fixed,
                     label in clear,
                     symbol in grounded,
@@ -725,6 +738,18 @@ def _by_owner(
         c: widths[k] for k, grid in enumerate(found) if framed[k] == frame for c in grid.columns
     }
     return [owner[c] for c, _ in frame]
+
+
+def _spread_of(
+    spread: Spread, axis: str, label: str, table: _Symbols, size: float
+) -> tuple[float, float] | None:
+    """The range the input's elements of ``label`` span along ``axis`` (``spread``) that
+    are now the size of ``size``'s symbol in ``table`` (``_Symbols.of``: every size it
+    names); None when none is (a band)."""
+    ranges = [spread[key] for k in table.seen(size) if (key := (axis, label, k)) in spread]
+    if not ranges:
+        return None
+    return min(low for low, _ in ranges), max(high for _, high in ranges)
 
 
 def _gap(size: float, repeated: bool, margined: bool) -> str:

@@ -355,9 +355,11 @@ def _axis(spans: list[tuple[str, float, float]], extent: float) -> list[tuple[fl
             median = statistics.median(size[k] for k in cluster)
             for k in cluster:
                 size[k] = median
+    leading = sorted(by_label, key=lambda name: (-len(by_label[name]), name != STRUCTURE, name))
+    _twins_sized(spans, size, leading)
     reference: list[float] = []
     near = NEAR * extent
-    for label in sorted(by_label, key=lambda name: (-len(by_label[name]), name != STRUCTURE, name)):
+    for label in leading:
         members = sorted(by_label[label], key=centre.__getitem__)
 
         def close(a: int, b: int) -> bool:
@@ -381,6 +383,22 @@ def _axis(spans: list[tuple[str, float, float]], extent: float) -> list[tuple[fl
         low = round(max(0.0, centre[k] - size[k] / 2), DIGITS)
         out.append((low, round(min(extent, low + size[k]), DIGITS)))
     return out
+
+
+def _twins_sized(
+    spans: list[tuple[str, float, float]], size: dict[int, float], leading: list[str]
+) -> None:
+    """Elements of different labels on one span (a sill snapped to its window's edges)
+    keep one size: that of the label first in ``leading`` (the structure's), so their
+    edges stay one after each label's sizes are clustered on its own."""
+    rank = {label: n for n, label in enumerate(leading)}
+    first: dict[tuple[float, float], int] = {}
+    for k in sorted((k for k in size if spans[k][0] in rank), key=lambda k: (rank[spans[k][0]], k)):
+        label, a, b = spans[k]
+        if (a, b) in first and spans[first[(a, b)]][0] != label:
+            size[k] = size[first[(a, b)]]
+        else:
+            first.setdefault((a, b), k)
 
 
 def _mirrored(lines: list[float], extent: float, near: float) -> list[float]:
