@@ -21,8 +21,8 @@ from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.grammar.model import Options
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import MOVE_SHARE
-from facadecli.infer.bays import FAITHFUL, KEEP, LOOSE, Bays, _common, find_bays
 from facadecli.infer import run
+from facadecli.infer.bays import FAITHFUL, KEEP, LOOSE, Bays, _common, find_bays
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.spec_text import layer_names, spec_text
 from facadecli.infer.structure import structured

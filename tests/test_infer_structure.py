@@ -537,3 +537,18 @@ def test_a_sill_drawn_on_its_windows_edges_keeps_them() -> None:
     placed = structured(layout)
     for window, sill in zip(placed.rects[:3], placed.rects[4:], strict=True):
         assert (sill.x0, sill.x1) == pytest.approx((window.x0, window.x1), abs=1e-6)
+
+
+def test_a_door_on_its_windows_edges_keeps_its_own_width() -> None:
+    """A door snapped to the edges of the windows over it keeps its own label's width:
+    the windows' sizes clustered have a median of 1.125 m, the door was drawn 1.12 m
+    wide (family-with-defects seed 2's door, drawn wider than its windows, took their
+    width and lost 0.05 of IoU). Only a companion (a sill) takes its opening's size."""
+    widths = [1.10, 1.12, 1.13, 1.14]
+    windows = [
+        Rect("window", 1.0 + 2.0 * k, 3.0, 1.0 + 2.0 * k + w, 4.5) for k, w in enumerate(widths)
+    ]
+    door = Rect("door", windows[1].x0, 0.0, windows[1].x1, 2.5)
+    placed = structured(LabelledLayout(10.0, 6.0, (*windows, door)))
+    assert placed.rects[4].x1 - placed.rects[4].x0 == pytest.approx(1.12, abs=1e-6)
+    assert placed.rects[1].x1 - placed.rects[1].x0 == pytest.approx(1.125, abs=1e-6)

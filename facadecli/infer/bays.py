@@ -20,7 +20,9 @@ a kind of several bays in at most ``ODD`` opening each way is a *variant* of it
 (``_variants``): its own kind, written once, on its base's width and symbols. Of the
 bays' other elements, those every bay of the kind shows alike stay in it, the rest stand
 apart (a balcony on one of them). Each kind is put on one shape (the median of its
-bays, so that every layer's word repeats it exactly), and the façade's x words become
+bays, so that every layer's word repeats it exactly) on one set of lines along x that
+its layers share (``_lined``: edges within ``COLUMN`` are one, so every layer writes
+its gaps in the bay between the same lines), and the façade's x words become
 one sequence of bays, written alike in every layer that stands in bays (each layer shows its own
 elements; a bay where it shows none is one hidden spacer): a repeated unit of one or
 two bays (never a unique label's: a door's bay is written once) gets a counter, at
@@ -38,8 +40,9 @@ only along y (a thin sill drawn a good share of its height off its row in some b
 stands on the shape along x and on one row of its own along y (the structure's where
 it has one in every bay of the kind, else their median where each element stays a
 companion of its openings: touching them, not behind one, its height within
-``SIZED`` but in at most ``ODD`` bay of several, a hand's outlier), as many such slots as keep the layout within ``KEEP`` of the structure's IoU,
-the cheapest first. Otherwise a slot's elements stay as the structure put them, in
+``SIZED`` but in at most ``ODD`` bay of several, a hand's outlier), as many such
+slots as keep the layout within ``KEEP`` of the structure's IoU, the cheapest first.
+Otherwise a slot's elements stay as the structure put them, in
 layers of their own off the bays (``Bays.apart``), with their own x words, and do not
 follow their windows when the façade gains or drops bays.
 

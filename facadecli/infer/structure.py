@@ -390,12 +390,14 @@ def _twins_sized(
 ) -> None:
     """Elements of different labels on one span (a sill snapped to its window's edges)
     keep one size: that of the label first in ``leading`` (the structure's), so their
-    edges stay one after each label's sizes are clustered on its own."""
+    edges stay one after each label's sizes are clustered on its own. An opening keeps
+    its own label's (a door snapped to the windows' edges over it, drawn wider than
+    they are, took their width: family-with-defects seed 2's door lost 0.05 of IoU)."""
     rank = {label: n for n, label in enumerate(leading)}
     first: dict[tuple[float, float], int] = {}
     for k in sorted((k for k in size if spans[k][0] in rank), key=lambda k: (rank[spans[k][0]], k)):
         label, a, b = spans[k]
-        if (a, b) in first and spans[first[(a, b)]][0] != label:
+        if (a, b) in first and spans[first[(a, b)]][0] != label and label not in OPENINGS:
             size[k] = size[first[(a, b)]]
         else:
             first.setdefault((a, b), k)
