@@ -80,7 +80,7 @@ bench: $(STAMP) ## Time solving the examples, a 24-layer façade, grammar extrac
 	$(BIN)/python tests/benchmarks/variations_bench.py
 	$(BIN)/python tests/benchmarks/watch_bench.py
 
-bench-large: $(STAMP) ## Time facade grammar on three large generated layouts, and facade city on a generated town of FACADE_BENCH_N buildings (default 100,000: hours; its planning memory first, FACADE_BENCH_PLAN_ONLY=1 stops there)
+bench-large: $(STAMP) ## Time facade grammar on three large generated layouts, and facade city on a generated town of FACADE_BENCH_N buildings (default 100,000: hours; its planning memory first, FACADE_BENCH_PLAN_ONLY=1 stops there; FACADE_BENCH_FORMAT=osm|pbf|gpkg|shp writes the town in that format)
 	$(BIN)/python tests/benchmarks/grammar_large_bench.py
 	$(BIN)/python tests/benchmarks/city_large_bench.py
 

@@ -39,6 +39,10 @@ PICTURES: dict[str, tuple[str, str, str]] = {
     # the whole façade; and from below, as from the street, 40° round and 12° down
     "townhouse-rooms-depth": ("townhouse", "model", "30,5,5,0.6,0.45,0.9"),
     "townhouse-rooms-street": ("townhouse", "model", "40,-12,2.4,0.5,0.35,0.9"),
+    # the rooms as wide as a room, floor at the storey's floor: 35° round, level, six
+    # times closer than the whole façade; and from below as townhouse-rooms-street
+    "townhouse-rooms-wide": ("townhouse", "model", "35,0,6,0.45,0.5,0.9"),
+    "townhouse-rooms-below": ("townhouse", "model", "40,-12,2.4,0.5,0.35,0.9"),
     "parts": ("parts", "model", "35,10,1.1,0.5,0.5"),
     "parts-elevation": ("parts", "elevation", ""),
 }

@@ -145,10 +145,11 @@ def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
     assert high[1] >= 9.0  # the tallest building's roof
     looks = [g.visual.material for g in merged.geometry.values()]
     # the recesses behind windows show a room's picture (the specs' `interior: {library:
-    # rooms}`), under mid-grey as rooms seen from a daylit street (about 118 of 255 now)
+    # rooms}`), about mid-grey as rooms seen from a daylit street read (134 of 255 now;
+    # 118 drew them as dark holes), darker than a pale wall
     interiors = [m for m in looks if m.name == "interior"]
     assert interiors and all(m.baseColorTexture is not None for m in interiors)
-    assert all(max(_seen_colour(m)) < 128 for m in interiors)
+    assert all(max(_seen_colour(m)) < 145 for m in interiors)
     written = (out / "demo-district.report.json").read_bytes()
     first = json.loads(written)["buildings"][0]
     assert first["facades"] >= 4 and first["id"] == "way/1000"

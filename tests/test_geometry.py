@@ -19,7 +19,7 @@ import trimesh
 from facadecli import load_spec, parse_spec, solve
 from facadecli.export.gltf import glb_bytes
 from facadecli.export.obj import obj_files
-from facadecli.geometry.facade import facade_scene, see_through
+from facadecli.geometry.facade import facade_scene, look, see_through
 from facadecli.geometry.primitives import GLAZED, PANES, PRIMITIVES, Cell, asset
 from facadecli.geometry.runs import built
 from facadecli.layout import SOLID_BACK, Shape, _covered, cull, uncovered_area
@@ -72,6 +72,12 @@ def _scene(path: Path) -> tuple[object, trimesh.Scene]:
     return layout, facade_scene(layout, path.parent)
 
 
+def _overlap(bounds: np.ndarray, shape: Shape) -> bool:
+    """Whether a box (bounds) overlaps a shape's cell, seen head-on."""
+    across = min(bounds[1, 0], shape.x1) > max(bounds[0, 0], shape.x0)
+    return across and min(bounds[1, 1], shape.y1) > max(bounds[0, 1], shape.y0)
+
+
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_glb_and_obj_load_back_with_the_canvas_bounds(path: Path, tmp_path: Path) -> None:
     layout, scene = _scene(path)
@@ -89,9 +95,30 @@ def test_glb_and_obj_load_back_with_the_canvas_bounds(path: Path, tmp_path: Path
     glazed += [s for s in panes if see_through(spec, s.look.pane_material)]
     walls = [s for s in pieces if s.mesh == "box" and not see_through(spec, s.material)]
     groups = {(s.layer, s.material, min(s.z0, s.z1 - 1e-4), s.z1) for s in walls}
-    # a node per piece (the walls of a layer: per material and depth), pane, recess
-    assert len(instances) == len(pieces) - len(walls) + len(groups) + len(panes) + len(glazed)
-    assert len([n for n in instances if n.endswith("/recess")]) == len(glazed)
+    # a node per piece (the walls of a layer: per material and depth), pane, and a recess
+    # behind each glass; with a ``rooms`` interior, one room a window (a frame's pane and
+    # the glazing behind it share one: :func:`.rooms.rooms`), holding each glass
+    recesses = [n for n in instances if n.endswith("/recess")]
+    assert len(instances) == len(pieces) - len(walls) + len(groups) + len(panes) + len(recesses)
+    if look(spec, "interior").library != "rooms":
+        assert len(recesses) == len(glazed)
+    else:
+        assert 0 < len(recesses) <= len(glazed)
+        held = [
+            trimesh.transform_points(loaded.geometry[loaded.graph[n][1]].bounds, loaded.graph[n][0])
+            for n in recesses
+        ]
+        for s in glazed:  # a box's glass is its cell; a frame's pane is within its frame
+            if s.mesh not in GLAZED:
+                assert any(_overlap(b, s) for b in held), (s.layer, s.x, s.y)
+                continue
+            assert any(
+                b[0, 0] <= s.x0 + 0.2
+                and b[1, 0] >= s.x1 - 0.2
+                and b[0, 1] <= s.y0 + 0.2
+                and b[1, 1] >= s.y1 - 0.2
+                for b in held
+            ), (s.layer, s.x, s.y)
     assert all(len(loaded.geometry[loaded.graph[n][1]].faces) >= 1 for n in instances)
     text, files = obj_files(scene, "f")
     (tmp_path / "f.obj").write_text(text)

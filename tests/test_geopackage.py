@@ -14,6 +14,9 @@ from shapely.geometry import Polygon
 from facadecli.city.footprints import read_footprints
 from tests.running import facade
 from tests.test_city_inputs import MANIFEST, square, town
+from tests.towns import planning_slope, write_town
+
+ROOT = Path(__file__).resolve().parents[1]
 
 RD_NEW_WKT = 'PROJCS["Amersfoort / RD New",AUTHORITY["EPSG","28992"]]'
 
@@ -129,3 +132,24 @@ def test_a_file_that_is_not_a_geopackage_is_exit_2(
     manifest.write_text(MANIFEST.replace("f.geojson", "e.gpkg"))
     code, _, err = facade(capsys, "city", manifest, "-o", tmp_path / "out", "-j", "1")
     assert code == 2 and "no feature table" in err
+
+
+def test_planning_a_geopackage_holds_no_row_of_it(tmp_path: Path) -> None:
+    """The feature table's rows are given to the survey one at a time as SQLite reads
+    them: planning a generated town of 1,600 terraces peaks at a few hundred bytes a
+    building more than one of 400 (tracemalloc; 1,959 B when every row's feature was
+    read first, about 200 B now, as the same town as GeoJSON)."""
+    slope = planning_slope(ROOT, tmp_path, "gpkg")
+    assert slope < 600, slope
+
+
+def test_a_geopackage_changed_while_it_is_read_is_an_error(tmp_path: Path) -> None:
+    from facadecli.city.geopackage import read_geopackage
+    from facadecli.errors import SpecError
+
+    path = write_town(tmp_path / "t", 5, "gpkg")
+    document = read_geopackage(path)
+    with sqlite3.connect(path) as db:
+        db.execute("DELETE FROM buildings WHERE fid = 3")
+    with pytest.raises(SpecError, match="changed while it was read"):
+        list(document.features)

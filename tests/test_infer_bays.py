@@ -165,16 +165,19 @@ def test_a_mirrored_facade_whose_bays_do_not_read_backwards_stays_mirrored(
 def test_a_facade_whose_bays_cannot_narrow_keeps_per_layer_words_and_says_so(
     tmp_path: Path,
 ) -> None:
-    """Four window bays each unlike the others (widths 1.0-1.9 m): no kind repeats, so
-    nothing could drop at 0.7x; the spec keeps a word a layer, and the spec, the report
-    and a warning say why."""
+    """Three window bays each unlike the others (widths 1.0-1.6 m), a door under the
+    middle one's windows: no kind repeats, the end bays are never repeated and the
+    door's bay is written once, so nothing could drop at 0.7x; the spec keeps a word a
+    layer, and the spec, the report and a warning say why. (Four such bays without a
+    door now share: their two inner bays each have a counter.)"""
     rects = [
         {"label": "window", "x0": x, "y0": y, "x1": x + w, "y1": y + 1.5}
-        for x, w in ((1.0, 1.0), (4.0, 1.3), (7.0, 1.6), (10.0, 1.9))
+        for x, w in ((1.0, 1.0), (4.0, 1.3), (7.0, 1.6))
         for y in (2.0, 5.0, 8.0)
     ]
+    rects.append({"label": "door", "x0": 4.0, "y0": 0.0, "x1": 5.3, "y1": 1.8})
     layout = tmp_path / "unlike.json"
-    layout.write_text(json.dumps({"canvas": {"width": 13.0, "height": 11.0}, "rects": rects}))
+    layout.write_text(json.dumps({"canvas": {"width": 9.6, "height": 11.0}, "rects": rects}))
     out = tmp_path / "unlike.yaml"
     run = subprocess.run(
         [sys.executable, "-m", "facadecli", "infer", str(layout), "-o", str(out), "--no-check"],
@@ -182,7 +185,7 @@ def test_a_facade_whose_bays_cannot_narrow_keeps_per_layer_words_and_says_so(
         text=True,
     )
     assert run.returncode == 0, run.stderr
-    assert "warning: bays not shared: none of its 4 bays of 4 kinds repeat" in run.stderr
+    assert "warning: bays not shared: none of its 3 bays of 3 kinds repeat" in run.stderr
     assert "# Bays not shared:" in out.read_text()
     report = json.loads(out.with_name("unlike.infer.json").read_text())
     assert report["bays"].startswith("not shared")
@@ -516,10 +519,11 @@ def test_a_facade_of_unlike_bays_keeps_its_windows_sized_when_narrower(
 ) -> None:
     """Five bays each unlike the others (window widths 0.9-1.7 m, a door, sills under the
     windows, the top floor's windows narrower), as real façades are drawn: no kind
-    repeats, so each layer keeps its own x word and nothing can drop at 0.7x. The walls
-    and margins take the slack, not the openings: every window and the door solved there
-    are within 15% of the width of one drawn (before, the windows were squeezed to
-    slivers)."""
+    repeats side by side. The openings are never squeezed: every window and the door
+    solved at 0.7x are within 15% of the width of one drawn (before the walls and
+    margins took the slack, the windows were squeezed to slivers); the inner bays but
+    the door's each have a counter (bays drawn once), so the façade drops bays there,
+    keeping its one door."""
     bays = ((0.6, 1.2), (3.2, 0.9), (5.6, 1.7), (8.9, 1.1), (11.4, 1.4))
     rects = []
     for k, (x, w) in enumerate(bays):
@@ -535,12 +539,12 @@ def test_a_facade_of_unlike_bays_keeps_its_windows_sized_when_narrower(
     path = tmp_path / "unlike.json"
     path.write_text(json.dumps({"canvas": {"width": 13.5, "height": 12.5}, "rects": rects}))
     inference = infer(path, path.stem, Options())
-    assert inference.bays.startswith("not shared"), inference.bays
+    assert inference.bays.startswith("5 bays of 5 kinds"), inference.bays
     spec = parse_spec(inference.text, path.stem)
     for label in ("window", "door"):
         drawn = [r["x1"] - r["x0"] for r in rects if r["label"] == label]
         found = [r.x1 - r.x0 for r in _solved(inference, spec, 0.7) if r.label == label]
-        assert len(found) == len(drawn)
+        assert 0 < len(found) <= len(drawn) and (label == "window") == (len(found) < len(drawn))
         squeezed = [w for w in found if not any(abs(w / d - 1) <= 0.15 for d in drawn)]
         assert not squeezed, (label, squeezed)
 
@@ -589,3 +593,126 @@ def test_every_layer_writes_its_bay_gaps_from_the_lines_the_bay_shares() -> None
     spec = parse_spec(text, "lines.xml")
     shapes = solve(spec).shapes
     assert sum(s.layer.startswith("sill") for s in shapes) == 5
+
+
+def _bays_drawn_unlike(seed: int) -> list[tuple[str, float, float, float, float]]:
+    """Family seed ``seed`` (mirrored, no blinds) with each bay's windows and sills drawn
+    a fifth wider a bay in from the ends (about their centres; the middle bay's as its
+    neighbours'): mirrored partners stay nearly alike (the drawing's jitter), no two bays
+    of the half are alike, as on CMP."""
+    boxes, _ = family(seed)
+    centres = sorted({round((b[1] + b[3]) / 2, 2) for b in boxes if b[0] == "window"})
+    columns: list[float] = []
+    for c in centres:
+        if not columns or c - columns[-1] > 0.02:
+            columns.append(c)
+    out = []
+    for label, x0, y0, x1, y1 in boxes:
+        if label in ("window", "sill"):
+            centre = (x0 + x1) / 2
+            bay = min(range(len(columns)), key=lambda k: abs(columns[k] - centre))
+            scale = 1 + 0.2 * min(bay, len(columns) - 1 - bay, 2)
+            half = (x1 - x0) * scale / 2
+            x0, x1 = centre - half, centre + half
+        out.append((label, x0, y0, x1, y1))
+    return out
+
+
+def test_bays_drawn_once_drop_and_gain_in_mirrored_pairs(tmp_path: Path) -> None:
+    """Seed 48 (seven bays of four floors, mirrored, the door's bay in the middle) with
+    every pair of bays the same way in drawn a fifth wider than the pair outside it
+    (``ABCDCBA``): no unit of bays repeats side by side, so before, the spec kept a word
+    a layer and solved at 0.7x or 2x kept its seven columns. Now the inner bays each
+    have a counter, at one where drawn, shared with their mirrored partner: the layout
+    at 1x keeps its 7 columns, and solved narrower or wider the façade drops or gains
+    whole columns of windows (density within 0.85-1.15), stays mirrored, and every
+    window keeps its drawn width (within 15%)."""
+    path = tmp_path / "unlike-48.xml"
+    path.write_text(cmp_xml(_bays_drawn_unlike(48)))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    assert inference.bays.startswith("7 bays of 4 kinds (ABCDCBA)"), inference.bays
+    spec = parse_spec(inference.text, path.stem)
+    raw = list((inference.raw or inference.layout).rects)
+    drawn = [r for r in raw if r.label == "window"]
+    widths = [r.x1 - r.x0 for r in drawn]
+    assert len(_columns(list(solved_layout(solve(spec), spec, inference).rects))) == 7
+    for share in (0.7, 2.0):
+        rects = _solved(inference, spec, share)
+        windows = [r for r in rects if r.label == "window"]
+        assert (len(_columns(rects)) < 7) if share < 1 else (len(_columns(rects)) > 7)
+        assert 0.85 <= len(windows) / len(drawn) / share <= 1.15, (share, len(windows))
+        assert _mirrored(rects, inference.layout.width * share)
+        assert all(any(abs((r.x1 - r.x0) / w - 1) <= 0.15 for w in widths) for r in windows)
+        assert sum(r.label == "door" for r in rects) == 1
+
+
+def _bays_each_unlike(seed: int) -> list[tuple[str, float, float, float, float]]:
+    """Family seed ``seed`` with each bay's windows and sills drawn wider or narrower
+    about their centres, by a share of their own that no other bay shares (0.7-1.4):
+    every bay a kind of its own, as on most CMP samples."""
+    boxes, _ = family(seed)
+    centres = sorted({round((b[1] + b[3]) / 2, 2) for b in boxes if b[0] == "window"})
+    columns: list[float] = []
+    for c in centres:
+        if not columns or c - columns[-1] > 0.02:
+            columns.append(c)
+    scales = (1.0, 1.3, 0.85, 1.15, 0.7, 1.4, 0.95, 1.22, 0.78)
+    out = []
+    for label, x0, y0, x1, y1 in boxes:
+        if label in ("window", "sill"):
+            centre = (x0 + x1) / 2
+            bay = min(range(len(columns)), key=lambda k: abs(columns[k] - centre))
+            half = (x1 - x0) * scales[bay] / 2
+            x0, x1 = centre - half, centre + half
+        out.append((label, x0, y0, x1, y1))
+    return out
+
+
+def test_bays_drawn_once_solve_at_their_drawn_counts_at_1x(tmp_path: Path) -> None:
+    """Seed 13 (five bays of four floors, the door under the second's windows) with
+    every bay drawn unlike the others (``ABCDE``): the three inner bays are on counters
+    at one where drawn. The structure leaves one sill a fifth of a millimetre in from
+    its bay's edge; written as a gap, that sliver is under the solver's least letter (a
+    millimetre), so the drawn counts had no layout and the solver took others at the
+    input's size (before: no end bays, the narrowest bay four times, the door's column
+    moved). Now the element meets the edge: solved at 1x every counter of bays is at
+    its drawn count and the columns are the drawing's; narrower the façade drops bays,
+    wider it gains them, every window at a drawn width (within 15%), one door."""
+    path = tmp_path / "unlike-13.xml"
+    boxes = _bays_each_unlike(13)
+    path.write_text(cmp_xml(boxes))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    assert inference.bays.startswith("5 bays of 5 kinds (ABCDE)"), inference.bays
+    spec = parse_spec(inference.text, path.stem)
+    raw = list((inference.raw or inference.layout).rects)
+    widths = [r.x1 - r.x0 for r in raw if r.label == "window"]
+    layout = solve(spec)
+    assert {n: v for n, v in layout.counters.items() if n.startswith("bays")} == {
+        "bays1": 1,
+        "bays2": 1,
+        "bays3": 1,
+    }
+    assert _columns(list(solved_layout(layout, spec, inference).rects)) == _columns(raw)
+    for share in (0.7, 2.0):
+        rects = _solved(inference, spec, share)
+        columns = len(_columns(rects))
+        assert columns < len(_columns(raw)) if share < 1 else columns > len(_columns(raw))
+        windows = [r for r in rects if r.label == "window"]
+        assert all(any(abs((r.x1 - r.x0) / w - 1) <= 0.15 for w in widths) for r in windows)
+        assert sum(r.label == "door" for r in rects) == 1
+
+
+@pytest.mark.parametrize("seed", [8, 14])
+def test_a_mirrored_facade_of_bays_drawn_once_stays_mirrored(tmp_path: Path, seed: int) -> None:
+    """Family seeds 8 and 14 with defects (wider end bays, odd windows): mirrored as
+    drawn, every bay unlike the others. Put as the structure placed them (bays drawn
+    once), their bays passed the gate on a sequence not written reflected, and solved
+    at 0.7x and 2x the façade went lopsided; on shapes fitted about the middle it stays
+    mirrored at every width."""
+    path = tmp_path / f"family-{seed}.xml"
+    path.write_text(cmp_xml(family(seed, defects=True)[0]))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    spec = parse_spec(inference.text, path.stem)
+    for share in (0.7, 1.0, 2.0):
+        rects = _solved(inference, spec, share)
+        assert _mirrored(rects, inference.layout.width * share), share

@@ -271,17 +271,21 @@ def test_a_floors_windows_drawn_in_two_grids_never_meet_at_other_widths(
     tmp_path: Path, seed: int, share: float
 ) -> None:
     """The two grids of the floor share one x word, each showing its own windows: solved
-    narrower or wider, their windows keep their order and spacing and never overlap (each
-    grid in a word of its own narrowed its gaps on its own: 2 overlaps at 0.7x)."""
+    narrower or wider, their windows never overlap (each grid in a word of its own
+    narrowed its gaps on its own: 2 overlaps at 0.7x). The floor's bays are each drawn
+    a little unlike, so each inner bay has a counter (bays drawn once): narrower, the
+    floor drops windows, wider it gains them; at the input's width the counters are
+    at their drawn counts, so the high and low windows alternate as drawn."""
     path = _two_kinds(tmp_path / f"two-kinds-{seed}.json", seed)
     drawn = json.loads(path.read_text())["rects"]
     inference = infer(path, path.stem)
     assert len(inference.grids) == 2
     solved = _solved(path, WIDTH * share, 8.0)
     windows = sorted(_of(solved, "window"), key=lambda r: r.x0)
-    assert len(windows) == len(drawn)
+    assert (len(windows) < len(drawn)) if share < 1 else (len(windows) > len(drawn))
     assert _overlapping(solved) == 0
-    assert [r.y0 > 3.1 for r in windows] == [k % 2 == 1 for k in range(len(drawn))]  # order
+    at_input = sorted(_of(_solved(path, WIDTH, 8.0), "window"), key=lambda r: r.x0)
+    assert [r.y0 > 3.1 for r in at_input] == [k % 2 == 1 for k in range(len(drawn))]  # order
 
 
 TWO_FLOORS = 7.0  # m: the height of a façade of two floors (and a roof's margin)

@@ -13,6 +13,9 @@ import shapely
 from facadecli.city.footprints import read_footprints
 from tests.running import facade
 from tests.test_city_inputs import MANIFEST, SPEC, square, town
+from tests.towns import planning_slope, write_town
+
+ROOT = Path(__file__).resolve().parents[1]
 
 pyogrio_raw = pytest.importorskip("pyogrio.raw", reason="pyogrio is a test dependency")
 
@@ -72,3 +75,28 @@ def test_facade_city_reads_a_shapefile_and_refuses_one_without_a_crs(
     (tmp_path / "f.prj").unlink()
     code, _, err = facade(capsys, "city", tmp_path / "m.yaml", "-o", tmp_path / "o2", "-j", "1")
     assert code == 2 and "no CRS" in err and "Traceback" not in err
+
+
+def test_planning_a_shapefile_holds_no_record_of_it(tmp_path: Path) -> None:
+    """The layer's records are given to the survey a batch at a time: planning a
+    generated town of 1,600 terraces peaks at a few hundred bytes a building more than
+    one of 400 (tracemalloc; 1,978 B when the whole layer was read first, about 200 B
+    now, as the same town as GeoJSON)."""
+    slope = planning_slope(ROOT, tmp_path, "shp")
+    assert slope < 600, slope
+
+
+@pytest.mark.parametrize("batch", [1, 7])
+def test_a_layer_read_in_batches_is_the_layer_read_at_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, batch: int
+) -> None:
+    from facadecli.city import ogr
+
+    path = write_town(tmp_path / "t", 30, "shp")
+    whole = read_footprints(path)
+    monkeypatch.setattr(ogr, "BATCH", batch)
+    again = read_footprints(path)
+    assert len(whole.footprints) == 30
+    assert [(f.id, f.properties, f.parts) for f in again.footprints] == [
+        (f.id, f.properties, f.parts) for f in whole.footprints
+    ]

@@ -119,6 +119,9 @@ def solve_rung(spec: Spec, axis: str, canvas: float, variants: int = 1) -> tuple
 
 
 FacadeMeshes = tuple[tuple[str, np.ndarray, np.ndarray], ...]  # (material, vertices, faces)
+# a façade built: its spec's key, its rungs across and up, its layouts' indices, and the
+# metres its rooms may reach behind the wall (room_reach)
+FacadeSlot = tuple[str, int, int, int, int, float]
 # a part a façade places again and again: its material, vertices, faces, placements
 Part = tuple[str, np.ndarray, np.ndarray, tuple[np.ndarray, ...]]
 PlacedParts = list[tuple[str, trimesh.Trimesh, list[np.ndarray]]]  # the same, on a wall
@@ -140,10 +143,8 @@ class AxisCache:
     same way, so the files do not depend on which worker built what."""
 
     axes: dict[Slot, tuple[AxisLayout, ...]] = field(default_factory=dict)
-    facades: dict[tuple[str, int, int, int, int], FacadeMeshes] = field(default_factory=dict)
-    parts: dict[tuple[str, int, int, int, int], tuple[FacadeMeshes, tuple[Part, ...]]] = field(
-        default_factory=dict
-    )
+    facades: dict[FacadeSlot, FacadeMeshes] = field(default_factory=dict)
+    parts: dict[FacadeSlot, tuple[FacadeMeshes, tuple[Part, ...]]] = field(default_factory=dict)
     solved: int = 0  # axes this cache solved itself (not given it solved ahead)
 
     def get(
@@ -188,16 +189,19 @@ class AxisCache:
         base_dir: Path | None,
         variants: int = 1,
         pick: int = 0,
+        behind: float = math.inf,
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """The façade of a wall ``width`` x ``height`` in its own frame (x along, y up, z
-        out), one mesh per material; None where no layout fits (a plain wall)."""
+        out), one mesh per material, its rooms reaching ``behind`` the wall at the most
+        (:func:`room_reach`); None where no layout fits (a plain wall)."""
         picked = self._picked(key, spec, width, height, variants, pick)
         if picked is None:
             return None
         x, y, horizontal, vertical = picked
-        slot = (key, rung(width), rung(height), x, y)
+        slot = (key, rung(width), rung(height), x, y, behind)
         if slot not in self.facades:
-            self.facades[slot] = _merged_facade(_facade(spec, horizontal, vertical), base_dir)
+            layout = _facade(spec, horizontal, vertical)
+            self.facades[slot] = _merged_facade(layout, base_dir, behind)
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
         return _scaled(self.facades[slot], scale)
 
@@ -211,6 +215,7 @@ class AxisCache:
         doors: Sequence[float],
         variants: int = 1,
         pick: int = 0,
+        behind: float = math.inf,
     ) -> list[tuple[str, trimesh.Trimesh]] | None:
         """:meth:`facade` with a door at each of ``doors`` (metres along the wall, where
         entrances are: :func:`.with_doors`); a wall's own, so not kept."""
@@ -221,7 +226,7 @@ class AxisCache:
         stretch = horizontal.canvas / width
         layout = with_doors(_facade(spec, horizontal, vertical), [d * stretch for d in doors])
         scale = np.array([1 / stretch, height / vertical.canvas, 1.0])
-        return _scaled(_merged_facade(layout, base_dir), scale)
+        return _scaled(_merged_facade(layout, base_dir, behind), scale)
 
     def facade_parts(
         self,
@@ -232,6 +237,7 @@ class AxisCache:
         base_dir: Path | None,
         variants: int = 1,
         pick: int = 0,
+        behind: float = math.inf,
     ) -> tuple[list[tuple[str, trimesh.Trimesh]], PlacedParts] | None:
         """:meth:`facade`, with the parts it places :data:`.MIN_INSTANCES` times or more
         apart, those of :data:`.MIN_TRIANGLES` triangles or more (each in its own frame,
@@ -242,9 +248,9 @@ class AxisCache:
         if picked is None:
             return None
         x, y, horizontal, vertical = picked
-        slot = (key, rung(width), rung(height), x, y)
+        slot = (key, rung(width), rung(height), x, y, behind)
         if slot not in self.parts:
-            scene = facade_scene(_facade(spec, horizontal, vertical), base_dir)
+            scene = facade_scene(_facade(spec, horizontal, vertical), base_dir, behind)
             self.parts[slot] = _parts(scene, _stretchable(spec))
         merged, parts = self.parts[slot]
         scale = np.array([width / horizontal.canvas, height / vertical.canvas, 1.0])
@@ -370,16 +376,17 @@ def build_building(
             tried = _tried(chosen, fallback)
             dressed = chosen
             if length >= min_facade_width and not party_wall:
+                behind = room_reach(block.part, a, b)
                 for dressed in tried:
                     wall_args = (dressed.key, dressed.spec, length, wall_height, dressed.base_dir)
                     if doors:  # entrances on this wall: its façade with doors, its own
-                        meshes = cache.facade_with_doors(*wall_args, doors, variants, pick)
+                        meshes = cache.facade_with_doors(*wall_args, doors, variants, pick, behind)
                         entrances += len(doors) if meshes is not None else 0
                     elif instanced:
-                        found = cache.facade_parts(*wall_args, variants, pick)
+                        found = cache.facade_parts(*wall_args, variants, pick, behind)
                         meshes, repeated = found if found is not None else (None, [])
                     else:
-                        meshes = cache.facade(*wall_args, variants, pick)
+                        meshes = cache.facade(*wall_args, variants, pick, behind)
                     if meshes is not None:
                         break
             if meshes is None:
@@ -396,8 +403,6 @@ def build_building(
                 reasons[reason] = reasons.get(reason, 0) + 1
                 continue
             facades += 1
-            behind = room_reach(block.part, a, b)
-            meshes = [(n, _within(m, behind) if n == INTERIOR_MATERIAL else m) for n, m in meshes]
             out = max(float(mesh.vertices[:, 2].max(initial=0.0)) for _, mesh in meshes)
             for _, mesh, placed in repeated:  # how far they stand out, on the wall
                 corners = trimesh.bounds.corners(mesh.bounds)
@@ -525,7 +530,7 @@ def room_reach(part: Polygon, a: tuple[float, float], b: tuple[float, float]) ->
     """How far behind the wall from ``a`` to ``b`` (outwards on its right) the rooms
     behind its windows may reach: the deepest of :data:`ROOM_STEPS` such that the
     building is twice as deep behind the wall (less its ends, which the rooms near a
-    corner do not reach: :func:`.room_depth`) and :data:`ROOM_GAP` more, so that rooms
+    corner do not reach: :func:`.rooms.room_depth`) and :data:`ROOM_GAP` more, so that rooms
     behind facing walls of a narrow building stay apart and never come out at its far
     side; the least step where none fits."""
     length = math.dist(a, b)
@@ -547,13 +552,6 @@ def room_reach(part: Polygon, a: tuple[float, float], b: tuple[float, float]) ->
         if inside.contains(strip):
             return reach
     return ROOM_STEPS[-1]
-
-
-def _within(mesh: trimesh.Trimesh, reach: float) -> trimesh.Trimesh:
-    """A wall's rooms (in its frame: z out of the wall) cut back to ``reach`` behind it."""
-    points = mesh.vertices.copy()
-    points[:, 2] = np.maximum(points[:, 2], -reach)
-    return trimesh.Trimesh(points, mesh.faces, process=False)
 
 
 def building_solids(
@@ -907,10 +905,11 @@ def _merged(
     return merged
 
 
-def _merged_facade(layout: Layout, base_dir: Path | None) -> FacadeMeshes:
-    """A façade's meshes placed and merged per material."""
+def _merged_facade(layout: Layout, base_dir: Path | None, behind: float = math.inf) -> FacadeMeshes:
+    """A façade's meshes placed and merged per material (its rooms reaching ``behind``
+    the wall at the most)."""
     merged: dict[str, list[trimesh.Trimesh]] = {}
-    for mesh in _placed(facade_scene(layout, base_dir)):
+    for mesh in _placed(facade_scene(layout, base_dir, behind)):
         merged.setdefault(mesh.visual.material.name, []).append(mesh)
     return tuple(
         (name, joined.vertices.copy(), joined.faces.copy())

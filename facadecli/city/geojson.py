@@ -16,7 +16,7 @@ import os
 import re
 import stat
 from array import array
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -82,7 +82,7 @@ class Places:
 @dataclass(frozen=True)
 class GeoJSON:
     file: str
-    features: Sequence[Any]  # as read: each may be anything
+    features: Iterable[Any]  # as read, each may be anything: walked once, in the file's order
     crs: pyproj.CRS
     places: Places
     reasons: Mapping[int, str] = field(default_factory=dict)  # index -> why it has no geometry
@@ -140,6 +140,18 @@ def _text(path: Path) -> str:
     if raw is None:
         raise too_long(path)
     return decode_utf8(raw, str(path), "save the GeoJSON as UTF-8 (RFC 7946)")
+
+
+def changed_while_read(file: str) -> SpecError:
+    """The error of a footprints file whose features, read again a feature at a time,
+    are not those its first pass counted (GeoJSON, GeoPackage, Shapefile, FlatGeobuf)."""
+    return SpecError.at(
+        file,
+        None,
+        None,
+        "the footprints file changed while it was read",
+        "run again once the file is written",
+    )
 
 
 def too_long(path: Path) -> SpecError:
@@ -219,13 +231,7 @@ class Features(Sequence[Any]):
         except (OSError, _NotStreamed, _TooLong, json.JSONDecodeError, ValueError):
             found = -1  # UnicodeDecodeError is a ValueError
         if found != self.length:
-            raise SpecError.at(
-                str(self.path),
-                None,
-                None,
-                "the footprints file changed while it was read",
-                "run again once the file is written",
-            )
+            raise changed_while_read(str(self.path))
 
     @overload
     def __getitem__(self, index: int) -> Any: ...

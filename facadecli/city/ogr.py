@@ -5,13 +5,15 @@ pyogrio is an optional dependency (``pip install 'facadecli[gdal]'``: GDAL is so
 without it, such a file is a SpecError saying how to get it. The first layer is read; each
 record becomes a GeoJSON feature (its id the record's, its properties the attribute
 columns), checked as a GeoJSON file's are, in the layer's CRS (a Shapefile without its
-``.prj`` has none: exit 2).
+``.prj`` has none: exit 2). The records are read from the file a batch at a time as the
+survey walks them, not the whole layer at once.
 """
 
 from __future__ import annotations
 
 import json
 import math
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +22,7 @@ import pyproj.exceptions
 import shapely
 import shapely.errors
 
-from facadecli.city.geojson import GeoJSON, NoPlaces, too_long
+from facadecli.city.geojson import GeoJSON, NoPlaces, changed_while_read, too_long
 from facadecli.errors import SpecError
 from facadecli.limits import GEOJSON_BYTES_MAX
 
@@ -33,11 +35,12 @@ def is_ogr(path: Path) -> bool:
 
 
 def read_ogr(path: Path) -> GeoJSON:
-    """The features and CRS of the file's first layer (see the module)."""
+    """The CRS of the file's first layer and its records as features, read BATCH at a
+    time as they are iterated (:class:`Records`; see the module)."""
     file = str(path)
     try:
+        import pyogrio
         import pyogrio.errors
-        import pyogrio.raw
     except ImportError:
         raise SpecError.at(
             file,
@@ -49,28 +52,62 @@ def read_ogr(path: Path) -> GeoJSON:
     if path.stat().st_size > GEOJSON_BYTES_MAX:
         raise too_long(path)
     try:
-        meta, ids, geometries, columns = pyogrio.raw.read(path, return_fids=True)
+        info = pyogrio.read_info(path, force_feature_count=True)
     except (pyogrio.errors.DataSourceError, pyogrio.errors.DataLayerError) as error:
         raise SpecError.at(file, None, None, f"cannot read it: {error}", HINT) from None
-    if not meta.get("crs"):
+    if not info.get("crs"):
         raise SpecError.at(file, None, None, "the layer has no CRS (no .prj?)", HINT)
     try:
-        crs = pyproj.CRS.from_user_input(meta["crs"])
+        crs = pyproj.CRS.from_user_input(info["crs"])
     except pyproj.exceptions.CRSError:
-        raise SpecError.at(file, None, None, f"unknown CRS {meta['crs']!r}", HINT) from None
-    names = [str(name) for name in meta["fields"]]
-    features = []
-    for i, blob in enumerate(geometries):
-        properties = {name: _value(column[i]) for name, column in zip(names, columns, strict=True)}
-        features.append(
-            {
-                "type": "Feature",
-                "id": int(ids[i]) if ids is not None else i,
-                "properties": {k: v for k, v in properties.items() if v is not None},
-                "geometry": _geometry(blob),
-            }
-        )
-    return GeoJSON(file, features, crs, NoPlaces())
+        raise SpecError.at(file, None, None, f"unknown CRS {info['crs']!r}", HINT) from None
+    return GeoJSON(file, Records(path, int(info["features"])), crs, NoPlaces())
+
+
+BATCH = 1024  # records read from the file at once
+
+
+class Records(Iterable[dict[str, Any]]):
+    """The first layer's records as GeoJSON features (its id the record's, its properties
+    the attribute columns), read from the file BATCH at a time as they are iterated."""
+
+    def __init__(self, path: Path, count: int) -> None:
+        self.path = path
+        self.count = count
+
+    def __iter__(self) -> Iterator[dict[str, Any]]:
+        import pyogrio.errors
+        import pyogrio.raw
+
+        file = str(self.path)
+        found = 0
+        for skip in range(0, self.count, BATCH):
+            try:
+                meta, ids, geometries, columns = pyogrio.raw.read(
+                    self.path, return_fids=True, skip_features=skip, max_features=BATCH
+                )
+            except (pyogrio.errors.DataSourceError, pyogrio.errors.DataLayerError) as error:
+                raise SpecError.at(file, None, None, f"cannot read it: {error}", HINT) from None
+            names = [str(name) for name in meta["fields"]]
+            for i, blob in enumerate(geometries):
+                found += 1
+                yield _feature(
+                    int(ids[i]) if ids is not None else skip + i,
+                    {name: _value(column[i]) for name, column in zip(names, columns, strict=True)},
+                    blob,
+                )
+            del meta, ids, geometries, columns
+        if found != self.count:
+            raise changed_while_read(file)
+
+
+def _feature(fid: int, properties: dict[str, Any], blob: Any) -> dict[str, Any]:
+    return {
+        "type": "Feature",
+        "id": fid,
+        "properties": {k: v for k, v in properties.items() if v is not None},
+        "geometry": _geometry(blob),
+    }
 
 
 def _value(value: Any) -> Any:

@@ -5,8 +5,13 @@ Every area tagged ``building`` or ``building:part`` is a footprint: closed ways 
 multipolygon relations, assembled by libosmium (holes and all). Its id is ``way/<id>`` or
 ``relation/<id>``, its properties its tags, so heights, levels, roof shapes, colours and
 building parts work as in a GeoJSON export (the city's S3DB rules). Coordinates are
-lon/lat (EPSG:4326). The file is read in one streaming pass per object kind; only the
-buildings are kept.
+lon/lat (EPSG:4326). The buildings are given one at a time as libosmium draws them in
+its pass over the file (:class:`Buildings`), never gathered: the survey walks them once
+and spools what it keeps (footprints.py). What is held besides is compact or small:
+libosmium's index of node locations (C++, 16 bytes a node), the entrance nodes (24
+bytes each, :class:`Entrances`), each feature's element (9 bytes) and, for XML, its
+place (17 bytes, :class:`.osmxml.Places`), the building relations' members, and the
+building ways read but not yet drawn (libosmium draws a buffer's worth at a time).
 
 An XML extract is checked first (:mod:`facadecli.city.osmxml`: its inflated size, ids,
 coordinates and tag text, each problem at its line); a PBF's blocks are counted
@@ -18,8 +23,10 @@ without a geometry, with the reason, which the caller reports and counts as reje
 
 from __future__ import annotations
 
+import bisect
 import json
-from collections.abc import Iterable
+from array import array
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -27,7 +34,7 @@ from typing import Any
 import pyproj
 
 from facadecli.city.geojson import GeoJSON, NoPlaces
-from facadecli.city.osmxml import KEYS, check_xml
+from facadecli.city.osmxml import ELEMENTS, KEYS, Places, check_xml
 from facadecli.errors import SpecError
 from facadecli.limits import OSM_ID_MAX, OSM_TEXT_CHARS_MAX
 
@@ -46,132 +53,270 @@ def is_osm(path: Path) -> bool:
 
 
 class OsmPlaces(NoPlaces):
-    """The line and column where each feature's element starts (XML), when known."""
+    """The line and column where each feature's element starts (XML), when known: the
+    element of the feature at an index (:class:`Buildings` keeps it, as it is read), then
+    its place (:class:`.osmxml.Places`)."""
 
-    def __init__(self, places: dict[int, tuple[int, int]]):
+    def __init__(self, places: Places, buildings: Buildings):
         super().__init__()
         self.places = places
+        self.buildings = buildings
 
     def feature(self, index: int) -> tuple[int, int] | None:
-        return self.places.get(index)
-
-
-@dataclass
-class _Drawn:
-    """What the pass over the file found: the areas libosmium drew, and the building
-    ways and relations, to tell which it could not draw and why."""
-
-    features: list[dict[str, Any]]
-    reasons: dict[int, str]  # feature index -> why it has no geometry
-    ways: dict[int, tuple[bool, list[int]]]  # id -> closed, missing nodes
-    relations: dict[int, tuple[str, list[tuple[str, int, str]]]]  # id -> type, members
-    entrances: dict[int, tuple[float, float]] = field(default_factory=dict)  # node -> lon, lat
-    doors: dict[int, list[tuple[float, float]]] = field(default_factory=dict)  # way -> theirs
+        element = self.buildings.element(index)
+        return None if element is None or not self.places else self.places.get(*element)
 
 
 def read_osm(path: Path) -> GeoJSON:
-    """The building areas of an extract (see the module)."""
+    """The building areas of an extract (see the module), read one at a time as they are
+    iterated (:class:`Buildings`)."""
     file = str(path)
-    places = {}
+    places = Places()
     if not path.name.lower().endswith(".pbf"):
         places = check_xml(path)
     else:
         from facadecli.city.osmpbf import check_pbf
 
         check_pbf(path)
-    try:
-        drawn = _read(file)
-        _undrawn(file, drawn)
-    except SpecError:
-        raise
-    except Exception as error:  # libosmium's own refusals: RuntimeError, ValueError, ...
-        message = f"libosmium cannot read it: {error}" if str(error) else type(error).__name__
-        hint = HINT
-        if "out of order" in message or "twice" in message:
-            hint = SORT
-        elif "uncompress" in message:
-            hint = "download the extract again"
-        raise SpecError.at(file, None, None, message, hint) from None
-    at = {}
-    for index, feature in enumerate(drawn.features):
-        kind, oid = feature["id"].split("/")
-        if (kind, int(oid)) in places:
-            at[index] = places[(kind, int(oid))]
-    return GeoJSON(file, drawn.features, pyproj.CRS.from_epsg(4326), OsmPlaces(at), drawn.reasons)
-
-
-def _read(file: str) -> _Drawn:
-    import osmium  # imported here: only OSM extracts need it
-
-    factory = osmium.geom.GeoJSONFactory()
-    drawn = _Drawn([], {}, {}, {})
-    processor = (
-        osmium.FileProcessor(file)
-        .with_areas(osmium.filter.KeyFilter(*KEYS))
-        .with_filter(osmium.filter.KeyFilter(*KEYS, ENTRANCE))
+    buildings = Buildings(file)
+    return GeoJSON(
+        file, buildings, pyproj.CRS.from_epsg(4326), OsmPlaces(places, buildings), buildings.reasons
     )
-    for item in processor:
-        if isinstance(item, osmium.osm.Node):
-            if ENTRANCE in item.tags and item.location.valid():
-                drawn.entrances[item.id] = (item.location.lon, item.location.lat)
-            continue
-        if not any(key in item.tags for key in KEYS):  # a way or relation tagged entrance
-            continue
-        if isinstance(item, osmium.osm.Area):
-            kind = "way" if item.from_way() else "relation"
-            reason = ""
-            try:
-                geometry = json.loads(factory.create_multipolygon(item))
-            except RuntimeError as error:
-                geometry, reason = None, f"libosmium cannot draw its outline: {error}"
-            _add(drawn, kind, item.orig_id(), _tags(file, kind, item.orig_id(), item.tags), reason)
-            drawn.features[-1]["geometry"] = geometry
-        elif isinstance(item, osmium.osm.Way):
-            _tags(file, "way", _id(file, "way", item.id), item.tags)
-            missing = [node.ref for node in item.nodes if not node.location.valid()]
-            drawn.ways[item.id] = (item.is_closed(), missing)
-            doors = [drawn.entrances[n.ref] for n in item.nodes if n.ref in drawn.entrances]
-            if doors:
-                drawn.doors[item.id] = list(dict.fromkeys(doors))  # a ring's last node: its first
-        elif isinstance(item, osmium.osm.Relation):
-            tags = _tags(file, "relation", _id(file, "relation", item.id), item.tags)
-            members = [(m.type, m.ref, m.role) for m in item.members]
-            drawn.relations[item.id] = (tags.get("type", ""), members)
-    _relation_doors(file, drawn)
-    for feature in drawn.features:
-        kind, oid = feature["id"].split("/")
-        if kind == "way" and int(oid) in drawn.doors:
-            feature["entrances"] = drawn.doors[int(oid)]
-    return drawn
 
 
-def _relation_doors(file: str, drawn: _Drawn) -> None:
-    """The entrances of multipolygon buildings: the entrance nodes of their outer member
+class Entrances:
+    """The entrance nodes read so far, id -> (lon, lat): 24 bytes a node in arrays,
+    looked up by bisection (an extract's nodes come sorted by id; sorted here when not,
+    a node given twice found at its last place, as a dict would keep it)."""
+
+    def __init__(self) -> None:
+        self.ids = array("q")
+        self.lon_lat = array("d")
+        self.sorted = True
+
+    def __bool__(self) -> bool:
+        return bool(self.ids)
+
+    def add(self, oid: int, lon: float, lat: float) -> None:
+        if self.ids and oid < self.ids[-1]:
+            self.sorted = False
+        self.ids.append(oid)
+        self.lon_lat.extend((lon, lat))
+
+    def get(self, oid: int) -> tuple[float, float] | None:
+        if not self.sorted:
+            order = sorted(range(len(self.ids)), key=self.ids.__getitem__)
+            self.ids = array("q", (self.ids[k] for k in order))
+            self.lon_lat = array("d", (v for k in order for v in self.lon_lat[2 * k : 2 * k + 2]))
+            self.sorted = True
+        at = bisect.bisect_right(self.ids, oid) - 1
+        if at < 0 or self.ids[at] != oid:
+            return None
+        return self.lon_lat[2 * at], self.lon_lat[2 * at + 1]
+
+    def doors(self, nodes: Iterable[int]) -> list[tuple[float, float]]:
+        """The places of those of ``nodes`` that are entrances, each once, in their order
+        (a ring's last node is its first)."""
+        found = (self.get(node) for node in nodes)
+        return list(dict.fromkeys(door for door in found if door is not None))
+
+
+@dataclass
+class _Pass:
+    """What the pass over the file holds besides the feature it gives: the entrance
+    nodes, the building ways not drawn yet (a way's area follows it) with their doors,
+    the building relations' members, the relations drawn, and the nodes of multipolygons'
+    outer ways (read when the first multipolygon with entrances is drawn)."""
+
+    entrances: Entrances = field(default_factory=Entrances)
+    ways: dict[int, tuple[bool, list[int]]] = field(default_factory=dict)  # closed, missing
+    doors: dict[int, list[tuple[float, float]]] = field(default_factory=dict)  # way -> its
+    relations: dict[int, tuple[str, list[tuple[str, int, str]]]] = field(default_factory=dict)
+    drawn: set[int] = field(default_factory=set)  # relations
+    outers: dict[int, list[list[int]]] | None = None  # relation -> its outer ways' nodes
+
+
+class Buildings(Iterable[dict[str, Any]]):
+    """An extract's building areas as GeoJSON features, made one at a time as the file is
+    read (libosmium assembles them, its node locations in its own compact index), then
+    the building ways and multipolygons it could not draw, each with the reason
+    (``reasons``, by index, filled as they are given). A feature is not held once the
+    next is made: what is kept a feature is its element (9 bytes, for its place)."""
+
+    def __init__(self, file: str):
+        self.file = file
+        self.reasons: dict[int, str] = {}  # feature index -> why it has no geometry
+        self.kinds = array("b")  # each feature's element: ELEMENTS' index, id
+        self.ids = array("q")
+
+    def element(self, index: int) -> tuple[str, int] | None:
+        if 0 <= index < len(self.ids):
+            return ELEMENTS[self.kinds[index]], self.ids[index]
+        return None
+
+    def __iter__(self) -> Iterator[dict[str, Any]]:
+        self.reasons.clear()
+        self.kinds, self.ids = array("b"), array("q")
+        try:
+            yield from self._features()
+        except SpecError:
+            raise
+        except Exception as error:  # libosmium's own refusals: RuntimeError, ValueError, ...
+            raise _refused(self.file, error) from None
+
+    def _feature(
+        self, kind: str, oid: int, tags: dict[str, str], reason: str = ""
+    ) -> dict[str, Any]:
+        """A feature; one without a geometry has the reason (and no need of its tags)."""
+        if reason:
+            self.reasons[len(self.ids)] = reason
+        self.kinds.append(ELEMENTS.index(kind))
+        self.ids.append(oid)
+        return {"type": "Feature", "id": f"{kind}/{oid}", "properties": tags, "geometry": None}
+
+    def _features(self) -> Iterator[dict[str, Any]]:
+        import osmium  # imported here: only OSM extracts need it
+
+        file = self.file
+        factory = osmium.geom.GeoJSONFactory()
+        found = _Pass()
+        processor = (
+            osmium.FileProcessor(file)
+            .with_areas(osmium.filter.KeyFilter(*KEYS))
+            .with_filter(osmium.filter.KeyFilter(*KEYS, ENTRANCE))
+        )
+        for item in processor:
+            if isinstance(item, osmium.osm.Node):
+                if ENTRANCE in item.tags and item.location.valid():
+                    found.entrances.add(item.id, item.location.lon, item.location.lat)
+                continue
+            if not any(key in item.tags for key in KEYS):  # a way or relation tagged entrance
+                continue
+            if isinstance(item, osmium.osm.Area):
+                kind = "way" if item.from_way() else "relation"
+                oid = item.orig_id()
+                reason = ""
+                try:
+                    geometry = json.loads(factory.create_multipolygon(item))
+                except RuntimeError as error:
+                    geometry, reason = None, f"libosmium cannot draw its outline: {error}"
+                feature = self._feature(kind, oid, _tags(file, kind, oid, item.tags), reason)
+                feature["geometry"] = geometry
+                if kind == "way":
+                    found.ways.pop(oid, None)
+                    doors = found.doors.pop(oid, None)
+                else:
+                    found.drawn.add(oid)
+                    doors = _relation_doors(file, found, oid)
+                if doors:
+                    feature["entrances"] = doors
+                yield feature
+                del feature, geometry
+            elif isinstance(item, osmium.osm.Way):
+                _tags(file, "way", _id(file, "way", item.id), item.tags)
+                missing = [node.ref for node in item.nodes if not node.location.valid()]
+                found.ways[item.id] = (item.is_closed(), missing)
+                doors = found.entrances.doors(node.ref for node in item.nodes)
+                if doors:
+                    found.doors[item.id] = doors
+            elif isinstance(item, osmium.osm.Relation):
+                tags = _tags(file, "relation", _id(file, "relation", item.id), item.tags)
+                members = [(m.type, m.ref, m.role) for m in item.members]
+                found.relations[item.id] = (tags.get("type", ""), members)
+        yield from self._undrawn(found)
+
+    def _undrawn(self, found: _Pass) -> Iterator[dict[str, Any]]:
+        """The building ways and multipolygons libosmium drew no area of, as features
+        without a geometry, each with the reason (a missing node or member way, an open
+        ring)."""
+        file = self.file
+        in_relations = {
+            ref
+            for _, members in found.relations.values()
+            for kind, ref, _ in members
+            if kind == "w"
+        }
+        undrawn = [(oid, way) for oid, way in sorted(found.ways.items()) if oid not in in_relations]
+        late = _present_nodes(file, {node for _, (_, missing) in undrawn for node in missing})
+        for oid, (closed, missing) in undrawn:
+            if missing:
+                reason = _missing(missing, late)
+            elif not closed:
+                reason = "the way is not closed (its first and last nodes differ)"
+            else:
+                reason = "libosmium could not make a ring of it (too few nodes?)"
+            yield self._feature("way", oid, {}, reason)
+        broken = {
+            oid: members
+            for oid, (kind, members) in found.relations.items()
+            if oid not in found.drawn and kind in ("multipolygon", "boundary")
+        }
+        if not broken:
+            return
+        refs = {ref for members in broken.values() for kind, ref, _ in members if kind == "w"}
+        ways = _member_ways(file, refs)
+        for oid, members in sorted(broken.items()):
+            yield self._feature("relation", oid, {}, _broken(members, ways))
+
+
+def _refused(file: str, error: Exception) -> SpecError:
+    """libosmium's refusal of the file, as a SpecError with a hint."""
+    message = f"libosmium cannot read it: {error}" if str(error) else type(error).__name__
+    hint = HINT
+    if "out of order" in message or "twice" in message:
+        hint = SORT
+    elif "uncompress" in message:
+        hint = "download the extract again"
+    return SpecError.at(file, None, None, message, hint)
+
+
+def _broken(members: list[tuple[str, int, str]], found: dict[int, list[int]]) -> str:
+    """Why a multipolygon of these members was not drawn (``found``: its member ways the
+    file holds, each with the nodes it names that are missing)."""
+    ways = [(ref, role) for t, ref, role in members if t == "w"]
+    absent = [f"{role or 'member'} way {ref}" for ref, role in ways if ref not in found]
+    nodes = [node for ref, _ in ways for node in found.get(ref, [])]
+    if absent:
+        more = f" and {len(absent) - LISTED} more" if len(absent) > LISTED else ""
+        verb = "are" if len(absent) > 1 else "is"
+        return f"its {', '.join(absent[:LISTED])}{more} {verb} not in the file"
+    if nodes:
+        return f"its ways name nodes the file lacks: {_missing(nodes, set())}"
+    if not ways:
+        return "the multipolygon has no member way"
+    return "its member ways do not close into rings"
+
+
+def _relation_doors(file: str, found: _Pass, oid: int) -> list[tuple[float, float]]:
+    """The entrances of a multipolygon building: the entrance nodes of its outer member
     ways (role ``outer``, or none as in old multipolygons), which the pass over the file
-    did not see when untagged; read in a second pass over those ways only."""
-    drawn_relations = [
-        int(f["id"].split("/")[1]) for f in drawn.features if f["id"].startswith("relation/")
-    ]
-    outers = {
-        oid: [ref for kind, ref, role in drawn.relations[oid][1] if kind == "w" and role in OUTER]
-        for oid in drawn_relations
-        if oid in drawn.relations
+    did not see when untagged. When the first is asked for (every node, so every
+    entrance, is read by then: an extract is sorted), the building relations are read
+    again for their outer ways, and those ways for their nodes."""
+    if not found.entrances:
+        return []
+    if found.outers is None:
+        outers = _outer_ways(file)
+        nodes = _way_nodes(file, {ref for refs in outers.values() for ref in refs})
+        found.outers = {
+            relation: [nodes[ref] for ref in refs if ref in nodes]
+            for relation, refs in outers.items()
+        }
+    return found.entrances.doors(node for way in found.outers.get(oid, []) for node in way)
+
+
+def _outer_ways(file: str) -> dict[int, list[int]]:
+    """The outer member ways of every building relation of the file."""
+    import osmium
+
+    processor = osmium.FileProcessor(file, osmium.osm.RELATION).with_filter(
+        osmium.filter.KeyFilter(*KEYS)
+    )
+    return {
+        item.id: [m.ref for m in item.members if m.type == "w" and m.role in OUTER]
+        for item in processor
+        if isinstance(item, osmium.osm.Relation)
     }
-    if not drawn.entrances or not any(outers.values()):
-        return
-    nodes = _way_nodes(file, {ref for refs in outers.values() for ref in refs})
-    for feature in drawn.features:
-        kind, oid = feature["id"].split("/")
-        if kind != "relation" or int(oid) not in outers:
-            continue
-        doors = [
-            drawn.entrances[node]
-            for ref in outers[int(oid)]
-            for node in nodes.get(ref, ())
-            if node in drawn.entrances
-        ]
-        if doors:
-            feature["entrances"] = list(dict.fromkeys(doors))
 
 
 def _way_nodes(file: str, ids: set[int]) -> dict[int, list[int]]:
@@ -187,15 +332,6 @@ def _way_nodes(file: str, ids: set[int]) -> dict[int, list[int]]:
         for item in processor
         if isinstance(item, osmium.osm.Way)
     }
-
-
-def _add(drawn: _Drawn, kind: str, oid: int, tags: dict[str, str], reason: str = "") -> None:
-    """A feature; one without a geometry has the reason (and no need of its tags)."""
-    drawn.features.append(
-        {"type": "Feature", "id": f"{kind}/{oid}", "properties": tags, "geometry": None}
-    )
-    if reason:
-        drawn.reasons[len(drawn.features) - 1] = reason
 
 
 def _id(file: str, kind: str, oid: int) -> int:
@@ -221,53 +357,6 @@ def _tags(file: str, kind: str, oid: int, tags: Iterable[Any]) -> dict[str, str]
                 )
         found[tag.k] = tag.v
     return found
-
-
-def _undrawn(file: str, drawn: _Drawn) -> None:
-    """The building ways and multipolygons libosmium drew no area of, as features without
-    a geometry, each with the reason (a missing node or member way, an open ring)."""
-    done = {f["id"] for f in drawn.features}
-    in_relations = {
-        ref for _, members in drawn.relations.values() for kind, ref, _ in members if kind == "w"
-    }
-    undrawn = [
-        (oid, way)
-        for oid, way in sorted(drawn.ways.items())
-        if f"way/{oid}" not in done and oid not in in_relations
-    ]
-    late = _present_nodes(file, {node for _, (_, missing) in undrawn for node in missing})
-    for oid, (closed, missing) in undrawn:
-        if missing:
-            reason = _missing(missing, late)
-        elif not closed:
-            reason = "the way is not closed (its first and last nodes differ)"
-        else:
-            reason = "libosmium could not make a ring of it (too few nodes?)"
-        _add(drawn, "way", oid, {}, reason)
-    broken = {
-        oid: members
-        for oid, (kind, members) in drawn.relations.items()
-        if f"relation/{oid}" not in done and kind in ("multipolygon", "boundary")
-    }
-    if not broken:
-        return
-    refs = {ref for members in broken.values() for kind, ref, _ in members if kind == "w"}
-    found = _member_ways(file, refs)
-    for oid, members in sorted(broken.items()):
-        ways = [(ref, role) for t, ref, role in members if t == "w"]
-        absent = [f"{role or 'member'} way {ref}" for ref, role in ways if ref not in found]
-        nodes = [node for ref, _ in ways for node in found.get(ref, [])]
-        if absent:
-            more = f" and {len(absent) - LISTED} more" if len(absent) > LISTED else ""
-            verb = "are" if len(absent) > 1 else "is"
-            reason = f"its {', '.join(absent[:LISTED])}{more} {verb} not in the file"
-        elif nodes:
-            reason = f"its ways name nodes the file lacks: {_missing(nodes, set())}"
-        elif not ways:
-            reason = "the multipolygon has no member way"
-        else:
-            reason = "its member ways do not close into rings"
-        _add(drawn, "relation", oid, {}, reason)
 
 
 def _member_ways(file: str, ids: set[int]) -> dict[int, list[int]]:

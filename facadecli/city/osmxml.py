@@ -17,8 +17,10 @@ import gzip
 import io
 import re
 import zlib
+from array import array
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 from xml.parsers import expat
 
 from facadecli.errors import SpecError
@@ -42,7 +44,58 @@ INSIDE = {  # what libosmium takes inside an element (anything else is an error)
     "member": (),
 }
 SORT = "sort it: osmium sort FILE -o SORTED.osm"
-Places = dict[tuple[str, int], tuple[int, int]]  # (kind, id) -> (line, column)
+ELEMENTS = ("node", "way", "relation")
+
+
+class Places:
+    """Where each element tagged as a building starts, (kind, id) -> (line, column): 17
+    bytes an element in arrays, not a dict of tuples; looked up by bisection in the
+    elements sorted by kind and id (sorted when first looked up, stable: an element
+    given twice is found at its first place)."""
+
+    def __init__(self) -> None:
+        self.kinds = array("b")  # ELEMENTS' index
+        self.ids = array("q")
+        self.lines = array("L")
+        self.columns = array("L")
+        self.order: Any = None  # numpy: the elements' places here, sorted by kind and id
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def add(self, kind: str, oid: int, place: tuple[int, int]) -> None:
+        """The element's place, unless it is the element added last (its other tag)."""
+        code = ELEMENTS.index(kind)
+        if self.ids and self.ids[-1] == oid and self.kinds[-1] == code:
+            return
+        self.kinds.append(code)
+        self.ids.append(oid)
+        self.lines.append(place[0])
+        self.columns.append(place[1])
+        self.order = None
+
+    def get(self, kind: str, oid: int) -> tuple[int, int] | None:
+        import numpy as np
+
+        if self.order is None:
+            kinds = np.frombuffer(self.kinds, dtype=np.int8)
+            self.order = np.lexsort((np.frombuffer(self.ids, dtype=np.int64), kinds))
+        wanted = (ELEMENTS.index(kind), oid)
+        low, high = 0, len(self.order)
+        while low < high:  # the first place whose (kind, id) is not below the wanted
+            middle = (low + high) // 2
+            at = int(self.order[middle])
+            if (self.kinds[at], self.ids[at]) < wanted:
+                low = middle + 1
+            else:
+                high = middle
+        if low == len(self.order):
+            return None
+        at = int(self.order[low])
+        if (self.kinds[at], self.ids[at]) != wanted:
+            return None
+        return self.lines[at], self.columns[at]
+
 
 _ID = re.compile(r"-?\d{1,19}", re.ASCII)
 _COUNT = re.compile(r"\d{1,10}", re.ASCII)  # version, changeset: 32-bit
@@ -127,7 +180,7 @@ class _Checker:
         self.parser = parser
         self.root = False
         self.object: tuple[str, int] | None = None  # the node, way or relation open
-        self.places: Places = {}
+        self.places = Places()
         self.at = (1, 1)  # where the open object starts
         self.seen: set[tuple[str, int]] = set()  # relations (ways are checked in order)
         self.way: tuple[int, int] | None = None  # the last way's place in libosmium's order
@@ -164,7 +217,7 @@ class _Checker:
             self.at = (self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1)
             self._once(name, who)
         elif name == "tag" and self.object is not None and attributes.get("k") in KEYS:
-            self.places.setdefault(self.object, self.at)
+            self.places.add(*self.object, self.at)
 
     def _once(self, name: str, who: str) -> None:
         """Each way and relation once, and the ways in the order of their ids, as

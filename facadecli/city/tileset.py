@@ -34,12 +34,11 @@ are removed. The same buildings give the same bytes.
 from __future__ import annotations
 
 import contextlib
-import functools
 import json
 import math
 import os
 import re
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -292,19 +291,19 @@ class TilesetWriter:
                 "geometricError": 0.0,
                 "refine": "REPLACE",
             }
-            root = functools.partial(_spliced, empty, None)
+            root = empty
             error = 0.0
         else:
-            root = functools.partial(self._tile, self.root, False, None, transform)
+            root = self._tile(self.root, False, None, transform)
             error = top[1]
         tileset = {
             "asset": {"version": "1.1", "generator": "facadecli"},
             "extras": {"name": name, "georeference": georeference(self.georef)},
             "geometricError": error,
-            "root": _MARK,
+            "root": root,
         }
         with atomic_output(self.folder / "tileset.json") as out:
-            for chunk in _batched(_spliced(tileset, root, 0)):
+            for chunk in _batched(_text(tileset, 0)):
                 out.write(chunk)
             out.write(b"\n")
         return {
@@ -332,20 +331,15 @@ class TilesetWriter:
         return _unbox(_box(square.box)), _errors(square, covered)[0]
 
     def _tile(
-        self,
-        square: Square,
-        covered: bool,
-        ceiling: float | None,
-        first: dict[str, Any],
-        depth: int,
-    ) -> Iterator[str]:
-        """The JSON text of the square's tile at ``depth`` (json.dumps' indent of one):
-        its chain of content, coarse first, each the only child of the one before, its
-        children's tiles under the last; or, without content, a tile holding its
-        children's. A tile without content under one with content (``ceiling``, its
-        error) takes that one's error: a viewer that refined it goes on through it to the
-        content below (with a smaller error it would stop there, and draw nothing).
-        ``first``: keys the tile starts with (the root's transform)."""
+        self, square: Square, covered: bool, ceiling: float | None, first: dict[str, Any]
+    ) -> dict[str, Any]:
+        """The square's tile: its chain of content, coarse first, each the only child of
+        the one before, its children's tiles under the last; or, without content, a tile
+        holding its children's. The children are made as they are written (an iterator,
+        :meth:`_children`), not here. A tile without content under one with content
+        (``ceiling``, its error) takes that one's error: a viewer that refined it goes on
+        through it to the content below (with a smaller error it would stop there, and
+        draw nothing). ``first``: keys the tile starts with (the root's transform)."""
         assert square.box is not None
         box = _box(square.box)
         below = covered or bool(square.tiles)
@@ -353,10 +347,13 @@ class TilesetWriter:
         errors = _errors(square, covered)
         if not square.tiles:
             error = errors[0] if ceiling is None else ceiling
-            tile = {**first, "boundingVolume": {"box": box}, "geometricError": error}
-            tile.update(refine="REPLACE", children=_MARK)
-            yield from _spliced(tile, self._children(shown, below, ceiling), depth)
-            return
+            return {
+                **first,
+                "boundingVolume": {"box": box},
+                "geometricError": error,
+                "refine": "REPLACE",
+                "children": self._children(shown, below, ceiling),
+            }
         chain = [
             {
                 **(first if number == 0 else {}),
@@ -364,20 +361,20 @@ class TilesetWriter:
                 "geometricError": error,
                 "refine": "REPLACE",
                 "content": {"uri": entry["uri"]},
-                **({"children": _MARK} if number + 1 < len(errors) or shown else {}),
             }
             for number, (entry, error) in enumerate(zip(square.tiles, errors, strict=True))
         ]
-        last = chain[-1]
-        finest = self._children(shown, below, last["geometricError"]) if shown else None
-        yield from _chained(chain, finest, depth)
+        if shown:
+            chain[-1]["children"] = self._children(shown, below, errors[-1])
+        for parent, child in zip(chain[-2::-1], chain[:0:-1], strict=True):
+            parent["children"] = iter([child])
+        return chain[0]
 
     def _children(
         self, squares: list[Square], covered: bool, ceiling: float | None
-    ) -> Callable[[int], Iterator[str]]:
-        """The JSON list of the squares' tiles, at the depth it is given."""
-        tiles = [functools.partial(self._tile, child, covered, ceiling, {}) for child in squares]
-        return functools.partial(_listed, tiles)
+    ) -> Iterator[dict[str, Any]]:
+        """The squares' tiles, each made when the one before is written."""
+        return (self._tile(child, covered, ceiling, {}) for child in squares)
 
     def _remove_stale(self) -> None:
         for folder, _, files in os.walk(self.folder):  # a folder at a time, none held
@@ -386,10 +383,6 @@ class TilesetWriter:
                 if TILE_FILE.fullmatch(file) and path not in self.written:
                     with contextlib.suppress(FileNotFoundError):
                         path.unlink()
-
-
-_MARK = "\0tiles\0"  # where a tile's children's JSON goes in its own (:func:`_spliced`)
-Text = Callable[[int], Iterator[str]]  # JSON text at a depth: a tile, a list of them
 
 
 def _errors(square: Square, covered: bool) -> list[float]:
@@ -411,39 +404,25 @@ def _errors(square: Square, covered: bool) -> list[float]:
     return errors[::-1]
 
 
-def _chained(chain: list[dict[str, Any]], finest: Text | None, depth: int) -> Iterator[str]:
-    """A square's chain of tiles at ``depth``, each the only child of the one before,
-    ``finest`` (its children's tiles) under the last."""
-    if len(chain) == 1:
-        yield from _spliced(chain[0], finest, depth)
-        return
-    rest = functools.partial(_chained, chain[1:], finest)
-    yield from _spliced(chain[0], functools.partial(_listed, [rest]), depth)
-
-
-def _spliced(value: dict[str, Any], inner: Text | None, depth: int) -> Iterator[str]:
-    """``value``'s text as ``json.dumps(..., indent=1)`` writes it at ``depth``, with the
-    text ``inner`` makes where it holds _MARK (one place at most)."""
-    text = json.dumps(value, indent=1).replace("\n", "\n" + " " * depth)
-    if inner is None:
-        yield text
-        return
-    before, after = text.split(json.dumps(_MARK), 1)
-    yield before
-    yield from inner(depth + 1)
-    yield after
-
-
-def _listed(items: Sequence[Text], depth: int) -> Iterator[str]:
-    """A JSON list of ``items`` at ``depth`` (json.dumps' indent of one)."""
-    if not items:
-        yield "[]"
-        return
+def _text(value: Any, depth: int) -> Iterator[str]:
+    """``value``'s JSON text as ``json.dumps(value, indent=1)`` writes it at ``depth``,
+    a piece at a time: a dict key by key, a list given as an iterator (a tile's children)
+    an item at a time, each made as it is written; anything else by ``json.dumps``."""
     inside = "\n" + " " * (depth + 1)
-    for number, item in enumerate(items):
-        yield ("[" if number == 0 else ",") + inside
-        yield from item(depth + 1)
-    yield "\n" + " " * depth + "]"
+    if isinstance(value, dict) and value:
+        for number, (key, item) in enumerate(value.items()):
+            yield ("{" if number == 0 else ",") + inside + json.dumps(key) + ": "
+            yield from _text(item, depth + 1)
+        yield "\n" + " " * depth + "}"
+    elif isinstance(value, Iterator):
+        opened = False
+        for item in value:
+            yield ("," if opened else "[") + inside
+            yield from _text(item, depth + 1)
+            opened = True
+        yield "\n" + " " * depth + "]" if opened else "[]"
+    else:
+        yield json.dumps(value, indent=1).replace("\n", "\n" + " " * depth)
 
 
 def _batched(chunks: Iterable[str], size: int = 1 << 16) -> Iterator[bytes]:

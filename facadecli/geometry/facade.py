@@ -8,7 +8,7 @@ along the façade, y up, z towards the viewer (SPEC 2.1), metres: glTF's own fra
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import lru_cache, partial
 from pathlib import Path
 
@@ -22,11 +22,12 @@ from facadecli.geometry.primitives import (
     PANES,
     PRIMITIVES,
     RECESS_DEPTH,
-    ROOM_DEPTH,
     Cell,
     asset,
+    open_box,
     recess,
 )
+from facadecli.geometry.rooms import Opening, Room, rooms
 from facadecli.geometry.runs import built
 from facadecli.geometry.walls import wall_mesh
 from facadecli.layout import (
@@ -434,14 +435,19 @@ def _mirror(mesh: trimesh.Trimesh, cell: Cell, x: bool, y: bool) -> None:
     mesh.apply_transform(matrix)  # trimesh flips the winding of a reflection
 
 
-def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
+def facade_scene(
+    layout: Layout, base_dir: Path | None = None, behind: float = math.inf
+) -> trimesh.Scene:
     """The visible shapes of a layout as a scene (hidden ones are culled). A frame or an
     arch is two meshes: its bars in the shape's material and its pane in the pane's. The
     walls (opaque boxes) of a layer are one mesh per material and depth, whatever their
     cells (:func:`.wall_mesh`): no seams between the cells. Every
     window is backed here, in one place: behind each see-through pane, and behind each box
     or panel of a see-through material, a closed dark recess (:func:`.recess`) in the
-    ``interior`` material, so that no view through a window passes through the model."""
+    ``interior`` material, so that no view through a window passes through the model;
+    with a ``rooms`` interior, one room box a window instead, as :func:`.rooms.rooms`
+    decides them (``behind``: metres behind the façade's plane a room may reach, the
+    building behind the wall; a façade alone has nothing behind it)."""
     spec = layout.spec
     assets: dict[str, trimesh.Trimesh] = {}
     scene = trimesh.Scene()
@@ -516,7 +522,36 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             mesh, geom_name=name, node_name=node, parent_node_name=parent, transform=placement
         )
 
+    def furnish(room: Room, shape: Shape, node: str) -> None:
+        """Add the node of a room box (sharing the mesh of an equal room built already)."""
+        nonlocal total
+        where = np.array([shape.x0, shape.y0, shape.z1])
+        number = int(room_variant(where, look(spec, INTERIOR_MATERIAL).seed)[0])
+        size = (room.x1 - room.x0, room.y1 - room.y0, room.depth)
+        key: tuple[object, ...] = ("room", *np.round(size, 6).tolist(), number)
+        placement = trimesh.transformations.translation_matrix((room.x0, room.y0, room.front))
+        parent = f"layer:{shape.layer}"
+        existing = shared.get(key)
+        if existing is None:
+            existing = f"room-{INTERIOR_MATERIAL}-{len(shared)}"
+            box = open_box((0.0, 0.0, -room.depth), (*size[:2], 0.0))
+            mesh = dress(box, INTERIOR_MATERIAL, number)
+            shared[key] = existing
+            faces[existing] = len(mesh.faces)
+            scene.add_geometry(mesh, geom_name=existing, node_name=node, parent_node_name=parent)
+            scene.graph.update(frame_to=node, frame_from=parent, matrix=placement)
+        else:
+            scene.graph.update(
+                frame_to=node, frame_from=parent, matrix=placement, geometry=existing
+            )
+        total = _count(spec.name, total, faces[existing])
+
     pieces = built(layout.shapes)
+    furnished = look(spec, INTERIOR_MATERIAL).library == ROOMS
+    backed = _backed(layout, pieces, base_dir, assets) if furnished else {}
+    placed_rooms = dict(
+        zip(backed, rooms(list(backed.values()), layout.width, layout.height, behind), strict=True)
+    )
     for layer in spec.layers:
         if not layer.enabled:
             continue
@@ -536,17 +571,23 @@ def facade_scene(layout: Layout, base_dir: Path | None = None) -> trimesh.Scene:
             cell = Cell.of(shape)
             build = partial(_build, shape, cell, base_dir, assets)
             place(shape, "", shape.material, build, node)
-            deep = room_depth(layout, shape)
             if shape.mesh in GLAZED and see_through(spec, shape.material):
-                behind = partial(_recess, build, deep)
-                place(shape, f"recess {deep:g}", INTERIOR_MATERIAL, behind, f"{node}/recess")
+                if furnished:
+                    if (room := placed_rooms.get((id(shape), ""))) is not None:
+                        furnish(room, shape, f"{node}/recess")
+                else:
+                    dark = partial(_recess, build, RECESS_DEPTH)
+                    place(shape, "recess", INTERIOR_MATERIAL, dark, f"{node}/recess")
             pane = PANES.get(shape.mesh)
             if pane is not None:
                 glass = shape.look.pane_material if shape.look else PANE_MATERIAL
                 place(shape, "pane", glass, partial(pane, cell), f"{node}/pane")
-                if see_through(spec, glass):
-                    back = partial(_recess, partial(pane, cell), deep)
-                    place(shape, f"pane-recess {deep:g}", INTERIOR_MATERIAL, back, f"{node}/recess")
+                if see_through(spec, glass) and furnished:
+                    if (room := placed_rooms.get((id(shape), "pane"))) is not None:
+                        furnish(room, shape, f"{node}/recess")
+                elif see_through(spec, glass):
+                    back = partial(_recess, partial(pane, cell), RECESS_DEPTH)
+                    place(shape, "pane-recess", INTERIOR_MATERIAL, back, f"{node}/recess")
         for (material, z0, z1), cells in walls.items():  # one mesh each: no seams
             mesh = dress(wall_mesh(cells, z0, z1), material)
             name = f"walls-{layer.name}-{material}-{count}"
@@ -573,19 +614,42 @@ def _recess(glass: Callable[[], trimesh.Trimesh | None], depth: float) -> trimes
     return None if mesh is None else recess(mesh, depth)
 
 
-def room_depth(layout: Layout, shape: Shape) -> float:
-    """How deep the recess behind a shape's glass is: :data:`.RECESS_DEPTH` (a dark
-    recess), or with a ``rooms`` interior a room :data:`.ROOM_DEPTH` deep where the wall
-    leaves room. A room reaches no further behind the façade's plane than its window
-    stands from the nearer end of the façade, so that at a building's corner it meets
-    no room of the other façade (whose windows stand as far from the corner as its
-    rooms reach in); it keeps :data:`.RECESS_DEPTH` at the least, and is a whole number
-    of decimetres, so that the windows of a façade share a few room boxes."""
-    if look(layout.spec, INTERIOR_MATERIAL).library != ROOMS:
-        return RECESS_DEPTH
-    free = min(shape.x0, layout.width - shape.x1) + shape.z0  # z0: the shape's back
-    deep = math.floor(min(ROOM_DEPTH, free) * 10 + 1e-9) / 10
-    return max(RECESS_DEPTH, deep)
+def _backed(
+    layout: Layout,
+    pieces: Sequence[Shape],
+    base_dir: Path | None,
+    assets: dict[str, trimesh.Trimesh],
+) -> dict[tuple[int, str], Opening]:
+    """The openings of a layout's windows, each keyed by its shape (``id``) and part (``""``:
+    a see-through box or panel, its glass; ``"pane"``: a frame's, an arch's or a door's
+    pane in a see-through material), in the order :func:`facade_scene` places them: what
+    the glass of each covers seen head-on (as its mesh is built and mirrored in its
+    cell), the back of that glass, and a door's threshold (its room's floor)."""
+    spec = layout.spec
+    found: dict[tuple[int, str], Opening] = {}
+    enabled = {layer.name for layer in spec.layers if layer.enabled}
+    for shape in pieces:
+        if shape.layer not in enabled:
+            continue
+        cell = Cell.of(shape)
+        glass: list[tuple[str, Callable[[], trimesh.Trimesh | None]]] = []
+        if shape.mesh in GLAZED and see_through(spec, shape.material):
+            glass.append(("", partial(_build, shape, cell, base_dir, assets)))
+        pane = PANES.get(shape.mesh)
+        pane_glass = shape.look.pane_material if shape.look else PANE_MATERIAL
+        if pane is not None and see_through(spec, pane_glass):
+            glass.append(("pane", partial(pane, cell)))
+        for part, build in glass:
+            mesh = build()
+            if mesh is None:
+                continue
+            _mirror(mesh, cell, shape.reflected_x, shape.reflected_y)
+            (x0, y0, z0), (x1, y1, _) = mesh.bounds
+            threshold = shape.y0 if shape.mesh == "door" else None  # the storey's floor
+            found[(id(shape), part)] = Opening(
+                shape.x0 + x0, shape.x0 + x1, shape.y0 + y0, shape.y0 + y1, shape.z1 + z0, threshold
+            )
+    return found
 
 
 def _builtin(material: str) -> Material:

@@ -8,7 +8,7 @@ and mirrored later (facade.py). Built with numpy only, so every mesh is determin
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import mapbox_earcut
 import numpy as np
@@ -26,11 +26,11 @@ from facadecli.geometry.cell import (
     shutter_plan,
 )
 
-__all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset", "recess"]
+__all__ = ["DEFAULT_SEGMENTS", "PANES", "PRIMITIVES", "Cell", "asset", "open_box", "recess"]
 
 RECESS_DEPTH = 0.12  # metres from the back of a window's glass to the plate behind it
 # metres from the back of a window's glass to the back wall of the room behind it (a
-# ``rooms`` interior), where the wall leaves room (:func:`.facade.room_depth`)
+# ``rooms`` interior), where the wall leaves room (:func:`.rooms.room_depth`)
 ROOM_DEPTH = 1.2
 
 
@@ -342,23 +342,29 @@ def shutter(cell: Cell) -> trimesh.Trimesh:
 def recess(glass: trimesh.Trimesh, depth: float = RECESS_DEPTH) -> trimesh.Trimesh:
     """The dark recess behind a window's glass (in the glass's frame), open towards the
     glass: a back plate ``depth`` behind the back of the glass, as large as the glass seen
-    head-on, and four reveals from it up to the glass, each a quad facing into the
-    opening (five quads, ten triangles, eight corners). A ray that passes the glass meets
-    the front of one of them, so the street behind a façade never shows through its
-    windows; nothing faces away from the window, where no one can see it. A room
-    (:data:`ROOM_DEPTH` deep) is the same box, its reveals the room's side walls, floor
-    and ceiling."""
+    head-on, and four reveals from it up to the glass (:func:`open_box`). A ray that
+    passes the glass meets the front of one of them, so the street behind a façade never
+    shows through its windows."""
     (x0, y0, z0), (x1, y1, _) = glass.bounds
-    back = z0 - depth
+    return open_box((x0, y0, z0 - depth), (x1, y1, z0))
+
+
+def open_box(low: Sequence[float], high: Sequence[float]) -> trimesh.Trimesh:
+    """A box between the corners ``low`` and ``high`` open at its front (towards +z), seen
+    from inside: a back plate and four sides, each a quad facing into it (five quads, ten
+    triangles, eight corners); nothing faces away from the opening, where no one can see
+    it. A dark recess (:func:`recess`) and a room behind a window
+    (:func:`.rooms.rooms`: its sides the room's side walls, floor and ceiling)."""
+    (x0, y0, back), (x1, y1, z0) = low, high
     corners = np.array(
         [(x, y, z) for z in (back, z0) for y in (y0, y1) for x in (x0, x1)], dtype=float
     )  # 0-3 the back plate's corners, 4-7 the opening's (x fastest, then y)
     quads = [
-        (0, 1, 3, 2),  # the back plate, facing the glass (+z)
-        (0, 2, 6, 4),  # the left reveal, facing right (+x)
-        (1, 5, 7, 3),  # the right reveal, facing left (-x)
-        (0, 4, 5, 1),  # the bottom reveal, facing up (+y)
-        (2, 3, 7, 6),  # the top reveal, facing down (-y)
+        (0, 1, 3, 2),  # the back plate, facing the opening (+z)
+        (0, 2, 6, 4),  # the left side, facing right (+x)
+        (1, 5, 7, 3),  # the right side, facing left (-x)
+        (0, 4, 5, 1),  # the bottom, facing up (+y)
+        (2, 3, 7, 6),  # the top, facing down (-y)
     ]
     faces = np.array([f for a, b, c, d in quads for f in ((a, b, c), (a, c, d))], dtype=np.int64)
     return trimesh.Trimesh(corners, faces, process=False)

@@ -395,7 +395,7 @@ def _room(m: int, rng: np.random.Generator) -> tuple[np.ndarray, Field]:
     walls next to it); in some the lights on (warmer and brighter, a lamp's glow under the
     ceiling); the inner reveal (:data:`ROOM_REVEAL`) round it, in the dim grey a reveal's
     plaster has. With its ambient occlusion: a room sees the sky through its window
-    alone, the less the deeper in (0.9 at the window to 0.55 at the back wall)."""
+    alone, the less the deeper in (0.95 at the window to 0.8 at the back wall)."""
     centres = (np.arange(m) + 0.5) / m
     s, t = np.meshgrid(centres, centres[::-1])  # 0..1 across, 0..1 up
     a0, a1, b0, b1 = ROOM_BACK
@@ -444,11 +444,12 @@ def _room(m: int, rng: np.random.Generator) -> tuple[np.ndarray, Field]:
         hung = ((side <= 1) & ~back & (depth > 1 - width)) & (t > b0) & (t < b1)
         folds = 0.75 + 0.25 * np.sin(2 * np.pi * depth / 0.12) ** 2
         colour[hung] = (cloth * (1.2 if lit else 1.0)) * folds[hung][..., None]
-    # a room by day is darker than the street it looks onto: a lit one less so
-    colour = colour * (0.65 if lit else 0.35)
+    # a room by day is darker than the street it looks onto (mid-grey seen through the
+    # glass), a lit one less so
+    colour = colour * (1.0 if lit else 0.75)
     edge = np.minimum.reduce([s, 1 - s, t, 1 - t])
     colour[edge < ROOM_REVEAL] = (0.16, 0.155, 0.145)
-    open_sky: Field = np.where(back, 0.55, 0.55 + 0.35 * depth)
+    open_sky: Field = np.where(back, 0.8, 0.8 + 0.15 * depth)
     return colour, open_sky
 
 

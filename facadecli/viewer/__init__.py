@@ -73,6 +73,7 @@ import {RenderPass} from 'three/addons/postprocessing/RenderPass.js';
 import {GTAOPass} from 'three/addons/postprocessing/GTAOPass.js';
 import {OutputPass} from 'three/addons/postprocessing/OutputPass.js';
 import {SimplexNoise} from 'three/addons/math/SimplexNoise.js';
+import {mergeGeometries} from 'three/addons/utils/BufferGeometryUtils.js';
 const view = document.getElementById('model');
 const status = document.getElementById('status');
 // the sky's light is 2.4 times the houses' (below): at 0.55 a sunlit wall is about as light
@@ -369,9 +370,15 @@ scene.add(ground);
 // of the streets. A picture of the plan's cells and a margin round it says how much of
 // each a place is (red paving, green asphalt, blue grass, alpha the kerb), and the
 // ground's shader mixes them; a façade's is all paving.
-const TOWN_PAVED = 40;  // metres past the plan's margin where the town is paved
+// Past the plan's margin the land round the district is, within TOWN_PAVED metres, what
+// most of the district's open ground is (``town``: paving, or grass for a town of lawns),
+// and the ground fades into the horizon's haze from ``hazeFrom`` metres from the eye to
+// the fog's far end (light), so no edge or band shows where the plan ends.
+const TOWN_PAVED = 20, TOWN_EDGE = 6;
+const PAVED = new THREE.Vector4(1, 0, 0, 0), LAWNS = new THREE.Vector4(0, 0, 1, 0);
 const uses = {regions: {value: null}, regionsFrom: {value: new THREE.Vector2(0, 0)},
-              regionsSize: {value: new THREE.Vector2(1, 1)}};
+              regionsSize: {value: new THREE.Vector2(1, 1)}, town: {value: PAVED.clone()},
+              hazeFrom: {value: 1}};
 function regionsPicture(data, columns, rows) {
   const picture = new THREE.DataTexture(data, columns, rows);
   picture.magFilter = picture.minFilter = THREE.LinearFilter;
@@ -386,15 +393,21 @@ ground.material.onBeforeCompile = shader => {
     '#include <begin_vertex>',
     '#include <begin_vertex>\\nvGround = (modelMatrix * vec4(position, 1.0)).xz;');
   shader.fragmentShader = `uniform sampler2D regions; uniform vec2 regionsFrom, regionsSize;
+    uniform vec4 town; uniform float hazeFrom;
     #define TOWN_PAVED ${TOWN_PAVED.toFixed(1)}
+    #define TOWN_EDGE ${TOWN_EDGE.toFixed(1)}
     varying vec2 vGround;\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
     #include <map_fragment>
     vec2 inPlan = (vGround - regionsFrom) / regionsSize;
     vec4 share = texture2D(regions, inPlan);
-    // past the plan's margin the town's streets give way to its paved squares, out to
-    // the haze: the district stands in a town, not in a field or on a car park
+    // past the plan's margin the town's streets give way to what most of the district's
+    // open ground is (its squares, or its lawns), out to the haze
+    // (from TOWN_EDGE metres inside the margin's edge: the picture's edge, clamped, drew
+    // streaks past it)
     vec2 past = (inPlan - clamp(inPlan, 0.0, 1.0)) * regionsSize;
-    share = mix(share, vec4(1.0, 0.0, 0.0, 0.0), smoothstep(0.0, TOWN_PAVED, length(past)));
+    vec2 inside = min(inPlan, 1.0 - inPlan) * abs(regionsSize);
+    float beyond = length(past) > 0.0 ? length(past) : -min(inside.x, inside.y);
+    share = mix(share, town, smoothstep(-TOWN_EDGE, TOWN_PAVED, beyond));
     float speck = fract(sin(dot(floor(vGround * 5.0), vec2(12.9898, 78.233))) * 43758.5453);
     vec3 asphalt = vec3(0.042, 0.042, 0.045) * (0.9 + 0.2 * speck);
     vec3 grass = vec3(0.05, 0.075, 0.028) * (0.8 + 0.4 * speck);
@@ -403,6 +416,18 @@ ground.material.onBeforeCompile = shader => {
       / max(share.r + share.g + share.b, 1e-3);`);
 };
 ground.material.customProgramCacheKey = () => 'ground-regions';
+{
+  const regions = ground.material.onBeforeCompile;
+  ground.material.onBeforeCompile = shader => {  // the ground fades into the haze
+    regions(shader);
+    shader.fragmentShader = shader.fragmentShader.replace('#include <fog_fragment>', `
+      #include <fog_fragment>
+      #ifdef USE_FOG
+      float hazed = clamp((vFogDepth - hazeFrom) / max(fogFar - hazeFrom, 1e-3), 0.0, 1.0);
+      gl_FragColor.rgb = mix(gl_FragColor.rgb, fogColor, hazed * hazed);
+      #endif`);
+  };
+}
 // The ground and what stands on it end where the haze has swallowed them (fog.far away),
 // so the sky's backdrop, its horizon there (placeBackdrop), shows over them
 function endsInHaze(material, more = shader => shader) {
@@ -414,8 +439,20 @@ function endsInHaze(material, more = shader => shader) {
 }
 endsInHaze(ground.material, ground.material.onBeforeCompile);
 // The street trees (a trunk and a crown, each one instanced mesh: two draw calls whatever
-// their number) and the centre-line dashes (one more), seeded: the same each time
+// their number), the centre-line dashes and the street lamps (one more each), seeded: the
+// same each time
 const TREE_TRUNK = 2.6;
+// A street lamp of painted steel, LAMP_HIGH metres, one mesh (one draw call for them all):
+// a tapering pole, an arm reaching LAMP_ARM metres over the road (+x), a flat lantern
+const LAMP_HIGH = 5.6, LAMP_ARM = 1.1;
+function lampShape() {
+  const pole = new THREE.CylinderGeometry(0.05, 0.08, LAMP_HIGH, 8).translate(0, LAMP_HIGH / 2, 0);
+  const arm = new THREE.BoxGeometry(LAMP_ARM, 0.06, 0.06)
+    .translate(LAMP_ARM / 2, LAMP_HIGH - 0.05, 0);
+  const lantern = new THREE.BoxGeometry(0.55, 0.12, 0.26)
+    .translate(LAMP_ARM - 0.05, LAMP_HIGH - 0.12, 0);
+  return mergeGeometries([pole, arm, lantern].map(part => part.toNonIndexed()));
+}
 const trees = {
   trunks: new THREE.InstancedMesh(
     new THREE.CylinderGeometry(0.12, 0.17, TREE_TRUNK, 7).translate(0, TREE_TRUNK / 2, 0),
@@ -427,15 +464,17 @@ const trees = {
     new THREE.PlaneGeometry(1, 1).rotateX(-Math.PI / 2),
     new THREE.MeshStandardMaterial({color: 0xd8d6cc, roughness: 0.8, polygonOffset: true,
                                     polygonOffsetFactor: -2, polygonOffsetUnits: -2}), 1),
+  lamps: new THREE.InstancedMesh(lampShape(), new THREE.MeshStandardMaterial(
+    {color: 0x3b3f42, roughness: 0.55, metalness: 0.6}), 1),
 };
 for (const part of Object.values(trees)) {
   endsInHaze(part.material);
   part.count = 0; part.frustumCulled = false; part.receiveShadow = true;
   scene.add(part);
 }
-trees.trunks.castShadow = trees.crowns.castShadow = true;
+trees.trunks.castShadow = trees.crowns.castShadow = trees.lamps.castShadow = true;
 const CROWN_GREENS = [0x3f5e2a, 0x4d6b30, 0x35522a, 0x56703a].map(c => new THREE.Color(c));
-function placeStreetParts(cells, dashes, place) {
+function placeStreetParts(cells, dashes, lamps, place) {
   const random = seeded(13), matrix = new THREE.Matrix4(), turn = new THREE.Quaternion();
   const up = new THREE.Vector3(0, 1, 0), size = new THREE.Vector3(), at = new THREE.Vector3();
   const grow = (mesh, count) => {
@@ -449,6 +488,7 @@ function placeStreetParts(cells, dashes, place) {
   trees.trunks = grow(trees.trunks, cells.length);
   trees.crowns = grow(trees.crowns, cells.length);
   trees.dashes = grow(trees.dashes, dashes.length);
+  trees.lamps = grow(trees.lamps, lamps.length);
   cells.forEach((cell, index) => {
     const [x, y, z] = place(cell);
     const radius = 1.5 + 0.6 * random(), tall = 1.1 + 0.35 * random();
@@ -467,8 +507,15 @@ function placeStreetParts(cells, dashes, place) {
     matrix.compose(at.set(x, y, z), turn, size.set(DASH, 1, 0.12));
     trees.dashes.setMatrixAt(index, matrix);
   });
+  lamps.forEach(([cell, across, down], index) => {
+    const [x, y, z] = place(cell);
+    turn.setFromAxisAngle(up, Math.atan2(down, across));  // the arm over the road
+    matrix.compose(at.set(x, y, z), turn, size.set(1, 1, 1));
+    trees.lamps.setMatrixAt(index, matrix);
+  });
   trees.trunks.count = trees.crowns.count = cells.length;
   trees.dashes.count = dashes.length;
+  trees.lamps.count = lamps.length;
   for (const part of Object.values(trees)) {
     part.instanceMatrix.needsUpdate = true;
     if (part.instanceColor) part.instanceColor.needsUpdate = true;
@@ -477,8 +524,9 @@ function placeStreetParts(cells, dashes, place) {
 function groundRegions(model, box, district) {  // a model after another: its own ground
   uses.regions.value.dispose();
   uses.regions.value = allPaving();
+  uses.town.value.copy(PAVED);
   delete document.body.dataset.ground;
-  placeStreetParts([], [], null);
+  placeStreetParts([], [], [], null);
   const buildings = model.children.length;
   if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
   const {cell, columns, rows, building} = districtPlan(model, box);
@@ -503,17 +551,19 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   const z = row => box.min.z + (rows + margin - row - 0.5) * cell;
   const place = at => [x(at % wide), box.min.y, z(Math.floor(at / wide))];
   const treesAt = treeCells(plan, wide, cell), dashes = dashCells(plan, wide, deep, cell);
-  placeStreetParts(treesAt, dashes, place);
+  const lamps = lampCells(plan, wide, deep, cell, treesAt);
+  placeStreetParts(treesAt, dashes, lamps, place);
   document.body.dataset.ground = JSON.stringify({
     paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
     grass: share(counts[3]), cell, area: +(columns * rows * cell * cell).toFixed(1),
     trees: treesAt.map(at => place(at).map(v => +v.toFixed(2))),
-    dashes: dashes.length});
+    dashes: dashes.length, lamps: lamps.map(([at]) => place(at).map(v => +v.toFixed(2)))});
   uses.regions.value.dispose();
   uses.regions.value = regionsPicture(data, wide, deep);
   // the picture's row 0 is the plan's, at the district's +z edge (districtPlan)
   uses.regionsFrom.value.set(box.min.x - margin * cell, box.min.z + (rows + margin) * cell);
   uses.regionsSize.value.set(wide * cell, -deep * cell);
+  uses.town.value.copy(counts[3] > counts[0] + counts[2] ? LAWNS : PAVED);
 }
 const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 5000);
 const controls = new OrbitControls(camera, renderer.domElement);
@@ -1053,6 +1103,8 @@ function light(model) {
       if (part.isMesh) for (const material of materialsOf(part)) material.fog = false;
     });
   }
+  // a district's ground fades from the distance of its middle: a façade's in the fog alone
+  uses.hazeFrom.value = district ? Math.min(scene.fog.near, fit) : scene.fog.far;
   ground.position.set(centre.x, box.min.y - radius * 1e-4, centre.z);
   ground.scale.setScalar(4 * haze);
   // the circle's texture coordinates span its diameter: slabs SLAB metres a side

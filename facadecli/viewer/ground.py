@@ -15,16 +15,25 @@ from __future__ import annotations
 #   street runs on ROOM metres past it (a wide street or the town's edge), then a kerb
 #   KERB wide, then asphalt; the land round the district is such a street, to the haze;
 # - a yard has a path YARD_PATH wide along its walls, then grass;
-# - a street's asphalt reaches ROAD_HALF[1] metres from the walls at most (the middle of
-#   a street 24 m wide); open ground farther out is a paved square (a green by distance
-#   alone, among the buildings, drew slivers of lawn along the plan's rows and columns);
+# - past its pavement a street is asphalt, to ROAD_HALF[1] metres from the walls at most
+#   (the middle of a street 24 m wide), and a paved square farther out, where buildings
+#   close the place in: its enclosure (the share of RAYS_AROUND rays from it that meet a
+#   wall within SQUARE_REACH metres, of those that stay in the plan) at least
+#   ROAD_ENCLOSED for a road, ENCLOSED for a square; open land no walls close in is grass,
+#   the lawns of a sparse town (by distance alone, a town of detached houses 30-100 m
+#   apart was all paved square);
 # - a tree every TREE_EVERY metres or more along the wide pavements, TREE_LINE metres from
 #   the walls; a dash DASH metres long every DASH_EVERY metres along a street's centre (the
-#   ridge of the distance to its walls), where the street is ROAD_HALF metres from its walls.
+#   ridge of the distance to its walls), where the street is ROAD_HALF metres from its walls;
+# - a street lamp every LAMP_EVERY metres or more, on a pavement LAMP_KERB metres short of
+#   its kerb where asphalt follows, LAMP_CLEAR metres or more from a tree, its arm over the
+#   road.
 GROUND = """
 const PAVEMENT = 2.5, WIDE_PAVEMENT = 4.5, KERB = 0.2, PASSAGE = 3, YARD_PATH = 1;
 const ROOM = 6, GROUND_MARGIN = 14;
 const TREE_LINE = 3.4, TREE_EVERY = 9, DASH = 3, DASH_EVERY = 7.5, ROAD_HALF = [3.5, 12];
+const LAMP_EVERY = 30, LAMP_KERB = 0.6, LAMP_CLEAR = 3;
+const SQUARE_REACH = 40, RAYS_AROUND = 32, ENCLOSED = 0.5, ROAD_ENCLOSED = 0.3;
 // The exact Euclidean distance of each cell of a grid (row by row, ``columns`` a row) to
 // the nearest cell set in ``seeds``, in cells: the lower envelope of parabolas
 // (Felzenszwalb and Huttenlocher), down each column, then along each row. A chamfer (steps
@@ -99,6 +108,47 @@ function roomy(near, columns, rows, cell, at) {
   const there = value(Math.round(column + dx * probe), Math.round(row + dy * probe));
   return there * cell >= near[at] * cell + ROOM - 1.5;
 }
+// How closed in by walls each place is, 0..1: of RAYS_AROUND rays from it, evenly round,
+// the share that meets a building within SQUARE_REACH metres, of those that do not leave
+// the plan first (what lies past the district is unknown), or of half the rays where
+// more leave (a few rays left drew streaks of square along their directions). Each ray
+// marches along the distance field (``near``, cells), a step as long as the way is clear:
+// a few steps a ray. Taken every ENCLOSURE_STEP metres and interpolated between, so a
+// boundary between square and lawn runs smooth, not in the rays' jagged fans.
+const ENCLOSURE_STEP = 4;
+function enclosureField(near, columns, rows, cell) {
+  const reach = SQUARE_REACH / cell, step = Math.max(1, Math.round(ENCLOSURE_STEP / cell));
+  const across = Math.ceil((columns - 1) / step) + 1, down = Math.ceil((rows - 1) / step) + 1;
+  const coarse = new Float32Array(across * down);
+  const directions = Array.from({length: RAYS_AROUND}, (_, ray) => {
+    const angle = 2 * Math.PI * (ray + 0.5) / RAYS_AROUND;
+    return [Math.cos(angle), Math.sin(angle)];
+  });
+  for (let j = 0; j < down; j++) for (let i = 0; i < across; i++) {
+    const column = Math.min(i * step, columns - 1), row = Math.min(j * step, rows - 1);
+    let walls = 0, out = 0;
+    for (const [dx, dy] of directions) {
+      for (let along = 0; along <= reach;) {
+        const x = Math.round(column + dx * along), y = Math.round(row + dy * along);
+        if (x < 0 || x >= columns || y < 0 || y >= rows) { out++; break; }
+        const clear = near[y * columns + x];
+        if (clear < 1) { walls++; break; }
+        along += Math.max(1, clear - 1);
+      }
+    }
+    coarse[j * across + i] = walls / Math.max(RAYS_AROUND - out, RAYS_AROUND / 2);
+  }
+  return at => {  // bilinear between the four places taken round ``at``
+    const column = at % columns, row = (at - column) / columns;
+    const u = column / step, v = row / step;
+    const i = Math.min(Math.floor(u), across - 2), j = Math.min(Math.floor(v), down - 2);
+    const fu = across > 1 ? u - i : 0, fv = down > 1 ? v - j : 0;
+    const value = (a, b) => coarse[Math.min(b, down - 1) * across + Math.min(a, across - 1)];
+    const top = value(i, j) + (value(i + 1, j) - value(i, j)) * fu;
+    const bottom = value(i, j + 1) + (value(i + 1, j + 1) - value(i, j + 1)) * fu;
+    return top + (bottom - top) * fv;
+  };
+}
 // What each cell of a grid is, the buildings' cells set in ``building``: 0 building,
 // 1 pavement (a path, in a yard), 2 kerb, 3 asphalt, 4 grass; and the distance to the
 // nearest building (metres), whether each is street, and whether its pavement is wide
@@ -108,6 +158,7 @@ function groundKinds(building, columns, rows, cell) {
   const toStreet = distanceField(reached, columns, rows);
   const kinds = new Uint8Array(columns * rows), street = new Uint8Array(columns * rows);
   const wide = new Uint8Array(columns * rows);
+  const enclosed = enclosureField(near, columns, rows, cell);
   for (let at = 0; at < columns * rows; at++) {
     if (building[at]) continue;
     const metres = near[at] * cell;
@@ -120,8 +171,10 @@ function groundKinds(building, columns, rows, cell) {
       wide[at] = roomy(near, columns, rows, cell, at) ? 1 : 0;
     }
     const kerb = wide[at] ? WIDE_PAVEMENT : PAVEMENT;
-    // past the middle of the widest street: a paved square
-    kinds[at] = metres < kerb ? 1 : metres < kerb + KERB ? 2 : metres <= ROAD_HALF[1] ? 3 : 1;
+    if (metres < kerb) { kinds[at] = 1; continue; }
+    const road = metres <= ROAD_HALF[1];  // past the middle of the widest street: a square
+    if (enclosed(at) < (road ? ROAD_ENCLOSED : ENCLOSED)) { kinds[at] = 4; continue; }
+    kinds[at] = metres < kerb + KERB ? 2 : road ? 3 : 1;
   }
   return {kinds, near, street, wide};
 }
@@ -158,10 +211,32 @@ function treeCells(ground, columns, cell) {
   }
   return spaced(candidates, columns, cell, TREE_EVERY);
 }
+// Whether a dash at ``at`` along ``angle`` stops DASH_STOP metres short of any junction:
+// within the street's half width, half a dash and DASH_STOP of it, no ridge cell off its
+// line by more than JUNCTION_BAND metres (the middle of a street meeting it) and no place
+// farther than ROAD_HALF[1] from the walls (a square or open land it opens into)
+const DASH_STOP = 1.5, JUNCTION_BAND = 1.5;
+function clearOfJunctions(ground, ridge, columns, rows, cell, at, angle) {
+  const {near} = ground, column = at % columns, row = (at - column) / columns;
+  const reach = near[at] + (DASH / 2 + DASH_STOP) / cell, band = Math.max(2, JUNCTION_BAND / cell);
+  const acrossX = -Math.sin(angle), acrossY = Math.cos(angle), open = ROAD_HALF[1] / cell;
+  const r = Math.ceil(reach);
+  for (let y = Math.max(0, row - r); y <= Math.min(rows - 1, row + r); y++) {
+    for (let x = Math.max(0, column - r); x <= Math.min(columns - 1, column + r); x++) {
+      if (Math.hypot(x - column, y - row) > reach) continue;
+      const there = y * columns + x;
+      if (near[there] > open) return false;
+      const off = Math.abs((x - column) * acrossX + (y - row) * acrossY);
+      if (ridge[there] && off > band) return false;
+    }
+  }
+  return true;
+}
 // The road's centre-line dashes: on a street's ridge (the distance to its walls highest
 // across it, in one of four directions), ROAD_HALF metres from its walls, DASH_EVERY
 // apart, each along the ridge's cells within DASH metres (their principal axis), where
-// those lie along a line (not at a crossing) -> [[cell, along x, along rows], ...]
+// those lie along a line, stopping short of junctions (clearOfJunctions)
+// -> [[cell, along x, along rows], ...]
 function dashCells(ground, columns, rows, cell) {
   const {kinds, near, street} = ground, k = 2, ridge = new Uint8Array(kinds.length);
   const candidates = [];
@@ -192,8 +267,49 @@ function dashCells(ground, columns, rows, cell) {
     const along = mean + spread, across = mean - spread;
     if (across * 6 > along) continue;  // no line: a crossing or a square
     const angle = 0.5 * Math.atan2(2 * cxy, cxx - cyy);
+    if (!clearOfJunctions(ground, ridge, columns, rows, cell, at, angle)) continue;
     dashes.push([at, Math.cos(angle), Math.sin(angle)]);
   }
   return dashes;
+}
+// Whether a cell of ``kind`` lies within ``metres`` of the cell at ``at``
+function besideKind(kinds, columns, cell, at, kind, metres) {
+  const column = at % columns, row = (at - column) / columns, rows = kinds.length / columns;
+  const reach = Math.max(1, Math.round(metres / cell));
+  for (let y = Math.max(0, row - reach); y <= Math.min(rows - 1, row + reach); y++) {
+    for (let x = Math.max(0, column - reach); x <= Math.min(columns - 1, column + reach); x++) {
+      if (kinds[y * columns + x] === kind && Math.hypot(x - column, y - row) <= reach) return true;
+    }
+  }
+  return false;
+}
+// The street lamps: cells on a street's pavement LAMP_KERB metres (within half a cell) short
+// of its kerb, asphalt beyond it, LAMP_EVERY apart and LAMP_CLEAR from the trees at
+// ``trees`` -> [[cell, along x, along rows], ...], the way to the road (the distance to
+// the walls growing)
+function lampCells(ground, columns, rows, cell, trees = []) {
+  const {kinds, near, street, wide} = ground, candidates = [];
+  const byTree = new Uint8Array(kinds.length), clear = Math.ceil(LAMP_CLEAR / cell);
+  for (const tree of trees) {
+    const x = tree % columns, y = (tree - x) / columns;
+    for (let r = Math.max(0, y - clear); r <= Math.min(rows - 1, y + clear); r++) {
+      for (let c = Math.max(0, x - clear); c <= Math.min(columns - 1, x + clear); c++) {
+        if (Math.hypot(c - x, r - y) * cell < LAMP_CLEAR) byTree[r * columns + c] = 1;
+      }
+    }
+  }
+  for (let row = 1; row < rows - 1; row++) for (let column = 1; column < columns - 1; column++) {
+    const at = row * columns + column;
+    if (kinds[at] !== 1 || !street[at] || byTree[at]) continue;
+    const line = (wide[at] ? WIDE_PAVEMENT : PAVEMENT) - LAMP_KERB;
+    if (Math.abs(near[at] * cell - line) > 0.5 * cell) continue;
+    if (!besideKind(kinds, columns, cell, at, 3, LAMP_KERB + KERB + cell)) continue;
+    candidates.push(at);
+  }
+  return spaced(candidates, columns, cell, LAMP_EVERY).map(at => {
+    const dx = near[at + 1] - near[at - 1], dy = near[at + columns] - near[at - columns];
+    const length = Math.hypot(dx, dy) || 1;
+    return [at, dx / length, dy / length];
+  });
 }
 """

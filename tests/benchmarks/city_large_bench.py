@@ -18,7 +18,10 @@ resident memory when the first and the last building end; the output sizes (the 
 smaller size also runs in one process under cProfile, and the functions taking the most
 CPU (own and cumulative) are printed. First, the client's memory once the town is read
 and planned (no building built) at 1,000, 10,000, 100,000 (up to ``FACADE_BENCH_N``)
-buildings, and its slope; ``FACADE_BENCH_PLAN_ONLY=1`` stops there.
+buildings, and its slope; ``FACADE_BENCH_PLAN_ONLY=1`` stops there. The town's
+footprints are GeoJSON; ``FACADE_BENCH_FORMAT`` writes them as ``osm`` (OSM XML, in
+lon/lat, some entrances and multipolygons), ``pbf``, ``gpkg`` or ``shp`` instead
+(tests/towns.py), to compare the readers' memory.
 
 With ``FACADE_BENCH_TRACE=1``, where that memory goes (tracemalloc, Python's own
 allocations, not GEOS's nor the C libraries'): for planning, what it holds once done
@@ -74,6 +77,7 @@ ROOT = Path(__file__).resolve().parents[2]
 SEED = 1
 TRACED = bool(os.environ.get("FACADE_BENCH_TRACE"))
 TOP = 8  # source lines listed by FACADE_BENCH_TRACE
+FORMAT = os.environ.get("FACADE_BENCH_FORMAT", "geojson")  # of the footprints (tests/towns.py)
 
 
 def _trace() -> tracemalloc.Snapshot:
@@ -304,14 +308,31 @@ def planning(manifest: Path, figures: Path) -> None:
     del hashes
 
 
+def town_of(folder: Path, count: int) -> Path:
+    """The manifest of a generated town of ``count`` terraces, its footprints in the
+    format FACADE_BENCH_FORMAT (default geojson; osm, pbf, gpkg, shp: tests/towns.py)."""
+    from facadecli.city.demo import write_terraces
+
+    manifest = write_terraces(folder, ROOT / "specs", count, SEED)
+    if FORMAT == "geojson":
+        return manifest
+    sys.path.append(str(ROOT))
+    from tests.towns import write_town
+
+    (folder / "footprints.geojson").unlink()
+    written = write_town(folder, count, FORMAT, SEED)
+    text = manifest.read_text().replace("footprints.geojson", written.name)
+    manifest.write_text(text)
+    return manifest
+
+
 def measure_planning(counts: list[int], folder: Path) -> None:
     """The client's memory once a town of each size is read and planned, each in a fresh
     process: what it holds through the run, before the buildings' entries."""
-    from facadecli.city.demo import write_terraces
-
     rows = []
+    print(f"footprints as {FORMAT}")
     for count in counts:
-        manifest = write_terraces(folder / f"plan-{count}", ROOT / "specs", count, SEED)
+        manifest = town_of(folder / f"plan-{count}", count)
         figures = folder / f"plan-{count}.json"
         command = [sys.executable, __file__, "--plan", str(manifest), str(figures)]
         subprocess.run(command, check=True)
@@ -383,17 +404,13 @@ def _size(path: Path) -> int:
 def measure(count: int, jobs: int, folder: Path) -> dict[str, float]:
     """The town of ``count`` buildings built by a fresh client process (going on from a
     stopped run's segments in a kept ``folder``); prints its figures."""
-    from facadecli.city.demo import write_terraces
-
     done = folder / f"done-{count}.txt"
     if done.exists():  # measured to its end by an earlier start
         print(done.read_text(), end="")
         return json.loads(done.read_text().splitlines()[-1].removeprefix("# "))
     town = folder / f"town-{count}"
-    if (town / "district.yaml").exists():  # a stopped run's town: the same bytes
-        manifest = town / "district.yaml"
-    else:
-        manifest = write_terraces(town, ROOT / "specs", count, SEED)
+    kept = town / "district.yaml"  # a stopped run's town: the same bytes
+    manifest = kept if kept.exists() else town_of(town, count)
     out = folder / f"out-{count}"
     figures = folder / f"figures-{count}.json"
     started = time.perf_counter()
