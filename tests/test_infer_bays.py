@@ -595,17 +595,23 @@ def test_every_layer_writes_its_bay_gaps_from_the_lines_the_bay_shares() -> None
     assert sum(s.layer.startswith("sill") for s in shapes) == 5
 
 
+def _window_columns(boxes: list[tuple[str, float, float, float, float]]) -> list[float]:
+    """The centres of the columns of windows (centres within 2 cm are one column)."""
+    centres = sorted({round((b[1] + b[3]) / 2, 2) for b in boxes if b[0] == "window"})
+    columns: list[float] = []
+    for c in centres:
+        if not columns or c - columns[-1] > 0.02:
+            columns.append(c)
+    return columns
+
+
 def _bays_drawn_unlike(seed: int) -> list[tuple[str, float, float, float, float]]:
     """Family seed ``seed`` (mirrored, no blinds) with each bay's windows and sills drawn
     a fifth wider a bay in from the ends (about their centres; the middle bay's as its
     neighbours'): mirrored partners stay nearly alike (the drawing's jitter), no two bays
     of the half are alike, as on CMP."""
     boxes, _ = family(seed)
-    centres = sorted({round((b[1] + b[3]) / 2, 2) for b in boxes if b[0] == "window"})
-    columns: list[float] = []
-    for c in centres:
-        if not columns or c - columns[-1] > 0.02:
-            columns.append(c)
+    columns = _window_columns(boxes)
     out = []
     for label, x0, y0, x1, y1 in boxes:
         if label in ("window", "sill"):
@@ -651,11 +657,7 @@ def _bays_each_unlike(seed: int) -> list[tuple[str, float, float, float, float]]
     about their centres, by a share of their own that no other bay shares (0.7-1.4):
     every bay a kind of its own, as on most CMP samples."""
     boxes, _ = family(seed)
-    centres = sorted({round((b[1] + b[3]) / 2, 2) for b in boxes if b[0] == "window"})
-    columns: list[float] = []
-    for c in centres:
-        if not columns or c - columns[-1] > 0.02:
-            columns.append(c)
+    columns = _window_columns(boxes)
     scales = (1.0, 1.3, 0.85, 1.15, 0.7, 1.4, 0.95, 1.22, 0.78)
     out = []
     for label, x0, y0, x1, y1 in boxes:

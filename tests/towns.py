@@ -21,6 +21,7 @@ import pyproj
 import shapely
 
 from facadecli.city.demo import terraces
+from tests.fuzz.city_doors import GPKG_SCHEMA
 
 RD_NEW = 28992
 ENTRANCE_EVERY = 7  # houses: one in this many has an entrance node on its front wall
@@ -107,17 +108,13 @@ def write_pbf(path: Path, xml: Path) -> Path:
     return path
 
 
-GPKG_TABLES = """
-CREATE TABLE gpkg_spatial_ref_sys (srs_name TEXT, srs_id INTEGER PRIMARY KEY,
-    organization TEXT, organization_coordsys_id INTEGER, definition TEXT, description TEXT);
-CREATE TABLE gpkg_contents (table_name TEXT PRIMARY KEY, data_type TEXT, identifier TEXT,
-    description TEXT, last_change TEXT, min_x REAL, min_y REAL, max_x REAL, max_y REAL,
-    srs_id INTEGER);
-CREATE TABLE gpkg_geometry_columns (table_name TEXT, column_name TEXT,
-    geometry_type_name TEXT, srs_id INTEGER, z TINYINT, m TINYINT);
+GPKG_TABLES = (
+    GPKG_SCHEMA
+    + """
 CREATE TABLE buildings (fid INTEGER PRIMARY KEY, geom BLOB, building TEXT,
     "building:levels" TEXT, height REAL, "roof:shape" TEXT);
 """
+)
 COLUMNS = ("building", "building:levels", "height", "roof:shape")
 
 
