@@ -96,7 +96,7 @@ COLUMN = 0.01  # m: a kind's elements of a label and size this close stand in on
 MARGIN = 0.005  # of the façade's width: what an end bay leaves of the margin beyond it
 DIGITS = 4  # of a metre: a kind's shape is rounded to this, so every word adds up alike
 ROUNDING = 1e-4  # m: the most rounding to DIGITS moves an edge, with float noise
-SLIVER = MIN_SIZE  # m: an element this near a bay's edge or another's meets it (``_unslivered``)
+SLIVER = MIN_SIZE  # m: a bay's edges this near one another are one line, as placed (``_lined``)
 CENTRED = 1e3  # the weight of a mirrored façade's bays standing in its middle
 SETTLE = 1e-3  # the weight of a kind's width and centres as first read, against the elements'
 AXIS = 0.01  # of the façade's width: an opening this close to another's reflection mirrors it
@@ -147,6 +147,17 @@ class Bays:
     counters: tuple[tuple[str, float, int, int | None], ...]  # name, pitch, count, most
     walls: tuple[float, ...]  # per kind: the wall after its last element (0: none)
     apart: frozenset[int] = frozenset()  # rectangles left as drawn, in layers of their own
+
+    def steady(self) -> frozenset[int]:
+        """The kinds whose wall keeps its size (the rest may narrow to ``WALL``): where
+        the bays stand in the façade's middle (one margin each side), the last bay's
+        kind where it stands nowhere else. Its wall is the last before the margin:
+        narrowed, it moved that bay's elements off the mirror image of the first's
+        (family seed 14 with defects at 2x, once the tidy-up kept its drawn widths)."""
+        last = self.kinds[-1]
+        if self.margins[0] != self.margins[1] or self.kinds.count(last) > 1:
+            return frozenset()
+        return frozenset({last})
 
     def describe(self) -> str:
         letters = "".join(chr(ord("A") + k) for k in self.kinds)
@@ -309,27 +320,12 @@ def _found(
             centred = False  # centred, a bay's elements would leave its frame: as drawn
             fitted = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths, 0, ties)
         start, widths, shapes = fitted
-        shapes = _tied([_lined(shape) for shape in shapes], ties)
-    symmetric = _palindrome(kinds, mirrored)
-    left, right = spans[0][0], width - spans[-1][1]
-    total = sum(widths[k] for k in kinds)
-    if symmetric and abs(left - right) <= ALIKE * statistics.median(widths):
-        start = round((width - total) / 2, DIGITS)
-    else:
-        symmetric = False
-    end = start if centred else round(width - start - total, DIGITS)
-    if start <= 0 or end <= 0:
-        yield "the bays reach the façade's edge (no margin to take the slack)"
+        shapes = _tied([_lined(s, w, COLUMN) for s, w in zip(shapes, widths, strict=True)], ties)
+    laid = _laid(kinds, mirrored, spans, width, widths, shapes, ties, start, centred)
+    if isinstance(laid, str):
+        yield laid
         return
-    unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
-    unique |= set(ties)  # a variant is written once, as drawn
-    runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
-    if symmetric and not any(r.counter and r.most is None for r in runs):
-        symmetric = False  # the halves would keep no repeat: the whole sequence, then
-        runs, counters = _plan(kinds, mirrored, unique, widths, False)
-    if not any(r.counter and r.most is None for r in runs):
-        yield f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
-        return
+    symmetric, start, runs, counters, end = laid
     narrowest = _narrowest(runs, kinds, widths, symmetric)
     if narrowest > NARROWEST * width:
         yield (
@@ -370,6 +366,42 @@ def _found(
                 walls,
                 frozenset(apart),
             )
+
+
+def _laid(
+    kinds: list[int],
+    mirrored: list[bool],
+    spans: list[Span],
+    width: float,
+    widths: tuple[float, ...],
+    shapes: list[list[Slot]],
+    ties: Ties,
+    start: float,
+    centred: bool,
+) -> tuple[bool, float, list[Run], list[tuple[str, float, int, int | None]], float] | str:
+    """The bays on their kinds' ``widths`` laid along the façade: whether they are
+    written mirrored, the first's start, the runs and counters (``_plan``) and the
+    margin after the last (``centred``: the same as before the first); or why they
+    cannot be (no margin, no repeat)."""
+    symmetric = _palindrome(kinds, mirrored)
+    left, right = spans[0][0], width - spans[-1][1]
+    total = sum(widths[k] for k in kinds)
+    if symmetric and abs(left - right) <= ALIKE * statistics.median(widths):
+        start = round((width - total) / 2, DIGITS)
+    else:
+        symmetric = False
+    end = start if centred else round(width - start - total, DIGITS)
+    if start <= 0 or end <= 0:
+        return "the bays reach the façade's edge (no margin to take the slack)"
+    unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
+    unique |= set(ties)  # a variant is written once, as drawn
+    runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
+    if symmetric and not any(r.counter and r.most is None for r in runs):
+        symmetric = False  # the halves would keep no repeat: the whole sequence, then
+        runs, counters = _plan(kinds, mirrored, unique, widths, False)
+    if not any(r.counter and r.most is None for r in runs):
+        return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
+    return symmetric, start, runs, counters, end
 
 
 def _rowed(
@@ -777,39 +809,12 @@ def _as_placed(
             (round(centre - size / 2, DIGITS), round(centre + size / 2, DIGITS))
             for _, centre, size, _, _ in mine
         ]
-        edges = _unslivered(edges, width)
-        shapes.append(
-            [
-                (label, (low + high) / 2, round(high - low, DIGITS), y0, y1)
-                for (label, _, _, y0, y1), (low, high) in zip(mine, edges, strict=True)
-            ]
-        )
+        shape = [
+            (label, (low + high) / 2, round(high - low, DIGITS), y0, y1)
+            for (label, _, _, y0, y1), (low, high) in zip(mine, edges, strict=True)
+        ]
+        shapes.append(_lined(shape, width, SLIVER))
     return round(spans[0][0], DIGITS), widths, shapes
-
-
-def _unslivered(edges: list[Span], width: float) -> list[Span]:
-    """A bay's elements (edges in its frame, rounded to ``DIGITS``), each moved (its
-    size kept) by less than ``SLIVER`` onto the bay's edge or another element's edge
-    where it stands nearer than that to one: a gap that narrow is no gap the solver can
-    make (its least letter, ``solver.sizing.MIN_SIZE``), so a bay on a counter holding
-    one (an element drawn a fifth of a millimetre in from the bay's edge: CMP's b0003
-    and b0008) gave a spec that cannot solve at the drawn counts, and the solver took
-    other counts at the input's size. The first in the order of their left edges settle
-    first; the later ones snap to them."""
-    placed: list[int] = []
-    order = sorted(range(len(edges)), key=lambda k: edges[k])
-    out = list(edges)
-    for k in order:
-        low, high = out[k]
-        targets = [0.0, width, *(e for j in placed for e in out[j])]
-        shift = min(
-            (t - e for e in (low, high) for t in targets if 1e-9 < abs(t - e) < SLIVER),
-            key=abs,
-            default=0.0,
-        )
-        out[k] = (round(low + shift, DIGITS), round(high + shift, DIGITS))
-        placed.append(k)
-    return out
 
 
 def _sized(slot: Slot) -> tuple[float, float, float, float]:
@@ -925,31 +930,41 @@ def _columns(shape: list[Slot]) -> list[Slot]:
     return out
 
 
-def _lined(shape: list[Slot]) -> list[Slot]:
-    """A kind's shape on one set of lines along x that every layer of its bays shares:
-    its elements' edges (of any label) within ``COLUMN`` of one another, or of the
-    bay's left edge, are one line, that of the openings' edges among them (their
-    median), else the bay's edge, else their median. Each layer's word of the bay
-    writes its gaps between these lines, so no two layers' gaps differ by a sliver: a
-    sill drawn 0.7 mm off its window's edge wrote a 0.7 mm gap before the kind's wall,
-    which the solver cannot size (``sizing.MIN_SIZE``; hold-out seed 116's spec did
-    not solve), and at other widths would stand that far off its window."""
+def _lined(shape: list[Slot], width: float, reach: float) -> list[Slot]:
+    """A bay kind's shape on one set of lines along x that every layer of its bays
+    shares: its elements' edges (of any label) within ``reach`` of one another, or of
+    the bay's edges (0 and ``width``), are one line: the bay's edge, else the openings'
+    edges among them (their median), else their median. Each layer's word of the bay
+    writes its gaps between these lines, so no gap is a sliver the solver cannot size
+    (``sizing.MIN_SIZE``). One rule for the bays as fitted (``reach``: ``COLUMN``: a
+    sill drawn 0.7 mm off its window wrote a 0.7 mm gap before the kind's wall the
+    window's layer did not, and hold-out seed 116's spec did not solve) and as placed
+    (``SLIVER``: an element a fifth of a millimetre in from its bay's edge, CMP's b0003
+    and b0008, left the drawn counts no layout, and the solver took others at 1x).
+    The shape as it is where a line would leave an element no width."""
     edges = sorted(
-        (round(c - w / 2, DIGITS) + side * w, n, side)
-        for n, (_, c, w, _, _) in enumerate(shape)
-        for side in (0, 1)
+        [
+            *(
+                (round(c - w / 2, DIGITS) + side * w, n, side)
+                for n, (_, c, w, _, _) in enumerate(shape)
+                for side in (0, 1)
+            ),
+            (0.0, -1, 0),  # the bay's edges
+            (width, -1, 1),
+        ]
     )
     at: dict[tuple[int, int], float] = {}
-    cluster: list[tuple[float, int, int]] = [(0.0, -1, 0)]  # the bay's left edge
-    for edge in [*edges, (float("inf"), -1, 0)]:
-        if edge[0] - cluster[-1][0] <= COLUMN:
+    cluster = edges[:1]
+    for edge in [*edges[1:], (float("inf"), -1, 0)]:
+        if edge[0] - cluster[-1][0] <= reach:
             cluster.append(edge)
             continue
+        bay = [v for v, n, _ in cluster if n < 0]
         opening = [v for v, n, _ in cluster if n >= 0 and shape[n][0] in CUTS]
-        if opening:
+        if bay:
+            line = bay[0]
+        elif opening:
             line = round(statistics.median(opening), DIGITS)
-        elif cluster[0][1] < 0 and cluster[0][0] == 0.0:
-            line = 0.0
         else:
             line = round(statistics.median(v for v, _, _ in cluster), DIGITS)
         at.update(((n, side), line) for _, n, side in cluster if n >= 0)
@@ -958,7 +973,7 @@ def _lined(shape: list[Slot]) -> list[Slot]:
     for n, (label, _, _, y0, y1) in enumerate(shape):
         low, high = at[n, 0], at[n, 1]
         if high - low <= 0:
-            return shape  # an element narrower than a line's reach: the shape as it is
+            return shape
         out.append((label, round((low + high) / 2, DIGITS + 1), round(high - low, DIGITS), y0, y1))
     return out
 

@@ -487,14 +487,16 @@ def spec_text(
         for gaps in bay_gaps
     ]
     if in_bay and shared is not None:
+        held_walls = shared.steady()
         sizes.append(
             [
                 (
                     f"bay{kind + 1}_w",
-                    f"{{size: {_number(wall)}, min: {_number(WALL * wall)}, max: {_number(wall)}}}",
+                    f"{{size: {_number(wall)}, min: {_number(least)}, max: {_number(wall)}}}",
                 )
                 for kind, wall in enumerate(shared.walls)
                 if wall
+                for least in [wall if kind in held_walls else WALL * wall]
             ]
         )
     sizes.append([(symbol, _number(size)) for size, symbol in bay_margins.sizes.items()])

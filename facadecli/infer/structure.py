@@ -8,7 +8,9 @@ them. Each axis on its own, for every element that is not a band across the faç
 
 1. **Sizes**: a label's sizes each within ``SIZE`` of the next smaller, or within
    ``JITTER`` of the façade (and a quarter of the size), are one, up to twice that from
-   the smallest: the cluster's median, one symbol in the spec.
+   the smallest and spanning no more than the regulariser's ``RELATIVE`` of it (or
+   ``JITTER``; a wider cluster is cut at its widest step, ``_split``): the cluster's
+   median, one symbol in the spec.
 2. **Columns** (rows along y): a label's element centres within ``NEAR`` of the façade
    (and half the elements' size, so only elements that already overlap along the axis
    merge) are one line, their mean.
@@ -38,6 +40,7 @@ from collections import defaultdict
 from collections.abc import Callable
 
 from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
+from facadecli.grammar.regularize import RELATIVE
 from facadecli.grammar.tiling import MOVE_SHARE, move_limits
 from facadecli.infer.layers import BAND, OPENINGS
 
@@ -83,11 +86,12 @@ def structured(layout: LabelledLayout) -> LabelledLayout:
 
 def _sizes_shared(rects: list[Rect], keep: set[int], axis: str, extent: float) -> list[Rect]:
     """A label's sizes along ``axis`` that the move limits left apart (a sill under one
-    window, a blind beside another), each within ``2 * SIZE`` of the smallest of its
-    cluster, given the cluster's median about each element's centre, where no edge moves
-    more than ``ROW_MOVE`` of the element (and ``NEAR`` of the façade): the floors of a
-    façade one height, so that its spec repeats them with a counter. Elements in ``keep``
-    stay as they are."""
+    window, a blind beside another), each within ``RELATIVE`` of the smallest of its
+    cluster (the share the regulariser asks equal sizes within, which its move limit
+    no longer lets it meet), given the cluster's median about each element's centre,
+    where no edge moves more than ``ROW_MOVE`` of the element (and ``NEAR`` of the
+    façade): the floors of a façade one height, so that its spec repeats them with a
+    counter. Elements in ``keep`` stay as they are."""
     near = NEAR * extent
 
     def span(r: Rect) -> tuple[float, float]:
@@ -101,7 +105,7 @@ def _sizes_shared(rects: list[Rect], keep: set[int], axis: str, extent: float) -
     out = list(rects)
     for members in by_label.values():
         ordered = sorted(members, key=size.__getitem__)
-        for cluster in _chains(ordered, size, lambda first, b: b - first <= 2 * SIZE * first):
+        for cluster in _chains(ordered, size, lambda first, b: b - first <= RELATIVE * first):
             median = statistics.median(size[k] for k in cluster)
             if any(abs(size[k] - median) / 2 > min(near, ROW_MOVE * size[k]) for k in cluster):
                 continue
@@ -351,7 +355,8 @@ def _axis(spans: list[tuple[str, float, float]], extent: float) -> list[tuple[fl
         def step(a: int, b: int) -> bool:
             return size[b] - size[a] <= max(SIZE * size[a], min(JITTER * extent, 0.25 * size[a]))
 
-        for cluster in _chains(sorted(members, key=size.__getitem__), size, similar, step):
+        chains = _chains(sorted(members, key=size.__getitem__), size, similar, step)
+        for cluster in (c for chain in chains for c in _split(chain, size, JITTER * extent)):
             median = statistics.median(size[k] for k in cluster)
             for k in cluster:
                 size[k] = median
@@ -383,6 +388,18 @@ def _axis(spans: list[tuple[str, float, float]], extent: float) -> list[tuple[fl
         low = round(max(0.0, centre[k] - size[k] / 2), DIGITS)
         out.append((low, round(min(extent, low + size[k]), DIGITS)))
     return out
+
+
+def _split(cluster: list[int], size: dict[int, float], jitter: float) -> list[list[int]]:
+    """A cluster of sizes (sorted) cut at its widest step until each spans no more than
+    the regulariser's share of its least (``RELATIVE``) or a hand's ``jitter``: a chain
+    of steps each within a hand's error can bridge two sizes drawn apart (bays of
+    windows a fifth wider than their neighbours' and the jittered ones between them)."""
+    low, high = size[cluster[0]], size[cluster[-1]]
+    if high - low <= max(RELATIVE * low, jitter):
+        return [cluster]
+    cut = max(range(1, len(cluster)), key=lambda n: size[cluster[n]] - size[cluster[n - 1]])
+    return _split(cluster[:cut], size, jitter) + _split(cluster[cut:], size, jitter)
 
 
 def _twins_sized(
