@@ -86,12 +86,11 @@ def structured(layout: LabelledLayout) -> LabelledLayout:
 
 def _sizes_shared(rects: list[Rect], keep: set[int], axis: str, extent: float) -> list[Rect]:
     """A label's sizes along ``axis`` that the move limits left apart (a sill under one
-    window, a blind beside another), each within ``RELATIVE`` of the smallest of its
-    cluster (the share the regulariser asks equal sizes within, which its move limit
-    no longer lets it meet), given the cluster's median about each element's centre,
-    where no edge moves more than ``ROW_MOVE`` of the element (and ``NEAR`` of the
-    façade): the floors of a façade one height, so that its spec repeats them with a
-    counter. Elements in ``keep`` stay as they are."""
+    window, a blind beside another), each within ``2 * SIZE`` of the smallest of its
+    cluster, given the cluster's median about each element's centre, where no edge moves
+    more than ``ROW_MOVE`` of the element (and ``NEAR`` of the façade): the floors of a
+    façade one height, so that its spec repeats them with a counter. Elements in ``keep``
+    stay as they are."""
     near = NEAR * extent
 
     def span(r: Rect) -> tuple[float, float]:
@@ -105,7 +104,7 @@ def _sizes_shared(rects: list[Rect], keep: set[int], axis: str, extent: float) -
     out = list(rects)
     for members in by_label.values():
         ordered = sorted(members, key=size.__getitem__)
-        for cluster in _chains(ordered, size, lambda first, b: b - first <= RELATIVE * first):
+        for cluster in _chains(ordered, size, lambda first, b: b - first <= 2 * SIZE * first):
             median = statistics.median(size[k] for k in cluster)
             if any(abs(size[k] - median) / 2 > min(near, ROW_MOVE * size[k]) for k in cluster):
                 continue
