@@ -621,7 +621,14 @@ def city(
         _warn(f"{outdir}: no merged {report['name']}.glb: {models['merged_left_out']}")
     merged = [models["merged"] or models["tiles"]] if models["merged"] or models["tiles"] else []
     tileset = [models["3dtiles"]["tileset"]] if "3dtiles" in models else []
-    names = [*merged, f"{report['name']}.city.json", f"{report['name']}.report.json", *tileset]
+    beside = [models[key] for key in ("usd", "ground") if models.get(key)]  # when written
+    names = [
+        *merged,
+        f"{report['name']}.city.json",
+        f"{report['name']}.report.json",
+        *tileset,
+        *beside,
+    ]
     _say(
         f"{summary['ok']} of {summary['buildings']} buildings built{rejected} in "
         f"{summary['seconds']} s -> " + ", ".join(f"{outdir}/{name}" for name in names)

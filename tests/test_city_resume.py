@@ -182,7 +182,7 @@ def test_results_are_taken_as_they_finish() -> None:
         stream = _bounded(lambda batch: pool.submit(work, list(batch)), [0, 1, 2, 3], 2)
         first = [next(stream), next(stream)]  # in order, this would wait for the first
         released.set()
-        assert first == [20, 30] and list(stream) == [0, 10]
+        assert first == [(2, 20), (3, 30)] and list(stream) == [(0, 0), (1, 10)]
 
 
 def test_kill_9_then_resume_gives_a_fresh_runs_files(tmp_path: Path) -> None:

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from facadecli.viewer.ground import GROUND
+from facadecli.viewer.landcover import COVER
 
 pytestmark = pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed")
 
@@ -32,7 +33,12 @@ const ground = groundKinds(built, plan.columns, plan.rows, plan.cell);
 const dashes = dashCells(ground, plan.columns, plan.rows, plan.cell);
 const trees = treeCells(ground, plan.columns, plan.cell);
 const lamps = lampCells(ground, plan.columns, plan.rows, plan.cell, trees);
-console.log(JSON.stringify({kinds: Array.from(ground.kinds), dashes, lamps, trees}));
+const benches = benchCells(ground, plan.columns, plan.rows, plan.cell,
+                           [...trees, ...lamps.map(([at]) => at)]);
+const kindsAt = places => places.map(at => ground.kinds[at]);
+console.log(JSON.stringify({kinds: Array.from(ground.kinds), dashes, lamps, trees, benches,
+                            treeKinds: kindsAt(trees),
+                            benchKinds: kindsAt(benches.map(([at]) => at))}));
 """
 
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 in metres
@@ -41,12 +47,16 @@ Box = tuple[float, float, float, float]  # x0, y0, x1, y1 in metres
 @dataclass(frozen=True)
 class Ground:
     """A plan's ground as GROUND makes it: the kind of each cell (rows from the top), the
-    dashes and the lamps (x, y in metres, then the way they face: x, y), the trees."""
+    dashes, the lamps and the benches (x, y in metres, then the way they face: x, y), the
+    trees, and the kind of ground each tree and each bench stands on."""
 
     kinds: np.ndarray
     dashes: list[tuple[float, float, float, float]]
     lamps: list[tuple[float, float, float, float]]
     trees: list[tuple[float, float]]
+    benches: list[tuple[float, float, float, float]]
+    tree_kinds: list[int]
+    bench_kinds: list[int]
 
     def inner(self) -> np.ndarray:
         """The plan's cells, not the town's margin round it."""
@@ -97,6 +107,9 @@ def _ground(buildings: list[Box]) -> Ground:
         [(*place(at), across, -down) for at, across, down in found["dashes"]],
         [(*place(at), across, -down) for at, across, down in found["lamps"]],
         [place(at) for at in found["trees"]],
+        [(*place(at), across, -down) for at, across, down in found["benches"]],
+        found["treeKinds"],
+        found["benchKinds"],
     )
 
 
@@ -125,15 +138,15 @@ def _blocks(seed: int, street: float) -> tuple[list[Box], list[Box], float]:
     return buildings, junctions, lawn
 
 
-def _houses(seed: int) -> list[Box]:
-    """A sparse town: 100 detached houses, 8-14 m a side, on a grid 45 m apart, each moved
-    up to 8 m (seeded): lawns round them, as Kotka has."""
+def _houses(seed: int, sides: tuple[float, float] = (8, 14)) -> list[Box]:
+    """A sparse town: 100 detached houses, ``sides`` metres a side, on a grid 45 m apart,
+    each moved up to 8 m (seeded): lawns round them, as Kotka has."""
     chance = random.Random(seed)
     houses = []
     for i in range(10):
         for j in range(10):
             x, y = i * 45 + chance.uniform(-8, 8), j * 45 + chance.uniform(-8, 8)
-            houses.append((x, y, x + chance.uniform(8, 14), y + chance.uniform(8, 14)))
+            houses.append((x, y, x + chance.uniform(*sides), y + chance.uniform(*sides)))
     return houses
 
 
@@ -195,3 +208,189 @@ def test_centre_line_dashes_stop_before_each_junction(seed: int) -> None:
         dash = LineString([(x - half * along_x, y - half * along_y),
                            (x + half * along_x, y + half * along_y)])  # fmt: skip
         assert not any(dash.intersects(crossing) for crossing in crossings), (x, y)
+
+
+def _wall_distance(buildings: list[Box], x: float, y: float) -> float:
+    from shapely.geometry import Point, box
+
+    return min(box(*b).distance(Point(x, y)) for b in buildings)
+
+
+@pytest.mark.parametrize("seed", [10, 11, 12])
+def test_trees_stand_on_lawn_or_in_pits_along_roads_never_on_the_paving_round_a_house(
+    seed: int,
+) -> None:
+    """A tree stands on a lawn, 6 m or more from the walls, or in a pit on a street's wide
+    pavement with the road past its kerb, where the pavement runs straight for 14 m;
+    never in a road or on a kerb. Small detached houses (7-10 m a side) in their lawns
+    keep no tree on the ring of paving round them (each had four or five there, 3.4 m
+    from its walls); a town of closed blocks keeps its street trees in pits."""
+    from shapely.geometry import Point, box
+
+    houses = _houses(seed, (7, 10))
+    sparse = _ground(houses)
+    assert len(sparse.trees) >= 100
+    for (x, y), kind in zip(sparse.trees, sparse.tree_kinds, strict=True):
+        assert kind == GRASS and _wall_distance(houses, x, y) >= 6 - CELL, (x, y, kind)
+    buildings, _, _ = _blocks(seed, 16)
+    dense = _ground(buildings)
+    roads = [
+        (x, y)
+        for (x, y), kind in zip(dense.trees, dense.tree_kinds, strict=True)
+        if kind == PAVEMENT
+    ]
+    assert len(roads) >= 20
+    asphalt = np.argwhere(dense.kinds == ASPHALT)
+    for (x, y), kind in zip(dense.trees, dense.tree_kinds, strict=True):
+        assert kind in (PAVEMENT, GRASS)
+        assert _wall_distance(buildings, x, y) >= (3 if kind == PAVEMENT else 6) - CELL
+    # each pit's road: asphalt within 1.3 m (the pavement's 1.1 m left and the kerb)
+    left = min(b[0] for b in buildings) - MARGIN
+    top = max(b[3] for b in buildings) + MARGIN
+    for x, y in roads:
+        row, column = (top - y) / CELL - 0.5, (x - left) / CELL - 0.5
+        nearest = np.hypot(asphalt[:, 0] - row, asphalt[:, 1] - column).min() * CELL
+        assert nearest <= 1.3 + CELL, (x, y, nearest)
+    courtyards = [
+        box(b[2], b[1], c[0], c[3]) for b, c in zip(buildings[2::4], buildings[3::4], strict=True)
+    ]
+    assert not any(c.contains(Point(tree)) for c in courtyards for tree in dense.trees)
+
+
+@pytest.mark.parametrize("seed", [13, 14, 15])
+def test_a_road_meets_a_lawn_at_a_kerb(seed: int) -> None:
+    """Where the enclosure turns a road into lawn, a kerb lies between them: no asphalt
+    cell has a grass cell beside it (the asphalt ran into the grass with no edge)."""
+    ground = _ground(_houses(seed))
+    kinds = ground.kinds
+    asphalt = kinds == ASPHALT
+    assert asphalt.sum() > 1000 and (kinds == GRASS).sum() > 1000
+    beside = np.zeros_like(asphalt)
+    beside[1:] |= kinds[:-1] == GRASS
+    beside[:-1] |= kinds[1:] == GRASS
+    beside[:, 1:] |= kinds[:, :-1] == GRASS
+    beside[:, :-1] |= kinds[:, 1:] == GRASS
+    assert not (asphalt & beside).any(), int((asphalt & beside).sum())
+
+
+@pytest.mark.parametrize("seed", [16, 17, 18])
+def test_benches_stand_on_paving_at_a_lawns_edge_facing_it(seed: int) -> None:
+    """Benches along the paving where a lawn opens before it: on paving, 2.5 m or more
+    from the walls, no road within 4 m, facing the lawn (3 m ahead is grass, the way
+    away from the walls), 40 m apart and 2.5 m clear of the trees and lamps."""
+    houses = _houses(seed)
+    ground = _ground(houses)
+    assert len(ground.benches) >= 20
+    left = min(b[0] for b in houses) - MARGIN
+    top = max(b[3] for b in houses) + MARGIN
+    asphalt = np.argwhere(ground.kinds == ASPHALT)
+
+    def kind(x: float, y: float) -> int:
+        return int(ground.kinds[int((top - y) / CELL), int((x - left) / CELL)])
+
+    for (x, y, ahead_x, ahead_y), under in zip(ground.benches, ground.bench_kinds, strict=True):
+        assert under == PAVEMENT
+        wall = _wall_distance(houses, x, y)
+        assert wall >= 2.5 - CELL
+        row, column = (top - y) / CELL - 0.5, (x - left) / CELL - 0.5
+        assert np.hypot(asphalt[:, 0] - row, asphalt[:, 1] - column).min() * CELL > 4 - CELL
+        assert kind(x + 3 * ahead_x, y + 3 * ahead_y) == GRASS
+        assert _wall_distance(houses, x + 3 * ahead_x, y + 3 * ahead_y) > wall
+        others = [*ground.trees, *((lx, ly) for lx, ly, *_ in ground.lamps)]
+        assert all(np.hypot(ox - x, oy - y) >= 2.5 - CELL for ox, oy in others)
+    for index, (x, y, *_) in enumerate(ground.benches):
+        for other in ground.benches[index + 1 :]:
+            assert np.hypot(other[0] - x, other[1] - y) >= 40 - CELL
+
+
+# The land cover on the plan (facadecli.viewer.landcover's COVER, after GROUND's besideKind)
+COVER_DRIVER = """
+const plan = JSON.parse(require('fs').readFileSync(0, 'utf8'));
+const cover = coverCells(plan.polygons, plan.columns, plan.rows);
+const trees = coverTreeCells(cover, Float32Array.from(plan.near), plan.columns, plan.rows,
+                             plan.cell);
+console.log(JSON.stringify({cover: Array.from(cover), trees}));
+"""
+WOOD, PARK, WATER = 1, 3, 7  # COVER_KINDS' codes
+
+
+def _cover(
+    polygons: list[dict[str, Any]], columns: int, rows: int, near: np.ndarray | None = None
+) -> tuple[np.ndarray, list[int]]:
+    """COVER over a plan of ``columns`` x ``rows`` cells of CELL metres: each cell's kind
+    (rows from the top), and the trees' cells; ``near``: the distance to the buildings in
+    cells (none: far from any)."""
+    far = np.full(columns * rows, 1e9) if near is None else near.ravel()
+    plan = {"polygons": polygons, "columns": columns, "rows": rows, "cell": CELL}
+    done = subprocess.run(
+        ["node", "-e", GROUND + COVER + COVER_DRIVER],
+        input=json.dumps({**plan, "near": far.tolist()}),
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+    )
+    found: dict[str, Any] = json.loads(done.stdout)
+    return np.array(found["cover"], dtype=np.uint8).reshape(rows, columns), found["trees"]
+
+
+def _square(x0: float, y0: float, x1: float, y1: float) -> list[list[float]]:
+    return [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_ponds_island_is_the_park_round_it_and_water_lies_over_the_park(seed: int) -> None:
+    """Scanlines fill what each polygon holds (a ring's hole not), a later kind over an
+    earlier one whatever the order given: the pond's cells are its area less its island,
+    the island is the park's, nothing outside the park is covered."""
+    chance = random.Random(seed)
+    x0, y0 = chance.uniform(5, 15), chance.uniform(5, 15)
+    w, d = chance.uniform(100, 160), chance.uniform(100, 160)  # cells
+    px, py, pw = x0 + chance.uniform(10, 30), y0 + chance.uniform(10, 30), chance.uniform(30, 50)
+    island = _square(px + pw / 2 - 5, py + pw / 2 - 5, px + pw / 2 + 5, py + pw / 2 + 5)
+    polygons = [
+        {"kind": "water", "rings": [_square(px, py, px + pw, py + pw), island]},
+        {"kind": "park", "rings": [_square(x0, y0, x0 + w, y0 + d)]},
+        {"kind": "moor", "rings": [_square(0, 0, 200, 200)]},  # no kind drawn: left out
+    ]
+    cover, _ = _cover(polygons, 200, 200)
+    water = int((cover == WATER).sum())
+    assert water == pytest.approx(pw * pw - 100, abs=4 * pw)  # within a cell of the edges
+    assert cover[int(py + pw / 2), int(px + pw / 2)] == PARK  # the island
+    assert int((cover > 0).sum()) == pytest.approx(w * d, abs=2 * (w + d) + 4)
+    assert cover[int(y0 + d) + 2, int(x0 + w) + 2] == 0
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_trees_stand_in_woods_and_parks_never_on_water_nor_by_a_building(seed: int) -> None:
+    """A wood (west half) has a tree about every WOOD_EVERY (4.5 m), the park (east half)
+    fewer; none on the pond or within TREE_CLEAR (2.5 m) of it, none within 2.5 m of the
+    house standing in the wood; seeded lattice: the same trees each time."""
+    chance = random.Random(seed)
+    columns = rows = 240  # 120 m
+    middle = chance.uniform(100, 140)
+    pond = [chance.uniform(150, 170), chance.uniform(60, 120)]
+    house = (chance.uniform(20, 60), chance.uniform(20, 60))  # 16 x 16 cells
+    polygons = [
+        {"kind": "wood", "rings": [_square(0, 0, middle, rows)]},
+        {"kind": "park", "rings": [_square(middle, 0, columns, rows)]},
+        {"kind": "water", "rings": [_square(pond[0], pond[1], pond[0] + 40, pond[1] + 40)]},
+    ]
+    ys, xs = np.mgrid[0:rows, 0:columns] + 0.5
+    dx = np.maximum(np.maximum(house[0] - xs, xs - house[0] - 16), 0)
+    dy = np.maximum(np.maximum(house[1] - ys, ys - house[1] - 16), 0)
+    near = np.hypot(dx, dy)
+    cover, trees = _cover(polygons, columns, rows, near)
+    assert trees == _cover(polygons, columns, rows, near)[1]
+    kinds = [int(cover.ravel()[at]) for at in trees]
+    assert set(kinds) <= {WOOD, PARK}
+    in_wood = kinds.count(WOOD) / ((middle * rows - 256) * CELL * CELL)
+    in_park = kinds.count(PARK) / (((columns - middle) * rows - 1600) * CELL * CELL)
+    assert in_wood == pytest.approx(1 / 4.5**2, rel=0.35)
+    assert in_park < in_wood / 4
+    water_rows, water_columns = np.nonzero(cover == WATER)
+    for at in trees:
+        row, column = divmod(at, columns)
+        nearest = np.hypot(water_rows - row, water_columns - column).min() * CELL
+        assert nearest >= 2.5
+        assert near[row, column] * CELL >= 2.5

@@ -186,3 +186,87 @@ def test_contradicting_bounds_are_only_claimed_where_the_qp_finds_no_layout() ->
                 claimed += 1
                 assert sized is None, (seed, trial)
     assert claimed >= 20 and feasible >= 40, (claimed, feasible)
+
+
+# -- Clarabel's matrices, made from the nonzeros alone -----------------------------------
+def _dense(matrix: sizing._Csc) -> np.ndarray:
+    made = np.zeros(matrix.shape)
+    for j in range(matrix.shape[1]):
+        cut = slice(matrix.indptr[j], matrix.indptr[j + 1])
+        made[matrix.indices[cut], j] = matrix.data[cut]
+    return made
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_qp_solver_is_given_the_dense_constraints_nonzeros_in_canonical_order(
+    seed: int,
+) -> None:
+    """Clarabel's constraint matrix, made from the equalities' nonzeros and the bounds
+    (not from a dense matrix of them, tens of millions of entries on a long façade), is
+    the dense ``[E; -I_lower; I_upper]``: the same entries, column by column with the rows
+    in order (canonical), so Clarabel is given the same problem, value for value."""
+    rng = np.random.default_rng(seed)
+    e, d = random_system(seed, rows=10 + seed, variables=14)
+    n = e.shape[1]
+    made = bounded(e, d, np.where(rng.random(n) < 0.6, 0.0, -np.inf), np.full(n, np.inf))
+    made.upper = np.where(rng.random(n) < 0.3, 5.0, np.inf)
+    low, high = np.flatnonzero(np.isfinite(made.lower)), np.flatnonzero(np.isfinite(made.upper))
+    matrix = sizing._constraints(made, low, high)
+    expected = np.vstack([e, -np.eye(n)[low], np.eye(n)[high]])
+    assert matrix.shape == expected.shape
+    assert np.array_equal(_dense(matrix), expected)
+    assert matrix.nnz == np.count_nonzero(expected)
+    for j in range(n):  # rows in order within each column: canonical
+        rows = matrix.indices[matrix.indptr[j] : matrix.indptr[j + 1]]
+        assert (np.diff(rows) > 0).all()
+
+
+# -- alignments sized once per axis solve -----------------------------------------------
+def _solved(text: str, width: float) -> tuple[object, ...]:
+    from facadecli import parse_spec, retarget, solve
+
+    layout = solve(retarget(parse_spec(text, "generated"), width=width))
+    return (
+        layout.shapes,
+        dict(layout.x.letters),
+        dict(layout.y.letters),
+        layout.x.objective,
+        layout.x.proven,
+        layout.warnings,
+    )
+
+
+@pytest.mark.parametrize(
+    ("layers", "bays", "stretch"), [(6, 3, 1.07), (10, 5, 0.83), (14, 4, 1.31)]
+)
+def test_alignments_sized_once_give_the_layouts_sized_anew_with_fewer_programs(
+    monkeypatch: pytest.MonkeyPatch, layers: int, bays: int, stretch: float
+) -> None:
+    """The constructions remember the alignments they sized (``sizing.sized_alignments``,
+    by each group's rows and entries): generated façades at a width their words do not
+    fill solve to the same layouts, byte for byte, as when every construction builds and
+    solves its program anew, with fewer programs built (the work saved)."""
+    from tests.benchmarks.generated import generated_spec
+
+    text = generated_spec(layers=layers, bays=bays)
+    width = round((1.0 + bays * 2.4) * stretch, 2)
+    built = [0]
+    build = sizing.build_program
+
+    def counted(*args: object, **kwargs: object) -> sizing.Program:
+        built[0] += 1
+        return build(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(sizing, "build_program", counted)
+    remembered = _solved(text, width)
+    with_memory = built[0]
+    sized = sizing.sized_alignments
+    monkeypatch.setattr(
+        sizing,
+        "sized_alignments",
+        lambda spec, groups, canvas, known=None: sized(spec, groups, canvas),
+    )
+    built[0] = 0
+    anew = _solved(text, width)
+    assert remembered == anew
+    assert with_memory < built[0], (with_memory, built[0])

@@ -308,22 +308,32 @@ def test_lod_lists_are_read_coarse_to_fine() -> None:
 def test_the_quadtree_holds_every_building_once_in_a_leaf_it_lies_in(seed: int) -> None:
     rng = random.Random(seed)
     spread = rng.choice([5.0, 300.0, 20_000.0])
-    points = [(f"b{k}", (rng.uniform(-spread, spread), rng.uniform(0, spread))) for k in range(300)]
-    points += [("twin-a", (1.0, 1.0)), ("twin-b", (1.0, 1.0))]  # one centroid for two
+    points = [(rng.uniform(-spread, spread), rng.uniform(0, spread)) for k in range(300)]
+    points += [(1.0, 1.0), (1.0, 1.0)]  # one centroid for two
     capacity = rng.choice([1, 8, 32])
-    root, leaf_of = quadtree(points, capacity)
-    assert sorted(leaf_of) == sorted(bid for bid, _ in points)
+    tree = quadtree(points, capacity)
+    assert sorted(tree.order.tolist()) == list(range(len(points)))  # each building once
     leaves = []
-    stack = [root]
+    stack = [tree.root]
     while stack:
         square = stack.pop()
         stack.extend(square.children)
         assert len(square.children) <= 4
+        members = tree.members(square)
+        assert members == sorted(members)  # in the run's order
+        assert members == sorted(k for child in square.children for k in tree.members(child)) or (
+            not square.children
+        )
         if not square.children:
             leaves.append(square)
-            assert len(square.members) <= capacity or square.level == tileset_module.MAX_LEVEL
-    assert sum(len(leaf.members) for leaf in leaves) == len(points)
-    assert leaf_of["twin-a"] is leaf_of["twin-b"]
+            assert square.count <= capacity or square.level == tileset_module.MAX_LEVEL
+    assert sum(leaf.count for leaf in leaves) == len(points)
+    for position, point in enumerate(points):  # the leaf found again from its centroid
+        *_, leaf = tree.path(point)
+        assert position in tree.members(leaf) and not leaf.children
+        assert tree.find(leaf.level, leaf.column, leaf.row) is leaf
+    *_, twin = tree.path(points[-1])
+    assert {len(points) - 2, len(points) - 1} <= set(tree.members(twin))
 
 
 # Outside tools, where they are installed: the 3D Tiles validator and CesiumJS
@@ -467,20 +477,20 @@ def test_a_leaf_is_written_when_its_last_building_is_done(city: Path, tmp_path: 
     frame = json.loads((city / f"{city.name}.georef.json").read_text())
     georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
     glbs = sorted((city / "buildings").glob("*/*.glb"))
-    places = [(glb.stem, (100.0 * (k % 2), 0.0)) for k, glb in enumerate(glbs)]  # two leaves
+    places = [(100.0 * (k % 2), 0.0) for k, _ in enumerate(glbs)]  # two leaves
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(tileset_module, "CAPACITY", dict.fromkeys((1, 2, 3), len(glbs) // 2))
         writer = TilesetWriter(tmp_path, georef, (1, 2, 3), places)
-    east = [glb for k, glb in enumerate(glbs) if k % 2]
-    west = [glb for k, glb in enumerate(glbs) if not k % 2]
-    for glb in east[:-1]:
-        writer.done(glb.stem, glb)
+    east = [(k, glb) for k, glb in enumerate(glbs) if k % 2]
+    west = [(k, glb) for k, glb in enumerate(glbs) if not k % 2]
+    for k, glb in east[:-1]:
+        writer.done(k, glb.stem, glb)
     assert not list((tmp_path / "3dtiles").rglob("*.glb"))
-    writer.done(east[-1].stem, east[-1])
+    writer.done(east[-1][0], east[-1][1].stem, east[-1][1])
     assert len(list((tmp_path / "3dtiles").rglob("*.glb"))) == 3  # LOD1, 2, 3 of one leaf
-    for glb in west[:-1]:
-        writer.done(glb.stem, glb)
-    writer.done(west[-1].stem, None)  # a failed building: left out, its leaf written
+    for k, glb in west[:-1]:
+        writer.done(k, glb.stem, glb)
+    writer.done(west[-1][0], west[-1][1].stem, None)  # a failed building: left out
     assert len(list((tmp_path / "3dtiles").rglob("*.glb"))) == 6
     assert not (tmp_path / "3dtiles" / "tileset.json").exists()
     summary = writer.close("streamed")
@@ -510,12 +520,12 @@ def test_a_viewer_goes_on_through_empty_squares_to_the_content_below(
     frame = json.loads((city / f"{city.name}.georef.json").read_text())
     georef = Georef(frame["crs"], tuple(frame["origin"][:2]))
     glbs = sorted((city / "buildings").glob("*/*.glb"))
-    places = [(glb.stem, (37.0 * k % 100, 11.0 * k)) for k, glb in enumerate(glbs)]
+    places = [(37.0 * k % 100, 11.0 * k) for k, _ in enumerate(glbs)]
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(tileset_module, "CAPACITY", {1: 10, 2: 10, 3: 1})
         writer = TilesetWriter(tmp_path, georef, (1, 2, 3), places)
-    for glb in glbs:
-        writer.done(glb.stem, glb)
+    for k, glb in enumerate(glbs):
+        writer.done(k, glb.stem, glb)
     writer.close("deep")
     root = _tileset(tmp_path)["root"]
     assert root["content"]["uri"].endswith("lod1.glb")
@@ -577,14 +587,12 @@ def _tileset_peak(tmp_path: Path, glb: Path, count: int) -> int:
     """The peak of Python's allocations (bytes) while ``tileset.json`` is written for
     ``count`` buildings a tile apiece, on a jittered grid (the tiles written before)."""
     rng = random.Random(count)
-    places = [
-        (f"b{k}", (10.0 * (k % 97) + rng.uniform(0, 3), 10.0 * (k // 97))) for k in range(count)
-    ]
+    places = [(10.0 * (k % 97) + rng.uniform(0, 3), 10.0 * (k // 97)) for k in range(count)]
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(tileset_module, "CAPACITY", {1: 64, 2: 8, 3: 1})
         writer = TilesetWriter(tmp_path / str(count), georef_of(glb), (3,), places)
-    for key, _ in places:
-        writer.done(key, glb)
+    for k in range(count):
+        writer.done(k, f"b{k}", glb)
     tracemalloc.start()
     try:
         writer.close("memory")

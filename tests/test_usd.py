@@ -81,3 +81,35 @@ def test_a_city_stage_holds_every_building_as_a_payload(
         .ComputeAlignedRange()
     )
     assert bound.GetMax()[0] - bound.GetMin()[0] > 45  # the three side by side, 50 m
+
+
+def test_a_city_stage_gives_every_building_its_own_prim(tmp_path: Path) -> None:
+    """Prim names are unique by construction (:func:`.building_prim`), for ids that read
+    the same as USD names ('a-b', 'a.b', 'a_b'), ids that read like a hashed file name,
+    and many generated ones; the plain ids of letters, digits and '_', and the hashed
+    file names (OSM's ids), keep their names as before; the stage names them so."""
+    import random
+    import re
+
+    from facadecli.city.folders import building_file, safe_name
+    from facadecli.export.usd import building_prim, city_usda, usd_name
+
+    rng = random.Random(7)
+    alphabet = "ab1_.-/~AB "
+    ids = ["a-b", "a.b", "a_b", "ab", "1ab", "_1ab", "way/12", "Way/12", "a_0123456789abcdef"]
+    ids += [safe_name("way/12").replace("~", "_"), "x" * 130]
+    ids += ["".join(rng.choice(alphabet) for _ in range(rng.randint(1, 6))) for _ in range(3000)]
+    ids = list(dict.fromkeys(ids))
+    stems = [safe_name(i) for i in ids]
+    assert len(set(stems)) == len(stems)  # as a run's FileNames checks
+    prims = [building_prim(stem) for stem in stems]
+    assert len(set(prims)) == len(prims)
+    assert all(usd_name(p) == p for p in prims)
+    assert building_prim("ab") == "ab" and building_prim("t12") == "t12"
+    assert building_prim("1ab") == "_1ab" and building_prim("a_b") == "a_b"
+    hashed = safe_name("way/12")
+    assert building_prim(hashed) == usd_name(hashed)
+    assert building_prim("a-b") != building_prim("a_b") != building_prim("a.b")
+    glbs = [tmp_path / building_file(i) for i in ids[:40]]
+    text = city_usda("c", glbs, tmp_path)
+    assert re.findall(r'    def Xform "(\w+)" \(', text) == prims[:40]

@@ -29,7 +29,8 @@ PLAIN_NAME = re.compile(r"[a-z0-9][a-z0-9._-]{0,119}")  # ids used as file names
 READABLE = 100  # characters of any other id kept, made safe, in front of its hash
 
 
-def _digest(building_id: str) -> str:
+def id_digest(building_id: str) -> str:
+    """The SHA-256 of a building's id (or a file name), in hex: its hashed names' part."""
     return hashlib.sha256(building_id.encode("utf-8", "surrogatepass")).hexdigest()
 
 
@@ -41,12 +42,12 @@ def safe_name(building_id: str) -> str:
     if PLAIN_NAME.fullmatch(building_id):
         return building_id
     readable = re.sub(r"[^A-Za-z0-9._-]", "_", building_id[:READABLE]).strip("._") or "building"
-    return f"{readable}~{_digest(building_id)[:16]}"
+    return f"{readable}~{id_digest(building_id)[:16]}"
 
 
 def shard(building_id: str) -> str:
     """The sub-folder of ``buildings/`` a building's files go in: a hash of its id."""
-    return _digest(building_id)[:SHARD_DIGITS]
+    return id_digest(building_id)[:SHARD_DIGITS]
 
 
 def building_file(building_id: str, suffix: str = ".glb") -> PurePosixPath:

@@ -27,12 +27,21 @@ import numpy as np
 import pyproj
 import shapely
 import shapely.affinity
-from shapely.geometry import MultiPolygon, Polygon
-from shapely.geometry.polygon import orient
+from shapely.geometry import Polygon
 
 from facadecli.city.geojson import GeoJSON, printable, read_feature, read_geojson
 from facadecli.city.geopackage import read_geopackage
 from facadecli.city.georef import utm_epsg
+from facadecli.city.landcover import (
+    LAND_COVER,
+    Area,
+    clipped,
+    cover_kind,
+    district_box,
+    ignored_tag,
+    is_cover,
+    oriented_parts,
+)
 from facadecli.city.ogr import is_ogr, read_ogr
 from facadecli.city.osm import is_osm, read_osm
 from facadecli.city.packed import Spooled
@@ -95,6 +104,9 @@ class FootprintSet:
     outside: int = 0  # features left out by a bounding box
     unit: float = 1.0  # metres per unit of ``crs`` (a CRS in feet is scaled to metres)
     warnings: tuple[Rejected, ...] = ()  # footprints built without some of their tags
+    ground: tuple[Area, ...] = ()  # the land cover of the district (landcover.py)
+    ignored: tuple[Rejected, ...] = ()  # land-cover features of a kind not drawn
+    built_up: int = 0  # land-use areas of the town itself, left to the footprint rules
 
 
 def feature_id(feature: Any, index: int) -> str:
@@ -111,6 +123,7 @@ def feature_id(feature: Any, index: int) -> str:
 
 
 Found = tuple[int, str, dict[str, Any], Any]  # index, id, properties, geometry
+Cover = tuple[int, str, str, Any]  # index, id, kind, geometry (the file's CRS)
 Record = tuple[int, str, dict[str, Any], Any, list[tuple[float, float]]]  # and entrances
 
 
@@ -178,6 +191,9 @@ class Survey:
     warned: list[Rejected]  # tags left out, of every kept feature
     doors: list[Found]  # entrance points inside the box, as read (the file's CRS)
     door_points: Any  # numpy (m, 2): those points in local metres
+    cover: Spooled[Cover] = field(default_factory=Spooled)  # land cover (landcover.py)
+    ignored: list[Rejected] = field(default_factory=list)  # land cover of no kind drawn
+    built_up: int = 0  # land-use areas of the town itself
 
     def __len__(self) -> int:
         return len(self.indices)
@@ -230,6 +246,23 @@ class Survey:
     def unit(self) -> float:
         return _unit(self.crs)
 
+    def ground(self) -> list[Area]:
+        """The land cover of the district, in local metres, clipped to the buildings'
+        extent and the margin round it (landcover.py), read from the spool a feature at
+        a time."""
+        project = _projection(self.document.crs, self.crs)
+        box = district_box(self.boxes)
+        minx, miny = self.origin
+        areas = []
+        for place in range(len(self.cover)):
+            index, fid, kind, geometry = self.cover[place]
+            metres = shapely.transform(geometry, project, interleaved=False)
+            local = shapely.affinity.translate(metres, -minx, -miny)
+            area = clipped(kind, fid, index, local, box)
+            if area is not None:
+                areas.append(area)
+        return areas
+
     def found(
         self,
         footprints: list[Footprint],
@@ -254,6 +287,9 @@ class Survey:
             self.outside,
             unit=self.unit,
             warnings=(*self.warnings(made, near_doors), *planned),
+            ground=tuple(self.ground()),
+            ignored=tuple(self.ignored),
+            built_up=self.built_up,
         )
 
     def made(self, made: bytearray, index: int | None) -> bool:
@@ -292,6 +328,9 @@ def survey(path: Path, bbox: BBox | None = None, names: Names | None = None) -> 
     warned: list[Rejected] = []
     doors: list[Found] = []
     spool: Spooled[Record] = Spooled()
+    cover: Spooled[Cover] = Spooled()  # land cover, kept apart from the footprints
+    ignored: list[Rejected] = []
+    built_up = 0
     kept = array("q")
     middles = array("d")  # each kept feature's box's middle, x then y (the file's CRS)
     readable = 0
@@ -311,6 +350,15 @@ def survey(path: Path, bbox: BBox | None = None, names: Names | None = None) -> 
         read = reason if reason is not None else read_feature(feature, document.crs)
         if isinstance(read, str):
             rejected.append(_rejected(document, index, fid, read))
+            continue
+        if feature.get(LAND_COVER) is True or is_cover(read[0]):
+            kind = cover_kind(read[0])
+            if kind is None:
+                ignored.append(_rejected(document, index, fid, ignored_tag(read[0])))
+            elif kind == "built_up":
+                built_up += 1
+            else:
+                cover.append((index, fid, kind, read[1]))
             continue
         readable += 1
         properties, problems = checked_properties(read[0], names)
@@ -367,6 +415,9 @@ def survey(path: Path, bbox: BBox | None = None, names: Names | None = None) -> 
         warned,
         doors,
         door_points,
+        cover,
+        ignored,
+        built_up,
     )
 
 
@@ -411,7 +462,7 @@ def _footprint(fid: str, properties: dict[str, Any], local: Any) -> Footprint | 
     if not local.is_valid:
         local = shapely.make_valid(local)
         repaired = True
-    parts = tuple(orient(part, sign=1.0) for part in _polygons(local) if part.area >= MIN_AREA)
+    parts = oriented_parts(local, MIN_AREA)
     if not parts:
         return "no part of at least 1 m² (degenerate footprint)"
     parts, simplified = _simplify(parts)
@@ -433,9 +484,7 @@ def _simplify(parts: tuple[Polygon, ...]) -> tuple[tuple[Polygon, ...], Simplifi
     tolerance = SIMPLIFY_TOLERANCE
     while True:
         simpler = [part.simplify(tolerance, preserve_topology=True) for part in parts]
-        kept = tuple(
-            orient(p, sign=1.0) for s in simpler for p in _polygons(s) if p.area >= MIN_AREA
-        )
+        kept = tuple(p for s in simpler for p in oriented_parts(s, MIN_AREA))
         if kept and (_vertices(kept) <= MAX_VERTICES or tolerance * 2 > MAX_TOLERANCE):
             return kept, Simplified(before, _vertices(kept), tolerance)
         if not kept:  # simplified away: keep the outline as it is
@@ -487,16 +536,6 @@ def _nothing_usable(document: GeoJSON, rejected: list[Rejected]) -> SpecError:
         )
     )
     return SpecError(problems)
-
-
-def _polygons(geometry: Any) -> list[Polygon]:
-    if isinstance(geometry, Polygon):
-        return [geometry]
-    if isinstance(geometry, MultiPolygon):
-        return list(geometry.geoms)
-    if hasattr(geometry, "geoms"):  # a collection from make_valid: keep its polygons
-        return [p for g in geometry.geoms for p in _polygons(g)]
-    return []
 
 
 def _projected(source: pyproj.CRS, middles: Sequence[float]) -> pyproj.CRS:

@@ -34,6 +34,7 @@ from typing import Any
 import pyproj
 
 from facadecli.city.geojson import GeoJSON, NoPlaces
+from facadecli.city.landcover import COVER_KEYS, LAND_COVER
 from facadecli.city.osmxml import ELEMENTS, KEYS, Places, check_xml
 from facadecli.errors import SpecError
 from facadecli.limits import OSM_ID_MAX, OSM_TEXT_CHARS_MAX
@@ -182,15 +183,18 @@ class Buildings(Iterable[dict[str, Any]]):
         found = _Pass()
         processor = (
             osmium.FileProcessor(file)
-            .with_areas(osmium.filter.KeyFilter(*KEYS))
-            .with_filter(osmium.filter.KeyFilter(*KEYS, ENTRANCE))
+            .with_areas(osmium.filter.KeyFilter(*KEYS, *COVER_KEYS))
+            .with_filter(osmium.filter.KeyFilter(*KEYS, *COVER_KEYS, ENTRANCE))
         )
         for item in processor:
             if isinstance(item, osmium.osm.Node):
                 if ENTRANCE in item.tags and item.location.valid():
                     found.entrances.add(item.id, item.location.lon, item.location.lat)
                 continue
-            if not any(key in item.tags for key in KEYS):  # a way or relation tagged entrance
+            if isinstance(item, osmium.osm.Area) and not _building(item.tags):
+                yield from self._cover(item, factory)  # land cover (landcover.py)
+                continue
+            if not _building(item.tags):  # a way or relation of land cover, or an entrance
                 continue
             if isinstance(item, osmium.osm.Area):
                 kind = "way" if item.from_way() else "relation"
@@ -225,6 +229,24 @@ class Buildings(Iterable[dict[str, Any]]):
                 found.relations[item.id] = (tags.get("type", ""), members)
         yield from self._undrawn(found)
 
+    def _cover(self, item: Any, factory: Any) -> Iterator[dict[str, Any]]:
+        """A land-cover area as a feature (survey() tells it from a building by its tags);
+        one libosmium cannot draw is left out: a forest cut by the extract's edge is
+        common, and no building depends on it."""
+        kind = "way" if item.from_way() else "relation"
+        oid = item.orig_id()
+        try:
+            geometry = json.loads(factory.create_multipolygon(item))
+        except RuntimeError:
+            return
+        tags = _tags(self.file, kind, oid, item.tags)
+        if not any(key in tags for key in COVER_KEYS):
+            return  # an old-style multipolygon's untagged ring, or an entrance way
+        feature = self._feature(kind, oid, tags)
+        feature["geometry"] = geometry
+        feature[LAND_COVER] = True  # not a footprint, whatever its tags (survey())
+        yield feature
+
     def _undrawn(self, found: _Pass) -> Iterator[dict[str, Any]]:
         """The building ways and multipolygons libosmium drew no area of, as features
         without a geometry, each with the reason (a missing node or member way, an open
@@ -257,6 +279,11 @@ class Buildings(Iterable[dict[str, Any]]):
         ways = _member_ways(file, refs)
         for oid, members in sorted(broken.items()):
             yield self._feature("relation", oid, {}, _broken(members, ways))
+
+
+def _building(tags: Any) -> bool:
+    """Whether an element is tagged as a building (or a building's part)."""
+    return any(key in tags for key in KEYS)
 
 
 def _refused(file: str, error: Exception) -> SpecError:

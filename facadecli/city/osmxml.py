@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 from xml.parsers import expat
 
+from facadecli.city.landcover import COVER_KEYS
 from facadecli.errors import SpecError
 from facadecli.limits import (
     OSM_ID_MAX,
@@ -172,6 +173,13 @@ def check_xml(path: Path) -> Places:
     return checker.places
 
 
+def _placed(kind: str, attributes: dict[str, str]) -> bool:
+    """Whether a tag makes its element's place worth keeping: a building's, or a land-cover
+    way's or relation's (a warning names its line)."""
+    key = attributes.get("k")
+    return key in KEYS or (kind != "node" and key in COVER_KEYS)
+
+
 class _Checker:
     """expat's handlers: each element's attributes checked as it starts."""
 
@@ -216,7 +224,7 @@ class _Checker:
             self.object = (name, int(attributes.get("id", "0")))
             self.at = (self.parser.CurrentLineNumber, self.parser.CurrentColumnNumber + 1)
             self._once(name, who)
-        elif name == "tag" and self.object is not None and attributes.get("k") in KEYS:
+        elif name == "tag" and self.object is not None and _placed(self.object[0], attributes):
             self.places.add(*self.object, self.at)
 
     def _once(self, name: str, who: str) -> None:

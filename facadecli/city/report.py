@@ -128,6 +128,7 @@ class Summary:
     collinear_nodes_merged: int
     warnings_by_tag: dict[str, int]
     seconds: float
+    ground: dict[str, int] = dataclasses.field(default_factory=dict)  # land cover by kind
 
 
 @dataclass(frozen=True)

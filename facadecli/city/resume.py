@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -208,9 +208,9 @@ def reusable(
 
 
 def stamped(
-    results: Iterable[dict[str, Any]], hashes: Sequence[str], order: Mapping[str, int]
-) -> Iterator[dict[str, Any]]:
-    """Report entries as they come, each with its building's hash (``hashes`` by the
-    position ``order`` gives a building id)."""
-    for result in results:
-        yield {**result, HASH: hashes[order[result["id"]]]}
+    results: Iterable[tuple[int, dict[str, Any]]], hashes: Sequence[str]
+) -> Iterator[tuple[int, dict[str, Any]]]:
+    """Report entries as they come, each at its building's position, with its building's
+    hash (``hashes`` at that position)."""
+    for position, result in results:
+        yield position, {**result, HASH: hashes[position]}

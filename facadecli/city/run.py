@@ -70,6 +70,7 @@ from facadecli.city.footprints import (
 )
 from facadecli.city.georef import Georef, georeference
 from facadecli.city.heap import EVERY, give_back
+from facadecli.city.landcover import kind_counts
 from facadecli.city.lods import feature_scene
 from facadecli.city.manifest import Choice, City, Roof, WallRule
 from facadecli.city.packed import Packed, Picked, Points, Spooled
@@ -647,6 +648,7 @@ def check_output(outdir: Path, name: str) -> None:
         outdir / f"{name}.tiles.json",
         outdir / f"{name}.georef.json",
         outdir / f"{name}.report.jsonl",
+        outdir / f"{name}.ground.geojson",
     ):
         if os.path.isdir(output):
             problem = f"'{output}' is a folder, where an output file goes"
@@ -665,7 +667,7 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
     regular files named as this tool names them, beside the outputs it writes."""
     plain = re.escape(name)
     patterns = {
-        outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda)"
+        outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda|ground\.geojson)"
         rf"{_RANDOM}(?:tmp|bin|objects|vertices|ids)",
         outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
@@ -963,18 +965,20 @@ def _build(
     The client holds no more a building than its task and its report entry as a line
     (report.py): the merged models, the CityJSON and the report are streamed to disk."""
     georef = Georef(found.crs, found.origin, found.unit)
-    order: dict[str, int] = {}  # building id -> its position in the manifest's order
+    warned = {warning.id for warning in found.warnings}  # a few ids, those warned about
+    present: set[str] = set()  # which of them are buildings of this run
     centroids = Points()  # each building's, in the manifest's order
     entries = Entries(len(tasks), outdir)
     built = bytearray(len(tasks))  # 1 for a building built (or kept), in the manifest's order
     tally = Tally()
-    todo = []  # positions of the buildings to build
-    resumed = []  # positions of the buildings kept from the last run
+    todo = array("q")  # positions of the buildings to build
+    resumed = array("q")  # positions of the buildings kept from the last run
     hashes = Hashes()  # each building's (resume.py), in the manifest's order
     digests = spec_digests(city)
     previous = recorded(outdir, city.manifest.name) if resume else {}
     for index, task in enumerate(tasks):  # one pass: each read unpacks its tasks' chunk
-        order[task.footprint.id] = index
+        if task.footprint.id in warned:
+            present.add(task.footprint.id)
         centroids.append(_centroid(task.footprint))
         hashes.append(building_hash(task, digests))
         entry = reusable(task, hashes[index], previous, usd)
@@ -990,14 +994,18 @@ def _build(
     done = len(resumed)
     tileset = None
     if lods:  # 3D Tiles: a leaf's tiles are written as soon as its buildings are done
-        tileset = TilesetWriter(outdir, georef, lods, list(zip(order, centroids, strict=True)))
+        tileset = TilesetWriter(outdir, georef, lods, centroids)
     local = scheduler is None
     building = Picked(tasks, todo)
     del todo
-    mapped = stamped(
-        _map_local(building, jobs) if local else _map_dask(building, str(scheduler)),
+    mapped = stamped(  # each result at its task's position (the results' order is theirs)
+        (
+            (building.positions[k], result)
+            for k, result in (
+                _map_local(building, jobs) if local else _map_dask(building, str(scheduler))
+            )
+        ),
         hashes,
-        order,
     )
     log = outdir / f"{city.manifest.name}.report.jsonl"  # a line a building, as they end
     try:
@@ -1005,14 +1013,13 @@ def _build(
         with open(log, "wb") as lines:
             for index in resumed:
                 lines.write(entries.line(index) + b"\n")
-                _tiled(tileset, outdir, entries[index]["id"], built[index])
-            for result in mapped:
-                index = order[result["id"]]
+                _tiled(tileset, outdir, index, entries[index]["id"], built[index])
+            for index, result in mapped:
                 lines.write(entries.put(index, result) + b"\n")
                 lines.flush()
                 built[index] = result["status"] == "ok"
                 tally.add(result)
-                _tiled(tileset, outdir, result["id"], built[index])
+                _tiled(tileset, outdir, index, result["id"], built[index])
                 done += 1
                 if done % EVERY == 0:  # what the tiles written since freed
                     give_back()
@@ -1039,7 +1046,7 @@ def _build(
         instanced,
     )
     _prune_pictures(outdir)
-    formats = ["glb", "3dtiles", "usd", "cityjson"]  # CITY_WRITERS' order: the report's too
+    formats = ["glb", "3dtiles", "usd", "cityjson", "ground"]  # CITY_WRITERS' order: the report's
     asked = {"3dtiles": tileset is not None, "usd": usd}
     models: dict[str, Any] = {}
     for name in (name for name in formats if asked.get(name, True)):
@@ -1051,10 +1058,10 @@ def _build(
         georeference(georef),
         entries,
         [_rejected(r) for r in found.rejected],
-        [_warning(w) for w in found.warnings if w.id in order],
+        [_warning(w) for w in (*(w for w in found.warnings if w.id in present), *found.ignored)],
         [{"id": key, "parts": ids, "kept_m2": kept[key]} for key, ids in sorted(replaced.items())],
         models,
-        _summary(tally, found, kept, order, straight, time.perf_counter() - started),
+        _summary(tally, found, kept, len(tasks), present, straight, time.perf_counter() - started),
         timings=timings,
     )
     try:
@@ -1114,14 +1121,16 @@ def _summary(
     tally: Tally,
     found: FootprintSet,
     kept: dict[str, float],
-    order: dict[str, int],
+    buildings: int,
+    present: Container[str],
     straight: Straightened | None,
     seconds: float,
 ) -> Summary:
-    """The report's summary of a run: ``tally`` of its buildings, what was read."""
-    warned = [w for w in found.warnings if w.id in order]
+    """The report's summary of a run of ``buildings``: ``tally`` of them, what was read
+    (the warnings about those ``present`` among them, and the features ignored)."""
+    warned = [w for w in found.warnings if w.id in present] + list(found.ignored)
     return Summary(
-        buildings=len(order),
+        buildings=buildings,
         ok=tally.ok,
         failed=tally.failed,
         rejected=len(found.rejected),
@@ -1134,16 +1143,20 @@ def _summary(
         collinear_nodes_merged=straight.nodes if straight else 0,
         warnings_by_tag=dict(sorted(Counter(w.reason.split(" ", 1)[0] for w in warned).items())),
         seconds=round(seconds, 2),
+        ground=kind_counts(found.ground, found.built_up),
     )
 
 
-def _tiled(tileset: TilesetWriter | None, outdir: Path, building_id: str, built: int) -> None:
-    """A building done (built or resumed, or failed: ``built`` 0), for the 3D Tiles of its
-    leaf: its glb (where :func:`plan` put it, in ``outdir``)."""
+def _tiled(
+    tileset: TilesetWriter | None, outdir: Path, index: int, building_id: str, built: int
+) -> None:
+    """The building at ``index`` done (built or resumed, or failed: ``built`` 0), for the
+    3D Tiles of its leaf: its glb (where :func:`plan` put it, in ``outdir``)."""
     if tileset is None:
         return
     try:
-        tileset.done(building_id, outdir / building_file(building_id) if built else None)
+        glb = outdir / building_file(building_id) if built else None
+        tileset.done(index, building_id, glb)
     except OSError as error:
         raise OutputError(
             f"{outdir}: cannot write the 3D Tiles: {error.strerror or error}; the "
@@ -1193,16 +1206,17 @@ def _presolve(submit: Submit, tasks: Sequence[Task], chunk: int) -> dict[Slot, A
     specs.update({f.key: f.spec for task in tasks for _, f in task.walls})
     specs.update({t.fallback[1].key: t.fallback[1].spec for t in tasks if t.fallback is not None})
     needs = _bounded(lambda batch: submit(_each, _needs, batch), tasks, chunk)
-    tries = sorted({tried for need in needs for tried in need})
+    tries = sorted({tried for _, need in needs for tried in need})
     solved: dict[Slot, Axes] = {}
     while slots := sorted(axes_to_solve(tries, solved)):
         jobs = [(specs[slot[0]], slot) for slot in slots]
-        solved.update(_bounded(lambda batch: submit(_each, _solve, batch), jobs, 1))
+        solved.update(found for _, found in _bounded(lambda b: submit(_each, _solve, b), jobs, 1))
     return dict(sorted(solved.items()))  # in order, whichever order they ended in
 
 
-def _map_dask(tasks: Sequence[Task], scheduler: str) -> Iterator[dict[str, Any]]:
-    """The buildings on a Dask distributed cluster, results as they finish: the axes are
+def _map_dask(tasks: Sequence[Task], scheduler: str) -> Iterator[tuple[int, dict[str, Any]]]:
+    """The buildings on a Dask distributed cluster, results as they finish, each with its
+    task's position in ``tasks`` (:func:`_bounded`): the axes are
     solved ahead over the cluster (:func:`_presolve`), sent to every worker once, and
     each worker's cache is seeded with them before its first building."""
     from distributed import Client
@@ -1218,13 +1232,14 @@ def _map_dask(tasks: Sequence[Task], scheduler: str) -> Iterator[dict[str, Any]]
         )
 
 
-def _map_local(tasks: Sequence[Task], jobs: int) -> Iterator[dict[str, Any]]:
-    """The buildings in ``jobs`` local processes, results as they finish. With several
+def _map_local(tasks: Sequence[Task], jobs: int) -> Iterator[tuple[int, dict[str, Any]]]:
+    """The buildings in ``jobs`` local processes, results as they finish, each with its
+    task's position in ``tasks`` (:func:`_bounded`). With several
     processes, the axes every building needs are solved first (:func:`_presolve`) and
     handed to each process as it starts; one process solves them as it goes."""
     if jobs <= 1 or len(tasks) < 2:
-        for task in tasks:
-            yield build(task)
+        for index, task in enumerate(tasks):
+            yield index, build(task)
         return
     chunk = _chunk(len(tasks), jobs)
     with ProcessPoolExecutor(max_workers=jobs) as pool:
@@ -1237,25 +1252,28 @@ T = TypeVar("T")
 R = TypeVar("R")
 
 
-def _bounded(hand: Callable[[Sequence[T]], Any], items: Sequence[T], chunk: int) -> Iterator[Any]:
+def _bounded(
+    hand: Callable[[Sequence[T]], Any], items: Sequence[T], chunk: int
+) -> Iterator[tuple[int, Any]]:
     """A map as a bounded stream: ``hand`` gives a chunk of ``chunk`` items to the workers
     (a future of their results, a local pool's or Dask's); results come as their chunks
     finish, whichever first, with at most IN_FLIGHT chunks handed out at once
     (``Executor.map`` would queue every item first, and a city of a million buildings with
-    it; taking them in order would let one slow chunk hold up the rest). Callers put the
-    results in order themselves."""
+    it; taking them in order would let one slow chunk hold up the rest). Each result
+    comes with its item's position in ``items``: callers put them in order by it, with
+    no map of their own from the results back to the items."""
     finished: queue.SimpleQueue[Any] = queue.SimpleQueue()
-    pending: set[Any] = set()  # Dask cancels a future nobody holds
+    pending: dict[Any, int] = {}  # each chunk's future and its first item's position (Dask
+    # cancels a future nobody holds)
 
-    def take() -> list[Any]:
+    def take() -> list[tuple[int, Any]]:
         future = finished.get()
-        pending.discard(future)
-        results: list[Any] = future.result()
-        return results
+        start = pending.pop(future)
+        return list(enumerate(future.result(), start))
 
     for start in range(0, len(items), chunk):
         future = hand(items[start : start + chunk])
-        pending.add(future)
+        pending[future] = start
         future.add_done_callback(finished.put)
         if len(pending) >= IN_FLIGHT:
             yield from take()

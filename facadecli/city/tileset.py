@@ -38,8 +38,9 @@ import json
 import math
 import os
 import re
+from array import array
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -61,6 +62,7 @@ CAPACITY = {1: 256, 2: 32, 3: 8}  # buildings a tile of each level of detail hol
 MAX_LEVEL = 20  # quadtree levels at most (buildings sharing a centroid stay together)
 MIN_ERROR = {1: 4.0, 2: 3.0}  # metres: what a block or a façade-less model gets wrong at least
 TILE_FILE = re.compile(r"\d+\.lod[123]\.glb")
+NUMBER = re.compile(r"0|[1-9]\d*")  # a level, column or row as a tile's name writes it
 Box = tuple[float, float, float, float, float, float]  # min x, y, z, max x, y, z (z up)
 
 
@@ -124,71 +126,138 @@ def _to_ecef() -> pyproj.Transformer:
     )
 
 
-@dataclass
+@dataclass(slots=True)
 class Square:
-    """A square of the quadtree: its place, its children, its buildings, and the levels
-    of detail whose tiles it holds (:meth:`TilesetWriter.__init__`)."""
+    """A square of the quadtree: its place, its children, where its buildings are in the
+    tree's order (:func:`quadtree`), and the levels of detail whose tiles it holds
+    (:meth:`TilesetWriter.__init__`)."""
 
     level: int
     column: int
     row: int
-    children: list[Square] = field(default_factory=list)
-    members: list[str] = field(default_factory=list)  # its building ids, in run order
+    children: tuple[Square, ...] = ()  # none for a leaf: no list a leaf
+    start: int = 0  # its buildings: the tree's order from ``start`` to ``end``
+    end: int = 0
     lods: tuple[int, ...] = ()  # the levels of detail of its tiles, coarse first
     left: int = 0  # its buildings not done yet
-    tiles: list[dict[str, Any]] = field(default_factory=list)  # its chain, coarse first
+    tiles: Sequence[dict[str, Any]] = ()  # its chain, coarse first, once written
     box: Box | None = None  # of its content; and its children's, once spanned (_span)
     # the largest of its children's errors, once spanned; None when none of its
     # buildings was built
     below: float | None = None
 
+    @property
+    def count(self) -> int:
+        """How many buildings lie in it."""
+        return self.end - self.start
 
-Centroids = Sequence[tuple[str, tuple[float, float]]]  # building ids and their centroids
+
+Centroids = Sequence[tuple[float, float]]  # each building's centroid, in the run's order
 
 
-def quadtree(centroids: Centroids, capacity: int) -> tuple[Square, dict[str, Square]]:
-    """The quadtree of the buildings (id, centroid in local metres), split until a square
-    holds at most ``capacity`` buildings, and each building's leaf. The root square is the
-    smallest power-of-two side (from 1 m) holding them all, its south-west corner at the
-    lowest centroid."""
+@dataclass(frozen=True)
+class Quadtree:
+    """The quadtree of a run's buildings (:func:`quadtree`): its root square, its frame
+    (the root's south-west corner and side, metres) and ``order``, the buildings'
+    positions in the run leaf by leaf, depth first, each leaf's in the run's order: a
+    square's buildings are ``order[square.start:square.end]``, 8 bytes a building in
+    one array, not a list of ids in every square on the way to its leaf."""
+
+    root: Square
+    west: float
+    south: float
+    side: float
+    order: np.ndarray
+
+    def members(self, square: Square) -> list[int]:
+        """The positions of the square's buildings, in the run's order."""
+        return [int(k) for k in np.sort(self.order[square.start : square.end])]
+
+    def path(self, point: tuple[float, float]) -> Iterator[Square]:
+        """The squares from the root to the leaf a centroid lies in."""
+        square = self.root
+        yield square
+        while square.children:
+            column, row = _quarter(square, point, self.west, self.south, self.side)
+            square = next(c for c in square.children if (c.column, c.row) == (column, row))
+            yield square
+
+    def find(self, level: int, column: int, row: int) -> Square | None:
+        """The square at ``level``, ``column``, ``row``; None when the tree has none."""
+        square = self.root
+        while square.level < level:
+            shift = level - square.level - 1
+            inner = [
+                c for c in square.children if (c.column, c.row) == (column >> shift, row >> shift)
+            ]
+            if not inner:
+                return None
+            square = inner[0]
+        return square if (square.level, square.column, square.row) == (level, column, row) else None
+
+
+def _quarter(
+    square: Square, point: tuple[float, float], west: float, south: float, side: float
+) -> tuple[int, int]:
+    """The column and row of the square's quarter a point lies in (one rule for splitting
+    the tree and for finding a building's leaf in it)."""
+    size = side / 2 ** (square.level + 1)
+    x, y = point
+    column = min(square.column * 2 + 1, max(square.column * 2, int((x - west) // size)))
+    row = min(square.row * 2 + 1, max(square.row * 2, int((y - south) // size)))
+    return column, row
+
+
+def quadtree(centroids: Centroids, capacity: int) -> Quadtree:
+    """The quadtree of the buildings (centroids in local metres, in the run's order), split
+    until a square holds at most ``capacity`` buildings. The root square is the smallest
+    power-of-two side (from 1 m) holding them all, its south-west corner at the lowest
+    centroid."""
     if not centroids:
-        return Square(0, 0, 0), {}
-    xs = [c[0] for _, c in centroids]
-    ys = [c[1] for _, c in centroids]
-    west, south = math.floor(min(xs)), math.floor(min(ys))
+        return Quadtree(Square(0, 0, 0), 0.0, 0.0, 1.0, np.zeros(0, dtype=np.int64))
+    west = math.floor(min(x for x, _ in centroids))
+    south = math.floor(min(y for _, y in centroids))
+    east, north = max(x for x, _ in centroids), max(y for _, y in centroids)
     side = 1.0
-    while west + side <= max(xs) or south + side <= max(ys):
+    while west + side <= east or south + side <= north:
         side *= 2
     root = Square(0, 0, 0)
-    leaf_of: dict[str, Square] = {}
+    leaves: list[array[int]] = []  # each leaf's positions, depth first
+    placed = [0]  # positions put in the order so far
 
-    def split(square: Square, items: list[tuple[str, tuple[float, float]]]) -> None:
-        square.members = [bid for bid, _ in items]
+    def split(square: Square, items: array[int]) -> None:
+        square.start = placed[0]
         if len(items) <= capacity or square.level >= MAX_LEVEL:
-            leaf_of.update((bid, square) for bid, _ in items)
+            leaves.append(items)
+            placed[0] += len(items)
+            square.end = placed[0]
             return
-        size = side / 2 ** (square.level + 1)
-        quarters: dict[tuple[int, int], list[tuple[str, tuple[float, float]]]] = {}
-        for bid, (x, y) in items:
-            column = min(square.column * 2 + 1, max(square.column * 2, int((x - west) // size)))
-            row = min(square.row * 2 + 1, max(square.row * 2, int((y - south) // size)))
-            quarters.setdefault((column, row), []).append((bid, (x, y)))
-        for (column, row), inside in sorted(quarters.items()):
-            child = Square(square.level + 1, column, row)
-            square.children.append(child)
-            split(child, inside)
+        quarters: dict[tuple[int, int], array[int]] = {}
+        for position in items:
+            key = _quarter(square, centroids[position], west, south, side)
+            quarters.setdefault(key, array("q")).append(position)
+        del items
+        square.children = tuple(Square(square.level + 1, *key) for key in sorted(quarters))
+        for child in square.children:
+            split(child, quarters.pop((child.column, child.row)))
+        square.end = placed[0]
 
-    split(root, list(centroids))
-    return root, leaf_of
+    split(root, array("q", range(len(centroids))))
+    order = np.concatenate([np.frombuffer(leaf, dtype=np.int64) for leaf in leaves])
+    return Quadtree(root, west, south, side, order)
 
 
 class TilesetWriter:
     """Writes the 3D Tiles of a run as its buildings finish: :meth:`done` for every
-    building (its glb and CityJSON feature, or None when it failed), in any order;
-    :meth:`close` writes ``tileset.json``. The quadtree is planned from every building's
-    centroid before the first is built: it is split until a square holds CAPACITY of the
-    finest LOD chosen; each coarser LOD goes to the largest squares holding at most its
-    CAPACITY (the leaves for what is left), so far views load few, larger tiles."""
+    building (its position in the run, its id and glb, or None when it failed), in any
+    order; :meth:`close` writes ``tileset.json``. The quadtree is planned from every
+    building's centroid before the first is built: it is split until a square holds
+    CAPACITY of the finest LOD chosen; each coarser LOD goes to the largest squares
+    holding at most its CAPACITY (the leaves for what is left), so far views load few,
+    larger tiles. What it keeps of a building while the run goes is its place in the
+    tree's order (8 bytes, :class:`Quadtree`) and, from its end to its square's, its
+    glb: a building's squares are found again from its centroid (``centroids``, the
+    run's, read not copied)."""
 
     def __init__(
         self,
@@ -200,12 +269,15 @@ class TilesetWriter:
         self.folder = outdir / FOLDER
         self.georef = georef
         self.lods = tuple(sorted(lods))
-        self.root, _ = quadtree(centroids, CAPACITY[self.lods[-1]])
-        self.holders: dict[str, list[Square]] = {}  # the squares with tiles of a building
+        self.centroids = centroids
+        self.tree = quadtree(centroids, CAPACITY[self.lods[-1]])
+        self.root = self.tree.root
+        self._chains: dict[tuple[int, ...], tuple[int, ...]] = {}
         self._assign(self.root, ())
-        self.ready: dict[str, Path] = {}  # built buildings' glbs, until their tiles are written
-        self.boxes: dict[str, Box] = {}  # their LOD3 boxes, likewise
-        self.written: set[Path] = set()
+        self.ready: dict[int, tuple[str, Path]] = {}  # built buildings' ids and glbs, by
+        # position, until their tiles are written
+        self.boxes: dict[int, Box] = {}  # their LOD3 boxes, likewise
+        self.written = 0  # tile files
         self.triangles = dict.fromkeys(self.lods, 0)
         self.bytes = dict.fromkeys(self.lods, 0)
 
@@ -213,37 +285,43 @@ class TilesetWriter:
         """The LODs of the square's tiles: each not yet above it, once it holds at most
         that LOD's CAPACITY of buildings (or it is a leaf)."""
         leaf = not square.children
-        square.lods = tuple(
-            k for k in self.lods if k not in done and (len(square.members) <= CAPACITY[k] or leaf)
+        lods = tuple(
+            k for k in self.lods if k not in done and (square.count <= CAPACITY[k] or leaf)
         )
+        square.lods = self._chains.setdefault(lods, lods)  # a few different ones, each held once
         if square.lods:
-            square.left = len(square.members)
-            for bid in square.members:
-                self.holders.setdefault(bid, []).append(square)
+            square.left = square.count
         for child in square.children:
             self._assign(child, done + square.lods)
 
-    def done(self, building_id: str, glb: Path | None) -> None:
+    def _holders(self, position: int) -> list[Square]:
+        """The squares with tiles of the building at ``position``, root first."""
+        return [s for s in self.tree.path(self.centroids[position]) if s.lods]
+
+    def done(self, position: int, building_id: str, glb: Path | None) -> None:
+        """The building at ``position`` in the run (``building_id``) has ended: built
+        into ``glb``, or failed (None); the squares it completes are written."""
         if glb is not None:
-            self.ready[building_id] = glb
-        for square in self.holders[building_id]:
+            self.ready[position] = (building_id, glb)
+        for square in self._holders(position):
             square.left -= 1
             if square.left == 0:
                 self._write_square(square)
 
-    def _lod3_box(self, building_id: str) -> Box:
-        if building_id not in self.boxes:
-            (self.boxes[building_id],) = _glb_boxes([self.ready[building_id]])
-        return self.boxes[building_id]
+    def _lod3_box(self, position: int) -> Box:
+        if position not in self.boxes:
+            (self.boxes[position],) = _glb_boxes([self.ready[position][1]])
+        return self.boxes[position]
 
     def _write_square(self, square: Square) -> None:
-        built = [(bid, self.ready[bid]) for bid in square.members if bid in self.ready]
+        members = [k for k in self.tree.members(square) if k in self.ready]
+        built = [self.ready[k] for k in members]
         if not built:
             return
         features = [feature_of(glb) for _, glb in built] if square.lods[0] < 3 else []
         boxes: dict[int, Box] = {}
         relief = {1: 0.0, 2: 0.0}  # how far each building's LOD3 stands out of the LOD's box
-        finest = [self._lod3_box(bid) for bid, _ in built]
+        finest = [self._lod3_box(k) for k in members]
         name = f"{square.level}/{square.column}/{square.row}"
         for lod in square.lods:
             path = self.folder / f"{name}.lod{lod}.glb"
@@ -261,19 +339,21 @@ class TilesetWriter:
                 relief[lod] = max(_outside(a, b) for a, b in zip(finest, own, strict=True))
                 self.triangles[lod] += sum(len(g.faces) for g in scene.geometry.values())
             self.bytes[lod] += path.stat().st_size
-            self.written.add(path)
+            self.written += 1
         roofs = max((roof_depth(f) for f in features), default=0.0)
+        tiles = []
         for lod in square.lods:  # what each gets wrong; finer tiles below may raise it
             missed = 0.0
             if lod != 3:
                 missed = max(relief[lod], MIN_ERROR[lod]) + (roofs if lod == 1 else 0.0)
             uri = f"{name}.lod{lod}.glb"
-            square.tiles.append({"lod": lod, "uri": uri, "error": round(missed, 3)})
+            tiles.append({"lod": lod, "uri": uri, "error": round(missed, 3)})
+        square.tiles = tiles
         square.box = _union(boxes.values())
-        for bid, _ in built:  # a building's glb is let go with the last of its tiles
-            if all(holder.left == 0 for holder in self.holders[bid]):
-                self.ready.pop(bid)
-                self.boxes.pop(bid, None)
+        for k in members:  # a building's glb is let go with the last of its tiles
+            if all(holder.left == 0 for holder in self._holders(k)):
+                self.ready.pop(k)
+                self.boxes.pop(k, None)
 
     def close(self, name: str) -> dict[str, Any]:
         """Write ``tileset.json`` (and remove tiles an earlier run left that it does not
@@ -309,7 +389,7 @@ class TilesetWriter:
         return {
             "tileset": f"{FOLDER}/tileset.json",
             "lods": list(self.lods),
-            "tiles": len(self.written),
+            "tiles": self.written,
             "triangles": {f"lod{k}": v for k, v in self.triangles.items()},
             "bytes": {f"lod{k}": v for k, v in self.bytes.items()},
         }
@@ -377,12 +457,25 @@ class TilesetWriter:
         return (self._tile(child, covered, ceiling, {}) for child in squares)
 
     def _remove_stale(self) -> None:
+        """The tile files in the folder this run did not write (an earlier run's): each
+        file's square looked up in the tree by its name, no list of the files kept."""
         for folder, _, files in os.walk(self.folder):  # a folder at a time, none held
             for file in files:
                 path = Path(folder) / file
-                if TILE_FILE.fullmatch(file) and path not in self.written:
+                if TILE_FILE.fullmatch(file) and not self._wrote(path):
                     with contextlib.suppress(FileNotFoundError):
                         path.unlink()
+
+    def _wrote(self, path: Path) -> bool:
+        """Whether ``path`` is a tile this run wrote: ``<level>/<column>/<row>.lod<k>.glb``
+        of a square holding that tile."""
+        parts = path.relative_to(self.folder).parts
+        numbers = [*parts[:-1], *parts[-1].split(".")[:1]]
+        if len(parts) != 3 or not all(NUMBER.fullmatch(n) for n in numbers):
+            return False
+        square = self.tree.find(*(int(n) for n in numbers))
+        uri = "/".join(parts)
+        return square is not None and any(tile["uri"] == uri for tile in square.tiles)
 
 
 def _errors(square: Square, covered: bool) -> list[float]:

@@ -172,16 +172,31 @@ def _write_cityjson(built: BuiltCity) -> dict[str, Any]:
     return {}
 
 
+def _write_city_ground(built: BuiltCity) -> dict[str, Any]:
+    """The district's land cover, ``<name>.ground.geojson`` (city/landcover.py), when its
+    input maps any; else no such file (one an earlier run left is removed)."""
+    from facadecli.city.landcover import ordered, write_ground
+
+    path = built.outdir / f"{built.name}.ground.geojson"
+    found = built.found
+    if not found.ground:
+        path.unlink(missing_ok=True)
+        return {}
+    write_ground(path, ordered(found.ground), found.crs, found.origin, found.unit)
+    return {"ground": path.name}
+
+
 #: format name -> the writer of a city's output of that format (``facade city``), each
 #: reading the buildings' own files again in the manifest's order, never all at once:
 #: ``glb`` the merged model or its square tiles and ``<name>.georef.json``, ``3dtiles``
 #: the tileset (with ``--3dtiles``), ``usd`` the city's stage (with ``--usd``),
-#: ``cityjson`` the CityJSON
+#: ``cityjson`` the CityJSON, ``ground`` the land cover (``<name>.ground.geojson``)
 CITY_WRITERS: dict[str, CityWriter] = {
     "glb": CityWriter("merged model", _write_city_models),
     "3dtiles": CityWriter("3D Tiles", _write_city_3dtiles),
     "usd": CityWriter("USD stage", _write_city_usd),
     "cityjson": CityWriter("CityJSON", _write_cityjson),
+    "ground": CityWriter("land cover", _write_city_ground),
 }
 
 

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from facadecli.city.folders import id_digest
 from facadecli.export.atomic import write_atomic
 from facadecli.export.obj import ordered_nodes
 from facadecli.export.texture_store import TextureStore
@@ -267,16 +268,37 @@ def city_usda(name: str, buildings: Iterable[Path], folder: Path) -> str:
 
 def city_usda_lines(name: str, buildings: Iterable[Path], folder: Path) -> Iterator[str]:
     """:func:`city_usda` a line at a time (each with its newline), the buildings taken as
-    they come: a city of any size is written without its text held."""
+    they come: a city of any size is written without its text held, nor its prims'
+    names (:func:`building_prim`: unique by construction)."""
     for line in _head(name, "assembly"):
         yield line + "\n"
-    taken: set[str] = set()
     for glb in buildings:
-        prim = usd_name(glb.stem)
-        while prim in taken:  # two file names may read the same as prim names
-            prim += "_"
-        taken.add(prim)
         stage = glb.with_suffix(".usda").relative_to(folder).as_posix()
+        prim = building_prim(glb.stem)
         yield f'    def Xform "{prim}" (\n        prepend payload = @./{stage}@\n'
         yield "    )\n    {\n    }\n"
     yield "}\n"
+
+
+HASHED = re.compile(r".+_[0-9a-f]{16}")  # a prim name ending as a hashed file name's does
+
+
+def building_prim(stem: str) -> str:
+    """A building's prim name in a city's stage, from its file name (``stem``, a
+    :func:`facadecli.city.folders.safe_name`, each a different one in a run).
+
+    - A hashed name (``<readable>~<16 hex digits of the id's SHA-256>``) gives
+      :func:`usd_name` of it: the readable part, ``_`` and the hash.
+    - A plain name (the id itself: lower-case letters, digits and ``._-``) gives itself
+      (``_`` in front of a leading digit), unless it holds ``.`` or ``-`` (both read
+      ``_``) or reads like a hashed one: then it takes ``_`` and the hash too.
+
+    So two different names never give one prim: those without a hash are the plain names
+    of ``[a-z0-9_]`` as they are (a leading ``_`` marks a digit: none starts with ``_``),
+    and they never end as HASHED; those with one differ in it, unless two ids' hashes
+    share 64 bits (the chance that a file name of :func:`.safe_name` relies on too). No
+    list of the names given is needed to keep them apart."""
+    name = usd_name(stem)
+    if "~" not in stem and ("." in stem or "-" in stem or HASHED.fullmatch(name)):
+        name += "_" + id_digest(stem)[:16]
+    return name

@@ -233,6 +233,7 @@ class _SearchMemory:
     cores: dict[_CoreKey, _Core] = field(default_factory=dict)  # candidates' relaxations
     relaxed: dict[int, construct.Relaxation] = field(default_factory=dict)  # by order
     bounds: dict[int, float] = field(default_factory=dict)  # candidates' bounds, by order
+    sized: sizing.Sized = field(default_factory=dict)  # alignments sized, by what they are
 
 
 # a candidate without one pattern's layers: that pattern, and the other patterns' words
@@ -696,7 +697,9 @@ def _constructions(
         if relaxed is None:
             return None
         rows = _candidate_rows(spec, uses, candidate, memory)
-        built = construct.construct(spec, rows, canvas, memory.prepared, relaxed, tie, fitted)
+        built = construct.construct(
+            spec, rows, canvas, memory.prepared, relaxed, tie, fitted, memory.sized
+        )
         if built is None:
             return None
         found = _Evaluated(candidate, built.groups, built.program, built.sizing)

@@ -29,14 +29,15 @@ def finest(
     groups: Mapping[str, Alignment],
     program: sizing.Program,
     solved: sizing.Sizing,
+    known: sizing.Sized | None = None,
 ) -> tuple[dict[str, Alignment], sizing.Program, sizing.Sizing]:
     """The alignments cut into as many columns as their sizes allow, with their program
-    and sizing; the originals when nothing can be cut."""
+    and sizing; the originals when nothing can be cut. ``known``: alignments sized
+    before (:func:`sizing.sized_alignments`)."""
     refined = {name: _refine(name, a, program, solved) for name, a in groups.items()}
     if all(refined[name] is groups[name] for name in groups):
         return dict(groups), program, solved
-    finer = sizing.build_program(spec, refined, canvas)
-    resized = sizing.search_solve(finer)
+    finer, resized = sizing.sized_alignments(spec, refined, canvas, known)
     if resized is None or resized.objective > solved.objective + REGULARIZATION:
         return dict(groups), program, solved
     return refined, finer, resized

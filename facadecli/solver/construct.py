@@ -496,14 +496,15 @@ def construct(
     relaxed: Relaxation,
     same: float,
     fitted: Mapping[str, float] | None = None,
+    known: sizing.Sized | None = None,
 ) -> Constructed | None:
     """The best layout the constructions find for a candidate's rows: laid at the
     relaxation's sizes (cut where the rows agree exactly, then within growing shares of
     the shortest letter), then again at each layout's solved sizes while that improves;
     it stops as soon as a layout reaches the relaxation's bound (``same``: objectives this
     close are equal). ``fitted``: sizes found to lay the rows (every letter's; see
-    ``axis._fitted_to_backs``), tried first. None when no construction gives a valid
-    layout."""
+    ``axis._fitted_to_backs``), tried first; ``known``: alignments sized before
+    (:func:`sizing.sized_alignments`). None when no construction gives a valid layout."""
     best: Constructed | None = None
     shortest = shortest_letter(groups, relaxed.lengths)
     laid = placeholders_laid(groups, relaxed, canvas)
@@ -526,11 +527,12 @@ def construct(
                     break
                 aligned[name] = alignment
             else:
-                program = sizing.build_program(spec, aligned, canvas)
-                solved = sizing.search_solve(program)
+                program, solved = sizing.sized_alignments(spec, aligned, canvas, known)
                 if solved is None:
                     break
-                finer, program, solved = columns.finest(spec, canvas, aligned, program, solved)
+                finer, program, solved = columns.finest(
+                    spec, canvas, aligned, program, solved, known
+                )
                 if best is not None and solved.objective >= best.sizing.objective - same:
                     break
                 best = Constructed(finer, program, solved)

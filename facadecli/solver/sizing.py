@@ -81,14 +81,6 @@ class Program:
     sized: list[int]  # variables whose deviation is the objective
 
     @functools.cached_property
-    def equalities(self) -> np.ndarray:
-        """The equalities as a dense matrix E (E z = rhs), for the QP solvers."""
-        matrix = np.zeros((len(self.rows), len(self.names)))
-        row, column, value = self._triplets
-        matrix[row, column] = value
-        return matrix
-
-    @functools.cached_property
     def _triplets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The equalities' nonzero coefficients: (row, variable, coefficient) arrays."""
         at = [(i, j, c) for i, (terms, _) in enumerate(self.rows) for j, c in terms.items()]
@@ -213,6 +205,30 @@ def build_program(spec: Spec, groups: Mapping[str, Alignment], canvas: float) ->
         pieces=pieces,
         sized=sized,
     )
+
+
+# what a program is made of: the canvas, and each group's name, rows and entries
+AlignedKey = tuple[float, tuple[tuple[str, tuple[object, ...], tuple[object, ...]], ...]]
+Sized = dict[AlignedKey, tuple[Program, "Sizing | None"]]
+
+
+def sized_alignments(
+    spec: Spec, groups: Mapping[str, Alignment], canvas: float, known: Sized | None = None
+) -> tuple[Program, Sizing | None]:
+    """The alignments' program (:func:`build_program`) and its optimum
+    (:func:`search_solve`); remembered in ``known`` (one spec's: the caller keeps it for
+    one axis solve) by what the program is made of, each group's rows and entries and the
+    canvas, so that constructions laid from other sizes that cut the rows into the same
+    columns are sized once. The same program, so the same answer."""
+    if known is None:
+        program = build_program(spec, groups, canvas)
+        return program, search_solve(program)
+    key = (canvas, tuple((name, a.rows, a.entries) for name, a in sorted(groups.items())))
+    found = known.get(key)
+    if found is None:
+        program = build_program(spec, groups, canvas)
+        found = known[key] = (program, search_solve(program))
+    return found
 
 
 def _difference(a: Mapping[int, float], b: Mapping[int, float]) -> tuple[tuple[int, float], ...]:
@@ -406,25 +422,36 @@ def _clarabel(program: Program) -> Sizing | None:
     n = len(program.names)
     low = np.flatnonzero(np.isfinite(program.lower))
     high = np.flatnonzero(np.isfinite(program.upper))
-    cones = [clarabel.ZeroConeT(program.equalities.shape[0])]
+    cones = [clarabel.ZeroConeT(len(program.rows))]
     if low.size + high.size:
         cones.append(clarabel.NonnegativeConeT(int(low.size + high.size)))
     settings = clarabel.DefaultSettings()
     settings.verbose = False
-    hessian = _csc(np.diag(2.0 * program.weight))
+    everything = np.arange(n)
+    hessian = _csc(everything, everything, 2.0 * program.weight, (n, n))
     linear = -2.0 * program.weight * program.target
-    identity = np.eye(n)
-    constraints = np.vstack([program.equalities, -identity[low], identity[high]])
     rhs = np.concatenate([program.rhs, -program.lower[low], program.upper[high]])
-    solution = clarabel.DefaultSolver(
-        hessian, linear, _csc(constraints), rhs, cones, settings
-    ).solve()
+    constraints = _constraints(program, low, high)
+    solution = clarabel.DefaultSolver(hessian, linear, constraints, rhs, cones, settings).solve()
     if solution.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
         return None
     values = np.clip(np.asarray(solution.x, dtype=float), program.lower, program.upper)
     if program.residual(values) > 1e-6:
         return None
     return _result(program, values)
+
+
+def _constraints(program: Program, low: np.ndarray, high: np.ndarray) -> _Csc:
+    """Clarabel's constraint matrix: the equalities, then one row a bound, ``-z >= -lower``
+    for the variables ``low`` and ``z <= upper`` for ``high``."""
+    row, column, value = program._triplets
+    m = len(program.rows)
+    return _csc(
+        np.concatenate([row, m + np.arange(low.size), m + low.size + np.arange(high.size)]),
+        np.concatenate([column, low, high]),
+        np.concatenate([value, np.full(low.size, -1.0), np.ones(high.size)]),
+        (m + int(low.size + high.size), len(program.names)),
+    )
 
 
 @dataclass(frozen=True)
@@ -446,14 +473,23 @@ class _Csc:
         return int(self.data.size)
 
 
-def _csc(matrix: np.ndarray) -> _Csc:
-    """A dense matrix's nonzeros in compressed columns (what Clarabel takes), made from
-    its arrays directly."""
-    column, row = np.nonzero(matrix.T)  # column by column, rows in order: canonical CSC
-    starts = np.zeros(matrix.shape[1] + 1, dtype=np.int64)
-    np.cumsum(np.bincount(column, minlength=matrix.shape[1]), out=starts[1:])
-    shape = (int(matrix.shape[0]), int(matrix.shape[1]))
-    return _Csc(np.ascontiguousarray(matrix[row, column]), row.astype(np.int64), starts, shape)
+def _csc(row: np.ndarray, column: np.ndarray, value: np.ndarray, shape: tuple[int, int]) -> _Csc:
+    """The matrix of the given nonzeros (``row``, ``column``, ``value``; each place at most
+    once) in compressed columns, what Clarabel takes: sorted by column, then row, and
+    explicit zeros left out, as a dense matrix's nonzeros would be. Made from the nonzeros
+    alone: a long façade's program has thousands of variables, and a dense matrix of its
+    equalities and bounds (tens of millions of entries) took most of a solve's CPU."""
+    kept = value != 0.0
+    row, column, value = row[kept], column[kept], value[kept]
+    order = np.lexsort((row, column))  # column by column, rows in order: canonical CSC
+    starts = np.zeros(shape[1] + 1, dtype=np.int64)
+    np.cumsum(np.bincount(column, minlength=shape[1]), out=starts[1:])
+    return _Csc(
+        np.ascontiguousarray(value[order], dtype=float),
+        row[order].astype(np.int64),
+        starts,
+        (int(shape[0]), int(shape[1])),
+    )
 
 
 def solve(program: Program) -> Sizing | None:
@@ -465,7 +501,13 @@ def solve(program: Program) -> Sizing | None:
     z = cp.Variable(n)
     root = np.sqrt(program.weight)
     objective = cp.Minimize(cp.sum_squares(cp.multiply(root, z - program.target)))
-    constraints = [sparse.csr_matrix(program.equalities) @ z == program.rhs]
+    row, column, value = program._triplets
+    kept = value != 0.0  # as a dense matrix's nonzeros: no explicit zeros, rows sorted
+    equalities = sparse.csr_matrix(
+        (value[kept], (row[kept], column[kept])), shape=(len(program.rows), n)
+    )
+    equalities.sort_indices()
+    constraints = [equalities @ z == program.rhs]
     finite_low = np.isfinite(program.lower)
     finite_high = np.isfinite(program.upper)
     if finite_low.any():

@@ -18,6 +18,7 @@ from html import escape
 from importlib import resources
 
 from facadecli.viewer.ground import GROUND
+from facadecli.viewer.landcover import COVER, COVER_DRAWN
 
 THREE_VERSION = "0.162.0"
 # specifier -> bundled file
@@ -156,15 +157,16 @@ function cloudiness(direction) {  // 0 (clear) .. 1 (thick cloud) in a direction
 // a little cool: the white balance (below) warms the whole sky as it cancels its blue
 const CLOUD_TOP = new THREE.Color(0xeef3ff), CLOUD_BASE = new THREE.Color(0xa9b4c6);
 const GLOW = new THREE.Color(0xfff1dc);
-function skyRadiance(direction, colour) {
+function cloudShade(direction, cloud, shade) {  // a cloud's colour, lit from the sun's side
+  const lit = 0.9 + 0.3 * Math.max(0, direction.dot(sunDirection));
+  return shade.copy(CLOUD_BASE).lerp(CLOUD_TOP, 1 - cloud * 0.6)
+    .multiplyScalar(SKY_LIGHT * 1.35 * lit);
+}
+function skyRadiance(direction, colour, clouds = true) {
   const y = Math.max(direction.y, 0);
   colour.copy(HORIZON).lerp(ZENITH, Math.pow(y, 0.6)).multiplyScalar(SKY_LIGHT);
-  const cloud = cloudiness(direction);
-  if (cloud > 0) {  // lit from the sun's side: brighter towards it
-    const lit = 0.9 + 0.3 * Math.max(0, direction.dot(sunDirection));
-    const shade = CLOUD_BASE.clone().lerp(CLOUD_TOP, 1 - cloud * 0.6);
-    colour.lerp(shade.multiplyScalar(SKY_LIGHT * 1.35 * lit), cloud);
-  }
+  const cloud = clouds ? cloudiness(direction) : 0;
+  if (cloud > 0) colour.lerp(cloudShade(direction, cloud, new THREE.Color()), cloud);
   const towards = Math.max(0, direction.dot(sunDirection));
   colour.add(GLOW.clone().multiplyScalar(2.5 * Math.pow(towards, 24)));
   if (towards > SUN_DISC) colour.add(GLOW.clone().multiplyScalar(40));
@@ -179,7 +181,7 @@ function skyRadiance(direction, colour) {
 // mirrors is here, 5-15° below the horizon: it was paving as bright as the haze, the
 // same grey all over, so a pane showed nothing but a dark slate.
 const FRONTS = 0.26, WINDOWS = 0.5, SUNLIT = 2;
-function skyPicture(width, height, below, skyline) {
+function skyPicture(width, height, below, skyline, clouds = true) {
   const data = new Float32Array(width * height * 4);
   const direction = new THREE.Vector3(), colour = new THREE.Color(), house = new THREE.Color();
   const horizon = HORIZON.clone().multiplyScalar(SKY_LIGHT);
@@ -192,7 +194,7 @@ function skyPicture(width, height, below, skyline) {
                     Math.sin(azimuth) * Math.cos(elevation));
       if (skyline) while (skyline[block][1] <= u) block++;
       if (y >= 0) {
-        skyRadiance(direction, colour);
+        skyRadiance(direction, colour, clouds);
         if (skyline) {
           const [, , top, tone, light] = skyline[block];
           if (y < top) {  // a house far off: lit by the sky, half lost in the haze
@@ -274,8 +276,30 @@ function sky() {
   const haze = HORIZON.clone().multiplyScalar(SKY_LIGHT);
   haze.setRGB(haze.r * gains[0], haze.g * gains[1], haze.b * gains[2]);
   const backdrop = equirectangular(
-    balanced(skyPicture(2048, 1024, () => {}, null), gains), 2048, 1024);  // haze below
-  return {environment, backdrop, haze};
+    balanced(skyPicture(1024, 512, () => {}, null, false), gains), 1024, 512);  // haze below
+  const clouds = equirectangular(balanced(cloudPicture(2048, 1024), gains), 2048, 1024);
+  return {environment, backdrop, clouds, haze};
+}
+// The backdrop's clouds apart from its clear sky, an equirectangular picture as
+// skyPicture's: each cloud's colour and, as alpha, how thick it is (0 clear), so the
+// backdrop lays them over the sky at elevations of their own (placeBackdrop)
+function cloudPicture(width, height) {
+  const data = new Float32Array(width * height * 4);
+  const direction = new THREE.Vector3(), shade = new THREE.Color();
+  for (let row = height / 2; row < height; row++) {
+    const elevation = ((row + 0.5) / height - 0.5) * Math.PI, y = Math.sin(elevation);
+    for (let column = 0; column < width; column++) {
+      const azimuth = ((column + 0.5) / width - 0.5) * 2 * Math.PI;
+      direction.set(Math.cos(azimuth) * Math.cos(elevation), y,
+                    Math.sin(azimuth) * Math.cos(elevation));
+      const cloud = cloudiness(direction);
+      if (cloud <= 0) continue;
+      cloudShade(direction, cloud, shade);
+      const at = (row * width + column) * 4;
+      data[at] = shade.r; data[at + 1] = shade.g; data[at + 2] = shade.b; data[at + 3] = cloud;
+    }
+  }
+  return data;
 }
 const scene = new THREE.Scene();
 const daylight = sky();
@@ -286,26 +310,35 @@ scene.environment = daylight.environment;
 // eye high over a district, which at 30-35 degrees up looks down at its picture's top.
 // Above that horizon the sky's gradient, its elevations stretched up to SKY_STRETCH times
 // as the horizon drops, so the top of such a picture is sky (pale at the haze, bluer
-// above), where it was the haze below the sky's horizon.
-const SKY_STRETCH = 3;
+// above), where it was the haze below the sky's horizon. The clouds are not stretched
+// (three times flatter, they read as streaks over a district): over a lowered horizon
+// they are those up to CLOUD_LIFT radians higher in the sky, as an eye over the town
+// sees them, fading in over CLOUD_FADE radians above the haze.
+const SKY_STRETCH = 3, CLOUD_LIFT = 0.25, CLOUD_FADE = 0.08;
 let lowHorizon = false;  // a district seen from above (light); a façade's is at eye level
 const backdrop = new THREE.Scene();
 const dome = new THREE.Mesh(new THREE.SphereGeometry(1, 64, 32), new THREE.ShaderMaterial({
-  uniforms: {sky: {value: daylight.backdrop}, horizon: {value: 0}, stretch: {value: 1}},
+  uniforms: {sky: {value: daylight.backdrop}, clouds: {value: daylight.clouds},
+             horizon: {value: 0}, stretch: {value: 1}, lift: {value: 0}},
   vertexShader: `varying vec3 vDirection;
     void main() {
       vDirection = position;
       gl_Position = (projectionMatrix * modelViewMatrix * vec4(position, 1.0)).xyww;
     }`,
-  fragmentShader: `uniform sampler2D sky; uniform float horizon, stretch;
+  fragmentShader: `uniform sampler2D sky, clouds; uniform float horizon, stretch, lift;
     varying vec3 vDirection;
     #include <common>
+    vec2 equirectangular(float around, float up) {
+      return vec2(around, clamp(up, -0.5 * PI, 0.5 * PI) * RECIPROCAL_PI + 0.5);
+    }
     void main() {
       vec3 d = normalize(vDirection);
-      float up = (asin(clamp(d.y, -1.0, 1.0)) - horizon) * stretch;
-      vec2 uv = vec2(atan(d.z, d.x) * RECIPROCAL_PI2 + 0.5,
-                     clamp(up, -0.5 * PI, 0.5 * PI) * RECIPROCAL_PI + 0.5);
-      gl_FragColor = vec4(texture2D(sky, uv).rgb, 1.0);
+      float above = asin(clamp(d.y, -1.0, 1.0)) - horizon;
+      float around = atan(d.z, d.x) * RECIPROCAL_PI2 + 0.5;
+      vec3 colour = texture2D(sky, equirectangular(around, above * stretch)).rgb;
+      vec4 cloud = texture2D(clouds, equirectangular(around, above + lift));
+      float fade = lift > 0.0 ? smoothstep(0.0, ${CLOUD_FADE.toFixed(2)}, above) : 1.0;
+      gl_FragColor = vec4(mix(colour, cloud.rgb, cloud.a * fade), 1.0);
       #include <tonemapping_fragment>
       #include <colorspace_fragment>
     }`,
@@ -321,8 +354,9 @@ function placeBackdrop() {
   const horizon = !lowHorizon ? 0
     : -Math.asin(Math.min(1, high / Math.max(scene.fog.far, 1e-6)));
   dome.material.uniforms.horizon.value = horizon;
-  dome.material.uniforms.stretch.value =
-    1 + (SKY_STRETCH - 1) * THREE.MathUtils.smoothstep(-horizon, 0.01, 0.1);
+  const lowered = THREE.MathUtils.smoothstep(-horizon, 0.01, 0.1);
+  dome.material.uniforms.stretch.value = 1 + (SKY_STRETCH - 1) * lowered;
+  dome.material.uniforms.lift.value = CLOUD_LIFT * lowered;
 }
 // placed by frame(): the model clear, the ground fading out into the horizon's haze
 scene.fog = new THREE.Fog(daylight.haze, 1, 2);
@@ -385,6 +419,32 @@ function regionsPicture(data, columns, rows) {
   picture.needsUpdate = true;
   return picture;
 }
+// A lawn's edge, soft and ragged (a verge, not a line ruled at the plan's cell): its
+// share of grass the mean of four places LAWN_BLUR metres round, each moved by a smooth
+// noise up to LAWN_WOBBLE metres, eased; and the grass's tone, smooth noise at two
+// scales (blades and patches), not squares of 0.2 m, which drew a staircase along every
+// lawn's edge. The same at a place each time.
+const LAWN_BLUR = 0.5, LAWN_WOBBLE = 0.45;
+const LAWN_EDGE = `
+  float lawnHash(vec2 p) { return fract(sin(dot(p, vec2(12.9898, 78.233))) * 43758.5453); }
+  float lawnNoise(vec2 p) {
+    vec2 i = floor(p), f = fract(p);
+    f = f * f * (3.0 - 2.0 * f);
+    return mix(mix(lawnHash(i), lawnHash(i + vec2(1.0, 0.0)), f.x),
+               mix(lawnHash(i + vec2(0.0, 1.0)), lawnHash(i + vec2(1.0, 1.0)), f.x), f.y);
+  }
+  float lawnAt(vec2 place) { return texture2D(regions, (place - regionsFrom) / regionsSize).b; }
+  float lawnEdge(vec2 place) {
+    vec2 moved = place + ${(2 * LAWN_WOBBLE).toFixed(2)} * (vec2(
+      lawnNoise(place * 1.3), lawnNoise(place * 1.3 + 17.0)) - 0.5);
+    float blur = ${LAWN_BLUR.toFixed(2)};
+    float share = 0.25 * (lawnAt(moved + vec2(blur, 0.0)) + lawnAt(moved - vec2(blur, 0.0))
+                          + lawnAt(moved + vec2(0.0, blur)) + lawnAt(moved - vec2(0.0, blur)));
+    return smoothstep(0.15, 0.85, share);
+  }
+  float lawnTone(vec2 place) {
+    return 0.72 + 0.32 * lawnNoise(place * 7.0) + 0.24 * lawnNoise(place * 0.35);
+  }`;
 const allPaving = () => regionsPicture(new Uint8Array([255, 0, 0, 0]), 1, 1);
 uses.regions.value = allPaving();
 ground.material.onBeforeCompile = shader => {
@@ -396,10 +456,12 @@ ground.material.onBeforeCompile = shader => {
     uniform vec4 town; uniform float hazeFrom;
     #define TOWN_PAVED ${TOWN_PAVED.toFixed(1)}
     #define TOWN_EDGE ${TOWN_EDGE.toFixed(1)}
-    varying vec2 vGround;\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
+    varying vec2 vGround;
+    ${LAWN_EDGE}\\n` + shader.fragmentShader.replace('#include <map_fragment>', `
     #include <map_fragment>
     vec2 inPlan = (vGround - regionsFrom) / regionsSize;
     vec4 share = texture2D(regions, inPlan);
+    share.b = lawnEdge(vGround);
     // past the plan's margin the town's streets give way to what most of the district's
     // open ground is (its squares, or its lawns), out to the haze
     // (from TOWN_EDGE metres inside the margin's edge: the picture's edge, clamped, drew
@@ -410,7 +472,7 @@ ground.material.onBeforeCompile = shader => {
     share = mix(share, town, smoothstep(-TOWN_EDGE, TOWN_PAVED, beyond));
     float speck = fract(sin(dot(floor(vGround * 5.0), vec2(12.9898, 78.233))) * 43758.5453);
     vec3 asphalt = vec3(0.042, 0.042, 0.045) * (0.9 + 0.2 * speck);
-    vec3 grass = vec3(0.05, 0.075, 0.028) * (0.8 + 0.4 * speck);
+    vec3 grass = vec3(0.05, 0.075, 0.028) * lawnTone(vGround);
     vec3 paved = diffuseColor.rgb * mix(1.0, 1.5, share.a);
     diffuseColor.rgb = (paved * share.r + asphalt * share.g + grass * share.b)
       / max(share.r + share.g + share.b, 1e-3);`);
@@ -438,6 +500,21 @@ function endsInHaze(material, more = shader => shader) {
   };
 }
 endsInHaze(ground.material, ground.material.onBeforeCompile);
+// What stands on a district's ground (trees, dashes, lamps, benches) fades into the haze
+// as the ground under it does: with the fog alone, the trees on a lawn far off stood
+// out of the hazed ground as pale ghosts over the horizon
+function fadesWithGround(material) {
+  endsInHaze(material, shader => {
+    shader.uniforms.hazeFrom = uses.hazeFrom;
+    shader.fragmentShader = 'uniform float hazeFrom;\\n' + shader.fragmentShader.replace(
+      '#include <fog_fragment>', `#include <fog_fragment>
+      #ifdef USE_FOG
+      float hazed = clamp((vFogDepth - hazeFrom) / max(fogFar - hazeFrom, 1e-3), 0.0, 1.0);
+      gl_FragColor.rgb = mix(gl_FragColor.rgb, fogColor, hazed * hazed);
+      #endif`);
+  });
+  material.customProgramCacheKey = () => 'fades-with-ground';
+}
 // The street trees (a trunk and a crown, each one instanced mesh: two draw calls whatever
 // their number), the centre-line dashes and the street lamps (one more each), seeded: the
 // same each time
@@ -468,7 +545,7 @@ const trees = {
     {color: 0x3b3f42, roughness: 0.55, metalness: 0.6}), 1),
 };
 for (const part of Object.values(trees)) {
-  endsInHaze(part.material);
+  fadesWithGround(part.material);
   part.count = 0; part.frustumCulled = false; part.receiveShadow = true;
   scene.add(part);
 }
@@ -521,12 +598,57 @@ function placeStreetParts(cells, dashes, lamps, place) {
     if (part.instanceColor) part.instanceColor.needsUpdate = true;
   }
 }
+// The benches (street furniture, one instanced mesh: one draw call whatever their
+// number, no randomness): a seat of timber slats BENCH_SEAT metres up on two cast-iron
+// ends, a back rest leaning back; the seat's front faces +x, the way benchCells gives
+const BENCH_LONG = 1.8, BENCH_SEAT = 0.45;
+function benchShape() {
+  const slat = (deep, high, x, y, lean = 0) => new THREE.BoxGeometry(deep, high, BENCH_LONG)
+    .rotateZ(lean).translate(x, y, 0);
+  const parts = [slat(0.14, 0.04, 0.13, BENCH_SEAT), slat(0.14, 0.04, -0.02, BENCH_SEAT),
+                 slat(0.04, 0.14, -0.14, BENCH_SEAT + 0.2, 0.2),
+                 slat(0.04, 0.14, -0.17, BENCH_SEAT + 0.38, 0.2)];
+  const timber = mergeGeometries(parts.map(part => part.toNonIndexed()));
+  const ends = [-1, 1].map(side => new THREE.BoxGeometry(0.42, BENCH_SEAT, 0.06)
+    .translate(0.02, BENCH_SEAT / 2, side * (BENCH_LONG / 2 - 0.15)).toNonIndexed());
+  const iron = mergeGeometries(ends);
+  // one mesh, two materials (groups): timber, then the iron ends
+  return mergeGeometries([timber, iron], true);
+}
+let benches = new THREE.InstancedMesh(benchShape(), [
+  new THREE.MeshStandardMaterial({color: 0x8a6240, roughness: 0.8}),
+  new THREE.MeshStandardMaterial({color: 0x2b2e2f, roughness: 0.5, metalness: 0.6})], 1);
+for (const material of benches.material) fadesWithGround(material);
+benches.count = 0; benches.frustumCulled = false;
+benches.castShadow = benches.receiveShadow = true;
+scene.add(benches);
+function placeBenches(cells, place) {
+  if (benches.instanceMatrix.count < cells.length) {  // grown: a mesh with room for them
+    const bigger = new THREE.InstancedMesh(benches.geometry, benches.material, cells.length);
+    bigger.frustumCulled = false; bigger.castShadow = bigger.receiveShadow = true;
+    scene.remove(benches); benches.dispose(); scene.add(bigger);
+    benches = bigger;
+  }
+  const matrix = new THREE.Matrix4(), turn = new THREE.Quaternion();
+  const up = new THREE.Vector3(0, 1, 0), at = new THREE.Vector3();
+  const size = new THREE.Vector3(1, 1, 1);
+  cells.forEach(([cell, across, down], index) => {
+    const [x, y, z] = place(cell);
+    turn.setFromAxisAngle(up, Math.atan2(down, across));  // rows run to -z, as the lamps
+    benches.setMatrixAt(index, matrix.compose(at.set(x, y, z), turn, size));
+  });
+  benches.count = cells.length;
+  benches.instanceMatrix.needsUpdate = true;
+}
 function groundRegions(model, box, district) {  // a model after another: its own ground
   uses.regions.value.dispose();
   uses.regions.value = allPaving();
   uses.town.value.copy(PAVED);
   delete document.body.dataset.ground;
   placeStreetParts([], [], [], null);
+  placeBenches([], null);
+  placeLandCover([], 0);  // the land cover mapped (facadecli.viewer.landcover)
+  delete document.body.dataset.cover;
   const buildings = model.children.length;
   if (!district || buildings < 2 || buildings > 65535) return;  // its plan, as a street's
   const {cell, columns, rows, building} = districtPlan(model, box);
@@ -550,14 +672,25 @@ function groundRegions(model, box, district) {  // a model after another: its ow
   const x = column => box.min.x + (column - margin + 0.5) * cell;
   const z = row => box.min.z + (rows + margin - row - 0.5) * cell;
   const place = at => [x(at % wide), box.min.y, z(Math.floor(at / wide))];
-  const treesAt = treeCells(plan, wide, cell), dashes = dashCells(plan, wide, deep, cell);
-  const lamps = lampCells(plan, wide, deep, cell, treesAt);
-  placeStreetParts(treesAt, dashes, lamps, place);
+  const covered = coverPlan(plan, box.min.x - margin * cell, box.min.z + (rows + margin) * cell,
+                            wide, deep, cell);  // what OSM maps there: the rules fill the rest
+  const treesAt = treeCells(plan, wide, cell).filter(covered.open);
+  const dashes = dashCells(plan, wide, deep, cell).filter(([at]) => covered.open(at));
+  const lamps = lampCells(plan, wide, deep, cell, treesAt).filter(([at]) => covered.open(at));
+  const trees = [...treesAt, ...covered.trees.map((_, k) => -1 - k)];  // theirs below 0
+  placeStreetParts(trees, dashes, lamps, at => at >= 0 ? place(at)
+    : [covered.trees[-1 - at][0], box.min.y, covered.trees[-1 - at][1]]);
+  const benchesAt = benchCells(plan, wide, deep, cell, [...treesAt, ...lamps.map(([at]) => at)])
+    .filter(([at]) => covered.open(at));
+  placeBenches(benchesAt, place);
+  placeLandCover(covered.polygons, box.min.y);
+  document.body.dataset.cover = JSON.stringify(coverCounts(covered, wide, margin, rows, columns));
   document.body.dataset.ground = JSON.stringify({
     paving: share(counts[0]), kerb: share(counts[1]), asphalt: share(counts[2]),
     grass: share(counts[3]), cell, area: +(columns * rows * cell * cell).toFixed(1),
     trees: treesAt.map(at => place(at).map(v => +v.toFixed(2))),
-    dashes: dashes.length, lamps: lamps.map(([at]) => place(at).map(v => +v.toFixed(2)))});
+    dashes: dashes.length, lamps: lamps.map(([at]) => place(at).map(v => +v.toFixed(2))),
+    benches: benchesAt.map(([at]) => place(at).map(v => +v.toFixed(2)))});
   uses.regions.value.dispose();
   uses.regions.value = regionsPicture(data, wide, deep);
   // the picture's row 0 is the plan's, at the district's +z edge (districtPlan)
@@ -1053,7 +1186,8 @@ function bounds(model) {
   const box = new THREE.Box3().setFromObject(model);
   if (box.isEmpty()) box.setFromCenterAndSize(new THREE.Vector3(), new THREE.Vector3(10, 10, 10));
   const size = box.getSize(new THREE.Vector3());
-  const district = Math.min(size.x, size.z) > 2 * size.y;  // wider and deeper than tall
+  // wider and deeper than tall, or with the land cover of a city round it
+  const district = Math.min(size.x, size.z) > 2 * size.y || Boolean(landCover);
   let points = corners(box);
   if (district && model.children.length <= FRAMED_BUILDINGS) {
     points = [];
@@ -1174,6 +1308,7 @@ function show(id, keep = false) {  // keep: the camera where the user turned it,
     shown = gltf.scene;
     castsShadows(shown);
     scene.add(shown);
+    landCover = landCoverOf(id);  // drawn by light() (groundRegions)
     light(shown);
     if (!(keep && moved)) frame(shown);
     status.textContent = 'drag to orbit, scroll to zoom';
@@ -1186,6 +1321,7 @@ resize();
 window.facadeShow = show;  // for a page's own scripts (facade watch swaps the model)
 """
 VIEWER += GROUND  # the ground under a district (facadecli.viewer.ground)
+VIEWER += COVER + COVER_DRAWN  # the land cover on it (facadecli.viewer.landcover)
 
 STYLE = (
     "body{margin:0;font-family:sans-serif;display:flex;height:100vh;background:#f4f4f4}"

@@ -35,6 +35,7 @@ from facadecli.viewer.kinds import kind_problem
 
 PAGE_NAME = "index.html"
 BUILDINGS = "buildings"  # where ``facade city`` writes one glb per building
+GROUND = ".ground.geojson"  # a city's land cover, beside its merged glb
 HINT = (
     "run 'facade solve SPEC -o FOLDER' first, or facade vary or facade city: "
     "they write the .glb models this page shows"
@@ -49,6 +50,7 @@ class Model:
     name: str
     glb: Path
     svg: Path | None
+    ground: Path | None = None  # a city's land cover, <name>.ground.geojson
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,7 @@ class Loaded:
     model: Model
     glb: bytes
     svg: bytes | None
+    ground: bytes | None = None
 
 
 def natural_key(name: str) -> tuple[tuple[str | int, ...], str]:
@@ -106,7 +109,15 @@ def find_models(folder: Path) -> list[Model]:
     models = []
     for glb in glbs:
         svg = glb.with_suffix(".svg")
-        models.append(Model(glb.stem, glb, svg if os.path.lexists(svg) else None))
+        ground = glb.with_suffix(GROUND)
+        models.append(
+            Model(
+                glb.stem,
+                glb,
+                svg if os.path.lexists(svg) else None,
+                ground if os.path.lexists(ground) else None,
+            )
+        )
     return models
 
 
@@ -185,19 +196,24 @@ def read_models(
         except _Skip as skip:
             raise _Skip(f"its texture picture {unquote(uri)}: {skip}") from None
 
+    def optional(path: Path | None) -> bytes | None:
+        """A file beside a model's glb (its SVG, its ground), if it has one and it reads;
+        one that does not is skipped, the model kept."""
+        if path is None:
+            return None
+        try:
+            return read(path)
+        except _Skip as skip:
+            skipped.append(Skipped(path, str(skip)))
+            return None
+
     for model in models:
         try:  # a city's glb names the pictures of its run's textures/: the page holds them
             glb = embedded(read(model.glb), partial(picture, model))
         except _Skip as skip:
             skipped.append(Skipped(model.glb, str(skip)))
             continue
-        svg = None
-        if model.svg is not None:
-            try:
-                svg = read(model.svg)
-            except _Skip as skip:
-                skipped.append(Skipped(model.svg, str(skip)))
-        loaded.append(Loaded(model, glb, svg))
+        loaded.append(Loaded(model, glb, optional(model.svg), optional(model.ground)))
     return loaded, skipped
 
 
@@ -274,6 +290,8 @@ def gallery_parts(title: str, models: list[Loaded], note: str = "") -> Iterator[
         )
         for index, loaded in enumerate(models):
             yield glb_element(f"glb-{index}", loaded.glb)
+            if loaded.ground is not None:  # drawn by show() (facadecli.viewer.landcover)
+                yield glb_element(f"glb-{index}-ground", loaded.ground)
 
     return document_parts(title, STYLE, body(), SCRIPT)
 

@@ -22,17 +22,24 @@ from __future__ import annotations
 #   ROAD_ENCLOSED for a road, ENCLOSED for a square; open land no walls close in is grass,
 #   the lawns of a sparse town (by distance alone, a town of detached houses 30-100 m
 #   apart was all paved square);
-# - a tree every TREE_EVERY metres or more along the wide pavements, TREE_LINE metres from
-#   the walls; a dash DASH metres long every DASH_EVERY metres along a street's centre (the
-#   ridge of the distance to its walls), where the street is ROAD_HALF metres from its walls;
+# - a road meets a lawn at a kerb (kerbLawns);
+# - a tree every TREE_EVERY metres or more in pits along the wide pavements of roads,
+#   TREE_LINE metres from the walls, where the pavement runs straight for TREE_STRAIGHT
+#   metres (not on the ring of paving round a detached house), and scattered on the open
+#   lawns (treeCells); a dash DASH metres long every DASH_EVERY metres along a street's
+#   centre (the ridge of the distance to its walls), where the street is ROAD_HALF metres
+#   from its walls;
 # - a street lamp every LAMP_EVERY metres or more, on a pavement LAMP_KERB metres short of
 #   its kerb where asphalt follows, LAMP_CLEAR metres or more from a tree, its arm over the
-#   road.
+#   road;
+# - a bench every BENCH_EVERY metres or more on the paving at a lawn's edge, facing the
+#   lawn, away from roads, trees and lamps (benchCells).
 GROUND = """
 const PAVEMENT = 2.5, WIDE_PAVEMENT = 4.5, KERB = 0.2, PASSAGE = 3, YARD_PATH = 1;
 const ROOM = 6, GROUND_MARGIN = 14;
 const TREE_LINE = 3.4, TREE_EVERY = 9, DASH = 3, DASH_EVERY = 7.5, ROAD_HALF = [3.5, 12];
 const LAMP_EVERY = 30, LAMP_KERB = 0.6, LAMP_CLEAR = 3;
+const TREE_STRAIGHT = 14, LAWN_TREE_WALL = 6, LAWN_TREE_EDGE = 2, LAWN_TREE_EVERY = 18;
 const SQUARE_REACH = 40, RAYS_AROUND = 32, ENCLOSED = 0.5, ROAD_ENCLOSED = 0.3;
 // The exact Euclidean distance of each cell of a grid (row by row, ``columns`` a row) to
 // the nearest cell set in ``seeds``, in cells: the lower envelope of parabolas
@@ -176,12 +183,33 @@ function groundKinds(building, columns, rows, cell) {
     if (enclosed(at) < (road ? ROAD_ENCLOSED : ENCLOSED)) { kinds[at] = 4; continue; }
     kinds[at] = metres < kerb + KERB ? 2 : road ? 3 : 1;
   }
+  kerbLawns(kinds, columns, rows);
   return {kinds, near, street, wide};
 }
-// Cells at least ``every`` metres apart, the first of each crowd in the grid's order (the
-// same each time): a coarse grid of buckets ``every`` wide keeps the test local
-function spaced(candidates, columns, cell, every) {
+// A kerb where a road meets a lawn (the enclosure turns asphalt to grass across a
+// street): the road's cells beside the grass (four neighbours) are kerb, as along a
+// pavement; the asphalt ran into the grass with no edge
+function kerbLawns(kinds, columns, rows) {
+  const edge = [];
+  for (let at = 0; at < kinds.length; at++) {
+    if (kinds[at] !== 3) continue;
+    const column = at % columns;
+    if ((column > 0 && kinds[at - 1] === 4) || (column < columns - 1 && kinds[at + 1] === 4)
+        || (at >= columns && kinds[at - columns] === 4)
+        || (at < (rows - 1) * columns && kinds[at + columns] === 4)) edge.push(at);
+  }
+  for (const at of edge) kinds[at] = 2;
+}
+// Cells at least ``every`` metres apart (and from those ``taken``), the first of each
+// crowd in the candidates' order (the same each time): a coarse grid of buckets ``every``
+// wide keeps the test local
+function spaced(candidates, columns, cell, every, taken = []) {
   const buckets = new Map(), chosen = [], span = every / cell;
+  for (const at of taken) {  // already placed: kept clear of, not chosen again
+    const column = at % columns, row = (at - column) / columns;
+    const key = Math.floor(column / span) + ',' + Math.floor(row / span);
+    buckets.set(key, [...(buckets.get(key) || []), at]);
+  }
   for (const at of candidates) {
     const column = at % columns, row = (at - column) / columns;
     const bx = Math.floor(column / span), by = Math.floor(row / span);
@@ -200,16 +228,44 @@ function spaced(candidates, columns, cell, every) {
   }
   return chosen;
 }
-// The street trees: cells on a wide pavement TREE_LINE metres (within a cell) from the walls,
-// TREE_EVERY apart
+// The trees, on lawn or in tree pits along streets, never on the paving round a house
+// nor in a road: in a pit on a wide pavement TREE_LINE metres (within a cell) from the
+// walls, where the street's asphalt lies past its kerb and the pavement runs straight
+// for TREE_STRAIGHT metres (a street's, not the ring of paving round a detached house),
+// TREE_EVERY apart; and on a street's open lawn (not a yard's: a courtyard, a back
+// garden), LAWN_TREE_WALL metres or more from the walls and LAWN_TREE_EDGE from
+// anything not grass, LAWN_TREE_EVERY apart, scattered (lawnOrder)
 function treeCells(ground, columns, cell) {
-  const {kinds, near, wide} = ground, candidates = [];
+  const {kinds, near, wide, street} = ground, rows = kinds.length / columns;
+  const pits = [], lawn = [], line = new Uint8Array(kinds.length);
   for (let at = 0; at < kinds.length; at++) {
-    if (kinds[at] === 1 && wide[at] && Math.abs(near[at] * cell - TREE_LINE) <= 0.75 * cell) {
-      candidates.push(at);
+    line[at] = kinds[at] === 1 && Math.abs(near[at] * cell - TREE_LINE) <= 0.75 * cell ? 1 : 0;
+  }
+  const pitReach = WIDE_PAVEMENT + KERB - TREE_LINE + cell;
+  const reach = Math.max(2, Math.round(TREE_STRAIGHT / 2 / cell));
+  const toEdge = distanceField(kinds.map(kind => kind === 4 ? 0 : 1), columns, rows);
+  for (let at = 0; at < kinds.length; at++) {
+    if (line[at] && wide[at] && besideKind(kinds, columns, cell, at, 3, pitReach)) {
+      if (straight(line, columns, rows, at, reach, 0.75 + 0.25 / cell)) pits.push(at);
+    } else if (kinds[at] === 4 && street[at] && near[at] * cell >= LAWN_TREE_WALL
+               && toEdge[at] * cell >= LAWN_TREE_EDGE) {
+      lawn.push(at);
     }
   }
-  return spaced(candidates, columns, cell, TREE_EVERY);
+  const inPits = spaced(pits, columns, cell, TREE_EVERY);
+  return inPits.concat(spaced(lawnOrder(lawn), columns, cell, LAWN_TREE_EVERY, inPits));
+}
+// Places in a scattered order, the same each time (an integer hash of each place): the
+// first of each crowd ``spaced`` keeps then lie as a wood's trees do, not on a lattice
+function lawnOrder(places) {
+  const hash = at => {
+    let h = Math.imul(at ^ 0x9e3779b9, 0x85ebca6b);
+    h = Math.imul(h ^ (h >>> 13), 0xc2b2ae35);
+    return (h ^ (h >>> 16)) >>> 0;
+  };
+  const keyed = places.map(at => [hash(at), at]);
+  keyed.sort((a, b) => a[0] - b[0] || a[1] - b[1]);
+  return keyed.map(([, at]) => at);
 }
 // Whether a dash at ``at`` along ``angle`` stops DASH_STOP metres short of any junction:
 // within the street's half width, half a dash and DASH_STOP of it, no ridge cell off its
@@ -228,6 +284,40 @@ function clearOfJunctions(ground, ridge, columns, rows, cell, at, angle) {
       if (near[there] > open) return false;
       const off = Math.abs((x - column) * acrossX + (y - row) * acrossY);
       if (ridge[there] && off > band) return false;
+    }
+  }
+  return true;
+}
+// The cells set in ``mask`` within ``reach`` cells of ``at``: how many, their spread
+// (variance, cells²) along and across their principal axis, and the axis' angle
+function lineOf(mask, columns, rows, at, reach) {
+  const column = at % columns, row = (at - column) / columns;
+  let n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+  for (let y = Math.max(0, row - reach); y <= Math.min(rows - 1, row + reach); y++) {
+    for (let x = Math.max(0, column - reach); x <= Math.min(columns - 1, column + reach); x++) {
+      if (!mask[y * columns + x] || Math.hypot(x - column, y - row) > reach) continue;
+      n++; sx += x; sy += y; sxx += x * x; syy += y * y; sxy += x * y;
+    }
+  }
+  if (!n) return {n, along: 0, across: 0, angle: 0, x: column, y: row};
+  const cxx = sxx / n - (sx / n) ** 2, cyy = syy / n - (sy / n) ** 2;
+  const cxy = sxy / n - (sx / n) * (sy / n);
+  const spread = Math.sqrt(((cxx - cyy) / 2) ** 2 + cxy * cxy), mean = (cxx + cyy) / 2;
+  return {n, along: mean + spread, across: mean - spread,
+          angle: 0.5 * Math.atan2(2 * cxy, cxx - cyy), x: sx / n, y: sy / n};
+}
+// Whether the cells set in ``mask`` within ``reach`` cells of ``at`` run straight: as
+// many as a band along the whole reach holds, none farther than ``off`` cells from
+// their principal axis (the ring of paving round a small house curves within it)
+function straight(mask, columns, rows, at, reach, off) {
+  const {n, angle, x: meanX, y: meanY} = lineOf(mask, columns, rows, at, reach);
+  if (n < 1.5 * reach) return false;
+  const column = at % columns, row = (at - column) / columns;
+  const acrossX = -Math.sin(angle), acrossY = Math.cos(angle);
+  for (let y = Math.max(0, row - reach); y <= Math.min(rows - 1, row + reach); y++) {
+    for (let x = Math.max(0, column - reach); x <= Math.min(columns - 1, column + reach); x++) {
+      if (!mask[y * columns + x] || Math.hypot(x - column, y - row) > reach) continue;
+      if (Math.abs((x - meanX) * acrossX + (y - meanY) * acrossY) > off) return false;
     }
   }
   return true;
@@ -252,21 +342,9 @@ function dashCells(ground, columns, rows, cell) {
   }
   const dashes = [], reach = Math.round(DASH / cell);
   for (const at of spaced(candidates, columns, cell, DASH_EVERY)) {
-    const column = at % columns, row = (at - column) / columns;
-    let n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-    for (let y = Math.max(0, row - reach); y <= Math.min(rows - 1, row + reach); y++) {
-      for (let x = Math.max(0, column - reach); x <= Math.min(columns - 1, column + reach); x++) {
-        if (!ridge[y * columns + x] || Math.hypot(x - column, y - row) > reach) continue;
-        n++; sx += x; sy += y; sxx += x * x; syy += y * y; sxy += x * y;
-      }
-    }
+    const {n, along, across, angle} = lineOf(ridge, columns, rows, at, reach);
     if (n < reach) continue;  // a speck of ridge, not a street's
-    const cxx = sxx / n - (sx / n) ** 2, cyy = syy / n - (sy / n) ** 2;
-    const cxy = sxy / n - (sx / n) * (sy / n);
-    const spread = Math.sqrt(((cxx - cyy) / 2) ** 2 + cxy * cxy), mean = (cxx + cyy) / 2;
-    const along = mean + spread, across = mean - spread;
     if (across * 6 > along) continue;  // no line: a crossing or a square
-    const angle = 0.5 * Math.atan2(2 * cxy, cxx - cyy);
     if (!clearOfJunctions(ground, ridge, columns, rows, cell, at, angle)) continue;
     dashes.push([at, Math.cos(angle), Math.sin(angle)]);
   }
@@ -283,21 +361,26 @@ function besideKind(kinds, columns, cell, at, kind, metres) {
   }
   return false;
 }
+// The cells within ``metres`` of any of ``places`` (a mask)
+function nearPlaces(places, columns, rows, cell, metres) {
+  const mask = new Uint8Array(columns * rows), clear = Math.ceil(metres / cell);
+  for (const at of places) {
+    const x = at % columns, y = (at - x) / columns;
+    for (let r = Math.max(0, y - clear); r <= Math.min(rows - 1, y + clear); r++) {
+      for (let c = Math.max(0, x - clear); c <= Math.min(columns - 1, x + clear); c++) {
+        if (Math.hypot(c - x, r - y) * cell < metres) mask[r * columns + c] = 1;
+      }
+    }
+  }
+  return mask;
+}
 // The street lamps: cells on a street's pavement LAMP_KERB metres (within half a cell) short
 // of its kerb, asphalt beyond it, LAMP_EVERY apart and LAMP_CLEAR from the trees at
 // ``trees`` -> [[cell, along x, along rows], ...], the way to the road (the distance to
 // the walls growing)
 function lampCells(ground, columns, rows, cell, trees = []) {
   const {kinds, near, street, wide} = ground, candidates = [];
-  const byTree = new Uint8Array(kinds.length), clear = Math.ceil(LAMP_CLEAR / cell);
-  for (const tree of trees) {
-    const x = tree % columns, y = (tree - x) / columns;
-    for (let r = Math.max(0, y - clear); r <= Math.min(rows - 1, y + clear); r++) {
-      for (let c = Math.max(0, x - clear); c <= Math.min(columns - 1, x + clear); c++) {
-        if (Math.hypot(c - x, r - y) * cell < LAMP_CLEAR) byTree[r * columns + c] = 1;
-      }
-    }
-  }
+  const byTree = nearPlaces(trees, columns, rows, cell, LAMP_CLEAR);
   for (let row = 1; row < rows - 1; row++) for (let column = 1; column < columns - 1; column++) {
     const at = row * columns + column;
     if (kinds[at] !== 1 || !street[at] || byTree[at]) continue;
@@ -311,5 +394,42 @@ function lampCells(ground, columns, rows, cell, trees = []) {
     const length = Math.hypot(dx, dy) || 1;
     return [at, dx / length, dy / length];
   });
+}
+// The benches: on a street's paving (a pavement, the paving round a house) where a lawn
+// opens before it, BENCH_EDGE metres (within a cell) short of the grass and facing it,
+// the grass going on BENCH_VIEW metres ahead; BENCH_WALL metres or more from the walls,
+// no road within BENCH_ROAD metres (not a bus stop's), BENCH_EVERY apart, scattered
+// (lawnOrder), BENCH_CLEAR from the trees and lamps (cells) -> [[cell, ahead x, ahead
+// rows], ...]
+const BENCH_EDGE = 0.6, BENCH_VIEW = 3, BENCH_WALL = 2.5, BENCH_ROAD = 4, BENCH_EVERY = 40;
+const BENCH_CLEAR = 2.5;
+function benchCells(ground, columns, rows, cell, taken = []) {
+  const {kinds, near, street} = ground, candidates = [];
+  const toGrass = distanceField(kinds.map(kind => kind === 4 ? 1 : 0), columns, rows);
+  const byOthers = nearPlaces(taken, columns, rows, cell, BENCH_CLEAR);
+  const facing = at => {
+    const dx = toGrass[at - 1] - toGrass[at + 1];
+    const dy = toGrass[at - columns] - toGrass[at + columns];
+    const length = Math.hypot(dx, dy);
+    return length > 1e-6 ? [dx / length, dy / length] : null;
+  };
+  for (let row = 1; row < rows - 1; row++) for (let column = 1; column < columns - 1; column++) {
+    const at = row * columns + column, metres = toGrass[at] * cell;
+    if (kinds[at] !== 1 || !street[at] || byOthers[at]) continue;
+    if (metres < BENCH_EDGE || metres > BENCH_EDGE + cell) continue;
+    if (near[at] * cell < BENCH_WALL) continue;
+    if (besideKind(kinds, columns, cell, at, 3, BENCH_ROAD)) continue;
+    const ahead = facing(at);
+    if (!ahead) continue;
+    let open = true;  // grass all the way BENCH_VIEW ahead, past the edge
+    for (let metre = metres + cell / 2; metre <= metres + BENCH_VIEW && open; metre += cell) {
+      const x = Math.round(column + ahead[0] * metre / cell);
+      const y = Math.round(row + ahead[1] * metre / cell);
+      open = x >= 0 && x < columns && y >= 0 && y < rows && kinds[y * columns + x] === 4;
+    }
+    if (open) candidates.push(at);
+  }
+  return spaced(lawnOrder(candidates), columns, cell, BENCH_EVERY)
+    .map(at => [at, ...facing(at)]);
 }
 """

@@ -1,7 +1,8 @@
 """Whether a file is what its name says, before a page inlines it: a ``.glb`` is glTF 2.0
 binary with a JSON chunk that parses, an ``.svg`` is XML whose root is ``<svg>`` with no
 document type (so no entity of any kind, inside or outside), a ``.png`` starts with the
-PNG signature. Each check returns why the bytes are not of their kind, or None."""
+PNG signature, a ``.geojson`` is a JSON FeatureCollection. Each check returns why the
+bytes are not of their kind, or None."""
 
 from __future__ import annotations
 
@@ -94,10 +95,22 @@ def png_problem(data: bytes) -> str | None:
     return None if data.startswith(PNG_SIGNATURE) else "not a PNG image (no PNG signature)"
 
 
+def geojson_problem(data: bytes) -> str | None:
+    """Why ``data`` is not a GeoJSON FeatureCollection (a city's land cover), or None."""
+    try:
+        document = json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError):
+        return "not JSON"
+    if not isinstance(document, dict) or document.get("type") != "FeatureCollection":
+        return "not a GeoJSON FeatureCollection"
+    return None
+
+
 CHECKS: dict[str, Callable[[bytes], str | None]] = {
     ".glb": glb_problem,
     ".svg": svg_problem,
     ".png": png_problem,
+    ".geojson": geojson_problem,
 }
 
 

@@ -38,7 +38,7 @@ def filled(square: Square, rng: random.Random) -> None:
 def main(count: int) -> None:
     rng = random.Random(1)
     side = 8 * count**0.5  # metres: about a building every 64 m²
-    places = [(f"b{k:06d}", (rng.uniform(0, side), rng.uniform(0, side))) for k in range(count)]
+    places = [(rng.uniform(0, side), rng.uniform(0, side)) for k in range(count)]
     with tempfile.TemporaryDirectory(prefix="tileset-") as folder:
         writer = TilesetWriter(
             Path(folder), Georef("EPSG:3067", (385000.0, 6672000.0)), (1, 2, 3), places
