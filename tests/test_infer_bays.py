@@ -16,13 +16,13 @@ import pytest
 
 from facadecli import parse_spec, solve
 from facadecli.grammar.deadline import Deadline
-from facadecli.grammar.fidelity import fidelity
+from facadecli.grammar.fidelity import FAITHFUL, fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.grammar.model import Options
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import MOVE_SHARE
 from facadecli.infer import run
-from facadecli.infer.bays import FAITHFUL, KEEP, LOOSE, Bays, _common, find_bays
+from facadecli.infer.bays import KEEP, LOOSE, ODD, Bays, _common, find_bays
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.spec_text import layer_names, spec_text
 from facadecli.infer.structure import structured
@@ -279,7 +279,9 @@ def test_family_sills_at_1x_stay_where_drawn_or_where_the_structure_put_them(
     """Seeds whose sills were drawn a few centimetres off their floor's row in some bays
     (one shared row a kind moved seed 24's sills: IoU 0.844 -> 0.681): the spec solved at
     1x puts every sill where the structure put it or within an eighth of its height (and
-    width: the tidy-up's move limit, to which the bays hold it) of where it was drawn."""
+    width: the tidy-up's move limit, to which the bays hold it) of where it was drawn, or,
+    at most ``ODD`` of a row, on the row of the others of its slot (a hand's outlier the
+    companions' reach left off its window's offset, put on its row by ``bays._apart``)."""
     inference, spec = _inferred(tmp_path, seed)
     assert not inference.unshared
     layout = solve(spec)
@@ -289,7 +291,7 @@ def test_family_sills_at_1x_stay_where_drawn_or_where_the_structure_put_them(
     tidied = tidy_layout(path, options, Deadline(options.time_limit, str(path)))
     pairs = [
         (r, d)
-        for r, d in zip(structured(tidied.layout).rects, tidied.raw.rects, strict=True)
+        for r, d in zip(structured(tidied.layout, tidied.raw).rects, tidied.raw.rects, strict=True)
         if r.label == "sill"
     ]
     assert len(solved) == len(pairs)
@@ -301,9 +303,17 @@ def test_family_sills_at_1x_stay_where_drawn_or_where_the_structure_put_them(
             <= share * (b.y1 - b.y0) + 1e-3  # sizes written to 0.1 mm
         )
 
+    rows = Counter((round(q.y0, 3), round(q.y1, 3)) for q in solved)
+    outliers: Counter[tuple[float, float]] = Counter()
     for r, d in pairs:
         q = min(solved, key=lambda q: abs(q.x0 - r.x0) + abs(q.y0 - r.y0))
-        assert near(q, r, 0.0) or near(q, d, MOVE_SHARE)
+        if near(q, r, 0.0) or near(q, d, MOVE_SHARE):
+            continue
+        row = (round(q.y0, 3), round(q.y1, 3))  # the bays' one outlier a slot, on its row
+        reach = MOVE_SHARE * (r.x1 - r.x0) + 1e-3  # along x, as the bays hold any
+        assert rows[row] > 1 + ODD and max(abs(q.x0 - r.x0), abs(q.x1 - r.x1)) <= reach
+        outliers[row] += 1
+    assert all(count <= ODD for count in outliers.values())
 
 
 def _touching(a: Rect, b: Rect, reach: float = 0.05) -> bool:

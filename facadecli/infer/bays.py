@@ -81,8 +81,9 @@ from itertools import pairwise
 
 import numpy as np
 
-from facadecli.grammar.fidelity import Fidelity, fidelity
+from facadecli.grammar.fidelity import FAITHFUL, Fidelity, fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
+from facadecli.infer.companions import touching
 from facadecli.infer.layers import BAND, OPENINGS, Grid, Span
 from facadecli.infer.structure import SHARE, beyond_limits
 from facadecli.solver.sizing import MIN_SIZE
@@ -105,12 +106,10 @@ UNIQUE = ("door",)  # labels whose bays are never repeated
 CUTS = ("window", "door")  # the openings the bays are cut on
 KEEP = 0.002  # of the mean IoU against the drawing: the most the bays' shapes may lose
 LOOSE = 0.01  # of it: the most they may lose where no way keeps KEEP, staying at FAITHFUL
-FAITHFUL = 0.9  # the mean IoU against the drawing a façade's layout must keep (issue 34)
 HELD = SHARE / 2  # of the narrowest span an edge bounds: the most a kind's shape moves it
 FOLLOW = SHARE  # of it: the most a kind's shape moves a companion's edge from where drawn
 ODD = 1  # openings: a bay this many unlike a kind's (each way) is a variant of it; and
 # companions: this many of a slot's may be resized past SIZED onto its row (``_apart``)
-TOUCH = 0.05  # m: a companion this close to an opening (overlapping it along the other axis)
 SIZED = 0.15  # of its size: the most a companion put on its slot's row may grow or shrink
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
@@ -1268,23 +1267,16 @@ def _companion(
     layout: LabelledLayout, after: list[Rect], k: int, row: Span, openings: list[int]
 ) -> bool:
     """Rectangle ``k`` on its shape along x (``after``) and on ``row`` along y still
-    touches (within ``TOUCH``) each of its bay's ``openings`` it touched as the
+    touches (``companions.touching``) each of its bay's ``openings`` it touched as the
     structure put them, and is not hidden wholly behind one of them (on their shapes)."""
     was = layout.rects[k]
     now = Rect(was.label, after[k].x0, row[0], after[k].x1, row[1], was.z)
     for j in openings:
-        if _touching(was, layout.rects[j]) and not _touching(now, after[j]):
+        if touching(was, layout.rects[j]) and not touching(now, after[j]):
             return False
         if _within(now, after[j]):
             return False
     return True
-
-
-def _touching(a: Rect, b: Rect) -> bool:
-    """Overlapping along one axis, at most ``TOUCH`` apart (or overlapping) along the other."""
-    over_x = min(a.x1, b.x1) - max(a.x0, b.x0)
-    over_y = min(a.y1, b.y1) - max(a.y0, b.y0)
-    return (over_x > 0 and over_y >= -TOUCH) or (over_y > 0 and over_x >= -TOUCH)
 
 
 def _within(a: Rect, b: Rect) -> bool:

@@ -46,9 +46,10 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from itertools import pairwise
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.bays import WALL, Bays, in_bays, segment
+from facadecli.infer.bays import SLIVER, WALL, Bays, in_bays, segment
 from facadecli.infer.floors import (
     ALIKE,
     Floors,
@@ -303,6 +304,7 @@ def spec_text(
         base = ident(grid.label)
         elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
     names = layer_names(found)
+    kind_lines = _kind_lines(shared, found) if shared is not None else []
     framed: list[Frame | None] = frames(found) if shared is None else [None] * len(found)
     widths = _width_tables(found, framed, names, elements)
     unique = {t.prefix for g, t in zip(found, widths, strict=True) if g.label in UNIQUE}
@@ -324,7 +326,9 @@ def spec_text(
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
         bay_word = None
         if shared is not None and not grid.apart and in_bays(shared, grid):
-            bay_word = _bay_word(shared, grid, symbols[0], bay_gaps, bay_margins, in_bay)
+            bay_word = _bay_word(
+                shared, grid, symbols[0], bay_gaps, bay_margins, in_bay, kind_lines
+            )
         row_key = (grid.rows, index in tops and grid.label not in UNIQUE)
         introduced = [
             *(
@@ -565,6 +569,19 @@ def _bays_note(bays: Bays | str | None) -> list[str]:
     ]
 
 
+def _kind_lines(bays: Bays, found: list[Grid]) -> list[list[float]]:
+    """Each bay kind's lines along x in its frame: the edges of every element that
+    stands in its bays, of every layer written on them (``segment``), sorted."""
+    lines: list[set[float]] = [set() for _ in bays.widths]
+    for grid in found:
+        if grid.apart or not in_bays(bays, grid):
+            continue
+        for k, kind in enumerate(bays.kinds):
+            for a, b in segment(bays, grid, k) or []:
+                lines[kind].update((a, b))
+    return [sorted(kind) for kind in lines]
+
+
 def _bay_word(
     bays: Bays,
     grid: Grid,
@@ -572,26 +589,36 @@ def _bay_word(
     gaps: list[_Symbols],
     margins: _Symbols,
     fixed: set[str],
+    lines: list[list[float]],
 ) -> str:
     """The grid's x word on the façade's bays (``infer.bays``): the left margin, each run
     of bays (its unit once, with its counter, or as drawn), the right margin; mirrored
     as the left half, the middle bay and the half reflected when the bays read so. The
-    element symbols go into ``fixed``. Each bay ends with its kind's wall (``bayK_w``:
-    ``Bays.walls``), alike in every layer."""
+    element symbols go into ``fixed``. A gap before an element is written as the spaces
+    between its kind's ``lines`` (``_kind_lines``) it spans, so that every layer of the
+    kind names a space between two lines alike (a window's inset in its sill's span
+    is one symbol on either side). Each bay ends with its kind's wall (``bayK_w``:
+    ``Bays.walls``), alike in every layer; a bay where the layer shows nothing is one
+    hidden spacer."""
     walls = [f"bay{kind + 1}_w" for kind in range(len(bays.widths))]
+
+    def spaces(kind: int, start: float, end: float) -> list[str]:
+        cuts = [v for v in lines[kind] if start + SLIVER < v < end - SLIVER]
+        return [gaps[kind].of(round(b - a, 4)) for a, b in pairwise([start, *cuts, end])]
 
     def bay(k: int) -> str:
         kind = bays.kinds[k]
         letters, cursor = [], 0.0
         for a, b in segment(bays, grid, k) or []:
             if a - cursor > 1e-9:
-                letters.append(gaps[kind].of(round(a - cursor, 4)))
+                letters.extend(spaces(kind, cursor, a))
             letters.append(element.of(b - a))
             fixed.add(letters[-1])
             cursor = b
         wall = bays.walls[kind]
-        if bays.widths[kind] - wall - cursor > 1e-9:
-            letters.append(gaps[kind].of(round(bays.widths[kind] - wall - cursor, 4)))
+        end = bays.widths[kind] - wall
+        if end - cursor > 1e-9:
+            letters.extend(spaces(kind, cursor, end) if cursor else [gaps[kind].of(round(end, 4))])
         if wall:
             letters.append(walls[kind])
         text = " ".join(letters)

@@ -39,9 +39,11 @@ import statistics
 from collections import defaultdict
 from collections.abc import Callable
 
+from facadecli.grammar.fidelity import FAITHFUL, fidelity
 from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
 from facadecli.grammar.regularize import RELATIVE
 from facadecli.grammar.tiling import MOVE_SHARE, move_limits
+from facadecli.infer.companions import REACHES, companions_placed
 from facadecli.infer.layers import BAND, OPENINGS
 
 SIZE = 0.03  # sizes of a label within this share of one another are one
@@ -54,11 +56,15 @@ DIGITS = 9  # of a metre: lines and sizes equal to that are equal (one gap symbo
 ROW = 0.5  # elements side by side overlapping by this share of the smaller: one row
 ROW_MOVE = 0.1  # of its size: the most an edge of an element moves onto its row
 STRUCTURE = "window"  # of labels with as many elements, the one that sets the structure
+SOLVED = 0.005  # of the mean IoU: what the bays' shapes and the solve may lose past the structure
 
 
-def structured(layout: LabelledLayout) -> LabelledLayout:
-    """The layout with its elements on shared sizes, lines and pitches (see the module);
-    the rectangles in the same order."""
+def structured(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> LabelledLayout:
+    """The layout with its elements on shared sizes, lines and pitches (see the module),
+    then its companions placed from their openings (``companions``), at the widest
+    reach (``companions.REACHES``) that keeps the layout's mean IoU against ``drawn``
+    (the annotation, when given) at ``FAITHFUL`` with ``SOLVED`` to spare; the
+    rectangles in the same order."""
     rects = list(layout.rects)
     x = _axis([(r.label, r.x0, r.x1) for r in rects], layout.width)
     y = _axis([(r.label, r.y0, r.y1) for r in rects], layout.height)
@@ -75,13 +81,29 @@ def structured(layout: LabelledLayout) -> LabelledLayout:
     lined = _sizes_shared(placed, behind, "y", layout.height)
     lined = _sizes_shared(lined, behind, "x", layout.width)
     lined = _rows_shared(lined, behind, "y", layout.height)
-    lined = _rows_shared(lined, behind, "x", layout.width)
+    lined = _settled(placed, _rows_shared(lined, behind, "x", layout.width))
+    for share in REACHES:
+        out = LabelledLayout(
+            layout.width,
+            layout.height,
+            tuple(_settled(placed, companions_placed(lined, layout.width, layout.height, share))),
+        )
+        if drawn is None or fidelity(drawn, out).iou_mean >= FAITHFUL + SOLVED:
+            break
+    return out
+
+
+def _settled(placed: list[Rect], lined: list[Rect]) -> list[Rect]:
+    """``lined`` with each element that now overlaps, touches or nearly meets one of its
+    label (``_colliding``, ``_closing``) as ``placed`` had it; which may close another
+    gap: again, until none does."""
+    lined = list(lined)
     moved = {k for k, (a, b) in enumerate(zip(placed, lined, strict=True)) if a != b}
     while back := (_colliding(placed, lined) | _closing(placed, lined)) & moved:
-        for k in back:  # as the structure had them; which may close another gap: again
+        for k in back:
             lined[k] = placed[k]
         moved -= back
-    return LabelledLayout(layout.width, layout.height, tuple(lined))
+    return lined
 
 
 def _sizes_shared(rects: list[Rect], keep: set[int], axis: str, extent: float) -> list[Rect]:
