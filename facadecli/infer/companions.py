@@ -13,20 +13,23 @@ it shares most with) is placed from its opening.
 Along each axis, each of a companion's two edges is measured from the nearer edge of its
 opening (a sill's top from its window's bottom, its ends from the window's sides). The
 offsets of one kind (the companion's label and edge, the opening's label and edge) are
-clustered across the façade, each within twice ``share`` of the companion's size (and
-``NEAR`` of the façade) of the cluster's least; a cluster's offset is its median, or
-none where that is within ``FLUSH`` (drawn flush). A companion takes its two offsets
-along an axis where neither edge moves further than ``share`` of its size (and ``NEAR``
-of the façade), else it stays as it is along that axis. An edge behind its opening both
-before and after (hidden by it: CMP's z-order) moves freely: what shows of the
-companion is what was drawn. Sills on their windows' rows at one offset are one grid,
-one size and one set of gaps, written once.
+clustered across the façade, each within twice its reach (below) of the cluster's least;
+a cluster's offset is its median, or none where that is within ``FLUSH`` (drawn flush).
+A companion takes its two offsets along an axis where neither edge moves further than
+its reach, ``share`` of what shows of it (its size less what its opening hides of it)
+and ``NEAR`` of the façade, else it stays as it is along that axis. An edge behind its
+opening both before and after (hidden by it: CMP's z-order) moves freely, but what
+shows of the companion beside the openings in front of it never shrinks by more than
+``share``: a blind drawn behind its window but for a sliver is never hidden whole.
+Sills on their windows' rows at one offset are one grid, one size and one set of gaps,
+written once.
 """
 
 from __future__ import annotations
 
 import statistics
 from collections import defaultdict
+from itertools import pairwise
 
 from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, Rect
 from facadecli.infer.layers import BAND, OPENINGS
@@ -46,6 +49,7 @@ def companions_placed(
     """``rects`` with each companion placed from its opening (see the module; ``share``:
     of a companion's size, the most an edge moves); the rest as they are."""
     pairs = _pairs(rects, width, height)
+    openings = [r for r in rects if r.label in OPENINGS]
     out = list(rects)
     for axis, extent in (("x", width), ("y", height)):
         offsets: dict[Key, list[tuple[int, float]]] = defaultdict(list)
@@ -59,7 +63,7 @@ def companions_placed(
                 offsets[key].append((k, edges[side] - frame[ref]))
         target: dict[tuple[int, int], float] = {}
         for (_, _, side, _), members in offsets.items():
-            for cluster in _clusters(members, rects, axis, extent, share):
+            for cluster in _clusters(members, rects, pairs, axis, extent, share):
                 value = statistics.median(offset for _, offset in cluster)
                 for k, _ in cluster:
                     target[k, side] = 0.0 if abs(value) <= FLUSH else value
@@ -70,12 +74,36 @@ def companions_placed(
             if high - low <= 0 or not _near(rects[k], (low, high), rects[j], axis, extent, share):
                 continue
             r = out[k]
-            out[k] = (
+            moved = (
                 Rect(r.label, low, r.y0, high, r.y1, r.z)
                 if axis == "x"
                 else Rect(r.label, r.x0, low, r.x1, high, r.z)
             )
+            fronts = [o for o in openings if _order(o) > _order(r)]
+            if _shown(moved, fronts) >= (1 - share) * _shown(r, fronts):
+                out[k] = moved
     return out
+
+
+def _order(rect: Rect) -> tuple[int, float]:
+    return (CMP_Z_ORDER.get(rect.label, 99), rect.z)
+
+
+def _shown(rect: Rect, fronts: list[Rect]) -> float:
+    """The area of ``rect`` that none of ``fronts`` covers."""
+    over = [
+        (max(rect.x0, f.x0), max(rect.y0, f.y0), min(rect.x1, f.x1), min(rect.y1, f.y1))
+        for f in fronts
+    ]
+    over = [o for o in over if o[2] > o[0] and o[3] > o[1]]
+    xs = sorted({rect.x0, rect.x1, *(v for o in over for v in (o[0], o[2]))})
+    ys = sorted({rect.y0, rect.y1, *(v for o in over for v in (o[1], o[3]))})
+    return sum(
+        (x1 - x0) * (y1 - y0)
+        for x0, x1 in pairwise(xs)
+        for y0, y1 in pairwise(ys)
+        if not any(o[0] <= x0 and x1 <= o[2] and o[1] <= y0 and y1 <= o[3] for o in over)
+    )
 
 
 def _pairs(rects: list[Rect], width: float, height: float) -> dict[int, int]:
@@ -95,13 +123,19 @@ def _pairs(rects: list[Rect], width: float, height: float) -> dict[int, int]:
 
 
 def _clusters(
-    members: list[tuple[int, float]], rects: list[Rect], axis: str, extent: float, share: float
+    members: list[tuple[int, float]],
+    rects: list[Rect],
+    pairs: dict[int, int],
+    axis: str,
+    extent: float,
+    share: float,
 ) -> list[list[tuple[int, float]]]:
     """Offsets, sorted, cut into runs each within twice its reach (``_reach``) of the
     run's least: each within reach of the run's middle."""
     runs: list[list[tuple[int, float]]] = []
     for k, offset in sorted(members, key=lambda m: (m[1], m[0])):
-        if runs and offset - runs[-1][0][1] <= 2 * _reach(rects[k], axis, extent, share):
+        reach = _reach(rects[k], rects[pairs[k]], axis, extent, share)
+        if runs and offset - runs[-1][0][1] <= 2 * reach:
             runs[-1].append((k, offset))
         else:
             runs.append([(k, offset)])
@@ -113,24 +147,38 @@ def _near(
 ) -> bool:
     """Each edge of ``was`` along ``axis`` within reach of where it goes in ``to``
     (``_reach``), or behind ``opening`` both where it was and where it goes."""
-    across = "y" if axis == "x" else "x"
-    frame, (a, b), (c, d) = _span(opening, axis), _span(opening, across), _span(was, across)
-    behind = CMP_Z_ORDER.get(was.label, 99) < CMP_Z_ORDER.get(opening.label, 99)
-    covered = behind and a - 1e-9 <= c and d <= b + 1e-9
+    frame = _span(opening, axis)
+    covered = _covered(was, opening, axis)
 
     def hidden(edge: float) -> bool:
         return covered and frame[0] <= edge <= frame[1]
 
-    reach = _reach(was, axis, extent, share)
+    reach = _reach(was, opening, axis, extent, share)
     return all(
         abs(now - edge) <= reach or (hidden(now) and hidden(edge))
         for edge, now in zip(_span(was, axis), to, strict=True)
     )
 
 
-def _reach(rect: Rect, axis: str, extent: float, share: float) -> float:
+def _covered(rect: Rect, opening: Rect, axis: str) -> bool:
+    """``rect`` is behind ``opening`` (CMP's z-order) and within its span across
+    ``axis``: the opening hides what of it stands within its span along ``axis``."""
+    across = "y" if axis == "x" else "x"
+    (a, b), (c, d) = _span(opening, across), _span(rect, across)
+    behind = CMP_Z_ORDER.get(rect.label, 99) < CMP_Z_ORDER.get(opening.label, 99)
+    return behind and a - 1e-9 <= c and d <= b + 1e-9
+
+
+def _reach(rect: Rect, opening: Rect, axis: str, extent: float, share: float) -> float:
+    """How far an edge of ``rect`` may move along ``axis``: ``share`` of what shows of
+    it beside ``opening`` (of a blind drawn behind its window but for a sliver: of the
+    sliver), and ``NEAR`` of the façade."""
     low, high = _span(rect, axis)
-    return min(share * (high - low), NEAR * extent)
+    shown = high - low
+    if _covered(rect, opening, axis):
+        a, b = _span(opening, axis)
+        shown -= max(0.0, min(high, b) - max(low, a))
+    return min(share * shown, NEAR * extent)
 
 
 def _span(rect: Rect, axis: str) -> tuple[float, float]:
