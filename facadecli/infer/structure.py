@@ -39,7 +39,7 @@ import statistics
 from collections import defaultdict
 from collections.abc import Callable
 
-from facadecli.grammar.fidelity import FAITHFUL, fidelity
+from facadecli.grammar.fidelity import FAITHFUL, Fidelity, fidelity
 from facadecli.grammar.inputs import BACKGROUND, CMP_Z_ORDER, LabelledLayout, Rect
 from facadecli.grammar.regularize import RELATIVE
 from facadecli.grammar.tiling import MOVE_SHARE, move_limits
@@ -62,9 +62,8 @@ SOLVED = 0.005  # of the mean IoU: what the bays' shapes and the solve may lose 
 def structured(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> LabelledLayout:
     """The layout with its elements on shared sizes, lines and pitches (see the module),
     then its companions placed from their openings (``companions``), at the widest
-    reach (``companions.REACHES``) that keeps the layout's mean IoU against ``drawn``
-    (the annotation, when given) at ``FAITHFUL`` with ``SOLVED`` to spare; the
-    rectangles in the same order."""
+    reach (``companions.REACHES``) that keeps the layout faithful to ``drawn`` (the
+    annotation, when given: ``_keeps``); the rectangles in the same order."""
     rects = list(layout.rects)
     x = _axis([(r.label, r.x0, r.x1) for r in rects], layout.width)
     y = _axis([(r.label, r.y0, r.y1) for r in rects], layout.height)
@@ -82,15 +81,29 @@ def structured(layout: LabelledLayout, drawn: LabelledLayout | None = None) -> L
     lined = _sizes_shared(lined, behind, "x", layout.width)
     lined = _rows_shared(lined, behind, "y", layout.height)
     lined = _settled(placed, _rows_shared(lined, behind, "x", layout.width))
+    before = None if drawn is None else fidelity(drawn, _with(layout, lined))
     for share in REACHES:
-        out = LabelledLayout(
-            layout.width,
-            layout.height,
-            tuple(_settled(placed, companions_placed(lined, layout.width, layout.height, share))),
+        out = _with(
+            layout, _settled(placed, companions_placed(lined, layout.width, layout.height, share))
         )
-        if drawn is None or fidelity(drawn, out).iou_mean >= FAITHFUL + SOLVED:
+        if drawn is None or before is None or _keeps(fidelity(drawn, out), before):
             break
     return out
+
+
+def _with(layout: LabelledLayout, rects: list[Rect]) -> LabelledLayout:
+    return LabelledLayout(layout.width, layout.height, tuple(rects))
+
+
+def _keeps(placed: Fidelity, before: Fidelity) -> bool:
+    """Whether companions placed from their openings keep the layout faithful: its mean
+    IoU at ``FAITHFUL`` with ``SOLVED`` to spare, and no element lost or fused that the
+    layout before them kept (a companion moved over another element hides it)."""
+    return (
+        placed.iou_mean >= FAITHFUL + SOLVED
+        and placed.lost <= before.lost
+        and placed.fused <= before.fused
+    )
 
 
 def _settled(placed: list[Rect], lined: list[Rect]) -> list[Rect]:
