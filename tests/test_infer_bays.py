@@ -16,14 +16,15 @@ import pytest
 
 from facadecli import parse_spec, solve
 from facadecli.grammar.deadline import Deadline
-from facadecli.grammar.fidelity import fidelity
+from facadecli.grammar.fidelity import FAITHFUL, fidelity
 from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 from facadecli.grammar.model import Options
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import MOVE_SHARE
-from facadecli.infer.bays import FAITHFUL, KEEP, LOOSE, Bays, _common, find_bays
+from facadecli.infer import run
+from facadecli.infer.bays import KEEP, LOOSE, ODD, Bays, _common, find_bays
 from facadecli.infer.run import infer, solved_layout
-from facadecli.infer.spec_text import layer_names
+from facadecli.infer.spec_text import layer_names, spec_text
 from facadecli.infer.structure import structured
 from facadecli.solve import retarget
 from tests.benchmarks.annotated_family import cmp_xml, family
@@ -278,7 +279,9 @@ def test_family_sills_at_1x_stay_where_drawn_or_where_the_structure_put_them(
     """Seeds whose sills were drawn a few centimetres off their floor's row in some bays
     (one shared row a kind moved seed 24's sills: IoU 0.844 -> 0.681): the spec solved at
     1x puts every sill where the structure put it or within an eighth of its height (and
-    width: the tidy-up's move limit, to which the bays hold it) of where it was drawn."""
+    width: the tidy-up's move limit, to which the bays hold it) of where it was drawn, or,
+    at most ``ODD`` of a row, on the row of the others of its slot (a hand's outlier the
+    companions' reach left off its window's offset, put on its row by ``bays._apart``)."""
     inference, spec = _inferred(tmp_path, seed)
     assert not inference.unshared
     layout = solve(spec)
@@ -288,7 +291,7 @@ def test_family_sills_at_1x_stay_where_drawn_or_where_the_structure_put_them(
     tidied = tidy_layout(path, options, Deadline(options.time_limit, str(path)))
     pairs = [
         (r, d)
-        for r, d in zip(structured(tidied.layout).rects, tidied.raw.rects, strict=True)
+        for r, d in zip(structured(tidied.layout, tidied.raw).rects, tidied.raw.rects, strict=True)
         if r.label == "sill"
     ]
     assert len(solved) == len(pairs)
@@ -300,9 +303,17 @@ def test_family_sills_at_1x_stay_where_drawn_or_where_the_structure_put_them(
             <= share * (b.y1 - b.y0) + 1e-3  # sizes written to 0.1 mm
         )
 
+    rows = Counter((round(q.y0, 3), round(q.y1, 3)) for q in solved)
+    outliers: Counter[tuple[float, float]] = Counter()
     for r, d in pairs:
         q = min(solved, key=lambda q: abs(q.x0 - r.x0) + abs(q.y0 - r.y0))
-        assert near(q, r, 0.0) or near(q, d, MOVE_SHARE)
+        if near(q, r, 0.0) or near(q, d, MOVE_SHARE):
+            continue
+        row = (round(q.y0, 3), round(q.y1, 3))  # the bays' one outlier a slot, on its row
+        reach = MOVE_SHARE * (r.x1 - r.x0) + 1e-3  # along x, as the bays hold any
+        assert rows[row] > 1 + ODD and max(abs(q.x0 - r.x0), abs(q.x1 - r.x1)) <= reach
+        outliers[row] += 1
+    assert all(count <= ODD for count in outliers.values())
 
 
 def _touching(a: Rect, b: Rect, reach: float = 0.05) -> bool:
@@ -565,6 +576,33 @@ def test_bays_the_gate_refused_are_kept_where_the_facade_keeps_the_bar(tmp_path:
     assert faithful.iou_mean >= FAITHFUL and faithful.lost == 0 and faithful.fused == 0
     wider = [r for r in _solved(inference, spec, 2.0) if r.label == "window"]
     assert len(wider) >= 2 * 0.85 * known.windows, (len(wider), known.windows)
+
+
+def test_every_layer_writes_its_bay_gaps_from_the_lines_the_bay_shares() -> None:
+    """Five bays alike, a window over a sill of its width, each sill drawn on its window
+    but the first, 3.5 mm to the right (as on hold-out seed 116): the kind's sill,
+    fitted on its own, stood 0.7 mm off its window, the window layer's word wrote a
+    0.7 mm gap before the kind's wall that the sill layer's did not, and with the
+    elements' widths held the spec did not solve (the solver sizes no letter under a
+    millimetre). On the kind's shared lines the sill stands on its window's edges, and
+    the spec solves at the façade's width."""
+    rects = [Rect(BACKGROUND, 0.0, 0.0, 11.0, 6.0, 0)]
+    for k in range(5):
+        shift = 0.0035 if k == 0 else 0.0
+        rects.append(Rect("window", 1.0 + 2 * k, 2.0, 2.0 + 2 * k, 3.5, 1))
+        rects.append(Rect("sill", 1.0 + 2 * k + shift, 1.8, 2.0 + 2 * k + shift, 2.0, 2))
+    layout = LabelledLayout(11.0, 6.0, tuple(rects))
+    bays = find_bays(layout)
+    assert isinstance(bays, Bays) and bays.kinds == (0,) * 5 and not bays.apart
+    placed = bays.layout.rects
+    for window, sill in zip(placed[1::2], placed[2::2], strict=True):
+        assert (sill.x0, sill.x1) == (window.x0, window.x1)
+    regular, found, shared, alike = run._layered(layout, bays, by_floor=False)
+    spread = run.size_spread(regular, layout)  # the elements' widths held, as infer's
+    text = spec_text("lines", 11.0, 6.0, found, "lines.xml", spread, shared, alike)
+    spec = parse_spec(text, "lines.xml")
+    shapes = solve(spec).shapes
+    assert sum(s.layer.startswith("sill") for s in shapes) == 5
 
 
 def _window_columns(boxes: list[tuple[str, float, float, float, float]]) -> list[float]:

@@ -185,7 +185,7 @@ def _layout(boxes: list[Box], width: float, height: float) -> LabelledLayout:
 
 
 def test_regularisation_evens_out_hand_drawn_runs() -> None:
-    layout = _layout(_palazzo(jitter=0.05, seed=3), 11.4, 10.0)
+    layout = _layout(_palazzo(jitter=0.03, seed=3), 11.4, 10.0)
     regular, report = regularize(layout, tolerance=0.01)
     for floor in range(3):
         row = sorted(
@@ -196,12 +196,13 @@ def test_regularisation_evens_out_hand_drawn_runs() -> None:
         pitches = [b - a for a, b in itertools.pairwise(row)]
         assert max(pitches) - min(pitches) < 1e-6, pitches
     assert any(g.kind == "run" and g.label == "window" for g in report.groups)
-    drawn = sorted(b.x0 for b in _palazzo(jitter=0.05, seed=3) if b.y0 == 3.5)
+    drawn = sorted(b.x0 for b in _palazzo(jitter=0.03, seed=3) if b.y0 == 3.5)
     assert abs((drawn[1] - drawn[0]) - (drawn[2] - drawn[1])) > 0.01  # the run was uneven
 
 
 def test_regularisation_lines_up_a_door_under_a_window_column() -> None:
-    boxes = [b for b in _palazzo() if b.label != "door"] + [Box("door", 5.15, 0.0, 6.35, 2.6)]
+    door = Box("door", 5.13, 0.0, 6.33, 2.6)  # 3 cm off: within FAITHFUL of its width
+    boxes = [b for b in _palazzo() if b.label != "door"] + [door]
     regular, report = regularize(_layout(boxes, 11.4, 10.0), tolerance=0.01)
     door = next(r for r in regular.rects if r.label == "door")
     middle = next(r for r in regular.rects if r.label == "window" and 4 < r.x0 < 6)

@@ -39,6 +39,7 @@ from facadecli.grammar.inputs import BACKGROUND, LabelledLayout, Rect
 RESOLUTION = 0.025  # the side of a cell, in the layout's units (metres)
 SIDE_MIN = 400  # cells along the longer side, at least
 CELLS_MAX = 4_000_000  # cells of one raster, at most (2000 x 2000; 16 MB a raster)
+FAITHFUL = 0.9  # the mean IoU against the drawing a façade's layout must keep (issue 34)
 COVERED = 0.5  # share of an annotated element an output element must cover to keep it
 IOU_WARN = 0.85  # a mean IoU below this is warned about
 

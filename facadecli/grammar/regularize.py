@@ -18,12 +18,14 @@ edges keep their order, and
   window).
 
 Fidelity comes first (issue 34): no edge goes further from where it was drawn than the
-tolerance, nor than an eighth of the narrowest element, gap between two elements of one
-label, or visible part of an element it bounds (``tiling.move_limits``; ``bounds_of``),
-so nothing is lost, shrunk away or fused. Within those bounds every equality is first
-asked for softly (weighted by kind, ``WEIGHTS``: elements, then strips, runs and
-line-ups); those the soft QP meets are then made exact together, and the rest stay as
-drawn (the report counts them). What moved is returned for the report.
+tolerance, nor than ``FAITHFUL`` (a thirty-second) of the narrowest element, gap between
+two elements of one label, or visible part of an element it bounds (``tiling.move_limits``;
+``bounds_of``), so an equal size changes no member's size by more than a sixteenth and
+nothing is lost, shrunk away or fused. Within those bounds every equality is first asked
+for softly (weighted by kind, ``WEIGHTS``: elements, then strips, runs and line-ups);
+those the soft QP meets are then made exact together (where they cannot all be, an exact
+penalty keeps the most), and the rest stay exactly as drawn, never moved part of the way
+(the report counts them). What moved is returned for the report.
 """
 
 from __future__ import annotations
@@ -43,6 +45,8 @@ MET = 1e-4  # of the extent: equal sizes and line-ups the soft QP brings this ne
 EQUAL = 1e-6  # of the extent: sizes this near are equal
 # weights of equal sizes against moving edges (both squared), the weightiest kept first
 WEIGHTS = {"element": 1e4, "strip": 3e3, "run": 1e3, "line-up": 1e2}
+FAITHFUL = 1 / 32  # an edge moves at most this share of the narrowest element or gap it bounds
+YIELD = 10.0  # an equality made exact costs this many times the objective's steepest slope
 PITCH = 2.0  # pitches of a run may differ by this many tolerances (hand drawing jitters)
 
 
@@ -225,10 +229,14 @@ def _solve_axis(
     elements: list[tuple[float, float]],
     soft: list[tuple[float, list[list[tuple[float, float]]]]],
     bounds: tuple[np.ndarray, np.ndarray],
+    yielding: bool = False,
 ) -> list[float] | None:
     """Edges as near as they can be to where they were and within their ``bounds`` (low,
     high), with the spans of each group equal, and those of each ``soft`` group as near to
-    equal as they can be (its weight times the square of the difference)."""
+    equal as they can be (its weight times the square of the difference). ``yielding``:
+    the groups' equalities are an exact penalty (``YIELD`` times the absolute difference)
+    instead of constraints, so groups that cannot all be equal together leave the fewest
+    apart and the rest exactly equal."""
     import cvxpy as cp  # imported here: it takes half a second
 
     index = {value: i for i, value in enumerate(edges)}
@@ -249,7 +257,14 @@ def _solve_axis(
         constraints.append(v[stops] - v[starts] >= drawn / 2)
         objective += cp.sum_squares(v[stops] - v[starts] - drawn)
     if len(equal):
-        constraints.append(v[equal[:, 3]] - v[equal[:, 2]] == v[equal[:, 1]] - v[equal[:, 0]])
+        difference = v[equal[:, 3]] - v[equal[:, 2]] - v[equal[:, 1]] + v[equal[:, 0]]
+        if yielding:
+            # above the steepest the rest of the objective can be within the bounds
+            free = reach[1:-1] if len(reach) > 2 else reach  # the façade's edges stay
+            steepest = 2 * extent * (1 + (reach.max() / free.min()) ** 2)
+            objective += YIELD * steepest * cp.norm1(difference)
+        else:
+            constraints.append(difference == 0)
     near = _pairs([group for _, groups in soft for group in groups], index)
     if len(near):
         weights = np.sqrt(np.array([w for w, g in soft for _ in g]))
@@ -266,6 +281,36 @@ def _solve_axis(
     return [float(x) for x in v.value]
 
 
+def _made_equal(
+    edges: list[float],
+    extent: float,
+    met: list[list[Span]],
+    spans: list[Span],
+    bounds: tuple[np.ndarray, np.ndarray],
+    deadline: Deadline,
+) -> list[float]:
+    """The edges with the pairs the soft QP ``met`` exactly equal, all at once where they
+    can be. Where they cannot (near equalities chained over many edges add up past the
+    bounds), those the exact penalty leaves apart stay apart. Never the soft solution: it
+    moves every edge part of the way, equal or not. As drawn where nothing is met."""
+    if not met:
+        return list(edges)
+    deadline.check("regularising")
+    exact = _solve_axis(edges, extent, met, spans, [], bounds)
+    if exact is not None:
+        return exact
+    deadline.check("regularising")
+    yielded = _solve_axis(edges, extent, met, spans, [], bounds, yielding=True)
+    if yielded is None:
+        return list(edges)
+    at = dict(zip(edges, yielded, strict=True))
+    held = [pair for pair in met if _size_gap(pair, at) <= EQUAL * extent]
+    if not held:
+        return list(edges)
+    deadline.check("regularising")
+    return _solve_axis(edges, extent, held, spans, [], bounds) or list(edges)
+
+
 def bounds_of(
     layout: LabelledLayout,
     drawn: LabelledLayout,
@@ -273,6 +318,7 @@ def bounds_of(
     edges: list[float],
     tolerance: float,
     background: str,
+    share: float = FAITHFUL,
 ) -> tuple[np.ndarray, np.ndarray]:
     """How far each edge of ``layout`` (snapped from ``drawn``: the same rectangles in the
     same order) may go: within ``move_limits`` (the tolerance, and a share of the narrowest
@@ -294,6 +340,7 @@ def bounds_of(
         [span(r) for r, _ in pairs],
         [(r.y0, r.y1) if axis == "x" else (r.x0, r.x1) for r, _ in pairs],
         tolerance * extent,
+        share,
     )
     index = {value: i for i, value in enumerate(edges)}
     low = np.array(edges) - tolerance * extent
@@ -363,10 +410,7 @@ def regularize(
         # what the soft QP met is made exact, all at once where it can be
         at = dict(zip(edges, solved, strict=True))
         met = [pair for _, (pair,) in soft if _size_gap(pair, at) <= MET * extent]
-        if met:
-            deadline.check("regularising")
-            exact = _solve_axis(edges, extent, met, spans, [], bounds)
-            solved = exact or solved
+        solved = _made_equal(edges, extent, met, spans, bounds, deadline)
         solved[0], solved[-1] = 0.0, extent
         merged = snap(solved, 1e-7 * extent, (0.0, extent))  # edges the QP joined are one
         solved = [merged[value] for value in solved]

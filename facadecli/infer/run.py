@@ -67,7 +67,7 @@ def infer(
     ``progress`` is told each stage as it starts."""
     options = options or Options()
     tidied = tidy_layout(path, options, Deadline(options.time_limit, str(path)), progress)
-    regular = structured(tidied.layout)
+    regular = structured(tidied.layout, tidied.raw)
     if not any(r.label != BACKGROUND for r in regular.rects):
         raise SpecError.at(str(path), None, None, "no elements", "label some elements")
     progress("finding the bays and the grids of each label")

@@ -46,9 +46,10 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from itertools import pairwise
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.bays import WALL, Bays, in_bays, segment
+from facadecli.infer.bays import SLIVER, WALL, Bays, in_bays, segment
 from facadecli.infer.floors import (
     ALIKE,
     Floors,
@@ -102,13 +103,26 @@ class _Symbols:
 
     prefix: str
     sizes: dict[float, str] = field(default_factory=dict)
+    keys: dict[float, float] = field(default_factory=dict)  # each size seen: its symbol's
 
     def of(self, size: float) -> str:
+        """The symbol of ``size``: that of a size already named within ``10**-SIZE_KEY``
+        of it, else a new one. Rounding alone splits sizes a float's noise apart that
+        fall either side of a rounding boundary (family seed 3's windows, 0.8346675 m
+        each as the structure put them, became two height symbols of one size)."""
         key = round(size, SIZE_KEY)
-        name = self.sizes.get(key)
+        known = self.keys.get(key)
+        if known is None:
+            known = next((k for k in self.sizes if abs(k - size) < 10**-SIZE_KEY), key)
+            self.keys[key] = known
+        name = self.sizes.get(known)
         if name is None:
-            name = self.sizes[key] = f"{self.prefix}{len(self.sizes) + 1}"
+            name = self.sizes[known] = f"{self.prefix}{len(self.sizes) + 1}"
         return name
+
+    def seen(self, size: float) -> list[float]:
+        """The sizes seen (rounded to ``SIZE_KEY``) that ``size``'s symbol names."""
+        return [k for k, known in self.keys.items() if known == size]
 
 
 @dataclass
@@ -290,12 +304,22 @@ def spec_text(
         base = ident(grid.label)
         elements.setdefault(grid.label, (_Symbols(f"{base}_w"), _Symbols(f"{base}_h")))
     names = layer_names(found)
+    kind_lines = _kind_lines(shared, found) if shared is not None else []
     framed: list[Frame | None] = frames(found) if shared is None else [None] * len(found)
     widths = _width_tables(found, framed, names, elements)
     unique = {t.prefix for g, t in zip(found, widths, strict=True) if g.label in UNIQUE}
     top = floors_top(found)
     floors = floor_run(found, height, alike)
-    tops = top_floors(found, width, height)
+    # a top floor repeats upwards only where no run of the openings' floors stands under
+    # it, or where it stands on the run's floors: over them (an attic's windows, a top
+    # floor drawn apart), its copies and the floors the run gains would take the same
+    # height (cmp_b0011 at 1.5x: 33 pairs of windows over one another); it moves up with
+    # the floors instead, as everything over them does
+    tops = {
+        k: pitch
+        for k, pitch in top_floors(found, width, height).items()
+        if floors is None or found[k].rows[0][0] < top
+    }
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
     # where a layer's top floor repeats upwards with nothing on the run's floors (its
     # floors gained are copies of the top one, ``_floors_above``), every layer with
@@ -306,12 +330,18 @@ def spec_text(
         k in tops and found[k].label not in UNIQUE and not on_run(found[k].rows, floors[1])
         for k in range(len(found))
     )
+    # the layers with a margin at both ends along y (where their first and last rows
+    # start, the margins) and where the top floors that repeat upwards start
+    margins_y: list[tuple[float, float, str, str]] = []
+    copied_from: list[float] = []
     for index, (layer, grid, frame) in enumerate(zip(names, found, framed, strict=True)):
         symbols = (widths[index], elements[grid.label][1])
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
         bay_word = None
         if shared is not None and not grid.apart and in_bays(shared, grid):
-            bay_word = _bay_word(shared, grid, symbols[0], bay_gaps, bay_margins, in_bay)
+            bay_word = _bay_word(
+                shared, grid, symbols[0], bay_gaps, bay_margins, in_bay, kind_lines
+            )
         row_key = (grid.rows, index in tops and grid.label not in UNIQUE)
         introduced = [
             *(
@@ -379,6 +409,7 @@ def spec_text(
                 # to the ground, and the copies and the roof's margin take what a taller
                 # façade gains
                 word, gap = _floors_above(tokens, pitch, gaps, counters)
+                copied_from.append(grid.rows[-1][0])
                 held.update((tokens[0][0], gap))
                 # and the gaps between its floors below do not grow (free, they would
                 # stretch while the openings' floors keep their pitch); a shorter façade
@@ -388,11 +419,10 @@ def spec_text(
                 words.append(word)
                 continue
             if axis == "y" and tokens[0][0] in ends and tokens[-1][0] in ends:
-                # a taller façade grows at the top of the floors: what stands on them keeps
-                # its margin to the ground, what stands above them its margin to the top
+                # which of its margins keeps its size is said after every layer is written
                 bottom, high = tokens[0][0], tokens[-1][0]
                 if bottom != high:
-                    margined.add(high if grid.rows[0][0] >= top else bottom)
+                    margins_y.append((grid.rows[0][0], grid.rows[-1][0], bottom, high))
             elif axis == "y" and tokens[-1][0] in ends and tokens[0][0] not in ends:
                 grounded.update(symbol for symbol, _ in tokens[:-1])  # a door keeps its height
             if not {tokens[0][0], tokens[-1][0]} & ends:  # no margin: its letters stay free
@@ -415,6 +445,16 @@ def spec_text(
             unshrunk.update(symbols[0].of(b - a) for a, b in columns)
             unshrunk.update(symbols[1].of(b - a) for a, b in grid.rows)
         layers.append((layer, grid, words[0], words[1]))
+    # a taller façade grows at the top of the floors: what stands on them keeps its
+    # margin to the ground, what stands above them its margin to the top; what stands
+    # wholly under a top floor that repeats upwards keeps its margin to the ground, as
+    # that floor does (moved up with the roof, cmp_b0005's upper floors stood over the
+    # copies of its top one at 1.5x height)
+    copies = min(copied_from, default=top)
+    margined.update(
+        high if first >= top and last >= copies else bottom
+        for first, last, bottom, high in margins_y
+    )
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
         "# a label's elements on a grid (its columns x its rows), back to front, with the",
@@ -448,7 +488,7 @@ def spec_text(
                 symbol,
                 _size(
                     size,
-                    None if symbol in stretched else spread.get((axis, label, size)),
+                    None if symbol in stretched else _spread_of(spread, axis, label, table, size),
                     symbol in fixed,
                     label in clear,
                     symbol in grounded,
@@ -474,14 +514,16 @@ def spec_text(
         for gaps in bay_gaps
     ]
     if in_bay and shared is not None:
+        held_walls = shared.steady()
         sizes.append(
             [
                 (
                     f"bay{kind + 1}_w",
-                    f"{{size: {_number(wall)}, min: {_number(WALL * wall)}, max: {_number(wall)}}}",
+                    f"{{size: {_number(wall)}, min: {_number(least)}, max: {_number(wall)}}}",
                 )
                 for kind, wall in enumerate(shared.walls)
                 if wall
+                for least in [wall if kind in held_walls else WALL * wall]
             ]
         )
     sizes.append([(symbol, _number(size)) for size, symbol in bay_margins.sizes.items()])
@@ -550,6 +592,19 @@ def _bays_note(bays: Bays | str | None) -> list[str]:
     ]
 
 
+def _kind_lines(bays: Bays, found: list[Grid]) -> list[list[float]]:
+    """Each bay kind's lines along x in its frame: the edges of every element that
+    stands in its bays, of every layer written on them (``segment``), sorted."""
+    lines: list[set[float]] = [set() for _ in bays.widths]
+    for grid in found:
+        if grid.apart or not in_bays(bays, grid):
+            continue
+        for k, kind in enumerate(bays.kinds):
+            for a, b in segment(bays, grid, k) or []:
+                lines[kind].update((a, b))
+    return [sorted(kind) for kind in lines]
+
+
 def _bay_word(
     bays: Bays,
     grid: Grid,
@@ -557,26 +612,36 @@ def _bay_word(
     gaps: list[_Symbols],
     margins: _Symbols,
     fixed: set[str],
+    lines: list[list[float]],
 ) -> str:
     """The grid's x word on the façade's bays (``infer.bays``): the left margin, each run
     of bays (its unit once, with its counter, or as drawn), the right margin; mirrored
     as the left half, the middle bay and the half reflected when the bays read so. The
-    element symbols go into ``fixed``. Each bay ends with its kind's wall (``bayK_w``:
-    ``Bays.walls``), alike in every layer."""
+    element symbols go into ``fixed``. A gap before an element is written as the spaces
+    between its kind's ``lines`` (``_kind_lines``) it spans, so that every layer of the
+    kind names a space between two lines alike (a window's inset in its sill's span
+    is one symbol on either side). Each bay ends with its kind's wall (``bayK_w``:
+    ``Bays.walls``), alike in every layer; a bay where the layer shows nothing is one
+    hidden spacer."""
     walls = [f"bay{kind + 1}_w" for kind in range(len(bays.widths))]
+
+    def spaces(kind: int, start: float, end: float) -> list[str]:
+        cuts = [v for v in lines[kind] if start + SLIVER < v < end - SLIVER]
+        return [gaps[kind].of(round(b - a, 4)) for a, b in pairwise([start, *cuts, end])]
 
     def bay(k: int) -> str:
         kind = bays.kinds[k]
         letters, cursor = [], 0.0
         for a, b in segment(bays, grid, k) or []:
             if a - cursor > 1e-9:
-                letters.append(gaps[kind].of(round(a - cursor, 4)))
+                letters.extend(spaces(kind, cursor, a))
             letters.append(element.of(b - a))
             fixed.add(letters[-1])
             cursor = b
         wall = bays.walls[kind]
-        if bays.widths[kind] - wall - cursor > 1e-9:
-            letters.append(gaps[kind].of(round(bays.widths[kind] - wall - cursor, 4)))
+        end = bays.widths[kind] - wall
+        if end - cursor > 1e-9:
+            letters.extend(spaces(kind, cursor, end) if cursor else [gaps[kind].of(round(end, 4))])
         if wall:
             letters.append(walls[kind])
         text = " ".join(letters)
@@ -725,6 +790,18 @@ def _by_owner(
         c: widths[k] for k, grid in enumerate(found) if framed[k] == frame for c in grid.columns
     }
     return [owner[c] for c, _ in frame]
+
+
+def _spread_of(
+    spread: Spread, axis: str, label: str, table: _Symbols, size: float
+) -> tuple[float, float] | None:
+    """The range the input's elements of ``label`` span along ``axis`` (``spread``) that
+    are now the size of ``size``'s symbol in ``table`` (``_Symbols.of``: every size it
+    names); None when none is (a band)."""
+    ranges = [spread[key] for k in table.seen(size) if (key := (axis, label, k)) in spread]
+    if not ranges:
+        return None
+    return min(low for low, _ in ranges), max(high for _, high in ranges)
 
 
 def _gap(size: float, repeated: bool, margined: bool) -> str:
