@@ -465,14 +465,10 @@ function driveCells(kinds, owner, near, pieces, blocks, columns, rows, cell) {
     let at = own[id];
     for (let steps = 0; at >= 0 && near[at] * cell >= YARD_PATH && steps < 4 * columns; steps++) {
       way.push(at);  // down the distance to the walls: straight to the nearest
-      const column = at % columns, row = (at - column) / columns;
       let next = -1;
-      for (let y = Math.max(0, row - 1); y <= Math.min(rows - 1, row + 1); y++) {
-        for (let x = Math.max(0, column - 1); x <= Math.min(columns - 1, column + 1); x++) {
-          const there = y * columns + x;
-          if (near[there] < (next < 0 ? near[at] : near[next])) next = there;
-        }
-      }
+      aroundEach(at, columns, rows, there => {
+        if (near[there] < (next < 0 ? near[at] : near[next])) next = there;
+      });
       at = next;
     }
     if (own[id] >= 0 || fromBlock[id] < 0) continue;
