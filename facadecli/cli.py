@@ -199,6 +199,8 @@ class _Run:
             except SpecError as error:
                 self.fail(path, error)
                 continue
+            for problem in spec.warnings:  # file:line:col: warning: ... (the report keeps them)
+                _warn(str(problem))
             yield path, spec
 
     def fail(self, path: Path, error: FacadeError) -> None:
@@ -296,7 +298,7 @@ def solve_command(
         except (InfeasibleError, SearchLimitError) as error:
             run.fail(path, error)
             continue
-        for warning in layout.warnings:
+        for warning in (*layout.x.warnings, *layout.y.warnings):  # the spec's: told at load
             _warn(f"{_shown(path)}: warning: {warning}")
         for axis in (layout.x, layout.y):
             _detail(f"{_shown(path)}: {_axis_detail(axis)}")
@@ -399,6 +401,8 @@ def vary(
 
     spec = _load(spec_path)
     shown = _shown(spec_path)
+    for problem in spec.warnings:
+        _warn(str(problem))
 
     rows: list[list[Variant]] = []
     failed = 0

@@ -25,12 +25,13 @@ class Problem:
     col: int | None
     message: str
     hint: str = ""
+    severity: str = "error"  # or "warning": the input is used as it is, but reads wrong
 
     def __str__(self) -> str:
         where = self.file
         if self.line is not None:
             where += f":{self.line}:{self.col if self.col is not None else 1}"
-        text = f"{where}: error: {self.message}"
+        text = f"{where}: {self.severity}: {self.message}"
         if self.hint:
             text += f" ({self.hint})"
         return text

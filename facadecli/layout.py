@@ -101,7 +101,9 @@ class Layout:
 
     @property
     def warnings(self) -> tuple[str, ...]:
-        return self.x.warnings + self.y.warnings
+        """The spec's (each ``file:line:col: warning: ...``), then the axes'."""
+        spec = tuple(str(problem) for problem in self.spec.warnings)
+        return spec + self.x.warnings + self.y.warnings
 
     def letters(self, layer: int, axis: str) -> tuple[PlacedLetter, ...]:
         return (self.x if axis == "x" else self.y).letters.get(layer, ())

@@ -89,6 +89,31 @@ def finished(material: Material) -> Material:
     return base.model_copy(update=update)
 
 
+#: the least share of the light in each channel (red, green, blue) a glass lets through
+#: before the rooms behind it read dark and tinted: half, one photographic stop. Clear
+#: float glass passes 0.8-0.9 of every channel (EN 410's light transmittance; the
+#: library's ``float-glass`` 0.72 / 0.79 / 0.78 of its colour), body-tinted solar glass
+#: (grey, bronze, blue) 0.4-0.6 and reflective glass less: what is drawn behind a pane
+#: is lit through it, so a pane passing half the red darkens a room's red twice as much
+#: as a real shop window would (docs/reference/materials.md, "Glass").
+GLASS_LEAST = 0.5
+
+
+def light_through(material: Material) -> tuple[float, float, float]:
+    """The share of the light in each channel (red, green, blue) a material lets through:
+    its base colour in linear light times its transmission (KHR_materials_transmission
+    tints what passes by the base colour); 0 for a material that lets none through."""
+    from facadecli.materials.textures import linear
+
+    colour = material.color
+    red, green, blue = (linear(int(colour[k : k + 2], 16) / 255) for k in (1, 3, 5))
+    return (
+        red * material.transmission,
+        green * material.transmission,
+        blue * material.transmission,
+    )
+
+
 @dataclass(frozen=True)
 class Images:
     """A library material's texture images (PIL) and the metres one copy covers."""

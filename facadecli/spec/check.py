@@ -7,6 +7,7 @@ user sees every mistake at once, each with a way to fix it.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path as FilePath
 
 from facadecli.errors import Problem
@@ -37,6 +38,7 @@ class Checker:
         self.source = source or SourceMap("<spec>")
         self.base_dir = base_dir
         self.problems: list[Problem] = []
+        self.warnings: list[Problem] = []  # what is used as written but reads wrong
         self.parsed: dict[Path, Node | None] = {}
         self.file_problems: dict[FilePath, str | None] = {}  # each file is read once
 
@@ -45,12 +47,17 @@ class Checker:
     ) -> None:
         self.problems.append(self.source.problem(path, message, hint, key=key, offset=offset))
 
+    def warn(self, path: Path, message: str, hint: str) -> None:
+        problem = self.source.problem(path, message, hint)
+        self.warnings.append(replace(problem, severity="warning"))
+
     def run(self) -> list[Problem]:
         for name in self.spec.patterns:
             self.check_named_pattern(name)
         self.check_layers()
         self.check_counter_axes()
         self.check_appearance()
+        self.check_glass()
         return self.problems
 
     # -- patterns ---------------------------------------------------------------------
@@ -268,6 +275,33 @@ class Checker:
             self.check_material(("defaults", "material"), defaults.material)
         self.check_mesh(("defaults", "mesh"), defaults.mesh)
 
+    def check_glass(self) -> None:
+        """A glass that lets less than :data:`GLASS_LEAST` of the light through in some
+        channel darkens and tints the rooms drawn behind it: a warning at its colour (or
+        its transmission, when that is what dims it)."""
+        from facadecli.materials.library import GLASS_LEAST, LIBRARY, finished, light_through
+
+        for name, declared in self.spec.materials.items():
+            if declared.library is not None and declared.library not in LIBRARY:
+                continue  # reported as unknown
+            material = finished(declared)
+            if material.transmission <= 0:
+                continue
+            through = light_through(material)
+            if min(through) >= GLASS_LEAST:
+                continue
+            fields = declared.model_fields_set
+            set_here = [key for key in ("color", "transmission") if key in fields]
+            shares = " / ".join(f"{round(100 * share)}%" for share in through)
+            self.warn(
+                ("materials", name, *set_here[:1]),
+                f"glass '{name}' lets {shares} of the red / green / blue light through "
+                f"(less than {GLASS_LEAST:.0%} in a channel): the rooms behind it read dark "
+                "and tinted",
+                "use the library's float glass ('library: float-glass', #dde6e4, 72% / 79% "
+                "/ 78%), or a paler colour",
+            )
+
     def check_rule(self, path: Path, rule: ShapeRule) -> None:
         for axis in AXES:
             name = getattr(rule.match, axis)
@@ -389,4 +423,13 @@ def check_spec(
     spec: Spec, source: SourceMap | None = None, base_dir: FilePath | None = None
 ) -> list[Problem]:
     """Every cross-check problem of a spec (empty when it is valid)."""
-    return Checker(spec, source, base_dir).run()
+    return checked(spec, source, base_dir)[0]
+
+
+def checked(
+    spec: Spec, source: SourceMap | None = None, base_dir: FilePath | None = None
+) -> tuple[list[Problem], list[Problem]]:
+    """Every cross-check problem of a spec, and every warning: what is used as written
+    but reads wrong (a glass that darkens the rooms behind it)."""
+    checker = Checker(spec, source, base_dir)
+    return checker.run(), checker.warnings

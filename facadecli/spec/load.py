@@ -18,7 +18,7 @@ from facadecli.errors import Problem, SpecError
 from facadecli.files import read_prefix
 from facadecli.hints import did_you_mean
 from facadecli.limits import COUNT_MAX, LENGTH_MAX, SPEC_BYTES_MAX
-from facadecli.spec.check import check_spec
+from facadecli.spec.check import checked
 from facadecli.spec.model import Spec
 from facadecli.spec.source import Path, SourceMap, format_path, read_document
 
@@ -81,9 +81,10 @@ def validate_spec(
     """Validate plain data (e.g. parsed YAML) as a spec; raises :class:`SpecError`."""
     source = source or SourceMap("<spec>")
     spec = validate_model(Spec, data, source, "version, name, canvas, ...")
-    problems = check_spec(spec, source, base_dir)
+    problems, warnings = checked(spec, source, base_dir)
     if problems:
         raise SpecError(problems)
+    spec._warnings = tuple(warnings)  # the layout's report and the command line tell them
     return spec
 
 

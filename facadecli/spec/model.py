@@ -16,12 +16,14 @@ from pydantic import (
     ConfigDict,
     Discriminator,
     Field,
+    PrivateAttr,
     StringConstraints,
     Tag,
     field_validator,
     model_validator,
 )
 
+from facadecli.errors import Problem
 from facadecli.limits import CANVAS_MAX, COUNT_MAX, LENGTH_MAX
 
 NAME_RE = r"^[A-Za-z0-9_.-]+$"
@@ -305,6 +307,13 @@ class Spec(Model):
     materials: dict[Ident, Material] = {}
     defaults: Defaults = Defaults()
     solver: Solver = Solver()
+    # what its checks found used as written but reading wrong, each at its place in the
+    # file (spec/check.py: a glass that darkens the rooms behind it); not a field
+    _warnings: tuple[Problem, ...] = PrivateAttr(default=())
+
+    @property
+    def warnings(self) -> tuple[Problem, ...]:
+        return self._warnings
 
     @field_validator("canvas")
     @classmethod
