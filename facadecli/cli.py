@@ -528,6 +528,15 @@ def city(
             "building), instead of naming the run's textures/, where each is stored once.",
         ),
     ] = False,
+    ground: Annotated[
+        bool,
+        typer.Option(
+            "--ground",
+            help="Lay the district's ground under the buildings: <name>.ground.glb (a base "
+            "plane and the land cover the input maps), in the merged glb and as a tile of "
+            "--3dtiles. Off by default: a globe or an engine with its own terrain has one.",
+        ),
+    ] = False,
 ) -> None:
     """Build every footprint of a city manifest, or of a footprints file with sensible
     defaults, into whole buildings (SPEC 5)."""
@@ -573,6 +582,7 @@ def city(
         instanced=instance,
         timings=timings,
         shared_textures=not embed_textures,
+        ground=ground,
     )
     if _state["quiet"]:
         report = run(loaded, outdir, workers, limit, resume, None)
@@ -626,6 +636,8 @@ def city(
     merged = [models["merged"] or models["tiles"]] if models["merged"] or models["tiles"] else []
     tileset = [models["3dtiles"]["tileset"]] if "3dtiles" in models else []
     beside = [models[key] for key in ("usd", "ground") if models.get(key)]  # when written
+    if models.get("ground_model"):  # --ground
+        beside.append(models["ground_model"]["file"])
     names = [
         *merged,
         f"{report['name']}.city.json",

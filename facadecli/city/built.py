@@ -70,6 +70,7 @@ class BuiltCity:
     tileset: TilesetWriter | None = None  # with --3dtiles: leaves written as buildings ended
     merged_lod: int = 3  # the merged models' level of detail (``--lod``)
     instanced: bool = False  # repeated parts gathered as GPU instances (``--instance``)
+    ground: bool = False  # the district's ground in the merged model and tiles (``--ground``)
 
     def ok(self) -> Iterator[Task]:
         """The buildings built, in the manifest's order."""

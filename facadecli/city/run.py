@@ -722,6 +722,7 @@ def run_city(
     instanced: bool = False,
     timings: bool = False,
     shared_textures: bool = True,
+    ground: bool = False,
 ) -> CityReport:
     """Build a city; returns the report (also written to ``<name>.report.json``).
     With ``lods`` (levels of detail, of 1, 2, 3), 3D Tiles too (tileset.py); the merged
@@ -730,6 +731,8 @@ def run_city(
     ``timings``, the report file keeps the times (else null there: reproducible bytes).
     The texture pictures are stored once for the run, in ``textures/`` (texture_store.py),
     and every model names them there; with ``shared_textures`` False, each glb embeds its own.
+    With ``ground``, the district's ground too (ground.py): ``<name>.ground.glb``, in the
+    merged model and as a tile of the 3D Tiles.
 
     Buildings run in ``jobs`` local worker processes, or, with ``scheduler`` (a Dask
     scheduler's address), on that Dask cluster: the same tasks, the same axes solved
@@ -758,6 +761,7 @@ def run_city(
             merged_lod,
             instanced,
             timings,
+            ground,
         )
 
 
@@ -958,6 +962,7 @@ def _build(
     merged_lod: int = 3,
     instanced: bool = False,
     timings: bool = False,
+    ground: bool = False,
 ) -> CityReport:
     """The planned buildings built (those built before skipped with ``resume``), then
     the merged models, the CityJSON and the report written; returns the report.
@@ -1044,6 +1049,7 @@ def _build(
         tileset,
         merged_lod,
         instanced,
+        ground,
     )
     _prune_pictures(outdir)
     formats = ["glb", "3dtiles", "usd", "cityjson", "ground"]  # CITY_WRITERS' order: the report's

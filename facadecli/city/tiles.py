@@ -16,6 +16,7 @@ the CityJSON feature beside a building's glb."""
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import math
 from collections import Counter
@@ -47,6 +48,7 @@ def merge_city(
     streamed: bool = False,
     lod: int = 3,
     instanced: bool = False,
+    ground: Path | None = None,
 ) -> dict[str, Any]:
     """Write the merged model(s) of the built buildings (``buildings()`` gives them again
     each time it is called: id, glb file, centroid in local metres; none is held) at level
@@ -56,7 +58,8 @@ def merge_city(
     MERGED_BUILDINGS_MAX buildings or MERGED_GLB_MAX bytes), ``tiles`` (the index file, or
     None) and ``georef``. The tiles are written when ``size`` is given, or in DEFAULT_TILE
     squares when there is no merged glb, unless the run writes 3D Tiles (``streamed``), a
-    viewer's way in then."""
+    viewer's way in then. With ``ground`` (a glb: city/ground.py), the merged model holds
+    it too, after the buildings, under a root node ``ground``."""
     frame = georeference(georef)
     extras = {"georeference": frame}
     sidecar = f"{name}.georef.json"
@@ -70,7 +73,8 @@ def merge_city(
     left_out = _left_out(count, total, "open 3dtiles/tileset.json" if streamed else _TILED)
     if left_out is None:
         merged_parts = ((bid, _at(path, lod)) for bid, path, _ in buildings())
-        merge_glb(merged_parts, outdir / f"{name}.glb", extras, instanced)
+        laid: list[tuple[str, Path | bytes]] = [] if ground is None else [("ground", ground)]
+        merge_glb(itertools.chain(merged_parts, laid), outdir / f"{name}.glb", extras, instanced)
     else:
         merged = None
         size = size or (None if streamed else DEFAULT_TILE)

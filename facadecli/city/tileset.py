@@ -62,6 +62,7 @@ from facadecli.export.gltf import glb_bytes
 from facadecli.export.instancing import EXTENSION, node_matrix, placements
 
 FOLDER = "3dtiles"
+GROUND_TILE = "ground.glb"  # the district's ground (--ground), a tile beside the buildings'
 LODS = (1, 2, 3)
 CAPACITY = {1: 256, 2: 32, 3: 8}  # buildings a tile of each level of detail holds at most
 MAX_LEVEL = 20  # quadtree levels at most (buildings sharing a centroid stay together)
@@ -473,15 +474,20 @@ class TilesetWriter:
                 self.ready.pop(k)
                 self.boxes.pop(k, None)
 
-    def close(self, name: str) -> dict[str, Any]:
+    def close(self, name: str, ground: Path | None = None) -> dict[str, Any]:
         """Write ``tileset.json`` (and remove tiles an earlier run left that it does not
         name); returns what the report says of the tiles. The file is written as its
         text is made, a tile at a time from the squares' records read back in the tree's
         order (:class:`SquareRecords`, :meth:`_span`): no tile's JSON is held but those on
-        the way from the root to the one written."""
+        the way from the root to the one written. With ``ground`` (the district's ground,
+        city/ground.py), it is a tile of its own, ``ground.glb``, beside the buildings'
+        (:meth:`_with_ground`)."""
         top = self._span(self.tree.root, covered=False)
         self.folder.mkdir(parents=True, exist_ok=True)
         self._remove_stale()
+        laid = self.folder / GROUND_TILE
+        if ground is None:
+            laid.unlink(missing_ok=True)
         transform = {"transform": ecef_transform(self.georef)}
         if top is None:  # no building built: an empty tileset, placed all the same
             empty: dict[str, Any] = {
@@ -493,8 +499,10 @@ class TilesetWriter:
             root = empty
             error = 0.0
         else:
-            root = self._tile(self.tree.root, False, None, transform)
+            root = self._tile(self.tree.root, False, None, {} if ground else transform)
             error = top[1]
+        if ground is not None and top is not None:
+            root = self._with_ground(root, top[0], error, ground, transform)
         tileset = {
             "asset": {"version": "1.1", "generator": "facadecli"},
             "extras": {"name": name, "georeference": georeference(self.georef)},
@@ -511,6 +519,35 @@ class TilesetWriter:
             "tiles": self.written,
             "triangles": {f"lod{k}": v for k, v in self.triangles.items()},
             "bytes": {f"lod{k}": v for k, v in self.bytes.items()},
+        }
+
+    def _with_ground(
+        self,
+        buildings: dict[str, Any],
+        box: Box,
+        error: float,
+        ground: Path,
+        transform: dict[str, Any],
+    ) -> dict[str, Any]:
+        """A root over the ground's tile and the buildings' root: both drawn (``refine:
+        ADD``), the ground whenever the district is (its geometric error 0: nothing
+        finer replaces it). Its glb is ``ground`` copied into the folder, the pictures it
+        names in the run's ``textures/`` named from there."""
+        laid = self.folder / GROUND_TILE
+        merge_glb([("ground", ground)], laid)
+        (own,) = _glb_boxes([laid])
+        self.written += 1
+        tile = {
+            "boundingVolume": {"box": _box(own)},
+            "geometricError": 0.0,
+            "content": {"uri": GROUND_TILE},
+        }
+        return {
+            **transform,
+            "boundingVolume": {"box": _box(_union([box, own]))},
+            "geometricError": error,
+            "refine": "ADD",
+            "children": iter([tile, buildings]),
         }
 
     def _tiles(self, square: Square) -> tuple[Box, list[float]] | None:

@@ -133,7 +133,8 @@ def _write_city_models(built: BuiltCity) -> dict[str, Any]:
     from facadecli.city.tiles import merge_city
 
     streamed = built.tileset is not None  # 3D Tiles: no square tiles unless asked for
-    return merge_city(
+    ground = _write_city_ground_model(built)
+    written = merge_city(
         built.placed,
         built.outdir,
         built.name,
@@ -142,13 +143,33 @@ def _write_city_models(built: BuiltCity) -> dict[str, Any]:
         streamed,
         built.merged_lod,
         built.instanced,
+        built.outdir / ground["file"] if ground else None,
     )
+    return {**written, "ground_model": ground} if ground else written
+
+
+def _write_city_ground_model(built: BuiltCity) -> dict[str, Any]:
+    """With ``--ground``, the district's ground (city/ground.py) as ``<name>.ground.glb``:
+    its file and triangles a kind, for the report; without, none (one an earlier run
+    left is removed)."""
+    from facadecli.city.ground import write_ground_glb
+
+    path = built.outdir / f"{built.name}.ground.glb"
+    parts = [part for task in built.ok() for part in task.footprint.parts]
+    if not (built.ground and parts):
+        path.unlink(missing_ok=True)
+        return {}
+    store = next((task.pictures for task in built.ok()), None)
+    triangles = write_ground_glb(path, parts, built.found.ground, store)
+    return {"file": path.name, "triangles": triangles}
 
 
 def _write_city_3dtiles(built: BuiltCity) -> dict[str, Any]:
     if built.tileset is None:
         raise ValueError("a city without --3dtiles has no tileset to write")
-    return {"3dtiles": built.tileset.close(built.name)}
+    ground = built.outdir / f"{built.name}.ground.glb" if built.ground else None
+    laid = ground if ground is not None and ground.is_file() else None
+    return {"3dtiles": built.tileset.close(built.name, laid)}
 
 
 def _write_city_usd(built: BuiltCity) -> dict[str, Any]:

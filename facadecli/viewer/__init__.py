@@ -1318,6 +1318,7 @@ function frame(model) {  // seen from 35 degrees round; a facade from 8.5 up, a 
   moved = false;
   redraw();
 }
+let laidGround = null;  // a city's own ground, shown with ?ground=model
 function show(id, keep = false) {  // keep: the camera where the user turned it, if they did
   const mine = ++asked;
   status.textContent = 'loading the model';
@@ -1328,12 +1329,31 @@ function show(id, keep = false) {  // keep: the camera where the user turned it,
   new GLTFLoader().parse(bytes.buffer, '', gltf => {
     if (mine !== asked) { dispose(gltf.scene); return; }
     if (shown) { scene.remove(shown); dispose(shown); }
+    if (laidGround) { scene.remove(laidGround); dispose(laidGround); laidGround = null; }
     shown = gltf.scene;
+    // a city's merged glb may carry its ground (facade city --ground: a root node
+    // 'ground', facadecli.city.ground): the page lays its own, with streets and trees, so
+    // that one is set aside (the page's plan and framing are the buildings'); ?ground=model
+    // shows it instead of the page's, beside the model, as an engine importing it has it
+    const laid = shown.getObjectByName('ground');
+    if (laid) laid.removeFromParent();
     castsShadows(shown);
     scene.add(shown);
     landCover = landCoverOf(id);  // drawn by light() (groundRegions)
     light(shown);
     if (!(keep && moved)) frame(shown);
+    if (laid && query.get('ground') === 'model') {
+      let fogged = true;  // in the haze as the buildings are (light()): a district's not
+      shown.traverse(part => { if (part.isMesh) fogged = materialsOf(part)[0].fog; });
+      laid.traverse(part => {
+        if (!part.isMesh) return;
+        part.receiveShadow = true;
+        for (const material of materialsOf(part)) material.fog = fogged;
+      });
+      laidGround = laid;
+      scene.add(laid);
+      ground.visible = false;
+    }
     status.textContent = 'drag to orbit, scroll to zoom';
     document.title = document.title.replace('loading: ', '');
   }, error => {

@@ -36,6 +36,7 @@ from facadecli.viewer.kinds import kind_problem
 PAGE_NAME = "index.html"
 BUILDINGS = "buildings"  # where ``facade city`` writes one glb per building
 GROUND = ".ground.geojson"  # a city's land cover, beside its merged glb
+LAID_GROUND = ".ground.glb"  # a city's ground (--ground), beside its merged glb, in it too
 HINT = (
     "run 'facade solve SPEC -o FOLDER' first, or facade vary or facade city: "
     "they write the .glb models this page shows"
@@ -87,6 +88,13 @@ def _buildings(folder: Path) -> list[Path]:
     return sorted(found, key=lambda path: natural_key(path.name))
 
 
+def _laid_ground(glb: Path) -> bool:
+    """Whether ``glb`` is a city's ground (``<name>.ground.glb``, ``facade city --ground``)
+    beside its merged model ``<name>.glb``, which holds it: not a model of its own."""
+    name = glb.name.removesuffix(LAID_GROUND)
+    return name != glb.name and os.path.lexists(glb.with_name(f"{name}.glb"))
+
+
 def find_models(folder: Path) -> list[Model]:
     """The models of ``folder``, in order; a SpecError (exit 2) when there are none or the
     folder cannot be read. Every ``*.glb`` name is listed here, whatever it names:
@@ -99,7 +107,8 @@ def find_models(folder: Path) -> list[Model]:
             where, None, None, "is a file, not a folder", "give the folder the models are in"
         )
     try:
-        glbs = _glbs(folder) or _buildings(folder / BUILDINGS)
+        glbs = [glb for glb in _glbs(folder) if not _laid_ground(glb)]
+        glbs = glbs or _buildings(folder / BUILDINGS)
     except OSError as error:
         raise SpecError.at(
             where, None, None, f"cannot read: {error.strerror}", "check its permissions"
