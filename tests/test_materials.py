@@ -214,6 +214,28 @@ def test_obj_and_usd_name_the_pictures_written_beside_them(
     assert pictures == set(named)  # OBJ and USD name the same files, and nothing else is left
 
 
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_every_material_of_the_examples_has_its_pictures_in_obj_and_usd(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, path: Path
+) -> None:
+    """As in the glb (above): each OBJ material names a base colour (``map_Kd``) and a
+    normal picture (``norm``) written beside it, and each USD material connects its
+    diffuse colour and its normal to a picture."""
+    code, _, err = facade(capsys, "solve", str(path), "-o", str(tmp_path), "-f", "obj,usd")
+    assert code == 0, err
+    entries = (tmp_path / f"{path.stem}.mtl").read_text().split("newmtl ")[1:]
+    assert entries
+    for entry in entries:
+        for key in ("map_Kd", "norm"):
+            (line,) = [x for x in entry.splitlines() if x.startswith(key + " ")]
+            assert (tmp_path / line.split()[-1]).is_file(), (entry.split()[0], line)
+    materials = (tmp_path / f"{path.stem}.usda").read_text().split('def Material "')[1:]
+    assert len(materials) == len(entries)
+    for material in materials:
+        assert "inputs:diffuseColor.connect" in material, material.split('"')[0]
+        assert "inputs:normal.connect" in material, material.split('"')[0]
+
+
 def test_a_city_stores_each_picture_once(tmp_path: Path) -> None:
     data = _wall("brick-flemish", "{wall: {library: render}}")
     for name in ("a", "b"):
