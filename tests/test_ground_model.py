@@ -172,3 +172,17 @@ def test_the_same_district_lays_the_same_ground_and_none_without_the_flag(
     document, _ = read_glb((again / "t.glb").read_bytes())
     assert "ground" not in [node.get("name") for node in document["nodes"]]
     assert "ground.glb" not in (again / "3dtiles/tileset.json").read_text()
+
+
+def test_a_killed_runs_half_written_ground_is_found_as_leftovers(tmp_path: Path) -> None:
+    """The temporary files of the ground's glb (atomic: ``.t.ground.glb.<8>.tmp``) and of
+    its tile (merge_glb's spool, ``3dtiles/.ground.glb.<8>.bin``) are the run's
+    leftovers, removed by the next; a user's files of other names are not."""
+    from facadecli.city.run import leftovers
+
+    (tmp_path / "3dtiles").mkdir()
+    ours = [tmp_path / ".t.ground.glb.ab12cd34.tmp", tmp_path / "3dtiles/.ground.glb.x1y2z3w4.bin"]
+    theirs = [tmp_path / ".t.ground.glb.old", tmp_path / "3dtiles/.ground.glb.tmp"]
+    for path in (*ours, *theirs):
+        path.write_bytes(b"")
+    assert leftovers(tmp_path, "t") == sorted(ours)

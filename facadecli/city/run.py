@@ -649,6 +649,7 @@ def check_output(outdir: Path, name: str) -> None:
         outdir / f"{name}.georef.json",
         outdir / f"{name}.report.jsonl",
         outdir / f"{name}.ground.geojson",
+        outdir / f"{name}.ground.glb",
     ):
         if os.path.isdir(output):
             problem = f"'{output}' is a folder, where an output file goes"
@@ -667,11 +668,12 @@ def leftovers(outdir: Path, name: str) -> list[Path]:
     regular files named as this tool names them, beside the outputs it writes."""
     plain = re.escape(name)
     patterns = {
-        outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda|ground\.geojson)"
-        rf"{_RANDOM}(?:tmp|bin|objects|vertices|ids)",
+        outdir: rf"\.{plain}\.(?:glb|report\.json|city\.json|tiles\.json|usda|ground\.geojson"
+        rf"|ground\.glb){_RANDOM}(?:tmp|bin|objects|vertices|ids)",
         outdir / BUILDINGS: BUILT,  # a run before the shards wrote there
         outdir / "tiles": rf"\.{plain}_-?\d+_-?\d+\.glb{_RANDOM}(?:tmp|bin)",
-        outdir / TILESET_FOLDER: rf"\.tileset\.json{_RANDOM}tmp",
+        outdir / TILESET_FOLDER: rf"\.(?:tileset\.json{_RANDOM}tmp"
+        rf"|ground\.glb{_RANDOM}(?:tmp|bin))",  # the ground's tile (--ground)
         outdir / TEXTURES: rf"\.{PICTURE.pattern}{_RANDOM}tmp",  # a picture (texture_store.py)
     }
     with contextlib.suppress(OSError):  # buildings/<shard>/ (folders.py)
