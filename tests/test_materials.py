@@ -326,8 +326,9 @@ def _faces(name: str, resolution: int) -> tuple[list[np.ndarray], np.ndarray, np
     a wall in even light shows) and its normals' tilt (degrees), at ``resolution``."""
     from scipy import ndimage
 
+    from facadecli.materials.colour import linear
     from facadecli.materials.library import KINDS
-    from facadecli.materials.textures import GENERATORS, STREAMS, linear, texture_set
+    from facadecli.materials.textures import GENERATORS, STREAMS, texture_set
 
     material = LIBRARY[name]
     kind, tile = KINDS[name], TILES[name]
@@ -365,8 +366,9 @@ def _open_surface(name: str, resolution: int) -> tuple[np.ndarray, np.ndarray, n
     """A jointless library material's occlusion (0..1) and normals' tilt (degrees), and
     the mask of its open surface: all of render; concrete away from its formwork lines
     (2 cm) and tie holes (4 cm)."""
+    from facadecli.materials.colour import linear
     from facadecli.materials.library import KINDS
-    from facadecli.materials.textures import coursed, grid, linear, texture_set
+    from facadecli.materials.textures import coursed, grid, texture_set
 
     material = LIBRARY[name]
     kind, tile = KINDS[name], TILES[name]

@@ -42,13 +42,13 @@ from facadecli.layout import (
 )
 from facadecli.limits import SCENE_FACES_MAX
 from facadecli.materials import images, resolve
+from facadecli.materials.colour import linear
 from facadecli.materials.textures import (
     ROOM_BACK,
     ROOM_HEIGHT,
     ROOM_REVEAL,
     ROOM_WIDTH,
     ROOMS_GRID,
-    linear,
 )
 from facadecli.spec.assets import load_mesh
 from facadecli.spec.model import Material, Spec

@@ -103,7 +103,7 @@ def light_through(material: Material) -> tuple[float, float, float]:
     """The share of the light in each channel (red, green, blue) a material lets through:
     its base colour in linear light times its transmission (KHR_materials_transmission
     tints what passes by the base colour); 0 for a material that lets none through."""
-    from facadecli.materials.textures import linear
+    from facadecli.materials.colour import linear
 
     colour = material.color
     red, green, blue = (linear(int(colour[k : k + 2], 16) / 255) for k in (1, 3, 5))
@@ -136,8 +136,9 @@ def images(material: Material) -> Images:
 def _images(material: Material) -> Images:
     from PIL import Image
 
+    from facadecli.materials.colour import linear
     from facadecli.materials.pictures import picture
-    from facadecli.materials.textures import linear, texture_set
+    from facadecli.materials.textures import texture_set
 
     assert material.library is not None
     tile = TILES[material.library]

@@ -519,12 +519,6 @@ def occlusion(height: Field, tile: float) -> Field:
     return open_sky
 
 
-def linear(encoded: float) -> float:
-    """An sRGB-encoded value (0-1, as colours are written) in linear light: the inverse
-    of :func:`srgb`."""
-    return encoded / 12.92 if encoded <= 0.04045 else ((encoded + 0.055) / 1.055) ** 2.4
-
-
 def srgb(linear: np.ndarray) -> np.ndarray:
     linear = np.clip(linear, 0.0, 1.0)
     encoded: np.ndarray = np.where(
