@@ -46,8 +46,8 @@ $(CESIUM): | $(VALIDATOR)
 TEST_JOBS ?= logical
 TEST_PARALLEL := -n $(TEST_JOBS) --dist loadfile
 
-test: $(STAMP) $(VALIDATOR) $(CESIUM) ## Run the whole test suite
-	$(BIN)/python -m pytest $(TEST_PARALLEL)
+test: $(STAMP) $(VALIDATOR) $(CESIUM) ## Run the whole test suite (and name its 25 slowest steps)
+	$(BIN)/python -m pytest $(TEST_PARALLEL) --durations=25
 
 test-fast: $(STAMP) ## Run the tests not marked slow (under a minute; make test runs them all)
 	$(BIN)/python -m pytest $(TEST_PARALLEL) -m "not slow"
