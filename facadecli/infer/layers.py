@@ -11,6 +11,7 @@ background becomes the wall behind them all.
 
 from __future__ import annotations
 
+import statistics
 from collections import defaultdict
 from dataclasses import dataclass
 from itertools import pairwise
@@ -214,26 +215,41 @@ def _one_word(group: list[tuple[Span, ...]]) -> bool:
 
 def top_floors(found: list[Grid], width: float, height: float) -> dict[int, float]:
     """The grids whose top row is their label's top floor, by index, each with the pitch
-    of its floors: elements, not bands across the façade (``BAND`` of its ``width``: a
-    balcony or a cornice along a floor stretches with the façade and is not a bay's), no
-    element of its label starts above that row, and below it stands a
-    row of its label (of the grid, or of another in columns overlapping its own) of a
-    height within ``FLOOR`` of its own, at most ``STOREY`` of the façade's ``height``
-    lower (the floor below); the pitch is the distance from the start of the nearest such
-    row to the start of the top one. A façade of one floor over another has no run of
-    floors, nor one whose top floor is drawn apart from the rest (its windows a few
+    its copies stand at: elements, not bands across the façade (``BAND`` of its
+    ``width``: a balcony or a cornice along a floor stretches with the façade and is not a
+    bay's), no element of its label like it (a height within ``FLOOR`` of its own) starts
+    above that row, and the nearest row of its label under it (of the grid, or of another
+    in columns overlapping its own) is like it, at most ``STOREY`` of the façade's
+    ``height`` lower (the floor below); the pitch is the distance from the start of the
+    nearest such row to the start of the top one. So the top floor is the last floor like
+    one under it: a floor of lower windows over it (cmp_b0007's, an attic's) is no floor
+    like it and moves up with its copies (``spec_text``). A façade of one floor over another has no
+    run of floors, nor one whose top floor is drawn apart from the rest (its windows a few
     centimetres off the others' rows): written as a top floor that repeats upwards from
-    none more, a taller façade still gains floors at its pitch. Labels other than the
-    openings' only at the pitch of an opening's top floor (within ``FLOOR_PITCH``)."""
+    none more, a taller façade still gains floors at its pitch.
+
+    Every copy stands at one pitch, the openings' (the middle one of their top floors'):
+    the top floors share one counter, and at pitches a hand's jitter apart a window's
+    copies and its blind's drift apart floor by floor, and layers on the same rows, which
+    share their margin to the roof, admit no copy at all (the family with defects' seed 24
+    gained no floor). Only grids at that pitch (within ``FLOOR_PITCH``: a floor of lower
+    windows over the last like those under it finds its like floors under them, a pitch
+    too far, and does not repeat), whose top row is lower than it; and labels other than
+    the openings' only on the openings' top floor (a sill under it, a cornice over it,
+    never a floor under it copied into the floors over it)."""
     out: dict[int, float] = {}
     for k, grid in enumerate(found):
         low, high = grid.rows[-1]
         if any(b - a > BAND * width for a, b in grid.columns):
             continue
         mine = [g for g in found if g.label == grid.label]
-        if any(row[0] >= high - 1e-9 for g in mine for row in g.rows):
-            continue  # not the top floor: something of its label stands above it
         size = high - low
+        if any(
+            row[0] >= high - 1e-9 and abs(row[1] - row[0] - size) <= FLOOR * size
+            for g in mine
+            for row in g.rows
+        ):
+            continue  # not the top floor: one of its label like it stands above it
         below = [
             row[0]
             for g in mine
@@ -243,11 +259,18 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
         ]
         if below and low - max(below) <= STOREY * height:
             out[k] = low - max(below)
-    # what is not an opening repeats with the openings' floors: at their pitch, as a sill,
-    # a blind or a balcony of every floor does (a pillar's base and capital do not)
-    pitches = [p for k, p in out.items() if found[k].label in OPENINGS]
+    openings = [k for k in out if found[k].label in OPENINGS]
+    if not openings:
+        return {}
+    pitch = statistics.median_low(out[k] for k in openings)
+    floor = (
+        min(found[k].rows[-1][0] for k in openings) - pitch / 2,
+        max(found[k].rows[-1][1] for k in openings),
+    )
     return {
-        k: p
+        k: pitch
         for k, p in out.items()
-        if found[k].label in OPENINGS or any(abs(p - q) <= FLOOR_PITCH * q for q in pitches)
+        if found[k].rows[-1][1] - found[k].rows[-1][0] < pitch
+        and abs(p - pitch) <= FLOOR_PITCH * pitch
+        and (found[k].label in OPENINGS or floor[0] <= found[k].rows[-1][0] <= floor[1])
     }
