@@ -467,10 +467,16 @@ def spec_text(
             # it moves up with the copies, a hidden spacer of their pitch each (with the
             # roof, a copy more than the height gained held stood over it)
             pitch = next(iter(tops.values()))
-            spacer = f"{gaps.of(pitch)}^{counters.floors(pitch)}"
-            layers[k] = (layer, grid, x, y.replace(bottom, f"{bottom} {spacer}", 1))
+            spacer = gaps.of(pitch)
+            run = f"{bottom} {spacer}^{counters.floors(pitch)}"
+            layers[k] = (layer, grid, x, y.replace(bottom, run, 1))
             held.update((bottom, spacer))
             roofs.add(high)
+        elif floors is None and copied_to and last < over:
+            # on the top floor that repeats or under it (a window of that floor drawn
+            # apart, that does not repeat): it stays, as that floor does (moved up with
+            # the roof, cmp_b0002's stood over the attic moved up with the copies)
+            margined.add(bottom)
         else:
             margined.add(high if first >= top and last >= copies else bottom)
     out = [
