@@ -656,9 +656,11 @@ def test_floors_drawn_unlike_gain_whole_floors_under_the_attic_within_the_densit
 ) -> None:
     """1.5 times as tall, a façade whose floors are each a layer of their own gains the
     floors that fit in the height gained, copies of the last floor like the ones under it
-    at its pitch, with the lower top floor and the attic moved up over them: the windows
-    a square metre within 0.85-1.15 of the input's, none over another. Before, the floors
-    over the ground floor moved up with the roof and none was gained (0.67)."""
+    at its pitch, with the lower top floor and the attic moved up with the roof over
+    them (the rest of the height gained, less than a pitch, under the lower top floor):
+    the windows a square metre within 0.85-1.15 of the input's, none over another.
+    Before, the floors over the ground floor moved up with the roof and none was gained
+    (0.67)."""
     path = _floors_unlike(tmp_path / "unlike.json", seed)
     windows = _of(_solved(path, WIDTH, 16.0 * 1.5), "window")
     assert _overlapping(windows) == 0
@@ -666,7 +668,10 @@ def test_floors_drawn_unlike_gain_whole_floors_under_the_attic_within_the_densit
     rows = sorted({round(r.y0, 2) for r in windows})
     assert len(rows) == 5 + int(8.0 / PITCH_Y) + 1  # the floors gained: those that fit
     assert rows[0] == pytest.approx(1.2, abs=0.03)  # the drawn floors stay
-    assert all(b - a == pytest.approx(PITCH_Y, abs=0.05) for a, b in itertools.pairwise(rows[:-1]))
+    gained = rows[:-2]  # the floors drawn under the lower top floor and their copies
+    assert all(b - a == pytest.approx(PITCH_Y, abs=0.05) for a, b in itertools.pairwise(gained))
+    assert PITCH_Y - 0.05 <= rows[-2] - gained[-1] < 2 * PITCH_Y  # the lower top floor
+    assert rows[-2] == pytest.approx(1.2 + 4 * PITCH_Y + 8.0, abs=0.05)  # at the roof's
     assert all(sum(round(r.y0, 2) == row for r in windows) == 5 for row in rows)  # whole floors
     attic = [r for r in windows if r.y1 - r.y0 < 0.5]
     assert len(attic) == 5 and min(r.y0 for r in attic) > max(

@@ -25,8 +25,7 @@
   floor like the one under it repeats upwards (``_floors_above``), every copy at one
   pitch and one counter, as many as fit in the height gained (the roof's margin never
   shrinks); the floors under it keep their sizes, and what stands wholly over it (a
-  lower top floor, an attic) moves up with the copies, a hidden spacer of the pitch
-  each.
+  lower top floor, an attic) keeps its margin to the roof, clear of the copies.
 - Repeats: where a word repeats a gap and an element twice or more (three elements), or
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
@@ -331,7 +330,7 @@ def spec_text(
     roofed: set[str] = set()  # the margins over floors gained: they never shrink (``_gap``)
     # the layers with a margin at both ends along y (where their first and last rows
     # start, the margins) and where the top floors that repeat upwards start
-    margins_y: list[tuple[float, float, str, str, int, _Symbols]] = []
+    margins_y: list[tuple[float, float, str, str]] = []
     copied_from: list[float] = []
     copied_to: list[float] = []  # where the top floors that repeat upwards end
     for index, (layer, grid, frame) in enumerate(zip(names, found, framed, strict=True)):
@@ -429,7 +428,7 @@ def spec_text(
                 # which of its margins keeps its size is said after every layer is written
                 bottom, high = tokens[0][0], tokens[-1][0]
                 if bottom != high:
-                    margins_y.append((grid.rows[0][0], grid.rows[-1][0], bottom, high, index, gaps))
+                    margins_y.append((grid.rows[0][0], grid.rows[-1][0], bottom, high))
             elif axis == "y" and tokens[-1][0] in ends and tokens[0][0] not in ends:
                 grounded.update(symbol for symbol, _ in tokens[:-1])  # a door keeps its height
             if not {tokens[0][0], tokens[-1][0]} & ends:  # no margin: its letters stay free
@@ -455,30 +454,23 @@ def spec_text(
         layers.append((layer, grid, words[0], words[1]))
     # a taller façade grows at the top of the floors: what stands on them keeps its
     # margin to the ground, what stands above them its margin to the top; what stands
-    # wholly under a top floor that repeats upwards keeps its margin to the ground, as
-    # that floor does (moved up with the roof, cmp_b0005's upper floors stood over the
-    # copies of its top one at 1.5x height)
+    # wholly under a top floor that repeats upwards, or on it (a window of that floor
+    # drawn apart, which does not repeat), keeps its margin to the ground, as that floor
+    # does (moved up with the roof, cmp_b0005's upper floors stood over the copies of its
+    # top one at 1.5x height, and cmp_b0002's window over the last copy); what stands
+    # wholly over it (a lower top floor, an attic) keeps its margin to the roof, and
+    # since the copies never take more than the height gained (``roofed``), it stays
+    # clear of them
     copies = min(copied_from, default=top)
     over = min(copied_to, default=float("inf"))
-    for first, last, bottom, high, k, gaps in margins_y:
-        layer, grid, x, y = layers[k]
-        if floors is None and first >= over - 1e-9 and y.startswith(f"{bottom} "):
-            # wholly over a top floor that repeats upwards (an attic's windows, a cornice):
-            # it moves up with the copies, a hidden spacer of their pitch each (with the
-            # roof, a copy more than the height gained held stood over it)
-            pitch = next(iter(tops.values()))
-            spacer = gaps.of(pitch)
-            run = f"{bottom} {spacer}^{counters.floors(pitch)}"
-            layers[k] = (layer, grid, x, y.replace(bottom, run, 1))
-            held.update((bottom, spacer))
-            roofs.add(high)
-        elif floors is None and copied_to and last < over:
-            # on the top floor that repeats or under it (a window of that floor drawn
-            # apart, that does not repeat): it stays, as that floor does (moved up with
-            # the roof, cmp_b0002's stood over the attic moved up with the copies)
-            margined.add(bottom)
-        else:
-            margined.add(high if first >= top and last >= copies else bottom)
+    margined.update(
+        bottom
+        if floors is None and copied_to and last < over
+        else high
+        if first >= top and last >= copies
+        else bottom
+        for first, last, bottom, high in margins_y
+    )
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
         "# a label's elements on a grid (its columns x its rows), back to front, with the",
