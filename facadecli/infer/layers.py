@@ -218,15 +218,16 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
     its copies stand at: elements, not bands across the façade (``BAND`` of its
     ``width``: a balcony or a cornice along a floor stretches with the façade and is not a
     bay's), no element of its label like it (a height within ``FLOOR`` of its own) starts
-    above that row, and the nearest row of its label under it (of the grid, or of another
-    in columns overlapping its own) is like it, at most ``STOREY`` of the façade's
-    ``height`` lower (the floor below); the pitch is the distance from the start of the
-    nearest such row to the start of the top one. So the top floor is the last floor like
-    one under it: a floor of lower windows over it (cmp_b0007's, an attic's) is no floor
-    like it and moves up with its copies (``spec_text``). A façade of one floor over another has no
-    run of floors, nor one whose top floor is drawn apart from the rest (its windows a few
-    centimetres off the others' rows): written as a top floor that repeats upwards from
-    none more, a taller façade still gains floors at its pitch.
+    above that row, and below it stands a row of its label like it (of the grid, or of
+    another in columns overlapping its own), at most ``STOREY`` of the façade's ``height``
+    lower (the floor below); the pitch is the distance from the start of the nearest such
+    row to the start of the top one. So the top floor is the last floor like one under
+    it: a floor of lower windows over it (cmp_b0007's, an attic's) is no floor like it,
+    and keeps its margin to the roof over the copies (``spec_text``). A façade of one
+    floor over another has no run of floors, nor one whose top floor is drawn apart from
+    the rest (its windows a few centimetres off the others' rows): written as a top floor
+    that repeats upwards from none more, a taller façade still gains floors at its
+    pitch.
 
     Every copy stands at one pitch, the openings' (the middle one of their top floors'):
     the top floors share one counter, and at pitches a hand's jitter apart a window's
