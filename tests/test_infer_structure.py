@@ -327,7 +327,11 @@ def test_the_top_floor_is_its_labels_top_row_with_a_floor_like_it_below() -> Non
         1: pytest.approx(2.6),  # from the ground floor's windows below its own
         2: pytest.approx(2.6),  # its own rows: two floors of sills
     }
-    assert top_floors([ground, upper, attic], 10.0, 10.0) == {}  # the attic is over them
+    # an attic's windows over it are no floor like it: it still repeats (the attic moves
+    # up with its copies), and so does no floor under a floor like it
+    assert top_floors([ground, upper, attic], 10.0, 10.0) == {1: pytest.approx(2.6)}
+    over = Grid("window", ((3.0, 4.0),), ((6.7, 8.2),))  # a floor like it over it
+    assert top_floors([ground, upper, over], 10.0, 10.0) == {2: pytest.approx(2.6)}
     assert top_floors([ground, upper], 10.0, 5.0) == {}  # 2.6 m: more than a floor of 5 m
 
 
@@ -341,11 +345,10 @@ def test_a_facade_of_two_floors_gains_floors_with_their_sills_at_its_pitch(
     windows, sills = _of(solved, "window"), _of(solved, "sill")
     floors = sorted({round(r.y0, 2) for r in windows})
     assert floors[0] == pytest.approx(1.5, abs=0.03)  # the ground floor stays
-    # whole floors over the top one: as many as the height gained is pitches (one fewer
-    # where the last would not fit under the roof's margin)
+    # whole floors over the top one: as many as fit in the height gained (the roof's
+    # margin takes the rest, never less than drawn)
     pitch, gained = PITCH_Y + 0.02, TWO_FLOORS * (share - 1)
-    roof = TWO_FLOORS - (1.5 + pitch + 1.5)
-    assert len(floors) == 2 + min(round(gained / pitch), int((gained + roof) / pitch))
+    assert len(floors) == 2 + int(gained / pitch)
     assert all(
         b - a == pytest.approx(PITCH_Y + 0.02, abs=0.05) for a, b in itertools.pairwise(floors)
     )
@@ -610,3 +613,67 @@ def test_a_taller_facade_gains_its_floors_in_one_place_with_no_opening_over_anot
     windows = _of(_solved(path, WIDTH, height * 1.5), "window")
     assert _overlapping(windows) == 0
     assert len(windows) > drawn  # floors gained
+
+
+def _floors_unlike(path: Path, seed: int) -> Path:
+    """Five floors of five windows (1.2 x 1.5 m) with sills, each floor with one window
+    drawn 20% narrower, in a bay of its own (no two floors alike: each floor a layer, no
+    counted stack), the top floor's windows lower (1.1 m: no floor like the ones under
+    it) and an attic's small windows (0.6 x 0.4 m) over it; every height jittered by up
+    to 3% and every edge by up to 1 cm."""
+    rng = random.Random(seed)
+    rects = []
+    narrow = rng.sample(range(5), 5)  # each floor's narrower window, by bay
+    for f in range(5):
+        for k in range(5):
+            cx = 2.3 + k * 2.6 + rng.uniform(-0.01, 0.01)
+            w = 1.2 * (0.8 if k == narrow[f] else 1.0)
+            y0 = 1.2 + f * PITCH_Y + rng.uniform(-0.01, 0.01)
+            y1 = y0 + (1.1 if f == 4 else 1.5) * (1 + rng.uniform(-0.03, 0.03))
+            rects.append(
+                {"label": "window", "x0": cx - w / 2, "y0": y0, "x1": cx + w / 2, "y1": y1}
+            )
+            rects.append(
+                {
+                    "label": "sill",
+                    "x0": cx - w / 2 - 0.1,
+                    "y0": y0 - 0.2,
+                    "x1": cx + w / 2 + 0.1,
+                    "y1": y0,
+                }
+            )
+    for k in range(5):
+        cx = 2.3 + k * 2.6 + rng.uniform(-0.01, 0.01)
+        y0 = 1.2 + 4 * PITCH_Y + 2.0 + rng.uniform(-0.01, 0.01)
+        rects.append({"label": "window", "x0": cx - 0.3, "y0": y0, "x1": cx + 0.3, "y1": y0 + 0.4})
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 16.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_floors_drawn_unlike_gain_whole_floors_under_the_attic_within_the_density(
+    tmp_path: Path, seed: int
+) -> None:
+    """1.5 times as tall, a façade whose floors are each a layer of their own gains the
+    floors that fit in the height gained, copies of the last floor like the ones under it
+    at its pitch, with the lower top floor and the attic moved up with the roof over
+    them (the rest of the height gained, less than a pitch, under the lower top floor):
+    the windows a square metre within 0.85-1.15 of the input's, none over another.
+    Before, the floors over the ground floor moved up with the roof and none was gained
+    (0.67)."""
+    path = _floors_unlike(tmp_path / "unlike.json", seed)
+    windows = _of(_solved(path, WIDTH, 16.0 * 1.5), "window")
+    assert _overlapping(windows) == 0
+    assert 0.85 <= len(windows) / 30 / 1.5 <= 1.15
+    rows = sorted({round(r.y0, 2) for r in windows})
+    assert len(rows) == 5 + int(8.0 / PITCH_Y) + 1  # the floors gained: those that fit
+    assert rows[0] == pytest.approx(1.2, abs=0.03)  # the drawn floors stay
+    gained = rows[:-2]  # the floors drawn under the lower top floor and their copies
+    assert all(b - a == pytest.approx(PITCH_Y, abs=0.05) for a, b in itertools.pairwise(gained))
+    assert PITCH_Y - 0.05 <= rows[-2] - gained[-1] < 2 * PITCH_Y  # the lower top floor
+    assert rows[-2] == pytest.approx(1.2 + 4 * PITCH_Y + 8.0, abs=0.05)  # at the roof's
+    assert all(sum(round(r.y0, 2) == row for r in windows) == 5 for row in rows)  # whole floors
+    attic = [r for r in windows if r.y1 - r.y0 < 0.5]
+    assert len(attic) == 5 and min(r.y0 for r in attic) > max(
+        r.y1 for r in windows if r not in attic
+    )

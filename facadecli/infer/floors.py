@@ -27,11 +27,11 @@ floor of the run is one grid, so that a floor lacking one column's sill does not
 the others' from following.
 
 A layer with nothing on the run's floors (a top floor's sills alone) moves with the top
-floor, over the floors gained. Where a layer of the façade instead repeats its top floor
-upwards (``spec_text._floors_above``: its top floor is one like those under it, so the
-floors gained are copies of it, with what it shows), the layers with nothing on the run
-stay as drawn (``spec_text``): the two ways mixed would take a floor's sills up with the
-top floor and leave its blinds with the copies.
+floor, over the floors gained. Where the openings have a run, it is the one place a
+taller façade gains floors: no layer's top floor repeats upwards
+(``spec_text._floors_above``) but one standing on the run's floors; the two ways mixed
+would gain floors twice, the copies of a floor's sills over the windows the run moved up
+(the family with defects' seed 1 at 1.5x height: four windows over others).
 """
 
 from __future__ import annotations

@@ -11,6 +11,7 @@ background becomes the wall behind them all.
 
 from __future__ import annotations
 
+import statistics
 from collections import defaultdict
 from dataclasses import dataclass
 from itertools import pairwise
@@ -214,40 +215,76 @@ def _one_word(group: list[tuple[Span, ...]]) -> bool:
 
 def top_floors(found: list[Grid], width: float, height: float) -> dict[int, float]:
     """The grids whose top row is their label's top floor, by index, each with the pitch
-    of its floors: elements, not bands across the façade (``BAND`` of its ``width``: a
-    balcony or a cornice along a floor stretches with the façade and is not a bay's), no
-    element of its label starts above that row, and below it stands a
-    row of its label (of the grid, or of another in columns overlapping its own) of a
-    height within ``FLOOR`` of its own, at most ``STOREY`` of the façade's ``height``
+    its copies stand at: elements, not bands across the façade (``BAND`` of its
+    ``width``: a balcony or a cornice along a floor stretches with the façade and is not a
+    bay's), no element of its label like it (a height within ``FLOOR`` of its own) starts
+    above that row, and below it stands a row of its label like it (of the grid, or of
+    another in columns overlapping its own), at most ``STOREY`` of the façade's ``height``
     lower (the floor below); the pitch is the distance from the start of the nearest such
-    row to the start of the top one. A façade of one floor over another has no run of
-    floors, nor one whose top floor is drawn apart from the rest (its windows a few
-    centimetres off the others' rows): written as a top floor that repeats upwards from
-    none more, a taller façade still gains floors at its pitch. Labels other than the
-    openings' only at the pitch of an opening's top floor (within ``FLOOR_PITCH``)."""
+    row to the start of the top one. So the top floor is the last floor like one under
+    it: a floor of lower windows over it (cmp_b0007's, an attic's) is no floor like it,
+    and keeps its margin to the roof over the copies (``spec_text``). A façade of one
+    floor over another has no run of floors, nor one whose top floor is drawn apart from
+    the rest (its windows a few centimetres off the others' rows): written as a top floor
+    that repeats upwards from none more, a taller façade still gains floors at its
+    pitch.
+
+    Every copy stands at one pitch, the openings' (the middle one of their top floors'):
+    the top floors share one counter, and at pitches a hand's jitter apart a window's
+    copies and its blind's drift apart floor by floor, and layers on the same rows, which
+    share their margin to the roof, admit no copy at all (the family with defects' seed 24
+    gained no floor). Only grids at that pitch (within ``FLOOR_PITCH``: a floor of lower
+    windows over the last like those under it finds its like floors under them, a pitch
+    too far, and does not repeat), whose top row is lower than it; and labels other than
+    the openings' only on the openings' top floor (a sill under it, a cornice over it,
+    never a floor under it copied into the floors over it) with a row of their label that
+    pitch under it, of any height (sills drawn 1-2 cm tall differ in height by more than
+    ``FLOOR``: the family with defects' seed 24 gained floors without them)."""
     out: dict[int, float] = {}
+    under: dict[int, list[float]] = {}  # each candidate's rows under it: where they start
     for k, grid in enumerate(found):
         low, high = grid.rows[-1]
         if any(b - a > BAND * width for a, b in grid.columns):
             continue
         mine = [g for g in found if g.label == grid.label]
-        if any(row[0] >= high - 1e-9 for g in mine for row in g.rows):
-            continue  # not the top floor: something of its label stands above it
         size = high - low
-        below = [
-            row[0]
+        if any(
+            row[0] >= high - 1e-9 and abs(row[1] - row[0] - size) <= FLOOR * size
+            for g in mine
+            for row in g.rows
+        ):
+            continue  # not the top floor: one of its label like it stands above it
+        rows = [
+            row
             for g in mine
             if g is grid or any(_overlap(c, d) for c in g.columns for d in grid.columns)
             for row in g.rows
-            if row[1] <= low + 1e-9 and abs(row[1] - row[0] - size) <= FLOOR * size
+            if row[1] <= low + 1e-9
         ]
+        under[k] = [row[0] for row in rows]
+        below = [row[0] for row in rows if abs(row[1] - row[0] - size) <= FLOOR * size]
         if below and low - max(below) <= STOREY * height:
             out[k] = low - max(below)
-    # what is not an opening repeats with the openings' floors: at their pitch, as a sill,
-    # a blind or a balcony of every floor does (a pillar's base and capital do not)
-    pitches = [p for k, p in out.items() if found[k].label in OPENINGS]
-    return {
-        k: p
-        for k, p in out.items()
-        if found[k].label in OPENINGS or any(abs(p - q) <= FLOOR_PITCH * q for q in pitches)
-    }
+    openings = [k for k in out if found[k].label in OPENINGS]
+    if not openings:
+        return {}
+    pitch = statistics.median_low(out[k] for k in openings)
+    floor = (
+        min(found[k].rows[-1][0] for k in openings) - pitch / 2,
+        max(found[k].rows[-1][1] for k in openings),
+    )
+
+    def repeats(k: int) -> bool:
+        """An opening's floor at the pitch; another label's on the openings' top floor,
+        with a row of its label a pitch under it (a sill of the floor below, whatever
+        the jitter of its height)."""
+        low, high = found[k].rows[-1]
+        if high - low >= pitch:
+            return False
+        if found[k].label in OPENINGS:
+            return k in out and abs(out[k] - pitch) <= FLOOR_PITCH * pitch
+        return floor[0] <= low <= floor[1] and any(
+            abs(low - start - pitch) <= FLOOR_PITCH * pitch for start in under[k]
+        )
+
+    return {k: pitch for k in under if repeats(k)}

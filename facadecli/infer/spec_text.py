@@ -21,6 +21,11 @@
   one label in such a word have a width in common, the later one's widths are symbols
   of its own (``window_2_w1``; ``_width_tables``): a mask names symbols, so each would
   show the other's window.
+- Top floors (``layers.top_floors``): where the openings have no run of floors, the last
+  floor like the one under it repeats upwards (``_floors_above``), every copy at one
+  pitch and one counter, as many as fit in the height gained (the roof's margin never
+  shrinks); the floors under it keep their sizes, and what stands wholly over it (a
+  lower top floor, an attic) keeps its margin to the roof, clear of the copies.
 - Repeats: where a word repeats a gap and an element twice or more (three elements), or
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
@@ -312,28 +317,22 @@ def spec_text(
     floors = floor_run(found, height, alike)
     # a top floor repeats upwards only where no run of the openings' floors stands under
     # it, or where it stands on the run's floors: over them (an attic's windows, a top
-    # floor drawn apart), its copies and the floors the run gains would take the same
-    # height (cmp_b0011 at 1.5x: 33 pairs of windows over one another); it moves up with
-    # the floors instead, as everything over them does
+    # floor drawn apart, the sills of the floors over the run), its copies and the floors
+    # the run gains would take the same height (cmp_b0011 at 1.5x: 33 pairs of windows
+    # over one another; the family with defects' seed 1: four); it moves up with the
+    # floors instead, as everything over them does
     tops = {
         k: pitch
         for k, pitch in top_floors(found, width, height).items()
-        if floors is None or found[k].rows[0][0] < top
+        if floors is None or on_run(found[k].rows, floors[1])
     }
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
-    # where a layer's top floor repeats upwards with nothing on the run's floors (its
-    # floors gained are copies of the top one, ``_floors_above``), every layer with
-    # nothing on the run stays as it was drawn: the top floor stays too, and the floors
-    # gained stand over it, at its pitch, with what it shows; otherwise the top floor
-    # moves up over the floors the run gains, with what stands on it
-    copied = floors is not None and any(
-        k in tops and found[k].label not in UNIQUE and not on_run(found[k].rows, floors[1])
-        for k in range(len(found))
-    )
+    roofed: set[str] = set()  # the margins over floors gained: they never shrink (``_gap``)
     # the layers with a margin at both ends along y (where their first and last rows
     # start, the margins) and where the top floors that repeat upwards start
     margins_y: list[tuple[float, float, str, str]] = []
     copied_from: list[float] = []
+    copied_to: list[float] = []  # where the top floors that repeat upwards end
     for index, (layer, grid, frame) in enumerate(zip(names, found, framed, strict=True)):
         symbols = (widths[index], elements[grid.label][1])
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
@@ -364,7 +363,6 @@ def spec_text(
             and 0 < grid.rows[0][0] < top
             and grid.rows[-1][1] < height
             and follows(grid.rows, floors[1])
-            and (on_run(grid.rows, floors[1]) or not copied)
         ):
             # what stands on the openings' floors follows their one sequence: gained and
             # dropped with them, at their pitch, by their counter
@@ -410,12 +408,20 @@ def spec_text(
                 # façade gains
                 word, gap = _floors_above(tokens, pitch, gaps, counters)
                 copied_from.append(grid.rows[-1][0])
+                if grid.label in OPENINGS:
+                    copied_to.append(grid.rows[-1][1])
                 held.update((tokens[0][0], gap))
-                # and the gaps between its floors below do not grow (free, they would
-                # stretch while the openings' floors keep their pitch); a shorter façade
-                # may still close them up
-                margined.update(s for s in gaps.sizes.values() if s != gap)
+                # the copies are whole floors, and the floors under them stay as drawn:
+                # their elements keep their size (free, the solver shrank cmp_b0010's
+                # windows 11% to fit a floor more)
+                repeated.update(s for s, _ in tokens[1:-1] if s not in gaps.sizes.values())
+                # and the gaps between its floors below keep their size: free, they would
+                # stretch while the openings' floors keep their pitch; bounded above only,
+                # a taller façade closed them up to fit a copy more than the height gained
+                # holds (the family with defects' seed 13 at 1.5x height)
+                held.update(gaps.sizes.values())
                 roofs.add(tokens[-1][0])
+                roofed.add(tokens[-1][0])
                 words.append(word)
                 continue
             if axis == "y" and tokens[0][0] in ends and tokens[-1][0] in ends:
@@ -436,6 +442,7 @@ def spec_text(
                     # ways (as a top floor repeating upwards does, ``_floors_above``):
                     # the roof's margin and the counter take the slack, not the ground's
                     held.add(bottom)
+                    roofed.add(tokens[-1][0])
             else:
                 margined.update(gaps.sizes.values())
             words.append(word)
@@ -447,12 +454,21 @@ def spec_text(
         layers.append((layer, grid, words[0], words[1]))
     # a taller façade grows at the top of the floors: what stands on them keeps its
     # margin to the ground, what stands above them its margin to the top; what stands
-    # wholly under a top floor that repeats upwards keeps its margin to the ground, as
-    # that floor does (moved up with the roof, cmp_b0005's upper floors stood over the
-    # copies of its top one at 1.5x height)
+    # wholly under a top floor that repeats upwards, or on it (a window of that floor
+    # drawn apart, which does not repeat), keeps its margin to the ground, as that floor
+    # does (moved up with the roof, cmp_b0005's upper floors stood over the copies of its
+    # top one at 1.5x height, and cmp_b0002's window over the last copy); what stands
+    # wholly over it (a lower top floor, an attic) keeps its margin to the roof, and
+    # since the copies never take more than the height gained (``roofed``), it stays
+    # clear of them
     copies = min(copied_from, default=top)
+    over = min(copied_to, default=float("inf"))
     margined.update(
-        high if first >= top and last >= copies else bottom
+        bottom
+        if floors is None and copied_to and last < over
+        else high
+        if first >= top and last >= copies
+        else bottom
         for first, last, bottom, high in margins_y
     )
     out = [
@@ -503,7 +519,7 @@ def spec_text(
     ]
     sizes += [
         [
-            (symbol, _gap(size, symbol in fixed | held, symbol in margined))
+            (symbol, _gap(size, symbol in fixed | held, symbol in margined, symbol in roofed))
             for gaps in mine
             for size, symbol in gaps.sizes.items()
         ]
@@ -804,20 +820,27 @@ def _spread_of(
     return min(low for low, _ in ranges), max(high for _, high in ranges)
 
 
-def _gap(size: float, repeated: bool, margined: bool) -> str:
+def _gap(size: float, repeated: bool, margined: bool, roofed: bool = False) -> str:
     """A gap's size: the gaps of a word with a run and a margin keep it (``min`` and
     ``max``: the bays keep their pitch and the counter and the margins take the slack, so
     layers whose runs share a counter keep their columns together at any size); other
     gaps of a word with a margin do not grow (the margins take what the façade gains, so
     every such layer moves alike, yet a narrower façade may close them up); margins, and
     gaps of words without one, are free, and so is a gap under the solver's tolerance (a
-    sliver between elements drawn touching: bounded, it leaves the solver no layout)."""
+    sliver between elements drawn touching: bounded, it leaves the solver no layout).
+    ``roofed``: the margin to the roof over floors a taller façade gains, which never
+    shrinks (``min``, less the solver's tolerance): the floors gained are those that fit
+    in the height gained, the rest of it goes to the roof's margin (rounded to the
+    nearest floor, a floor more than fits ate into it, and cmp_b0005 at 1.5x height had
+    20% more windows a square metre than drawn)."""
     if size < TOLERANCE:
         return _number(size)
     if repeated:
         return f"{{size: {_number(size)}, min: {_number(size)}, max: {_number(size)}}}"
     if margined:
         return f"{{size: {_number(size)}, max: {_number(size)}}}"
+    if roofed:  # to the solver's tolerance: the sizes are written rounded
+        return f"{{size: {_number(size)}, min: {_number(size - TOLERANCE)}}}"
     return _number(size)
 
 
