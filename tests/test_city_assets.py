@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import subprocess
-import sys
 from collections import Counter
 from pathlib import Path
 
@@ -25,10 +23,10 @@ from facadecli.city.run import _pick, run_city
 from facadecli.export.glb_merge import merge_glb, read_glb
 from facadecli.export.texture_store import PICTURE, image_uris, picture_name, pictures_missing
 from facadecli.geometry.facade import plane_uv, weld
+from tests.khronos import VALIDATOR, validates
 from tests.rays import city_leaks
 
 ROOT = Path(__file__).resolve().parent.parent
-VALIDATOR = Path(sys.prefix) / "node" / "node_modules"  # make test installs it in the venv
 BUILDINGS = 50
 
 
@@ -281,18 +279,6 @@ def test_the_seed_varies_the_walls_and_the_same_seed_gives_the_same_bytes(
     assert merged[0] == merged[1]  # the same city and seed: the same bytes
     assert len(walls[0]) >= 4  # the houses and flats with brick or render walls
     assert walls[2] != walls[0] or walls[3] != walls[0]  # another seed: other tones somewhere
-
-
-def validates(glb: Path) -> None:
-    """The Khronos validator finds no error and no warning in ``glb``."""
-    result = subprocess.run(
-        ["node", str(ROOT / "tests" / "gltf_validate.js"), str(VALIDATOR), str(glb)],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    report = json.loads(result.stdout)
-    assert (report["errors"], report["warnings"]) == (0, 0), report
 
 
 def _rooms_shown(glb: Path) -> tuple[int, set[tuple[int, int]]]:

@@ -18,8 +18,8 @@ from facadecli.city.building import AxisCache, Slot, rung
 from facadecli.city.default import FALLBACK, default_city
 from facadecli.city.run import planned, run_city
 from facadecli.export.glb_merge import read_glb
+from tests.khronos import VALIDATOR, validates
 from tests.osm_district import box
-from tests.test_city_assets import VALIDATOR, validates
 
 ROOT = Path(__file__).resolve().parent.parent
 CRS = {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::28992"}}

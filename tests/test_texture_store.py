@@ -12,8 +12,6 @@ import json
 import os
 import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -37,9 +35,9 @@ from facadecli.export.texture_store import (
     unpadded,
 )
 from facadecli.viewer.gallery import read_models, write_gallery
+from tests.khronos import VALIDATOR, reports
 
 ROOT = Path(__file__).resolve().parent.parent
-VALIDATOR = Path(sys.prefix) / "node" / "node_modules"
 
 
 def _png(colour: tuple[int, int, int], size: int = 8) -> bytes:
@@ -126,21 +124,11 @@ def test_the_validator_reads_the_pictures_a_glb_names(tmp_path: Path) -> None:
     store = TextureStore(tmp_path / "textures")
     glb.write_bytes(externalised(_textured_glb([(10, 20, 30)]), store, glb))
 
-    def validate() -> dict[str, object]:
-        done = subprocess.run(
-            ["node", str(ROOT / "tests" / "gltf_validate.js"), str(VALIDATOR), str(glb)],
-            capture_output=True,
-            text=True,
-            check=True,
-        )
-        report: dict[str, object] = json.loads(done.stdout)
-        return report
-
-    found = validate()
+    (found,) = reports(glb)
     assert (found["errors"], found["warnings"]) == (0, 0), found
     for picture in store.folder.iterdir():
         picture.unlink()
-    found = validate()  # a missing picture is an error: the validator read them before
+    (found,) = reports(glb)  # a missing picture is an error: the validator read them before
     assert found["errors"] == 1 and "IO_ERROR" in json.dumps(found["messages"])
 
 
