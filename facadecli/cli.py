@@ -758,6 +758,8 @@ def infer(
     target.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(target, inferred.text)
     write_atomic(report_path, json.dumps(report, indent=2) + "\n")
+    for warning in inferred.warnings:
+        _warn(f"{layout}: warning: {warning}")
     if inferred.unshared:
         _warn(f"{layout}: warning: bays {inferred.bays}; each layer has its own x word")
     summary = (

@@ -20,6 +20,10 @@ BUILTIN_GLASS = Material(
 )
 INTERIOR_MATERIAL = "interior"  # the dark recess behind every window: the spec's, else this
 BUILTIN_INTERIOR = Material(color="#26282c", metallic=0.0, roughness=0.95)
+# the rooms of the ground floor (a ``rooms`` interior), lit as a shop or a room is at
+# street level: the spec's, else its interior giving off LIT_INTERIOR of its colour
+LIT_INTERIOR_MATERIAL = "interior-lit"
+LIT_INTERIOR = 1.2
 
 
 @dataclass(frozen=True)

@@ -368,3 +368,28 @@ def test_a_quiet_watch_still_gives_its_address(
     out, err = capsys.readouterr()
     assert out == "x.yaml: serving http://127.0.0.1:8765/ (Ctrl-C to stop)\n"
     assert err == "x.yaml:1:1: error: bad\n"
+
+
+@pytest.mark.parametrize("command", ["grammar", "infer"])
+def test_a_cmp_annotation_without_its_size_is_read_as_one_metre_and_says_so(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, command: str
+) -> None:
+    """A CMP annotation is a unit square: read without ``--size`` it is a 1 x 1 m façade,
+    which a user is told on stderr (and ``infer`` in its report); with it, nothing."""
+    sample = ROOT / "samples" / "five-bays.xml"
+    options = ["-n", "50", "--method", "greedy"] if command == "grammar" else ["--no-check"]
+    for sized, folder in ((False, "unsized"), (True, "sized")):
+        target = tmp_path / folder / "s.yaml"
+        output = ["-o", str(target if command == "infer" else target.parent)]
+        size = ["--size", "15x12"] if sized else []
+        code, _, err = run(capsys, command, str(sample), *options, *output, *size)
+        assert code == 0, err
+        told = [line for line in err.splitlines() if "a CMP annotation has no size" in line]
+        assert len(told) == (0 if sized else 1), err
+        assert all(
+            line.startswith(f"{sample}: warning: ") and "read as a 1 x 1 m façade" in line
+            for line in told
+        )
+        if command == "infer":
+            report = json.loads(target.with_name("s.infer.json").read_text())
+            assert bool(report["warnings"]) is not sized

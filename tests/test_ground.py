@@ -276,11 +276,13 @@ def test_a_road_meets_a_lawn_at_a_kerb(seed: int) -> None:
 @pytest.mark.parametrize("seed", [16, 17, 18])
 def test_benches_stand_on_paving_at_a_lawns_edge_facing_it(seed: int) -> None:
     """Benches along the paving where a lawn opens before it: on paving, 2.5 m or more
-    from the walls, no road within 4 m, facing the lawn (3 m ahead is grass, the way
-    away from the walls), 40 m apart and 2.5 m clear of the trees and lamps."""
-    houses = _houses(seed)
+    from the walls, no road within 4 m, facing the lawn (3 m ahead is grass), 40 m apart
+    and 2.5 m clear of the trees and lamps. The lawns are the public ones between blocks
+    50 m apart (a detached house's are its garden's, where no bench stands:
+    test_detached_houses_stand_in_gardens_with_a_drive_each)."""
+    houses, _, _ = _blocks(seed, 50)
     ground = _ground(houses)
-    assert len(ground.benches) >= 20
+    assert len(ground.benches) >= 12
     left = min(b[0] for b in houses) - MARGIN
     top = max(b[3] for b in houses) + MARGIN
     asphalt = np.argwhere(ground.kinds == ASPHALT)
@@ -295,7 +297,6 @@ def test_benches_stand_on_paving_at_a_lawns_edge_facing_it(seed: int) -> None:
         row, column = (top - y) / CELL - 0.5, (x - left) / CELL - 0.5
         assert np.hypot(asphalt[:, 0] - row, asphalt[:, 1] - column).min() * CELL > 4 - CELL
         assert kind(x + 3 * ahead_x, y + 3 * ahead_y) == GRASS
-        assert _wall_distance(houses, x + 3 * ahead_x, y + 3 * ahead_y) > wall
         others = [*ground.trees, *((lx, ly) for lx, ly, *_ in ground.lamps)]
         assert all(np.hypot(ox - x, oy - y) >= 2.5 - CELL for ox, oy in others)
     for index, (x, y, *_) in enumerate(ground.benches):
@@ -394,3 +395,43 @@ def test_trees_stand_in_woods_and_parks_never_on_water_nor_by_a_building(seed: i
         nearest = np.hypot(water_rows - row, water_columns - column).min() * CELL
         assert nearest >= 2.5
         assert near[row, column] * CELL >= 2.5
+
+
+def _band(houses: list[Box], kinds: np.ndarray, near: float, far: float) -> list[np.ndarray]:
+    """The kinds of the cells from ``near`` to ``far`` metres round each house (of a plan
+    drawn by _ground; the nearest house's, others' cells left out)."""
+    rows, columns = kinds.shape
+    left = min(b[0] for b in houses) - MARGIN
+    top = max(b[3] for b in houses) + MARGIN
+    x = left + (np.arange(columns) + 0.5) * CELL
+    y = top - (np.arange(rows) + 0.5) * CELL
+    bands = []
+    for x0, y0, x1, y1 in houses:
+        dx = np.maximum(np.maximum(x0 - x, x - x1), 0)[None, :]
+        dy = np.maximum(np.maximum(y0 - y, y - y1), 0)[:, None]
+        distance = np.hypot(dx, dy)
+        bands.append(kinds[(distance >= near) & (distance < far)])
+    return bands
+
+
+@pytest.mark.parametrize("seed", [19, 20, 21])
+def test_detached_houses_stand_in_gardens_with_a_drive_each(seed: int) -> None:
+    """A town of detached houses has streets between blocks of houses, each house in its
+    garden with a drive to the street (on main a ring of paving, then a ring road, round
+    every house: 4 m round each was paving and asphalt): from 1.5 to 4 m round a house
+    mostly lawn, its drive across it; each house's drive reaches a road's asphalt over
+    paving alone; the street lamps along the roads, no bench in a garden."""
+    from scipy.ndimage import label
+
+    houses = _houses(seed)
+    ground = _ground(houses)
+    bands = _band(houses, ground.kinds, 1.5, 4)
+    lawn = [float((band == GRASS).mean()) for band in bands]
+    assert min(lawn) > 0.5 and float(np.mean(lawn)) > 0.75, (min(lawn), np.mean(lawn))
+    assert float(np.mean([(band == ASPHALT).mean() for band in bands])) < 0.02
+    paved, _ = label(np.isin(ground.kinds, (PAVEMENT, KERB, ASPHALT)))
+    for house, band in zip(houses, _band(houses, paved, 0, 1), strict=True):
+        ways = set(band[band > 0].tolist())
+        assert (ground.kinds[np.isin(paved, list(ways))] == ASPHALT).any(), house
+    assert (ground.kinds == ASPHALT).mean() > 0.08  # streets, not lanes
+    assert len(ground.lamps) >= 40 and not ground.benches

@@ -201,7 +201,8 @@ def test_obj_and_usd_name_the_pictures_written_beside_them(
             assert (tmp_path / line.split()[-1]).is_file(), line
     stage = (tmp_path / "townhouse.usda").read_text()
     named = re.findall(r"asset inputs:file = @\./([^@]+)@", stage)
-    assert len(named) == 3 * len(entries)
+    lit = sum("map_Ke " in entry for entry in entries)  # a lit room's: its base colour again
+    assert lit == 1 and len(named) == 3 * len(entries) + lit
     assert all((tmp_path / name).is_file() for name in named)
     for name in set(named):
         with Image.open(tmp_path / name) as image:
@@ -372,3 +373,61 @@ def test_render_and_concrete_shade_only_at_their_lines(name: str, resolution: in
     assert float(tilt[open_surface].mean()) <= 1.5, float(tilt[open_surface].mean())
     if name == "concrete":  # the lines and the tie holes still shade
         assert ao[~open_surface].min() <= 0.5
+
+
+# two storeys of one window 1.5 x 1.5 m each, a room behind each (the library's rooms)
+LIT_SPEC = """
+version: 1
+name: lit
+canvas: {width: 6.0, height: 6.0}
+symbol_defaults: {opaque: true}
+symbols:
+  A: {size: 2.25, label: wall}
+  B: {size: 1.5, label: window}
+  P: {size: 0.75, label: plinth}
+patterns: {across: "A B A", up: "P B P P B P"}
+layers: [{name: base, x: across, y: up}]
+shapes:
+  - {match: {x: B, y: B}, material: glass, depth: -0.08, thickness: 0.02}
+materials:
+  plaster: {library: render, resolution: 64}
+  glass: {library: float-glass, resolution: 64}
+  interior: {library: rooms, resolution: 64}
+defaults: {mesh: box, material: plaster, thickness: 0.2}
+"""
+
+
+def test_the_ground_floors_rooms_are_lit_in_every_format(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The room behind the ground floor's window (its floor under 2 m) gives off light,
+    1.2 times its pictures' colours, warm or cool as each room is drawn: in the glb
+    emissiveFactor 1 and KHR_materials_emissive_strength 1.2 over the room's own
+    picture, the upper floor's room unlit; in OBJ ``Ke`` and ``map_Ke``, in USD an
+    emissiveColor read from the base colour picture scaled by 1.2."""
+    (tmp_path / "lit.yaml").write_text(LIT_SPEC)
+    layout = solve(load_spec(tmp_path / "lit.yaml"))
+    scene = facade_scene(layout)
+    tree, _ = read_glb(glb_bytes(scene, material_extensions(layout.spec)))
+    by_name = {m["name"]: m for m in tree["materials"]}
+    lit, unlit = by_name["interior-lit"], by_name["interior"]
+    assert lit["emissiveFactor"] == [1.0, 1.0, 1.0] and "emissiveFactor" not in unlit
+    assert lit["extensions"]["KHR_materials_emissive_strength"] == {"emissiveStrength": 1.2}
+    assert lit["emissiveTexture"] == lit["pbrMetallicRoughness"]["baseColorTexture"]
+    assert "KHR_materials_emissive_strength" in tree["extensionsUsed"]
+    floors = {}  # each room's material -> the heights of its rooms' floors
+    for node in scene.graph.nodes_geometry:
+        matrix, geometry = scene.graph[node]
+        if geometry.startswith("room-"):
+            low = scene.geometry[geometry].bounds[0][1] + matrix[1, 3]
+            floors.setdefault(geometry.split("-", 1)[1].rsplit("-", 1)[0], []).append(low)
+    assert max(floors["interior-lit"]) < 2.0 <= min(floors["interior"]), floors
+    code, _, err = facade(capsys, "solve", tmp_path / "lit.yaml", "-o", tmp_path, "-f", "obj,usd")
+    assert code == 0, err
+    mtl = (tmp_path / "lit.mtl").read_text().split("newmtl ")
+    (entry,) = [e for e in mtl if e.startswith("interior-lit")]
+    assert "Ke 1.20000000 1.20000000 1.20000000" in entry
+    assert "map_Ke lit_interior_basecolor.png" in entry
+    stage = (tmp_path / "lit.usda").read_text()
+    assert stage.count("inputs:emissiveColor.connect") == 1
+    assert "float4 inputs:scale = (1.2, 1.2, 1.2, 1)" in stage

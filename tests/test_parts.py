@@ -11,7 +11,7 @@ import pytest
 
 from facadecli import load_spec, parse_spec, solve
 from facadecli.export.glb_merge import merge_glb, read_glb
-from facadecli.export.gltf import glb_bytes
+from facadecli.export.gltf import EMISSIVE_STRENGTH, glb_bytes
 from facadecli.export.svg import svg_text
 from facadecli.geometry.cell import Cell, railing_plan, shutter_plan
 from facadecli.geometry.facade import IOR, TRANSMISSION, facade_scene, material_extensions
@@ -192,8 +192,12 @@ def test_glass_lets_light_through_in_the_glb(tmp_path: Path) -> None:
     glass = [m for m in document["materials"] if m["name"] == "glass"]
     assert glass and glass[0]["extensions"] == glass_light
     assert {TRANSMISSION, IOR} <= set(document["extensionsUsed"])
-    others = [m for m in document["materials"] if m["name"] != "glass"]
-    assert all("extensions" not in m for m in others)
+    others = {m["name"]: m.get("extensions", {}) for m in document["materials"]}
+    del others["glass"]
+    # no other material lets light through; the one given off by a lit ground floor's
+    # rooms is stronger than 1 by an extension of its own
+    assert {name for name, found in others.items() if found} <= {"interior-lit"}
+    assert all(set(found) <= {EMISSIVE_STRENGTH} for found in others.values())
     # a city merges building files: the extension stays declared
     for name in ("a", "b"):
         (tmp_path / f"{name}.glb").write_bytes(
@@ -201,7 +205,7 @@ def test_glass_lets_light_through_in_the_glb(tmp_path: Path) -> None:
         )
     merge_glb([(n, tmp_path / f"{n}.glb") for n in ("a", "b")], tmp_path / "city.glb")
     merged, _ = read_glb((tmp_path / "city.glb").read_bytes())
-    assert merged["extensionsUsed"] == [IOR, TRANSMISSION]
+    assert merged["extensionsUsed"] == [EMISSIVE_STRENGTH, IOR, TRANSMISSION]
 
 
 def test_without_transmission_no_extension_is_declared() -> None:

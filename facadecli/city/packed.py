@@ -6,7 +6,9 @@ and GEOS objects: kilobytes a building, held for the whole run. Packed, tasks ar
 in chunks of :data:`CHUNK`, each pickled (geometry as its WKB: exact coordinates) and
 compressed, the run's specs (large, and the same objects for many buildings) named by a
 key rather than copied (:meth:`pickle.Pickler.persistent_id`); a task is made again when
-it is read, equal to the one put in. Reading in order decodes each chunk once.
+it is read, equal to the one put in. Reading in order decodes each chunk once. The
+packed chunks are spilled to an unnamed temporary file (gone when the object is, or the
+process): what stays in memory is where each chunk starts, 8 bytes for CHUNK items.
 """
 
 from __future__ import annotations
@@ -105,22 +107,27 @@ class Spooled(Pickling, Positional[T]):
 
 
 class Packed(Pickling, Positional[T]):
-    """Items appended (:meth:`append`) then read by position, kept packed in chunks.
-    ``shared`` names the large objects the items refer to and that stay in memory
-    anyway (the run's specs, by their manifest path): they are packed as their name.
-    Items must be picklable, and equal to themselves pickled and unpickled."""
+    """Items appended (:meth:`append`) then read by position, kept packed in chunks
+    spilled to an unnamed temporary file (see the module). ``shared`` names the large
+    objects the items refer to and that stay in memory anyway (the run's specs, by
+    their manifest path): they are packed as their name. Items must be picklable, and
+    equal to themselves pickled and unpickled."""
 
     def __init__(self, shared: dict[str, object] | None = None, chunk: int = CHUNK):
         super().__init__(shared)
         self._chunk = chunk
-        self._packed: list[bytes] = []
+        self._file = tempfile.TemporaryFile()  # noqa: SIM115 (open as long as the items)
+        self._starts = array("q", [0])  # where each packed chunk starts in the file, then the end
         self._open: list[T] = []  # the last chunk, not yet packed
         self._cached: tuple[int, list[T]] = (-1, [])  # the last chunk read
 
     def append(self, item: T) -> None:
         self._open.append(item)
         if len(self._open) == self._chunk:
-            self._packed.append(self._pack(self._open))
+            data = self._pack(self._open)
+            self._file.seek(self._starts[-1])
+            self._file.write(data)
+            self._starts.append(self._starts[-1] + len(data))
             self._open = []
 
     def extend(self, items: Iterable[T]) -> None:
@@ -128,8 +135,14 @@ class Packed(Pickling, Positional[T]):
             self.append(item)
 
     def packed_bytes(self) -> int:
-        """The bytes the packed chunks take (their payload)."""
-        return sum(len(data) for data in self._packed)
+        """The bytes the packed chunks take (their payload, on disk)."""
+        return self._starts[-1]
+
+    def _packed(self, number: int) -> bytes:
+        """The packed chunk ``number``, read from the file."""
+        start = self._starts[number]
+        self._file.seek(start)
+        return self._file.read(self._starts[number + 1] - start)
 
     def _pack(self, items: list[T]) -> bytes:
         return self._dumps(items)
@@ -139,21 +152,21 @@ class Packed(Pickling, Positional[T]):
         return items
 
     def _chunk_at(self, number: int) -> list[T]:
-        if number == len(self._packed):
+        if number == len(self._starts) - 1:
             return self._open
         if self._cached[0] != number:
-            self._cached = (number, self._unpack(self._packed[number]))
+            self._cached = (number, self._unpack(self._packed(number)))
         return self._cached[1]
 
     def __len__(self) -> int:
-        return len(self._packed) * self._chunk + len(self._open)
+        return (len(self._starts) - 1) * self._chunk + len(self._open)
 
     def _at(self, index: int) -> T:
         return self._chunk_at(index // self._chunk)[index % self._chunk]
 
     def __iter__(self) -> Iterator[T]:
-        for number in range(len(self._packed)):
-            yield from self._unpack(self._packed[number])  # not cached: a pass in order
+        for number in range(len(self._starts) - 1):
+            yield from self._unpack(self._packed(number))  # not cached: a pass in order
         yield from list(self._open)
 
     def __repr__(self) -> str:

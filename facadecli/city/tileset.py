@@ -28,7 +28,10 @@ factor are in them) and up, measured with PROJ at the origin.
 **Files.** ``3dtiles/<level>/<column>/<row>.lod<k>.glb``: a square's tiles are written,
 each atomically, as soon as its last building is done (or failed), and
 ``tileset.json`` last, atomically; files of an earlier run the tileset no longer names
-are removed. The same buildings give the same bytes.
+are removed. The same buildings give the same bytes. While the run goes, what each
+square's tiles leave for ``tileset.json`` is kept in an unnamed temporary file in
+``3dtiles/`` (:class:`SquareRecords`): nothing of it is left beside the outputs, even
+when the run is killed.
 """
 
 from __future__ import annotations
@@ -38,6 +41,8 @@ import json
 import math
 import os
 import re
+import struct
+import tempfile
 from array import array
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
@@ -126,25 +131,19 @@ def _to_ecef() -> pyproj.Transformer:
     )
 
 
-@dataclass(slots=True)
+@dataclass(frozen=True, slots=True)
 class Square:
-    """A square of the quadtree: its place, its children, where its buildings are in the
-    tree's order (:func:`quadtree`), and the levels of detail whose tiles it holds
-    (:meth:`TilesetWriter.__init__`)."""
+    """A square of the quadtree as read from its arrays (:meth:`Quadtree.square`), made
+    when asked for, not held: its place in the tree's depth-first order (``index``), its
+    level, column and row, and where its buildings are in the tree's order (from
+    ``start`` to ``end``)."""
 
+    index: int
     level: int
     column: int
     row: int
-    children: tuple[Square, ...] = ()  # none for a leaf: no list a leaf
-    start: int = 0  # its buildings: the tree's order from ``start`` to ``end``
-    end: int = 0
-    lods: tuple[int, ...] = ()  # the levels of detail of its tiles, coarse first
-    left: int = 0  # its buildings not done yet
-    tiles: Sequence[dict[str, Any]] = ()  # its chain, coarse first, once written
-    box: Box | None = None  # of its content; and its children's, once spanned (_span)
-    # the largest of its children's errors, once spanned; None when none of its
-    # buildings was built
-    below: float | None = None
+    start: int
+    end: int
 
     @property
     def count(self) -> int:
@@ -157,17 +156,54 @@ Centroids = Sequence[tuple[float, float]]  # each building's centroid, in the ru
 
 @dataclass(frozen=True)
 class Quadtree:
-    """The quadtree of a run's buildings (:func:`quadtree`): its root square, its frame
-    (the root's south-west corner and side, metres) and ``order``, the buildings'
+    """The quadtree of a run's buildings (:func:`quadtree`): its frame (the root's
+    south-west corner and side, metres), its squares and ``order``, the buildings'
     positions in the run leaf by leaf, depth first, each leaf's in the run's order: a
-    square's buildings are ``order[square.start:square.end]``, 8 bytes a building in
-    one array, not a list of ids in every square on the way to its leaf."""
+    square's buildings are ``order[start:end]``, 8 bytes a building in one array, not a
+    list of ids in every square on the way to its leaf.
 
-    root: Square
+    The squares are numpy arrays in the tree's depth-first order (the root first, each
+    square before its children, a square's children in column and row order): their
+    ``level``, ``column``, ``row``, ``start``, ``end`` and ``after`` (the first square
+    past its own and its children's: a leaf's is the next one). 33 bytes a square, where
+    a Python object a square took over 100 and a tuple of its children."""
+
     west: float
     south: float
     side: float
     order: np.ndarray
+    level: np.ndarray
+    column: np.ndarray
+    row: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    after: np.ndarray
+
+    def __len__(self) -> int:
+        """How many squares the tree has."""
+        return len(self.level)
+
+    def square(self, index: int) -> Square:
+        """The square at ``index`` in the tree's depth-first order."""
+        return Square(
+            index,
+            int(self.level[index]),
+            int(self.column[index]),
+            int(self.row[index]),
+            int(self.start[index]),
+            int(self.end[index]),
+        )
+
+    @property
+    def root(self) -> Square:
+        return self.square(0)
+
+    def children(self, square: Square) -> Iterator[Square]:
+        """The square's children, in column and row order (none for a leaf)."""
+        index = square.index + 1
+        while index < self.after[square.index]:
+            yield self.square(index)
+            index = int(self.after[index])
 
     def members(self, square: Square) -> list[int]:
         """The positions of the square's buildings, in the run's order."""
@@ -177,9 +213,9 @@ class Quadtree:
         """The squares from the root to the leaf a centroid lies in."""
         square = self.root
         yield square
-        while square.children:
+        while self.after[square.index] > square.index + 1:
             column, row = _quarter(square, point, self.west, self.south, self.side)
-            square = next(c for c in square.children if (c.column, c.row) == (column, row))
+            square = next(c for c in self.children(square) if (c.column, c.row) == (column, row))
             yield square
 
     def find(self, level: int, column: int, row: int) -> Square | None:
@@ -188,7 +224,9 @@ class Quadtree:
         while square.level < level:
             shift = level - square.level - 1
             inner = [
-                c for c in square.children if (c.column, c.row) == (column >> shift, row >> shift)
+                c
+                for c in self.children(square)
+                if (c.column, c.row) == (column >> shift, row >> shift)
             ]
             if not inner:
                 return None
@@ -214,37 +252,107 @@ def quadtree(centroids: Centroids, capacity: int) -> Quadtree:
     power-of-two side (from 1 m) holding them all, its south-west corner at the lowest
     centroid."""
     if not centroids:
-        return Quadtree(Square(0, 0, 0), 0.0, 0.0, 1.0, np.zeros(0, dtype=np.int64))
-    west = math.floor(min(x for x, _ in centroids))
-    south = math.floor(min(y for _, y in centroids))
-    east, north = max(x for x, _ in centroids), max(y for _, y in centroids)
-    side = 1.0
-    while west + side <= east or south + side <= north:
-        side *= 2
-    root = Square(0, 0, 0)
+        west = south = 0.0
+        side = 1.0
+    else:
+        west = math.floor(min(x for x, _ in centroids))
+        south = math.floor(min(y for _, y in centroids))
+        east, north = max(x for x, _ in centroids), max(y for _, y in centroids)
+        side = 1.0
+        while west + side <= east or south + side <= north:
+            side *= 2
+    rows: dict[str, array[int]] = {key: array("q") for key in FIELDS}
     leaves: list[array[int]] = []  # each leaf's positions, depth first
     placed = [0]  # positions put in the order so far
 
     def split(square: Square, items: array[int]) -> None:
-        square.start = placed[0]
+        index = square.index
+        values = (square.level, square.column, square.row, placed[0], 0, 0)  # end, after: below
+        for field, value in zip(FIELDS, values, strict=True):
+            rows[field].append(value)
         if len(items) <= capacity or square.level >= MAX_LEVEL:
             leaves.append(items)
             placed[0] += len(items)
-            square.end = placed[0]
-            return
-        quarters: dict[tuple[int, int], array[int]] = {}
-        for position in items:
-            key = _quarter(square, centroids[position], west, south, side)
-            quarters.setdefault(key, array("q")).append(position)
-        del items
-        square.children = tuple(Square(square.level + 1, *key) for key in sorted(quarters))
-        for child in square.children:
-            split(child, quarters.pop((child.column, child.row)))
-        square.end = placed[0]
+        else:
+            quarters: dict[tuple[int, int], array[int]] = {}
+            for position in items:
+                key = _quarter(square, centroids[position], west, south, side)
+                quarters.setdefault(key, array("q")).append(position)
+            del items
+            for column, row in sorted(quarters):
+                child = Square(len(rows["level"]), square.level + 1, column, row, 0, 0)
+                split(child, quarters.pop((column, row)))
+        rows["end"][index] = placed[0]
+        rows["after"][index] = len(rows["level"])
 
-    split(root, array("q", range(len(centroids))))
+    split(Square(0, 0, 0, 0, 0, 0), array("q", range(len(centroids))))
     order = np.concatenate([np.frombuffer(leaf, dtype=np.int64) for leaf in leaves])
-    return Quadtree(root, west, south, side, order)
+    found = {key: np.frombuffer(rows[key], dtype=np.int64).astype(KINDS[key]) for key in FIELDS}
+    return Quadtree(west, south, side, order, **found)
+
+
+FIELDS = ("level", "column", "row", "start", "end", "after")  # a square's, in its arrays
+KINDS = {"level": np.uint8, "column": np.int32, "row": np.int32}
+KINDS |= {"start": np.int64, "end": np.int64, "after": np.int64}
+
+
+class SquareRecords:
+    """What the squares' tiles leave for ``tileset.json``, spilled to an unnamed temporary
+    file in ``folder`` (made on the first record; gone with the object or the process,
+    nothing beside the outputs) at each square's place in the tree's depth-first order:
+    a sorted run, read back in that order as ``tileset.json`` is written. Two fixed-size
+    records a square: its tiles' (:meth:`put_tiles`: its content's box and each tile's
+    error, once written) and its span's (:meth:`put_span`: the box of its content and
+    its children's, and their largest error). Nothing a square is held in memory."""
+
+    TILES = struct.Struct(f"<?6d{len(LODS)}d")  # written, box, each tile's error (its chain's)
+    SPAN = struct.Struct("<?6dd")  # spanned (any building built), box, largest error below
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self._file: Any = None
+        self._size = self.TILES.size + self.SPAN.size
+
+    def _at(self, index: int, offset: int) -> Any:
+        if self._file is None:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            self._file = tempfile.TemporaryFile(dir=self.folder)  # noqa: SIM115 (with self)
+        self._file.seek(index * self._size + offset)
+        return self._file
+
+    def _read(self, index: int, offset: int, record: struct.Struct) -> tuple[Any, ...] | None:
+        if self._file is None:
+            return None
+        data = self._at(index, offset).read(record.size)
+        if len(data) < record.size or not data[0]:  # past the end, or a hole: not put
+            return None
+        return record.unpack(data)
+
+    def put_tiles(self, index: int, box: Box, errors: Sequence[float]) -> None:
+        padded = [*errors, *[0.0] * (len(LODS) - len(errors))]
+        self._at(index, 0).write(self.TILES.pack(True, *box, *padded))
+
+    def tiles(self, index: int, count: int) -> tuple[Box, list[float]] | None:
+        """The square's content box and its ``count`` tiles' errors; None when not written."""
+        found = self._read(index, 0, self.TILES)
+        if found is None:
+            return None
+        return _six(found[1:7]), list(found[7 : 7 + count])
+
+    def put_span(self, index: int, box: Box, below: float) -> None:
+        self._at(index, self.TILES.size).write(self.SPAN.pack(True, *box, below))
+
+    def span(self, index: int) -> tuple[Box, float] | None:
+        """The square's spanned box and largest error below; None when none of its
+        buildings was built."""
+        found = self._read(index, self.TILES.size, self.SPAN)
+        if found is None:
+            return None
+        return _six(found[1:7]), found[7]
+
+
+def _six(values: Sequence[float]) -> Box:
+    return (values[0], values[1], values[2], values[3], values[4], values[5])
 
 
 class TilesetWriter:
@@ -257,7 +365,10 @@ class TilesetWriter:
     larger tiles. What it keeps of a building while the run goes is its place in the
     tree's order (8 bytes, :class:`Quadtree`) and, from its end to its square's, its
     glb: a building's squares are found again from its centroid (``centroids``, the
-    run's, read not copied)."""
+    run's, read not copied). Of a square, its place in the tree's arrays, its chain of
+    LODs and its buildings not done yet (42 bytes); what its tiles leave for
+    ``tileset.json`` (their box and errors) is spilled to disk as they are written
+    (:class:`SquareRecords`) and read back in the tree's order by :meth:`close`."""
 
     def __init__(
         self,
@@ -271,9 +382,11 @@ class TilesetWriter:
         self.lods = tuple(sorted(lods))
         self.centroids = centroids
         self.tree = quadtree(centroids, CAPACITY[self.lods[-1]])
-        self.root = self.tree.root
-        self._chains: dict[tuple[int, ...], tuple[int, ...]] = {}
-        self._assign(self.root, ())
+        self.chains: list[tuple[int, ...]] = [()]  # the few chains of LODs, each held once
+        self.chain = np.zeros(len(self.tree), dtype=np.uint8)  # each square's, in chains
+        self.left = np.zeros(len(self.tree), dtype=np.int64)  # its buildings not done yet
+        self._assign(self.tree.root, ())
+        self.records = SquareRecords(self.folder)  # the squares' tiles once written
         self.ready: dict[int, tuple[str, Path]] = {}  # built buildings' ids and glbs, by
         # position, until their tiles are written
         self.boxes: dict[int, Box] = {}  # their LOD3 boxes, likewise
@@ -284,19 +397,25 @@ class TilesetWriter:
     def _assign(self, square: Square, done: tuple[int, ...]) -> None:
         """The LODs of the square's tiles: each not yet above it, once it holds at most
         that LOD's CAPACITY of buildings (or it is a leaf)."""
-        leaf = not square.children
+        children = list(self.tree.children(square))
         lods = tuple(
-            k for k in self.lods if k not in done and (square.count <= CAPACITY[k] or leaf)
+            k for k in self.lods if k not in done and (square.count <= CAPACITY[k] or not children)
         )
-        square.lods = self._chains.setdefault(lods, lods)  # a few different ones, each held once
-        if square.lods:
-            square.left = square.count
-        for child in square.children:
-            self._assign(child, done + square.lods)
+        if lods not in self.chains:
+            self.chains.append(lods)
+        self.chain[square.index] = self.chains.index(lods)
+        if lods:
+            self.left[square.index] = square.count
+        for child in children:
+            self._assign(child, done + lods)
+
+    def lods_of(self, square: Square) -> tuple[int, ...]:
+        """The levels of detail of the square's tiles, coarse first (none: no content)."""
+        return self.chains[int(self.chain[square.index])]
 
     def _holders(self, position: int) -> list[Square]:
         """The squares with tiles of the building at ``position``, root first."""
-        return [s for s in self.tree.path(self.centroids[position]) if s.lods]
+        return [s for s in self.tree.path(self.centroids[position]) if self.chain[s.index]]
 
     def done(self, position: int, building_id: str, glb: Path | None) -> None:
         """The building at ``position`` in the run (``building_id``) has ended: built
@@ -304,8 +423,8 @@ class TilesetWriter:
         if glb is not None:
             self.ready[position] = (building_id, glb)
         for square in self._holders(position):
-            square.left -= 1
-            if square.left == 0:
+            self.left[square.index] -= 1
+            if self.left[square.index] == 0:
                 self._write_square(square)
 
     def _lod3_box(self, position: int) -> Box:
@@ -318,12 +437,13 @@ class TilesetWriter:
         built = [self.ready[k] for k in members]
         if not built:
             return
-        features = [feature_of(glb) for _, glb in built] if square.lods[0] < 3 else []
+        lods = self.lods_of(square)
+        features = [feature_of(glb) for _, glb in built] if lods[0] < 3 else []
         boxes: dict[int, Box] = {}
         relief = {1: 0.0, 2: 0.0}  # how far each building's LOD3 stands out of the LOD's box
         finest = [self._lod3_box(k) for k in members]
-        name = f"{square.level}/{square.column}/{square.row}"
-        for lod in square.lods:
+        name = _name(square)
+        for lod in lods:
             path = self.folder / f"{name}.lod{lod}.glb"
             if lod == 3:
                 merge_glb(built, path)
@@ -341,26 +461,25 @@ class TilesetWriter:
             self.bytes[lod] += path.stat().st_size
             self.written += 1
         roofs = max((roof_depth(f) for f in features), default=0.0)
-        tiles = []
-        for lod in square.lods:  # what each gets wrong; finer tiles below may raise it
+        errors = []
+        for lod in lods:  # what each gets wrong; finer tiles below may raise it
             missed = 0.0
             if lod != 3:
                 missed = max(relief[lod], MIN_ERROR[lod]) + (roofs if lod == 1 else 0.0)
-            uri = f"{name}.lod{lod}.glb"
-            tiles.append({"lod": lod, "uri": uri, "error": round(missed, 3)})
-        square.tiles = tiles
-        square.box = _union(boxes.values())
+            errors.append(round(missed, 3))
+        self.records.put_tiles(square.index, _union(boxes.values()), errors)
         for k in members:  # a building's glb is let go with the last of its tiles
-            if all(holder.left == 0 for holder in self._holders(k)):
+            if all(self.left[holder.index] == 0 for holder in self._holders(k)):
                 self.ready.pop(k)
                 self.boxes.pop(k, None)
 
     def close(self, name: str) -> dict[str, Any]:
         """Write ``tileset.json`` (and remove tiles an earlier run left that it does not
         name); returns what the report says of the tiles. The file is written as its
-        text is made, a tile at a time from the squares' spans (:meth:`_span`): no tile's
-        JSON is held but those on the way from the root to the one written."""
-        top = self._span(self.root, covered=False)
+        text is made, a tile at a time from the squares' records read back in the tree's
+        order (:class:`SquareRecords`, :meth:`_span`): no tile's JSON is held but those on
+        the way from the root to the one written."""
+        top = self._span(self.tree.root, covered=False)
         self.folder.mkdir(parents=True, exist_ok=True)
         self._remove_stale()
         transform = {"transform": ecef_transform(self.georef)}
@@ -374,7 +493,7 @@ class TilesetWriter:
             root = empty
             error = 0.0
         else:
-            root = self._tile(self.root, False, None, transform)
+            root = self._tile(self.tree.root, False, None, transform)
             error = top[1]
         tileset = {
             "asset": {"version": "1.1", "generator": "facadecli"},
@@ -394,21 +513,27 @@ class TilesetWriter:
             "bytes": {f"lod{k}": v for k, v in self.bytes.items()},
         }
 
+    def _tiles(self, square: Square) -> tuple[Box, list[float]] | None:
+        """The square's content box and its tiles' errors, coarse first, once written."""
+        return self.records.tiles(square.index, len(self.lods_of(square)))
+
     def _span(self, square: Square, covered: bool) -> tuple[Box, float] | None:
         """The square's tile as its parent sees it: its box (as written, widened) and
         its geometric error, before :meth:`_tile` raises an error under content; None
-        when none of its buildings was built. What :meth:`_tile` needs again is kept in
-        the square, in place of what it held (``box``: its content's and its children's
-        now; ``below``: their largest error). ``covered``: a square above has content."""
-        below = covered or bool(square.tiles)
-        found = [span for child in square.children if (span := self._span(child, below))]
-        square.below = None
-        if not found and not square.tiles:
+        when none of its buildings was built. What :meth:`_tile` needs again is put in
+        the square's span record (:class:`SquareRecords`: the box of its content and its
+        children's, and their largest error). ``covered``: a square above has content."""
+        tiles = self._tiles(square)
+        below = covered or tiles is not None
+        found = [span for child in self.tree.children(square) if (span := self._span(child, below))]
+        if not found and tiles is None:
             return None
-        own = [square.box] if square.box is not None else []
-        square.box = _union([*(box for box, _ in found), *own])
-        square.below = max((error for _, error in found), default=0.0)
-        return _unbox(_box(square.box)), _errors(square, covered)[0]
+        own = [tiles[0]] if tiles is not None else []
+        box = _union([*(box for box, _ in found), *own])
+        largest = max((error for _, error in found), default=0.0)
+        self.records.put_span(square.index, box, largest)
+        errors = _errors(box, largest, tiles[1] if tiles is not None else [], covered)
+        return _unbox(_box(box)), errors[0]
 
     def _tile(
         self, square: Square, covered: bool, ceiling: float | None, first: dict[str, Any]
@@ -420,12 +545,14 @@ class TilesetWriter:
         (``ceiling``, its error) takes that one's error: a viewer that refined it goes on
         through it to the content below (with a smaller error it would stop there, and
         draw nothing). ``first``: keys the tile starts with (the root's transform)."""
-        assert square.box is not None
-        box = _box(square.box)
-        below = covered or bool(square.tiles)
-        shown = [child for child in square.children if child.below is not None]
-        errors = _errors(square, covered)
-        if not square.tiles:
+        span = self.records.span(square.index)
+        assert span is not None
+        tiles = self._tiles(square)
+        box = _box(span[0])
+        below = covered or tiles is not None
+        shown = [c for c in self.tree.children(square) if self.records.span(c.index) is not None]
+        errors = _errors(span[0], span[1], tiles[1] if tiles is not None else [], covered)
+        if tiles is None:
             error = errors[0] if ceiling is None else ceiling
             return {
                 **first,
@@ -434,15 +561,16 @@ class TilesetWriter:
                 "refine": "REPLACE",
                 "children": self._children(shown, below, ceiling),
             }
+        name = _name(square)
         chain = [
             {
                 **(first if number == 0 else {}),
                 "boundingVolume": {"box": box},
                 "geometricError": error,
                 "refine": "REPLACE",
-                "content": {"uri": entry["uri"]},
+                "content": {"uri": f"{name}.lod{lod}.glb"},
             }
-            for number, (entry, error) in enumerate(zip(square.tiles, errors, strict=True))
+            for number, (lod, error) in enumerate(zip(self.lods_of(square), errors, strict=True))
         ]
         if shown:
             chain[-1]["children"] = self._children(shown, below, errors[-1])
@@ -474,25 +602,31 @@ class TilesetWriter:
         if len(parts) != 3 or not all(NUMBER.fullmatch(n) for n in numbers):
             return False
         square = self.tree.find(*(int(n) for n in numbers))
-        uri = "/".join(parts)
-        return square is not None and any(tile["uri"] == uri for tile in square.tiles)
+        if square is None or self._tiles(square) is None:
+            return False
+        return int(parts[-1].split(".")[1][3:]) in self.lods_of(square)
 
 
-def _errors(square: Square, covered: bool) -> list[float]:
-    """The geometric errors of the square's tiles (its chain, coarse first; or its one
-    tile without content) before a tile above with content raises the latter's: each at
-    least its children's (``below``); without content, all of it missing (the diagonal
-    of its box, at least twice its children's) unless ``covered``."""
-    assert square.box is not None and square.below is not None
-    box, error = square.box, square.below
-    if not square.tiles:
+def _name(square: Square) -> str:
+    """The square's tiles' name: ``<level>/<column>/<row>``."""
+    return f"{square.level}/{square.column}/{square.row}"
+
+
+def _errors(box: Box, below: float, own: Sequence[float], covered: bool) -> list[float]:
+    """The geometric errors of a square's tiles (its chain, coarse first, whose own
+    errors are ``own``; or its one tile without content, ``own`` empty) before a tile
+    above with content raises the latter's: each at least its children's (``below``,
+    the largest; ``box``, theirs and its content's); without content, all of it missing
+    (the diagonal of its box, at least twice its children's) unless ``covered``."""
+    error = below
+    if not own:
         if not covered:
             lo, hi = np.array(box[:3]), np.array(box[3:])
             error = max(float(np.linalg.norm(hi - lo)), 2 * error)
         return [round(error, 3)]
     errors = []
-    for entry in reversed(square.tiles):
-        error = max(error, entry["error"])  # at least what the finer tiles get wrong
+    for missed in reversed(own):
+        error = max(error, missed)  # at least what the finer tiles get wrong
         errors.append(round(error, 3))
     return errors[::-1]
 

@@ -33,7 +33,7 @@ def _finish(extensions: Extensions | None) -> Callable[[dict[str, Any]], None]:
     def finish(tree: dict[str, Any]) -> None:
         _share_images(tree)
         _tangent_space(tree)
-        used: set[str] = set()
+        used: set[str] = set(_emissive_strength(tree))
         for material in tree.get("materials", []):
             for extension, value in (extensions or {}).get(material.get("name", ""), {}).items():
                 material.setdefault("extensions", {})[extension] = dict(value)
@@ -42,6 +42,26 @@ def _finish(extensions: Extensions | None) -> Callable[[dict[str, Any]], None]:
             tree["extensionsUsed"] = sorted({*tree.get("extensionsUsed", []), *used})
 
     return finish
+
+
+EMISSIVE_STRENGTH = "KHR_materials_emissive_strength"
+
+
+def _emissive_strength(tree: dict[str, Any]) -> list[str]:
+    """A material giving off more light than its colour (a lit room: ``emissive`` over 1)
+    as glTF has it: ``emissiveFactor`` within 0..1 and the rest as
+    ``KHR_materials_emissive_strength``. Returns the extension if any material uses it."""
+    used = []
+    for material in tree.get("materials", []):
+        factor = material.get("emissiveFactor")
+        strongest = max(factor) if factor else 0.0
+        if strongest > 1.0:
+            material["emissiveFactor"] = [value / strongest for value in factor]
+            material.setdefault("extensions", {})[EMISSIVE_STRENGTH] = {
+                "emissiveStrength": strongest
+            }
+            used = [EMISSIVE_STRENGTH]
+    return used
 
 
 def _share_images(tree: dict[str, Any]) -> None:

@@ -22,10 +22,13 @@ def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, dict[str, bytes]]:
         layer = node.split("/", 1)[0]
         groups.setdefault((layer, mesh.visual.material.name), []).append(mesh)
     flat = trimesh.Scene()
+    materials = {}
     for (layer, material), meshes in groups.items():
         merged = trimesh.util.concatenate(meshes)
         if meshes[0].visual.uv is None:
             merged.visual = trimesh.visual.TextureVisuals(material=meshes[0].visual.material)
+        materials[material] = merged.visual.material
+        merged.visual.material = _Simple.of(merged.visual.material)
         flat.add_geometry(merged, geom_name=f"{layer}.{material}")
     text, textures = export_obj(
         flat,
@@ -35,11 +38,27 @@ def obj_files(scene: trimesh.Scene, name: str) -> tuple[str, dict[str, bytes]]:
         return_texture=True,
         mtl_name=f"{name}.mtl",
     )
-    materials = {m.name: m for m in (g.visual.material for g in flat.geometry.values())}
     pictures = texture_files(sorted(materials.items()), name)
     if pictures.files:
         textures = _pbr_library(textures, f"{name}.mtl", materials, pictures)
     return text, dict(sorted(textures.items()))
+
+
+class _Simple(trimesh.visual.material.SimpleMaterial):  # type: ignore[misc]
+    """An MTL entry as trimesh writes a PBR material's (its base colour and picture), told
+    apart by its name too: trimesh folds materials of equal colours and pictures into one
+    entry, and the upper floors' rooms were drawn in the lit ground floor's."""
+
+    @classmethod
+    def of(cls, material: object) -> object:
+        simple = getattr(material, "to_simple", None)
+        if simple is None:
+            return material
+        plain = simple()
+        return cls(image=plain.image, diffuse=plain.diffuse, name=plain.name)
+
+    def __hash__(self) -> int:
+        return hash((super().__hash__(), self.name))
 
 
 def _pbr_library(
@@ -77,6 +96,8 @@ def _entry(name: str, material: object, pictures: TextureFiles) -> str:
     colour = getattr(material, "baseColorFactor", None)
     opacity = 1.0 if colour is None else float(colour[3]) / 255.0
     base, normal, orm = (pictures.names[(name, slot)] for slot in ("base_colour", "normal", "orm"))
+    glow = getattr(material, "emissiveFactor", None)  # a lit room: its base colour, dimmed
+    lit = [] if glow is None else ["Ke " + " ".join(f"{c:.8f}" for c in glow), f"map_Ke {base}"]
     return "\n".join(
         [
             name,
@@ -88,6 +109,7 @@ def _entry(name: str, material: object, pictures: TextureFiles) -> str:
             f"map_Pr -imfchan g {orm}",
             f"map_Pm -imfchan b {orm}",
             f"map_ao -imfchan r {orm}",
+            *lit,
             "",
         ]
     )

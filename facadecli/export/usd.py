@@ -16,7 +16,7 @@ and the rest of the USD world, written without USD's own library.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +60,7 @@ def _material(
     roughness = 1.0 if roughness is None else roughness
     path = f"{root}/Materials/{name}"
     reads = f"{path}/base_colour.outputs:rgb"
+    glow = getattr(material, "emissiveFactor", None)  # a lit room: its base colour, dimmed
     if pictures:
         inputs = [
             f"                color3f inputs:diffuseColor.connect = <{reads}>",
@@ -68,12 +69,20 @@ def _material(
             f"                float inputs:roughness.connect = <{path}/orm.outputs:g>",
             f"                float inputs:occlusion.connect = <{path}/orm.outputs:r>",
         ]
+        if glow is not None:
+            emission = f"{path}/emission.outputs:rgb"
+            inputs.append(f"                color3f inputs:emissiveColor.connect = <{emission}>")
+            pictures = {**pictures, "emission": pictures["base_colour"]}
     else:
         inputs = [
             f"                color3f inputs:diffuseColor = ({_floats(rgba[:3])})",
             f"                float inputs:metallic = {metallic:.6g}",
             f"                float inputs:roughness = {roughness:.6g}",
         ]
+        if glow is not None:
+            inputs.append(
+                f"                color3f inputs:emissiveColor = ({_floats(np.asarray(glow))})"
+            )
     lines = [
         f'        def Material "{name}"',
         "        {",
@@ -87,13 +96,15 @@ def _material(
         "            }",
     ]
     if pictures:
-        lines += _texture_network(path, pictures)
+        lines += _texture_network(path, pictures, glow)
     return [*lines, "        }"]
 
 
-def _texture_network(path: str, pictures: dict[str, str]) -> list[str]:
+def _texture_network(
+    path: str, pictures: dict[str, str], glow: Sequence[float] | None = None
+) -> list[str]:
     """The ``st`` reader and a UsdUVTexture per picture (normals from 0..1 to -1..1, raw:
-    only the base colour is sRGB)."""
+    only the base colour is sRGB; ``emission``, the base colour scaled by ``glow``)."""
     lines = [
         '            def Shader "st"',
         "            {",
@@ -103,7 +114,7 @@ def _texture_network(path: str, pictures: dict[str, str]) -> list[str]:
         "            }",
     ]
     for slot, file in pictures.items():
-        space = "sRGB" if slot == "base_colour" else "raw"
+        space = "sRGB" if slot in ("base_colour", "emission") else "raw"
         lines += [
             f'            def Shader "{slot}"',
             "            {",
@@ -119,6 +130,8 @@ def _texture_network(path: str, pictures: dict[str, str]) -> list[str]:
                 "                float4 inputs:scale = (2, 2, 2, 1)",
                 "                float4 inputs:bias = (-1, -1, -1, 0)",
             ]
+        if slot == "emission" and glow is not None:
+            lines.append(f"                float4 inputs:scale = ({_floats(np.asarray(glow))}, 1)")
         lines += [
             "                float3 outputs:rgb",
             "                float outputs:r",

@@ -34,6 +34,8 @@ from facadecli.layout import (
     BUILTIN_GLASS,
     BUILTIN_INTERIOR,
     INTERIOR_MATERIAL,
+    LIT_INTERIOR,
+    LIT_INTERIOR_MATERIAL,
     PANE_MATERIAL,
     Layout,
     Shape,
@@ -77,6 +79,7 @@ def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMater
     rgb = linear_rgb(material.color)
     alpha = round(255 * material.opacity)
     blend = "BLEND" if material.opacity < 1.0 else "OPAQUE"
+    glow = material.emissive  # past 1, the glb writes KHR_materials_emissive_strength
     if material.library is not None:
         drawn = images(material)
         return PBRMaterial(
@@ -90,6 +93,8 @@ def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMater
             roughnessFactor=1.0,
             alphaMode=blend,
             doubleSided=False,
+            emissiveFactor=[glow, glow, glow] if glow else None,
+            emissiveTexture=drawn.base_colour if glow else None,
         )
     texture = None
     if material.texture is not None:
@@ -105,6 +110,8 @@ def pbr(name: str, material: Material, base_dir: Path | None = None) -> PBRMater
         roughnessFactor=material.roughness,
         alphaMode=blend,
         doubleSided=False,
+        emissiveFactor=[glow * c / 255 for c in rgb] if glow else None,
+        emissiveTexture=texture if glow else None,
     )
 
 
@@ -117,8 +124,13 @@ def texture_metres(material: Material) -> float | None:
 
 def look(spec: Spec, name: str) -> Material:
     """The material a name stands for in a spec: its own (over the library entry it
-    starts from), a library material, or a built-in (:func:`_builtin`)."""
-    return resolve(spec.materials, name) or _builtin(name)
+    starts from), a library material, or a built-in (:func:`_builtin`); the lit
+    ground floor's rooms, unless the spec names its own, its interior giving off
+    :data:`LIT_INTERIOR` of its colour."""
+    found = resolve(spec.materials, name)
+    if found is None and name == LIT_INTERIOR_MATERIAL:
+        return look(spec, INTERIOR_MATERIAL).model_copy(update={"emissive": LIT_INTERIOR})
+    return found or _builtin(name)
 
 
 def material_names(spec: Spec) -> list[str]:
@@ -131,6 +143,7 @@ def material_names(spec: Spec) -> list[str]:
         *(rule.pane_material for rule in rules),
         PANE_MATERIAL,
         INTERIOR_MATERIAL,
+        LIT_INTERIOR_MATERIAL,
     )
     names = dict.fromkeys(spec.materials)
     for name in named:
@@ -174,6 +187,9 @@ def metric_uv(mesh: trimesh.Trimesh, size: float) -> trimesh.Trimesh:
 
 
 ROOMS = "rooms"  # the library's interiors: an atlas of rooms, one a window (room_uv)
+#: metres up a façade under which a room's floor is the ground floor's (lit: a shop, a
+#: room seen from the street; the first floor's lies a storey, about 3 m, up)
+GROUND_FLOOR_UNDER = 2.0
 
 
 def room_variant(points: np.ndarray, seed: int) -> np.ndarray:
@@ -523,19 +539,22 @@ def facade_scene(
         )
 
     def furnish(room: Room, shape: Shape, node: str) -> None:
-        """Add the node of a room box (sharing the mesh of an equal room built already)."""
+        """Add the node of a room box (sharing the mesh of an equal room built already);
+        a room of the ground floor (its floor under :data:`GROUND_FLOOR_UNDER`) lit."""
         nonlocal total
         where = np.array([shape.x0, shape.y0, shape.z1])
         number = int(room_variant(where, look(spec, INTERIOR_MATERIAL).seed)[0])
         size = (room.x1 - room.x0, room.y1 - room.y0, room.depth)
-        key: tuple[object, ...] = ("room", *np.round(size, 6).tolist(), number)
+        lit = room.y0 < GROUND_FLOOR_UNDER
+        material = LIT_INTERIOR_MATERIAL if lit else INTERIOR_MATERIAL
+        key: tuple[object, ...] = ("room", *np.round(size, 6).tolist(), number, lit)
         placement = trimesh.transformations.translation_matrix((room.x0, room.y0, room.front))
         parent = f"layer:{shape.layer}"
         existing = shared.get(key)
         if existing is None:
-            existing = f"room-{INTERIOR_MATERIAL}-{len(shared)}"
+            existing = f"room-{material}-{len(shared)}"
             box = open_box((0.0, 0.0, -room.depth), (*size[:2], 0.0))
-            mesh = dress(box, INTERIOR_MATERIAL, number)
+            mesh = dress(box, material, number)
             shared[key] = existing
             faces[existing] = len(mesh.faces)
             scene.add_geometry(mesh, geom_name=existing, node_name=node, parent_node_name=parent)

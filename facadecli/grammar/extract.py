@@ -58,7 +58,7 @@ def extract_grammar(
     extraction.snapping = snapping
     extraction.drawn = tidied.snapped
     extraction.style = style_of_drawing(tidied.snapped)
-    extraction.warnings = extraction_warnings(extraction)
+    extraction.warnings = [*tidied.warnings, *extraction_warnings(extraction)]
     progress("measuring the derivation against the annotation")
     terminals = [Rect(*box) for box in derive(found.grammar, tiling.xs[-1], tiling.ys[-1])]
     extraction.fidelity = fidelity(tidied.raw, regular, terminals)

@@ -122,6 +122,7 @@ class Tidied:
     regularization: Regularization
     snapped: LabelledLayout  # before regularising: its rectangles in the same order
     raw: LabelledLayout  # as read (stretched to the size): what fidelity is measured against
+    warnings: tuple[str, ...] = ()  # about the input as read (``tidy.read_warnings``)
 
 
 @dataclass

@@ -48,6 +48,7 @@ def tidy_layout(
     layout, kind = read_layout(path)
     if not layout.rects:
         raise SpecError.at(str(path), None, None, "no rectangles", "label some elements")
+    warnings = read_warnings(kind, options)
     if options.size is not None:
         layout = resize(layout, *options.size)
     snap = options.snap if options.snap is not None else TIDY[kind][0]
@@ -57,4 +58,17 @@ def tidy_layout(
     check_cells(path, snapped, snap)
     progress("regularising")
     regular, regularization = regularize(snapped, tolerance, deadline=deadline, drawn=layout)
-    return Tidied(regular, snapping, regularization, snapped, layout)
+    return Tidied(regular, snapping, regularization, snapped, layout, warnings)
+
+
+def read_warnings(kind: str, options: Options) -> tuple[str, ...]:
+    """What a user should know of the input as read: a CMP annotation has no real size
+    (the unit square its XML is drawn on), so without ``--size`` the façade is read as
+    1 x 1 m, its spec is in those metres, and what the tidy-up keeps or drops at a
+    millimetre or a centimetre is a share of it a real façade never has."""
+    if kind == "cmp" and options.size is None:
+        return (
+            "a CMP annotation has no size: read as a 1 x 1 m façade (give its real size, "
+            "e.g. --size 15x12, for a spec in metres and the tidy-up's limits to fit it)",
+        )
+    return ()

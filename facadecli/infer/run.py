@@ -44,6 +44,7 @@ class Inference:
     fidelity: Fidelity | None = None  # the spec solved at the input's size vs ``raw``
     bays: str = ""  # how the x words follow the bays (``infer.bays``), or why they do not
     unshared: bool = False  # the bays are not shared: each layer has its own x word
+    warnings: tuple[str, ...] = ()  # about the input as read (``grammar.tidy.read_warnings``)
 
     def report(self) -> dict[str, object]:
         lines = [line for line in self.text.splitlines() if line.strip()[:1] not in ("", "#")]
@@ -54,6 +55,7 @@ class Inference:
             "layers": len(self.grids) + 1,
             "spec_lines": len(lines),
             "bays": self.bays,
+            "warnings": list(self.warnings),
             **self.checks,
         }
 
@@ -121,7 +123,15 @@ def _inference(
     note = bays.describe() if isinstance(bays, Bays) else f"not shared: {bays}"
     unshared = isinstance(bays, str) and bays != FEW_BAYS
     return Inference(
-        path.name, regular, tiling, found, text, raw=tidied.raw, bays=note, unshared=unshared
+        path.name,
+        regular,
+        tiling,
+        found,
+        text,
+        raw=tidied.raw,
+        bays=note,
+        unshared=unshared,
+        warnings=tidied.warnings,
     )
 
 

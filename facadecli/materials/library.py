@@ -102,6 +102,8 @@ class Images:
 def images(material: Material) -> Images:
     """The texture images of a finished library material (see :func:`finished`)."""
     assert material.library is not None
+    if material.emissive:  # the same pictures as unlit: a lit room's are its room's
+        material = material.model_copy(update={"emissive": 0.0})
     return _images(material)
 
 

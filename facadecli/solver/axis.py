@@ -17,7 +17,7 @@ from facadecli.patterns import (
     format_word,
     length_range,
 )
-from facadecli.solver import columns, construct, exact, sizing
+from facadecli.solver import columns, construct, exact, sizing, unseen
 from facadecli.solver.alignment import (
     INF,
     Alignment,
@@ -559,6 +559,18 @@ class _AxisProblem:
         if not self.evaluated and self.unproven and not self.timed_out and not self.heuristic_done:
             self.heuristic_pass()  # the exact search ran out of work: the heuristic may align
 
+    def never_made(self) -> float:
+        """A lower bound on the candidates never made: where a cap cut the list, what the
+        rows every candidate has bound; else those with a word beyond the space's reach
+        (:mod:`.unseen`, worked out only when the space's own bound does not reach the
+        best layout: the relaxation of those rows is a QP of its own)."""
+        if not self.truncated and self.space.beyond >= self.best_objective() - self.tie:
+            return self.space.beyond
+        found = unseen.unseen_bounds(
+            self.spec, self.uses, self.space, self.canvas, self.memory.full
+        )
+        return found.every if self.truncated else found.beyond
+
     def layouts(self) -> list[AxisLayout]:
         """The layouts found, best first (SPEC 2.7), sized exactly, each with what is
         proven of it."""
@@ -567,12 +579,7 @@ class _AxisProblem:
             lower = 0.0
         else:
             lower = _lower_bound(
-                self.bounds,
-                self.above,
-                self.best_objective(),
-                self.tie,
-                self.truncated,
-                self.space.beyond,
+                self.bounds, self.above, self.best_objective(), self.tie, self.never_made()
             )
         layouts: list[AxisLayout] = []
         first: float | None = None
@@ -1220,17 +1227,13 @@ def _lower_bound(
     above: Mapping[int, float],
     best: float,
     tie: float,
-    truncated: bool,
-    beyond: float,
+    never_made: float,
 ) -> float:
     """The best lower bound on the axis' objective once the searches are done: the least
     bound of a candidate whose layouts were not all ruled out below ``best`` (each beyond
-    what its searches proved), or ``best`` itself when there is none. Candidates that
-    were never generated bound nothing (0) where a cap cut the list, and ``beyond`` where
-    their words are longer than twice the canvas."""
-    if truncated:
-        return 0.0
-    lower = min(best, beyond)
+    what its searches proved), or ``best`` itself when there is none, and ``never_made``,
+    the bound of the candidates never generated (:meth:`_AxisProblem.never_made`)."""
+    lower = min(best, never_made)
     for bound, _, candidate in bounds:
         if bound >= lower - tie:
             break
@@ -1407,9 +1410,12 @@ def _finish(
     tie: float,
 ) -> AxisLayout:
     """The placed letters of a chosen candidate, with the warnings a user should see;
-    ``lower``: the best lower bound found on its objective."""
+    ``lower``: the best lower bound found on its objective. It is proven when the bound
+    reaches its objective as sized exactly or as the searches sized it (the same program:
+    on a large objective, two QP solvers' optima differ by their precision, 1e-8 of it,
+    more than the noise of the canvas, ``tie``)."""
     warnings = []
-    proven = lower >= final.objective - tie
+    proven = lower >= min(final.objective, choice.estimate.objective) - tie
     if not proven:
         warnings.append(
             f"{axis}: the layout is not proven optimal: its objective is {final.objective:.6g} "

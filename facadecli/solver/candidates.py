@@ -120,6 +120,8 @@ class CandidateSpace:
     beyond: float = math.inf
     # per pattern, its words, those that need least tolerance (Eq. 7) first
     words: dict[str, list[Enumerated]] = field(default_factory=dict)
+    reach: float = 2.0  # words up to this many canvases long are made
+    reached: frozenset[str] = frozenset()  # patterns whose words were cut at the reach
     made: int = 0  # candidates made so far (their order)
 
     @classmethod
@@ -135,13 +137,14 @@ class CandidateSpace:
         words: dict[str, list[Enumerated]] = {}
         truncated = False
         beyond = math.inf
+        reached = set()
         for use in uses:
             # words up to twice the canvas: a longer one has sized letters whose preferred
             # sizes add up to more than twice the canvas, so laid on it they shrink by more
             # than half their length in all: its objective is at least (l - L)^2 / n >=
             # (smallest size)^2 / 4 (n letters, l >= n * smallest, l - L > l / 2)
             found = []
-            if _finite(use):  # all its words, if they are few
+            if finite(use):  # all its words, if they are few
                 found = _words(use, sizes, transparent, bounds, math.inf, FINITE_LETTERS)
                 if len(found) > WORDS_PER_PATTERN or any(
                     len(item.word) >= FINITE_LETTERS for item in found
@@ -152,6 +155,7 @@ class CandidateSpace:
                     (size for size in (sizes.get(n) for n in _names(use)) if size), default=0.0
                 )
                 beyond = min(beyond, smallest * smallest / 4.0)
+                reached.add(use.key)
                 found = _words(use, sizes, transparent, bounds, reach * canvas)
             if not found:  # not one word that short: the shortest there are
                 found = _words(use, sizes, transparent, bounds, math.inf)
@@ -199,7 +203,16 @@ class CandidateSpace:
             key: sorted(found, key=lambda item: needs[id(item)]) for key, found in words.items()
         }
         return cls(
-            canvas, clusters, ranked, _layers_above(uses), opaque, truncated, beyond, by_need
+            canvas,
+            clusters,
+            ranked,
+            _layers_above(uses),
+            opaque,
+            truncated,
+            beyond,
+            by_need,
+            reach,
+            frozenset(reached),
         )
 
     def candidate(self, choice: Sequence[dict[str, Enumerated]]) -> Candidate:
@@ -235,7 +248,7 @@ def _names(use: PatternUse) -> set[str]:
     return {symbol.name for root in roots for symbol in symbols(root)}
 
 
-def _finite(use: PatternUse) -> bool:
+def finite(use: PatternUse) -> bool:
     """Whether a pattern makes finitely many words: no counter, named or anonymous."""
     roots = (use.pattern.root, *use.pattern.contents.values())
     return not any(

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import bisect
 import itertools
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,9 +45,24 @@ class Relaxation:
     lengths: Mapping[str, float]  # symbol -> length (placeholders included)
 
 
-def relax(spec: Spec, groups: Mapping[str, Sequence[Row]], canvas: float) -> Relaxation | None:
+# whether a row (among its group's rows) may make room for a layer in front
+GivesWay = Callable[[Row, Sequence[Row]], bool]
+
+
+def _covered(row: Row, rows: Sequence[Row]) -> bool:
+    return any(other.covers(row) for other in rows)
+
+
+def relax(
+    spec: Spec,
+    groups: Mapping[str, Sequence[Row]],
+    canvas: float,
+    gives_way: GivesWay = _covered,
+) -> Relaxation | None:
     """The relaxation of a candidate's rows; None when even it has no solution (then the
-    candidate has no layout: its rows cannot all fit the canvas)."""
+    candidate has no layout: its rows cannot all fit the canvas). ``gives_way``: whether a
+    row may leave room (then it fits in the canvas rather than fills it); by default, when
+    a row of its group covers it."""
     names: list[str] = []
     index: dict[str, int] = {}
     for rows in groups.values():
@@ -65,7 +80,7 @@ def relax(spec: Spec, groups: Mapping[str, Sequence[Row]], canvas: float) -> Rel
             for letter in row.word:
                 j = index[letter.symbol]
                 counts[j] = counts.get(j, 0.0) + 1.0
-            may_give_way = any(other.covers(row) for other in rows)
+            may_give_way = gives_way(row, rows)
             key = (*sorted(counts.items()), (-1, 1.0 if may_give_way else 0.0))
             if key in seen:
                 continue

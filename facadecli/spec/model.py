@@ -49,6 +49,7 @@ PositiveLength = Annotated[float, Field(gt=0, le=LENGTH_MAX, allow_inf_nan=False
 NonNegativeLength = Annotated[float, Field(ge=0, le=LENGTH_MAX, allow_inf_nan=False)]
 Count = Annotated[int, Field(ge=0, le=COUNT_MAX)]
 Unit = Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)]
+EMISSIVE_MOST = 10.0  # a material's emissive: a room lit by day is 2 or 3 times its colour
 
 
 class Model(BaseModel):
@@ -251,6 +252,9 @@ class Material(Model):
     resolution: Literal[64, 128, 256, 512, 1024] = 512  # library: pixels a side
     seed: Annotated[int, Field(ge=0, le=2**32 - 1)] = 0  # library: its texture's random choices
     ior: Annotated[float, Field(ge=1, le=3, allow_inf_nan=False)] | None = None  # glass: 1.5
+    # light it gives off, times its colour (a lit room): glTF's emissiveFactor, over 1 with
+    # KHR_materials_emissive_strength
+    emissive: Annotated[float, Field(ge=0, le=EMISSIVE_MOST, allow_inf_nan=False)] = 0.0
 
     @model_validator(mode="after")
     def _library_fields(self) -> Material:

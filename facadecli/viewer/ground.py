@@ -15,6 +15,11 @@ from __future__ import annotations
 #   street runs on ROOM metres past it (a wide street or the town's edge), then a kerb
 #   KERB wide, then asphalt; the land round the district is such a street, to the haze;
 # - a yard has a path YARD_PATH wide along its walls, then grass;
+# - round detached houses (DETACHED_MOST m² or less) the street runs between blocks of
+#   their plots (plotBlocks: the plots whose houses stand closest joined first, up to
+#   BLOCK_PLOTS m² a block), not round each house: asphalt LANE metres either side of
+#   where two blocks meet, a kerb, a SIDEWALK, then the garden's lawn, a path YARD_PATH
+#   wide round the house and a drive DRIVE wide from the road to it (driveCells);
 # - past its pavement a street is asphalt, to ROAD_HALF[1] metres from the walls at most
 #   (the middle of a street 24 m wide), and a paved square farther out, where buildings
 #   close the place in: its enclosure (the share of RAYS_AROUND rays from it that meet a
@@ -36,7 +41,7 @@ from __future__ import annotations
 #   lawn, away from roads, trees and lamps (benchCells).
 GROUND = """
 const PAVEMENT = 2.5, WIDE_PAVEMENT = 4.5, KERB = 0.2, PASSAGE = 3, YARD_PATH = 1;
-const ROOM = 6, GROUND_MARGIN = 14;
+const ROOM = 6, GROUND_MARGIN = 14, LANE = 3, SIDEWALK = 2;
 const TREE_LINE = 3.4, TREE_EVERY = 9, DASH = 3, DASH_EVERY = 7.5, ROAD_HALF = [3.5, 12];
 const LAMP_EVERY = 30, LAMP_KERB = 0.6, LAMP_CLEAR = 3;
 const TREE_STRAIGHT = 14, LAWN_TREE_WALL = 6, LAWN_TREE_EDGE = 2, LAWN_TREE_EVERY = 18;
@@ -44,15 +49,18 @@ const SQUARE_REACH = 40, RAYS_AROUND = 32, ENCLOSED = 0.5, ROAD_ENCLOSED = 0.3;
 // The exact Euclidean distance of each cell of a grid (row by row, ``columns`` a row) to
 // the nearest cell set in ``seeds``, in cells: the lower envelope of parabolas
 // (Felzenszwalb and Huttenlocher), down each column, then along each row. A chamfer (steps
-// of 1 and the square root of 2) drew octagons round a building's corner.
-function distanceField(seeds, columns, rows) {
+// of 1 and the square root of 2) drew octagons round a building's corner. With
+// ``nearest`` (an Int32Array as long), each cell's nearest seed (its index) is put there.
+function distanceField(seeds, columns, rows, nearest = null) {
   const FAR = 1e20, squared = new Float64Array(columns * rows);
   for (let at = 0; at < columns * rows; at++) squared[at] = seeds[at] ? 0 : FAR;
+  if (nearest) for (let at = 0; at < columns * rows; at++) nearest[at] = seeds[at] ? at : -1;
   const size = Math.max(columns, rows);
   const f = new Float64Array(size), lowest = new Int32Array(size);
-  const from = new Float64Array(size + 1);
+  const from = new Float64Array(size + 1), whose = new Int32Array(size);
   const line = (start, step, count) => {
     for (let i = 0; i < count; i++) f[i] = squared[start + i * step];
+    if (nearest) for (let i = 0; i < count; i++) whose[i] = nearest[start + i * step];
     let k = 0;
     lowest[0] = 0; from[0] = -Infinity; from[1] = Infinity;
     for (let q = 1; q < count; q++) {
@@ -70,6 +78,7 @@ function distanceField(seeds, columns, rows) {
       while (from[k + 1] < q) k++;
       const p = lowest[k];
       squared[start + q * step] = (q - p) * (q - p) + f[p];
+      if (nearest) nearest[start + q * step] = whose[p];
     }
   };
   for (let column = 0; column < columns; column++) line(column, columns, rows);
@@ -90,14 +99,17 @@ function reachedFromEdge(near, columns, rows, least) {
     visit(column); visit((rows - 1) * columns + column);
   }
   for (let row = 0; row < rows; row++) { visit(row * columns); visit(row * columns + columns - 1); }
-  while (head < tail) {
-    const at = queue[head++], column = at % columns;
-    if (column > 0) visit(at - 1);
-    if (column < columns - 1) visit(at + 1);
-    if (at >= columns) visit(at - columns);
-    if (at < (rows - 1) * columns) visit(at + columns);
-  }
+  while (head < tail) besideEach(queue[head++], columns, rows, visit);
   return reached;
+}
+// Calls visit with each of the (up to) four cells beside the cell at, on a grid of
+// columns x rows: the step of every flood over the grid.
+function besideEach(at, columns, rows, visit) {
+  const column = at % columns;
+  if (column > 0) visit(at - 1);
+  if (column < columns - 1) visit(at + 1);
+  if (at >= columns) visit(at - columns);
+  if (at < (rows - 1) * columns) visit(at + columns);
 }
 // Whether the street at ``at`` runs on ROOM metres past it, away from its nearest wall
 // (the way the distance grows): a wide street, or the open town round the district
@@ -156,16 +168,188 @@ function enclosureField(near, columns, rows, cell) {
     return top + (bottom - top) * fv;
   };
 }
+// The buildings of a plan: each connected piece of its built cells (four neighbours) a
+// number from 1 -> {piece: each cell's (0 open), areas: each piece's cells (areas[0] 0)}
+function buildingPieces(building, columns, rows) {
+  const piece = new Int32Array(columns * rows), areas = [0];
+  const queue = new Int32Array(columns * rows);
+  for (let start = 0; start < columns * rows; start++) {
+    if (!building[start] || piece[start]) continue;
+    const id = areas.length;
+    let head = 0, tail = 0;
+    const visit = at => { if (building[at] && !piece[at]) { piece[at] = id; queue[tail++] = at; } };
+    visit(start);
+    while (head < tail) besideEach(queue[head++], columns, rows, visit);
+    areas.push(tail);
+  }
+  return {piece, areas};
+}
+// The buildings of a plan as buildingPieces, those less than ROW_GAP metres apart one
+// piece (a terrace of houses whose footprints do not quite touch is a row, not detached
+// houses): a piece's area counts its built cells alone
+const ROW_GAP = 3;
+function buildingRows(building, near, columns, rows, cell) {
+  const joined = near.map(distance => distance * cell <= ROW_GAP / 2 ? 1 : 0);
+  const {piece} = buildingPieces(joined, columns, rows);
+  const areas = [0];
+  for (let at = 0; at < piece.length; at++) {
+    if (!building[at]) { piece[at] = 0; continue; }
+    while (areas.length <= piece[at]) areas.push(0);
+    areas[piece[at]]++;
+  }
+  return {piece, areas};
+}
+// Detached houses stand in gardens along streets (a town of them was a ring of paving and
+// a ring road round each house, at fixed distances from its walls). Each open place
+// belongs to the plot of its nearest building (``owner``: a piece of buildingPieces). A
+// building of DETACHED_MOST m² or less is detached: the plots of two detached buildings
+// that meet join one block, the narrowest gap between them first (a shed in a garden,
+// the side gap between neighbours in a row, then back gardens), while the block's plots
+// hold BLOCK_PLOTS m² or less of the land within ROAD_REACH metres of a wall; a street
+// runs where two blocks' plots meet (or a detached house's plot meets another building's),
+// within ROAD_REACH metres of the walls (past it open land, no road). A building whose
+// ground within GARDEN_ROUND metres of its walls is closed in by others (enclosureField)
+// GARDEN_ENCLOSED or more on average stands in a town's street, paved to its walls, not
+// in a garden (the demo district's houses 8 m apart; Kotka's stand in open land, about
+// 0.1 to 0.4, as do 100 houses 45 m apart, about 0.3). Returns each
+// piece's block (a piece not detached is its own) and whether each piece is detached.
+const DETACHED_MOST = 400, BLOCK_PLOTS = 10000, ROAD_REACH = 30;
+const GARDEN_ROUND = 10, GARDEN_ENCLOSED = 0.7;
+function plotBlocks(owner, near, areas, columns, rows, cell, enclosed) {
+  const pieces = areas.length, square = cell * cell, reach = ROAD_REACH / cell;
+  const closed = new Float64Array(pieces), round = new Float64Array(pieces);
+  for (let at = 0; at < columns * rows; at += 3) {  // every third place is enough
+    if (!near[at] || near[at] * cell > GARDEN_ROUND) continue;
+    closed[owner[at]] += enclosed(at); round[owner[at]]++;
+  }
+  const detached = areas.map((area, id) => id > 0 && area * square <= DETACHED_MOST
+    && closed[id] < GARDEN_ENCLOSED * round[id]);
+  const plots = new Float64Array(pieces);
+  for (let at = 0; at < columns * rows; at++) {
+    if (near[at] > 0 && near[at] <= reach) plots[owner[at]] += square;
+  }
+  const narrowest = new Map();  // two detached plots that meet -> the narrowest gap between them
+  const meet = (at, next) => {
+    const a = owner[at], b = owner[next];
+    if (a === b || !detached[a] || !detached[b] || !near[at] || !near[next]) return;
+    const key = Math.min(a, b) * pieces + Math.max(a, b), gap = Math.min(near[at], near[next]);
+    if (!(narrowest.get(key) <= gap)) narrowest.set(key, gap);
+  };
+  for (let at = 0; at < columns * rows; at++) {
+    if (at % columns < columns - 1) meet(at, at + 1);
+    if (at < (rows - 1) * columns) meet(at, at + columns);
+  }
+  const block = Int32Array.from({length: pieces}, (_, id) => id);
+  const find = id => { while (block[id] !== id) id = block[id] = block[block[id]]; return id; };
+  const pairs = [...narrowest.entries()].sort((p, q) => p[1] - q[1] || p[0] - q[0]);
+  for (const [key] of pairs) {
+    const a = find(Math.floor(key / pieces)), b = find(key % pieces);
+    if (a === b || plots[a] + plots[b] > BLOCK_PLOTS) continue;
+    const [kept, joined] = a < b ? [a, b] : [b, a];
+    block[joined] = kept; plots[kept] += plots[joined];
+  }
+  return {block: Int32Array.from({length: pieces}, (_, id) => find(id)), detached};
+}
+// The middle of each street between blocks (plotBlocks): the open places where the plot
+// of a block meets another's, one of them detached, within ROAD_REACH metres of the walls
+function streetMiddles(owner, near, blocks, columns, rows, cell) {
+  const {block, detached} = blocks, middle = new Uint8Array(columns * rows);
+  const reach = ROAD_REACH / cell;
+  const mark = (at, next) => {
+    const a = owner[at], b = owner[next];
+    if (!near[at] || !near[next] || block[a] === block[b]) return;
+    if (!detached[a] && !detached[b]) return;
+    if (near[at] <= reach) middle[at] = 1;
+  };
+  for (let at = 0; at < columns * rows; at++) {
+    if (at % columns < columns - 1) mark(at, at + 1);
+    if (at < (rows - 1) * columns) mark(at, at + columns);
+  }
+  return middle;
+}
+// A drive DRIVE metres wide from the street to each detached house of OUTBUILDING m² or
+// more: from the road's place in its plot nearest its walls, straight to them (down the
+// distance to the walls, ``near``); a house whose plot no road reaches (its block's
+// street runs past a neighbour's plot), from the road's place in its block nearest the
+// house's middle, straight to its nearest wall, DRIVE_REACH metres at most. Paved over
+// the lawn and the kerb -> the drives' cells
+const DRIVE = 2.5, OUTBUILDING = 40, DRIVE_REACH = 60;
+function driveCells(kinds, owner, near, pieces, blocks, columns, rows, cell) {
+  const {piece, areas} = pieces, {block, detached} = blocks, count = areas.length;
+  const house = id => detached[id] && areas[id] * cell * cell >= OUTBUILDING;
+  const middleX = new Float64Array(count), middleY = new Float64Array(count);
+  const low = new Int32Array(count).fill(rows), high = new Int32Array(count).fill(-1);
+  for (let at = 0; at < kinds.length; at++) {
+    const id = piece[at], row = Math.floor(at / columns);
+    if (!id) continue;
+    middleX[id] += at % columns; middleY[id] += row;
+    low[id] = Math.min(low[id], row); high[id] = Math.max(high[id], row);
+  }
+  for (let id = 1; id < count; id++) { middleX[id] /= areas[id]; middleY[id] /= areas[id]; }
+  const inBlock = new Map();  // a block -> its houses
+  for (let id = 1; id < count; id++) {
+    if (house(id)) inBlock.set(block[id], [...(inBlock.get(block[id]) || []), id]);
+  }
+  const own = new Int32Array(count).fill(-1), fromBlock = new Int32Array(count).fill(-1);
+  const best = new Float64Array(count).fill(Infinity);
+  for (let at = 0; at < kinds.length; at++) {
+    if (kinds[at] !== 3) continue;
+    const id = owner[at];
+    if (house(id) && (own[id] < 0 || near[at] < near[own[id]])) own[id] = at;
+    const column = at % columns, row = (at - column) / columns;
+    for (const other of inBlock.get(block[id]) || []) {
+      const far = (column - middleX[other]) ** 2 + (row - middleY[other]) ** 2;
+      if (far < best[other]) { best[other] = far; fromBlock[other] = at; }
+    }
+  }
+  const way = [];
+  for (let id = 1; id < count; id++) {
+    let at = own[id];
+    for (let steps = 0; at >= 0 && near[at] * cell >= YARD_PATH && steps < 4 * columns; steps++) {
+      way.push(at);  // down the distance to the walls: straight to the nearest
+      const column = at % columns, row = (at - column) / columns;
+      let next = -1;
+      for (let y = Math.max(0, row - 1); y <= Math.min(rows - 1, row + 1); y++) {
+        for (let x = Math.max(0, column - 1); x <= Math.min(columns - 1, column + 1); x++) {
+          const there = y * columns + x;
+          if (near[there] < (next < 0 ? near[at] : near[next])) next = there;
+        }
+      }
+      at = next;
+    }
+    if (own[id] >= 0 || fromBlock[id] < 0) continue;
+    const from = fromBlock[id], fx = from % columns, fy = (from - fx) / columns;
+    let wall = -1, closest = Infinity;  // the house's cell nearest the road's place
+    for (let at = low[id] * columns; at < (high[id] + 1) * columns; at++) {  // its rows
+      if (piece[at] !== id) continue;
+      const far = (at % columns - fx) ** 2 + (Math.floor(at / columns) - fy) ** 2;
+      if (far < closest) { closest = far; wall = at; }
+    }
+    const wx = wall % columns, wy = (wall - wx) / columns, length = Math.sqrt(closest);
+    if (length * cell > DRIVE_REACH) continue;  // across open land: no drive
+    for (let t = 0; t <= length; t += 0.5) {
+      way.push(Math.round(fy + (wy - fy) * t / length) * columns
+               + Math.round(fx + (wx - fx) * t / length));
+    }
+  }
+  return nearPlaces(way, columns, rows, cell, DRIVE / 2);
+}
 // What each cell of a grid is, the buildings' cells set in ``building``: 0 building,
 // 1 pavement (a path, in a yard), 2 kerb, 3 asphalt, 4 grass; and the distance to the
 // nearest building (metres), whether each is street, and whether its pavement is wide
 function groundKinds(building, columns, rows, cell) {
-  const near = distanceField(building, columns, rows);
+  const nearest = new Int32Array(columns * rows);
+  const near = distanceField(building, columns, rows, nearest);
   const reached = reachedFromEdge(near, columns, rows, PASSAGE / cell);
   const toStreet = distanceField(reached, columns, rows);
   const kinds = new Uint8Array(columns * rows), street = new Uint8Array(columns * rows);
-  const wide = new Uint8Array(columns * rows);
+  const wide = new Uint8Array(columns * rows), garden = new Uint8Array(columns * rows);
   const enclosed = enclosureField(near, columns, rows, cell);
+  const {piece, areas} = buildingRows(building, near, columns, rows, cell);
+  const owner = nearest.map(at => at < 0 ? 0 : piece[at]);  // each place's plot
+  const blocks = plotBlocks(owner, near, areas, columns, rows, cell, enclosed);
+  const toMiddle = distanceField(streetMiddles(owner, near, blocks, columns, rows, cell),
+                                 columns, rows);
   for (let at = 0; at < columns * rows; at++) {
     if (building[at]) continue;
     const metres = near[at] * cell;
@@ -174,6 +358,13 @@ function groundKinds(building, columns, rows, cell) {
       continue;
     }
     street[at] = 1;
+    if (blocks.detached[owner[at]]) {  // a detached house's plot: a garden, or the street
+      const road = toMiddle[at] * cell;
+      kinds[at] = metres < YARD_PATH ? 1 : road <= LANE ? 3 : road <= LANE + KERB ? 2
+        : road <= LANE + KERB + SIDEWALK ? 1 : 4;
+      garden[at] = road > LANE + KERB + SIDEWALK ? 1 : 0;
+      continue;
+    }
     if (metres >= PAVEMENT && metres < WIDE_PAVEMENT + KERB) {
       wide[at] = roomy(near, columns, rows, cell, at) ? 1 : 0;
     }
@@ -184,7 +375,12 @@ function groundKinds(building, columns, rows, cell) {
     kinds[at] = metres < kerb + KERB ? 2 : road ? 3 : 1;
   }
   kerbLawns(kinds, columns, rows);
-  return {kinds, near, street, wide};
+  const drives = driveCells(kinds, owner, near, {piece, areas}, blocks, columns, rows, cell);
+  for (let at = 0; at < kinds.length; at++) {
+    if (!drives[at] || building[at] || kinds[at] === 3) continue;
+    kinds[at] = 1; garden[at] = 1;
+  }
+  return {kinds, near, street, wide, garden, middle: toMiddle};
 }
 // A kerb where a road meets a lawn (the enclosure turns asphalt to grass across a
 // street): the road's cells beside the grass (four neighbours) are kerb, as along a
@@ -247,7 +443,7 @@ function treeCells(ground, columns, cell) {
   for (let at = 0; at < kinds.length; at++) {
     if (line[at] && wide[at] && besideKind(kinds, columns, cell, at, 3, pitReach)) {
       if (straight(line, columns, rows, at, reach, 0.75 + 0.25 / cell)) pits.push(at);
-    } else if (kinds[at] === 4 && street[at] && near[at] * cell >= LAWN_TREE_WALL
+    } else if (kinds[at] === 4 && street[at] && near[at] * cell - cell / 2 >= LAWN_TREE_WALL
                && toEdge[at] * cell >= LAWN_TREE_EDGE) {
       lawn.push(at);
     }
@@ -379,18 +575,25 @@ function nearPlaces(places, columns, rows, cell, metres) {
 // ``trees`` -> [[cell, along x, along rows], ...], the way to the road (the distance to
 // the walls growing)
 function lampCells(ground, columns, rows, cell, trees = []) {
-  const {kinds, near, street, wide} = ground, candidates = [];
+  const {kinds, near, street, wide, middle, garden} = ground, candidates = [];
   const byTree = nearPlaces(trees, columns, rows, cell, LAMP_CLEAR);
+  // along a street between detached houses' blocks the kerb runs LANE + KERB from the
+  // street's middle, the pavement outside it: the distance from the middle, falling
+  // towards the road; elsewhere the distance from the walls, growing towards it
+  const suburb = at => middle[at] * cell < LANE + KERB + SIDEWALK + cell;
   for (let row = 1; row < rows - 1; row++) for (let column = 1; column < columns - 1; column++) {
     const at = row * columns + column;
-    if (kinds[at] !== 1 || !street[at] || byTree[at]) continue;
-    const line = (wide[at] ? WIDE_PAVEMENT : PAVEMENT) - LAMP_KERB;
-    if (Math.abs(near[at] * cell - line) > 0.5 * cell) continue;
+    if (kinds[at] !== 1 || !street[at] || garden[at] || byTree[at]) continue;
+    const [from, line] = suburb(at) ? [middle, LANE + KERB + LAMP_KERB]
+      : [near, (wide[at] ? WIDE_PAVEMENT : PAVEMENT) - LAMP_KERB];
+    if (Math.abs(from[at] * cell - line) > 0.5 * cell) continue;
     if (!besideKind(kinds, columns, cell, at, 3, LAMP_KERB + KERB + cell)) continue;
     candidates.push(at);
   }
   return spaced(candidates, columns, cell, LAMP_EVERY).map(at => {
-    const dx = near[at + 1] - near[at - 1], dy = near[at + columns] - near[at - columns];
+    const [from, sign] = suburb(at) ? [middle, -1] : [near, 1];
+    const dx = sign * (from[at + 1] - from[at - 1]);
+    const dy = sign * (from[at + columns] - from[at - columns]);
     const length = Math.hypot(dx, dy) || 1;
     return [at, dx / length, dy / length];
   });
@@ -404,7 +607,7 @@ function lampCells(ground, columns, rows, cell, trees = []) {
 const BENCH_EDGE = 0.6, BENCH_VIEW = 3, BENCH_WALL = 2.5, BENCH_ROAD = 4, BENCH_EVERY = 40;
 const BENCH_CLEAR = 2.5;
 function benchCells(ground, columns, rows, cell, taken = []) {
-  const {kinds, near, street} = ground, candidates = [];
+  const {kinds, near, street, garden} = ground, candidates = [];
   const toGrass = distanceField(kinds.map(kind => kind === 4 ? 1 : 0), columns, rows);
   const byOthers = nearPlaces(taken, columns, rows, cell, BENCH_CLEAR);
   const facing = at => {
@@ -415,7 +618,7 @@ function benchCells(ground, columns, rows, cell, taken = []) {
   };
   for (let row = 1; row < rows - 1; row++) for (let column = 1; column < columns - 1; column++) {
     const at = row * columns + column, metres = toGrass[at] * cell;
-    if (kinds[at] !== 1 || !street[at] || byOthers[at]) continue;
+    if (kinds[at] !== 1 || !street[at] || garden[at] || byOthers[at]) continue;
     if (metres < BENCH_EDGE || metres > BENCH_EDGE + cell) continue;
     if (near[at] * cell < BENCH_WALL) continue;
     if (besideKind(kinds, columns, cell, at, 3, BENCH_ROAD)) continue;

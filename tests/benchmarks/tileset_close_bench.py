@@ -2,7 +2,7 @@
 
 ``python tests/benchmarks/tileset_close_bench.py N``: a :class:`TilesetWriter` planned for
 N buildings at seeded random places (LOD 1, 2, 3, the default capacities), each square's
-tiles filled as writing its glb files would fill them (seeded boxes and errors, no glb
+tiles' record filled as writing its glb files would fill it (seeded boxes and errors, no glb
 written: no building is built), then :meth:`TilesetWriter.close` measured: the peak of
 Python's allocations while it writes (tracemalloc) and the process's resident peak
 (``ru_maxrss``). Figures for docs/benchmarks.md, never asserted by the tests.
@@ -21,18 +21,17 @@ from facadecli.city.georef import Georef
 from facadecli.city.tileset import Square, TilesetWriter
 
 
-def filled(square: Square, rng: random.Random) -> None:
-    """The square's tiles and box as writing its content would leave them, its children's too."""
-    if square.lods:
-        name = f"{square.level}/{square.column}/{square.row}"
-        square.tiles = [
-            {"lod": k, "uri": f"{name}.lod{k}.glb", "error": round(rng.uniform(3, 9), 3) * (k < 3)}
-            for k in square.lods
-        ]
+def filled(writer: TilesetWriter, square: Square, rng: random.Random) -> None:
+    """The square's tiles and box as writing its content would leave them (its record,
+    :class:`.SquareRecords`), its children's too."""
+    lods = writer.lods_of(square)
+    if lods:
+        errors = [round(rng.uniform(3, 9), 3) * (k < 3) for k in lods]
         x, y = rng.uniform(0, 1000), rng.uniform(0, 1000)
-        square.box = (x, y, 0.0, x + rng.uniform(5, 50), y + rng.uniform(5, 50), rng.uniform(6, 20))
-    for child in square.children:
-        filled(child, rng)
+        box = (x, y, 0.0, x + rng.uniform(5, 50), y + rng.uniform(5, 50), rng.uniform(6, 20))
+        writer.records.put_tiles(square.index, box, errors)
+    for child in writer.tree.children(square):
+        filled(writer, child, rng)
 
 
 def main(count: int) -> None:
@@ -43,7 +42,7 @@ def main(count: int) -> None:
         writer = TilesetWriter(
             Path(folder), Georef("EPSG:3067", (385000.0, 6672000.0)), (1, 2, 3), places
         )
-        filled(writer.root, rng)
+        filled(writer, writer.tree.root, rng)
         before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
         tracemalloc.start()
         writer.close("bench")
