@@ -27,7 +27,9 @@ one sequence of bays, written alike in every layer that stands in bays (each lay
 elements; a bay where it shows none is one hidden spacer): a repeated unit of one or
 two bays (never a unique label's: a door's bay is written once) gets a counter, at
 most ``COUNTERS`` of them; kinds found only at the façade's ends share one counter
-that can only drop them (its most: one, as drawn). Where no unit repeats (a façade
+that can only drop them (its most: one, as drawn), unless no other bay may repeat
+(``_ends_repeat``); a door's bay is unique unless every bay has a door (``_unique``).
+Where no unit repeats (a façade
 drawn by hand, each bay a little unlike every other: most of CMP's), each inner bay
 but a unique one is written once with a counter, at one where drawn, so the layout at
 the input's size is the drawing's and a façade of another width drops or gains copies
@@ -392,8 +394,7 @@ def _laid(
     end = start if centred else round(width - start - total, DIGITS)
     if start <= 0 or end <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
-    unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
-    unique |= set(ties)  # a variant is written once, as drawn
+    unique = _unique(shapes, kinds) | set(ties)  # a variant is written once, as drawn
     runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
     if symmetric and not any(r.counter and r.most is None for r in runs):
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
@@ -401,6 +402,14 @@ def _laid(
     if not any(r.counter and r.most is None for r in runs):
         return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
     return symmetric, start, runs, counters, end
+
+
+def _unique(shapes: list[list[Slot]], kinds: list[int]) -> set[int]:
+    """The kinds never repeated: those with an element of a unique label (a door),
+    unless every bay has one (a shop's door in every bay singles none out: the façade
+    repeats its bays, doors and all)."""
+    marked = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
+    return set() if set(kinds) <= marked else marked
 
 
 def _rowed(
@@ -1081,6 +1090,8 @@ def _plan(
     if not any(run.counter and run.most is None for run in taken.values()):
         for j, name in _drawn_once(kinds, unique | ends, written, counters, widths).items():
             taken.setdefault(j, Run(j, 1, 1, name))
+    if not any(run.counter and run.most is None for run in taken.values()):
+        _ends_repeat(taken, counters)
     runs = []
     k = 0
     while k < written:
@@ -1088,6 +1099,21 @@ def _plan(
         runs.append(run)
         k = run.start + run.unit * run.copies
     return runs, counters
+
+
+def _ends_repeat(taken: dict[int, Run], counters: list[tuple[str, float, int, int | None]]) -> None:
+    """Where no bay but the end bays may repeat (every inner bay unique: a door's
+    between two columns of windows), the ends' one counter loses its most: a wider
+    façade gains copies of its end bays beside them (both ends alike, so a mirrored
+    façade stays so) where it stretched its margins, its columns kept. (A narrower one
+    may drop both; at least one, a façade that cannot narrow them has no layout.)
+    ``taken`` and ``counters`` are mended in place."""
+    for n, (name, pitch, count, most) in enumerate(counters):
+        if most is not None:
+            counters[n] = (name, pitch, count, None)
+            for j, run in list(taken.items()):
+                if run.counter == name:
+                    taken[j] = Run(run.start, run.unit, run.copies, name)
 
 
 def _drawn_once(
