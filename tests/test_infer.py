@@ -71,7 +71,12 @@ def test_the_check_sees_a_spec_that_does_not_match(tmp_path: Path) -> None:
         inferred.layout,
         inferred.tiling,
         inferred.grids,
-        re.sub(r"door_w1: \{size: 1.2,( min: [0-9.]+,)?", "door_w1: {size: 0.6,", inferred.text),
+        # the door half as tall (its width is the bays': their gaps would size it back)
+        re.sub(
+            r"door_h1: \{size: 2.6,( max: [0-9.]+,)?",
+            "door_h1: {size: 1.3, max: 1.3,",
+            inferred.text,
+        ),
     )
     checks = check(wrong, parse_spec(wrong.text, "wrong.yaml"))
     assert checks["solves"] and checks["iou"]["door"] < 0.9  # type: ignore[index]
