@@ -725,14 +725,17 @@ def test_a_city_stage_names_its_buildings_without_keeping_the_names(tmp_path: Pa
     """The city's USD stage is written holding no name of the prims written (they are
     unique by construction, :func:`.building_prim`): the peak of Python's allocations
     while it is written grows by no byte a building from 2,000 to 8,000 (a set of the
-    names written took 100 bytes a building). The stage is written once untraced first:
-    the interpreter's own tables grow once by a few MB the first time so many file names
-    are made (``pathlib`` interns each part of a path), whatever the file is."""
+    names written took 100 bytes a building). ``pathlib`` interns each part of a path,
+    and the interpreter's table of interned strings is resized, by a few MB, whenever
+    inserts have used it up, dead strings or not (at 2,000 or at 8,000, as the tests run
+    before left it): the paths' parts, the stages' names too, are made and kept alive
+    before measuring, so that the paths the stage makes find them interned."""
     from facadecli.export.usd import city_usda_lines
 
     def files(count: int) -> Iterator[Path]:
         return (tmp_path / building_file(f"house-{k:05d}") for k in range(count))
 
+    interned = [(glb, glb.with_suffix(".usda").relative_to(tmp_path)) for glb in files(8000)]
     sum(1 for _ in city_usda_lines("c", files(8000), tmp_path))
     peaks = []
     for count in (2000, 8000):
@@ -743,3 +746,4 @@ def test_a_city_stage_names_its_buildings_without_keeping_the_names(tmp_path: Pa
         peaks.append(peak)
     slope = (peaks[1] - peaks[0]) / 6000
     assert slope < 8, slope
+    assert len(interned) == 8000

@@ -435,3 +435,95 @@ def test_detached_houses_stand_in_gardens_with_a_drive_each(seed: int) -> None:
         assert (ground.kinds[np.isin(paved, list(ways))] == ASPHALT).any(), house
     assert (ground.kinds == ASPHALT).mean() > 0.08  # streets, not lanes
     assert len(ground.lamps) >= 40 and not ground.benches
+
+
+def _clusters(seed: int, count: int = 4) -> list[Box]:
+    """Clusters of six detached houses (three by two, 22-24 m apart, 8-12 m a side), each
+    cluster 110 m or more from every other (seeded places): blocks of houses more than
+    30 m from any other block, as Kotka's outlying ones."""
+    chance = random.Random(seed)
+    centres: list[tuple[float, float]] = []
+    while len(centres) < count:
+        x, y = chance.uniform(0, 260), chance.uniform(0, 260)
+        if all(np.hypot(x - ox, y - oy) >= 110 for ox, oy in centres):
+            centres.append((x, y))
+    houses = []
+    for cx, cy in centres:
+        for i in range(3):
+            for j in range(2):
+                x, y = cx + i * 22 + chance.uniform(-3, 3), cy + j * 24 + chance.uniform(-3, 3)
+                houses.append((x, y, x + chance.uniform(8, 12), y + chance.uniform(8, 12)))
+    return houses
+
+
+def _reaches_asphalt(houses: list[Box], ground: Ground) -> list[bool]:
+    """Whether each house reaches a road's asphalt over paving alone (its drive)."""
+    from scipy.ndimage import label
+
+    paved, _ = label(np.isin(ground.kinds, (PAVEMENT, KERB, ASPHALT)))
+    reached = []
+    for band in _band(houses, paved, 0, 1):
+        ways = set(band[band > 0].tolist())
+        reached.append(bool((ground.kinds[np.isin(paved, list(ways))] == ASPHALT).any()))
+    return reached
+
+
+@pytest.mark.parametrize("seed", [22, 23, 24])
+def test_clusters_of_houses_far_apart_are_joined_by_one_network_of_streets(seed: int) -> None:
+    """Clusters of houses more than 30 m from any other block each get an access road,
+    joined into one network (on main a cluster that was one block had no road at all,
+    and the roads there were were pieces): the asphalt is one piece (eight neighbours),
+    some house of every cluster reaches it over its drive, and nine in ten houses do
+    (a drive from the access road's end runs 100 m at most, down the distance to the
+    walls, which can lead it to a neighbour)."""
+    from scipy.ndimage import label
+
+    houses = _clusters(seed)
+    ground = _ground(houses)
+    _, pieces = label(ground.kinds == ASPHALT, structure=np.ones((3, 3)))
+    assert pieces == 1, pieces
+    reached = _reaches_asphalt(houses, ground)
+    assert all(any(reached[k : k + 6]) for k in range(0, len(houses), 6)), reached
+    assert sum(reached) >= 0.9 * len(houses), reached
+
+
+ROUND = 7.0  # metres: the circle round a road's cell that tells an end (_road_ends)
+
+
+def _road_ends(ground: Ground) -> list[tuple[int, int, float]]:
+    """The ends of the roads: cells of a road's core (asphalt 2 m or more from its edge)
+    round which a circle of ROUND metres meets the core in one arc alone (along a road
+    two, at a junction three or more), and the widest asphalt within ROUND of each
+    (metres from its edge: a road's middle about 3, a turning head's 6); those within
+    ROUND + 2 of the plan's edge left out (a road going on into the town)."""
+    from scipy.ndimage import distance_transform_edt
+
+    asphalt = ground.kinds == ASPHALT
+    width = distance_transform_edt(asphalt) * CELL
+    core = width >= 2
+    angles = np.linspace(0, 2 * np.pi, 72, endpoint=False)
+    reach = _cells(ROUND)
+    ends = []
+    edge = _cells(ROUND + 2)
+    for row, column in np.argwhere(core[edge:-edge, edge:-edge]) + edge:
+        ring = core[
+            np.round(row + reach * np.sin(angles)).astype(int),
+            np.round(column + reach * np.cos(angles)).astype(int),
+        ]
+        if int((ring & ~np.roll(ring, 1)).sum()) == 1:
+            near = width[row - reach : row + reach + 1, column - reach : column + reach + 1]
+            ends.append((int(row), int(column), float(near.max())))
+    return ends
+
+
+@pytest.mark.parametrize("seed", [25, 26, 27])
+def test_every_street_ends_in_a_turning_head_or_goes_on_past_the_plan(seed: int) -> None:
+    """A street between blocks of detached houses that stops (30 m from the walls, where
+    open land begins) ends in a turning head, asphalt 6 m round (on main in a stub, as
+    wide as the road, 3 m from its middle): every end of a road's core within the plan
+    has asphalt 5 m or more from its edge within 7 m."""
+    ground = _ground(_houses(seed))
+    ends = _road_ends(ground)
+    assert ends
+    stubs = [(row, column) for row, column, widest in ends if widest < 5]
+    assert not stubs, stubs[:5]

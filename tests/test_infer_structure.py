@@ -12,6 +12,7 @@ from __future__ import annotations
 import itertools
 import json
 import random
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -556,3 +557,56 @@ def test_a_door_on_its_windows_edges_keeps_its_own_width() -> None:
     placed = structured(LabelledLayout(10.0, 6.0, (*windows, door)))
     assert placed.rects[4].x1 - placed.rects[4].x0 == pytest.approx(1.12, abs=1e-6)
     assert placed.rects[1].x1 - placed.rects[1].x0 == pytest.approx(1.125, abs=1e-6)
+
+
+def _stack_under_a_top_floor(path: Path, seed: int) -> Path:
+    """Five floors of windows in five bays (a counted stack of rows) and over them a top
+    floor of three wider windows in the middle bays, drawn 0.5 m further up than the
+    stack's pitch; every height jittered by up to 3% and every edge by up to 1 cm."""
+    rng = random.Random(seed)
+    rects = []
+    floors = [(f, k, 1.2, 1.5) for f in range(5) for k in range(5)]
+    floors += [(5, k, 1.8, 1.4) for k in range(1, 4)]
+    for f, k, width, height in floors:
+        cx = 2.3 + k * 2.6 + rng.uniform(-0.01, 0.01)
+        y0 = 1.2 + f * PITCH_Y + (0.5 if f == 5 else 0.0) + rng.uniform(-0.01, 0.01)
+        y1 = y0 + height * (1 + rng.uniform(-0.03, 0.03))
+        rects.append(
+            {"label": "window", "x0": cx - width / 2, "y0": y0, "x1": cx + width / 2, "y1": y1}
+        )
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 18.0}, "rects": rects}))
+    return path
+
+
+def _floors_apart(path: Path, seed: int) -> Path:
+    """Five floors of four windows each, every floor's columns shifted from the others'
+    (no floor's windows over another's: each floor a layer, no counted stack), so the
+    top floor repeats upwards; every height jittered by up to 3%, every edge by 1 cm."""
+    rng = random.Random(seed)
+    rects = []
+    for f, shift in enumerate((0.0, 0.4, 0.8, 0.2, 0.6)):
+        for k in range(4):
+            cx = 2.3 + shift + k * 2.6 + rng.uniform(-0.01, 0.01)
+            y0 = 1.2 + f * PITCH_Y + rng.uniform(-0.01, 0.01)
+            y1 = y0 + 1.5 * (1 + rng.uniform(-0.03, 0.03))
+            rects.append({"label": "window", "x0": cx - 0.6, "y0": y0, "x1": cx + 0.6, "y1": y1})
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 15.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize("facade", [_stack_under_a_top_floor, _floors_apart])
+def test_a_taller_facade_gains_its_floors_in_one_place_with_no_opening_over_another(
+    tmp_path: Path, facade: Callable[[Path, int], Path], seed: int
+) -> None:
+    """1.5 times as tall, a façade gains floors either in its counted stack (the floors
+    over it moving up with it) or as copies of its top floor (everything under it staying
+    as drawn), never both: a top floor drawn over the stack was copied upwards from where
+    it stood while the stack grew into it, and under a top floor copied upwards the floors
+    drawn apart moved up with the roof over its copies (cmp_b0011, b0005, b0006)."""
+    path = facade(tmp_path / "facade.json", seed)
+    height = json.loads(path.read_text())["canvas"]["height"]
+    drawn = len(json.loads(path.read_text())["rects"])
+    windows = _of(_solved(path, WIDTH, height * 1.5), "window")
+    assert _overlapping(windows) == 0
+    assert len(windows) > drawn  # floors gained

@@ -310,7 +310,16 @@ def spec_text(
     unique = {t.prefix for g, t in zip(found, widths, strict=True) if g.label in UNIQUE}
     top = floors_top(found)
     floors = floor_run(found, height, alike)
-    tops = top_floors(found, width, height)
+    # a top floor repeats upwards only where no run of the openings' floors stands under
+    # it, or where it stands on the run's floors: over them (an attic's windows, a top
+    # floor drawn apart), its copies and the floors the run gains would take the same
+    # height (cmp_b0011 at 1.5x: 33 pairs of windows over one another); it moves up with
+    # the floors instead, as everything over them does
+    tops = {
+        k: pitch
+        for k, pitch in top_floors(found, width, height).items()
+        if floors is None or found[k].rows[0][0] < top
+    }
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
     # where a layer's top floor repeats upwards with nothing on the run's floors (its
     # floors gained are copies of the top one, ``_floors_above``), every layer with
@@ -321,6 +330,10 @@ def spec_text(
         k in tops and found[k].label not in UNIQUE and not on_run(found[k].rows, floors[1])
         for k in range(len(found))
     )
+    # the layers with a margin at both ends along y (where their first and last rows
+    # start, the margins) and where the top floors that repeat upwards start
+    margins_y: list[tuple[float, float, str, str]] = []
+    copied_from: list[float] = []
     for index, (layer, grid, frame) in enumerate(zip(names, found, framed, strict=True)):
         symbols = (widths[index], elements[grid.label][1])
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
@@ -396,6 +409,7 @@ def spec_text(
                 # to the ground, and the copies and the roof's margin take what a taller
                 # façade gains
                 word, gap = _floors_above(tokens, pitch, gaps, counters)
+                copied_from.append(grid.rows[-1][0])
                 held.update((tokens[0][0], gap))
                 # and the gaps between its floors below do not grow (free, they would
                 # stretch while the openings' floors keep their pitch); a shorter façade
@@ -405,11 +419,10 @@ def spec_text(
                 words.append(word)
                 continue
             if axis == "y" and tokens[0][0] in ends and tokens[-1][0] in ends:
-                # a taller façade grows at the top of the floors: what stands on them keeps
-                # its margin to the ground, what stands above them its margin to the top
+                # which of its margins keeps its size is said after every layer is written
                 bottom, high = tokens[0][0], tokens[-1][0]
                 if bottom != high:
-                    margined.add(high if grid.rows[0][0] >= top else bottom)
+                    margins_y.append((grid.rows[0][0], grid.rows[-1][0], bottom, high))
             elif axis == "y" and tokens[-1][0] in ends and tokens[0][0] not in ends:
                 grounded.update(symbol for symbol, _ in tokens[:-1])  # a door keeps its height
             if not {tokens[0][0], tokens[-1][0]} & ends:  # no margin: its letters stay free
@@ -432,6 +445,16 @@ def spec_text(
             unshrunk.update(symbols[0].of(b - a) for a, b in columns)
             unshrunk.update(symbols[1].of(b - a) for a, b in grid.rows)
         layers.append((layer, grid, words[0], words[1]))
+    # a taller façade grows at the top of the floors: what stands on them keeps its
+    # margin to the ground, what stands above them its margin to the top; what stands
+    # wholly under a top floor that repeats upwards keeps its margin to the ground, as
+    # that floor does (moved up with the roof, cmp_b0005's upper floors stood over the
+    # copies of its top one at 1.5x height)
+    copies = min(copied_from, default=top)
+    margined.update(
+        high if first >= top and last >= copies else bottom
+        for first, last, bottom, high in margins_y
+    )
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
         "# a label's elements on a grid (its columns x its rows), back to front, with the",

@@ -1204,6 +1204,17 @@ function direction(angle, rise) {
   const a = angle * Math.PI / 180, r = rise * Math.PI / 180;
   return new THREE.Vector3(Math.sin(a) * Math.cos(r), Math.sin(r), Math.cos(a) * Math.cos(r));
 }
+// The corners (x, z) of the box round the land cover mapped (none without it)
+function coverCorners() {
+  const polygons = landCover ? coverPolygons(landCover) : [];
+  if (!polygons.length) return [];
+  let west = Infinity, east = -Infinity, north = Infinity, south = -Infinity;
+  for (const {rings} of polygons) for (const [x, z] of rings[0]) {
+    west = Math.min(west, x); east = Math.max(east, x);
+    north = Math.min(north, z); south = Math.max(south, z);
+  }
+  return [[west, north], [east, north], [west, south], [east, south]];
+}
 // The ground, the haze, the sun's shadows and the ambient occlusion's reach, fitted to the
 // model as first framed (not to where the camera is turned: a picture is the same each time)
 function light(model) {
@@ -1219,6 +1230,7 @@ function light(model) {
   // their streets, clear of the haze, the sky over them)
   const topEdge = (or(up, rise) - camera.fov / 2) * Math.PI / 180;
   lowHorizon = district && topEdge > 0;
+  let clearTo = 0;  // seen from above: the depth the ground stays clear to
   if (lowHorizon) {
     const seen = direction(or(around, SEEN_FROM), or(up, rise));
     const framed = fitBox(points, centre, seen, SKY_BAND);
@@ -1232,13 +1244,24 @@ function light(model) {
       farthest = Math.max(farthest, eyeAt.clone().sub(corner).dot(seen));
     }
     scene.fog.far = Math.min(scene.fog.far, Math.max(depth, 1.1 * farthest));
-    scene.fog.near = Math.min(scene.fog.near, Math.max(0.6 * scene.fog.far, 0.9 * farthest));
+    // the land round the buildings stays clear out to the scene's far edge (its mapped
+    // land cover's too; within the picture), the haze beyond it: fading from the
+    // district's middle hid a wood or a river 40 m past the buildings
+    let extent = farthest;
+    for (const [x, z] of coverCorners()) {
+      extent = Math.max(extent, eyeAt.clone().sub(new THREE.Vector3(x, box.min.y, z)).dot(seen));
+    }
+    extent = Math.min(extent, scene.fog.far);
+    scene.fog.near = Math.min(scene.fog.near, Math.max(0.6 * scene.fog.far, 0.9 * extent));
+    clearTo = Math.min(scene.fog.near, extent);
     model.traverse(part => {
       if (part.isMesh) for (const material of materialsOf(part)) material.fog = false;
     });
   }
-  // a district's ground fades from the distance of its middle: a façade's in the fog alone
-  uses.hazeFrom.value = district ? Math.min(scene.fog.near, fit) : scene.fog.far;
+  // a district's ground fades from the distance of its middle, or seen from above from
+  // its far edge (clearTo): a façade's in the fog alone
+  uses.hazeFrom.value = district ? Math.min(scene.fog.near, Math.max(fit, clearTo))
+    : scene.fog.far;
   ground.position.set(centre.x, box.min.y - radius * 1e-4, centre.z);
   ground.scale.setScalar(4 * haze);
   // the circle's texture coordinates span its diameter: slabs SLAB metres a side

@@ -20,6 +20,9 @@ from __future__ import annotations
 #   BLOCK_PLOTS m² a block), not round each house: asphalt LANE metres either side of
 #   where two blocks meet, a kerb, a SIDEWALK, then the garden's lawn, a path YARD_PATH
 #   wide round the house and a drive DRIVE wide from the road to it (driveCells);
+# - those streets lead somewhere (joinedStreets): their pieces, and each cluster of houses
+#   no street reaches, joined into one network along the boundaries between blocks'
+#   plots; a street that still stops short ends in a turning head TURNING_HEAD round;
 # - past its pavement a street is asphalt, to ROAD_HALF[1] metres from the walls at most
 #   (the middle of a street 24 m wide), and a paved square farther out, where buildings
 #   close the place in: its enclosure (the share of RAYS_AROUND rays from it that meet a
@@ -252,20 +255,175 @@ function plotBlocks(owner, near, areas, columns, rows, cell, enclosed) {
 }
 // The middle of each street between blocks (plotBlocks): the open places where the plot
 // of a block meets another's, one of them detached, within ROAD_REACH metres of the walls
+// -> {middle, boundary}: boundary, every place where two such plots meet, however far out
 function streetMiddles(owner, near, blocks, columns, rows, cell) {
   const {block, detached} = blocks, middle = new Uint8Array(columns * rows);
-  const reach = ROAD_REACH / cell;
+  const boundary = new Uint8Array(columns * rows), reach = ROAD_REACH / cell;
   const mark = (at, next) => {
     const a = owner[at], b = owner[next];
     if (!near[at] || !near[next] || block[a] === block[b]) return;
     if (!detached[a] && !detached[b]) return;
+    boundary[at] = 1;
     if (near[at] <= reach) middle[at] = 1;
   };
   for (let at = 0; at < columns * rows; at++) {
     if (at % columns < columns - 1) mark(at, at + 1);
     if (at < (rows - 1) * columns) mark(at, at + columns);
   }
-  return middle;
+  return {middle, boundary};
+}
+// Calls visit with each of the (up to) eight cells round the cell at: the step along a
+// street's middle, a line one or two cells thick that runs any way
+function aroundEach(at, columns, rows, visit) {
+  const column = at % columns, row = (at - column) / columns;
+  for (let y = Math.max(0, row - 1); y <= Math.min(rows - 1, row + 1); y++) {
+    for (let x = Math.max(0, column - 1); x <= Math.min(columns - 1, column + 1); x++) {
+      if (x !== column || y !== row) visit(y * columns + x);
+    }
+  }
+}
+// The blocks of houses (one with a detached building of OUTBUILDING m² or more) no
+// street's middle passes (none in their plots nor beside them): a cluster of houses more
+// than ROAD_REACH from any other block -> for each, the places of its plots ACCESS
+// metres (within a cell) from its walls, where its access road may end
+const ACCESS = 12;
+function unservedBlocks(streets, owner, near, pieces, blocks, columns, rows, cell) {
+  const {middle} = streets, {areas} = pieces, {block, detached} = blocks;
+  const served = new Uint8Array(areas.length), housed = new Uint8Array(areas.length);
+  for (let id = 1; id < areas.length; id++) {
+    if (detached[id] && areas[id] * cell * cell >= OUTBUILDING) housed[block[id]] = 1;
+  }
+  for (let at = 0; at < columns * rows; at++) {
+    if (!middle[at]) continue;
+    served[block[owner[at]]] = 1;
+    besideEach(at, columns, rows, next => { if (near[next]) served[block[owner[next]]] = 1; });
+  }
+  const places = new Map();  // a block -> its places
+  for (let at = 0; at < columns * rows; at++) {
+    const b = block[owner[at]];
+    if (!near[at] || !housed[b] || served[b] || Math.abs(near[at] * cell - ACCESS) > cell / 2) {
+      continue;
+    }
+    places.set(b, [...(places.get(b) || []), at]);
+  }
+  return [...places.values()];
+}
+// Streets that lead somewhere. The middles of streetMiddles stop ROAD_REACH metres from
+// the walls, so a street running out into open land ended in a stub there, and a
+// cluster of houses more than ROAD_REACH from any other block had no street at all. The
+// middles' pieces (eight neighbours) and the unserved blocks (unservedBlocks) are joined
+// into one network, the cheapest joins first: one search from every piece at once over
+// the open ground SIDEWALK or more past a road's kerb from the walls (Dijkstra; a step
+// along the boundaries between blocks' plots, where a street runs, costs a third of one
+// across a plot), a join where two pieces' searches meet, Kruskal over the joins
+// (Mehlhorn's Steiner tree). A street that still stops short (at the reach, or at an
+// unserved block) ends in a turning head: asphalt TURNING_HEAD metres round its end
+// (its middle a disc TURNING_HEAD - LANE round it). A street reaching the plan's edge
+// goes on into the town. -> the network's middle (a mask)
+const TURNING_HEAD = 6, ACROSS_PLOTS = 3;
+function joinedStreets(streets, owner, near, pieces, blocks, columns, rows, cell) {
+  const {middle, boundary} = streets, count = columns * rows, reach = ROAD_REACH / cell;
+  const network = Uint8Array.from(middle), joined = new Uint8Array(count);
+  const wave = new Int32Array(count).fill(-1), queue = new Int32Array(count);
+  let parts = 0;
+  for (let start = 0; start < count; start++) {  // the middles' pieces
+    if (!middle[start] || wave[start] >= 0) continue;
+    let head = 0, tail = 0;
+    wave[start] = parts; queue[tail++] = start;
+    while (head < tail) {
+      aroundEach(queue[head++], columns, rows, next => {
+        if (middle[next] && wave[next] < 0) { wave[next] = parts; queue[tail++] = next; }
+      });
+    }
+    parts++;
+  }
+  // an unserved block's places a piece; its road ends at one of them (two roads ending at
+  // two places of one block left the network in pieces): the one its cheapest join reaches
+  const unserved = unservedBlocks(streets, owner, near, pieces, blocks, columns, rows, cell);
+  const ringWave = Int32Array.from(wave);
+  unserved.forEach((places, k) => { for (const at of places) ringWave[at] = parts + k; });
+  const reaching = new Int32Array(unserved.length).fill(-1);
+  for (const way of joinedWays(ringWave, parts + unserved.length, middle, boundary, near,
+                               columns, rows, cell)) {
+    const end = way[way.length - 1], k = ringWave[end] - parts;
+    if (k >= 0 && reaching[k] < 0) reaching[k] = end;
+  }
+  const ends = [];
+  reaching.forEach((at, k) => { if (at >= 0) { wave[at] = parts + k; ends.push(at); } });
+  for (const way of joinedWays(wave, parts + unserved.length, middle, boundary, near,
+                               columns, rows, cell)) {
+    for (const at of way) { network[at] = 1; joined[at] = 1; }
+  }
+  const beside = Math.max(2, Math.round(2 / cell));  // stubs: middles cut at the reach
+  for (let at = 0; at < count; at++) {
+    if (!middle[at]) continue;
+    let cut = false;
+    aroundEach(at, columns, rows, next => {
+      cut = cut || (boundary[next] && !network[next] && near[next] > reach);
+    });
+    if (cut && !besideKind(joined, columns, cell, at, 1, beside * cell)) ends.push(at);
+  }
+  const heads = spaced(ends, columns, cell, 2 * TURNING_HEAD);
+  const discs = nearPlaces(heads, columns, rows, cell, TURNING_HEAD - LANE);
+  for (let at = 0; at < count; at++) if (discs[at]) network[at] = 1;
+  return network;
+}
+// The ways joining the pieces (``wave``: each seed's piece, 0..parts-1, else -1) into one
+// network (see joinedStreets): each way's cells from where two pieces' searches met back
+// to a seed of each, not the seed of a middle (the last cell of each: the seed reached,
+// the middle's neighbour), the cheapest joins first
+function joinedWays(seeds, parts, middle, boundary, near, columns, rows, cell) {
+  const count = columns * rows, wave = Int32Array.from(seeds);
+  // the search: each place's piece (wave), cost and the place it was reached from;
+  // costs in whole units (a step 2 along a boundary, 3 diagonally; ACROSS_PLOTS times
+  // that elsewhere), taken from buckets (Dial's); then where two pieces' searches meet,
+  // their join: two pieces -> [cost, at, next]
+  const clear = (LANE + KERB + SIDEWALK) / cell;
+  const open = at => near[at] >= clear || middle[at] === 1;
+  const stepTo = (at, next) => (next % columns !== at % columns && Math.abs(next - at) !== 1
+    ? 3 : 2) * (boundary[next] ? 1 : ACROSS_PLOTS);
+  const cost = new Int32Array(count).fill(-1), from = new Int32Array(count).fill(-1);
+  const buckets = [[]];
+  for (let at = 0; at < count; at++) if (wave[at] >= 0) { cost[at] = 0; buckets[0].push(at); }
+  for (let level = 0; level < buckets.length; level++) {
+    for (const at of buckets[level]) {
+      if (cost[at] !== level) continue;  // reached cheaper since
+      aroundEach(at, columns, rows, next => {
+        if (!open(next)) return;
+        const reached = level + stepTo(at, next);
+        if (cost[next] >= 0 && cost[next] <= reached) return;
+        cost[next] = reached; wave[next] = wave[at]; from[next] = at;
+        while (buckets.length <= reached) buckets.push([]);
+        buckets[reached].push(next);
+      });
+    }
+    buckets[level] = [];
+  }
+  const joins = new Map();
+  for (let at = 0; at < count; at++) {
+    if (cost[at] < 0) continue;
+    aroundEach(at, columns, rows, next => {
+      if (next < at || cost[next] < 0 || wave[next] === wave[at]) return;
+      const key = Math.min(wave[at], wave[next]) * parts + Math.max(wave[at], wave[next]);
+      const length = cost[at] + stepTo(at, next) + cost[next], known = joins.get(key);
+      if (!known || length < known[0]) joins.set(key, [length, at, next]);
+    });
+  }
+  const root = Int32Array.from({length: parts}, (_, id) => id);
+  const find = id => { while (root[id] !== id) id = root[id] = root[root[id]]; return id; };
+  const sorted = [...joins.entries()].sort((p, q) => p[1][0] - q[1][0] || p[0] - q[0]);
+  const ways = [];
+  for (const [key, [, at, next]] of sorted) {
+    const a = find(Math.floor(key / parts)), b = find(key % parts);
+    if (a === b) continue;
+    root[Math.max(a, b)] = Math.min(a, b);
+    for (const start of [at, next]) {  // back along each search to its piece
+      const cells = [];
+      for (let way = start; way >= 0 && !middle[way]; way = from[way]) cells.push(way);
+      if (cells.length) ways.push(cells);
+    }
+  }
+  return ways;
 }
 // A drive DRIVE metres wide from the street to each detached house of OUTBUILDING m² or
 // more: from the road's place in its plot nearest its walls, straight to them (down the
@@ -273,7 +431,7 @@ function streetMiddles(owner, near, blocks, columns, rows, cell) {
 // street runs past a neighbour's plot), from the road's place in its block nearest the
 // house's middle, straight to its nearest wall, DRIVE_REACH metres at most. Paved over
 // the lawn and the kerb -> the drives' cells
-const DRIVE = 2.5, OUTBUILDING = 40, DRIVE_REACH = 60;
+const DRIVE = 2.5, OUTBUILDING = 40, DRIVE_REACH = 100;
 function driveCells(kinds, owner, near, pieces, blocks, columns, rows, cell) {
   const {piece, areas} = pieces, {block, detached} = blocks, count = areas.length;
   const house = id => detached[id] && areas[id] * cell * cell >= OUTBUILDING;
@@ -307,14 +465,10 @@ function driveCells(kinds, owner, near, pieces, blocks, columns, rows, cell) {
     let at = own[id];
     for (let steps = 0; at >= 0 && near[at] * cell >= YARD_PATH && steps < 4 * columns; steps++) {
       way.push(at);  // down the distance to the walls: straight to the nearest
-      const column = at % columns, row = (at - column) / columns;
       let next = -1;
-      for (let y = Math.max(0, row - 1); y <= Math.min(rows - 1, row + 1); y++) {
-        for (let x = Math.max(0, column - 1); x <= Math.min(columns - 1, column + 1); x++) {
-          const there = y * columns + x;
-          if (near[there] < (next < 0 ? near[at] : near[next])) next = there;
-        }
-      }
+      aroundEach(at, columns, rows, there => {
+        if (near[there] < (next < 0 ? near[at] : near[next])) next = there;
+      });
       at = next;
     }
     if (own[id] >= 0 || fromBlock[id] < 0) continue;
@@ -348,8 +502,10 @@ function groundKinds(building, columns, rows, cell) {
   const {piece, areas} = buildingRows(building, near, columns, rows, cell);
   const owner = nearest.map(at => at < 0 ? 0 : piece[at]);  // each place's plot
   const blocks = plotBlocks(owner, near, areas, columns, rows, cell, enclosed);
-  const toMiddle = distanceField(streetMiddles(owner, near, blocks, columns, rows, cell),
-                                 columns, rows);
+  const streets = streetMiddles(owner, near, blocks, columns, rows, cell);
+  const network = joinedStreets(streets, owner, near, {piece, areas}, blocks, columns, rows,
+                                cell);
+  const toMiddle = distanceField(network, columns, rows);
   for (let at = 0; at < columns * rows; at++) {
     if (building[at]) continue;
     const metres = near[at] * cell;
