@@ -7,6 +7,7 @@ a façade whose bays cannot do that keeps per-layer words and says so."""
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from collections import Counter
@@ -165,17 +166,18 @@ def test_a_mirrored_facade_whose_bays_do_not_read_backwards_stays_mirrored(
 def test_a_facade_whose_bays_cannot_narrow_keeps_per_layer_words_and_says_so(
     tmp_path: Path,
 ) -> None:
-    """Three window bays each unlike the others (widths 1.0-1.6 m), a door under the
-    middle one's windows: no kind repeats, the end bays are never repeated and the
-    door's bay is written once, so nothing could drop at 0.7x; the spec keeps a word a
-    layer, and the spec, the report and a warning say why. (Four such bays without a
-    door now share: their two inner bays each have a counter.)"""
+    """Two doors under their columns of windows between two narrow window columns: the
+    end bays may drop (their counter, and a spare copy of the last, so one at a time)
+    but the doors' bays are written once and span 0.72 of the façade, so the bays could
+    not narrow to 0.7x; the spec keeps a word a layer, and the spec, the report and a
+    warning say why. (Three bays each unlike, a door under the middle one, did so
+    before the end bays repeated where no other bay may; they now share.)"""
     rects = [
         {"label": "window", "x0": x, "y0": y, "x1": x + w, "y1": y + 1.5}
-        for x, w in ((1.0, 1.0), (4.0, 1.3), (7.0, 1.6))
-        for y in (2.0, 5.0, 8.0)
+        for x, w in ((0.3, 0.4), (2.0, 1.2), (6.4, 1.2), (8.9, 0.4))
+        for y in (3.0, 5.5, 8.0)
     ]
-    rects.append({"label": "door", "x0": 4.0, "y0": 0.0, "x1": 5.3, "y1": 1.8})
+    rects += [{"label": "door", "x0": x, "y0": 0.0, "x1": x + 1.2, "y1": 2.6} for x in (2.0, 6.4)]
     layout = tmp_path / "unlike.json"
     layout.write_text(json.dumps({"canvas": {"width": 9.6, "height": 11.0}, "rects": rects}))
     out = tmp_path / "unlike.yaml"
@@ -185,11 +187,39 @@ def test_a_facade_whose_bays_cannot_narrow_keeps_per_layer_words_and_says_so(
         text=True,
     )
     assert run.returncode == 0, run.stderr
-    assert "warning: bays not shared: none of its 3 bays of 3 kinds repeat" in run.stderr
+    assert "warning: bays not shared: its 4 bays of 2 kinds cannot narrow below 0.72" in (
+        run.stderr
+    )
     assert "# Bays not shared:" in out.read_text()
     report = json.loads(out.with_name("unlike.infer.json").read_text())
     assert report["bays"].startswith("not shared")
     assert "bays_m" not in out.read_text()
+
+
+def test_three_unlike_bays_with_a_door_in_the_middle_share_their_bays(tmp_path: Path) -> None:
+    """Three window bays each unlike the others (widths 1.0-1.6 m), a door under the
+    middle one's windows: the end bays are the only ones that may repeat, so they do,
+    one at a time, and the bays are shared. At 0.7x one end column drops and the other
+    stays beside the door's (with the ends' counter alone both dropped, and the door's
+    bay stood alone); at 2x the ends gain columns; every window keeps a drawn width."""
+    rects = [
+        {"label": "window", "x0": x, "y0": y, "x1": x + w, "y1": y + 1.5}
+        for x, w in ((1.0, 1.0), (4.0, 1.3), (7.0, 1.6))
+        for y in (2.0, 5.0, 8.0)
+    ]
+    rects.append({"label": "door", "x0": 4.0, "y0": 0.0, "x1": 5.3, "y1": 1.8})
+    path = tmp_path / "unlike.json"
+    path.write_text(json.dumps({"canvas": {"width": 9.6, "height": 11.0}, "rects": rects}))
+    inference = infer(path, "unlike")
+    assert inference.bays == "3 bays of 3 kinds (ABC)", inference.bays
+    spec = parse_spec(inference.text, "unlike.yaml")
+    for share in (0.7, 2.0):
+        rects_at = _solved(inference, spec, share)
+        doors = [r for r in rects_at if r.label == "door"]
+        widths = {round(r.x1 - r.x0, 2) for r in rects_at if r.label == "window"}
+        assert len(doors) == 1 and widths <= {1.0, 1.3, 1.6}, share
+        assert len(_columns(rects_at)) >= 2, share  # never the door's bay alone
+    assert len(_columns(rects_at)) > 3
 
 
 def test_a_two_floor_family_facade_gains_a_floor_when_taller(tmp_path: Path) -> None:
@@ -743,32 +773,39 @@ def _aligned(rects: list[Rect]) -> bool:
     )
 
 
-@pytest.mark.parametrize(
-    "seed", [s for s in range(1, 80) if family(s)[1].mirrored and family(s)[1].bays == 3][:3]
-)
-def test_a_door_bay_between_two_window_columns_gains_columns_at_its_ends(
+ABA_SEEDS = [s for s in range(1, 80) if family(s)[1].mirrored and family(s)[1].bays == 3]
+
+
+@pytest.mark.parametrize("seed", ABA_SEEDS[:3] + ABA_SEEDS[-2:])
+def test_a_door_bay_between_two_window_columns_gains_and_drops_columns_at_its_ends(
     tmp_path: Path, seed: int
 ) -> None:
     """Three bays, the door's in the middle (``ABA``): no inner bay may repeat (the
-    door's is unique) and the end bays only dropped, so before, no counter of bays held
-    and each layer kept a word of its own: wider, the windows drifted off their columns
-    or the margins stretched (seed 46 at 2x: half the windows a square metre). Now the
-    ends' counter has no most: twice as wide, the façade gains whole columns of windows
-    beside its ends (density within 0.85-1.25: copies come in pairs, one each side);
-    at 1.5x and 2x every column is whole, one door."""
+    door's is unique), so the ends' counter has no most and a wider façade gains whole
+    columns of windows beside its ends (before, each layer kept a word of its own and
+    the windows drifted off their columns, or the margins stretched: seed 46 at 2x,
+    half the windows a square metre). The end bays change one at a time (a spare copy
+    of the last, at most one): at 0.7x one column stays beside the door, the windows'
+    density as drawn (with the ends' counter alone both ends dropped and left the
+    door's bay alone, a third of the windows: density 0.36-0.43). At every size every
+    column is whole and the door is there, once; twice as wide, about twice the
+    columns."""
     inference, spec = _inferred(tmp_path, seed)
     assert inference.bays.startswith("3 bays of 2 kinds (ABA)"), inference.bays
     raw = list((inference.raw or inference.layout).rects)
     drawn = [r for r in raw if r.label == "window"]
-    for share in (1.5, 2.0):  # 1.5x: a pair of bays more fits on some seeds, not on all
+    for share in (0.7, 1.5, 2.0):
         rects = _solved(inference, spec, share)
+        windows = [r for r in rects if r.label == "window"]
         assert set(_columns(rects)) <= set(_columns(raw)), share
         assert _aligned(rects), share
-        assert len(_columns(rects)) % 2 == 1, share  # gained in pairs, either side
-        assert sum(r.label == "door" for r in rects) == 1
-    windows = [r for r in rects if r.label == "window"]
+        assert sum(r.label == "door" for r in rects) == 1, share
+        density = len(windows) / len(drawn) / share
+        if share < 1:
+            assert len(_columns(rects)) == 2, share  # the door's and one beside it
+            assert 0.85 <= density <= 1.15, (share, density)
     assert len(_columns(rects)) > len(_columns(raw))
-    assert 0.85 <= len(windows) / len(drawn) / 2 <= 1.25, len(windows)
+    assert 0.85 <= density <= 1.25, density
 
 
 def _doors_in_every_bay(seed: int) -> list[tuple[str, float, float, float, float]]:
@@ -804,3 +841,35 @@ def test_a_door_in_every_bay_repeats_with_its_bays(tmp_path: Path, seed: int) ->
         assert sum(r.label == "door" for r in rects) == columns, share
         assert (columns < doors) if share < 1 else (columns > doors), share
         assert 0.85 <= columns / doors / share <= 1.15, (share, columns)
+
+
+def test_a_gap_in_a_bay_is_cut_only_at_the_lines_of_the_elements_beside_it(
+    tmp_path: Path,
+) -> None:
+    """Four bays of a window over its sill, a small ornament up in each bay's left
+    wall: the window's gap from its bay's edge is its sill's gap and the sill's inset
+    (one symbol either side, as the sill's layer names them), not cut again at the
+    ornament's edges, which stand beside neither; nor the ornament's gap after it at the
+    window's and sill's. Cut at every line of the kind, the words held every line of
+    every layer (CMP's b0001: 6,058 letters along x where 2,590 hold the same layout,
+    its solves five times the CPU)."""
+    rects: list[dict[str, object]] = []
+    for k in range(4):
+        x = 1.0 + 3.0 * k
+        for y in (2.0, 5.0, 8.0):
+            rects.append({"label": "window", "x0": x, "y0": y, "x1": x + 1.2, "y1": y + 1.5})
+            rects.append({"label": "sill", "x0": x - 0.1, "y0": y - 0.15, "x1": x + 1.3, "y1": y})
+        rects.append({"label": "deco", "x0": x - 0.7, "y0": 9.8, "x1": x - 0.5, "y1": 10.4})
+    path = tmp_path / "deco.json"
+    path.write_text(json.dumps({"canvas": {"width": 12.6, "height": 11.0}, "rects": rects}))
+    inference = infer(path, "deco")
+    assert inference.bays == "4 bays of 1 kinds (AAAA)", inference.bays
+    spec = parse_spec(inference.text, "deco.yaml")
+    words = {layer.name: layer.x for layer in spec.layers}
+    sill = re.fullmatch(r"bays_m1 \((\w+) sill_w1 bay1_w\)\^bays1 bays_m2", words["sill"])
+    assert sill, words["sill"]
+    inset = r"(bay1_g\d+)"
+    window = rf"bays_m1 \({sill[1]} {inset} window_w1 \1 bay1_w\)\^bays1 bays_m2"
+    assert re.fullmatch(window, words["window"]), words["window"]
+    deco = r"bays_m1 \(bay1_g\d+ deco_w1 bay1_g\d+ bay1_w\)\^bays1 bays_m2"
+    assert re.fullmatch(deco, words["deco"]), words["deco"]

@@ -28,7 +28,9 @@ elements; a bay where it shows none is one hidden spacer): a repeated unit of on
 two bays (never a unique label's: a door's bay is written once) gets a counter, at
 most ``COUNTERS`` of them; kinds found only at the façade's ends share one counter
 that can only drop them (its most: one, as drawn), unless no other bay may repeat
-(``_ends_repeat``); a door's bay is unique unless every bay has a door (``_unique``).
+(``_ends_repeat``: then it has no most, and a spare copy of the last bay, at most one,
+lets the end bays change one at a time, ``_spare``); a door's bay is unique unless
+every bay has a door (``_unique``).
 Where no unit repeats (a façade
 drawn by hand, each bay a little unlike every other: most of CMP's), each inner bay
 but a unique one is written once with a counter, at one where drawn, so the layout at
@@ -148,6 +150,7 @@ class Bays:
     counters: tuple[tuple[str, float, int, int | None], ...]  # name, pitch, count, most
     walls: tuple[float, ...]  # per kind: the wall after its last element (0: none)
     apart: frozenset[int] = frozenset()  # rectangles left as drawn, in layers of their own
+    spare: str | None = None  # the counter (at most 1) of a copy of the last bay (``_spare``)
 
     def steady(self) -> frozenset[int]:
         """The kinds whose wall keeps its size (the rest may narrow to ``WALL``): where
@@ -326,7 +329,7 @@ def _found(
     if isinstance(laid, str):
         yield laid
         return
-    symmetric, start, runs, counters, end = laid
+    symmetric, start, runs, counters, end, spare = laid
     narrowest = _narrowest(runs, kinds, widths, symmetric)
     if narrowest > NARROWEST * width:
         yield (
@@ -366,6 +369,7 @@ def _found(
                 tuple(counters),
                 walls,
                 frozenset(apart),
+                spare,
             )
 
 
@@ -379,11 +383,13 @@ def _laid(
     ties: Ties,
     start: float,
     centred: bool,
-) -> tuple[bool, float, list[Run], list[tuple[str, float, int, int | None]], float] | str:
+) -> (
+    tuple[bool, float, list[Run], list[tuple[str, float, int, int | None]], float, str | None] | str
+):
     """The bays on their kinds' ``widths`` laid along the façade: whether they are
-    written mirrored, the first's start, the runs and counters (``_plan``) and the
-    margin after the last (``centred``: the same as before the first); or why they
-    cannot be (no margin, no repeat)."""
+    written mirrored, the first's start, the runs and counters (``_plan``), the
+    margin after the last (``centred``: the same as before the first) and the spare end
+    bay's counter (``_spare``); or why they cannot be (no margin, no repeat)."""
     symmetric = _palindrome(kinds, mirrored)
     left, right = spans[0][0], width - spans[-1][1]
     total = sum(widths[k] for k in kinds)
@@ -395,13 +401,13 @@ def _laid(
     if start <= 0 or end <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = _unique(shapes, kinds) | set(ties)  # a variant is written once, as drawn
-    runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
+    runs, counters, spare = _plan(kinds, mirrored, unique, widths, symmetric)
     if symmetric and not any(r.counter and r.most is None for r in runs):
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
-        runs, counters = _plan(kinds, mirrored, unique, widths, False)
+        runs, counters, spare = _plan(kinds, mirrored, unique, widths, False)
     if not any(r.counter and r.most is None for r in runs):
         return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
-    return symmetric, start, runs, counters, end
+    return symmetric, start, runs, counters, end, spare
 
 
 def _unique(shapes: list[list[Slot]], kinds: list[int]) -> set[int]:
@@ -1021,7 +1027,7 @@ def _plan(
     unique: set[int],
     widths: tuple[float, ...],
     symmetric: bool,
-) -> tuple[list[Run], list[tuple[str, float, int, int | None]]]:
+) -> tuple[list[Run], list[tuple[str, float, int, int | None]], str | None]:
     """The runs the written bays are cut into (the left half's if ``symmetric``): ends
     of kinds found only there on a counter of their own (at most one: drop only), then
     up to ``COUNTERS`` repeated units of one or two bays, longest first, none of a
@@ -1090,30 +1096,53 @@ def _plan(
     if not any(run.counter and run.most is None for run in taken.values()):
         for j, name in _drawn_once(kinds, unique | ends, written, counters, widths).items():
             taken.setdefault(j, Run(j, 1, 1, name))
-    if not any(run.counter and run.most is None for run in taken.values()):
-        _ends_repeat(taken, counters)
+    spare = None
+    if not any(run.counter and run.most is None for run in taken.values()) and _ends_repeat(
+        taken, counters
+    ):
+        spare = _spare(kinds, widths, counters)
     runs = []
     k = 0
     while k < written:
         run = taken.get(k, Run(k, 1, 1))
         runs.append(run)
         k = run.start + run.unit * run.copies
-    return runs, counters
+    return runs, counters, spare
 
 
-def _ends_repeat(taken: dict[int, Run], counters: list[tuple[str, float, int, int | None]]) -> None:
+def _ends_repeat(taken: dict[int, Run], counters: list[tuple[str, float, int, int | None]]) -> bool:
     """Where no bay but the end bays may repeat (every inner bay unique: a door's
     between two columns of windows), the ends' one counter loses its most: a wider
     façade gains copies of its end bays beside them (both ends alike, so a mirrored
-    façade stays so) where it stretched its margins, its columns kept. (A narrower one
-    may drop both; at least one, a façade that cannot narrow them has no layout.)
-    ``taken`` and ``counters`` are mended in place."""
+    façade stays so) where it stretched its margins, its columns kept. ``taken`` and
+    ``counters`` are mended in place; returns whether there was such a counter."""
+    freed = False
     for n, (name, pitch, count, most) in enumerate(counters):
         if most is not None:
+            freed = True
             counters[n] = (name, pitch, count, None)
             for j, run in list(taken.items()):
                 if run.counter == name:
                     taken[j] = Run(run.start, run.unit, run.copies, name)
+    return freed
+
+
+def _spare(
+    kinds: list[int],
+    widths: tuple[float, ...],
+    counters: list[tuple[str, float, int, int | None]],
+) -> str:
+    """The counter of one more copy of the last bay, beside it (at most one; none as
+    drawn), for the ends' counter that gains and drops an end bay at each end at once
+    (``_ends_repeat``): with it the end bays change one at a time. At none, the ends'
+    counter alone left a narrower ``ABA`` (a door's bay between two columns of windows)
+    the door's bay alone, a third of its windows; now it keeps a column beside the door
+    (``BA``, the windows' density as drawn). The solver takes whichever count leaves the
+    margins nearest as drawn, so a wider façade may gain an odd number of end bays too
+    (one end a bay more than the other). The counter goes into ``counters``."""
+    name = f"bays{len(counters) + 1}"
+    counters.append((name, round(widths[kinds[-1]], DIGITS), 0, 1))
+    return name
 
 
 def _drawn_once(
