@@ -29,7 +29,8 @@ two bays (never a unique label's: a door's bay is written once) gets a counter, 
 most ``COUNTERS`` of them; kinds found only at the façade's ends share one counter
 that can only drop them (its most: one, as drawn), unless no other bay may repeat
 (``_ends_repeat``: then it has no most, and a spare copy of the last bay, at most one,
-lets the end bays change one at a time, ``_spare``); a door's bay is unique unless
+lets the end bays change one at a time, ``_spare``; not where the façade is mirrored,
+which keeps its mirror and a word a layer); a door's bay is unique unless
 every bay has a door (``_unique``).
 Where no unit repeats (a façade
 drawn by hand, each bay a little unlike every other: most of CMP's), each inner bay
@@ -388,8 +389,9 @@ def _laid(
 ):
     """The bays on their kinds' ``widths`` laid along the façade: whether they are
     written mirrored, the first's start, the runs and counters (``_plan``), the
-    margin after the last (``centred``: the same as before the first) and the spare end
-    bay's counter (``_spare``); or why they cannot be (no margin, no repeat)."""
+    margin after the last (``centred``: the same as before the first; the openings
+    mirror about the middle, ``_about_middle``) and the spare end bay's counter
+    (``_spare``); or why they cannot be (no margin, no repeat)."""
     symmetric = _palindrome(kinds, mirrored)
     left, right = spans[0][0], width - spans[-1][1]
     total = sum(widths[k] for k in kinds)
@@ -401,11 +403,17 @@ def _laid(
     if start <= 0 or end <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = _unique(shapes, kinds) | set(ties)  # a variant is written once, as drawn
-    runs, counters, spare = _plan(kinds, mirrored, unique, widths, symmetric)
+    runs, counters, spare = _plan(kinds, mirrored, unique, widths, symmetric, centred)
     if symmetric and not any(r.counter and r.most is None for r in runs):
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
-        runs, counters, spare = _plan(kinds, mirrored, unique, widths, False)
+        runs, counters, spare = _plan(kinds, mirrored, unique, widths, False, centred)
     if not any(r.counter and r.most is None for r in runs):
+        if centred and any(most is not None for *_, most in counters):
+            return (
+                f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat but its end "
+                "bays, and it is mirrored (dropping both would leave the middle alone, one "
+                "would lose the mirror)"
+            )
         return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
     return symmetric, start, runs, counters, end, spare
 
@@ -1027,6 +1035,7 @@ def _plan(
     unique: set[int],
     widths: tuple[float, ...],
     symmetric: bool,
+    centred: bool,
 ) -> tuple[list[Run], list[tuple[str, float, int, int | None]], str | None]:
     """The runs the written bays are cut into (the left half's if ``symmetric``): ends
     of kinds found only there on a counter of their own (at most one: drop only), then
@@ -1034,8 +1043,10 @@ def _plan(
     unique kind; where no unit is drawn twice in a row but the bays between the ends
     that are not unique are all of one kind (a window bay between wider end bays and a
     door's), each of them on that kind's counter; where none of that repeats, the inner
-    bays drawn once on counters of their own (``_drawn_once``); the rest one bay a run,
-    as drawn."""
+    bays drawn once on counters of their own (``_drawn_once``); where still none
+    repeats, the end bays (``_ends_repeat``, ``_spare``), unless the façade is
+    ``centred`` (its openings mirror about the middle); the rest one bay a run, as
+    drawn."""
     n = len(kinds)
     written = n // 2 if symmetric else n
     seq = list(zip(kinds, mirrored, strict=True))
@@ -1097,8 +1108,10 @@ def _plan(
         for j, name in _drawn_once(kinds, unique | ends, written, counters, widths).items():
             taken.setdefault(j, Run(j, 1, 1, name))
     spare = None
-    if not any(run.counter and run.most is None for run in taken.values()) and _ends_repeat(
-        taken, counters
+    if (
+        not centred  # a mirrored façade keeps its mirror: a word a layer (``_ends_repeat``)
+        and not any(run.counter and run.most is None for run in taken.values())
+        and _ends_repeat(taken, counters)
     ):
         spare = _spare(kinds, widths, counters)
     runs = []
@@ -1114,8 +1127,13 @@ def _ends_repeat(taken: dict[int, Run], counters: list[tuple[str, float, int, in
     """Where no bay but the end bays may repeat (every inner bay unique: a door's
     between two columns of windows), the ends' one counter loses its most: a wider
     façade gains copies of its end bays beside them (both ends alike, so a mirrored
-    façade stays so) where it stretched its margins, its columns kept. ``taken`` and
-    ``counters`` are mended in place; returns whether there was such a counter."""
+    façade stays so) where it stretched its margins, its columns kept. Not on a façade
+    whose openings mirror about its middle (``_about_middle``): narrower, it could only
+    drop both end bays (the door's bay alone, a third of its windows: density 0.36-0.43
+    on the generated ``ABA`` family at 0.7x) or, with the spare, one (the mirror lost:
+    hold-out seeds 121 and 123 at 0.7x and 2x); a word a layer keeps both, its columns
+    squeezed. ``taken`` and ``counters`` are mended in place; returns whether there was
+    such a counter."""
     freed = False
     for n, (name, pitch, count, most) in enumerate(counters):
         if most is not None:
