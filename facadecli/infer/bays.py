@@ -1153,11 +1153,12 @@ def _spare(
     """The counter of one more copy of the last bay, beside it (at most one; none as
     drawn), for the ends' counter that gains and drops an end bay at each end at once
     (``_ends_repeat``): with it the end bays change one at a time. At none, the ends'
-    counter alone left a narrower ``ABA`` (a door's bay between two columns of windows)
+    counter alone left a narrower ``ABC`` (a door's bay between two columns of windows)
     the door's bay alone, a third of its windows; now it keeps a column beside the door
-    (``BA``, the windows' density as drawn). The solver takes whichever count leaves the
+    (``BC``, the windows' density as drawn). The solver takes whichever count leaves the
     margins nearest as drawn, so a wider façade may gain an odd number of end bays too
-    (one end a bay more than the other). The counter goes into ``counters``."""
+    (one end a bay more than the other): never on a mirrored façade, which has neither
+    counter (``_plan``). The counter goes into ``counters``."""
     name = f"bays{len(counters) + 1}"
     counters.append((name, round(widths[kinds[-1]], DIGITS), 0, 1))
     return name
