@@ -71,7 +71,12 @@ def test_the_check_sees_a_spec_that_does_not_match(tmp_path: Path) -> None:
         inferred.layout,
         inferred.tiling,
         inferred.grids,
-        re.sub(r"door_w1: \{size: 1.2,( min: [0-9.]+,)?", "door_w1: {size: 0.6,", inferred.text),
+        # the door half as tall (its width is the bays': their gaps would size it back)
+        re.sub(
+            r"door_h1: \{size: 2.6,( max: [0-9.]+,)?",
+            "door_h1: {size: 1.3, max: 1.3,",
+            inferred.text,
+        ),
     )
     checks = check(wrong, parse_spec(wrong.text, "wrong.yaml"))
     assert checks["solves"] and checks["iou"]["door"] < 0.9  # type: ignore[index]
@@ -143,6 +148,7 @@ def test_runs_become_counters_and_a_wider_facade_gains_bays(tmp_path: Path) -> N
     from facadecli.solve import retarget
 
     inferred = infer(_write(tmp_path / "palazzo.json", _palazzo()), "palazzo")
+    # mirrored, its end bays the only ones that could repeat: a word a layer (``bays``)
     assert "(window_w1 window_gx" in inferred.text and "counters:" in inferred.text
     spec = parse_spec(inferred.text, "palazzo.yaml")
     windows = {}
@@ -293,13 +299,28 @@ def _widths(spec_text: str, name: str, width: float, layer: str) -> list[float]:
     return [round(s.x1 - s.x0, 6) for s in layout.shapes if s.layer == layer and s.visible]
 
 
+def _two_doors() -> list[dict[str, object]]:
+    """Two doors under their columns of windows between two narrow window columns, on a
+    9.6 x 11 façade: the doors' bays (unique) span 0.72 of it, so the bays cannot narrow
+    to 0.7 and each layer keeps a word of its own."""
+    rects: list[dict[str, object]] = [
+        {"label": "window", "x0": x, "y0": y, "x1": x + w, "y1": y + 1.5}
+        for x, w in ((0.3, 0.4), (2.0, 1.2), (6.4, 1.2), (8.9, 0.4))
+        for y in (3.0, 5.5, 8.0)
+    ]
+    rects += [{"label": "door", "x0": x, "y0": 0.0, "x1": x + 1.2, "y1": 2.6} for x in (2.0, 6.4)]
+    return rects
+
+
 def test_an_element_that_does_not_repeat_never_grows_beyond_what_the_input_shows(
     tmp_path: Path,
 ) -> None:
     """The palazzo's door and shop front appear once: a wider façade widens the wall
     around them, not them (without a bound, the sizing spread the extra width over every
-    letter of the word, and a 1.2 m door became 3.1 m at 1.5x); a narrower one may
-    shrink them to fit, an opening (the door) to ``SQUEEZE`` of its size at most."""
+    letter of the word, and a 1.2 m door became 3.1 m at 1.5x). Where each layer keeps a
+    word of its own (the palazzo, mirrored, its end bays the only ones that could repeat;
+    two doors' bays too wide to narrow), a narrower façade may shrink an opening to fit,
+    to ``SQUEEZE`` of its size at most."""
     inferred = infer(_write(tmp_path / "palazzo.json", _palazzo()), "palazzo")
     spec = parse_spec(inferred.text, "palazzo.yaml")
     assert spec.symbols["door_w1"].max == pytest.approx(1.2)
@@ -307,6 +328,14 @@ def test_an_element_that_does_not_repeat_never_grows_beyond_what_the_input_shows
     assert _widths(inferred.text, "palazzo", 17.1, "door") == [pytest.approx(1.2)]
     assert _widths(inferred.text, "palazzo", 17.1, "shop") == [pytest.approx(2.2)]
     assert all(w <= 1.2 + 1e-6 for w in _widths(inferred.text, "palazzo", 6.0, "door"))
+    inferred = infer(_write(tmp_path / "doors.json", _two_doors(), 9.6), "doors")
+    assert inferred.bays.startswith("not shared"), inferred.bays
+    spec = parse_spec(inferred.text, "doors.yaml")
+    assert spec.symbols["door_w1"].max == pytest.approx(1.2)
+    assert spec.symbols["door_w1"].min == pytest.approx(SQUEEZE * 1.2)  # it may shrink
+    assert _widths(inferred.text, "doors", 14.4, "door") == [pytest.approx(1.2)] * 2
+    narrow = _widths(inferred.text, "doors", 6.72, "door")
+    assert narrow and all(SQUEEZE * 1.2 - 1e-6 <= w <= 1.2 + 1e-6 for w in narrow)
 
 
 def test_elements_that_fill_their_word_without_gaps_stretch_with_the_facade(

@@ -27,7 +27,12 @@ one sequence of bays, written alike in every layer that stands in bays (each lay
 elements; a bay where it shows none is one hidden spacer): a repeated unit of one or
 two bays (never a unique label's: a door's bay is written once) gets a counter, at
 most ``COUNTERS`` of them; kinds found only at the façade's ends share one counter
-that can only drop them (its most: one, as drawn). Where no unit repeats (a façade
+that can only drop them (its most: one, as drawn), unless no other bay may repeat
+(``_ends_repeat``: then it has no most, and a spare copy of the last bay, at most one,
+lets the end bays change one at a time, ``_spare``; not where the façade is mirrored,
+which keeps its mirror and a word a layer); a door's bay is unique unless
+every bay has a door (``_unique``).
+Where no unit repeats (a façade
 drawn by hand, each bay a little unlike every other: most of CMP's), each inner bay
 but a unique one is written once with a counter, at one where drawn, so the layout at
 the input's size is the drawing's and a façade of another width drops or gains copies
@@ -146,6 +151,7 @@ class Bays:
     counters: tuple[tuple[str, float, int, int | None], ...]  # name, pitch, count, most
     walls: tuple[float, ...]  # per kind: the wall after its last element (0: none)
     apart: frozenset[int] = frozenset()  # rectangles left as drawn, in layers of their own
+    spare: str | None = None  # the counter (at most 1) of a copy of the last bay (``_spare``)
 
     def steady(self) -> frozenset[int]:
         """The kinds whose wall keeps its size (the rest may narrow to ``WALL``): where
@@ -324,7 +330,7 @@ def _found(
     if isinstance(laid, str):
         yield laid
         return
-    symmetric, start, runs, counters, end = laid
+    symmetric, start, runs, counters, end, spare = laid
     narrowest = _narrowest(runs, kinds, widths, symmetric)
     if narrowest > NARROWEST * width:
         yield (
@@ -364,6 +370,7 @@ def _found(
                 tuple(counters),
                 walls,
                 frozenset(apart),
+                spare,
             )
 
 
@@ -377,11 +384,14 @@ def _laid(
     ties: Ties,
     start: float,
     centred: bool,
-) -> tuple[bool, float, list[Run], list[tuple[str, float, int, int | None]], float] | str:
+) -> (
+    tuple[bool, float, list[Run], list[tuple[str, float, int, int | None]], float, str | None] | str
+):
     """The bays on their kinds' ``widths`` laid along the façade: whether they are
-    written mirrored, the first's start, the runs and counters (``_plan``) and the
-    margin after the last (``centred``: the same as before the first); or why they
-    cannot be (no margin, no repeat)."""
+    written mirrored, the first's start, the runs and counters (``_plan``), the
+    margin after the last (``centred``: the same as before the first; the openings
+    mirror about the middle, ``_about_middle``) and the spare end bay's counter
+    (``_spare``); or why they cannot be (no margin, no repeat)."""
     symmetric = _palindrome(kinds, mirrored)
     left, right = spans[0][0], width - spans[-1][1]
     total = sum(widths[k] for k in kinds)
@@ -392,15 +402,28 @@ def _laid(
     end = start if centred else round(width - start - total, DIGITS)
     if start <= 0 or end <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
-    unique = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
-    unique |= set(ties)  # a variant is written once, as drawn
-    runs, counters = _plan(kinds, mirrored, unique, widths, symmetric)
+    unique = _unique(shapes, kinds) | set(ties)  # a variant is written once, as drawn
+    runs, counters, spare = _plan(kinds, mirrored, unique, widths, symmetric, centred)
     if symmetric and not any(r.counter and r.most is None for r in runs):
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
-        runs, counters = _plan(kinds, mirrored, unique, widths, False)
+        runs, counters, spare = _plan(kinds, mirrored, unique, widths, False, centred)
     if not any(r.counter and r.most is None for r in runs):
+        if centred and any(most is not None for *_, most in counters):
+            return (
+                f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat but its end "
+                "bays, and it is mirrored (dropping both would leave the middle alone, one "
+                "would lose the mirror)"
+            )
         return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
-    return symmetric, start, runs, counters, end
+    return symmetric, start, runs, counters, end, spare
+
+
+def _unique(shapes: list[list[Slot]], kinds: list[int]) -> set[int]:
+    """The kinds never repeated: those with an element of a unique label (a door),
+    unless every bay has one (a shop's door in every bay singles none out: the façade
+    repeats its bays, doors and all)."""
+    marked = {k for k, shape in enumerate(shapes) if any(s[0] in UNIQUE for s in shape)}
+    return set() if set(kinds) <= marked else marked
 
 
 def _rowed(
@@ -1012,15 +1035,18 @@ def _plan(
     unique: set[int],
     widths: tuple[float, ...],
     symmetric: bool,
-) -> tuple[list[Run], list[tuple[str, float, int, int | None]]]:
+    centred: bool,
+) -> tuple[list[Run], list[tuple[str, float, int, int | None]], str | None]:
     """The runs the written bays are cut into (the left half's if ``symmetric``): ends
     of kinds found only there on a counter of their own (at most one: drop only), then
     up to ``COUNTERS`` repeated units of one or two bays, longest first, none of a
     unique kind; where no unit is drawn twice in a row but the bays between the ends
     that are not unique are all of one kind (a window bay between wider end bays and a
     door's), each of them on that kind's counter; where none of that repeats, the inner
-    bays drawn once on counters of their own (``_drawn_once``); the rest one bay a run,
-    as drawn."""
+    bays drawn once on counters of their own (``_drawn_once``); where still none
+    repeats, the end bays (``_ends_repeat``, ``_spare``), unless the façade is
+    ``centred`` (its openings mirror about the middle); the rest one bay a run, as
+    drawn."""
     n = len(kinds)
     written = n // 2 if symmetric else n
     seq = list(zip(kinds, mirrored, strict=True))
@@ -1081,13 +1107,61 @@ def _plan(
     if not any(run.counter and run.most is None for run in taken.values()):
         for j, name in _drawn_once(kinds, unique | ends, written, counters, widths).items():
             taken.setdefault(j, Run(j, 1, 1, name))
+    spare = None
+    if (
+        not centred  # a mirrored façade keeps its mirror: a word a layer (``_ends_repeat``)
+        and not any(run.counter and run.most is None for run in taken.values())
+        and _ends_repeat(taken, counters)
+    ):
+        spare = _spare(kinds, widths, counters)
     runs = []
     k = 0
     while k < written:
         run = taken.get(k, Run(k, 1, 1))
         runs.append(run)
         k = run.start + run.unit * run.copies
-    return runs, counters
+    return runs, counters, spare
+
+
+def _ends_repeat(taken: dict[int, Run], counters: list[tuple[str, float, int, int | None]]) -> bool:
+    """Where no bay but the end bays may repeat (every inner bay unique: a door's
+    between two columns of windows), the ends' one counter loses its most: a wider
+    façade gains copies of its end bays beside them (both ends alike, so a mirrored
+    façade stays so) where it stretched its margins, its columns kept. Not on a façade
+    whose openings mirror about its middle (``_about_middle``): narrower, it could only
+    drop both end bays (the door's bay alone, a third of its windows: density 0.36-0.43
+    on the generated ``ABA`` family at 0.7x) or, with the spare, one (the mirror lost:
+    hold-out seeds 121 and 123 at 0.7x and 2x); a word a layer keeps both, its columns
+    squeezed. ``taken`` and ``counters`` are mended in place; returns whether there was
+    such a counter."""
+    freed = False
+    for n, (name, pitch, count, most) in enumerate(counters):
+        if most is not None:
+            freed = True
+            counters[n] = (name, pitch, count, None)
+            for j, run in list(taken.items()):
+                if run.counter == name:
+                    taken[j] = Run(run.start, run.unit, run.copies, name)
+    return freed
+
+
+def _spare(
+    kinds: list[int],
+    widths: tuple[float, ...],
+    counters: list[tuple[str, float, int, int | None]],
+) -> str:
+    """The counter of one more copy of the last bay, beside it (at most one; none as
+    drawn), for the ends' counter that gains and drops an end bay at each end at once
+    (``_ends_repeat``): with it the end bays change one at a time. At none, the ends'
+    counter alone left a narrower ``ABC`` (a door's bay between two columns of windows)
+    the door's bay alone, a third of its windows; now it keeps a column beside the door
+    (``BC``, the windows' density as drawn). The solver takes whichever count leaves the
+    margins nearest as drawn, so a wider façade may gain an odd number of end bays too
+    (one end a bay more than the other): never on a mirrored façade, which has neither
+    counter (``_plan``). The counter goes into ``counters``."""
+    name = f"bays{len(counters) + 1}"
+    counters.append((name, round(widths[kinds[-1]], DIGITS), 0, 1))
+    return name
 
 
 def _drawn_once(
