@@ -154,7 +154,7 @@ def _write_city_ground_model(built: BuiltCity) -> dict[str, Any]:
     left is removed)."""
     from facadecli.city.ground import write_ground_glb
 
-    path = built.outdir / f"{built.name}.ground.glb"
+    path = _ground_model(built)
     parts = [part for task in built.ok() for part in task.footprint.parts]
     if not (built.ground and parts):
         path.unlink(missing_ok=True)
@@ -167,9 +167,14 @@ def _write_city_ground_model(built: BuiltCity) -> dict[str, Any]:
 def _write_city_3dtiles(built: BuiltCity) -> dict[str, Any]:
     if built.tileset is None:
         raise ValueError("a city without --3dtiles has no tileset to write")
-    ground = built.outdir / f"{built.name}.ground.glb" if built.ground else None
-    laid = ground if ground is not None and ground.is_file() else None
+    ground = _ground_model(built)  # written by the models' writer, before this one
+    laid = ground if built.ground and ground.is_file() else None
     return {"3dtiles": built.tileset.close(built.name, laid)}
+
+
+def _ground_model(built: BuiltCity) -> Path:
+    """Where the district's ground goes (``--ground``): ``<name>.ground.glb``."""
+    return built.outdir / f"{built.name}.ground.glb"
 
 
 def _write_city_usd(built: BuiltCity) -> dict[str, Any]:
