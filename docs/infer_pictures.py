@@ -32,6 +32,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parent.parent
 SIZES = {"1x": (1.0, 1.0), "0.7w": (0.7, 1.0), "1.5w": (1.5, 1.0), "2w": (2.0, 1.0)}
 SIZES["1.5h"] = (1.0, 1.5)
+SIZES["0.7h"] = (1.0, 0.7)
 SCALE = 24.0  # pixels a metre
 GAP = 24.0  # pixels between the two elevations and round them
 OVERLAP = 0.01  # m: openings overlapping by more than this both ways are marked

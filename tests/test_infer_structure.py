@@ -677,3 +677,52 @@ def test_floors_drawn_unlike_gain_whole_floors_under_the_attic_within_the_densit
     assert len(attic) == 5 and min(r.y0 for r in attic) > max(
         r.y1 for r in windows if r not in attic
     )
+
+
+def _two_houses(path: Path, seed: int) -> Path:
+    """Two houses side by side, each floor's windows a layer of its own (every floor's
+    columns shifted from the others', as ``_floors_apart``): on the left three floors
+    of taller windows (1.2 x 1.9 m) at a pitch of 3.3 m, on the right four floors of
+    lower ones (1.0 x 1.4 m) at 2.5 m, each floor with its sills; every height jittered
+    by up to 3% and every edge by up to 1 cm."""
+    rng = random.Random(seed)
+    rects = []
+    houses = ((1.2, 1.9, 3.3, 3, 0.8), (1.0, 1.4, 2.5, 4, 8.8))  # w, h, pitch, floors, x
+    for width, height, pitch, floors, left in houses:
+        for f in range(floors):
+            shift = (0.0, 0.3, 0.6, 0.15)[f]
+            for k in range(3):
+                cx = left + 0.9 + shift + k * 2.1 + rng.uniform(-0.01, 0.01)
+                y0 = 1.5 + f * pitch + rng.uniform(-0.01, 0.01)
+                y1 = y0 + height * (1 + rng.uniform(-0.03, 0.03))
+                x0, x1 = cx - width / 2, cx + width / 2
+                rects.append({"label": "window", "x0": x0, "y0": y0, "x1": x1, "y1": y1})
+                rects.append(
+                    {"label": "sill", "x0": x0 - 0.1, "y0": y0 - 0.2, "x1": x1 + 0.1, "y1": y0}
+                )
+    path.write_text(json.dumps({"canvas": {"width": 16.0, "height": 13.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_two_houses_of_unlike_floor_pitches_each_gain_floors_at_their_own_pitch(
+    tmp_path: Path, seed: int
+) -> None:
+    """1.5 times as tall, each house of a façade whose parts have floors of unlike
+    pitches gains the whole floors that fit at its own pitch, its windows with their
+    sills, none over another. Before, every copy stood at one pitch, the middle of the
+    openings' top floors': the house whose pitch is another (cmp_b0003's left part)
+    gained none (density 0.75 of the input's)."""
+    path = _two_houses(tmp_path / "houses.json", seed)
+    rects = _solved(path, 16.0, 13.0 * 1.5)
+    windows = _of(rects, "window")
+    assert _overlapping(windows) == 0
+    for lo, hi, pitch, drawn in ((0.0, 8.0, 3.3, 3), (8.0, 16.0, 2.5, 4)):
+        house = [r for r in windows if lo <= (r.x0 + r.x1) / 2 < hi]
+        rows = sorted({round(r.y0, 1) for r in house})
+        assert len(rows) == drawn + int(6.5 / pitch)  # the floors that fit in 6.5 m
+        assert all(b - a == pytest.approx(pitch, abs=0.06) for a, b in itertools.pairwise(rows))
+        sills = [r for r in _of(rects, "sill") if lo <= (r.x0 + r.x1) / 2 < hi]
+        assert all(
+            any(abs(s.y1 - w.y0) < 0.03 and s.x0 < w.x0 < s.x1 for s in sills) for w in house
+        )

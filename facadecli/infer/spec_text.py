@@ -22,10 +22,11 @@
   of its own (``window_2_w1``; ``_width_tables``): a mask names symbols, so each would
   show the other's window.
 - Top floors (``layers.top_floors``): where the openings have no run of floors, the last
-  floor like the one under it repeats upwards (``_floors_above``), every copy at one
-  pitch and one counter, as many as fit in the height gained (the roof's margin never
-  shrinks); the floors under it keep their sizes, and what stands wholly over it (a
-  lower top floor, an attic) keeps its margin to the roof, clear of the copies.
+  floor like the one under it repeats upwards (``_floors_above``), every copy at its
+  part's pitch, one counter a pitch, as many as fit in the height gained (the roof's
+  margin never shrinks); the floors under it keep their sizes, and what stands wholly
+  over it (a lower top floor, an attic) keeps its margin to the roof, clear of the
+  copies.
 - Repeats: where a word repeats a gap and an element twice or more (three elements), or
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
@@ -139,12 +140,11 @@ class _Counters:
     names: dict[tuple[str, float, int], str] = field(default_factory=dict)
 
     def floors(self, pitch: float) -> str:
-        """The one counter of every top floor's copies: a taller façade gains as many
-        floors in every column (``pitch``: the first floor's, for the comment)."""
-        for (along, _, copies), name in self.names.items():
-            if along == "y" and copies == 0:
-                return name
-        name = self.names[("y", round(pitch, 4), 0)] = f"n{len(self.names) + 1}"
+        """The one counter of every top floor's copies at ``pitch``: a taller façade
+        gains as many floors in every column of that pitch (``layers.top_floors``)."""
+        key = ("y", round(pitch, 4), 0)
+        name = self.names.get(key) or f"n{len(self.names) + 1}"
+        self.names[key] = name
         return name
 
     def of(self, axis: str, pitch: float, count: int) -> str:
@@ -727,8 +727,8 @@ def _floors_above(
     """The y word of a layer whose top row is its label's top floor (``layers.top_floors``;
     ``tokens`` from its margin below to its margin above), that floor repeating upwards
     at ``pitch``: ``... h (g h)^n m``, the gap ``g`` the pitch less the element ``h``,
-    ``n`` none at the input's size and shared by every such layer; and the gap's symbol
-    (its size is kept: the copies stand at the pitch)."""
+    ``n`` none at the input's size and shared by every such layer at that pitch; and
+    the gap's symbol (its size is kept: the copies stand at the pitch)."""
     element, size = tokens[-2]
     gap = gaps.of(pitch - size)
     symbols = [symbol for symbol, _ in tokens]
