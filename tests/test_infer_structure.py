@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import random
 from collections.abc import Callable
 from pathlib import Path
@@ -18,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from facadecli import parse_spec, solve
+from facadecli.errors import InfeasibleError
 from facadecli.grammar.inputs import LabelledLayout, Rect
 from facadecli.grammar.model import Options
 from facadecli.infer import run
@@ -726,3 +728,49 @@ def test_two_houses_of_unlike_floor_pitches_each_gain_floors_at_their_own_pitch(
         assert all(
             any(abs(s.y1 - w.y0) < 0.03 and s.x0 < w.x0 < s.x1 for s in sills) for w in house
         )
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize(
+    ("facade", "pitches"),
+    [(_floors_apart, {(0.0, 15.0): 2.6}), (_two_houses, {(0.0, 8.0): 3.3, (8.0, 16.0): 2.5})],
+)
+def test_a_shorter_facade_drops_whole_floors_from_the_top_keeping_its_windows(
+    tmp_path: Path,
+    facade: Callable[[Path, int], Path],
+    pitches: dict[tuple[float, float], float],
+    seed: int,
+) -> None:
+    """0.7 times as tall, a façade whose top floor repeats upwards drops the whole floors
+    it must from the top (as many as free the height lost: the roof's margin never
+    shrinks), in every column of a pitch alike and with their sills; the floors kept
+    stand where drawn, every window its size, none over another. Before, no layout
+    existed ("make the canvas taller"): the top floor's copies could only be added."""
+    path = facade(tmp_path / "facade.json", seed)
+    canvas = json.loads(path.read_text())["canvas"]
+    drawn = _of([Rect(**r) for r in json.loads(path.read_text())["rects"]], "window")
+    lost = 0.3 * canvas["height"]
+    rects = _solved(path, canvas["width"], 0.7 * canvas["height"])
+    windows = _of(rects, "window")
+    assert _overlapping(windows) == 0
+    for (lo, hi), pitch in pitches.items():
+        part = [r for r in drawn if lo <= (r.x0 + r.x1) / 2 < hi]
+        rows = sorted({round(r.y0, 1) for r in part})
+        kept = rows[: len(rows) - math.ceil(lost / pitch)]
+        found = [r for r in windows if lo <= (r.x0 + r.x1) / 2 < hi]
+        assert sorted({round(r.y0, 1) for r in found}) == kept
+        assert len(found) == sum(round(r.y0, 1) in kept for r in part)  # whole floors
+        for r in found:  # each where drawn, its size
+            assert any(
+                abs(r.y0 - d.y0) < 0.02 and abs(r.y1 - r.y0 - (d.y1 - d.y0)) < 0.03 for d in part
+            )
+        sills = [s for s in _of(rects, "sill") if lo <= (s.x0 + s.x1) / 2 < hi]
+        assert len(sills) == (len(found) if facade is _two_houses else 0)
+
+
+def test_a_facade_too_short_for_its_lowest_floor_says_so(tmp_path: Path) -> None:
+    """Where even one floor of the stack does not fit, there is no layout, and the
+    error says to make the canvas taller."""
+    path = _floors_apart(tmp_path / "facade.json", 1)
+    with pytest.raises(InfeasibleError, match="make the canvas larger"):
+        _solved(path, WIDTH, 3.0)

@@ -11,6 +11,7 @@ background becomes the wall behind them all.
 
 from __future__ import annotations
 
+import itertools
 import statistics
 from collections import defaultdict
 from dataclasses import dataclass
@@ -344,3 +345,82 @@ def _nearest(pitch: float, pitches: list[float]) -> float:
 def _over(a: Grid, b: Grid, reach: float = 0.0) -> bool:
     """Whether a column of ``a`` overlaps one of ``b`` (grown by ``reach`` either side)."""
     return any(_overlap(c, (d[0] - reach, d[1] + reach)) for c in a.columns for d in b.columns)
+
+
+@dataclass(frozen=True)
+class Stack:
+    """A top floor that repeats upwards (``top_floors``) with the floors like it under it
+    (``stacks``), as one layer sees them: ``floors`` slots of ``pitch``, the lowest
+    starting at ``bottom``, numbered from the top (0, the top floor's, where the copies
+    stand over); ``rows`` the layer's rows on them, each with its slot. The layer's other
+    rows stand under ``bottom``."""
+
+    top: bool  # the layer of the top floor (its copies are shown)
+    pitch: float
+    bottom: float
+    floors: int
+    rows: tuple[tuple[Span, int], ...]
+
+
+def stacks(found: list[Grid], tops: dict[int, float], height: float) -> dict[int, Stack]:
+    """The layers standing on the floors of a top floor that repeats upwards, and the top
+    floor's own layer, each with its ``Stack``, so that a shorter façade drops whole
+    floors from the top, with what stands on them, in every column alike, as a taller
+    one gains copies of the top floor (``spec_text._stack_word``). A top floor's stack
+    is the floors a pitch, two pitches, ... under its row (each within ``FLOOR_PITCH``
+    of the pitch) holding a row of its label in columns overlapping its own, like it in
+    height for the openings (``FLOOR``; sills drawn 1-2 cm tall are not), down to the
+    first floor without one; a layer of one row joins the first stack it stands on.
+    Each floor is a slot of the pitch whose start is the top row's less the pitches,
+    lowered by the most any row of the stack starts under its slot (a hand's jitter),
+    so each row stands in its slot. A stack whose rows do not fit in their slots, whose
+    top slot reaches the roof, or whose top layer has rows between its slots is none:
+    that top floor repeats upwards as it did, and a shorter façade has no layout."""
+    out: dict[int, Stack] = {}
+    for k, pitch in sorted(tops.items()):
+        grid = found[k]
+        start, end = grid.rows[-1]
+        size = end - start
+        like = grid.label in OPENINGS
+        found_rows: dict[int, list[tuple[int, Span]]] = {0: [(k, grid.rows[-1])]}
+        for depth in itertools.count(1):
+            at = start - depth * pitch
+            hits = [
+                (m, row)
+                for m, other in enumerate(found)
+                if m not in out
+                and (m == k or (m not in tops and len(other.rows) == 1 and _over(other, grid)))
+                and other.label == grid.label
+                and not other.apart
+                for row in other.rows
+                if abs(row[0] - at) <= FLOOR_PITCH * pitch
+                and (not like or abs(row[1] - row[0] - size) <= FLOOR * size)
+            ]
+            if at < 0 or not hits:
+                break
+            found_rows[depth] = hits
+        floors = len(found_rows)
+        lowest = start - (floors - 1) * pitch
+        under = max(
+            (start - d * pitch) - row[0] for d, hits in found_rows.items() for _, row in hits
+        )
+        bottom = lowest - max(under, 0.0)
+        slots = {d: bottom + (floors - 1 - d) * pitch for d in found_rows}
+        if any(
+            row[1] > slots[d] + pitch + 1e-9 for d, hits in found_rows.items() for _, row in hits
+        ):
+            continue  # a row beyond its slot
+        if bottom + floors * pitch >= height - 1e-6:
+            continue  # the top slot reaches the roof: no margin over it
+        own = [row for hits in found_rows.values() for m, row in hits if m == k]
+        if any(row[1] > bottom + 1e-9 for row in grid.rows if row not in own):
+            continue  # the top layer's rows between the slots
+        members: dict[int, list[tuple[Span, int]]] = {}
+        for d, hits in found_rows.items():
+            for m, row in hits:
+                members.setdefault(m, []).append((row, d))
+        if any(m != k and m in out for m in members):
+            continue
+        for m, rows in members.items():
+            out[m] = Stack(m == k, pitch, bottom, floors, tuple(sorted(rows)))
+    return out
