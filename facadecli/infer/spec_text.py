@@ -792,9 +792,10 @@ def _floors_above(
 
 
 def _stacked(found: list[Grid], stacked: dict[int, Stack]) -> dict[int, Stack]:
-    """The stacks (``layers.stacks``), where every layer standing higher than a stack's
-    lowest floor is on a stack or wholly over the top floors (an attic, a lower top
-    floor: it moves with the roof); else none. A layer on the floors that is on none
+    """The stacks (``layers.stacks``), where every layer standing higher than a floor a
+    shorter façade may drop (over the lowest of the deepest stacks, which stays) is on
+    a stack or wholly over the top floors (an attic, a lower top floor: it moves with
+    the roof); else none. A layer on the floors that is on none
     (a balcony, a blind or a sill not alike on every floor, a pillar up the façade)
     stays where drawn while the floors under it drop, and a shorter façade still has
     no layout; the spec is then as without stacks (their counters cost the solver a
@@ -802,7 +803,16 @@ def _stacked(found: list[Grid], stacked: dict[int, Stack]) -> dict[int, Stack]:
     past their budgets)."""
     if not stacked:
         return {}
-    bottom = min(stack.bottom for stack in stacked.values())
+    deepest = {
+        s.pitch: max(t.floors for t in stacked.values() if t.pitch == s.pitch)
+        for s in stacked.values()
+    }
+    # the lowest floor of the deepest stacks at a pitch stays (``_stack_word``): what
+    # stands on it (a door) stays with it
+    bottom = min(
+        stack.bottom + (stack.pitch if stack.floors == deepest[stack.pitch] else 0.0)
+        for stack in stacked.values()
+    )
     over = min(found[k].rows[-1][1] for k, stack in stacked.items() if stack.top)
     for k, grid in enumerate(found):
         if k not in stacked and grid.rows[-1][1] > bottom + 1e-9 and grid.rows[0][0] < over:
