@@ -301,7 +301,7 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
                 if high - low < pitch
                 and found[o].rows[-1][0] - pitch / 2 <= low <= found[o].rows[-1][1]
                 and _over(found[o], found[k], NEAR)
-                and any(abs(low - start - pitch) <= FLOOR_PITCH * pitch for start in under[k])
+                and any(abs(low - start - pitch) <= FLOOR * pitch for start in under[k])
             ),
             None,
         )

@@ -423,7 +423,13 @@ def spec_text(
                 # the floors of a top floor that repeats upwards, from the top: a shorter
                 # façade drops them, a taller one gains copies of the top one; the layer
                 # keeps its margin to the ground, its elements and gaps their sizes, and
-                # the roof's margin never shrinks
+                # the roof's margin never shrinks; that margin is the layer's own
+                # (``<layer>_mr``): every other letter keeps its size, so two layers on
+                # the same rows on stacks from unlike floors (a window's, its blind's)
+                # each sum to the canvas to the rounding of the sizes written, a tenth of
+                # a millimetre apart, and one margin shared would leave no layout
+                roofs_own = _Symbols(f"{layer}_mr")
+                owned[-1].append(roofs_own)
                 word, steady, roof, shown = _stack_word(
                     grid.rows,
                     stack,
@@ -431,6 +437,7 @@ def spec_text(
                     symbols[1],
                     gaps,
                     margins,
+                    roofs_own,
                     counters,
                     max(s.floors for s in stacked.values() if s.pitch == stack.pitch),
                 )
@@ -827,6 +834,7 @@ def _stack_word(
     element: _Symbols,
     gaps: _Symbols,
     margins: _Symbols,
+    roofs: _Symbols,
     counters: _Counters,
     deepest: int,
 ) -> tuple[str, list[str], str, list[str]]:
@@ -837,10 +845,10 @@ def _stack_word(
     from the top; a floor is the layer's row on it (a gap to where it starts, the
     element, the gap to the next floor) or one hidden gap of the pitch; over the top
     floor its copies (``_Counters.floors``: the top layer's, shown; hidden gaps in the
-    others), then the margin to the roof. The lowest floor of the ``deepest`` stacks at
-    its pitch has no counter: a façade keeps one floor of them at least. With the
-    symbols that keep their size (the margin to the ground and the gaps), the roof's
-    margin, and the elements."""
+    others), then the margin to the roof (a symbol of ``roofs``). The lowest floor of
+    the ``deepest`` stacks at its pitch has no counter: a façade keeps one floor of them
+    at least. With the symbols that keep their size (the margin to the ground and the
+    gaps), the roof's margin, and the elements."""
     on = dict(stack.rows)
     letters: list[str] = []
     cursor = 0.0
@@ -875,7 +883,7 @@ def _stack_word(
             if floor == deepest - 1
             else f"({letters_on})^{counters.drop(stack.pitch, floor)}"
         )
-    roof = margins.of(height - stack.bottom - stack.floors * stack.pitch)
+    roof = roofs.of(height - stack.bottom - stack.floors * stack.pitch)
     steady = [s for s in {*letters, *gaps.sizes.values()} if s not in shown]
     return " ".join([*letters, text, roof]), steady, roof, shown
 
