@@ -774,3 +774,46 @@ def test_a_facade_too_short_for_its_lowest_floor_says_so(tmp_path: Path) -> None
     path = _floors_apart(tmp_path / "facade.json", 1)
     with pytest.raises(InfeasibleError, match="make the canvas larger"):
         _solved(path, WIDTH, 3.0)
+
+
+def _blinds_upstairs(path: Path, seed: int) -> Path:
+    """A ground floor of four windows and over it two floors of five (1.2 x 1.6 m, one
+    grid of two rows), a blind beside each upper window only, every edge jittered by up
+    to 1 cm: the windows' stack stands on the ground floor, the blinds' on the first."""
+    rng = random.Random(seed)
+    rects = []
+    for f, bays in ((0, 4), (1, 5), (2, 5)):
+        for k in range(bays):
+            cx = 2.0 + k * (11.0 / (bays - 1)) + rng.uniform(-0.01, 0.01)
+            y0 = 1.5 + f * 3.2 + rng.uniform(-0.01, 0.01)
+            rects.append(
+                {"label": "window", "x0": cx - 0.6, "y0": y0, "x1": cx + 0.6, "y1": y0 + 1.6}
+            )
+            if f:
+                rects.append(
+                    {"label": "blind", "x0": cx + 0.6, "y0": y0, "x1": cx + 1.0, "y1": y0 + 1.6}
+                )
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 11.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_windows_and_blinds_on_stacks_from_unlike_floors_solve_at_every_height(
+    tmp_path: Path, seed: int
+) -> None:
+    """The upper windows and their blinds stand on the same rows, on stacks from unlike
+    floors (the windows' from the ground floor, the blinds' from the first): each solves
+    at the input's height, taller and shorter, every blind beside its window. When the
+    two layers shared their roof's margin, the sizes written to a tenth of a millimetre
+    left no layout even at the input's height."""
+    path = _blinds_upstairs(tmp_path / "blinds.json", seed)
+    for share, floors in ((1.0, 3), (1.5, 4), (0.75, 2)):
+        rects = _solved(path, WIDTH, 11.0 * share)
+        windows, blinds = _of(rects, "window"), _of(rects, "blind")
+        assert len({round(r.y0, 1) for r in windows}) == floors
+        assert _overlapping(windows) == 0
+        assert len(blinds) == len(windows) - 4
+        assert all(
+            any(abs(b.x0 - w.x1) < 0.03 and abs(b.y0 - w.y0) < 0.03 for w in windows)
+            for b in blinds
+        )

@@ -12,6 +12,7 @@ background becomes the wall behind them all.
 from __future__ import annotations
 
 import itertools
+import math
 import statistics
 from collections import defaultdict
 from dataclasses import dataclass
@@ -362,6 +363,19 @@ class Stack:
     rows: tuple[tuple[Span, int], ...]
 
 
+def _slot(found: list[Grid], tops: dict[int, float], k: int) -> float:
+    """Where the top floor's slot of top layer ``k`` starts: the middle of the wall under
+    the top row of the openings' top layer at its pitch nearest it (its own, for an
+    opening), moved by whole pitches to the floor ``k``'s top row stands on (a sill
+    under its window shares the window's slot)."""
+    pitch, start = tops[k], found[k].rows[-1][0]
+    openings = [o for o, p in tops.items() if p == pitch and found[o].label in OPENINGS]
+    o = min(openings, key=lambda o: abs(found[o].rows[-1][0] - start), default=k)
+    low, high = found[o].rows[-1]
+    first = low - (pitch - (high - low)) / 2
+    return first + math.floor((start - first) / pitch) * pitch
+
+
 def stacks(found: list[Grid], tops: dict[int, float], height: float) -> dict[int, Stack]:
     """The layers standing on the floors of a top floor that repeats upwards, and the top
     floor's own layer, each with its ``Stack``, so that a shorter façade drops whole
@@ -371,10 +385,13 @@ def stacks(found: list[Grid], tops: dict[int, float], height: float) -> dict[int
     of the pitch) holding a row of its label in columns overlapping its own, like it in
     height for the openings (``FLOOR``; sills drawn 1-2 cm tall are not), down to the
     first floor without one; a layer of one row joins the first stack it stands on.
-    Each floor is a slot of the pitch whose start is the top row's less the pitches,
-    lowered by the most any row of the stack starts under its slot (a hand's jitter),
-    so each row stands in its slot. A stack whose rows do not fit in their slots, whose
-    top slot reaches the roof, or whose top layer has rows between its slots is none:
+    Each floor is a slot of the pitch, from the middle of the wall under it to the
+    middle of the wall over it (as ``floors.Floors`` cuts the openings' run: a top floor
+    closer to the roof than a floor's wall, or a lowest one closer to the ground, still
+    has its slot), the top one's from the top row's, the others a pitch apart, lowered by
+    the most any row of the stack starts under its slot (a hand's jitter), so each row
+    stands in its slot. A stack whose rows do not fit in their slots, whose slots reach
+    the ground or the roof, or whose top layer has rows between its slots is none:
     that top floor repeats upwards as it did, and a shorter façade has no layout."""
     out: dict[int, Stack] = {}
     for k, pitch in sorted(tops.items()):
@@ -391,7 +408,6 @@ def stacks(found: list[Grid], tops: dict[int, float], height: float) -> dict[int
                 if m not in out
                 and (m == k or (m not in tops and len(other.rows) == 1 and _over(other, grid)))
                 and other.label == grid.label
-                and not other.apart
                 for row in other.rows
                 if abs(row[0] - at) <= FLOOR_PITCH * pitch
                 and (not like or abs(row[1] - row[0] - size) <= FLOOR * size)
@@ -400,18 +416,18 @@ def stacks(found: list[Grid], tops: dict[int, float], height: float) -> dict[int
                 break
             found_rows[depth] = hits
         floors = len(found_rows)
-        lowest = start - (floors - 1) * pitch
+        first = _slot(found, tops, k)
         under = max(
-            (start - d * pitch) - row[0] for d, hits in found_rows.items() for _, row in hits
+            (first - d * pitch) - row[0] for d, hits in found_rows.items() for _, row in hits
         )
-        bottom = lowest - max(under, 0.0)
+        bottom = first - (floors - 1) * pitch - max(under, 0.0)
         slots = {d: bottom + (floors - 1 - d) * pitch for d in found_rows}
         if any(
             row[1] > slots[d] + pitch + 1e-9 for d, hits in found_rows.items() for _, row in hits
         ):
             continue  # a row beyond its slot
-        if bottom + floors * pitch >= height - 1e-6:
-            continue  # the top slot reaches the roof: no margin over it
+        if bottom < 0 or bottom + floors * pitch >= height - 1e-6:
+            continue  # the slots reach the ground or the roof: no margin
         own = [row for hits in found_rows.values() for m, row in hits if m == k]
         if any(row[1] > bottom + 1e-9 for row in grid.rows if row not in own):
             continue  # the top layer's rows between the slots
