@@ -8,11 +8,12 @@ marks an opening (window or door) that overlaps another by more than 1 cm x 1 cm
 is taken as a PNG by headless Chromium (``pictures.screenshot``).
 
 A case is ``family-<seed>`` (``tests/benchmarks/annotated_family``) or the path of a CMP
-XML annotation, at ``1x``, ``0.7w``, ``1.5w``, ``2w`` or ``1.5h``; the façade is inferred
-at 15 x 15 m, as the benchmarks do. The code that draws the right side is the checkout
-whose root is given (``--code``, default this one); it is run in a child process of this
-interpreter with that checkout first on ``sys.path``, so an older commit's checkout (a
-``git worktree`` of it) gives its "before"::
+XML annotation (or of a JSON list of rectangles), at ``1x``, ``0.7w``, ``1.5w``, ``2w``,
+``1.5h`` or ``0.7h``; the façade is inferred at 15 x 15 m, as the benchmarks do. The
+code that draws the right side is the checkout whose root is given (``--code``, default
+this one); it is run in a child process of this interpreter with that checkout first on
+``sys.path``, so an older commit's checkout (a ``git worktree`` of it) gives its
+"before"::
 
     python docs/infer_pictures.py docs/pictures/infer-worst-family-12-1x-after.png \\
         family-12 1x "family seed 12 at 1x, after"
@@ -32,6 +33,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parent.parent
 SIZES = {"1x": (1.0, 1.0), "0.7w": (0.7, 1.0), "1.5w": (1.5, 1.0), "2w": (2.0, 1.0)}
 SIZES["1.5h"] = (1.0, 1.5)
+SIZES["0.7h"] = (1.0, 0.7)
 SCALE = 24.0  # pixels a metre
 GAP = 24.0  # pixels between the two elevations and round them
 OVERLAP = 0.01  # m: openings overlapping by more than this both ways are marked

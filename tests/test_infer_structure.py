@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import random
 from collections.abc import Callable
 from pathlib import Path
@@ -18,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from facadecli import parse_spec, solve
+from facadecli.errors import InfeasibleError
 from facadecli.grammar.inputs import LabelledLayout, Rect
 from facadecli.grammar.model import Options
 from facadecli.infer import run
@@ -677,3 +679,141 @@ def test_floors_drawn_unlike_gain_whole_floors_under_the_attic_within_the_densit
     assert len(attic) == 5 and min(r.y0 for r in attic) > max(
         r.y1 for r in windows if r not in attic
     )
+
+
+def _two_houses(path: Path, seed: int) -> Path:
+    """Two houses side by side, each floor's windows a layer of its own (every floor's
+    columns shifted from the others', as ``_floors_apart``): on the left three floors
+    of taller windows (1.2 x 1.9 m) at a pitch of 3.3 m, on the right four floors of
+    lower ones (1.0 x 1.4 m) at 2.5 m, each floor with its sills; every height jittered
+    by up to 3% and every edge by up to 1 cm."""
+    rng = random.Random(seed)
+    rects = []
+    houses = ((1.2, 1.9, 3.3, 3, 0.8), (1.0, 1.4, 2.5, 4, 8.8))  # w, h, pitch, floors, x
+    for width, height, pitch, floors, left in houses:
+        for f in range(floors):
+            shift = (0.0, 0.3, 0.6, 0.15)[f]
+            for k in range(3):
+                cx = left + 0.9 + shift + k * 2.1 + rng.uniform(-0.01, 0.01)
+                y0 = 1.5 + f * pitch + rng.uniform(-0.01, 0.01)
+                y1 = y0 + height * (1 + rng.uniform(-0.03, 0.03))
+                x0, x1 = cx - width / 2, cx + width / 2
+                rects.append({"label": "window", "x0": x0, "y0": y0, "x1": x1, "y1": y1})
+                rects.append(
+                    {"label": "sill", "x0": x0 - 0.1, "y0": y0 - 0.2, "x1": x1 + 0.1, "y1": y0}
+                )
+    path.write_text(json.dumps({"canvas": {"width": 16.0, "height": 13.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_two_houses_of_unlike_floor_pitches_each_gain_floors_at_their_own_pitch(
+    tmp_path: Path, seed: int
+) -> None:
+    """1.5 times as tall, each house of a façade whose parts have floors of unlike
+    pitches gains the whole floors that fit at its own pitch, its windows with their
+    sills, none over another. Before, every copy stood at one pitch, the middle of the
+    openings' top floors': the house whose pitch is another (cmp_b0003's left part)
+    gained none (density 0.75 of the input's)."""
+    path = _two_houses(tmp_path / "houses.json", seed)
+    rects = _solved(path, 16.0, 13.0 * 1.5)
+    windows = _of(rects, "window")
+    assert _overlapping(windows) == 0
+    for lo, hi, pitch, drawn in ((0.0, 8.0, 3.3, 3), (8.0, 16.0, 2.5, 4)):
+        house = [r for r in windows if lo <= (r.x0 + r.x1) / 2 < hi]
+        rows = sorted({round(r.y0, 1) for r in house})
+        assert len(rows) == drawn + int(6.5 / pitch)  # the floors that fit in 6.5 m
+        assert all(b - a == pytest.approx(pitch, abs=0.06) for a, b in itertools.pairwise(rows))
+        sills = [r for r in _of(rects, "sill") if lo <= (r.x0 + r.x1) / 2 < hi]
+        assert all(
+            any(abs(s.y1 - w.y0) < 0.03 and s.x0 < w.x0 < s.x1 for s in sills) for w in house
+        )
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize(
+    ("facade", "pitches"),
+    [(_floors_apart, {(0.0, 15.0): 2.6}), (_two_houses, {(0.0, 8.0): 3.3, (8.0, 16.0): 2.5})],
+)
+def test_a_shorter_facade_drops_whole_floors_from_the_top_keeping_its_windows(
+    tmp_path: Path,
+    facade: Callable[[Path, int], Path],
+    pitches: dict[tuple[float, float], float],
+    seed: int,
+) -> None:
+    """0.7 times as tall, a façade whose top floor repeats upwards drops the whole floors
+    it must from the top (as many as free the height lost: the roof's margin never
+    shrinks), in every column of a pitch alike and with their sills; the floors kept
+    stand where drawn, every window its size, none over another. Before, no layout
+    existed ("make the canvas taller"): the top floor's copies could only be added."""
+    path = facade(tmp_path / "facade.json", seed)
+    canvas = json.loads(path.read_text())["canvas"]
+    drawn = _of([Rect(**r) for r in json.loads(path.read_text())["rects"]], "window")
+    lost = 0.3 * canvas["height"]
+    rects = _solved(path, canvas["width"], 0.7 * canvas["height"])
+    windows = _of(rects, "window")
+    assert _overlapping(windows) == 0
+    for (lo, hi), pitch in pitches.items():
+        part = [r for r in drawn if lo <= (r.x0 + r.x1) / 2 < hi]
+        rows = sorted({round(r.y0, 1) for r in part})
+        kept = rows[: len(rows) - math.ceil(lost / pitch)]
+        found = [r for r in windows if lo <= (r.x0 + r.x1) / 2 < hi]
+        assert sorted({round(r.y0, 1) for r in found}) == kept
+        assert len(found) == sum(round(r.y0, 1) in kept for r in part)  # whole floors
+        for r in found:  # each where drawn, its size
+            assert any(
+                abs(r.y0 - d.y0) < 0.02 and abs(r.y1 - r.y0 - (d.y1 - d.y0)) < 0.03 for d in part
+            )
+        sills = [s for s in _of(rects, "sill") if lo <= (s.x0 + s.x1) / 2 < hi]
+        assert len(sills) == (len(found) if facade is _two_houses else 0)
+
+
+def test_a_facade_too_short_for_its_lowest_floor_says_so(tmp_path: Path) -> None:
+    """Where even one floor of the stack does not fit, there is no layout, and the
+    error says to make the canvas taller."""
+    path = _floors_apart(tmp_path / "facade.json", 1)
+    with pytest.raises(InfeasibleError, match="make the canvas larger"):
+        _solved(path, WIDTH, 3.0)
+
+
+def _blinds_upstairs(path: Path, seed: int) -> Path:
+    """A ground floor of four windows and over it two floors of five (1.2 x 1.6 m, one
+    grid of two rows), a blind beside each upper window only, every edge jittered by up
+    to 1 cm: the windows' stack stands on the ground floor, the blinds' on the first."""
+    rng = random.Random(seed)
+    rects = []
+    for f, bays in ((0, 4), (1, 5), (2, 5)):
+        for k in range(bays):
+            cx = 2.0 + k * (11.0 / (bays - 1)) + rng.uniform(-0.01, 0.01)
+            y0 = 1.5 + f * 3.2 + rng.uniform(-0.01, 0.01)
+            rects.append(
+                {"label": "window", "x0": cx - 0.6, "y0": y0, "x1": cx + 0.6, "y1": y0 + 1.6}
+            )
+            if f:
+                rects.append(
+                    {"label": "blind", "x0": cx + 0.6, "y0": y0, "x1": cx + 1.0, "y1": y0 + 1.6}
+                )
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 11.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_windows_and_blinds_on_stacks_from_unlike_floors_solve_at_every_height(
+    tmp_path: Path, seed: int
+) -> None:
+    """The upper windows and their blinds stand on the same rows, on stacks from unlike
+    floors (the windows' from the ground floor, the blinds' from the first): each solves
+    at the input's height, taller and shorter, every blind beside its window. When the
+    two layers shared their roof's margin, the sizes written to a tenth of a millimetre
+    left no layout even at the input's height."""
+    path = _blinds_upstairs(tmp_path / "blinds.json", seed)
+    for share, floors in ((1.0, 3), (1.5, 4), (0.75, 2)):
+        rects = _solved(path, WIDTH, 11.0 * share)
+        windows, blinds = _of(rects, "window"), _of(rects, "blind")
+        assert len({round(r.y0, 1) for r in windows}) == floors
+        assert _overlapping(windows) == 0
+        assert len(blinds) == len(windows) - 4
+        assert all(
+            any(abs(b.x0 - w.x1) < 0.03 and abs(b.y0 - w.y0) < 0.03 for w in windows)
+            for b in blinds
+        )

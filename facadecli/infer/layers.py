@@ -11,6 +11,8 @@ background becomes the wall behind them all.
 
 from __future__ import annotations
 
+import itertools
+import math
 import statistics
 from collections import defaultdict
 from dataclasses import dataclass
@@ -24,6 +26,7 @@ EDGE = 0.01  # a band this share of the façade or less from an edge reaches the
 FLOOR = 0.15  # rows of a label this close in height (a share of it) are floors alike
 STOREY = 0.4  # of the façade's height: the most a floor's pitch is (two floors and a base)
 FLOOR_PITCH = 0.05  # pitches this close (a share) are the openings' floors'
+NEAR = 0.05  # m: an element this close beside an opening's column stands with it (a blind)
 
 
 @dataclass(frozen=True)
@@ -229,17 +232,22 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
     that repeats upwards from none more, a taller façade still gains floors at its
     pitch.
 
-    Every copy stands at one pitch, the openings' (the middle one of their top floors'):
-    the top floors share one counter, and at pitches a hand's jitter apart a window's
-    copies and its blind's drift apart floor by floor, and layers on the same rows, which
-    share their margin to the roof, admit no copy at all (the family with defects' seed 24
-    gained no floor). Only grids at that pitch (within ``FLOOR_PITCH``: a floor of lower
-    windows over the last like those under it finds its like floors under them, a pitch
-    too far, and does not repeat), whose top row is lower than it; and labels other than
-    the openings' only on the openings' top floor (a sill under it, a cornice over it,
-    never a floor under it copied into the floors over it) with a row of their label that
-    pitch under it, of any height (sills drawn 1-2 cm tall differ in height by more than
-    ``FLOOR``: the family with defects' seed 24 gained floors without them)."""
+    Copies stand at the façade's floor pitches (``_pitches``): the openings' top floors'
+    pitches within ``FLOOR_PITCH`` of one another (a hand's jitter) are one, the middle
+    one, on one counter (at pitches a hand's jitter apart a window's copies and its
+    blind's drift apart floor by floor, and layers on the same rows, which share their
+    margin to the roof, admit no copy at all: the family with defects' seed 24 gained no
+    floor); a part of the façade whose floors are taller (two houses side by side,
+    cmp_b0003) keeps its own pitch and counter. Only grids at their pitch (within
+    ``FLOOR_PITCH``: a floor of lower windows over the last like those under it finds its
+    like floors under them, a pitch too far, and does not repeat), whose top row is lower
+    than it; and labels other than the openings' only on the top floor of an opening
+    grid that repeats, over or beside its columns (``NEAR``: a sill under its window, a
+    blind beside it, never a sill of another column whose window does not repeat), with
+    a row of their label that pitch under it, of any height (sills drawn 1-2 cm tall
+    differ in height by more than ``FLOOR``: the family with defects' seed 24 gained
+    floors without them); for those, "like it above" means in their own columns (the
+    other house's top sills stand higher)."""
     out: dict[int, float] = {}
     under: dict[int, list[float]] = {}  # each candidate's rows under it: where they start
     for k, grid in enumerate(found):
@@ -251,13 +259,14 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
         if any(
             row[0] >= high - 1e-9 and abs(row[1] - row[0] - size) <= FLOOR * size
             for g in mine
+            if grid.label in OPENINGS or g is grid or _over(g, grid)
             for row in g.rows
         ):
             continue  # not the top floor: one of its label like it stands above it
         rows = [
             row
             for g in mine
-            if g is grid or any(_overlap(c, d) for c in g.columns for d in grid.columns)
+            if g is grid or _over(g, grid)
             for row in g.rows
             if row[1] <= low + 1e-9
         ]
@@ -265,26 +274,169 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
         below = [row[0] for row in rows if abs(row[1] - row[0] - size) <= FLOOR * size]
         if below and low - max(below) <= STOREY * height:
             out[k] = low - max(below)
-    openings = [k for k in out if found[k].label in OPENINGS]
-    if not openings:
+    measured = [out[k] for k in out if found[k].label in OPENINGS]
+    if not measured:
         return {}
-    pitch = statistics.median_low(out[k] for k in openings)
-    floor = (
-        min(found[k].rows[-1][0] for k in openings) - pitch / 2,
-        max(found[k].rows[-1][1] for k in openings),
-    )
+    main = statistics.median_low(measured)
+    pitches = [main, *_pitches(sorted(p for p in measured if abs(p - main) > FLOOR_PITCH * main))]
+    copied = {
+        k: pitch
+        for k in out
+        if found[k].label in OPENINGS
+        for pitch in [_nearest(out[k], pitches)]
+        if found[k].rows[-1][1] - found[k].rows[-1][0] < pitch
+        and abs(out[k] - pitch) <= FLOOR_PITCH * pitch
+        and (pitch == main or _clear_above(found, found[k]))
+    }
 
-    def repeats(k: int) -> bool:
-        """An opening's floor at the pitch; another label's on the openings' top floor,
-        with a row of its label a pitch under it (a sill of the floor below, whatever
-        the jitter of its height)."""
+    def stands_on(k: int) -> float | None:
+        """The pitch of an opening grid that repeats whose top floor another label's
+        row stands on, beside or over its columns (``NEAR``), with a row of its label
+        that pitch under it (a sill of the floor below, whatever the jitter of its
+        height); None where it stands on none."""
         low, high = found[k].rows[-1]
-        if high - low >= pitch:
-            return False
-        if found[k].label in OPENINGS:
-            return k in out and abs(out[k] - pitch) <= FLOOR_PITCH * pitch
-        return floor[0] <= low <= floor[1] and any(
-            abs(low - start - pitch) <= FLOOR_PITCH * pitch for start in under[k]
+        return next(
+            (
+                pitch
+                for o, pitch in copied.items()
+                if high - low < pitch
+                and found[o].rows[-1][0] - pitch / 2 <= low <= found[o].rows[-1][1]
+                and _over(found[o], found[k], NEAR)
+                and any(abs(low - start - pitch) <= FLOOR * pitch for start in under[k])
+            ),
+            None,
         )
 
-    return {k: pitch for k in under if repeats(k)}
+    others = {k: stands_on(k) for k in under if found[k].label not in OPENINGS}
+    return {**copied, **{k: pitch for k, pitch in others.items() if pitch is not None}}
+
+
+def _clear_above(found: list[Grid], grid: Grid) -> bool:
+    """Whether no opening stands above ``grid``'s top row in its columns: a part of the
+    façade with floors of its own pitch (``top_floors``) copies its top floor upwards
+    only there (a window over it, of a pitch of the others', would stay where drawn
+    and the copies would run into it: cmp_b0006's windows 2 m apart under floors 1.8 m
+    apart)."""
+    top = grid.rows[-1][1]
+    return not any(
+        g.label in OPENINGS and g is not grid and _over(g, grid) and g.rows[-1][1] > top + 1e-9
+        for g in found
+    )
+
+
+def _pitches(measured: list[float]) -> list[float]:
+    """The floor pitches of the façade's parts from their top floors' (sorted, those
+    apart from the main one): the middle one of each run of pitches within
+    ``FLOOR_PITCH`` of the run's first (a hand's jitter), so that every copy of one
+    part stands at one pitch, and a part whose floors are taller (cmp_b0003: two
+    houses side by side) keeps its own."""
+    runs: list[list[float]] = []
+    for pitch in measured:
+        if runs and pitch - runs[-1][0] <= FLOOR_PITCH * runs[-1][0]:
+            runs[-1].append(pitch)
+        else:
+            runs.append([pitch])
+    return [statistics.median_low(run) for run in runs]
+
+
+def _nearest(pitch: float, pitches: list[float]) -> float:
+    return min(pitches, key=lambda p: abs(p - pitch))
+
+
+def _over(a: Grid, b: Grid, reach: float = 0.0) -> bool:
+    """Whether a column of ``a`` overlaps one of ``b`` (grown by ``reach`` either side)."""
+    return any(_overlap(c, (d[0] - reach, d[1] + reach)) for c in a.columns for d in b.columns)
+
+
+@dataclass(frozen=True)
+class Stack:
+    """A top floor that repeats upwards (``top_floors``) with the floors like it under it
+    (``stacks``), as one layer sees them: ``floors`` slots of ``pitch``, the lowest
+    starting at ``bottom``, numbered from the top (0, the top floor's, where the copies
+    stand over); ``rows`` the layer's rows on them, each with its slot. The layer's other
+    rows stand under ``bottom``."""
+
+    top: bool  # the layer of the top floor (its copies are shown)
+    pitch: float
+    bottom: float
+    floors: int
+    rows: tuple[tuple[Span, int], ...]
+
+
+def _slot(found: list[Grid], tops: dict[int, float], k: int) -> float:
+    """Where the top floor's slot of top layer ``k`` starts: the middle of the wall under
+    the top row of the openings' top layer at its pitch nearest it (its own, for an
+    opening), moved by whole pitches to the floor ``k``'s top row stands on (a sill
+    under its window shares the window's slot)."""
+    pitch, start = tops[k], found[k].rows[-1][0]
+    openings = [o for o, p in tops.items() if p == pitch and found[o].label in OPENINGS]
+    o = min(openings, key=lambda o: abs(found[o].rows[-1][0] - start), default=k)
+    low, high = found[o].rows[-1]
+    first = low - (pitch - (high - low)) / 2
+    return first + math.floor((start - first) / pitch) * pitch
+
+
+def stacks(found: list[Grid], tops: dict[int, float], height: float) -> dict[int, Stack]:
+    """The layers standing on the floors of a top floor that repeats upwards, and the top
+    floor's own layer, each with its ``Stack``, so that a shorter façade drops whole
+    floors from the top, with what stands on them, in every column alike, as a taller
+    one gains copies of the top floor (``spec_text._stack_word``). A top floor's stack
+    is the floors a pitch, two pitches, ... under its row (each within ``FLOOR_PITCH``
+    of the pitch) holding a row of its label in columns overlapping its own, like it in
+    height for the openings (``FLOOR``; sills drawn 1-2 cm tall are not), down to the
+    first floor without one; a layer of one row joins the first stack it stands on.
+    Each floor is a slot of the pitch, from the middle of the wall under it to the
+    middle of the wall over it (as ``floors.Floors`` cuts the openings' run: a top floor
+    closer to the roof than a floor's wall, or a lowest one closer to the ground, still
+    has its slot), the top one's from the top row's, the others a pitch apart, lowered by
+    the most any row of the stack starts under its slot (a hand's jitter), so each row
+    stands in its slot. A stack whose rows do not fit in their slots, whose slots reach
+    the ground or the roof, or whose top layer has rows between its slots is none:
+    that top floor repeats upwards as it did, and a shorter façade has no layout."""
+    out: dict[int, Stack] = {}
+    for k, pitch in sorted(tops.items()):
+        grid = found[k]
+        start, end = grid.rows[-1]
+        size = end - start
+        like = grid.label in OPENINGS
+        found_rows: dict[int, list[tuple[int, Span]]] = {0: [(k, grid.rows[-1])]}
+        for depth in itertools.count(1):
+            at = start - depth * pitch
+            hits = [
+                (m, row)
+                for m, other in enumerate(found)
+                if m not in out
+                and (m == k or (m not in tops and len(other.rows) == 1 and _over(other, grid)))
+                and other.label == grid.label
+                for row in other.rows
+                if abs(row[0] - at) <= FLOOR_PITCH * pitch
+                and (not like or abs(row[1] - row[0] - size) <= FLOOR * size)
+            ]
+            if at < 0 or not hits:
+                break
+            found_rows[depth] = hits
+        floors = len(found_rows)
+        first = _slot(found, tops, k)
+        under = max(
+            (first - d * pitch) - row[0] for d, hits in found_rows.items() for _, row in hits
+        )
+        bottom = first - (floors - 1) * pitch - max(under, 0.0)
+        slots = {d: bottom + (floors - 1 - d) * pitch for d in found_rows}
+        if any(
+            row[1] > slots[d] + pitch + 1e-9 for d, hits in found_rows.items() for _, row in hits
+        ):
+            continue  # a row beyond its slot
+        if bottom < 0 or bottom + floors * pitch >= height - 1e-6:
+            continue  # the slots reach the ground or the roof: no margin
+        own = [row for hits in found_rows.values() for m, row in hits if m == k]
+        if any(row[1] > bottom + 1e-9 for row in grid.rows if row not in own):
+            continue  # the top layer's rows between the slots
+        members: dict[int, list[tuple[Span, int]]] = {}
+        for d, hits in found_rows.items():
+            for m, row in hits:
+                members.setdefault(m, []).append((row, d))
+        if any(m != k and m in out for m in members):
+            continue
+        for m, rows in members.items():
+            out[m] = Stack(m == k, pitch, bottom, floors, tuple(sorted(rows)))
+    return out

@@ -22,10 +22,11 @@
   of its own (``window_2_w1``; ``_width_tables``): a mask names symbols, so each would
   show the other's window.
 - Top floors (``layers.top_floors``): where the openings have no run of floors, the last
-  floor like the one under it repeats upwards (``_floors_above``), every copy at one
-  pitch and one counter, as many as fit in the height gained (the roof's margin never
-  shrinks); the floors under it keep their sizes, and what stands wholly over it (a
-  lower top floor, an attic) keeps its margin to the roof, clear of the copies.
+  floor like the one under it repeats upwards (``_floors_above``), every copy at its
+  part's pitch, one counter a pitch, as many as fit in the height gained (the roof's
+  margin never shrinks); the floors under it keep their sizes, and what stands wholly
+  over it (a lower top floor, an attic) keeps its margin to the roof, clear of the
+  copies.
 - Repeats: where a word repeats a gap and an element twice or more (three elements), or
   an element alone three times, the run is written ``(gx2 window_w1)^n1`` with a free
   counter, so a wider or taller façade gains bays or floors. Layers whose runs have one
@@ -72,7 +73,9 @@ from facadecli.infer.layers import (
     Frame,
     Grid,
     Span,
+    Stack,
     frames,
+    stacks,
     top_floors,
     uncovered,
 )
@@ -139,12 +142,21 @@ class _Counters:
     names: dict[tuple[str, float, int], str] = field(default_factory=dict)
 
     def floors(self, pitch: float) -> str:
-        """The one counter of every top floor's copies: a taller façade gains as many
-        floors in every column (``pitch``: the first floor's, for the comment)."""
-        for (along, _, copies), name in self.names.items():
-            if along == "y" and copies == 0:
-                return name
-        name = self.names[("y", round(pitch, 4), 0)] = f"n{len(self.names) + 1}"
+        """The one counter of every top floor's copies at ``pitch``: a taller façade
+        gains as many floors in every column of that pitch (``layers.top_floors``)."""
+        key = ("y", round(pitch, 4), 0)
+        name = self.names.get(key) or f"n{len(self.names) + 1}"
+        self.names[key] = name
+        return name
+
+    def drop(self, pitch: float, floor: int) -> str:
+        """The counter of the ``floor``-th floor from the top (0: the top floor) of the
+        stacks at ``pitch`` (``layers.stacks``): 1 where it stands, 0 where a shorter
+        façade drops it; shared by every stack at that pitch, so every column drops as
+        many floors."""
+        key = ("y", round(pitch, 4), -1 - floor)
+        name = self.names.get(key) or f"n{len(self.names) + 1}"
+        self.names[key] = name
         return name
 
     def of(self, axis: str, pitch: float, count: int) -> str:
@@ -327,11 +339,15 @@ def spec_text(
         for k, pitch in top_floors(found, width, height).items()
         if floors is None or on_run(found[k].rows, floors[1])
     }
+    # a shorter façade drops the floors of its top floors that repeat upwards; a run of
+    # the openings' floors drops its own (with its counter), and what stands on it
+    stacked = _stacked(found, stacks(found, tops, height)) if floors is None else {}
     roofs: set[str] = set()  # the margins over top floors that repeat: free, whoever shares them
     roofed: set[str] = set()  # the margins over floors gained: they never shrink (``_gap``)
     # the layers with a margin at both ends along y (where their first and last rows
     # start, the margins) and where the top floors that repeat upwards start
     margins_y: list[tuple[float, float, str, str]] = []
+    over_y: list[list[str]] = []  # the elements of each of those layers
     copied_from: list[float] = []
     copied_to: list[float] = []  # where the top floors that repeat upwards end
     for index, (layer, grid, frame) in enumerate(zip(names, found, framed, strict=True)):
@@ -402,6 +418,39 @@ def spec_text(
                 # could not gain or drop what the bays do anyway)
                 runs = grid.label not in UNIQUE and not (grid.apart and axis == "x")
                 word = _word(tokens, axis, counters, repeated, runs, ends)
+            stack = stacked.get(index) if axis == "y" and grid.label not in UNIQUE else None
+            if stack is not None and ends >= {tokens[0][0], tokens[-1][0]}:
+                # the floors of a top floor that repeats upwards, from the top: a shorter
+                # façade drops them, a taller one gains copies of the top one; the layer
+                # keeps its margin to the ground, its elements and gaps their sizes, and
+                # the roof's margin never shrinks; that margin is the layer's own
+                # (``<layer>_mr``): every other letter keeps its size, so two layers on
+                # the same rows on stacks from unlike floors (a window's, its blind's)
+                # each sum to the canvas to the rounding of the sizes written, a tenth of
+                # a millimetre apart, and one margin shared would leave no layout
+                roofs_own = _Symbols(f"{layer}_mr")
+                owned[-1].append(roofs_own)
+                word, steady, roof, shown = _stack_word(
+                    grid.rows,
+                    stack,
+                    height,
+                    symbols[1],
+                    gaps,
+                    margins,
+                    roofs_own,
+                    counters,
+                    max(s.floors for s in stacked.values() if s.pitch == stack.pitch),
+                )
+                if stack.top:
+                    copied_from.append(grid.rows[-1][0])
+                    if grid.label in OPENINGS:
+                        copied_to.append(grid.rows[-1][1])
+                held.update(steady)
+                repeated.update(shown)
+                roofs.add(roof)
+                roofed.add(roof)
+                words.append(word)
+                continue
             pitch = tops.get(index) if axis == "y" and grid.label not in UNIQUE else None
             if pitch is not None and "^" not in word and ends >= {tokens[0][0], tokens[-1][0]}:
                 # the top floor repeats upwards from none more; the layer keeps its margin
@@ -430,6 +479,7 @@ def spec_text(
                 bottom, high = tokens[0][0], tokens[-1][0]
                 if bottom != high:
                     margins_y.append((grid.rows[0][0], grid.rows[-1][0], bottom, high))
+                    over_y.append([s for s, _ in tokens if s in symbols[1].sizes.values()])
             elif axis == "y" and tokens[-1][0] in ends and tokens[0][0] not in ends:
                 grounded.update(symbol for symbol, _ in tokens[:-1])  # a door keeps its height
             if not {tokens[0][0], tokens[-1][0]} & ends:  # no margin: its letters stay free
@@ -464,6 +514,15 @@ def spec_text(
     # clear of them
     copies = min(copied_from, default=top)
     over = min(copied_to, default=float("inf"))
+    if stacked:
+        # over floors a shorter façade drops (an attic, a lower top floor), a layer
+        # keeps its margin to the roof and its elements their size both ways: it moves
+        # down with the roof into the height the floors dropped leave (free, the solver
+        # squeezed a lower top floor's windows to nothing instead)
+        for (first, last, _, high), shown in zip(margins_y, over_y, strict=True):
+            if first >= top and last >= copies:
+                held.add(high)
+                repeated.update(shown)
     margined.update(
         bottom
         if floors is None and copied_to and last < over
@@ -558,6 +617,9 @@ def spec_text(
         out += [
             f"  {n}: {{min: 0}}  # {count or 'floors over the top one'} along {axis} at a "
             f"pitch of {_number(pitch)} m"
+            if count >= 0
+            else f"  {n}: {{min: 0, max: 1}}  # the floor {-1 - count} under the top one"
+            f" along {axis} at a pitch of {_number(pitch)} m (0: dropped)"
             for (axis, pitch, count), n in counters.names.items()
         ]
         out += [
@@ -739,13 +801,103 @@ def _floors_above(
     """The y word of a layer whose top row is its label's top floor (``layers.top_floors``;
     ``tokens`` from its margin below to its margin above), that floor repeating upwards
     at ``pitch``: ``... h (g h)^n m``, the gap ``g`` the pitch less the element ``h``,
-    ``n`` none at the input's size and shared by every such layer; and the gap's symbol
-    (its size is kept: the copies stand at the pitch)."""
+    ``n`` none at the input's size and shared by every such layer at that pitch; and
+    the gap's symbol (its size is kept: the copies stand at the pitch)."""
     element, size = tokens[-2]
     gap = gaps.of(pitch - size)
     symbols = [symbol for symbol, _ in tokens]
     run = f"({gap} {element})^{counters.floors(pitch)}"
     return " ".join([*symbols[:-1], run, symbols[-1]]), gap
+
+
+def _stacked(found: list[Grid], stacked: dict[int, Stack]) -> dict[int, Stack]:
+    """The stacks (``layers.stacks``), where every layer standing higher than a floor a
+    shorter façade may drop (over the lowest of the deepest stacks, which stays) is on
+    a stack or wholly over the top floors (an attic, a lower top floor: it moves with
+    the roof); else none. A layer on the floors that is on none
+    (a balcony, a blind or a sill not alike on every floor, a pillar up the façade)
+    stays where drawn while the floors under it drop, and a shorter façade still has
+    no layout; the spec is then as without stacks (their counters cost the solver a
+    search each: on CMP's samples they took b0001's and b0006's solves at 1.5x height
+    past their budgets)."""
+    if not stacked:
+        return {}
+    deepest = {
+        s.pitch: max(t.floors for t in stacked.values() if t.pitch == s.pitch)
+        for s in stacked.values()
+    }
+    # the lowest floor of the deepest stacks at a pitch stays (``_stack_word``): what
+    # stands on it (a door) stays with it
+    bottom = min(
+        stack.bottom + (stack.pitch if stack.floors == deepest[stack.pitch] else 0.0)
+        for stack in stacked.values()
+    )
+    over = min(found[k].rows[-1][1] for k, stack in stacked.items() if stack.top)
+    for k, grid in enumerate(found):
+        if k not in stacked and grid.rows[-1][1] > bottom + 1e-9 and grid.rows[0][0] < over:
+            return {}
+    return stacked
+
+
+def _stack_word(
+    rows: tuple[Span, ...],
+    stack: Stack,
+    height: float,
+    element: _Symbols,
+    gaps: _Symbols,
+    margins: _Symbols,
+    roofs: _Symbols,
+    counters: _Counters,
+    deepest: int,
+) -> tuple[str, list[str], str, list[str]]:
+    """The y word of a layer on a stack of floors (``layers.stacks``): its rows under the
+    stack as drawn (from its margin to the ground), then the stack's floors from the
+    lowest, each inside the one under it with its own counter (``_Counters.drop``), so
+    a floor stands only where every floor under it does and a shorter façade drops them
+    from the top; a floor is the layer's row on it (a gap to where it starts, the
+    element, the gap to the next floor) or one hidden gap of the pitch; over the top
+    floor its copies (``_Counters.floors``: the top layer's, shown; hidden gaps in the
+    others), then the margin to the roof (a symbol of ``roofs``). The lowest floor of
+    the ``deepest`` stacks at its pitch has no counter: a façade keeps one floor of them
+    at least. With the symbols that keep their size (the margin to the ground and the
+    gaps), the roof's margin, and the elements."""
+    on = dict(stack.rows)
+    letters: list[str] = []
+    cursor = 0.0
+    for a, b in sorted(r for r in rows if r not in on):
+        if a - cursor > SLIVER:
+            letters.append((margins if not letters else gaps).of(a - cursor))
+        letters.append(element.of(b - a))
+        cursor = b
+    if stack.bottom - cursor > TOLERANCE:
+        letters.append((margins if not letters else gaps).of(stack.bottom - cursor))
+    shown = [s for s in letters if s in element.sizes.values()]
+    units: dict[int, list[str]] = {}
+    for (a, b), floor in stack.rows:
+        # a gap under the solver's tolerance is free (``_gap``): an element that far
+        # from its slot's start stands at it, and one that far from the next slot's
+        # ends the slot (the roof's margin takes the centimetre)
+        start = stack.bottom + (stack.floors - 1 - floor) * stack.pitch
+        offset = a - start if a - start > TOLERANCE else 0.0
+        unit = [gaps.of(offset)] if offset else []
+        unit.append(element.of(b - a))
+        shown.append(unit[-1])
+        if start + stack.pitch - (offset + b - a) - start > TOLERANCE:
+            unit.append(gaps.of(stack.pitch - offset - (b - a)))
+        units[floor] = unit
+    hidden = gaps.of(stack.pitch)
+    copy = units[0] if stack.top else [hidden]
+    text = f"({' '.join(copy)})^{counters.floors(stack.pitch)}"
+    for floor in range(stack.floors):
+        letters_on = " ".join([*units.get(floor, [hidden]), text])
+        text = (
+            letters_on
+            if floor == deepest - 1
+            else f"({letters_on})^{counters.drop(stack.pitch, floor)}"
+        )
+    roof = roofs.of(height - stack.bottom - stack.floors * stack.pitch)
+    steady = [s for s in {*letters, *gaps.sizes.values()} if s not in shown]
+    return " ".join([*letters, text, roof]), steady, roof, shown
 
 
 def floor_run(found: list[Grid], height: float, alike: float = ALIKE) -> tuple[int, Floors] | None:

@@ -62,6 +62,7 @@ SIZES = {
     "2w": (2.0, 1.0),
     "1.5h": (1.0, 1.5),
 }
+SHORTER = {"0.7h": (1.0, 0.7)}  # ``--shorter``: a shorter façade drops floors
 NEAR = 0.15  # m: centres this close line up (1% of the input)
 KEEP = 0.15  # a window keeps its size within this share
 OPENINGS = ("window", "door")
@@ -213,6 +214,7 @@ def spec_size(text: str, name: str) -> tuple[int, int, int]:
 
 
 def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
+    """Tally the spec solved at each size of ``tallies`` (see the module)."""
     spec = parse_spec(inference.text, name)
     raw = inference.raw or inference.layout
     reference = windows(raw.rects)
@@ -222,8 +224,8 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
     in_overlaps = overlaps(list(raw.rects))
     mirrored = symmetric(reference, raw.width)
     drawn = companions(list(raw.rects), raw.width)
-    for size, (sx, sy) in SIZES.items():
-        tally = tallies[size]
+    for size, tally in tallies.items():
+        sx, sy = {**SIZES, **SHORTER}[size]
         tally.facades += 1
         width, height = round(raw.width * sx, 4), round(raw.height * sy, 4)
         try:
@@ -302,8 +304,8 @@ def report(
     )
 
 
-def run(paths: list[Path], title: str, verbose: bool) -> None:
-    tallies = {size: Tally() for size in SIZES}
+def run(paths: list[Path], title: str, verbose: bool, sizes_run: list[str]) -> None:
+    tallies = {size: Tally() for size in sizes_run}
     sizes = []
     cpu = 0.0
     for path in paths:
@@ -323,17 +325,25 @@ def main() -> None:
     ``--cmp``: CMP alone; ``--defects``: the family with its defects (wider end bays,
     missing and odd windows: ``annotated_family``); ``--paired``: the family with a narrow
     bay (a small window on the top floor) between its columns, every bay drawn unlike
-    (``annotated_family.paired_family``)."""
+    (``annotated_family.paired_family``); ``--only A,B``: the CMP façades whose names hold
+    one of these; ``--sizes 1x,1.5h``: those sizes alone; ``--shorter``: 0.7x the height
+    too (floors dropped)."""
     verbose = "-v" in sys.argv
+    sizes = [*SIZES, *(SHORTER if "--shorter" in sys.argv else ())]
+    if "--sizes" in sys.argv:
+        sizes = sys.argv[sys.argv.index("--sizes") + 1].split(",")
     seeds = SEEDS
     if "--seeds" in sys.argv:
         first, _, last = sys.argv[sys.argv.index("--seeds") + 1].partition("-")
         seeds = range(int(first), int(last or first) + 1)
     files = sorted(DATA.glob("*.xml")) if DATA.is_dir() else []
+    if "--only" in sys.argv:
+        only = sys.argv[sys.argv.index("--only") + 1].split(",")
+        files = [f for f in files if any(name in f.stem for name in only)]
     if "--family" in sys.argv:
         pass
     elif files:
-        run(files, "CMP samples", verbose)
+        run(files, "CMP samples", verbose, sizes)
     else:
         print(f"retargeting on CMP skipped: no CMP annotations in {DATA}")
     if "--cmp" in sys.argv:
@@ -343,7 +353,7 @@ def main() -> None:
         paths = written_family(Path(folder), seeds, defects, paired)
         title = f"generated family{' with defects' if defects else ''}"
         title += " with narrow bays between its columns" if paired else ""
-        run(paths, f"{title} (seeds {seeds[0]}-{seeds[-1]})", verbose)
+        run(paths, f"{title} (seeds {seeds[0]}-{seeds[-1]})", verbose, sizes)
 
 
 if __name__ == "__main__":
