@@ -10,7 +10,7 @@ from pathlib import Path
 
 BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
 
-WINDOW = ["--window-size=1000,600"]
+WINDOW = ("--window-size=1000,600",)
 # A page that draws on demand (the viewer's) fills a screen of the screenshot's size from
 # its first layout: in a window of that size alone, headless Chromium lays the page out
 # 1000 x 457 (the window less its toolbars), then resizes it to 1000 x 600 to take the
@@ -19,7 +19,7 @@ WINDOW = ["--window-size=1000,600"]
 # screen (the same picture: a mean difference of 0.003-0.012 grey levels, as between
 # two runs of either). A page drawing every frame (CesiumJS) keeps the window: filling
 # the screen, its test took 61-95 s where it took 16-36 s.
-SCREEN = ["--kiosk", "--screen-info={1000x600}", *WINDOW]
+SCREEN = ("--kiosk", "--screen-info={1000x600}", *WINDOW)
 
 
 def browse(
@@ -27,7 +27,7 @@ def browse(
     url: str,
     budgets: Iterable[int] = (120_000, 120_000, 120_000),
     loaded: Callable[[str], bool] = lambda dom: "<title>loading: " not in dom,
-    screen: list[str] = SCREEN,
+    screen: tuple[str, ...] = SCREEN,
 ) -> tuple[Path, str]:
     """A screenshot (1000 x 600, ``folder``/shot.png) of the page at ``url`` and its DOM
     once its scripts ran. Work outside Chromium's virtual time (decoding a textured
