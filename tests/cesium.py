@@ -18,7 +18,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from tests.browser import browse
+from tests.browser import WINDOW, browse
 
 # a folder with Cesium.js: npm cesium's Build/Cesium, which make test installs in the venv
 CESIUM = os.environ.get(
@@ -130,7 +130,10 @@ def open_tiles(run: Path, folder: Path, asked: list[str], missing: list[str]) ->
     (site / "run").symlink_to(run.resolve())
     (site / "index.html").write_text(PAGE, encoding="utf-8")
     with _served(site, asked, missing) as url:
-        return browse(folder, url, (20_000, 60_000), lambda dom: "<title>loaded" in dom)
+        # CesiumJS draws every frame: in a window (browser.WINDOW), not the whole screen
+        return browse(
+            folder, url, (20_000, 60_000), lambda dom: "<title>loaded" in dom, screen=WINDOW
+        )
 
 
 def title(dom: str) -> str:

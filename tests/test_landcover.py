@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from html import unescape
 from pathlib import Path
 
@@ -21,7 +22,7 @@ from facadecli.city.footprints import read_footprints
 from facadecli.city.landcover import DISTRICT_MARGIN, cover_kind, is_cover
 from tests.browser import BROWSER, browse
 from tests.landcover_town import lon_lat, town, write_geojson, write_osm
-from tests.running import facade
+from tests.running import facade, facade_output
 
 FORMS = ["t.osm", "t.osm.pbf", "t.geojson"]
 KINDS = {
@@ -98,29 +99,41 @@ def test_the_tags_that_make_land_cover() -> None:
     assert cover_kind({"natural": "scrub"}) == "wood"
 
 
-def _city(capsys: pytest.CaptureFixture[str], source: Path, out: Path) -> dict:
-    code, said, err = facade(capsys, "city", source, "-o", out, "-j", "1")
+def _city(capsys: pytest.CaptureFixture[str] | None, source: Path, out: Path) -> dict:
+    """The report of ``facade city`` building ``source`` into ``out``, its output taken
+    by ``capsys`` (or without it: for the module's fixture)."""
+    args = ("city", source, "-o", out, "-j", "1")
+    code, said, err = facade(capsys, *args) if capsys else facade_output(*args)
     assert code == 0, err
     assert "landuse 'railway' is not a land cover drawn here: ignored" in err
     assert said.rstrip().endswith(f"{out}/t.report.json, {out}/t.ground.geojson")  # named
     return json.loads((out / "t.report.json").read_text())
 
 
+@pytest.fixture(scope="module")
+def sample_town(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The district of seed 1 (the sample's) as ``t.osm``, built into ``a/``: built once
+    for the tests below that read its outputs (each built it before)."""
+    folder = tmp_path_factory.mktemp("town")
+    _city(None, write_osm(folder / "t.osm", town(1)), folder / "a")
+    return folder
+
+
 def test_a_city_writes_its_land_cover_georeferenced_and_the_same_bytes_each_run(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, sample_town: Path
 ) -> None:
     """``t.ground.geojson`` beside the models, named in the report's models, counted by
     kind in its summary with the railway yard under ``warnings_by_tag``; its coordinates
     the city's CRS (local metres plus the georeference's origin); the same bytes again."""
-    source = write_osm(tmp_path / "t.osm", town(1))
-    report = _city(capsys, source, tmp_path / "a")
+    source = sample_town / "t.osm"
+    report = json.loads((sample_town / "a" / "t.report.json").read_text())
     assert report["models"]["ground"] == "t.ground.geojson"
     summary = report["summary"]
     assert summary["ground"] == {"wood": 1, "park": 1, "parking": 1, "water": 2, "built_up": 1}
     assert summary["warnings_by_tag"] == {"landuse": 1}
     assert [w["id"] for w in report["warnings"]] == ["way/700"]
     assert report["warnings"][0]["line"] is not None  # its element's line in the XML
-    written = (tmp_path / "a" / "t.ground.geojson").read_bytes()
+    written = (sample_town / "a" / "t.ground.geojson").read_bytes()
     ground = json.loads(written)
     assert ground["crs"]["properties"]["name"] == "urn:ogc:def:crs:" + report["crs"].replace(
         ":", "::"
@@ -139,13 +152,15 @@ def test_a_city_writes_its_land_cover_georeferenced_and_the_same_bytes_each_run(
 
 
 def test_a_city_without_land_cover_writes_no_ground_file(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, sample_town: Path
 ) -> None:
     """Buildings alone: no ground file, an earlier run's removed, no ``ground`` model."""
     district = town(1)
-    source = write_osm(tmp_path / "t.osm", district)
+    source = tmp_path / "t.osm"
+    shutil.copy(sample_town / "t.osm", source)
     out = tmp_path / "out"
-    _city(capsys, source, out)
+    shutil.copytree(sample_town / "a", out)  # the earlier run's outputs, its ground file
+    assert (out / "t.ground.geojson").exists()
     bare = type(district)(district.buildings, [], district.district)
     write_osm(source, bare)
     code, _, err = facade(capsys, "city", source, "-o", out, "-j", "1")
@@ -157,15 +172,14 @@ def test_a_city_without_land_cover_writes_no_ground_file(
 
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 def test_the_viewer_draws_the_land_cover_with_trees_in_the_wood_and_none_on_water(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, sample_town: Path
 ) -> None:
     """The page inlines the ground file and draws a mesh for each of its four kinds; the
     wood and the park get their trees; no street tree, dash or lamp of the footprint rules
     stands where land cover is mapped; the river shows as dark water."""
-    source = write_osm(tmp_path / "t.osm", town(1))
-    _city(capsys, source, tmp_path / "city")
+    city = sample_town / "a"
     page = tmp_path / "city.html"
-    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
+    assert facade(capsys, "view", city, "-o", page)[0] == 0
     assert 'id="glb-0-ground"' in page.read_text()
     _shot, dom = browse(tmp_path, page.as_uri() + "?bare&view=-70,35")
     found = re.search(r'data-cover="([^"]+)"', dom)
@@ -173,12 +187,12 @@ def test_the_viewer_draws_the_land_cover_with_trees_in_the_wood_and_none_on_wate
     cover = json.loads(unescape(found.group(1)))
     assert cover["meshes"] == 4 and cover["trees"] > 20, cover
     ground = json.loads(unescape(re.search(r'data-ground="([^"]+)"', dom).group(1)))  # type: ignore[union-attr]
-    georef = json.loads((tmp_path / "city" / "t.georef.json").read_text())
+    georef = json.loads((city / "t.georef.json").read_text())
     origin = georef["origin"]
     mapped = shapely.union_all(
         [
             shape(f["geometry"])
-            for f in json.loads((tmp_path / "city" / "t.ground.geojson").read_text())["features"]
+            for f in json.loads((city / "t.ground.geojson").read_text())["features"]
         ]
     )
     trees = [shapely.Point(origin[0] + x, origin[1] - z) for x, _, z in ground["trees"]]

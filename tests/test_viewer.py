@@ -23,7 +23,7 @@ from facadecli.cli import main
 from facadecli.export import OutputOptions, write_outputs
 from facadecli.viewer import VIEWER, gallery
 from tests.browser import BROWSER, browse
-from tests.running import facade, files
+from tests.running import facade, facade_output, files
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -44,14 +44,20 @@ def _shown(tmp_path: Path, text: str, query: str) -> tuple[Path, str]:
     return browse(tmp_path, path.as_uri() + query)
 
 
-def _district_shown(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, manifest: Path, query: str, shows: str
-) -> tuple[Path, Any]:
-    """A city built from ``manifest`` and its page in the browser with ``query`` (its
-    view): the screenshot and what the page reports in its ``data-<shows>`` attribute."""
-    assert facade(capsys, "city", manifest, "-o", tmp_path / "city")[0] == 0
-    page = tmp_path / "city.html"
-    assert facade(capsys, "view", tmp_path / "city", "-o", page)[0] == 0
+def _district_page(folder: Path, manifest: Path) -> Path:
+    """The page of the city ``facade city`` builds from ``manifest`` into ``folder``/city
+    (``facade view``, ``folder``/city.html)."""
+    code, _, err = facade_output("city", manifest, "-o", folder / "city")
+    assert code == 0, err
+    page = folder / "city.html"
+    code, _, err = facade_output("view", folder / "city", "-o", page)
+    assert code == 0, err
+    return page
+
+
+def _district_shown(tmp_path: Path, page: Path, query: str, shows: str) -> tuple[Path, Any]:
+    """A district's ``page`` in the browser with ``query`` (its view): the screenshot (in
+    ``tmp_path``) and what the page reports in its ``data-<shows>`` attribute."""
     shot, dom = browse(tmp_path, page.as_uri() + query)
     found = re.search(rf'data-{shows}="([^"]+)"', dom)
     assert found, f"the page reports no {shows}"
@@ -513,10 +519,19 @@ def test_the_sky_behind_a_model_is_blue_and_has_clouds(tmp_path: Path) -> None:
         assert blueness(rgb, 0, 0.05) > blueness(rgb, 0.15, 0.2) + 1.5
 
 
+@pytest.fixture(scope="module")
+def demo_district(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo district of two blocks (``demo/``), built (``city/``) and its page
+    (``city.html``): one build for the views of it below, each a load of the page."""
+    folder = tmp_path_factory.mktemp("district")
+    _district_page(folder, write_demo(folder / "demo", ROOT / "specs", 2))
+    return folder
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 def test_a_districts_street_view_stands_in_a_street_among_its_buildings(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    tmp_path: Path, demo_district: Path
 ) -> None:
     """``?view=street`` of a district: the eye 1.6 m above the ground in the open between
     the buildings (outside every footprint, a few metres from the nearest), facing several
@@ -528,10 +543,10 @@ def test_a_districts_street_view_stands_in_a_street_among_its_buildings(
     from PIL import Image
     from shapely.geometry import Point, shape
 
-    manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
-    shot, street = _district_shown(capsys, tmp_path, manifest, "?bare&view=street", "street")
-    georef = json.loads((tmp_path / "city" / "demo-district.georef.json").read_text())
-    features = json.loads((tmp_path / "demo" / "footprints.geojson").read_text())["features"]
+    page = demo_district / "city.html"
+    shot, street = _district_shown(tmp_path, page, "?bare&view=street", "street")
+    georef = json.loads((demo_district / "city" / "demo-district.georef.json").read_text())
+    features = json.loads((demo_district / "demo" / "footprints.geojson").read_text())["features"]
     footprints = {f["properties"]["osm_id"]: shape(f["geometry"]) for f in features}
     x, height, z = street["eye"]
     eye = Point(georef["origin"][0] + x, georef["origin"][1] - z)  # glTF x east, z south
@@ -615,9 +630,7 @@ def _windows_and_blank_walls(folder: Path) -> tuple[Path, set[str]]:
 
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-def test_a_districts_street_view_looks_at_windows_from_a_distance(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
-) -> None:
+def test_a_districts_street_view_looks_at_windows_from_a_distance(tmp_path: Path) -> None:
     """``?view=street`` prefers façades with openings to blank walls, and stands back from
     a house rather than fill the picture with it: of a street of tall blank buildings and
     a row of lower windowed houses, the view looks at the houses (they fill most of the
@@ -626,7 +639,8 @@ def test_a_districts_street_view_looks_at_windows_from_a_distance(
     picture alone, stood in the blank street."""
 
     manifest, windowed = _windows_and_blank_walls(tmp_path / "district")
-    _shot, street = _district_shown(capsys, tmp_path, manifest, "?bare&view=street", "street")
+    page = _district_page(tmp_path, manifest)
+    _shot, street = _district_shown(tmp_path, page, "?bare&view=street", "street")
     seen = set(street["seen"])
     assert len(seen & windowed) >= 2 and len(seen - windowed) <= len(seen & windowed), seen
     shares = dict(zip(street["seen"], street["shares"], strict=True))
@@ -653,14 +667,14 @@ def _sky_at_the_top(shot: Path) -> tuple[float, float]:
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 def test_a_districts_ground_has_streets_trees_and_a_sky_over_the_haze_from_35_degrees(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    tmp_path: Path, demo_district: Path
 ) -> None:
     """The demo district's ground: paving along the walls, a kerb, asphalt between the
     blocks, no grass (every lot reaches a street; it was a lawn past the outer streets),
     street trees and centre-line dashes; seen from 35° up, the top of the picture is the
     sky's blue over the haze, where it was the haze's cream (blue less red about -13)."""
-    manifest = write_demo(tmp_path / "demo", ROOT / "specs", 2)
-    shot, ground = _district_shown(capsys, tmp_path, manifest, "?bare&view=35,35", "ground")
+    page = demo_district / "city.html"
+    shot, ground = _district_shown(tmp_path, page, "?bare&view=35,35", "ground")
     assert ground["paving"] > 0.1 and ground["asphalt"] > 0.3  # of the district's box
     assert 0 < ground["kerb"] < 0.1 and ground["grass"] < 0.01
     assert len(ground["trees"]) >= 10 and ground["dashes"] >= 10
@@ -721,7 +735,7 @@ def _courtyard_block(folder: Path) -> tuple[Path, list[Any], Any]:
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
 def test_a_districts_grass_is_its_courtyard_and_its_trees_stand_on_pavements(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    tmp_path: Path,
 ) -> None:
     """The ground by what each place is: the closed block's courtyard, which no street
     reaches, is grass inside a 1 m path (18 m square, 324 m²); the street between the
@@ -732,7 +746,8 @@ def test_a_districts_grass_is_its_courtyard_and_its_trees_stand_on_pavements(
     from shapely.geometry import Point
 
     manifest, footprints, courtyard = _courtyard_block(tmp_path / "district")
-    _shot, ground = _district_shown(capsys, tmp_path, manifest, "?bare&view=35,35", "ground")
+    page = _district_page(tmp_path, manifest)
+    _shot, ground = _district_shown(tmp_path, page, "?bare&view=35,35", "ground")
     assert 2000 < ground["grass"] * ground["area"] < 3500, ground
     assert ground["asphalt"] > 0.12 and ground["paving"] > 0.05  # streets round the block
     georef = json.loads((tmp_path / "city" / "courtyard.georef.json").read_text())
