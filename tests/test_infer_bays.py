@@ -25,7 +25,7 @@ from facadecli.grammar.tiling import MOVE_SHARE
 from facadecli.infer import run
 from facadecli.infer.bays import KEEP, LOOSE, ODD, Bays, _common, _units, find_bays
 from facadecli.infer.run import infer, solved_layout
-from facadecli.infer.spec_text import layer_names, spec_text
+from facadecli.infer.spec_text import _bay_counter_note, layer_names, spec_text
 from facadecli.infer.structure import structured
 from facadecli.solve import retarget
 from tests.benchmarks.annotated_family import cmp_xml, family, paired_family
@@ -929,3 +929,17 @@ def test_two_units_on_one_counter_drop_one_at_a_time_with_a_spare(tmp_path: Path
     rects = _solved(inference, spec, 0.7)
     windows = [r for r in rects if r.label == "window"]
     assert 0.85 <= len(windows) / len(drawn) / 0.7 <= 1.15, len(windows)
+
+
+@pytest.mark.parametrize(
+    ("count", "most", "note"),
+    [
+        (1, 1, "1 end bay (it may drop)"),
+        (2, 1, "2 end bays (they may drop)"),
+        (1, None, "1 bay"),
+        (3, None, "3 bays"),
+    ],
+)
+def test_a_bay_counters_comment_counts_in_words(count: int, most: int | None, note: str) -> None:
+    """The comment over a counter of bays reads as English: one end bay, not "1 end bays"."""
+    assert _bay_counter_note("bays1", count, most, None, None) == note

@@ -667,8 +667,10 @@ def _bay_counter_note(
     if most is not None and not count:
         return f"a copy of a unit of {unit} bays more (the units change one at a time)"
     if most is not None:
-        return f"{count} end bays (they may drop)"
-    return f"{count} bays" if unit == 1 else f"{count} units of {unit} bays"
+        return "1 end bay (it may drop)" if count == 1 else f"{count} end bays (they may drop)"
+    if unit == 1:
+        return "1 bay" if count == 1 else f"{count} bays"
+    return f"1 unit of {unit} bays" if count == 1 else f"{count} units of {unit} bays"
 
 
 def _bays_note(bays: Bays | str | None) -> list[str]:
