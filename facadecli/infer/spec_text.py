@@ -144,17 +144,17 @@ class _Counters:
     def floors(self, pitch: float) -> str:
         """The one counter of every top floor's copies at ``pitch``: a taller façade
         gains as many floors in every column of that pitch (``layers.top_floors``)."""
-        key = ("y", round(pitch, 4), 0)
-        name = self.names.get(key) or f"n{len(self.names) + 1}"
-        self.names[key] = name
-        return name
+        return self._named(("y", round(pitch, 4), 0))
 
     def drop(self, pitch: float, floor: int) -> str:
         """The counter of the ``floor``-th floor from the top (0: the top floor) of the
         stacks at ``pitch`` (``layers.stacks``): 1 where it stands, 0 where a shorter
         façade drops it; shared by every stack at that pitch, so every column drops as
         many floors."""
-        key = ("y", round(pitch, 4), -1 - floor)
+        return self._named(("y", round(pitch, 4), -1 - floor))
+
+    def _named(self, key: tuple[str, float, int]) -> str:
+        """The counter under ``key``, named the next ``n<i>`` where there is none yet."""
         name = self.names.get(key) or f"n{len(self.names) + 1}"
         self.names[key] = name
         return name
@@ -439,7 +439,7 @@ def spec_text(
                     margins,
                     roofs_own,
                     counters,
-                    max(s.floors for s in stacked.values() if s.pitch == stack.pitch),
+                    _deepest(stacked)[stack.pitch],
                 )
                 if stack.top:
                     copied_from.append(grid.rows[-1][0])
@@ -824,10 +824,7 @@ def _stacked(found: list[Grid], stacked: dict[int, Stack]) -> dict[int, Stack]:
     past their budgets)."""
     if not stacked:
         return {}
-    deepest = {
-        s.pitch: max(t.floors for t in stacked.values() if t.pitch == s.pitch)
-        for s in stacked.values()
-    }
+    deepest = _deepest(stacked)
     # the lowest floor of the deepest stacks at a pitch stays (``_stack_word``): what
     # stands on it (a door) stays with it
     bottom = min(
@@ -839,6 +836,14 @@ def _stacked(found: list[Grid], stacked: dict[int, Stack]) -> dict[int, Stack]:
         if k not in stacked and grid.rows[-1][1] > bottom + 1e-9 and grid.rows[0][0] < over:
             return {}
     return stacked
+
+
+def _deepest(stacked: dict[int, Stack]) -> dict[float, int]:
+    """The most floors of the stacks at each pitch (the deepest keep their lowest floor)."""
+    out: dict[float, int] = {}
+    for stack in stacked.values():
+        out[stack.pitch] = max(out.get(stack.pitch, 0), stack.floors)
+    return out
 
 
 def _stack_word(
@@ -884,7 +889,7 @@ def _stack_word(
         unit = [gaps.of(offset)] if offset else []
         unit.append(element.of(b - a))
         shown.append(unit[-1])
-        if start + stack.pitch - (offset + b - a) - start > TOLERANCE:
+        if stack.pitch - offset - (b - a) > TOLERANCE:
             unit.append(gaps.of(stack.pitch - offset - (b - a)))
         units[floor] = unit
     hidden = gaps.of(stack.pitch)
