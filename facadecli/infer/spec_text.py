@@ -552,7 +552,7 @@ def spec_text(
     out[-1] = out[-1].rstrip(",")
     out.append("}")
     bay_counters = shared.counters if shared is not None and in_bay else ()
-    spare = shared.spare if shared is not None else None
+    spares = (shared.spare, shared.spare_first) if shared is not None else (None, None)
     if counters.names or bay_counters:
         out.append("counters:")
         out += [
@@ -563,8 +563,9 @@ def spec_text(
         out += [
             f"  {n}: {{min: 0{'' if most is None else f', max: {most}'}}}  # "
             + (
-                "a copy of the last bay more (the end bays change one at a time)"
-                if n == spare
+                f"a copy of the {'last' if n == spares[0] else 'first'} bay more (the end bays "
+                "change one at a time)"
+                if n in spares
                 else f"{count} {'end bays (they may drop)' if most is not None else 'bays'}"
             )
             + f" along x at a pitch of {_number(pitch)} m"
@@ -649,7 +650,8 @@ def _bay_word(
     solver's work). Each bay ends with its kind's wall (``bayK_w``: ``Bays.walls``),
     alike in every layer; a bay where the layer shows nothing is one hidden spacer; the
     spare copy of the last bay (``Bays.spare``) stands beside its copies: before the
-    right margin, or before the reflected half where the word is mirrored."""
+    right margin, or before the reflected half where the word is mirrored; that of the
+    first (``Bays.spare_first``) after the left margin."""
     walls = [f"bay{kind + 1}_w" for kind in range(len(bays.widths))]
 
     def spaces(
@@ -707,8 +709,8 @@ def _bay_word(
         single = run.unit == 1 and " " not in unit and "(" not in unit
         return f"{unit}^{run.counter}" if single else f"({unit})^{run.counter}"
 
-    def sequence(runs: list[BayRun], last: list[str]) -> str:
-        parts = [written(run) for run in runs]
+    def sequence(runs: list[BayRun], last: list[str], first: list[str]) -> str:
+        parts = [*first, *(written(run) for run in runs)]
         left = margins.of(bays.margins[0])
         if bays.reflected:
             half = " ".join([left, *parts])
@@ -718,7 +720,8 @@ def _bay_word(
 
     last = len(bays.kinds) - 1  # the spare copy of the last bay stands before it, if any
     spare = [] if bays.spare is None else [written(BayRun(last, 1, 1, bays.spare, 1))]
-    return sequence(list(bays.runs), spare)
+    first = [] if bays.spare_first is None else [written(BayRun(0, 1, 1, bays.spare_first, 1))]
+    return sequence(list(bays.runs), spare, first)
 
 
 def _floors_above(
