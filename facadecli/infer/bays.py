@@ -40,7 +40,13 @@ drawn by hand, each bay a little unlike every other: most of CMP's), each inner 
 but a unique one is written once with a counter, at one where drawn, so the layout at
 the input's size is the drawing's and a façade of another width drops or gains copies
 of those bays (``_drawn_once``: bays the same way in from either end on one counter,
-every other such pair on a second). A sequence that reads the same mirrored is written
+every other such pair on a second). They are counted in the smallest unit that repeats
+(``_units``): single bays, or, where single bays hold unlike numbers of openings (a
+column of windows beside a narrow bay of one attic window), pairs side by side whose
+openings are alike, so that the façade gains and drops a column with its narrow bay
+and keeps its windows a metre; where one counter holds every unit and drops more than
+``1 - NARROWEST`` of the bays at once, a spare copy of the last unit (``_spare_unit``)
+lets them change one at a time. A sequence that reads the same mirrored is written
 as its left half, the middle and the half reflected (SPEC 2.2), so a wider façade
 gains bays on both sides alike.
 
@@ -99,6 +105,8 @@ from facadecli.solver.sizing import MIN_SIZE
 ALIKE = 0.05  # of the bay's width: elements this close are the same in two bays
 COUNTERS = 2  # the most counters of runs of bays
 PAIRED = 2  # counters of the bays drawn once where no unit repeats (``_drawn_once``)
+UNITS = (1, 2)  # bays: the units the bays drawn once are counted in, the smallest first
+AS_MANY = 1 / 3  # of the most: units whose openings are this near in number are alike
 NARROWEST = 0.7  # of the input's width: the bays must be able to narrow to this
 WALL = 0.85  # of itself: the narrowest the wall after a bay's last element may become
 COLUMN = 0.01  # m: a kind's elements of a label and size this close stand in one column
@@ -411,10 +419,11 @@ def _laid(
     if start <= 0 or end <= 0:
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = _unique(shapes, kinds) | set(ties)  # a variant is written once, as drawn
-    runs, counters, spares = _plan(kinds, mirrored, unique, widths, symmetric, mirror)
+    openings = tuple(sum(s[0] in CUTS for s in shape) for shape in shapes)
+    runs, counters, spares = _plan(kinds, mirrored, unique, widths, symmetric, mirror, openings)
     if symmetric and not any(r.counter and r.most is None for r in runs):
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
-        runs, counters, spares = _plan(kinds, mirrored, unique, widths, False, mirror)
+        runs, counters, spares = _plan(kinds, mirrored, unique, widths, False, mirror, openings)
     if not any(r.counter and r.most is None for r in runs):
         if mirror and any(most is not None for *_, most in counters):
             return (
@@ -1087,6 +1096,7 @@ def _plan(
     widths: tuple[float, ...],
     symmetric: bool,
     centred: bool,
+    openings: tuple[int, ...] = (),
 ) -> tuple[list[Run], list[tuple[str, float, int, int | None]], Spares]:
     """The runs the written bays are cut into (the left half's if ``symmetric``): ends
     of kinds found only there on a counter of their own (at most one: drop only), then
@@ -1105,6 +1115,7 @@ def _plan(
     ends = {k for k in (kinds[0], kinds[-1]) if k not in inner and k not in unique}
     taken: dict[int, Run] = {}
     counters: list[tuple[str, float, int, int | None]] = []
+    spare_unit: Run | None = None  # a copy of a unit drawn once more (``_spare_unit``)
 
     def counter(pitch: float, copies: int, most: int | None) -> str:
         for name, known, count, bound in counters:
@@ -1156,8 +1167,11 @@ def _plan(
             if kinds[j] == kind:
                 taken[j] = Run(j, 1, 1, counter(widths[kind], 1, None))
     if not any(run.counter and run.most is None for run in taken.values()):
-        for j, name in _drawn_once(kinds, unique | ends, written, counters, widths).items():
-            taken.setdefault(j, Run(j, 1, 1, name))
+        once = _drawn_once(kinds, unique | ends, written, counters, widths, openings)
+        for j, run in once.items():
+            taken.setdefault(j, run)
+        if not centred and not symmetric:
+            spare_unit = _spare_unit(once, counters, sum(widths[k] for k in kinds))
     spares: Spares = (None, None)
     if (
         not centred  # a mirrored façade keeps its mirror: a word a layer (``_ends_repeat``)
@@ -1170,6 +1184,8 @@ def _plan(
     while k < written:
         run = taken.get(k, Run(k, 1, 1))
         runs.append(run)
+        if spare_unit is not None and spare_unit.start == run.start:
+            runs.append(spare_unit)
         k = run.start + run.unit * run.copies
     return runs, counters, spares
 
@@ -1225,27 +1241,95 @@ def _drawn_once(
     written: int,
     counters: list[tuple[str, float, int, int | None]],
     widths: tuple[float, ...],
-) -> dict[int, str]:
+    openings: tuple[int, ...] = (),
+) -> dict[int, Run]:
     """Counters for bays no unit repeats (``PAIRED``): each inner bay written (not an
-    end bay, not of a kind in ``kept``: unique or found only at the ends) on one of two
-    counters, at one where drawn, so the layout at the input's size is the drawing's.
-    Bays the same way in from either end share one (a narrower or wider façade drops
-    or gains them both: a mirrored façade stays so), and every other such pair the
-    other, so that a narrower façade can drop about half of them or a third, and a
-    wider one gain copies of every bay. The counters go into ``counters`` (name, their
-    bays' mean width, their bays drawn, no most); returns each bay's counter."""
+    end bay, not of a kind in ``kept``: unique or found only at the ends) in a unit of
+    bays (``_units``: one bay, or two side by side where one bay alone holds too few of
+    the ``openings`` to stand for the others), each unit on one of two counters, at one
+    where drawn, so the layout at the input's size is the drawing's. Units the same way
+    in from either end share one (a narrower or wider façade drops or gains them both:
+    a mirrored façade stays so), and every other such pair the other, so that a
+    narrower façade can drop about half of them or a third, and a wider one gain copies
+    of every unit. The counters go into ``counters`` (name, their units' mean width,
+    their units drawn, no most); returns each bay's run (a unit's bays share one)."""
     n = len(kinds)
-    groups: dict[int, list[int]] = defaultdict(list)
-    for j in range(1, min(written, n - 1)):
-        if kinds[j] not in kept:
-            groups[(min(j, n - 1 - j) - 1) % PAIRED].append(j)
-    out: dict[int, str] = {}
+    counted = [j for j in range(1, min(written, n - 1)) if kinds[j] not in kept]
+    units = _units(counted, n, [openings[kinds[j]] for j in counted] if openings else [])
+    groups: dict[int, list[list[int]]] = defaultdict(list)
+    for unit in units:
+        groups[unit[0][1] % PAIRED].append([j for j, _ in unit])
+    out: dict[int, Run] = {}
     for _, held in sorted(groups.items()):
         name = f"bays{len(counters) + 1}"
-        pitch = statistics.mean(widths[kinds[j]] for j in held)
+        pitch = statistics.mean(sum(widths[kinds[j]] for j in bays) for bays in held)
         counters.append((name, round(pitch, DIGITS), len(held), None))
-        out.update((j, name) for j in held)
+        for bays in held:
+            run = Run(bays[0], len(bays), 1, name)
+            out.update((j, run) for j in bays)
     return out
+
+
+def _spare_unit(
+    once: dict[int, Run], counters: list[tuple[str, float, int, int | None]], bays: float
+) -> Run | None:
+    """A spare copy (at most one; none as drawn) of the last unit drawn once, beside it,
+    where its counter is the only one of the units drawn once and drops more than
+    ``1 - NARROWEST`` of the bays' width ``bays`` at once (one unit each side of a
+    unique bay, each a column with its narrow bay: the generated paired family's
+    ``ABAB``, CMP's b0002): with it, a narrower façade drops one unit and a wider one
+    gains them one at a time. Not where the façade is mirrored, which drops and gains
+    them in pairs. The counter goes into ``counters``."""
+    names = {run.counter for run in once.values()}
+    if len(names) != 1:
+        return None
+    (name,) = names
+    _, pitch, count, _ = next(c for c in counters if c[0] == name)
+    if count < 2 or pitch * count <= (1 - NARROWEST) * bays:
+        return None
+    last = max(once.values(), key=lambda run: run.start)
+    spare = f"bays{len(counters) + 1}"
+    counters.append((spare, pitch, 0, 1))
+    return Run(last.start, last.unit, 1, spare, 1)
+
+
+def _units(counted: list[int], n: int, openings: list[int]) -> list[list[tuple[int, int]]]:
+    """The bays ``counted`` (of ``n``, each with its number of ``openings``) cut into
+    units, each a list of (bay, the unit's place in from the nearer end): single bays
+    where they hold alike numbers of openings (``AS_MANY``), else the smallest of
+    ``UNITS`` bays side by side, counted in from the nearer end (so a mirrored façade's
+    units mirror), whose whole units do. A column of windows beside a narrow bay of one
+    attic window (``ABAB``: CMP's b0008 and b0002) holds several times its neighbour's:
+    counted alone, a façade of another width gained or dropped columns for narrow bays,
+    keeping its width but not its windows a metre; in pairs, every unit holds about as
+    many. A bay left over (the middle one, or a pair cut by a unique bay) is then
+    written once, as drawn. With no ``openings`` known: single bays."""
+    by_bay = dict(zip(counted, openings, strict=True)) if openings else {}
+
+    def place(j: int) -> int:
+        return min(j, n - 1 - j) - 1
+
+    singles = [[(j, place(j))] for j in counted]
+    if not by_bay or _alike_counts(list(by_bay.values())):
+        return singles
+    for size in UNITS[1:]:
+        cut: dict[tuple[int, int], list[int]] = defaultdict(list)
+        for j in counted:
+            side = 0 if 2 * j < n - 1 else 1 if 2 * j > n - 1 else 2  # the middle alone
+            cut[side, place(j) // size].append(j)
+        units = [
+            sorted(held)
+            for (side, _), held in cut.items()
+            if side < 2 and len(held) == size and max(held) - min(held) == size - 1
+        ]
+        if len(units) >= 2 and _alike_counts([sum(by_bay[j] for j in unit) for unit in units]):
+            return [[(j, place(unit[0]) // size) for j in unit] for unit in sorted(units)]
+    return singles
+
+
+def _alike_counts(counts: list[int]) -> bool:
+    """The numbers are within ``AS_MANY`` of the most of one another."""
+    return not counts or max(counts) - min(counts) <= AS_MANY * max(counts)
 
 
 def _narrowest(

@@ -54,7 +54,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.bays import SLIVER, WALL, Bays, in_bays, segment
+from facadecli.infer.bays import SLIVER, WALL, Bays, Spares, in_bays, segment
 from facadecli.infer.bays import Run as BayRun
 from facadecli.infer.floors import (
     ALIKE,
@@ -562,12 +562,7 @@ def spec_text(
         ]
         out += [
             f"  {n}: {{min: 0{'' if most is None else f', max: {most}'}}}  # "
-            + (
-                f"a copy of the {'last' if n == spares[0] else 'first'} bay more (the end bays "
-                "change one at a time)"
-                if n in spares
-                else f"{count} {'end bays (they may drop)' if most is not None else 'bays'}"
-            )
+            + _bay_counter_note(n, count, most, spares, shared)
             + f" along x at a pitch of {_number(pitch)} m"
             for n, pitch, count, most in bay_counters
         ]
@@ -596,6 +591,24 @@ def spec_text(
     colours += [(ident(label), label_colour(label)) for label in elements]
     out.append("materials: {" + ", ".join(f'{n}: {{color: "{c}"}}' for n, c in colours) + "}")
     return "\n".join(out) + "\n"
+
+
+def _bay_counter_note(
+    name: str, count: int, most: int | None, spares: Spares, bays: Bays | None
+) -> str:
+    """What a counter of bays counts, for its comment: a spare end bay (``spares``: the
+    last's, ``Bays.spare``, and the first's, ``Bays.spare_first``), a spare unit (a run
+    of most one, none as drawn: ``bays._spare_unit``), the end bays, or the units of
+    one or more bays drawn."""
+    unit = max((r.unit for r in bays.runs if r.counter == name), default=1) if bays else 1
+    if name in spares:
+        end = "last" if name == spares[0] else "first"
+        return f"a copy of the {end} bay more (the end bays change one at a time)"
+    if most is not None and not count:
+        return f"a copy of a unit of {unit} bays more (the units change one at a time)"
+    if most is not None:
+        return f"{count} end bays (they may drop)"
+    return f"{count} bays" if unit == 1 else f"{count} units of {unit} bays"
 
 
 def _bays_note(bays: Bays | str | None) -> list[str]:

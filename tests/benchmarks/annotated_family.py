@@ -21,7 +21,8 @@ annotation as ever.
 from __future__ import annotations
 
 import random
-from dataclasses import dataclass
+import statistics
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 Box = tuple[str, float, float, float, float]  # label, x0, y0, x1, y1 on the unit square, y up
@@ -137,12 +138,74 @@ def cmp_xml(boxes: list[Box]) -> str:
     )
 
 
-def written_family(folder: Path, seeds: list[int], defects: bool = False) -> list[Path]:
+def paired_family(seed: int) -> tuple[list[Box], Known]:
+    """``family(seed)`` with narrow bays between its columns (issue 34's coarse units): a
+    small window (with its sill) on the top floor in the middle of the wall between two
+    columns of windows, in every wall (``ABAB..``) or every other one (``AAB AAB..``, the
+    seed's draw), as on façades whose attic windows sit between the columns below. Each
+    column's windows are drawn narrower by a share of their own (0.6-0.85, a mirrored
+    façade's partners alike), so that no two bays read alike: every bay drawn once, as on
+    CMP. A column holds a window a floor (the door's one fewer) and a narrow bay one, so a
+    façade of another width keeps its density only by gaining or dropping a column with
+    the narrow bay beside it. ``Known.windows`` counts the small windows too."""
+    boxes, known = family(seed)
+    rng = random.Random(f"paired-{seed}")
+    columns: list[float] = []  # the columns' centres (the drawn ones within 2 cm are one)
+    for c in sorted((b[1] + b[3]) / 2 for b in boxes if b[0] in ("window", "door")):
+        if not columns or c - columns[-1] > 0.02:
+            columns.append(c)
+    count = len(columns)
+
+    def column(box: Box) -> int:
+        return min(range(count), key=lambda j: abs(columns[j] - (box[1] + box[3]) / 2))
+
+    scales = [rng.uniform(0.6, 0.85) for _ in range(count)]
+    if known.mirrored:
+        scales = [scales[min(k, count - 1 - k)] for k in range(count)]
+    every = rng.choice((1, 2))  # a narrow bay in every wall, or in every other one
+    out: list[Box] = []
+    for box in boxes:
+        label, x0, y0, x1, y1 = box
+        if label in ("window", "sill", "blind"):
+            k = column(box)
+            if label == "blind":  # beside its window: it moves with the window's edge
+                x0, x1 = (
+                    columns[k] + (x0 - columns[k]) * scales[k],
+                    x1 + (x0 - columns[k]) * (scales[k] - 1),
+                )
+            else:
+                half = (x1 - x0) * scales[k] / 2
+                x0, x1 = (x0 + x1) / 2 - half, (x0 + x1) / 2 + half
+        out.append((label, x0, y0, x1, y1))
+    top = max(b[2] for b in out if b[0] == "window")
+    row = [b for b in out if b[0] == "window" and top - b[2] < 0.02]
+    y0, y1 = statistics.median(b[2] for b in row), statistics.median(b[4] for b in row)
+    walls = [k for k in range(count - 1) if k % every == 0]
+    if known.mirrored:  # mirrored: the walls chosen mirror too
+        walls = sorted({*walls, *(count - 2 - k for k in walls)})
+    held = [b for b in out if b[0] in ("window", "door", "sill", "blind")]
+    added: list[Box] = []
+    for k in walls:
+        left = max(b[3] for b in held if column(b) == k)
+        right = min(b[1] for b in held if column(b) == k + 1)
+        middle, size = (left + right) / 2, 0.4 * (right - left)
+        added.append(("window", middle - size / 2, y0, middle + size / 2, y1))
+        added.append(("sill", middle - 0.55 * size, y0 - 0.012, middle + 0.55 * size, y0))
+    out += added
+    order = ("facade", "window", "cornice", "door", "sill", "blind")
+    out.sort(key=lambda b: order.index(b[0]))
+    return out, replace(known, windows=known.windows + len(added) // 2)
+
+
+def written_family(
+    folder: Path, seeds: list[int], defects: bool = False, paired: bool = False
+) -> list[Path]:
     """The annotations of ``seeds`` as CMP XML files in ``folder`` (``family-<seed>.xml``;
-    ``defects``: ``family``'s)."""
+    ``defects``: ``family``'s; ``paired``: ``paired_family``'s)."""
     paths = []
     for seed in seeds:
         path = folder / f"family-{seed}.xml"
-        path.write_text(cmp_xml(family(seed, defects)[0]))
+        boxes = paired_family(seed)[0] if paired else family(seed, defects)[0]
+        path.write_text(cmp_xml(boxes))
         paths.append(path)
     return paths

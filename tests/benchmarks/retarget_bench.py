@@ -332,8 +332,10 @@ def main() -> None:
     """``-v``: the façades that miss, per size; ``--seeds A-B``: the family's seeds (1-24;
     101-124 is the hold-out, never tuned on); ``--family``: the family alone, not CMP;
     ``--cmp``: CMP alone; ``--defects``: the family with its defects (wider end bays,
-    missing and odd windows: ``annotated_family``); ``--only b0004,b0006``: the CMP
-    façades whose names hold one of these (to iterate on a few)."""
+    missing and odd windows: ``annotated_family``); ``--paired``: the family with a narrow
+    bay (a small window on the top floor) between its columns, every bay drawn unlike
+    (``annotated_family.paired_family``); ``--only b0004,b0006``: the CMP façades whose
+    names hold one of these (to iterate on a few)."""
     verbose = "-v" in sys.argv
     seeds = SEEDS
     if "--seeds" in sys.argv:
@@ -352,9 +354,10 @@ def main() -> None:
     if "--cmp" in sys.argv:
         return
     with tempfile.TemporaryDirectory() as folder:
-        defects = "--defects" in sys.argv
-        paths = written_family(Path(folder), seeds, defects)
+        defects, paired = "--defects" in sys.argv, "--paired" in sys.argv
+        paths = written_family(Path(folder), seeds, defects, paired)
         title = f"generated family{' with defects' if defects else ''}"
+        title += " with narrow bays between its columns" if paired else ""
         run(paths, f"{title} (seeds {seeds[0]}-{seeds[-1]})", verbose)
 
 
