@@ -27,7 +27,7 @@ from facadecli.grammar.tiling import MOVE_SHARE
 from facadecli.infer import run
 from facadecli.infer.bays import KEEP, LOOSE, ODD, Bays, _common, _units, find_bays
 from facadecli.infer.run import infer, solved_layout
-from facadecli.infer.spec_text import layer_names, spec_text
+from facadecli.infer.spec_text import _bay_counter_note, layer_names, spec_text
 from facadecli.infer.structure import structured
 from facadecli.solve import retarget
 from tests.benchmarks.annotated_family import cmp_xml, family, paired_family
@@ -991,3 +991,14 @@ def test_two_units_on_one_counter_drop_one_at_a_time_with_a_spare(tmp_path: Path
     rects = _solved(inference, spec, 0.7)
     windows = [r for r in rects if r.label == "window"]
     assert 0.85 <= len(windows) / len(drawn) / 0.7 <= 1.15, len(windows)
+
+
+def test_the_counter_comment_names_which_end_bay_the_spare_copies() -> None:
+    """Where only the end bays repeat, each end has a spare copy (``Bays.spare``: the
+    last bay's, ``Bays.spare_first``: the first's); the spec's comment on each counter
+    says which, and the ends' own counter stays the end bays'."""
+    spares = ("bays3", "bays4")
+    assert _bay_counter_note("bays3", 0, 1, spares, None).startswith("a copy of the last bay")
+    assert _bay_counter_note("bays4", 0, 1, spares, None).startswith("a copy of the first bay")
+    assert _bay_counter_note("bays1", 2, 1, spares, None) == "2 end bays (they may drop)"
+    assert _bay_counter_note("bays2", 3, None, spares, None) == "3 bays"
