@@ -7,10 +7,12 @@ a façade whose bays cannot do that keeps per-layer words and says so."""
 from __future__ import annotations
 
 import json
+import random
 import re
 import subprocess
 import sys
 from collections import Counter
+from itertools import pairwise
 from pathlib import Path
 
 import pytest
@@ -856,6 +858,66 @@ def test_a_gap_in_a_bay_is_cut_only_at_the_lines_of_the_elements_beside_it(
     assert re.fullmatch(deco, words["deco"]), words["deco"]
 
 
+def _pilastered(seed: int) -> tuple[list[dict[str, object]], float]:
+    """A generated façade of bays drawn once (``seed``: 4-6 window columns, each its own
+    width, 1.0-2.0 m, on 3-4 floors, drawn with a hand's jitter), a door under one inner
+    column and a pillar in every wall between two columns and in both margins (as CMP's
+    b0001, b0004 and b0009-b0011, whose bays are each drawn once, draw them): its
+    rectangles and its width."""
+    rng = random.Random(seed)
+    bays, floors = rng.randint(4, 6), rng.randint(3, 4)
+    door = rng.randrange(1, bays - 1)
+    pillar = rng.uniform(0.25, 0.35)
+    widths = [1.0 + 0.2 * k for k in range(bays)]
+    rng.shuffle(widths)
+    x, rects = 0.5 + rng.uniform(0.0, 0.2), []
+    rects.append({"label": "pillar", "x0": x, "y0": 1.0, "x1": x + pillar, "y1": 3.0 * floors})
+    x += pillar
+    for k in range(bays):
+        wall, window = rng.uniform(0.6, 0.9), widths[k] + rng.uniform(-0.03, 0.03)
+        x += wall
+        for floor in range(1, floors):
+            jitter = rng.uniform(-0.02, 0.02)
+            rects.append(
+                {"label": "window", "x0": x + jitter, "y0": 3.0 * floor + 0.5}
+                | {"x1": x + window + jitter, "y1": 3.0 * floor + 2.0}
+            )
+        if k == door:
+            rects.append({"label": "door", "x0": x, "y0": 0.0, "x1": x + window, "y1": 2.4})
+        x += window + wall
+        rects.append({"label": "pillar", "x0": x, "y0": 1.0, "x1": x + pillar, "y1": 3.0 * floors})
+        x += pillar
+    return rects, round(x + 0.5 + rng.uniform(0.0, 0.2), 4)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_pillars_in_the_walls_between_bays_are_gained_and_dropped_with_them(
+    tmp_path: Path, seed: int
+) -> None:
+    """A pillar in every wall between two window columns and in both margins: each wall
+    is cut beside its pillar (the line the fewest elements stand across), and the end
+    bays reach over the margins' pillars, so every pillar is a bay's and is gained and
+    dropped with it. At 0.7x and 2x every wall between two columns still holds one
+    pillar, and no pillar stands over a window. Cut at the walls' middles, the pillars
+    stood in no bay and kept words of their own: at 2x they bunched over the windows."""
+    rects, width = _pilastered(seed)
+    path = tmp_path / f"pillars-{seed}.json"
+    path.write_text(json.dumps({"canvas": {"width": width, "height": 13.0}, "rects": rects}))
+    inference = infer(path, "pillars")
+    assert not inference.unshared, inference.bays
+    spec = parse_spec(inference.text, "pillars.yaml")
+    for share in (0.7, 1.0, 2.0):
+        solved = _solved(inference, spec, share)
+        windows = [r for r in solved if r.label == "window"]
+        pillars = sorted((r for r in solved if r.label == "pillar"), key=lambda r: r.x0)
+        assert not [
+            (p, w) for p in pillars for w in windows if min(p.x1, w.x1) - max(p.x0, w.x0) > 0.01
+        ], share
+        columns = sorted({round((w.x0 + w.x1) / 2, 1) for w in windows})
+        for left, right in pairwise(columns):  # one pillar in each wall between columns
+            assert sum(left < (p.x0 + p.x1) / 2 < right for p in pillars) == 1, (share, left)
+
+
 @pytest.mark.parametrize("seed", [12, 20])
 def test_a_column_and_its_narrow_bay_drop_and_gain_together(tmp_path: Path, seed: int) -> None:
     """Generated façades whose columns of windows alternate with narrow bays of one
@@ -942,4 +1004,15 @@ def test_two_units_on_one_counter_drop_one_at_a_time_with_a_spare(tmp_path: Path
 )
 def test_a_bay_counters_comment_counts_in_words(count: int, most: int | None, note: str) -> None:
     """The comment over a counter of bays reads as English: one end bay, not "1 end bays"."""
-    assert _bay_counter_note("bays1", count, most, None, None) == note
+    assert _bay_counter_note("bays1", count, most, (None, None), None) == note
+
+
+def test_the_counter_comment_names_which_end_bay_the_spare_copies() -> None:
+    """Where only the end bays repeat, each end has a spare copy (``Bays.spare``: the
+    last bay's, ``Bays.spare_first``: the first's); the spec's comment on each counter
+    says which, and the ends' own counter stays the end bays'."""
+    spares = ("bays3", "bays4")
+    assert _bay_counter_note("bays3", 0, 1, spares, None).startswith("a copy of the last bay")
+    assert _bay_counter_note("bays4", 0, 1, spares, None).startswith("a copy of the first bay")
+    assert _bay_counter_note("bays1", 2, 1, spares, None) == "2 end bays (they may drop)"
+    assert _bay_counter_note("bays2", 3, None, spares, None) == "3 bays"

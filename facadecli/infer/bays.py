@@ -3,12 +3,15 @@
 
 A *bay* is a vertical strip of the façade cut on its openings (``CUTS``: windows and
 doors; a window with the windows over it, the door with the windows over it): openings
-overlapping along x are one strip, and the bays' boundaries are the middles of the walls
-between strips; the first and last reach as far out as half the wall on their inner
-side. Every other element (a sill, a blind, a balcony under one window) is in the bay it
-stands in; one that stands across the middle of a wall (a balcony or a cornice over two
-bays, a pillar between them, a shop front) or out in a margin is in none: it stays as
-the structure put it, in a layer of its own (``Bays.apart``) with its own x word. Bands
+overlapping along x are one strip, and each wall between two strips is cut where the
+fewest other elements stand across it (``_wall_cut``: beside a pillar standing in it,
+else at its middle); the first and last bays reach as far out as half the wall on their
+inner side, and over what stands wholly in the margin beyond (a pillar beside the first
+window column). Every other element (a sill, a blind, a balcony under one window, a
+pillar in a wall) is in the bay it stands in; one that stands across a cut all the same
+(a balcony or a cornice over two bays, a shop front) or out at the façade's edge is in
+none: it stays as the structure put it, in a layer of its own (``Bays.apart``) with its
+own x word. Bands
 across the façade (``layers.BAND``) are in no bay either; one standing within a bay
 stands apart too.
 
@@ -129,6 +132,7 @@ FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none 
 Slot = tuple[str, float, float, float, float]  # label, centre x in the bay, width, y0, y1
 Ties = dict[int, tuple[int, list[int | None]]]  # variant kind: its base, each slot's in it
 Move = tuple[list[int], Span]  # a slot's rectangles, and the row they would stand on
+Spares = tuple[str | None, str | None]  # the spare copies' counters: the last bay's, the first's
 
 
 @dataclass(frozen=True)
@@ -160,6 +164,7 @@ class Bays:
     walls: tuple[float, ...]  # per kind: the wall after its last element (0: none)
     apart: frozenset[int] = frozenset()  # rectangles left as drawn, in layers of their own
     spare: str | None = None  # the counter (at most 1) of a copy of the last bay (``_spare``)
+    spare_first: str | None = None  # and of a copy of the first bay
 
     def steady(self) -> frozenset[int]:
         """The kinds whose wall keeps its size (the rest may narrow to ``WALL``): where
@@ -334,11 +339,12 @@ def _found(
             fitted = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths, 0, ties)
         start, widths, shapes = fitted
         shapes = _tied([_lined(s, w, COLUMN) for s, w in zip(shapes, widths, strict=True)], ties)
-    laid = _laid(kinds, mirrored, spans, width, widths, shapes, ties, start, centred)
+    mirror = _about_middle(list(layout.rects), width)  # centred or not, no spare end bays
+    laid = _laid(kinds, mirrored, spans, width, widths, shapes, ties, start, centred, mirror)
     if isinstance(laid, str):
         yield laid
         return
-    symmetric, start, runs, counters, end, spare = laid
+    symmetric, start, runs, counters, end, spares = laid
     narrowest = _narrowest(runs, kinds, widths, symmetric)
     if narrowest > NARROWEST * width:
         yield (
@@ -378,7 +384,7 @@ def _found(
                 tuple(counters),
                 walls,
                 frozenset(apart),
-                spare,
+                *spares,
             )
 
 
@@ -392,14 +398,16 @@ def _laid(
     ties: Ties,
     start: float,
     centred: bool,
-) -> (
-    tuple[bool, float, list[Run], list[tuple[str, float, int, int | None]], float, str | None] | str
-):
+    mirror: bool,
+) -> tuple[bool, float, list[Run], list[tuple[str, float, int, int | None]], float, Spares] | str:
     """The bays on their kinds' ``widths`` laid along the façade: whether they are
     written mirrored, the first's start, the runs and counters (``_plan``), the
     margin after the last (``centred``: the same as before the first; the openings
-    mirror about the middle, ``_about_middle``) and the spare end bay's counter
-    (``_spare``); or why they cannot be (no margin, no repeat)."""
+    mirror about the middle, ``_about_middle``, and the bays' elements stay in their
+    frames there) and the spare end bays' counters (``_spare``: the last's, the first's;
+    none where the openings mirror, ``mirror``, centred or not: CMP's b0005, once the
+    ornaments between its windows stood in its bays, was not centred, took spares and
+    lost its mirror at 0.7x and 2x); or why they cannot be (no margin, no repeat)."""
     symmetric = _palindrome(kinds, mirrored)
     left, right = spans[0][0], width - spans[-1][1]
     total = sum(widths[k] for k in kinds)
@@ -412,19 +420,19 @@ def _laid(
         return "the bays reach the façade's edge (no margin to take the slack)"
     unique = _unique(shapes, kinds) | set(ties)  # a variant is written once, as drawn
     openings = tuple(sum(s[0] in CUTS for s in shape) for shape in shapes)
-    runs, counters, spare = _plan(kinds, mirrored, unique, widths, symmetric, centred, openings)
+    runs, counters, spares = _plan(kinds, mirrored, unique, widths, symmetric, mirror, openings)
     if symmetric and not any(r.counter and r.most is None for r in runs):
         symmetric = False  # the halves would keep no repeat: the whole sequence, then
-        runs, counters, spare = _plan(kinds, mirrored, unique, widths, False, centred, openings)
+        runs, counters, spares = _plan(kinds, mirrored, unique, widths, False, mirror, openings)
     if not any(r.counter and r.most is None for r in runs):
-        if centred and any(most is not None for *_, most in counters):
+        if mirror and any(most is not None for *_, most in counters):
             return (
                 f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat but its end "
                 "bays, and it is mirrored (dropping both would leave the middle alone, one "
                 "would lose the mirror)"
             )
         return f"none of its {len(kinds)} bays of {len(shapes)} kinds repeat"
-    return symmetric, start, runs, counters, end, spare
+    return symmetric, start, runs, counters, end, spares
 
 
 def _unique(shapes: list[list[Slot]], kinds: list[int]) -> set[int]:
@@ -514,8 +522,8 @@ def _strips(
     overlap, left to right, each with the openings' span and the indices of its
     openings and of every other element (not a band) standing in its bay
     (``_bay_spans``); the bays' spans; and the elements that stand in no bay: across
-    the middle of a wall (a balcony or a cornice over two bays, a pillar between them,
-    a shop front) or out in a margin, and a band across a good share of the façade
+    the cut of a wall (a balcony or a cornice over two bays, a shop front) or out at
+    the façade's edge, and a band across a good share of the façade
     standing within one bay (which the bays' words would write but not place). Those
     stay as the structure put them, in layers of their own."""
     shown = [
@@ -533,7 +541,8 @@ def _strips(
             openings.append(((r.x0, r.x1), [k]))
     if len(openings) < 2:
         return openings, [], set()
-    spans = _bay_spans(openings, layout.width)
+    others = [layout.rects[k] for k in shown if not _cuts(layout.rects[k])]
+    spans = _bay_spans(openings, layout.width, others)
     over: set[int] = set()
     for k in shown:
         r = layout.rects[k]
@@ -628,17 +637,59 @@ def _alike(a: Slot, b: Slot, tolerance: float) -> bool:
     return a[0] == b[0] and all(abs(p - q) <= tolerance for p, q in zip(a[1:], b[1:], strict=True))
 
 
-def _bay_spans(strips: list[tuple[Span, list[int]]], width: float) -> list[Span]:
-    """Each strip widened to the middle of the wall on either side (the end ones
-    outwards by the half wall on their inner side, leaving the margin ``MARGIN`` of the
-    façade where it is that wide: the margins take the slack)."""
-    cuts = [(a[1] + b[0]) / 2 for (a, _), (b, _) in pairwise(strips)]
+def _bay_spans(
+    strips: list[tuple[Span, list[int]]], width: float, others: list[Rect] | None = None
+) -> list[Span]:
+    """Each strip widened to the wall's cut on either side (``_wall_cut``: where the
+    fewest of the ``others``, the elements but the openings, stand across it; else its
+    middle), the end ones outwards by the half wall on their inner side and over what
+    of ``others`` stands wholly in the margin beyond, leaving the margin ``MARGIN`` of
+    the façade where it is that wide: the margins take the slack."""
+    middles = [(a[1] + b[0]) / 2 for (a, _), (b, _) in pairwise(strips)]
+    cuts = [_wall_cut(a[1], b[0], others or []) for (a, _), (b, _) in pairwise(strips)]
     first, last = strips[0][0], strips[-1][0]
     edge = MARGIN * width  # left of the margin to the façade's edge, where it is that wide
-    low = first[0] - min(cuts[0] - first[1], max(0.0, first[0] - edge))
-    high = last[1] + min(last[0] - cuts[-1], max(0.0, width - last[1] - edge))
+    low = first[0] - min(middles[0] - first[1], max(0.0, first[0] - edge))
+    high = last[1] + min(last[0] - middles[-1], max(0.0, width - last[1] - edge))
+    # and out over what stands wholly in a margin, inside its edge (a pillar beside the
+    # first window column): it is the end bay's, dropped and gained with it
+    margins = others or []
+    low = min([low, *(r.x0 for r in margins if edge <= r.x0 and r.x1 <= cuts[0] + 1e-9)])
+    high = max([high, *(r.x1 for r in margins if r.x1 <= width - edge and r.x0 >= cuts[-1])])
     edges = [low, *cuts, high]
     return list(pairwise(edges))
+
+
+def _wall_cut(low: float, high: float, others: list[Rect]) -> float:
+    """Where the wall from ``low`` to ``high`` (between two strips of openings) is cut
+    into the bays either side: at its middle or an edge of one of ``others`` standing
+    wholly in the wall, whichever the fewest of ``others`` stand across, of those the
+    nearest the middle at or left of it, else the nearest right of it. (Moved only
+    where something of the wall's own stands across the middle, the cuts cost CMP's
+    b0004 its companions at 1.5x and 2x the width: 69% and 75% of its windows kept
+    them, for 100%.) A pillar, or a pilaster
+    with its base and capital, standing in the wall is then in the bay on one side and
+    is gained and dropped with it; one standing across the wall's middle goes to the bay
+    on its right whatever the hand's jitter, so every bay but the first holds the pillar
+    on its left and a bay dropped or gained leaves one pillar in every wall. (The
+    nearer side put it in one bay here and in the other there; the side nearer the
+    façade's middle, as a mirror image, left the middle bays two pillars and the others
+    none: the wall between two bays either side of a dropped middle one kept none.) Cut
+    at the middle, a pillar stood across the cut, in no bay, and at other widths stayed
+    where the structure put it in a word of its own (CMP's b0004 at 2x: its pillars
+    bunched in the middle, over the windows). What reaches over an opening beside the
+    wall (a balcony or a cornice over two bays, a sill wider than its window) neither
+    moves the cut nor gives a line to cut at: cut at such edges too, CMP's b0012, whose
+    walls hold nothing of their own, had other bays, and at 1.5x the width a density of
+    1.33 for 1.00."""
+    middle = (low + high) / 2
+    inside = [r for r in others if r.x0 >= low - 1e-9 and r.x1 <= high + 1e-9]
+    lines = {middle, *(x for r in inside for x in (r.x0, r.x1))}
+
+    def across(x: float) -> int:
+        return sum(r.x0 < x - 1e-9 and r.x1 > x + 1e-9 for r in others)
+
+    return min(sorted(lines), key=lambda x: (across(x), x > middle, abs(x - middle)))
 
 
 def _right_half_mirrored_first(count: int) -> list[bool]:
@@ -1046,7 +1097,7 @@ def _plan(
     symmetric: bool,
     centred: bool,
     openings: tuple[int, ...] = (),
-) -> tuple[list[Run], list[tuple[str, float, int, int | None]], str | None]:
+) -> tuple[list[Run], list[tuple[str, float, int, int | None]], Spares]:
     """The runs the written bays are cut into (the left half's if ``symmetric``): ends
     of kinds found only there on a counter of their own (at most one: drop only), then
     up to ``COUNTERS`` repeated units of one or two bays, longest first, none of a
@@ -1121,13 +1172,13 @@ def _plan(
             taken.setdefault(j, run)
         if not centred and not symmetric:
             spare_unit = _spare_unit(once, counters, sum(widths[k] for k in kinds))
-    spare = None
+    spares: Spares = (None, None)
     if (
         not centred  # a mirrored façade keeps its mirror: a word a layer (``_ends_repeat``)
         and not any(run.counter and run.most is None for run in taken.values())
         and _ends_repeat(taken, counters)
     ):
-        spare = _spare(kinds, widths, counters)
+        spares = (_spare(kinds, widths, counters, -1), _spare(kinds, widths, counters, 0))
     runs = []
     k = 0
     while k < written:
@@ -1136,7 +1187,7 @@ def _plan(
         if spare_unit is not None and spare_unit.start == run.start:
             runs.append(spare_unit)
         k = run.start + run.unit * run.copies
-    return runs, counters, spare
+    return runs, counters, spares
 
 
 def _ends_repeat(taken: dict[int, Run], counters: list[tuple[str, float, int, int | None]]) -> bool:
@@ -1165,18 +1216,22 @@ def _spare(
     kinds: list[int],
     widths: tuple[float, ...],
     counters: list[tuple[str, float, int, int | None]],
+    end: int,
 ) -> str:
-    """The counter of one more copy of the last bay, beside it (at most one; none as
-    drawn), for the ends' counter that gains and drops an end bay at each end at once
-    (``_ends_repeat``): with it the end bays change one at a time. At none, the ends'
-    counter alone left a narrower ``ABC`` (a door's bay between two columns of windows)
-    the door's bay alone, a third of its windows; now it keeps a column beside the door
-    (``BC``, the windows' density as drawn). The solver takes whichever count leaves the
-    margins nearest as drawn, so a wider façade may gain an odd number of end bays too
-    (one end a bay more than the other): never on a mirrored façade, which has neither
-    counter (``_plan``). The counter goes into ``counters``."""
+    """The counter of one more copy of the bay at ``end`` (-1: the last, 0: the first),
+    beside it (at most one; none as drawn), for the ends' counter that gains and drops
+    an end bay at each end at once (``_ends_repeat``): with a spare at each end the end
+    bays change one at a time, either first. At none, the ends' counter alone left a
+    narrower ``ABC`` (a door's bay between two columns of windows) the door's bay alone,
+    a third of its windows; a spare of the last bay kept a column beside the door
+    (``BC``, the windows' density as drawn), but only where the last bay fits beside it:
+    CMP's b0009, once its pillars stood in its bays, had a last bay 2.2 m wider than
+    its first and at 0.7x only the door's bay stood (``AB`` fits). The solver takes
+    whichever counts leave the margins nearest as drawn, so a wider façade may gain an
+    odd number of end bays too (one end a bay more than the other): never on a mirrored
+    façade, which has no spare (``_plan``). The counter goes into ``counters``."""
     name = f"bays{len(counters) + 1}"
-    counters.append((name, round(widths[kinds[-1]], DIGITS), 0, 1))
+    counters.append((name, round(widths[kinds[end]], DIGITS), 0, 1))
     return name
 
 

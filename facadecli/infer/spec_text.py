@@ -55,7 +55,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 
 from facadecli.grammar.palette import label_colour
-from facadecli.infer.bays import SLIVER, WALL, Bays, in_bays, segment
+from facadecli.infer.bays import SLIVER, WALL, Bays, Spares, in_bays, segment
 from facadecli.infer.bays import Run as BayRun
 from facadecli.infer.floors import (
     ALIKE,
@@ -611,7 +611,7 @@ def spec_text(
     out[-1] = out[-1].rstrip(",")
     out.append("}")
     bay_counters = shared.counters if shared is not None and in_bay else ()
-    spare = shared.spare if shared is not None else None
+    spares = (shared.spare, shared.spare_first) if shared is not None else (None, None)
     if counters.names or bay_counters:
         out.append("counters:")
         out += [
@@ -624,7 +624,7 @@ def spec_text(
         ]
         out += [
             f"  {n}: {{min: 0{'' if most is None else f', max: {most}'}}}  # "
-            + _bay_counter_note(n, count, most, spare, shared)
+            + _bay_counter_note(n, count, most, spares, shared)
             + f" along x at a pitch of {_number(pitch)} m"
             for n, pitch, count, most in bay_counters
         ]
@@ -656,14 +656,16 @@ def spec_text(
 
 
 def _bay_counter_note(
-    name: str, count: int, most: int | None, spare: str | None, bays: Bays | None
+    name: str, count: int, most: int | None, spares: Spares, bays: Bays | None
 ) -> str:
-    """What a counter of bays counts, for its comment: the spare end bay (``Bays.spare``),
-    a spare unit (a run of most one, none as drawn: ``bays._spare_unit``), the end bays,
-    or the units of one or more bays drawn."""
+    """What a counter of bays counts, for its comment: a spare end bay (``spares``: the
+    last's, ``Bays.spare``, and the first's, ``Bays.spare_first``), a spare unit (a run
+    of most one, none as drawn: ``bays._spare_unit``), the end bays, or the units of
+    one or more bays drawn."""
     unit = max((r.unit for r in bays.runs if r.counter == name), default=1) if bays else 1
-    if name == spare:
-        return "a copy of the last bay more (the end bays change one at a time)"
+    if name in spares:
+        end = "last" if name == spares[0] else "first"
+        return f"a copy of the {end} bay more (the end bays change one at a time)"
     if most is not None and not count:
         return f"a copy of a unit of {unit} bays more (the units change one at a time)"
     if most is not None:
@@ -725,7 +727,8 @@ def _bay_word(
     solver's work). Each bay ends with its kind's wall (``bayK_w``: ``Bays.walls``),
     alike in every layer; a bay where the layer shows nothing is one hidden spacer; the
     spare copy of the last bay (``Bays.spare``) stands beside its copies: before the
-    right margin, or before the reflected half where the word is mirrored."""
+    right margin, or before the reflected half where the word is mirrored; that of the
+    first (``Bays.spare_first``) after the left margin."""
     walls = [f"bay{kind + 1}_w" for kind in range(len(bays.widths))]
 
     def spaces(
@@ -783,8 +786,8 @@ def _bay_word(
         single = run.unit == 1 and " " not in unit and "(" not in unit
         return f"{unit}^{run.counter}" if single else f"({unit})^{run.counter}"
 
-    def sequence(runs: list[BayRun], last: list[str]) -> str:
-        parts = [written(run) for run in runs]
+    def sequence(runs: list[BayRun], last: list[str], first: list[str]) -> str:
+        parts = [*first, *(written(run) for run in runs)]
         left = margins.of(bays.margins[0])
         if bays.reflected:
             half = " ".join([left, *parts])
@@ -794,7 +797,8 @@ def _bay_word(
 
     last = len(bays.kinds) - 1  # the spare copy of the last bay stands before it, if any
     spare = [] if bays.spare is None else [written(BayRun(last, 1, 1, bays.spare, 1))]
-    return sequence(list(bays.runs), spare)
+    first = [] if bays.spare_first is None else [written(BayRun(0, 1, 1, bays.spare_first, 1))]
+    return sequence(list(bays.runs), spare, first)
 
 
 def _floors_above(

@@ -110,15 +110,24 @@ def aligned(found: list[Rect]) -> float:
     whose centre is within ``NEAR`` along x."""
     if len(found) < 2:
         return 1.0
-    hits = 0
+    return 1 - lonely(found) / len(found)
+
+
+def lonely(found: list[Rect]) -> int:
+    """The windows with no window of another floor (not overlapping it along y) whose
+    centre is within ``NEAR`` along x: what ``aligned`` counts against. A façade that
+    drops bays whose windows all stand in columns keeps its lonely ones (an attic's,
+    one drawn off its column), so its share aligned falls though no column drifted:
+    ``-v`` prints the count beside the share to tell the two apart."""
+    count = 0
     for r in found:
         cx = _centre(r)[0]
-        hits += any(
+        count += not any(
             abs(_centre(q)[0] - cx) <= NEAR and (q.y0 >= r.y1 - 1e-6 or q.y1 <= r.y0 + 1e-6)
             for q in found
             if q is not r
         )
-    return hits / len(found)
+    return count if len(found) >= 2 else 0
 
 
 def overlaps(rects: list[Rect]) -> int:
@@ -264,7 +273,9 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
         if failed or behind:
             tally.worst.append(
                 f"{name}: {share:.0%} sized, density {ratio:.2f}, aligned "
-                f"{aligned(found):.2f} (input {in_aligned:.2f}), overlaps {overlaps(rects)}, "
+                f"{aligned(found):.2f} (input {in_aligned:.2f}; lonely {lonely(found)} of "
+                f"{len(found)}, input {lonely(reference)} of {len(reference)}), "
+                f"overlaps {overlaps(rects)}, "
                 f"{along:.0%} with their companions, {behind} sills and blinds hidden"
             )
 
