@@ -25,7 +25,7 @@ from facadecli.grammar.model import Options
 from facadecli.grammar.tidy import tidy_layout
 from facadecli.grammar.tiling import MOVE_SHARE
 from facadecli.infer import run
-from facadecli.infer.bays import KEEP, LOOSE, ODD, Bays, _common, _units, find_bays
+from facadecli.infer.bays import KEEP, LOOSE, ODD, Bays, _common, _strips, _units, find_bays
 from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.spec_text import _bay_counter_note, layer_names, spec_text
 from facadecli.infer.structure import structured
@@ -916,6 +916,55 @@ def test_pillars_in_the_walls_between_bays_are_gained_and_dropped_with_them(
         columns = sorted({round((w.x0 + w.x1) / 2, 1) for w in windows})
         for left, right in pairwise(columns):  # one pillar in each wall between columns
             assert sum(left < (p.x0 + p.x1) / 2 < right for p in pillars) == 1, (share, left)
+
+
+def _ornamented(seed: int) -> tuple[LabelledLayout, list[Rect]]:
+    """A generated façade (``seed``: 4-6 window columns, each its own width, on 3-4
+    floors, walls 1.4-2.0 m between them) whose windows stand on balconies reaching from
+    a little left of the window to just past the middle of the wall on its right, and
+    with three ornaments in a row in every wall under the roof, the middle one across
+    the wall's middle by a hand's jitter (as CMP's b0007 draws them): the layout and
+    the ornaments across the walls' middles, left to right."""
+    rng = random.Random(seed)
+    columns, floors = rng.randint(4, 6), rng.randint(3, 4)
+    x, rects, middles = 1.0, [], []
+    for k in range(columns):
+        window = rng.uniform(1.0, 1.6)
+        wall = rng.uniform(1.4, 2.0)
+        middle = x + window + wall / 2
+        for floor in range(floors):
+            y = 3.0 * floor + 0.8
+            rects.append(Rect("window", x, y, x + window, y + 1.6))
+            if k < columns - 1:
+                rects.append(Rect("balcony", x - 0.1, y - 0.3, middle + 0.27, y))
+        if k < columns - 1:
+            jitter = rng.uniform(-0.1, 0.1)
+            middles.append(Rect("deco", middle - 0.15 + jitter, 12.5, middle + 0.15 + jitter, 13.0))
+            rects.append(middles[-1])
+            rects.append(Rect("deco", middle - 0.6, 12.5, middle - 0.3, 13.0))
+            rects.append(Rect("deco", middle + 0.3, 12.5, middle + 0.6, 13.0))
+        x += window + wall
+    return LabelledLayout(round(x + 0.5, 4), 14.0, tuple(rects)), middles
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4, 5, 6])
+def test_a_wall_is_cut_no_further_than_the_ornament_across_its_middle(seed: int) -> None:
+    """A wall is cut beside what of its own stands across its middle (an ornament, a
+    pillar), never further: the balconies that reach into it from the window on its
+    left, ending just past the middle, neither move the cut nor give it a line, so
+    the bays either side keep their widths but for the ornament's share. Cut where the
+    fewest elements stood across it, each wall was cut past the balconies' ends, at
+    the next ornament (every bay the wider by the wall's balcony reach; CMP's b0007
+    dropped two of its four window columns at 0.7x the width); cut at the middle, the
+    ornament stood across the cut, in no bay."""
+    layout, ornaments = _ornamented(seed)
+    strips, spans, _ = _strips(layout)
+    assert len(strips) == len(ornaments) + 1
+    cuts = [high for _, high in spans[:-1]]
+    for cut, ornament in zip(cuts, ornaments, strict=True):
+        assert min(abs(cut - ornament.x0), abs(cut - ornament.x1)) < 1e-9, (cut, ornament)
+    kept = {layout.rects.index(o) for o in ornaments}
+    assert kept <= {k for _, held in strips for k in held}  # each in a bay
 
 
 @pytest.mark.parametrize("seed", [12, 20])

@@ -3,17 +3,16 @@
 
 A *bay* is a vertical strip of the façade cut on its openings (``CUTS``: windows and
 doors; a window with the windows over it, the door with the windows over it): openings
-overlapping along x are one strip, and each wall between two strips is cut where the
-fewest other elements stand across it (``_wall_cut``: beside a pillar standing in it,
-else at its middle); the first and last bays reach as far out as half the wall on their
-inner side, and over what stands wholly in the margin beyond (a pillar beside the first
-window column). Every other element (a sill, a blind, a balcony under one window, a
-pillar in a wall) is in the bay it stands in; one that stands across a cut all the same
-(a balcony or a cornice over two bays, a shop front) or out at the façade's edge is in
-none: it stays as the structure put it, in a layer of its own (``Bays.apart``) with its
-own x word. Bands
-across the façade (``layers.BAND``) are in no bay either; one standing within a bay
-stands apart too.
+overlapping along x are one strip, and each wall between two strips is cut at its
+middle, or beside a pillar of its own standing across the middle (``_wall_cut``: the
+cut moves no further than the pillar reaches); the first and last bays reach as far
+out as half the wall on their inner side, and over what stands wholly in the margin
+beyond (a pillar beside the first window column). Every other element (a sill, a
+blind, a balcony under one window, a pillar in a wall) is in the bay it stands in; one
+that stands across a cut all the same (a balcony or a cornice over two bays, a shop
+front) or out at the façade's edge is in none: it stays as the structure put it, in a
+layer of its own (``Bays.apart``) with its own x word. Bands across the façade
+(``layers.BAND``) are in no bay either; one standing within a bay stands apart too.
 
 Bays whose openings are alike (label, place in the bay, size and rows within ``ALIKE``
 of the bay's width, read as drawn or mirrored) are one *kind*, compared about the middle
@@ -126,6 +125,7 @@ HELD = SHARE / 2  # of the narrowest span an edge bounds: the most a kind's shap
 FOLLOW = SHARE  # of it: the most a kind's shape moves a companion's edge from where drawn
 ODD = 1  # openings: a bay this many unlike a kind's (each way) is a variant of it; and
 # companions: this many of a slot's may be resized past SIZED onto its row (``_apart``)
+OVERHANG = 0.1  # of its width: the most a wall's own element reaches over the openings beside it
 SIZED = 0.15  # of its size: the most a companion put on its slot's row may grow or shrink
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
@@ -662,34 +662,68 @@ def _bay_spans(
 
 def _wall_cut(low: float, high: float, others: list[Rect]) -> float:
     """Where the wall from ``low`` to ``high`` (between two strips of openings) is cut
-    into the bays either side: at its middle or an edge of one of ``others`` standing
-    wholly in the wall, whichever the fewest of ``others`` stand across, of those the
-    nearest the middle at or left of it, else the nearest right of it. (Moved only
-    where something of the wall's own stands across the middle, the cuts cost CMP's
-    b0004 its companions at 1.5x and 2x the width: 69% and 75% of its windows kept
-    them, for 100%.) A pillar, or a pilaster
-    with its base and capital, standing in the wall is then in the bay on one side and
-    is gained and dropped with it; one standing across the wall's middle goes to the bay
-    on its right whatever the hand's jitter, so every bay but the first holds the pillar
-    on its left and a bay dropped or gained leaves one pillar in every wall. (The
-    nearer side put it in one bay here and in the other there; the side nearer the
-    façade's middle, as a mirror image, left the middle bays two pillars and the others
-    none: the wall between two bays either side of a dropped middle one kept none.) Cut
-    at the middle, a pillar stood across the cut, in no bay, and at other widths stayed
-    where the structure put it in a word of its own (CMP's b0004 at 2x: its pillars
-    bunched in the middle, over the windows). What reaches over an opening beside the
-    wall (a balcony or a cornice over two bays, a sill wider than its window) neither
-    moves the cut nor gives a line to cut at: cut at such edges too, CMP's b0012, whose
-    walls hold nothing of their own, had other bays, and at 1.5x the width a density of
-    1.33 for 1.00."""
+    into the bays either side: at its middle, unless something of the wall's own
+    (``_owned``) stands across the middle: a pillar, or a pilaster with its base and
+    capital (``_standing_across``). Then the cut moves to an edge of the wall's own
+    elements within that pillar's reach where none of them stands across it, of those
+    lines the one the fewest of ``others`` stand across (a capital reaching over a
+    window's blind), the nearest the middle at or left of it (the pillar goes to the bay
+    on its right whatever the hand's jitter, so a bay dropped or gained leaves one
+    pillar in every wall), else the nearest right of it; where no line frees it (a
+    base wider than the wall, reaching a little over both openings), at the middle.
+    The pillar is then in one bay, gained and dropped with it; cut at the middle, it
+    stood across the cut, in no bay, and at other widths stayed where the structure put
+    it in a word of its own (CMP's b0004 at 2x: its pillars bunched in the middle, over
+    the windows).
+
+    The cut moves no further than the pillar across the middle reaches, so each bay
+    beside it keeps its width but for the pillar's share. Moved to wherever the fewest
+    elements stood across it, a wall was cut at the end of a balcony reaching into it
+    from the window beside it, past the ornaments in the wall: CMP's b0007's end
+    bays grew by 0.49 and 0.23 m and at 0.7x the width it dropped two of its four
+    window columns (density 0.89 -> 0.60); b0011 at 2x went out of the band (1.17). What
+    reaches over an opening beside the wall (a balcony or a cornice over two bays, a
+    sill wider than its window) neither moves the cut nor gives a line to cut at: cut
+    at such edges too, CMP's b0012, whose walls hold nothing of their own, had other
+    bays, and at 1.5x the width a density of 1.33 for 1.00."""
     middle = (low + high) / 2
-    inside = [r for r in others if r.x0 >= low - 1e-9 and r.x1 <= high + 1e-9]
-    lines = {middle, *(x for r in inside for x in (r.x0, r.x1))}
+    own = [r for r in others if _owned(r, low, high)]
+    pillar = _standing_across(own, middle)
+    if not pillar:
+        return middle
+    reach = min(r.x0 for r in pillar), max(r.x1 for r in pillar)
+    edges = {min(high, max(low, x)) for r in own for x in (r.x0, r.x1)}
+    lines = [x for x in sorted(edges) if reach[0] - 1e-9 <= x <= reach[1] + 1e-9]
 
-    def across(x: float) -> int:
-        return sum(r.x0 < x - 1e-9 and r.x1 > x + 1e-9 for r in others)
+    def across(x: float, rects: list[Rect]) -> int:
+        return sum(r.x0 < x - 1e-9 and r.x1 > x + 1e-9 for r in rects)
 
-    return min(sorted(lines), key=lambda x: (across(x), x > middle, abs(x - middle)))
+    free = [x for x in lines if not across(x, own)]
+    if not free:
+        return middle
+    return min(free, key=lambda x: (across(x, others), x > middle, abs(x - middle)))
+
+
+def _standing_across(rects: list[Rect], x: float) -> list[Rect]:
+    """Those of ``rects`` standing across ``x`` and, in turn, every one overlapping
+    them along x (a pillar with its base and capital): empty where none stands across."""
+    held = [r for r in rects if r.x0 < x - 1e-9 and r.x1 > x + 1e-9]
+    while held:
+        low, high = min(r.x0 for r in held), max(r.x1 for r in held)
+        more = [r for r in rects if r not in held and r.x0 < high - 1e-9 and r.x1 > low + 1e-9]
+        if not more:
+            break
+        held += more
+    return held
+
+
+def _owned(rect: Rect, low: float, high: float) -> bool:
+    """Whether ``rect`` is the wall's from ``low`` to ``high``: standing in it but for
+    an overhang of at most ``OVERHANG`` of its width over the openings beside it (a
+    capital a few centimetres wider than the wall: CMP's b0004), never reaching over
+    them (a balcony under a window that ends in the wall is the window's)."""
+    over = max(0.0, low - rect.x0) + max(0.0, rect.x1 - high)
+    return rect.x1 > low and rect.x0 < high and over <= OVERHANG * (rect.x1 - rect.x0) + 1e-9
 
 
 def _right_half_mirrored_first(count: int) -> list[bool]:
