@@ -527,6 +527,11 @@ def spec_text(
         first >= top or _over_copies(grid, copying)
         for (first, *_), grid in zip(margins_y, margined_grids, strict=True)
     ]
+    # under or on a top floor that repeats upwards in its columns: it keeps its margin to
+    # the ground (a part whose floors end lower repeats too, so the lowest copied floor's
+    # end is no line for the façade: cmp_b0001's windows under the top floor in their
+    # columns moved up with the roof, over that floor's copies)
+    below = [_under_copies(grid, copying) for grid in margined_grids]
     if stacked:
         # over floors a shorter façade drops (an attic, a lower top floor), a layer
         # keeps its margin to the roof and its elements their size both ways: it moves
@@ -538,11 +543,11 @@ def spec_text(
                 repeated.update(shown)
     margined.update(
         bottom
-        if floors is None and copied_to and last < over
+        if floors is None and copied_to and (last < over or low)
         else high
         if up and last >= copies
         else bottom
-        for (_, last, bottom, high), up in zip(margins_y, aloft, strict=True)
+        for (_, last, bottom, high), up, low in zip(margins_y, aloft, below, strict=True)
     )
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
@@ -856,6 +861,13 @@ def _over_copies(grid: Grid, copying: list[Grid]) -> bool:
     upwards (``copying``), in a column of its: their copies would run into it, so it
     keeps its margin to the roof."""
     return any(over(grid, top) and grid.rows[0][0] >= top.rows[-1][1] - 1e-9 for top in copying)
+
+
+def _under_copies(grid: Grid, copying: list[Grid]) -> bool:
+    """Whether ``grid``'s top row starts under the end of one of the openings' top floors
+    that repeat upwards (``copying``), in a column of its: it stands under that floor or
+    on it, and keeps its margin to the ground as the floor does."""
+    return any(over(grid, top) and grid.rows[-1][0] < top.rows[-1][1] for top in copying)
 
 
 def _deepest(stacked: dict[int, Stack]) -> dict[float, int]:
