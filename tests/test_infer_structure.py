@@ -817,3 +817,71 @@ def test_windows_and_blinds_on_stacks_from_unlike_floors_solve_at_every_height(
             any(abs(b.x0 - w.x1) < 0.03 and abs(b.y0 - w.y0) < 0.03 for w in windows)
             for b in blinds
         )
+
+
+SHIFTS = (0.0, 0.2, 0.4, 0.1, 0.3)  # m: each floor's columns off the others' (by floor)
+
+
+def _attic_over_the_middle(path: Path, seed: int) -> Path:
+    """An end column of windows (1.0 x 1.4 m) each side with five floors at a pitch of
+    2.6 m, 0.3 m higher than the middle's floors; between them three columns of wider
+    windows (1.2 x 1.4 m, with sills) with three floors at that pitch, and between
+    those, narrow columns of small windows (0.6 x 0.7 m) on every floor; over the middle
+    part, an attic row of small windows over every wide and narrow column, like the
+    narrow ones. Every floor's columns are
+    shifted from the others' (each floor a layer, no run of floors: ``_floors_apart``),
+    every height jittered by up to 3% and every edge by up to 1 cm (cmp_b0008's shape)."""
+    rng = random.Random(seed)
+    rects = []
+
+    def window(cx: float, y0: float, width: float, height: float, sill: bool = False) -> None:
+        cx += SHIFTS[round((y0 - 1.5) / PITCH_Y)] + rng.uniform(-0.01, 0.01)
+        y0 += rng.uniform(-0.01, 0.01)
+        y1 = y0 + height * (1 + rng.uniform(-0.03, 0.03))
+        x0, x1 = cx - width / 2, cx + width / 2
+        rects.append({"label": "window", "x0": x0, "y0": y0, "x1": x1, "y1": y1})
+        if sill:
+            rects.append(
+                {"label": "sill", "x0": x0 - 0.1, "y0": y0 - 0.2, "x1": x1 + 0.1, "y1": y0}
+            )
+
+    for f in range(5):
+        for cx in (1.0, 14.0):
+            window(cx, 1.8 + f * PITCH_Y, 1.0, 1.4)
+    for f in range(3):
+        for cx in (4.0, 7.5, 11.0):
+            window(cx, 1.5 + f * PITCH_Y, 1.2, 1.4, sill=True)
+        for cx in (5.75, 9.25):
+            window(cx, 2.0 + f * PITCH_Y, 0.6, 0.7)
+    for cx in (4.0, 5.75, 7.5, 9.25, 11.0):
+        window(cx, 2.0 + 3 * PITCH_Y, 0.6, 0.7)
+    path.write_text(json.dumps({"canvas": {"width": WIDTH, "height": 15.0}, "rects": rects}))
+    return path
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_a_middle_part_under_an_attic_row_gains_floors_beside_taller_ends(
+    tmp_path: Path, seed: int
+) -> None:
+    """1.5 times as tall, a façade whose end columns have more floors than its middle
+    part, under whose top floor an attic row of small windows stands, gains the whole
+    floors that fit in the middle too, at the pitch, with their sills; the attic row
+    stays one row over them, none over another. Before, the middle's top floor was no
+    top floor (the ends' windows like it stand higher), and the attic row repeated
+    upwards instead, over the wide columns (cmp_b0008: density 0.81 of the input's)."""
+    path = _attic_over_the_middle(tmp_path / "attic.json", seed)
+    rects = _solved(path, WIDTH, 15.0 * 1.5)
+    windows = _of(rects, "window")
+    assert _overlapping(windows) == 0
+    gained = int(7.5 / PITCH_Y)  # the floors that fit in 7.5 m
+    for wide, drawn in ((1.2, 3), (1.0, 5)):
+        column = [r for r in windows if abs(r.x1 - r.x0 - wide) < 0.05 and r.y1 - r.y0 > 1.2]
+        rows = sorted({round(r.y0, 1) for r in column})
+        assert len(rows) == drawn + gained
+        gains = itertools.pairwise(rows[drawn - 1 :])  # from the top floor as drawn
+        assert all(b - a == pytest.approx(PITCH_Y, abs=0.06) for a, b in gains)
+    small = [r for r in windows if r.y1 - r.y0 < 0.9]
+    top_wide = max(r.y1 for r in windows if abs(r.x1 - r.x0 - 1.2) < 0.05)
+    assert len([r for r in small if r.y0 > top_wide]) == 5  # the attic row, once
+    sills = _of(rects, "sill")
+    assert len(sills) == 3 * (3 + gained)

@@ -259,19 +259,21 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
         if any(
             row[0] >= high - 1e-9 and abs(row[1] - row[0] - size) <= FLOOR * size
             for g in mine
-            if grid.label in OPENINGS or g is grid or _over(g, grid)
+            if g is grid or over(g, grid)
             for row in g.rows
         ):
             continue  # not the top floor: one of its label like it stands above it
         rows = [
             row
             for g in mine
-            if g is grid or _over(g, grid)
+            if g is grid or over(g, grid)
             for row in g.rows
             if row[1] <= low + 1e-9
         ]
         under[k] = [row[0] for row in rows]
         below = [row[0] for row in rows if abs(row[1] - row[0] - size) <= FLOOR * size]
+        if grid.label in OPENINGS and not _like_under(mine, grid):
+            continue  # a column of it over no floor like it: a row of its own (an attic's)
         if below and low - max(below) <= STOREY * height:
             out[k] = low - max(below)
     measured = [out[k] for k in out if found[k].label in OPENINGS]
@@ -301,7 +303,7 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
                 for o, pitch in copied.items()
                 if high - low < pitch
                 and found[o].rows[-1][0] - pitch / 2 <= low <= found[o].rows[-1][1]
-                and _over(found[o], found[k], NEAR)
+                and over(found[o], found[k], NEAR)
                 and any(abs(low - start - pitch) <= FLOOR * pitch for start in under[k])
             ),
             None,
@@ -309,6 +311,39 @@ def top_floors(found: list[Grid], width: float, height: float) -> dict[int, floa
 
     others = {k: stands_on(k) for k in under if found[k].label not in OPENINGS}
     return {**copied, **{k: pitch for k, pitch in others.items() if pitch is not None}}
+
+
+def _like_under(mine: list[Grid], grid: Grid) -> bool:
+    """Whether under ``grid``'s top row, and under every element of its label on that row
+    (like it, starting within ``FLOOR`` of its height: one floor drawn in several grids),
+    the elements of its label in that element's column are like it, or one of them is:
+    a floor that repeats across the façade (a column over a door, with none of its label
+    under it, stands on none). A row of small windows over columns of taller ones
+    (cmp_b0008's inner part: an attic's row) is no top floor, in any of its grids, and
+    the taller windows' own top floor under it repeats instead."""
+    low, high = grid.rows[-1]
+    size = high - low
+
+    def like(row: Span) -> bool:
+        return abs(row[1] - row[0] - size) <= FLOOR * size
+
+    on_row = [
+        column
+        for g in mine
+        if any(like(row) and abs(row[0] - low) <= FLOOR * size for row in g.rows)
+        for column in g.columns
+    ]
+    under = [
+        [
+            row
+            for g in mine
+            if any(_overlap(column, c) for c in g.columns)
+            for row in g.rows
+            if row[1] <= low + 1e-9
+        ]
+        for column in on_row
+    ]
+    return all(not rows or any(like(row) for row in rows) for rows in under)
 
 
 def _clear_above(found: list[Grid], grid: Grid) -> bool:
@@ -319,7 +354,7 @@ def _clear_above(found: list[Grid], grid: Grid) -> bool:
     apart)."""
     top = grid.rows[-1][1]
     return not any(
-        g.label in OPENINGS and g is not grid and _over(g, grid) and g.rows[-1][1] > top + 1e-9
+        g.label in OPENINGS and g is not grid and over(g, grid) and g.rows[-1][1] > top + 1e-9
         for g in found
     )
 
@@ -343,7 +378,7 @@ def _nearest(pitch: float, pitches: list[float]) -> float:
     return min(pitches, key=lambda p: abs(p - pitch))
 
 
-def _over(a: Grid, b: Grid, reach: float = 0.0) -> bool:
+def over(a: Grid, b: Grid, reach: float = 0.0) -> bool:
     """Whether a column of ``a`` overlaps one of ``b`` (grown by ``reach`` either side)."""
     return any(_overlap(c, (d[0] - reach, d[1] + reach)) for c in a.columns for d in b.columns)
 
@@ -406,7 +441,7 @@ def stacks(found: list[Grid], tops: dict[int, float], height: float) -> dict[int
                 (m, row)
                 for m, other in enumerate(found)
                 if m not in out
-                and (m == k or (m not in tops and len(other.rows) == 1 and _over(other, grid)))
+                and (m == k or (m not in tops and len(other.rows) == 1 and over(other, grid)))
                 and other.label == grid.label
                 for row in other.rows
                 if abs(row[0] - at) <= FLOOR_PITCH * pitch

@@ -75,6 +75,7 @@ from facadecli.infer.layers import (
     Span,
     Stack,
     frames,
+    over,
     stacks,
     top_floors,
     uncovered,
@@ -348,8 +349,10 @@ def spec_text(
     # start, the margins) and where the top floors that repeat upwards start
     margins_y: list[tuple[float, float, str, str]] = []
     over_y: list[list[str]] = []  # the elements of each of those layers
+    margined_grids: list[Grid] = []  # and their grids
     copied_from: list[float] = []
     copied_to: list[float] = []  # where the top floors that repeat upwards end
+    copying: list[Grid] = []  # the openings' top floors that repeat upwards
     for index, (layer, grid, frame) in enumerate(zip(names, found, framed, strict=True)):
         symbols = (widths[index], elements[grid.label][1])
         columns = grid.columns if frame is None else tuple(c for c, _ in frame)
@@ -445,6 +448,7 @@ def spec_text(
                     copied_from.append(grid.rows[-1][0])
                     if grid.label in OPENINGS:
                         copied_to.append(grid.rows[-1][1])
+                        copying.append(grid)
                 held.update(steady)
                 repeated.update(shown)
                 roofs.add(roof)
@@ -460,6 +464,7 @@ def spec_text(
                 copied_from.append(grid.rows[-1][0])
                 if grid.label in OPENINGS:
                     copied_to.append(grid.rows[-1][1])
+                    copying.append(grid)
                 held.update((tokens[0][0], gap))
                 # the copies are whole floors, and the floors under them stay as drawn:
                 # their elements keep their size (free, the solver shrank cmp_b0010's
@@ -479,6 +484,7 @@ def spec_text(
                 bottom, high = tokens[0][0], tokens[-1][0]
                 if bottom != high:
                     margins_y.append((grid.rows[0][0], grid.rows[-1][0], bottom, high))
+                    margined_grids.append(grid)
                     over_y.append([s for s, _ in tokens if s in symbols[1].sizes.values()])
             elif axis == "y" and tokens[-1][0] in ends and tokens[0][0] not in ends:
                 grounded.update(symbol for symbol, _ in tokens[:-1])  # a door keeps its height
@@ -514,22 +520,34 @@ def spec_text(
     # clear of them
     copies = min(copied_from, default=top)
     over = min(copied_to, default=float("inf"))
+    # over the floors: over the openings' floors, or wholly over a top floor that repeats
+    # upwards in its columns (an attic's row over a part of the façade whose floors end
+    # lower than the others': cmp_b0008's middle, whose copies ran into it)
+    aloft = [
+        first >= top or _over_copies(grid, copying)
+        for (first, *_), grid in zip(margins_y, margined_grids, strict=True)
+    ]
+    # under or on a top floor that repeats upwards in its columns: it keeps its margin to
+    # the ground (a part whose floors end lower repeats too, so the lowest copied floor's
+    # end is no line for the façade: cmp_b0001's windows under the top floor in their
+    # columns moved up with the roof, over that floor's copies)
+    below = [_under_copies(grid, copying) for grid in margined_grids]
     if stacked:
         # over floors a shorter façade drops (an attic, a lower top floor), a layer
         # keeps its margin to the roof and its elements their size both ways: it moves
         # down with the roof into the height the floors dropped leave (free, the solver
         # squeezed a lower top floor's windows to nothing instead)
-        for (first, last, _, high), shown in zip(margins_y, over_y, strict=True):
-            if first >= top and last >= copies:
+        for (_, last, _, high), shown, up in zip(margins_y, over_y, aloft, strict=True):
+            if up and last >= copies:
                 held.add(high)
                 repeated.update(shown)
     margined.update(
         bottom
-        if floors is None and copied_to and last < over
+        if floors is None and copied_to and (last < over or low)
         else high
-        if first >= top and last >= copies
+        if up and last >= copies
         else bottom
-        for first, last, bottom, high in margins_y
+        for (_, last, bottom, high), up, low in zip(margins_y, aloft, below, strict=True)
     )
     out = [
         f"# Inferred by `facade infer` from {source}: a wall and {len(layers)} layers, each",
@@ -840,6 +858,20 @@ def _stacked(found: list[Grid], stacked: dict[int, Stack]) -> dict[int, Stack]:
         if k not in stacked and grid.rows[-1][1] > bottom + 1e-9 and grid.rows[0][0] < over:
             return {}
     return stacked
+
+
+def _over_copies(grid: Grid, copying: list[Grid]) -> bool:
+    """Whether ``grid`` stands wholly over one of the openings' top floors that repeat
+    upwards (``copying``), in a column of its: their copies would run into it, so it
+    keeps its margin to the roof."""
+    return any(over(grid, top) and grid.rows[0][0] >= top.rows[-1][1] - 1e-9 for top in copying)
+
+
+def _under_copies(grid: Grid, copying: list[Grid]) -> bool:
+    """Whether ``grid``'s top row starts under the end of one of the openings' top floors
+    that repeat upwards (``copying``), in a column of its: it stands under that floor or
+    on it, and keeps its margin to the ground as the floor does."""
+    return any(over(grid, top) and grid.rows[-1][0] < top.rows[-1][1] for top in copying)
 
 
 def _deepest(stacked: dict[int, Stack]) -> dict[float, int]:
