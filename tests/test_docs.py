@@ -144,10 +144,12 @@ class SharedRuns:
     """``facade`` commands run in a fresh process each, the outputs of those that read only
     the repository's samples and specs kept (in ``store``): the README and the guides run
     the same ``facade city samples/...`` commands (6-8 CPU-s each), so a command seen
-    before copies the files its first run wrote to its own ``-o`` target, and answers
-    with its first run's exit code and output. Same command, same inputs, same bytes (the
-    project's rule; ``facade city`` into another folder writes the same files, the
-    report's timings aside), so each page is still checked in order, step by step."""
+    before gets the files its first run wrote, and answers with its first run's exit code
+    and output. A folder target is copied whole (under any name); a file target with the
+    files its run wrote beside it (``facade infer``'s report), under the same name. Same
+    command, same inputs, same bytes (the project's rule; ``facade city`` into another
+    folder writes the same files, the report's timings aside), so each page is still
+    checked in order, step by step."""
 
     def __init__(self, store: Path) -> None:
         self.store = store
@@ -156,17 +158,40 @@ class SharedRuns:
     def run(self, words: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
         """``facade WORDS`` run in ``cwd`` (or its first run's outputs copied)."""
         key = shared_key(words, cwd)
-        if key is not None and key in self.runs:
-            first, output, kept = self.runs[key]
-            target = words[key.index("<output>")]
-            (cwd / target).parent.mkdir(parents=True, exist_ok=True)
-            if kept.is_dir():
-                shutil.copytree(kept, cwd / target)
-            else:
-                shutil.copy2(kept, cwd / target)
-            said, err = (text.replace(output, target) for text in (first.stdout, first.stderr))
-            return subprocess.CompletedProcess(words, first.returncode, said, err)
-        done = subprocess.run(
+        if key is None:
+            return self._run(words, cwd)
+        output = words[key.index("<output>")]
+        target = cwd / output
+        if key in self.runs:
+            first, said_as, kept = self.runs[key]
+            whole = kept.name == "folder"
+            if whole or target.name == Path(said_as).name:
+                if whole:
+                    _copy(kept, target)
+                else:
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    for made in kept.iterdir():
+                        _copy(made, target.parent / made.name)
+                said, err = (t.replace(said_as, output) for t in (first.stdout, first.stderr))
+                return subprocess.CompletedProcess(words, first.returncode, said, err)
+        there = {p.name for p in target.parent.iterdir()} if target.parent.is_dir() else set()
+        done = self._run(words, cwd)
+        if done.returncode != 0 or not target.exists():
+            return done
+        kept = self.store / str(len(self.runs)) / ("folder" if target.is_dir() else "beside")
+        if target.is_dir():
+            _copy(target, kept)
+        else:  # the file and what its run wrote beside it
+            kept.mkdir(parents=True)
+            for made in target.parent.iterdir():
+                if made.name not in there:
+                    _copy(made, kept / made.name)
+        self.runs[key] = (done, output, kept)
+        return done
+
+    @staticmethod
+    def _run(words: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
             [sys.executable, "-m", "facadecli", *words],
             cwd=cwd,
             env=FACADE_ENV,
@@ -174,18 +199,14 @@ class SharedRuns:
             text=True,
             timeout=600,
         )
-        if key is not None and done.returncode == 0:
-            output = words[key.index("<output>")]
-            kept = self.store / str(len(self.runs)) / Path(output).name
-            kept.parent.mkdir(parents=True)
-            if (cwd / output).is_dir():
-                shutil.copytree(cwd / output, kept)
-            elif (cwd / output).exists():
-                shutil.copy2(cwd / output, kept)
-            else:  # it wrote elsewhere: not shared
-                return done
-            self.runs[key] = (done, output, kept)
-        return done
+
+
+def _copy(made: Path, to: Path) -> None:
+    """A file or a folder copied to ``to``."""
+    if made.is_dir():
+        shutil.copytree(made, to)
+    else:
+        shutil.copy2(made, to)
 
 
 @pytest.fixture(scope="module")
@@ -201,13 +222,16 @@ def test_a_command_run_before_copies_its_first_runs_outputs(
     its first run, its exit code and its output (the folder's name changed), and starts
     no process; one reading a file of the guide's or writing into an existing folder is
     never shared."""
-    (tmp_path / "specs").symlink_to(ROOT / "specs")
+    for name in ("specs", "samples"):
+        (tmp_path / name).symlink_to(ROOT / name)
     (tmp_path / "store").mkdir()
     runs = SharedRuns(tmp_path / "store")
     solve = ["solve", "specs/townhouse.yaml", "-f", "svg,json", "-o"]
     first = runs.run([*solve, "out/first"], tmp_path)
     assert first.returncode == 0, first.stderr
     assert "out/first/townhouse.svg" in first.stdout
+    infer = ["infer", "samples/five-bays.xml", "--size", "15x12", "-o"]
+    assert runs.run([*infer, "a/five-bays.yaml"], tmp_path).returncode == 0
 
     def no_process(*args: object, **kwargs: object) -> None:
         raise AssertionError("a command run again started a process")
@@ -221,6 +245,10 @@ def test_a_command_run_before_copies_its_first_runs_outputs(
         (tmp_path / "again" / name).read_bytes() == (tmp_path / "out/first" / name).read_bytes()
         for name in written
     )
+    # a file target: the files its run wrote beside it too (infer's report), same name
+    assert runs.run([*infer, "b/five-bays.yaml"], tmp_path).returncode == 0
+    beside = sorted(p.name for p in (tmp_path / "a").iterdir())
+    assert beside == sorted(p.name for p in (tmp_path / "b").iterdir()) and len(beside) == 2
     (tmp_path / "house.yaml").write_text("")
     assert shared_key(["solve", "house.yaml", "-o", "mine"], tmp_path) is None
     assert shared_key([*solve, "again"], tmp_path) is None  # there: a city would resume
