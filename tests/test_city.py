@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,8 @@ from shapely.geometry.polygon import orient
 from facadecli import SpecError
 from facadecli.city.demo import district, write_demo
 from facadecli.city.footprints import read_footprints
-from facadecli.city.manifest import Roof, load_city
+from facadecli.city.manifest import City, Roof, load_city
+from facadecli.city.report import CityReport
 from facadecli.city.roofs import roof_meshes
 from facadecli.city.run import axes_solved_while_building, run_city, safe_name
 from facadecli.city.s3db import tagged_heights, volume
@@ -132,11 +134,22 @@ def _seen_colour(material: trimesh.visual.material.PBRMaterial) -> np.ndarray:
     return colour
 
 
-def test_a_small_city_builds_and_resumes(tmp_path: Path) -> None:
-    manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
-    city = load_city(manifest)
+@pytest.fixture(scope="module")
+def one_block(tmp_path_factory: pytest.TempPathFactory) -> tuple[City, Path, CityReport]:
+    """The demo district of one block built by two local processes: the city, its outputs'
+    folder and the report. The build the test below resumes (in a copy) and the local run
+    a Dask cluster's files are compared with: one build for both (each built it)."""
+    folder = tmp_path_factory.mktemp("one-block")
+    city = load_city(write_demo(folder / "city", ROOT / "specs", blocks=1))
+    return city, folder / "local", run_city(city, folder / "local", jobs=2)
+
+
+def test_a_small_city_builds_and_resumes(
+    tmp_path: Path, one_block: tuple[City, Path, CityReport]
+) -> None:
+    city, local, report = one_block
     out = tmp_path / "out"
-    report = run_city(city, out, jobs=2)
+    shutil.copytree(local, out)  # resumed here: the module's build stays as it was made
     assert report["summary"] == {**report["summary"], "buildings": 4, "ok": 4, "failed": 0}
     merged = trimesh.load(out / "demo-district.glb", force="scene")
     assert len(list((out / "buildings").glob("*/*.glb"))) == 4  # in their shards
@@ -180,32 +193,30 @@ def test_the_demo_district_is_deterministic() -> None:
     assert len(district(2)["features"]) == 16  # type: ignore[arg-type]
 
 
-def test_a_dask_cluster_gives_the_same_files_as_local_processes(tmp_path: Path) -> None:
+def test_a_dask_cluster_gives_the_same_files_as_local_processes(
+    tmp_path: Path, one_block: tuple[City, Path, CityReport]
+) -> None:
     from distributed import Client
 
     from tests.dask_cluster import two_workers
 
-    manifest = write_demo(tmp_path / "city", ROOT / "specs", blocks=1)
-    city = load_city(manifest)
-    run_city(city, tmp_path / "local", jobs=2)
+    city, local, _ = one_block
     with two_workers() as cluster:
         report = run_city(city, tmp_path / "dask", scheduler=cluster.scheduler_address)
         with Client(cluster) as client:  # the axes came solved ahead: none while building
             assert list(client.run(axes_solved_while_building).values()) == [0, 0]
     assert report["summary"]["ok"] == 4
     assert all(b["facades"] >= 4 for b in report["buildings"])  # they needed axes
-    local = sorted(p.relative_to(tmp_path / "local") for p in (tmp_path / "local").rglob("*.glb"))
-    assert local == sorted(
+    built = sorted(p.relative_to(local) for p in local.rglob("*.glb"))
+    assert built == sorted(
         p.relative_to(tmp_path / "dask") for p in (tmp_path / "dask").rglob("*.glb")
     )
-    pictures = sorted(
-        p.relative_to(tmp_path / "local") for p in (tmp_path / "local").rglob("*.png")
-    )
+    pictures = sorted(p.relative_to(local) for p in local.rglob("*.png"))
     assert pictures == sorted(
         p.relative_to(tmp_path / "dask") for p in (tmp_path / "dask").rglob("*.png")
     )
-    for path in local + pictures:
-        assert (tmp_path / "local" / path).read_bytes() == (tmp_path / "dask" / path).read_bytes()
+    for path in built + pictures:
+        assert (local / path).read_bytes() == (tmp_path / "dask" / path).read_bytes()
 
 
 AWKWARD = {

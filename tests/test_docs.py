@@ -18,6 +18,7 @@ import importlib.util
 import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -115,51 +116,180 @@ def test_readme_has_a_tour() -> None:
     assert {"validate", "solve", "vary", "city"} <= verbs, verbs
 
 
-def run_facade(command: str, out: Path) -> subprocess.CompletedProcess[str]:
+FACADE_ENV = {
+    **os.environ,
+    "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
+}
+SHARED = ("samples/", "specs/")  # the repository's inputs, the same for every page
+OUTPUT = ("-o", "--output")
+
+
+def shared_key(words: list[str], cwd: Path) -> tuple[str, ...] | None:
+    """``facade WORDS`` run in ``cwd`` as a key its outputs can be shared under: the words
+    with the output's replaced by ``-o``'s marker, when the command reads only the
+    repository's samples/ and specs/ (every word naming a file or folder in ``cwd``
+    starts with one of them) and writes one ``-o`` target not there yet. None for any
+    other command (one reading what a guide created or wrote before, or writing into an
+    earlier run's folder, which ``facade city`` would resume)."""
+    targets = [k + 1 for k, word in enumerate(words[:-1]) if word in OUTPUT]
+    if len(targets) != 1 or (cwd / words[targets[0]]).exists():
+        return None
+    read = [w for k, w in enumerate(words) if k != targets[0] and not w.startswith("-")]
+    if any((cwd / w).exists() and not w.startswith(SHARED) for w in read):
+        return None
+    return tuple("<output>" if k == targets[0] else w for k, w in enumerate(words))
+
+
+class SharedRuns:
+    """``facade`` commands run in a fresh process each, the outputs of those that read only
+    the repository's samples and specs kept (in ``store``): the README and the guides run
+    the same ``facade city samples/...`` commands (6-8 CPU-s each), so a command seen
+    before gets the files its first run wrote, and answers with its first run's exit code
+    and output. A folder target is copied whole (under any name); a file target with the
+    files its run wrote beside it (``facade infer``'s report), under the same name. Same
+    command, same inputs, same bytes (the project's rule; ``facade city`` into another
+    folder writes the same files, the report's timings aside), so each page is still
+    checked in order, step by step."""
+
+    def __init__(self, store: Path) -> None:
+        self.store = store
+        self.runs: dict[tuple[str, ...], tuple[subprocess.CompletedProcess[str], str, Path]] = {}
+
+    def run(self, words: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
+        """``facade WORDS`` run in ``cwd`` (or its first run's outputs copied)."""
+        key = shared_key(words, cwd)
+        if key is None:
+            return self._run(words, cwd)
+        output = words[key.index("<output>")]
+        target = cwd / output
+        if key in self.runs:
+            first, said_as, kept = self.runs[key]
+            whole = kept.name == "folder"
+            if whole or target.name == Path(said_as).name:
+                if whole:
+                    _copy(kept, target)
+                else:
+                    target.parent.mkdir(parents=True, exist_ok=True)
+                    for made in kept.iterdir():
+                        _copy(made, target.parent / made.name)
+                said, err = (t.replace(said_as, output) for t in (first.stdout, first.stderr))
+                return subprocess.CompletedProcess(words, first.returncode, said, err)
+        there = {p.name for p in target.parent.iterdir()} if target.parent.is_dir() else set()
+        done = self._run(words, cwd)
+        if done.returncode != 0 or not target.exists():
+            return done
+        kept = self.store / str(len(self.runs)) / ("folder" if target.is_dir() else "beside")
+        if target.is_dir():
+            _copy(target, kept)
+        else:  # the file and what its run wrote beside it
+            kept.mkdir(parents=True)
+            for made in target.parent.iterdir():
+                if made.name not in there:
+                    _copy(made, kept / made.name)
+        self.runs[key] = (done, output, kept)
+        return done
+
+    @staticmethod
+    def _run(words: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [sys.executable, "-m", "facadecli", *words],
+            cwd=cwd,
+            env=FACADE_ENV,
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
+
+
+def _copy(made: Path, to: Path) -> None:
+    """A file or a folder copied to ``to``."""
+    if made.is_dir():
+        shutil.copytree(made, to)
+    else:
+        shutil.copy2(made, to)
+
+
+@pytest.fixture(scope="module")
+def facade_runs(tmp_path_factory: pytest.TempPathFactory) -> SharedRuns:
+    """The module's commands, the outputs of the shared ones kept (:class:`SharedRuns`)."""
+    return SharedRuns(tmp_path_factory.mktemp("shared-runs"))
+
+
+def test_a_command_run_before_copies_its_first_runs_outputs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A command of the repository's specs run again into another folder gets the files of
+    its first run, its exit code and its output (the folder's name changed), and starts
+    no process; one reading a file of the guide's or writing into an existing folder is
+    never shared."""
+    for name in ("specs", "samples"):
+        (tmp_path / name).symlink_to(ROOT / name)
+    (tmp_path / "store").mkdir()
+    runs = SharedRuns(tmp_path / "store")
+    solve = ["solve", "specs/townhouse.yaml", "-f", "svg,json", "-o"]
+    first = runs.run([*solve, "out/first"], tmp_path)
+    assert first.returncode == 0, first.stderr
+    assert "out/first/townhouse.svg" in first.stdout
+    infer = ["infer", "samples/five-bays.xml", "--size", "15x12", "-o"]
+    assert runs.run([*infer, "a/five-bays.yaml"], tmp_path).returncode == 0
+
+    def no_process(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a command run again started a process")
+
+    monkeypatch.setattr(subprocess, "run", no_process)
+    again = runs.run([*solve, "again"], tmp_path)
+    assert again.returncode == 0 and again.stdout == first.stdout.replace("out/first", "again")
+    written = sorted(p.name for p in (tmp_path / "out" / "first").iterdir())
+    assert written == sorted(p.name for p in (tmp_path / "again").iterdir())
+    assert written and all(
+        (tmp_path / "again" / name).read_bytes() == (tmp_path / "out/first" / name).read_bytes()
+        for name in written
+    )
+    # a file target: the files its run wrote beside it too (infer's report), same name
+    assert runs.run([*infer, "b/five-bays.yaml"], tmp_path).returncode == 0
+    beside = sorted(p.name for p in (tmp_path / "a").iterdir())
+    assert beside == sorted(p.name for p in (tmp_path / "b").iterdir()) and len(beside) == 2
+    (tmp_path / "house.yaml").write_text("")
+    assert shared_key(["solve", "house.yaml", "-o", "mine"], tmp_path) is None
+    assert shared_key([*solve, "again"], tmp_path) is None  # there: a city would resume
+    assert shared_key(["city", "specs/x.yaml", "-o", "a", "-o", "b"], tmp_path) is None
+    assert shared_key([*solve, "new"], tmp_path) == (*solve, "<output>")
+
+
+def run_facade(command: str, out: Path, runs: SharedRuns) -> subprocess.CompletedProcess[str]:
     """Run a README command from the root, its out/... paths moved into ``out``."""
     words = [re.sub(r"^out(?=/|$)", str(out), w) for w in shlex.split(command)]
     assert words[0] == "facade"
-    env = {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
-    }
-    return subprocess.run(
-        [sys.executable, "-m", "facadecli", *words[1:]],
-        cwd=ROOT,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
+    return runs.run(words[1:], ROOT)
 
 
 @pytest.mark.parametrize("command", [c for c in COMMANDS if shlex.split(c)[1] in FAST])
-def test_readme_fast_commands_run(command: str, tmp_path: Path) -> None:
-    done = run_facade(command, tmp_path / "out")
+def test_readme_fast_commands_run(command: str, tmp_path: Path, facade_runs: SharedRuns) -> None:
+    done = run_facade(command, tmp_path / "out", facade_runs)
     assert done.returncode == 0, f"{command}\n{done.stdout}\n{done.stderr}"
 
 
 @pytest.mark.slow
-def test_readme_commands_run_in_order(tmp_path: Path) -> None:
+def test_readme_commands_run_in_order(tmp_path: Path, facade_runs: SharedRuns) -> None:
     """The README's other commands, in order: `facade view out/vary` needs the vary before
     it. Its solves and validate each run in a test of their own above, and no command after
     them reads what they write."""
     for command in (c for c in COMMANDS if shlex.split(c)[1] not in FAST):
-        done = run_facade(command, tmp_path / "out")
+        done = run_facade(command, tmp_path / "out", facade_runs)
         assert done.returncode == 0, f"{command}\n{done.stdout}\n{done.stderr}"
     assert (tmp_path / "out" / "vary" / "index.html").is_file()
     assert (tmp_path / "out" / "town" / "town.glb").is_file()
 
 
 @pytest.mark.slow
-def test_samples_run(tmp_path: Path) -> None:
+def test_samples_run(tmp_path: Path, facade_runs: SharedRuns) -> None:
     for command in (
         "facade grammar samples/five-bays.xml --size 15x12 -o out/grammar",
         "facade grammar samples/five-bays.json -o out/grammar-json --derive 21x12 -f svg",
         "facade infer samples/five-bays.xml --size 15x12 -o out/infer/five-bays.yaml",
         "facade city samples/town.yaml -o out/town -j 1",
     ):
-        done = run_facade(command, tmp_path / "out")
+        done = run_facade(command, tmp_path / "out", facade_runs)
         assert done.returncode == 0, f"{command}\n{done.stdout}\n{done.stderr}"
     assert (tmp_path / "out" / "grammar" / "five-bays.grammar.txt").is_file()
     assert (tmp_path / "out" / "infer" / "five-bays.yaml").is_file()
@@ -234,16 +364,12 @@ def guide_steps(page: Path) -> list[tuple[str, str]]:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("page", GUIDES, ids=lambda p: str(p.relative_to(ROOT)))
-def test_guides_commands_run_in_order(page: Path, tmp_path: Path) -> None:
+def test_guides_commands_run_in_order(page: Path, tmp_path: Path, facade_runs: SharedRuns) -> None:
     """Every ``facade`` command of a guide (or the CLI reference, or the home page) runs
     as written, in order, in a folder holding the repository's specs/ and samples/ and
     the files the page asks the reader to create."""
     for name in ("specs", "samples"):
         (tmp_path / name).symlink_to(ROOT / name)
-    env = {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])),
-    }
     for kind, text in guide_steps(page):
         if kind == "file":
             name, _, body = text.partition("\n")
@@ -253,12 +379,5 @@ def test_guides_commands_run_in_order(page: Path, tmp_path: Path) -> None:
         for word in shlex.split(text)[1:]:
             matched = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.glob(word))
             words += matched if "*" in word and matched else [word]
-        done = subprocess.run(
-            [sys.executable, "-m", "facadecli", *words],
-            cwd=tmp_path,
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=600,
-        )
+        done = facade_runs.run(words, tmp_path)
         assert done.returncode == 0, f"{page.name}: {text}\n{done.stdout}\n{done.stderr}"

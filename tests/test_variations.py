@@ -147,9 +147,11 @@ def test_variations_are_deterministic_per_seed_and_seeds_differ(tmp_path: Path) 
     def drawn(seed: int) -> list[list[Box]]:
         return [_boxes(v.layout) for v in _draw(extraction, (16.0, 17.0), 3, seed)]
 
-    assert drawn(1) == drawn(1)
-    assert len({str(drawn(seed)) for seed in range(6)}) > 1
-    assert all(d[0] == drawn(0)[0] for d in map(drawn, range(3)))  # the best fit is fixed
+    first = drawn(1)
+    assert drawn(1) == first
+    seeds = [first if seed == 1 else drawn(seed) for seed in range(6)]  # each drawn once
+    assert len({str(boxes) for boxes in seeds}) > 1
+    assert all(boxes[0] == seeds[0][0] for boxes in seeds[:3])  # the best fit is fixed
 
 
 def test_symmetric_input_stays_symmetric_in_every_variation(tmp_path: Path) -> None:

@@ -343,14 +343,23 @@ def _mean_grey(shot: Path, box: tuple[float, float, float, float]) -> float:
         return float(ImageStat.Stat(grey.crop(tuple(round(edge) for edge in part))).mean[0])
 
 
+@pytest.fixture(scope="module")
+def pane_square_on(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """:data:`PANE_SPEC` seen square on (``?bare&view=0,0``): the screenshot and the DOM,
+    one load of the page for the two tests that read that picture (each loaded it)."""
+    return _shown(tmp_path_factory.mktemp("pane"), PANE_SPEC, "?bare&view=0,0")
+
+
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-def test_glass_reads_neither_black_nor_white_nor_as_the_wall(tmp_path: Path) -> None:
+def test_glass_reads_neither_black_nor_white_nor_as_the_wall(
+    pane_square_on: tuple[Path, str],
+) -> None:
     """A window seen square on, framed by the model's box (which fills the 1000 x 600
     screenshot, centred): its pane mirrors the sky and the street, so its mean grey lies
     in a band well inside 0..255 and apart from the wall's. Glass blended by its fallback
     alpha over a dark ground read about 37 (black); a pane as pale as the wall, or blown
     out, fails too."""
-    shot, dom = _shown(tmp_path, PANE_SPEC, "?bare&view=0,0")
+    shot, dom = pane_square_on
     assert "<title>pane</title>" in dom
     # the window spans 0.35..0.65 of the wall across and 0.25..0.75 up; the wall fills
     # 1/1.08 of the picture, so 0.42..0.58 of it is pane and 0.12..0.2 wall
@@ -398,7 +407,7 @@ def _pane_spread(shot: Path) -> float:
 
 
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-def test_a_pane_shows_the_room_behind_it(tmp_path: Path) -> None:
+def test_a_pane_shows_the_room_behind_it(tmp_path: Path, pane_square_on: tuple[Path, str]) -> None:
     """The window of :data:`PANE_SPEC` square on, behind it the dark recess (the built-in
     interior) and then a room of the library's ``rooms``: through the glass, the room's
     back wall (1.2 m back) lifts the pane's grey over the dark recess's. Mean grey over
@@ -408,12 +417,9 @@ def test_a_pane_shows_the_room_behind_it(tmp_path: Path) -> None:
     and 20.3; a room box seen square on shows its back wall, and the spread is the
     reflection's: 17.7 and 17.4.)"""
     with_room = PANE_SPEC.replace("materials:\n", "materials:\n  interior: {library: rooms}\n")
-    spreads = []
-    for name, text in (("dark", PANE_SPEC), ("room", with_room)):
-        (tmp_path / name).mkdir()
-        shot = _shown(tmp_path / name, text, "?bare&view=0,0")[0]
-        spreads.append(_mean_grey(shot, (0.38, 0.3, 0.62, 0.7)))
-    dark, room = spreads
+    assert "<title>pane</title>" in pane_square_on[1]
+    dark = _mean_grey(pane_square_on[0], (0.38, 0.3, 0.62, 0.7))
+    room = _mean_grey(_shown(tmp_path, with_room, "?bare&view=0,0")[0], (0.38, 0.3, 0.62, 0.7))
     assert room > dark + 15, (dark, room)
 
 
