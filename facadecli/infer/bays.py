@@ -1192,8 +1192,8 @@ def _gains(
     the façade's density: a façade of any width is filled at about its own. Nested, a
     copy is gained only where the units are kept: side by side (``A^k (wall A)^g``, a
     counter of units drawn several times) the solver dropped drawn units and gained wide
-    ones to fit a narrower façade in between (the generated ``doorway_family`` seed 2
-    at 0.7x: density 1.07 -> 0.71), so a run of several copies keeps its one counter;
+    ones to fit a narrower façade in between (``doorway_family`` seed 2, its columns
+    drawn alike, at 0.7x: density 1.07 -> 0.71), so a run of several copies keeps its one counter;
     and nested in the other gains' counters of units drawn once, so that none of those
     is dropped where copies are gained (CMP's b0001 at 0.7x dropped two columns on one
     counter and gained two wide copies of the third on its own: its columns lost). Not
