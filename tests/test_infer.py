@@ -194,8 +194,12 @@ def test_layers_on_the_same_columns_stay_aligned_at_other_widths(tmp_path: Path)
             )
             for label in ("window", "blind")
         }
-        # a narrower façade drops a bay of the run (windows and blinds alike)
-        assert len(spans["blind"]) >= 3 and set(spans["blind"]) <= set(spans["window"])
+        # a narrower façade drops bays (windows and blinds alike), never all of them: at
+        # 8 m (0.7x) the end bay, whose two columns the attic window over them made one
+        # bay, 3.5 m, what the façade loses (before copies no denser than the façade,
+        # ``bays._gains``, it dropped the attic bay too and copied a column at its drawn
+        # pitch: three columns left)
+        assert len(spans["blind"]) >= 2 and set(spans["blind"]) <= set(spans["window"])
 
 
 def test_a_runs_jittered_elements_are_one_size_kept_at_every_size(tmp_path: Path) -> None:

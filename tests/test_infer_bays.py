@@ -30,7 +30,7 @@ from facadecli.infer.run import infer, solved_layout
 from facadecli.infer.spec_text import _bay_counter_note, layer_names, spec_text
 from facadecli.infer.structure import structured
 from facadecli.solve import retarget
-from tests.benchmarks.annotated_family import cmp_xml, family, paired_family
+from tests.benchmarks.annotated_family import cmp_xml, doorway_family, family, paired_family
 
 NEAR = 0.15  # m: window centres this close are one column (1% of the façade)
 
@@ -740,6 +740,7 @@ def test_bays_drawn_once_solve_at_their_drawn_counts_at_1x(tmp_path: Path) -> No
         "bays1": 1,
         "bays2": 1,
         "bays3": 1,
+        "bays4": 0,  # the copies gained at the façade's density (``bays._gains``): none
     }
     assert _columns(list(solved_layout(layout, spec, inference).rects)) == _columns(raw)
     for share in (0.7, 2.0):
@@ -1065,3 +1066,39 @@ def test_the_counter_comment_names_which_end_bay_the_spare_copies() -> None:
     assert _bay_counter_note("bays4", 0, 1, spares, None).startswith("a copy of the first bay")
     assert _bay_counter_note("bays1", 2, 1, spares, None) == "2 end bays (they may drop)"
     assert _bay_counter_note("bays2", 3, None, spares, None) == "3 bays"
+
+
+@pytest.mark.parametrize("seed", [1, 11, 13])
+def test_copies_gained_are_no_denser_than_the_facade(tmp_path: Path, seed: int) -> None:
+    """Generated façades whose door stands in a bay of its own, no window over it
+    (``doorway_family``, as CMP's b0012): each column holds more windows a metre than
+    the façade, so a wider façade that gained columns at their drawn pitch grew denser
+    than drawn (before, at 1.5x / 2x: 1.11 / 1.33 on seed 1, 1.20 / 1.20 on seed 11,
+    1.00 / 1.25 on seed 13). The copies gained
+    are a counter of their own, each with the wall before it that puts it at the
+    façade's windows a metre (``bays._gains``): the windows a square metre stay within
+    0.85-1.15 of the drawing's, each window at a drawn size, one door; at 1x no copy is
+    gained and the drawn layout is kept."""
+    path = tmp_path / f"doorway-{seed}.xml"
+    boxes, known = doorway_family(seed)
+    path.write_text(cmp_xml(boxes))
+    inference = infer(path, path.stem, Options(size=(15.0, 15.0)))
+    spec = parse_spec(inference.text, path.stem)
+    gains = re.findall(r"(bays\d+): \{min: 0\}  # copies of the units of", inference.text)
+    assert gains, "no counter of copies gained at the façade's density"
+    assert all(solve(spec).counters[gain] == 0 for gain in gains)
+    drawn = [r for r in (inference.raw or inference.layout).rects if r.label == "window"]
+    assert len(drawn) == known.windows
+    sizes = [(r.x1 - r.x0, r.y1 - r.y0) for r in drawn]
+    for share in (1.5, 2.0):
+        rects = _solved(inference, spec, share)
+        windows = [r for r in rects if r.label == "window"]
+        assert 0.85 <= len(windows) / len(drawn) / share <= 1.15, (share, len(windows))
+        assert all(
+            any(
+                abs((r.x1 - r.x0) / w - 1) <= 0.15 and abs((r.y1 - r.y0) / h - 1) <= 0.15
+                for w, h in sizes
+            )
+            for r in windows
+        )
+        assert sum(r.label == "door" for r in rects) == 1

@@ -45,7 +45,11 @@ column of windows beside a narrow bay of one attic window), pairs side by side w
 openings are alike, so that the façade gains and drops a column with its narrow bay
 and keeps its windows a metre; where one counter holds every unit and drops more than
 ``1 - NARROWEST`` of the bays at once, a spare copy of the last unit (``_spare_unit``)
-lets them change one at a time. A sequence that reads the same mirrored is written
+lets them change one at a time. Where those units hold more windows a metre than the
+façade as a whole (its end bays, a door's bay or its margins hold fewer), the copies a
+wider façade gains are a counter of their own, nested in each unit, each with a wall
+before it that puts it at the façade's windows a metre (``_gains``). A sequence that
+reads the same mirrored is written
 as its left half, the middle and the half reflected (SPEC 2.2), so a wider façade
 gains bays on both sides alike.
 
@@ -127,6 +131,7 @@ ODD = 1  # openings: a bay this many unlike a kind's (each way) is a variant of 
 # companions: this many of a slot's may be resized past SIZED onto its row (``_apart``)
 OVERHANG = 0.1  # of its width: the most a wall's own element reaches over the openings beside it
 SIZED = 0.15  # of its size: the most a companion put on its slot's row may grow or shrink
+DENSE = 0.05  # of a unit's width: copies this much denser than the façade gain wall (``_gains``)
 FEW_BAYS = "fewer than two bays"  # why a façade of one bay (or none) has none to share
 
 Slot = tuple[str, float, float, float, float]  # label, centre x in the bay, width, y0, y1
@@ -148,6 +153,21 @@ class Run:
 
 
 @dataclass(frozen=True)
+class Gain:
+    """Copies of the units on counter ``drawn`` (each unit drawn once) gained at the
+    façade's density: each a unit with ``wall`` metres of wall before it, written after
+    its unit within its run (``(unit (wall unit)^counter)^drawn``: gained only where the
+    unit is kept) with counter ``counter`` (none as drawn, no most); ``drawn`` has a most
+    of one (it may drop its units, not copy them at their drawn pitch). The copies are
+    nested in each of ``guards`` too: gained only where no other such unit is dropped."""
+
+    drawn: str
+    counter: str
+    wall: float
+    guards: tuple[str, ...] = ()  # the other gains' drawn counters (``_gains``)
+
+
+@dataclass(frozen=True)
 class Bays:
     """A façade's bays (see the module): the layout with each kind on one shape, each
     bay's span, kind and whether it is drawn mirrored, the margins, and the word's plan."""
@@ -165,6 +185,8 @@ class Bays:
     apart: frozenset[int] = frozenset()  # rectangles left as drawn, in layers of their own
     spare: str | None = None  # the counter (at most 1) of a copy of the last bay (``_spare``)
     spare_first: str | None = None  # and of a copy of the first bay
+    gains: tuple[Gain, ...] = ()  # copies gained at the façade's density (``_gains``)
+    sparse: tuple[str, ...] = ()  # counters of units sparser than the façade: drop only
 
     def steady(self) -> frozenset[int]:
         """The kinds whose wall keeps its size (the rest may narrow to ``WALL``): where
@@ -345,6 +367,10 @@ def _found(
         yield laid
         return
     symmetric, start, runs, counters, end, spares = laid
+    gains: tuple[Gain, ...] = ()  # not where copies on one side would lose the mirror
+    sparse: tuple[str, ...] = ()
+    if symmetric or not centred:
+        counters, gains, sparse = _gains(runs, counters, kinds, widths, _windows(shapes), width)
     narrowest = _narrowest(runs, kinds, widths, symmetric)
     if narrowest > NARROWEST * width:
         yield (
@@ -385,6 +411,8 @@ def _found(
                 walls,
                 frozenset(apart),
                 *spares,
+                gains,
+                sparse,
             )
 
 
@@ -1222,6 +1250,79 @@ def _plan(
             runs.append(spare_unit)
         k = run.start + run.unit * run.copies
     return runs, counters, spares
+
+
+def _windows(shapes: list[list[Slot]]) -> tuple[int, ...]:
+    """Each kind's openings that may repeat (``CUTS`` but ``UNIQUE``: its windows)."""
+    return tuple(sum(s[0] in CUTS and s[0] not in UNIQUE for s in shape) for shape in shapes)
+
+
+def _gains(
+    runs: list[Run],
+    counters: list[tuple[str, float, int, int | None]],
+    kinds: list[int],
+    widths: tuple[float, ...],
+    windows: tuple[int, ...],
+    width: float,
+) -> tuple[list[tuple[str, float, int, int | None]], tuple[Gain, ...], tuple[str, ...]]:
+    """Copies no denser than the façade. A counter's units (those of its runs, ``runs``,
+    on ``kinds`` of ``widths`` holding ``windows``) gain copies at their drawn pitch; where
+    they hold more windows a metre than the façade as a whole (``width`` wide) by more than
+    ``DENSE`` (the façade's end bays, a door's bay or its margins hold fewer), a façade
+    gaining them grew denser than drawn (CMP's b0012: single columns 2.57 m wide beside a
+    door's bay, in a façade of one column per 3.75 m; density 1.25 at 2x). Where each
+    unit of such a counter is drawn once, the counter gets a most of one (it may drop
+    them), and the copies gained are a counter of their own (``Gain``), nested in each
+    unit's run, each unit with the wall before it that makes its pitch its windows at
+    the façade's density: a façade of any width is filled at about its own. Nested, a
+    copy is gained only where the units are kept: side by side (``A^k (wall A)^g``, a
+    counter of units drawn several times) the solver dropped drawn units and gained wide
+    ones to fit a narrower façade in between (``doorway_family`` seed 2, its columns
+    drawn alike, at 0.7x: density 1.07 -> 0.71), so a run of several copies keeps its one counter;
+    and nested in the other gains' counters of units drawn once, so that none of those
+    is dropped where copies are gained (CMP's b0001 at 0.7x dropped two columns on one
+    counter and gained two wide copies of the third on its own: its columns lost). Not
+    in the end bays' counter: a narrower façade may drop its end bays and gain a copy of
+    an inner unit, as it did at their drawn pitch (``tests/test_infer.py``'s blinds at
+    0.8x: with it, two of four columns left). Not called where the openings mirror
+    about the middle but the bays are not written mirrored: copies beside one side's
+    units lose the mirror (family seed 21 at 1.5x). Where some units gain so, a counter
+    of units drawn once that hold fewer windows a metre than the façade by more than
+    ``DENSE`` gets a most of one too: its copies, at their drawn pitch, filled the width
+    instead (``tests/test_infer.py``'s blinds at 1.5x: a bay of one attic window copied
+    six times). Returns the counters (the gains' after the rest), the gains and the
+    counters so capped."""
+    held = sum(windows[k] for k in kinds)
+    if not held:
+        return counters, (), ()
+    density = held / width
+    out = list(counters)
+    gains: list[Gain] = []
+    sparse: list[int] = []  # counters whose units hold fewer windows a metre than the façade
+    for n, (name, pitch, count, most) in enumerate(counters):
+        mine = [run for run in runs if run.counter == name]
+        if most is not None or not mine or any(run.copies != 1 for run in mine):
+            continue
+        units = [range(run.start, run.start + run.unit) for run in mine]
+        drawn = statistics.mean(sum(widths[kinds[j]] for j in unit) for unit in units)
+        shown = statistics.mean(sum(windows[kinds[j]] for j in unit) for unit in units)
+        wall = round(shown / density - drawn, DIGITS)
+        if wall < -DENSE * drawn:
+            sparse.append(n)
+        if wall <= DENSE * drawn:
+            continue
+        gain = f"bays{len(out) + 1}"
+        out[n] = (name, pitch, count, 1)
+        out.append((gain, round(drawn + wall, DIGITS), 0, None))
+        gains.append(Gain(name, gain, wall))
+    for n in sparse if gains else ():  # where copies gain at the façade's density, a sparser
+        name, pitch, count, _ = out[n]  # unit's copies would fill the width instead
+        out[n] = (name, pitch, count, 1)
+    dropping = [g.drawn for g in gains]
+    guarded = (
+        Gain(g.drawn, g.counter, g.wall, tuple(d for d in dropping if d != g.drawn)) for g in gains
+    )
+    return out, tuple(guarded), tuple(out[n][0] for n in sparse) if gains else ()
 
 
 def _ends_repeat(taken: dict[int, Run], counters: list[tuple[str, float, int, int | None]]) -> bool:

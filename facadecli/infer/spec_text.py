@@ -619,6 +619,14 @@ def spec_text(
                 if wall
                 for least in [wall if kind in held_walls else WALL * wall]
             ]
+            + [
+                (
+                    _gain_wall(n),
+                    f"{{size: {_number(gain.wall)}, min: {_number(WALL * gain.wall)}, "
+                    f"max: {_number(gain.wall)}}}",
+                )
+                for n, gain in enumerate(shared.gains)
+            ]
         )
     sizes.append([(symbol, _number(size)) for size, symbol in bay_margins.sizes.items()])
     out += [
@@ -681,6 +689,27 @@ def _bay_counter_note(
     of most one, none as drawn: ``bays._spare_unit``), the end bays, or the units of
     one or more bays drawn."""
     unit = max((r.unit for r in bays.runs if r.counter == name), default=1) if bays else 1
+    units = f"{unit} bays" if unit > 1 else "1 bay"
+    for n, gain in enumerate(bays.gains if bays else ()):
+        if name == gain.counter:
+            return (
+                f"copies of the units of {gain.drawn} gained, each a unit of {units} with "
+                f"{_gain_wall(n)} of wall before it (the façade's windows a metre)"
+            )
+        if name == gain.drawn:
+            drawn = (
+                f"{count} {'bay' if count == 1 else 'bays'}"
+                if unit == 1
+                else (f"{count} {'unit' if count == 1 else 'units'} of {units}")
+            )
+            return f"{drawn}, at most as drawn (a wider façade gains {gain.counter})"
+    if bays is not None and name in bays.sparse:
+        drawn = (
+            f"{count} {'bay' if count == 1 else 'bays'}"
+            if unit == 1
+            else (f"{count} {'unit' if count == 1 else 'units'} of {units}")
+        )
+        return f"{drawn}, at most as drawn (sparser than the façade: it may drop)"
     if name in spares:
         end = "last" if name == spares[0] else "first"
         return f"a copy of the {end} bay more (the end bays change one at a time)"
@@ -691,6 +720,11 @@ def _bay_counter_note(
     if unit == 1:
         return "1 bay" if count == 1 else f"{count} bays"
     return f"1 unit of {unit} bays" if count == 1 else f"{count} units of {unit} bays"
+
+
+def _gain_wall(n: int) -> str:
+    """The symbol of the wall before each copy of the ``n``-th gain (``Bays.gains``)."""
+    return f"bays_w{n + 1}"
 
 
 def _bays_note(bays: Bays | str | None) -> list[str]:
@@ -797,10 +831,18 @@ def _bay_word(
             return text  # nothing shown: nothing to mirror
         return f"({text})^-1"
 
+    gains = {gain.drawn: (n, gain) for n, gain in enumerate(bays.gains)}
+
     def written(run: BayRun) -> str:
         unit = " ".join(bay(k) for k in range(run.start, run.start + run.unit))
         if run.counter is None:
             return unit
+        if run.counter in gains:  # the copies gained follow the unit, each after its wall,
+            n, gain = gains[run.counter]  # where no counter drops a bay
+            copies = f"({_gain_wall(n)} {unit})^{gain.counter}"
+            for guard in gain.guards:
+                copies = f"({copies})^{guard}"
+            unit = f"{unit} {copies}"
         single = run.unit == 1 and " " not in unit and "(" not in unit
         return f"{unit}^{run.counter}" if single else f"({unit})^{run.counter}"
 

@@ -150,33 +150,17 @@ def paired_family(seed: int) -> tuple[list[Box], Known]:
     the narrow bay beside it. ``Known.windows`` counts the small windows too."""
     boxes, known = family(seed)
     rng = random.Random(f"paired-{seed}")
-    columns: list[float] = []  # the columns' centres (the drawn ones within 2 cm are one)
-    for c in sorted((b[1] + b[3]) / 2 for b in boxes if b[0] in ("window", "door")):
-        if not columns or c - columns[-1] > 0.02:
-            columns.append(c)
+    columns = _columns(boxes)
     count = len(columns)
 
     def column(box: Box) -> int:
-        return min(range(count), key=lambda j: abs(columns[j] - (box[1] + box[3]) / 2))
+        return _column(columns, box)
 
     scales = [rng.uniform(0.6, 0.85) for _ in range(count)]
     if known.mirrored:
         scales = [scales[min(k, count - 1 - k)] for k in range(count)]
     every = rng.choice((1, 2))  # a narrow bay in every wall, or in every other one
-    out: list[Box] = []
-    for box in boxes:
-        label, x0, y0, x1, y1 = box
-        if label in ("window", "sill", "blind"):
-            k = column(box)
-            if label == "blind":  # beside its window: it moves with the window's edge
-                x0, x1 = (
-                    columns[k] + (x0 - columns[k]) * scales[k],
-                    x1 + (x0 - columns[k]) * (scales[k] - 1),
-                )
-            else:
-                half = (x1 - x0) * scales[k] / 2
-                x0, x1 = (x0 + x1) / 2 - half, (x0 + x1) / 2 + half
-        out.append((label, x0, y0, x1, y1))
+    out = _narrowed(boxes, columns, scales)
     top = max(b[2] for b in out if b[0] == "window")
     row = [b for b in out if b[0] == "window" and top - b[2] < 0.02]
     y0, y1 = statistics.median(b[2] for b in row), statistics.median(b[4] for b in row)
@@ -197,15 +181,84 @@ def paired_family(seed: int) -> tuple[list[Box], Known]:
     return out, replace(known, windows=known.windows + len(added) // 2)
 
 
+def _columns(boxes: list[Box]) -> list[float]:
+    """The centres of the columns of openings (the drawn ones within 2 cm are one)."""
+    columns: list[float] = []
+    for c in sorted((b[1] + b[3]) / 2 for b in boxes if b[0] in ("window", "door")):
+        if not columns or c - columns[-1] > 0.02:
+            columns.append(c)
+    return columns
+
+
+def _column(columns: list[float], box: Box) -> int:
+    return min(range(len(columns)), key=lambda j: abs(columns[j] - (box[1] + box[3]) / 2))
+
+
+def _narrowed(boxes: list[Box], columns: list[float], scales: list[float]) -> list[Box]:
+    """The boxes with each column's windows and sills drawn narrower by its ``scales``
+    share about their middles, its blinds moved with their windows' edges."""
+    out: list[Box] = []
+    for box in boxes:
+        label, x0, y0, x1, y1 = box
+        if label in ("window", "sill", "blind"):
+            k = _column(columns, box)
+            if label == "blind":  # beside its window: it moves with the window's edge
+                x0, x1 = (
+                    columns[k] + (x0 - columns[k]) * scales[k],
+                    x1 + (x0 - columns[k]) * (scales[k] - 1),
+                )
+            else:
+                half = (x1 - x0) * scales[k] / 2
+                x0, x1 = (x0 + x1) / 2 - half, (x0 + x1) / 2 + half
+        out.append((label, x0, y0, x1, y1))
+    return out
+
+
+def doorway_family(seed: int) -> tuple[list[Box], Known]:
+    """``family(seed)`` whose door stands in a bay of its own: no window (sill, blind) over
+    it in its column, as over an entrance hall or a passage (issue 34's dense copies:
+    CMP's b0012). Every other bay holds a column of windows, so the façade holds fewer
+    windows a metre than each of its columns does; a wider façade that gains columns at
+    their drawn pitch grows denser than drawn. Each column's windows are drawn narrower
+    by a share of their own (0.6-0.85, a mirrored façade's partners alike), so that no
+    two bays read alike: every bay drawn once, as on CMP. ``Known.windows`` counts the
+    windows left."""
+    boxes, known = family(seed)
+    rng = random.Random(f"doorway-{seed}")
+    columns = _columns(boxes)
+    count = len(columns)
+    scales = [rng.uniform(0.6, 0.85) for _ in range(count)]
+    if known.mirrored:
+        scales = [scales[min(k, count - 1 - k)] for k in range(count)]
+    boxes = _narrowed(boxes, columns, scales)
+    door = next(b for b in boxes if b[0] == "door")
+    middle = (door[1] + door[3]) / 2
+
+    def over_door(box: Box) -> bool:
+        return box[0] in ("window", "sill", "blind") and box[1] < middle < box[3]
+
+    kept = [b for b in boxes if not over_door(b)]
+    gone = sum(b[0] == "window" for b in boxes) - sum(b[0] == "window" for b in kept)
+    return kept, replace(known, windows=known.windows - gone)
+
+
 def written_family(
-    folder: Path, seeds: list[int], defects: bool = False, paired: bool = False
+    folder: Path,
+    seeds: list[int],
+    defects: bool = False,
+    paired: bool = False,
+    doorway: bool = False,
 ) -> list[Path]:
     """The annotations of ``seeds`` as CMP XML files in ``folder`` (``family-<seed>.xml``;
-    ``defects``: ``family``'s; ``paired``: ``paired_family``'s)."""
+    ``defects``: ``family``'s; ``paired``: ``paired_family``'s; ``doorway``:
+    ``doorway_family``'s)."""
     paths = []
     for seed in seeds:
         path = folder / f"family-{seed}.xml"
-        boxes = paired_family(seed)[0] if paired else family(seed, defects)[0]
+        if doorway:
+            boxes = doorway_family(seed)[0]
+        else:
+            boxes = paired_family(seed)[0] if paired else family(seed, defects)[0]
         path.write_text(cmp_xml(boxes))
         paths.append(path)
     return paths

@@ -16,6 +16,11 @@ defects real façades have). Per size, over the façades:
   the annotation's less 0.05;
 - ``ovl``: façades with more windows and doors overlapping one another (by more than
   1 cm x 1 cm) than the annotation has;
+- ``cross``: façades where two elements of ``APART`` (window, door, shop, balcony, deco)
+  overlap (by more than 1 cm x 1 cm) whose labels never overlap in the annotation: a
+  shop front's frame (deco) over a door's edge, a balcony over another (a balcony drawn
+  over its window in the annotation lets balconies and windows overlap on that façade);
+  ``-v`` names the pairs;
 - ``sym``: of the façades whose annotation is mirrored (90% of windows have a mirror image
   within 0.15 m and 10% in size), those that stay so;
 - ``comp``: façades where 90% or more of the windows keep their companions: the labels
@@ -38,6 +43,7 @@ from __future__ import annotations
 import sys
 import tempfile
 import time
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -66,6 +72,7 @@ SHORTER = {"0.7h": (1.0, 0.7)}  # ``--shorter``: a shorter façade drops floors
 NEAR = 0.15  # m: centres this close line up (1% of the input)
 KEEP = 0.15  # a window keeps its size within this share
 OPENINGS = ("window", "door")
+APART = ("window", "door", "shop", "balcony", "deco")  # none over another unless drawn so
 TOUCH = 0.05  # m: an element this close to a window (overlapping along the other axis) is its
 BAND = 0.25  # of the façade's width: an element wider is a band, no window's companion
 HIDDEN = ("sill", "blind")  # companions counted when wholly behind an opening
@@ -81,6 +88,7 @@ class Tally:
     density: int = 0
     columns: int = 0
     overlaps: int = 0
+    crossed: int = 0
     mirrored: int = 0
     symmetric: int = 0
     companions: int = 0
@@ -130,17 +138,24 @@ def lonely(found: list[Rect]) -> int:
     return count if len(found) >= 2 else 0
 
 
+def _overlap(a: Rect, b: Rect) -> bool:
+    return min(a.x1, b.x1) - max(a.x0, b.x0) > 0.01 and min(a.y1, b.y1) - max(a.y0, b.y0) > 0.01
+
+
 def overlaps(rects: list[Rect]) -> int:
     shown = [r for r in rects if r.label in OPENINGS]
-    count = 0
-    for k, a in enumerate(shown):
-        for b in shown[k + 1 :]:
-            if (
-                min(a.x1, b.x1) - max(a.x0, b.x0) > 0.01
-                and min(a.y1, b.y1) - max(a.y0, b.y0) > 0.01
-            ):
-                count += 1
-    return count
+    return sum(_overlap(a, b) for k, a in enumerate(shown) for b in shown[k + 1 :])
+
+
+def crossings(rects: list[Rect] | tuple[Rect, ...]) -> Counter[tuple[str, str]]:
+    """The overlaps of two elements of ``APART`` labels, by their labels (sorted)."""
+    shown = [r for r in rects if r.label in APART]
+    return Counter(
+        (min(a.label, b.label), max(a.label, b.label))
+        for k, a in enumerate(shown)
+        for b in shown[k + 1 :]
+        if _overlap(a, b)
+    )
 
 
 def symmetric(found: list[Rect], width: float) -> bool:
@@ -231,6 +246,7 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
     density = len(reference) / area
     in_aligned = aligned(reference)
     in_overlaps = overlaps(list(raw.rects))
+    drawn_crossings = crossings(raw.rects)
     mirrored = symmetric(reference, raw.width)
     drawn = companions(list(raw.rects), raw.width)
     for size, tally in tallies.items():
@@ -256,6 +272,8 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
         tally.columns += kept
         extra = overlaps(rects) > in_overlaps
         tally.overlaps += extra
+        crossed = {pair: n for pair, n in crossings(rects).items() if pair not in drawn_crossings}
+        tally.crossed += bool(crossed)
         if mirrored:
             tally.mirrored += 1
             tally.symmetric += symmetric(found, width)
@@ -270,13 +288,15 @@ def measure(inference: Inference, name: str, tallies: dict[str, Tally]) -> None:
         along = held / len(found) if found else 1.0
         tally.companions += along >= 0.9
         failed = share < 0.9 or not 0.85 <= ratio <= 1.15 or not kept or extra or along < 0.9
-        if failed or behind:
+        if failed or behind or crossed:
+            across = ", ".join(f"{a}/{b} {n}" for (a, b), n in sorted(crossed.items()))
             tally.worst.append(
                 f"{name}: {share:.0%} sized, density {ratio:.2f}, aligned "
                 f"{aligned(found):.2f} (input {in_aligned:.2f}; lonely {lonely(found)} of "
                 f"{len(found)}, input {lonely(reference)} of {len(reference)}), "
                 f"overlaps {overlaps(rects)}, "
                 f"{along:.0%} with their companions, {behind} sills and blinds hidden"
+                + (f", crossed {across}" if crossed else "")
             )
 
 
@@ -291,14 +311,14 @@ def report(
     print(f"\n{title}: {n} façades at 15 x 15 m, the spec solved at other sizes")
     print(
         f"{'size':5} {'solve':>6} {'size':>6} {'size%':>6} {'dens':>6} {'cols':>6} "
-        f"{'ovl':>6} {'sym':>7} {'comp':>6} {'comp%':>6} {'hid':>10}"
+        f"{'ovl':>6} {'cross':>6} {'sym':>7} {'comp':>6} {'comp%':>6} {'hid':>10}"
     )
     for name, t in tallies.items():
         share = t.windows_ok / t.windows if t.windows else 1.0
         print(
             f"{name:5} {t.solve:3d}/{t.facades:<2d} {t.size:3d}/{t.solve:<2d} {share:6.0%} "
             f"{t.density:3d}/{t.solve:<2d} {t.columns:3d}/{t.solve:<2d} "
-            f"{t.overlaps:3d}/{t.solve:<2d} "
+            f"{t.overlaps:3d}/{t.solve:<2d} {t.crossed:3d}/{t.solve:<2d} "
             f"{t.symmetric:3d}/{t.mirrored:<3d} {t.companions:3d}/{t.solve:<2d} "
             f"{t.windows_with / t.windows if t.windows else 1.0:6.0%} "
             f"{t.hidden:4d}/{t.hideable:<5d}"
@@ -336,9 +356,10 @@ def main() -> None:
     ``--cmp``: CMP alone; ``--defects``: the family with its defects (wider end bays,
     missing and odd windows: ``annotated_family``); ``--paired``: the family with a narrow
     bay (a small window on the top floor) between its columns, every bay drawn unlike
-    (``annotated_family.paired_family``); ``--only A,B``: the CMP façades whose names hold
-    one of these; ``--sizes 1x,1.5h``: those sizes alone; ``--shorter``: 0.7x the height
-    too (floors dropped)."""
+    (``annotated_family.paired_family``); ``--doorway``: the family with no windows
+    over its door (``annotated_family.doorway_family``); ``--only A,B``: the CMP façades
+    whose names hold one of these; ``--sizes 1x,1.5h``: those sizes alone; ``--shorter``:
+    0.7x the height too (floors dropped)."""
     verbose = "-v" in sys.argv
     sizes = [*SIZES, *(SHORTER if "--shorter" in sys.argv else ())]
     if "--sizes" in sys.argv:
@@ -361,9 +382,11 @@ def main() -> None:
         return
     with tempfile.TemporaryDirectory() as folder:
         defects, paired = "--defects" in sys.argv, "--paired" in sys.argv
-        paths = written_family(Path(folder), seeds, defects, paired)
+        doorway = "--doorway" in sys.argv
+        paths = written_family(Path(folder), seeds, defects, paired, doorway)
         title = f"generated family{' with defects' if defects else ''}"
         title += " with narrow bays between its columns" if paired else ""
+        title += " with its door in a bay of its own" if doorway else ""
         run(paths, f"{title} (seeds {seeds[0]}-{seeds[-1]})", verbose, sizes)
 
 
