@@ -668,9 +668,9 @@ def _alike(a: Slot, b: Slot, tolerance: float) -> bool:
 def _bay_spans(
     strips: list[tuple[Span, list[int]]], width: float, others: list[Rect] | None = None
 ) -> list[Span]:
-    """Each strip widened to the wall's cut on either side (``_wall_cut``: where the
-    fewest of the ``others``, the elements but the openings, stand across it; else its
-    middle), the end ones outwards by the half wall on their inner side and over what
+    """Each strip widened to the wall's cut on either side (``_wall_cut``: its middle,
+    or beside a pillar of the wall's own among the ``others``, the elements but the
+    openings), the end ones outwards by the half wall on their inner side and over what
     of ``others`` stands wholly in the margin beyond, leaving the margin ``MARGIN`` of
     the façade where it is that wide: the margins take the slack."""
     middles = [(a[1] + b[0]) / 2 for (a, _), (b, _) in pairwise(strips)]

@@ -519,7 +519,7 @@ def spec_text(
     # since the copies never take more than the height gained (``roofed``), it stays
     # clear of them
     copies = min(copied_from, default=top)
-    over = min(copied_to, default=float("inf"))
+    copies_end = min(copied_to, default=float("inf"))  # the lowest end of a top floor copied
     # over the floors: over the openings' floors, or wholly over a top floor that repeats
     # upwards in its columns (an attic's row over a part of the façade whose floors end
     # lower than the others': cmp_b0008's middle, whose copies ran into it)
@@ -543,7 +543,7 @@ def spec_text(
                 repeated.update(shown)
     margined.update(
         bottom
-        if floors is None and copied_to and (last < over or low)
+        if floors is None and copied_to and (last < copies_end or low)
         else high
         if up and last >= copies
         else bottom
@@ -690,6 +690,11 @@ def _bay_counter_note(
     one or more bays drawn."""
     unit = max((r.unit for r in bays.runs if r.counter == name), default=1) if bays else 1
     units = f"{unit} bays" if unit > 1 else "1 bay"
+    drawn = (
+        f"{count} {'bay' if count == 1 else 'bays'}"
+        if unit == 1
+        else f"{count} {'unit' if count == 1 else 'units'} of {units}"
+    )
     for n, gain in enumerate(bays.gains if bays else ()):
         if name == gain.counter:
             return (
@@ -697,18 +702,8 @@ def _bay_counter_note(
                 f"{_gain_wall(n)} of wall before it (the façade's windows a metre)"
             )
         if name == gain.drawn:
-            drawn = (
-                f"{count} {'bay' if count == 1 else 'bays'}"
-                if unit == 1
-                else (f"{count} {'unit' if count == 1 else 'units'} of {units}")
-            )
             return f"{drawn}, at most as drawn (a wider façade gains {gain.counter})"
     if bays is not None and name in bays.sparse:
-        drawn = (
-            f"{count} {'bay' if count == 1 else 'bays'}"
-            if unit == 1
-            else (f"{count} {'unit' if count == 1 else 'units'} of {units}")
-        )
         return f"{drawn}, at most as drawn (sparser than the façade: it may drop)"
     if name in spares:
         end = "last" if name == spares[0] else "first"
@@ -717,9 +712,7 @@ def _bay_counter_note(
         return f"a copy of a unit of {unit} bays more (the units change one at a time)"
     if most is not None:
         return "1 end bay (it may drop)" if count == 1 else f"{count} end bays (they may drop)"
-    if unit == 1:
-        return "1 bay" if count == 1 else f"{count} bays"
-    return f"1 unit of {unit} bays" if count == 1 else f"{count} units of {unit} bays"
+    return drawn
 
 
 def _gain_wall(n: int) -> str:
