@@ -48,6 +48,25 @@ def _solved(inference, spec, share: float) -> list[Rect]:  # type: ignore[no-unt
     return list(solved_layout(layout, spec, inference).rects)
 
 
+def _in_band_at(inference, spec, drawn: list[Rect], shares: tuple[float, ...]) -> None:  # type: ignore[no-untyped-def]
+    """At each of ``shares`` of the width: the windows a square metre within 0.85-1.15
+    of the ``drawn`` windows', each window at a drawn size (within 15% both ways), and
+    one door."""
+    sizes = [(r.x1 - r.x0, r.y1 - r.y0) for r in drawn]
+    for share in shares:
+        rects = _solved(inference, spec, share)
+        windows = [r for r in rects if r.label == "window"]
+        assert 0.85 <= len(windows) / len(drawn) / share <= 1.15, (share, len(windows))
+        assert all(
+            any(
+                abs((r.x1 - r.x0) / w - 1) <= 0.15 and abs((r.y1 - r.y0) / h - 1) <= 0.15
+                for w, h in sizes
+            )
+            for r in windows
+        )
+        assert sum(r.label == "door" for r in rects) == 1
+
+
 def _columns(rects: list[Rect], label: str = "window") -> list[int]:
     """How many elements of ``label`` each column (centres within ``NEAR``) holds."""
     centres = sorted((r.x0 + r.x1) / 2 for r in rects if r.label == label)
@@ -987,19 +1006,7 @@ def test_a_column_and_its_narrow_bay_drop_and_gain_together(tmp_path: Path, seed
     raw = list((inference.raw or inference.layout).rects)
     drawn = [r for r in raw if r.label == "window"]
     assert len(drawn) == known.windows
-    sizes = [(r.x1 - r.x0, r.y1 - r.y0) for r in drawn]
-    for share in (0.7, 1.5, 2.0):
-        rects = _solved(inference, spec, share)
-        windows = [r for r in rects if r.label == "window"]
-        assert 0.85 <= len(windows) / len(drawn) / share <= 1.15, (share, len(windows))
-        assert all(
-            any(
-                abs((r.x1 - r.x0) / w - 1) <= 0.15 and abs((r.y1 - r.y0) / h - 1) <= 0.15
-                for w, h in sizes
-            )
-            for r in windows
-        )
-        assert sum(r.label == "door" for r in rects) == 1
+    _in_band_at(inference, spec, drawn, (0.7, 1.5, 2.0))
 
 
 def test_bays_drawn_once_are_counted_in_the_smallest_unit_that_holds_alike_openings() -> None:
@@ -1089,16 +1096,4 @@ def test_copies_gained_are_no_denser_than_the_facade(tmp_path: Path, seed: int) 
     assert all(solve(spec).counters[gain] == 0 for gain in gains)
     drawn = [r for r in (inference.raw or inference.layout).rects if r.label == "window"]
     assert len(drawn) == known.windows
-    sizes = [(r.x1 - r.x0, r.y1 - r.y0) for r in drawn]
-    for share in (1.5, 2.0):
-        rects = _solved(inference, spec, share)
-        windows = [r for r in rects if r.label == "window"]
-        assert 0.85 <= len(windows) / len(drawn) / share <= 1.15, (share, len(windows))
-        assert all(
-            any(
-                abs((r.x1 - r.x0) / w - 1) <= 0.15 and abs((r.y1 - r.y0) / h - 1) <= 0.15
-                for w, h in sizes
-            )
-            for r in windows
-        )
-        assert sum(r.label == "door" for r in rects) == 1
+    _in_band_at(inference, spec, drawn, (1.5, 2.0))
