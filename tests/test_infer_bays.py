@@ -1057,6 +1057,7 @@ def test_two_units_on_one_counter_drop_one_at_a_time_with_a_spare(tmp_path: Path
         (2, 1, "2 end bays (they may drop)"),
         (1, None, "1 bay"),
         (3, None, "3 bays"),
+        (0, 1, "a copy of a unit of 1 bay more (the units change one at a time)"),
     ],
 )
 def test_a_bay_counters_comment_counts_in_words(count: int, most: int | None, note: str) -> None:

@@ -709,7 +709,7 @@ def _bay_counter_note(
         end = "last" if name == spares[0] else "first"
         return f"a copy of the {end} bay more (the end bays change one at a time)"
     if most is not None and not count:
-        return f"a copy of a unit of {unit} bays more (the units change one at a time)"
+        return f"a copy of a unit of {units} more (the units change one at a time)"
     if most is not None:
         return "1 end bay (it may drop)" if count == 1 else f"{count} end bays (they may drop)"
     return drawn
