@@ -340,7 +340,8 @@ def _found(
     # each bay drawn once: as the structure put it, unless the openings mirror (then on
     # shapes fitted about the middle: as placed, the bays of family seeds 8 and 14 with
     # defects passed the gate and, never written reflected, went lopsided at 0.7x, 2x)
-    centred = _about_middle(list(layout.rects), width)
+    mirror = _about_middle(list(layout.rects), width)  # centred or not, no spare end bays
+    centred = mirror
     if len(set(kinds)) == len(kinds) and not centred:
         start, widths, shapes = _as_placed(slots, spans)
     else:
@@ -361,7 +362,6 @@ def _found(
             fitted = _fitted(slots, spans, kinds, mirrored, matches, shapes, widths, 0, ties)
         start, widths, shapes = fitted
         shapes = _tied([_lined(s, w, COLUMN) for s, w in zip(shapes, widths, strict=True)], ties)
-    mirror = _about_middle(list(layout.rects), width)  # centred or not, no spare end bays
     laid = _laid(kinds, mirrored, spans, width, widths, shapes, ties, start, centred, mirror)
     if isinstance(laid, str):
         yield laid
@@ -1157,7 +1157,7 @@ def _plan(
     unique: set[int],
     widths: tuple[float, ...],
     symmetric: bool,
-    centred: bool,
+    mirror: bool,
     openings: tuple[int, ...] = (),
 ) -> tuple[list[Run], list[tuple[str, float, int, int | None]], Spares]:
     """The runs the written bays are cut into (the left half's if ``symmetric``): ends
@@ -1168,7 +1168,7 @@ def _plan(
     door's), each of them on that kind's counter; where none of that repeats, the inner
     bays drawn once on counters of their own (``_drawn_once``); where still none
     repeats, the end bays (``_ends_repeat``, ``_spare``), unless the façade is
-    ``centred`` (its openings mirror about the middle); the rest one bay a run, as
+    ``mirror`` (its openings mirror about the middle); the rest one bay a run, as
     drawn."""
     n = len(kinds)
     written = n // 2 if symmetric else n
@@ -1232,11 +1232,11 @@ def _plan(
         once = _drawn_once(kinds, unique | ends, written, counters, widths, openings)
         for j, run in once.items():
             taken.setdefault(j, run)
-        if not centred and not symmetric:
+        if not mirror and not symmetric:
             spare_unit = _spare_unit(once, counters, sum(widths[k] for k in kinds))
     spares: Spares = (None, None)
     if (
-        not centred  # a mirrored façade keeps its mirror: a word a layer (``_ends_repeat``)
+        not mirror  # a mirrored façade keeps its mirror: a word a layer (``_ends_repeat``)
         and not any(run.counter and run.most is None for run in taken.values())
         and _ends_repeat(taken, counters)
     ):
